@@ -1,0 +1,6 @@
+#include "cli/commands.h"
+
+namespace skinlab::cli {
+// Placeholder: the owning module fills this in.
+void registerStudy(CLI::App& app) { (void)app; }
+} // namespace skinlab::cli

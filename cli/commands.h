@@ -1,0 +1,13 @@
+#pragma once
+// Each subcommand lives in its own cmd_*.cpp and registers itself on the CLI11 app.
+// Callbacks throw skinlab::InputError for bad input (exit 2) and skinlab::RuntimeError for failures (exit 1).
+#include <CLI/CLI.hpp>
+
+namespace skinlab::cli {
+void registerRender(CLI::App& app);
+void registerKernel(CLI::App& app);
+void registerStimuli(CLI::App& app);
+void registerStudy(CLI::App& app);
+void registerAnalyze(CLI::App& app);
+void registerBench(CLI::App& app);
+} // namespace skinlab::cli

@@ -1,0 +1,12 @@
+#!/usr/bin/env bash
+# The test command: sets everything up on a fresh Debian 12 machine, builds, and runs every test with ctest.
+# GL tests render through EGL (Mesa llvmpipe without a GPU); tests that need the scanned head look in
+# $SKINLAB_ASSETS (default ../shared/assets) and skip with a message when it is absent.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/build.sh
+if [ -f tests/browser/package.json ]; then
+  (cd tests/browser && npm install --no-audit --no-fund --loglevel=error >/dev/null)
+fi
+export SKINLAB_ASSETS="${SKINLAB_ASSETS:-$(cd .. && pwd)/shared/assets}"
+ctest --preset release -j "$(nproc)" "$@"
