@@ -5,7 +5,7 @@ set -euo pipefail
 
 PACKAGES=(
   # toolchain
-  build-essential cmake ninja-build pkg-config git ca-certificates
+  build-essential cmake ninja-build pkg-config git ca-certificates ccache
   # renderer: headless OpenGL through EGL, Mesa llvmpipe on the CPU
   libegl-dev libegl1 libegl-mesa0 libgl1-mesa-dri libgbm1 libepoxy-dev libglm-dev glslang-tools
   # images, colour, meshes
