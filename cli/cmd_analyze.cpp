@@ -1,6 +1,10 @@
 #include "cli/commands.h"
 
 namespace skinlab::cli {
-// Placeholder: the owning module fills this in.
-void registerAnalyze(CLI::App& app) { (void)app; }
+void registerAnalyze(CLI::App& app) {
+    CLI::App* analyze = app.add_subcommand("analyze", "Perceptual scaling of 2AFC responses; image-difference metrics");
+    analyze->require_subcommand(1);
+    registerAnalyzeScale(*analyze);
+    registerAnalyzeMetrics(*analyze);
+}
 } // namespace skinlab::cli

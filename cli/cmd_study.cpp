@@ -1,6 +1,191 @@
+// `skinlab study create|serve|simulate|status|export` — the 2AFC experiment runner (docs/experiments.md).
 #include "cli/commands.h"
+#include "common/error.h"
+#include "common/files.h"
+#include "experiments/simulated_observers.h"
+#include "experiments/study_creation.h"
+#include "experiments/study_export.h"
+#include "experiments/study_server.h"
+#include "experiments/study_store.h"
+
+#include <csignal>
+#include <cstdio>
+#include <pthread.h>
+#include <regex>
+#include <thread>
 
 namespace skinlab::cli {
-// Placeholder: the owning module fills this in.
-void registerStudy(CLI::App& app) { (void)app; }
+namespace ex = skinlab::experiments;
+
+namespace {
+
+struct StudyOptions {
+    std::string stimuli;
+    std::string design;
+    std::string output;
+    std::vector<std::string> overrides;
+    std::string study;
+    std::string host = "127.0.0.1";
+    int port = 8080;
+    int threads = 64;
+    std::string token;
+    std::string url = "http://127.0.0.1:8080";
+    int observers = 0;
+    std::string truth;
+    std::string truthFactor;
+    double lapse = 0;
+    double sideBias = 0;
+    int randomObservers = 0;
+    int invertedObservers = 0;
+    std::uint64_t seed = 1;
+    std::string think;
+    std::string labelPrefix;
+    std::string format;
+};
+
+void runCreate(const StudyOptions& o) {
+    const ex::CreatedStudy created = ex::createStudy(o.stimuli, o.design, o.overrides, o.output);
+    const ex::StudyDefinition& d = created.definition;
+    std::printf("%s: %zu block(s), %zu stimuli; per participant %d trials (%d practice, %d test, %d repeat, %d catch)\n",
+                o.output.c_str(), d.blocks.size(), d.stimuli.size(), created.trialsPerParticipant,
+                d.design.practiceTrials, d.testTrialCount(), d.repeatTrialCount(), d.catchTrialCount());
+    std::printf("next: skinlab study serve %s\n", o.output.c_str());
+}
+
+void runServe(const StudyOptions& o) {
+    // Block SIGINT/SIGTERM in every thread; one thread waits for them and stops the server cleanly.
+    sigset_t signals;
+    sigemptyset(&signals);
+    sigaddset(&signals, SIGINT);
+    sigaddset(&signals, SIGTERM);
+    pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+
+    ex::StudyStore store(o.study);
+    ex::ServerOptions options;
+    options.host = o.host;
+    options.port = o.port;
+    options.threads = o.threads;
+    options.researcherToken = o.token;
+    options.stimuliDir = o.stimuli;
+    ex::StudyServer server(store, options);
+    server.bind();
+    std::printf("serving %s on %s\n", o.study.c_str(), server.url().c_str());
+    std::printf("participant link: %s  (each visit without ?p= starts a new participant)\n", server.url().c_str());
+    std::printf("researcher token: %s\n", server.researcherToken().c_str());
+    std::printf("status: curl -H 'Authorization: Bearer %s' %sapi/researcher/status\n", server.researcherToken().c_str(),
+                server.url().c_str());
+    std::fflush(stdout);
+
+    std::thread waiter([&] {
+        int received = 0;
+        sigwait(&signals, &received);
+        server.stop();
+    });
+    server.run();
+    // If run() returned for another reason, wake the waiter.
+    pthread_kill(waiter.native_handle(), SIGTERM);
+    waiter.join();
+    std::printf("stopped\n");
+}
+
+void runSimulate(const StudyOptions& o) {
+    ex::StudyStore store(o.study);
+    ex::SimulationOptions options;
+    std::smatch m;
+    static const std::regex urlPattern(R"(http://([A-Za-z0-9.\-]+|\[[0-9a-fA-F:]+\]):(\d{1,5})/?)");
+    if (!std::regex_match(o.url, m, urlPattern)) throw InputError("--url: \"" + o.url + "\" is not http://HOST:PORT");
+    options.host = m[1].str();
+    options.port = std::stoi(m[2].str());
+    options.observers = o.observers;
+    if (!o.truth.empty() && !o.truthFactor.empty()) throw InputError("--truth and --truth-factor: give one of them");
+    if (!o.truth.empty()) options.truth = ex::readTruthJson(o.truth);
+    if (!o.truthFactor.empty()) options.truth = ex::truthFromFactor(store, o.truthFactor);
+    options.lapseRate = o.lapse;
+    options.sideBias = o.sideBias;
+    options.randomObservers = o.randomObservers;
+    options.invertedObservers = o.invertedObservers;
+    options.seed = o.seed;
+    options.labelPrefix = o.labelPrefix;
+    if (!o.think.empty()) {
+        static const std::regex thinkPattern(R"((\d+(?:\.\d+)?)(?::(\d+(?:\.\d+)?))?)");
+        if (!std::regex_match(o.think, m, thinkPattern)) throw InputError("--think-ms: \"" + o.think + "\" is not MS or MIN:MAX");
+        options.thinkMinMs = std::stod(m[1].str());
+        options.thinkMaxMs = m[2].matched ? std::stod(m[2].str()) : options.thinkMinMs;
+        if (options.thinkMaxMs < options.thinkMinMs) throw InputError("--think-ms: MAX is below MIN");
+    }
+    const ex::SimulationReport report = ex::simulateObservers(store, options);
+    for (const ex::ObserverResult& r : report.observers)
+        if (!r.failure.empty()) std::printf("%s: stopped: %s\n", r.label.c_str(), r.failure.c_str());
+    std::printf("%d/%d observers completed, %zu responses acknowledged, %d rejected, %d re-sends, %.1f s\n",
+                report.completed(), o.observers, report.acknowledged(), report.rejected(), report.transportRetries(),
+                report.wallSeconds);
+    std::printf("response latency: p50 %.2f ms, p99 %.2f ms\n", report.latencyPercentile(50), report.latencyPercentile(99));
+    if (report.completed() != o.observers) throw RuntimeError("not every simulated observer completed the study");
+}
+
+void runStatus(const StudyOptions& o) {
+    ex::StudyStore store(o.study);
+    if (o.format == "json") std::printf("%s\n", ex::statusJson(store).dump(2).c_str());
+    else std::printf("%s", ex::statusText(store).c_str());
+}
+
+void runExport(const StudyOptions& o) {
+    ex::StudyStore store(o.study);
+    const std::string text = ex::exportResponses(store, o.format);
+    if (o.output.empty() || o.output == "-") std::fwrite(text.data(), 1, text.size(), stdout);
+    else writeFileAtomic(o.output, text);
+}
+
+} // namespace
+
+void registerStudy(CLI::App& app) {
+    auto options = std::make_shared<StudyOptions>();
+    CLI::App* study = app.add_subcommand("study", "2AFC experiments: create a study, serve it, simulate observers, "
+                                                  "monitor and export responses");
+    study->require_subcommand(1);
+
+    CLI::App* create = study->add_subcommand("create", "Create study.db from a stimulus folder and a design file");
+    create->add_option("--stimuli", options->stimuli, "Stimulus folder holding manifest.json")->required();
+    create->add_option("--design", options->design, "Design file (TOML)")->required();
+    create->add_option("-o,--output", options->output, "Study file to create (never overwritten)")->required();
+    create->add_option("--set", options->overrides, "Override a design key: key=value (repeatable)");
+    create->callback([options] { runCreate(*options); });
+
+    CLI::App* serve = study->add_subcommand("serve", "Serve the participant page and API");
+    serve->add_option("study", options->study, "study.db")->required();
+    serve->add_option("--host", options->host, "Address to bind (default loopback only)")->capture_default_str();
+    serve->add_option("--port", options->port, "Port (0 = any free port)")->capture_default_str()->check(CLI::Range(0, 65535));
+    serve->add_option("--threads", options->threads, "Worker threads")->capture_default_str()->check(CLI::Range(2, 1024));
+    serve->add_option("--token", options->token, "Researcher token (default: random, printed at start)");
+    serve->add_option("--stimuli", options->stimuli, "Stimulus folder, if it moved since `study create`");
+    serve->callback([options] { runServe(*options); });
+
+    CLI::App* simulate = study->add_subcommand("simulate", "Run simulated Thurstone observers through the server");
+    simulate->add_option("study", options->study, "study.db (the one the server serves)")->required();
+    simulate->add_option("--observers", options->observers, "Number of simultaneous observers")->required()->check(CLI::Range(1, 5000));
+    simulate->add_option("--truth", options->truth, "JSON of true scores in JOD: {\"cond\": q} or {\"block\": {\"cond\": q}}");
+    simulate->add_option("--truth-factor", options->truthFactor, "Numeric manifest factor holding the true score");
+    simulate->add_option("--url", options->url, "Server URL")->capture_default_str();
+    simulate->add_option("--lapse", options->lapse, "Probability of a random answer")->check(CLI::Range(0.0, 1.0));
+    simulate->add_option("--side-bias", options->sideBias, "JOD added to the left image")->check(CLI::Range(-10.0, 10.0));
+    simulate->add_option("--random", options->randomObservers, "Observers answering at random")->check(CLI::Range(0, 5000));
+    simulate->add_option("--inverted", options->invertedObservers, "Observers with inverted scores")->check(CLI::Range(0, 5000));
+    simulate->add_option("--seed", options->seed, "Seed of the simulated answers")->capture_default_str();
+    simulate->add_option("--think-ms", options->think, "Pause before each answer: MS or MIN:MAX");
+    simulate->add_option("--label-prefix", options->labelPrefix, "Observer label prefix (default sim-XXXX)");
+    simulate->callback([options] { runSimulate(*options); });
+
+    CLI::App* status = study->add_subcommand("status", "Per-participant progress and catch-trial accuracy");
+    status->add_option("study", options->study, "study.db")->required();
+    status->add_option("--format", options->format, "text or json")->check(CLI::IsMember({"text", "json"}))->default_val("text");
+    status->callback([options] { runStatus(*options); });
+
+    CLI::App* exportCommand = study->add_subcommand("export", "Export responses (contract 3)");
+    exportCommand->add_option("study", options->study, "study.db")->required();
+    exportCommand->add_option("--format", options->format, "csv, json or pwcmp")
+        ->check(CLI::IsMember({"csv", "json", "pwcmp"}))->default_val("csv");
+    exportCommand->add_option("-o,--output", options->output, "Output file (default: standard output)");
+    exportCommand->callback([options] { runExport(*options); });
+}
+
 } // namespace skinlab::cli

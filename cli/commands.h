@@ -11,3 +11,9 @@ void registerStudy(CLI::App& app);
 void registerAnalyze(CLI::App& app);
 void registerBench(CLI::App& app);
 } // namespace skinlab::cli
+
+namespace skinlab::cli {
+// `skinlab analyze` sub-subcommands, registered by cmd_analyze.cpp on the `analyze` subcommand.
+void registerAnalyzeScale(CLI::App& analyze);    // scale, validate
+void registerAnalyzeMetrics(CLI::App& analyze);  // metrics
+} // namespace skinlab::cli

@@ -1,11 +1,50 @@
 #!/usr/bin/env bash
-# The main job: sets everything up on a fresh Debian 12 machine, builds, and renders the default scene with
-# every available method, printing where the images are.
+# The main job, end to end, on a fresh Debian 12 machine (no GPU needed):
+#   1. installs missing packages and builds (scripts/build.sh);
+#   2. builds the demo stimulus set (built-in head, every SSS method and the main extensions) with a contact sheet;
+#   3. creates a 2AFC study from it, serves it on loopback and runs 20 simulated observers through the real
+#      HTTP API (true scores in experiments/designs/demo-truth.json);
+#   4. scales the answers to JOD with confidence intervals;
+# and prints where everything is, and the command for a session with a real participant.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh
 export SKINLAB_ASSETS="${SKINLAB_ASSETS:-$(cd .. && pwd)/shared/assets}"
+skinlab=./build/release/cli/skinlab
 out=out/demo
 mkdir -p "$out"
-./build/release/cli/skinlab render --scene builtin:head -o "$out/head-none.exr" --png "$out/head-none.png"
-echo "demo: images in $(pwd)/$out"
+
+"$skinlab" stimuli build stimuli/specs/demo.toml -o "$out/stimuli"
+
+# A demo study is recreated on every run (a real study is never overwritten by `study create`).
+rm -f "$out/study.db" "$out/study.db-wal" "$out/study.db-shm"
+"$skinlab" study create --stimuli "$out/stimuli" --design experiments/designs/demo.toml -o "$out/study.db"
+
+"$skinlab" study serve "$out/study.db" --port 0 > "$out/serve.log" 2>&1 &
+server=$!
+trap 'kill $server 2>/dev/null || true' EXIT
+url=""
+for _ in $(seq 1 100); do
+  url=$(sed -n 's/^serving .* on \(http[^ ]*\)$/\1/p' "$out/serve.log" | head -n 1)
+  [ -n "$url" ] && break
+  sleep 0.1
+done
+[ -n "$url" ] || { echo "demo: the study server did not start:" >&2; cat "$out/serve.log" >&2; exit 1; }
+"$skinlab" study simulate "$out/study.db" --observers 20 --truth experiments/designs/demo-truth.json \
+  --seed 7 --label-prefix demo --url "$url"
+kill $server; wait $server 2>/dev/null || true
+trap - EXIT
+
+"$skinlab" study export "$out/study.db" --format csv -o "$out/responses.csv"
+"$skinlab" analyze scale "$out/study.db" -o "$out/scale"
+
+cat <<TXT
+
+demo: done
+  contact sheet:   $(pwd)/$out/stimuli/contact.html  (and contact.png)
+  stimuli:         $(pwd)/$out/stimuli/manifest.json
+  study database:  $(pwd)/$out/study.db  (20 simulated observers; responses in $out/responses.csv)
+  JOD scale:       $(pwd)/$out/scale/report_section.html  (scale.json, scores.csv, plots)
+  a session with a real participant:
+    $skinlab study serve $out/study.db        # then open the printed participant link in a browser
+TXT

@@ -20,6 +20,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   # browser test of the participant page
   chromium nodejs   # npm ships with the machine's Node.js (nodesource); Debian's npm conflicts with it
+  fonts-dejavu-core   # stimuli: captions of contact.png (OpenImageIO render_text needs a TrueType font)
 )
 
 missing=()

@@ -1,0 +1,115 @@
+#include "analysis/metrics/error_heatmap.h"
+
+#include "common/error.h"
+#include "common/files.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace skinlab::metrics {
+namespace {
+
+// Outline colours (BGR), chosen to stand apart from the black-purple-orange-yellow inferno ramp.
+cv::Scalar bandColour(Band band) {
+    switch (band) {
+    case Band::halo: return {255, 255, 0};      // cyan
+    case Band::bleed: return {0, 255, 0};       // green
+    case Band::spill: return {255, 96, 0};      // blue
+    case Band::interior: return {255, 255, 255};  // white
+    }
+    return {128, 128, 128};
+}
+
+constexpr int legendWidth = 170;        // pixels; fits "interior" and "10.0+" at the font scale below
+constexpr int legendMinimumHeight = 260;  // the colour bar and the four band keys
+constexpr double fontScale = 0.45;
+const cv::Scalar legendBackground{40, 40, 40};
+const cv::Scalar textColour{235, 235, 235};
+
+std::string formatScale(double value) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.3g", value);
+    return text;
+}
+
+cv::Mat colourise(const cv::Mat& values, double scaleMax) {
+    cv::Mat scaled(values.size(), CV_8UC1);
+    for (int y = 0; y < values.rows; ++y) {
+        const auto* in = values.ptr<float>(y);
+        auto* out = scaled.ptr<uint8_t>(y);
+        for (int x = 0; x < values.cols; ++x) {
+            double v = std::isfinite(in[x]) ? in[x] / scaleMax : 1.0;
+            out[x] = static_cast<uint8_t>(std::lround(255.0 * std::clamp(v, 0.0, 1.0)));
+        }
+    }
+    cv::Mat coloured;
+    cv::applyColorMap(scaled, coloured, cv::COLORMAP_INFERNO);
+    return coloured;
+}
+
+} // namespace
+
+cv::Mat renderErrorHeatmap(const cv::Mat& deltaE00, const ErrorBands& bands, double scaleMax) {
+    CV_Assert(deltaE00.type() == CV_32FC1 && scaleMax > 0.0);
+    cv::Mat heat = colourise(deltaE00, scaleMax);
+    for (Band band : allBands) {
+        std::vector<std::vector<cv::Point>> contours;
+        cv::findContours(bands.mask(band).clone(), contours, cv::RETR_LIST, cv::CHAIN_APPROX_NONE);
+        cv::drawContours(heat, contours, -1, bandColour(band), 1, cv::LINE_8);
+    }
+
+    const int height = std::max(heat.rows, legendMinimumHeight);
+    cv::Mat canvas(height, heat.cols + legendWidth, CV_8UC3, legendBackground);
+    heat.copyTo(canvas(cv::Rect(0, 0, heat.cols, heat.rows)));
+
+    // Legend: a vertical colour bar (top = scaleMax and above), then the band outline keys.
+    const int left = heat.cols + 12;
+    cv::putText(canvas, "dE00 (CIEDE2000)", {left, 18}, cv::FONT_HERSHEY_SIMPLEX, fontScale, textColour, 1, cv::LINE_AA);
+    const int barTop = 30;
+    const int barHeight = 120;
+    const int barWidth = 18;
+    cv::Mat ramp(barHeight, 1, CV_32FC1);
+    for (int i = 0; i < barHeight; ++i)
+        ramp.at<float>(i) = static_cast<float>(scaleMax * (1.0 - double(i) / double(barHeight - 1)));
+    cv::Mat rampColour;
+    cv::resize(colourise(ramp, scaleMax), rampColour, {barWidth, barHeight}, 0, 0, cv::INTER_NEAREST);
+    rampColour.copyTo(canvas(cv::Rect(left, barTop, barWidth, barHeight)));
+    const double ticks[3] = {scaleMax, 0.5 * scaleMax, 0.0};
+    for (int i = 0; i < 3; ++i) {
+        int y = barTop + static_cast<int>(std::lround(i * (barHeight - 1) / 2.0));
+        cv::line(canvas, {left + barWidth, y}, {left + barWidth + 4, y}, textColour, 1);
+        std::string label = formatScale(ticks[i]) + (i == 0 ? "+" : "");
+        cv::putText(canvas, label, {left + barWidth + 8, y + 5}, cv::FONT_HERSHEY_SIMPLEX, fontScale, textColour, 1,
+                    cv::LINE_AA);
+    }
+    int keyY = barTop + barHeight + 24;
+    for (Band band : allBands) {
+        cv::line(canvas, {left, keyY - 4}, {left + 24, keyY - 4}, bandColour(band), 2);
+        cv::putText(canvas, std::string(bandName(band)), {left + 32, keyY}, cv::FONT_HERSHEY_SIMPLEX, fontScale,
+                    textColour, 1, cv::LINE_AA);
+        keyY += 20;
+    }
+    return canvas;
+}
+
+void writeErrorHeatmap(const std::filesystem::path& path, const cv::Mat& deltaE00, const ErrorBands& bands,
+                       double scaleMax) {
+    cv::Mat picture = renderErrorHeatmap(deltaE00, bands, scaleMax);
+    AtomicOutput output(path);
+    bool written = false;
+    try {
+        written = cv::imwrite(output.tempPath().string(), picture);
+    } catch (const cv::Exception& e) {
+        throwInput(path.string(), "", std::string("cannot write PNG (") + e.err + ")");
+    }
+    if (!written) throwInput(path.string(), "", "cannot write PNG");
+    output.commit();
+}
+
+} // namespace skinlab::metrics

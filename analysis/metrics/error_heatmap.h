@@ -1,0 +1,20 @@
+#pragma once
+// Heat map of the per-pixel ΔE00 with the halo/bleed/spill/interior bands outlined and a colour legend
+// (docs/metrics.md, "Heat map").
+#include "analysis/metrics/error_bands.h"
+
+#include <filesystem>
+
+#include <opencv2/core.hpp>
+
+namespace skinlab::metrics {
+
+// Renders the picture as BGR 8-bit: the ΔE00 map (CV_32FC1) through the inferno colour map on [0, scaleMax]
+// (larger values saturate), band outlines one pixel wide, and a legend panel on the right.
+cv::Mat renderErrorHeatmap(const cv::Mat& deltaE00, const ErrorBands& bands, double scaleMax);
+
+// Writes renderErrorHeatmap(...) as a PNG atomically; throws InputError naming the path when it cannot.
+void writeErrorHeatmap(const std::filesystem::path& path, const cv::Mat& deltaE00, const ErrorBands& bands,
+                       double scaleMax);
+
+} // namespace skinlab::metrics

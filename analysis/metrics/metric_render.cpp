@@ -1,0 +1,130 @@
+#include "analysis/metrics/metric_render.h"
+
+#include "common/error.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <cmath>
+#include <memory>
+#include <vector>
+
+namespace skinlab::metrics {
+namespace {
+
+int channelIndex(const OIIO::ImageSpec& spec, const std::string& name) {
+    for (int c = 0; c < spec.nchannels; ++c)
+        if (spec.channelnames[static_cast<size_t>(c)] == name) return c;
+    return -1;
+}
+
+int requireChannel(const OIIO::ImageSpec& spec, const std::string& file, const std::string& name) {
+    int index = channelIndex(spec, name);
+    if (index < 0) throwInput(file, name, "channel is missing");
+    return index;
+}
+
+std::optional<double> floatAttribute(const OIIO::ImageSpec& spec, const std::string& file, const std::string& name,
+                                     bool required) {
+    const OIIO::ParamValue* value = spec.find_attribute(name);
+    if (!value) {
+        if (required) throwInput(file, name, "metadata attribute is missing");
+        return std::nullopt;
+    }
+    if (value->type().basetype != OIIO::TypeDesc::FLOAT && value->type().basetype != OIIO::TypeDesc::DOUBLE)
+        throwInput(file, name, "metadata attribute is not a number");
+    double number = value->get_float();
+    if (!std::isfinite(number) || number <= 0.0)
+        throwInput(file, name, "metadata attribute must be a positive number, got " + std::to_string(number));
+    return number;
+}
+
+// Copies one float channel of an interleaved buffer into a single-channel plane.
+void extractChannel(const std::vector<float>& pixels, int channels, int index, cv::Mat& plane) {
+    auto* out = plane.ptr<float>();
+    size_t count = plane.total();
+    for (size_t i = 0; i < count; ++i) out[i] = pixels[i * static_cast<size_t>(channels) + static_cast<size_t>(index)];
+}
+
+} // namespace
+
+namespace {
+
+struct OpenedRender {
+    std::unique_ptr<OIIO::ImageInput> input;
+    MetricRender render;
+    int channels[5] = {-1, -1, -1, -1, -1};  // R, G, B, depth.Z, mask.Y
+};
+
+OpenedRender openMetricRender(const std::filesystem::path& path, RenderRole role) {
+    const std::string file = path.string();
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) throwInput(file, "", "file not found");
+    OpenedRender opened;
+    opened.input = OIIO::ImageInput::open(file);
+    if (!opened.input) {
+        std::string reason = OIIO::geterror();
+        if (auto newline = reason.find('\n'); newline != std::string::npos) reason.resize(newline);
+        throwInput(file, "", "not a readable image (" + reason + ")");
+    }
+    const OIIO::ImageSpec& spec = opened.input->spec();
+    if (spec.depth != 1) throwInput(file, "", "volume images are not supported");
+
+    bool reference = role == RenderRole::reference;
+    opened.channels[0] = requireChannel(spec, file, "R");
+    opened.channels[1] = requireChannel(spec, file, "G");
+    opened.channels[2] = requireChannel(spec, file, "B");
+    if (reference) {
+        opened.channels[3] = requireChannel(spec, file, "depth.Z");
+        opened.channels[4] = requireChannel(spec, file, "mask.Y");
+    }
+    MetricRender& render = opened.render;
+    render.path = path;
+    render.width = spec.width;
+    render.height = spec.height;
+    render.focalLengthPixels = floatAttribute(spec, file, "skinlab:f_px", reference);
+    render.millimetresPerUnit = floatAttribute(spec, file, "skinlab:mm_per_unit", reference);
+    // Not required here: `--sss-radius-mm` may stand in for it (prepareReference checks).
+    render.sssRadiusMillimetres = floatAttribute(spec, file, "skinlab:sss_radius_mm", false);
+    return opened;
+}
+
+} // namespace
+
+MetricRender inspectMetricRender(const std::filesystem::path& path, RenderRole role) {
+    return openMetricRender(path, role).render;
+}
+
+MetricRender loadMetricRender(const std::filesystem::path& path, RenderRole role) {
+    OpenedRender opened = openMetricRender(path, role);
+    const std::string file = path.string();
+    const OIIO::ImageSpec& spec = opened.input->spec();
+    MetricRender render = std::move(opened.render);
+
+    // Whole image, all channels, as float: the contract stores float32, and half files convert losslessly.
+    std::vector<float> pixels(static_cast<size_t>(spec.width) * static_cast<size_t>(spec.height) *
+                              static_cast<size_t>(spec.nchannels));
+    if (!opened.input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data())) {
+        std::string reason = opened.input->geterror();
+        if (auto newline = reason.find('\n'); newline != std::string::npos) reason.resize(newline);
+        throwInput(file, "", "cannot read pixels (" + reason + ")");
+    }
+    opened.input->close();
+
+    cv::Mat planes[3];
+    for (int c = 0; c < 3; ++c) {
+        planes[c].create(spec.height, spec.width, CV_32FC1);
+        extractChannel(pixels, spec.nchannels, opened.channels[c], planes[c]);
+    }
+    cv::merge(planes, 3, render.beauty);
+    if (opened.channels[3] >= 0) {
+        render.depth.create(spec.height, spec.width, CV_32FC1);
+        extractChannel(pixels, spec.nchannels, opened.channels[3], render.depth);
+    }
+    if (opened.channels[4] >= 0) {
+        render.mask.create(spec.height, spec.width, CV_32FC1);
+        extractChannel(pixels, spec.nchannels, opened.channels[4], render.mask);
+    }
+    return render;
+}
+
+} // namespace skinlab::metrics

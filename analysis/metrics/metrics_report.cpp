@@ -1,0 +1,124 @@
+#include "analysis/metrics/metrics_report.h"
+
+#include "common/version.h"
+
+#include <cmath>
+#include <cstdio>
+
+namespace skinlab::metrics {
+
+const char* const displayEncodingDescription =
+    "linear Rec.709 beauty x exposure, each channel clipped to [0,1], to CIE XYZ (D65, Y_white = 1), to CIELAB "
+    "(D65); PSNR and SSIM on the sRGB-encoded clipped values scaled to 0-255";
+
+namespace {
+
+std::string csvNumber(double value) {
+    if (std::isnan(value)) return "";
+    if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+    char text[40];
+    std::snprintf(text, sizeof text, "%.9g", value);
+    return text;
+}
+
+std::string csvText(const std::string& text) {
+    if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
+    std::string quoted = "\"";
+    for (char c : text) {
+        if (c == '"') quoted += '"';
+        quoted += c;
+    }
+    return quoted + "\"";
+}
+
+nlohmann::json jsonNumber(double value) { return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(); }
+
+nlohmann::json regionJson(const RegionScores& scores) {
+    return {{"pixels", scores.pixels},
+            {"psnr_db", jsonNumber(scores.psnrDecibels)},
+            {"ssim", jsonNumber(scores.ssim)},
+            {"delta_e00_mean", jsonNumber(scores.deltaE00Mean)},
+            {"delta_e00_p95", jsonNumber(scores.deltaE00P95)}};
+}
+
+nlohmann::json bandJson(const BandScores& scores) {
+    return {{"pixels", scores.pixels},
+            {"fraction_of_image", jsonNumber(scores.fractionOfImage)},
+            {"fraction_of_skin", jsonNumber(scores.fractionOfSkin)},
+            {"delta_e00_mean", jsonNumber(scores.deltaE00Mean)},
+            {"delta_e00_p95", jsonNumber(scores.deltaE00P95)},
+            {"excess", jsonNumber(scores.excess)},
+            {"leak_energy", jsonNumber(scores.leakEnergy)}};
+}
+
+} // namespace
+
+std::string metricsCsv(const std::vector<ComparisonRecord>& records) {
+    std::string out = "reference,test,block,width,height,sss_radius_mm,mm_per_unit,support_radius_world,f_px";
+    for (const char* region : {"image", "skin"})
+        for (const char* field : {"pixels", "psnr_db", "ssim", "delta_e00_mean", "delta_e00_p95"})
+            out += std::string(",") + region + "_" + field;
+    for (Band band : allBands)
+        for (const char* field :
+             {"pixels", "fraction_of_image", "fraction_of_skin", "delta_e00_mean", "delta_e00_p95", "excess", "leak_energy"})
+            out += "," + std::string(bandName(band)) + "_" + field;
+    out += ",heatmap\n";
+    for (const ComparisonRecord& record : records) {
+        out += csvText(record.job.referenceName) + "," + csvText(record.job.testName) + "," + csvText(record.job.block);
+        out += "," + std::to_string(record.width) + "," + std::to_string(record.height);
+        for (double v : {record.sssRadiusMillimetres, record.millimetresPerUnit, record.geometry.supportRadiusWorld,
+                         record.geometry.focalLengthPixels})
+            out += "," + csvNumber(v);
+        for (const RegionScores* region : {&record.image, &record.skin}) {
+            out += "," + std::to_string(region->pixels);
+            for (double v : {region->psnrDecibels, region->ssim, region->deltaE00Mean, region->deltaE00P95})
+                out += "," + csvNumber(v);
+        }
+        for (const BandScores& band : record.bands) {
+            out += "," + std::to_string(band.pixels);
+            for (double v : {band.fractionOfImage, band.fractionOfSkin, band.deltaE00Mean, band.deltaE00P95, band.excess,
+                             band.leakEnergy})
+                out += "," + csvNumber(v);
+        }
+        out += "," + csvText(record.heatmap) + "\n";
+    }
+    return out;
+}
+
+nlohmann::json metricsJson(const std::vector<ComparisonRecord>& records, const ReportSettings& settings,
+                           const std::vector<std::string>& blocksWithoutReference) {
+    nlohmann::json comparisons = nlohmann::json::array();
+    for (const ComparisonRecord& record : records) {
+        nlohmann::json bands = nlohmann::json::object();
+        for (Band band : allBands) bands[std::string(bandName(band))] = bandJson(record.bands[size_t(band)]);
+        comparisons.push_back({
+            {"reference", {{"name", record.job.referenceName}, {"path", record.job.referencePath.string()}}},
+            {"test",
+             {{"name", record.job.testName}, {"path", record.job.testPath.string()}, {"factors", record.job.factors}}},
+            {"block", record.job.block},
+            {"width", record.width},
+            {"height", record.height},
+            {"sss_radius_mm", record.sssRadiusMillimetres},
+            {"mm_per_unit", record.millimetresPerUnit},
+            {"support_radius_world", record.geometry.supportRadiusWorld},
+            {"f_px", record.geometry.focalLengthPixels},
+            {"image", regionJson(record.image)},
+            {"skin", regionJson(record.skin)},
+            {"bands", bands},
+            {"heatmap", record.heatmap.empty() ? nlohmann::json() : nlohmann::json(record.heatmap)},
+        });
+    }
+    return {{"format", "skinlab-metrics"},
+            {"version", 1},
+            {"skinlab_version", version()},
+            {"settings",
+             {{"exposure", settings.exposure},
+              {"display_encoding", displayEncodingDescription},
+              {"skin_mask_threshold", 0.5},
+              {"percentile", "p95 with linear interpolation between order statistics"},
+              {"heatmap_max_delta_e00", settings.heatmapMax}}},
+            {"blocks_without_reference", blocksWithoutReference},
+            {"comparisons", comparisons}};
+}
+
+} // namespace skinlab::metrics

@@ -1,0 +1,78 @@
+#include "analysis/metrics/metrics_run.h"
+
+#include "analysis/metrics/error_heatmap.h"
+#include "common/error.h"
+#include "common/files.h"
+
+#include <cmath>
+#include <map>
+#include <memory>
+
+#include <spdlog/spdlog.h>
+
+namespace skinlab::metrics {
+namespace fs = std::filesystem;
+
+std::vector<ComparisonRecord> runMetrics(const ComparisonPlan& plan, const MetricsRunOptions& options,
+                                         const fs::path& outputFolder) {
+    if (plan.jobs.empty()) throwInput("", "", "nothing to compare: no test render besides the reference");
+    validateMetricOptions(options.metric);
+    if (!(options.heatmapMax > 0.0) || !std::isfinite(options.heatmapMax))
+        throwInput("--heatmap-max", "", std::to_string(options.heatmapMax) + " must be a positive number");
+
+    // 1. Check every input from its header before any output exists.
+    std::map<fs::path, MetricRender> referenceHeaders;
+    for (const ComparisonJob& job : plan.jobs) {
+        auto found = referenceHeaders.find(job.referencePath);
+        if (found == referenceHeaders.end())
+            found = referenceHeaders.emplace(job.referencePath, inspectMetricRender(job.referencePath, RenderRole::reference))
+                        .first;
+        const MetricRender& reference = found->second;
+        if (!options.metric.sssRadiusMillimetres && !reference.sssRadiusMillimetres)
+            throwInput(job.referencePath.string(), "skinlab:sss_radius_mm",
+                       "metadata attribute is missing (or give --sss-radius-mm)");
+        checkComparable(reference, inspectMetricRender(job.testPath, RenderRole::test));
+    }
+
+    // 2. Compare, one reference prepared once for all its tests.
+    ensureDirectory(outputFolder);
+    std::vector<ComparisonRecord> records;
+    std::map<fs::path, std::shared_ptr<const PreparedReference>> prepared;
+    for (const ComparisonJob& job : plan.jobs) {
+        auto found = prepared.find(job.referencePath);
+        if (found == prepared.end()) {
+            prepared.clear();  // jobs are grouped by reference; keep one in memory at a time
+            auto reference = std::make_shared<const PreparedReference>(
+                prepareReference(loadMetricRender(job.referencePath, RenderRole::reference), options.metric));
+            found = prepared.emplace(job.referencePath, reference).first;
+        }
+        const PreparedReference& reference = *found->second;
+        spdlog::info("metrics: {} vs {}", job.testName, job.referenceName);
+        ComparisonResult result =
+            compareWithReference(reference, loadMetricRender(job.testPath, RenderRole::test), options.metric);
+
+        ComparisonRecord record;
+        record.job = job;
+        record.width = reference.render.width;
+        record.height = reference.render.height;
+        record.sssRadiusMillimetres = reference.sssRadiusMillimetres;
+        record.millimetresPerUnit = *reference.render.millimetresPerUnit;
+        record.geometry = reference.geometry;
+        record.image = result.image;
+        record.skin = result.skin;
+        record.bands = result.bands;
+        if (options.heatmaps) {
+            record.heatmap = "heatmaps/" + job.testName + ".png";
+            writeErrorHeatmap(outputFolder / record.heatmap, result.deltaE00, reference.bands, options.heatmapMax);
+        }
+        records.push_back(std::move(record));
+    }
+
+    // 3. Tables last.
+    writeFileAtomic(outputFolder / "metrics.csv", metricsCsv(records));
+    ReportSettings settings{options.metric.exposure, options.heatmapMax};
+    writeFileAtomic(outputFolder / "metrics.json", metricsJson(records, settings, plan.blocksWithoutReference).dump(2) + "\n");
+    return records;
+}
+
+} // namespace skinlab::metrics

@@ -1,0 +1,79 @@
+#pragma once
+// One comparison of a test render with a reference: per-pixel ΔE00, global and skin PSNR/SSIM/ΔE00, and the
+// band scores of science.md §5 (docs/metrics.md lists every field).
+#include "analysis/metrics/error_bands.h"
+#include "analysis/metrics/metric_render.h"
+
+#include <array>
+#include <cstddef>
+#include <optional>
+
+#include <opencv2/core.hpp>
+
+namespace skinlab::metrics {
+
+struct MetricOptions {
+    // Linear multiplier applied to both renders before the display encoding for ΔE00/PSNR/SSIM (docs/metrics.md).
+    // 1 keeps the renderer's exposure, which the contract says is already applied.
+    double exposure = 1.0;
+    // Overrides the reference's skinlab:sss_radius_mm (millimetres) when set.
+    std::optional<double> sssRadiusMillimetres;
+};
+
+// The reference with everything that does not depend on the test render computed once.
+struct PreparedReference {
+    MetricRender render;
+    BandGeometry geometry;
+    double sssRadiusMillimetres = 0.0;
+    ErrorBands bands;
+    cv::Mat lab;        // CV_64FC3 L*, a*, b* of the display encoding
+    cv::Mat luminance;  // CV_64FC1 linear Y (× exposure), unclipped, for the leak energy
+    cv::Mat display;    // CV_64FC3 sRGB-encoded R, G, B on 0–255 for PSNR and SSIM
+    double skinLuminanceSum = 0.0;  // Σ_skin Y_R
+};
+
+// Throws InputError "--exposure: V must be a positive number" (or --sss-radius-mm) for a bad option.
+void validateMetricOptions(const MetricOptions& options);
+
+// Requires a render loaded with RenderRole::reference. Throws InputError for a non-positive exposure or radius.
+PreparedReference prepareReference(MetricRender reference, const MetricOptions& options);
+
+struct RegionScores {
+    std::size_t pixels = 0;
+    double psnrDecibels = 0.0;   // +inf when identical on the region
+    double ssim = 0.0;           // mean SSIM over the region
+    double deltaE00Mean = 0.0;
+    double deltaE00P95 = 0.0;    // 95th percentile, linear interpolation between order statistics
+};
+
+struct BandScores {
+    std::size_t pixels = 0;
+    double fractionOfImage = 0.0;
+    double fractionOfSkin = 0.0;  // band pixels / skin pixels (NaN without skin)
+    double deltaE00Mean = 0.0;    // NaN for an empty band
+    double deltaE00P95 = 0.0;     // NaN for an empty band
+    double excess = 0.0;          // band mean − interior mean; NaN if either is empty
+    double leakEnergy = 0.0;      // Σ_band |Y_T − Y_R| / Σ_skin Y_R; NaN without skin luminance
+};
+
+struct ComparisonResult {
+    RegionScores image;
+    RegionScores skin;
+    std::array<BandScores, 4> bands;  // indexed by Band
+    cv::Mat deltaE00;                 // CV_32FC1 per-pixel ΔE00
+    const BandScores& band(Band b) const { return bands[static_cast<std::size_t>(b)]; }
+};
+
+// Throws InputError "TEST: size WxH differs from the reference REF (WxH)" and, when both carry skinlab:f_px,
+// "TEST: skinlab:f_px: V differs from the reference's V (not the same camera)": the bands need the same camera.
+// Works on headers (inspectMetricRender) as well as on loaded renders.
+void checkComparable(const MetricRender& reference, const MetricRender& test);
+
+// Checks with checkComparable, then compares.
+ComparisonResult compareWithReference(const PreparedReference& reference, const MetricRender& test,
+                                      const MetricOptions& options);
+
+// 95th percentile with linear interpolation between order statistics (NumPy's default); NaN when empty.
+double percentile95(std::vector<double> values);
+
+} // namespace skinlab::metrics

@@ -1,0 +1,39 @@
+#pragma once
+// Which renders to compare with which reference: either files named on the command line, or every stimulus of a
+// stimulus set (manifest.json, contract 2) against the reference stimulus of its block.
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace skinlab::metrics {
+
+struct ComparisonJob {
+    std::string referenceName;  // file stem or stimulus id
+    std::filesystem::path referencePath;
+    std::string testName;       // file stem or stimulus id; names the heat map, so unique within a run
+    std::filesystem::path testPath;
+    std::string block;          // the stimulus block ("" for files)
+    nlohmann::json factors = nlohmann::json::object();  // the test stimulus's factor levels ({} for files)
+};
+
+struct ComparisonPlan {
+    std::vector<ComparisonJob> jobs;
+    std::vector<std::string> blocksWithoutReference;  // stimulus-set blocks that were skipped, in manifest order
+};
+
+// One reference file against each test file. Throws InputError when two tests share a file stem.
+ComparisonPlan planFileComparisons(const std::filesystem::path& reference,
+                                   const std::vector<std::filesystem::path>& tests);
+
+// Every stimulus of the set in `stimulusFolder` against its block's reference. Without `referenceId`, each
+// block's stimulus marked "reference": true is its reference (blocks without one are skipped and listed; a
+// set with none at all, or a block with two, is an error); with it, that stimulus is the reference of its own
+// block only. Checks each EXR's sha256 against the manifest. Errors name manifest.json and the JSON path
+// ("DIR/manifest.json: stimuli[2].files.exr: missing").
+ComparisonPlan planStimulusSetComparisons(const std::filesystem::path& stimulusFolder,
+                                          const std::optional<std::string>& referenceId);
+
+} // namespace skinlab::metrics

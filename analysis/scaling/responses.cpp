@@ -1,0 +1,282 @@
+#include "analysis/scaling/responses.h"
+
+#include "analysis/scaling/csv_reader.h"
+#include "common/error.h"
+#include "common/files.h"
+
+#include <sqlite3.h>
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+
+namespace skinlab::analysis::scaling {
+namespace {
+
+const std::array<const char*, 9> kSkinlabColumns = {"observer",      "scene",     "condition_A",
+                                                    "condition_B",   "is_A_selected", "A_on_left",
+                                                    "trial_kind",    "correct",   "response_ms"};
+const std::array<const char*, 5> kPwcmpColumns = {"observer", "scene", "condition_A", "condition_B", "is_A_selected"};
+
+std::string where(int line, std::string_view column) {
+    std::string out = "line " + std::to_string(line);
+    if (!column.empty()) out += ": column " + std::string(column);
+    return out;
+}
+
+bool parseFlag(const std::string& file, int line, std::string_view column, const std::string& value) {
+    if (value == "1" || value == "true" || value == "TRUE") return true;
+    if (value == "0" || value == "false" || value == "FALSE") return false;
+    throwInput(file, where(line, column), "'" + value + "' is not 0 or 1");
+}
+
+std::optional<bool> parseOptionalFlag(const std::string& file, int line, std::string_view column,
+                                      const std::string& value) {
+    if (value.empty() || value == "NULL") return std::nullopt;
+    return parseFlag(file, line, column, value);
+}
+
+double parseNumber(const std::string& file, int line, std::string_view column, const std::string& value) {
+    double number = 0.0;
+    const auto [end, error] = std::from_chars(value.data(), value.data() + value.size(), number);
+    if (value.empty() || error != std::errc() || end != value.data() + value.size() || !std::isfinite(number))
+        throwInput(file, where(line, column), "'" + value + "' is not a number");
+    return number;
+}
+
+TrialKind parseKind(const std::string& file, int line, const std::string& value) {
+    if (value == "test") return TrialKind::Test;
+    if (value == "repeat") return TrialKind::Repeat;
+    if (value == "catch") return TrialKind::Catch;
+    if (value == "practice") return TrialKind::Practice;
+    throwInput(file, where(line, "trial_kind"), "'" + value + "' is not one of test, repeat, catch, practice");
+}
+
+// Checks the fields every long format shares.
+void checkResponse(const std::string& file, const Response& r) {
+    if (r.observer.empty()) throwInput(file, where(r.line, "observer"), "empty observer");
+    if (r.conditionA.empty()) throwInput(file, where(r.line, "condition_A"), "empty condition");
+    if (r.conditionB.empty()) throwInput(file, where(r.line, "condition_B"), "empty condition");
+    if (r.conditionA == r.conditionB)
+        throwInput(file, where(r.line, "condition_B"),
+                   "condition '" + r.conditionA + "' is compared with itself (condition_A = condition_B)");
+}
+
+std::string joined(const auto& names) {
+    std::string out;
+    for (const auto& name : names) out += (out.empty() ? "" : ",") + std::string(name);
+    return out;
+}
+
+void readLongCsv(ResponseTable& table, const std::vector<CsvRecord>& records) {
+    const std::vector<std::string>& header = records.front().fields;
+    std::map<std::string, size_t> columnIndex;
+    for (size_t k = 0; k < header.size(); ++k) {
+        if (!columnIndex.emplace(header[k], k).second)
+            throwInput(table.file, where(records.front().line, header[k]), "column appears twice in the header");
+    }
+    auto column = [&](const char* name) -> size_t { return columnIndex.at(name); };
+    const bool full = table.format == ResponseFormat::SkinlabCsv;
+    for (size_t r = 1; r < records.size(); ++r) {
+        const CsvRecord& record = records[r];
+        if (record.fields.size() != header.size())
+            throwInput(table.file, where(record.line, ""),
+                       "has " + std::to_string(record.fields.size()) + " columns, the header has " +
+                           std::to_string(header.size()));
+        auto field = [&](const char* name) -> const std::string& { return record.fields[column(name)]; };
+        Response response;
+        response.line = record.line;
+        response.observer = field("observer");
+        response.block = field("scene");
+        response.conditionA = field("condition_A");
+        response.conditionB = field("condition_B");
+        response.aSelected = parseFlag(table.file, record.line, "is_A_selected", field("is_A_selected"));
+        if (full) {
+            response.aOnLeft = parseOptionalFlag(table.file, record.line, "A_on_left", field("A_on_left"));
+            response.kind = parseKind(table.file, record.line, field("trial_kind"));
+            response.correct = parseOptionalFlag(table.file, record.line, "correct", field("correct"));
+            if (!field("response_ms").empty() && field("response_ms") != "NULL")
+                response.responseMs = parseNumber(table.file, record.line, "response_ms", field("response_ms"));
+        }
+        checkResponse(table.file, response);
+        table.responses.push_back(std::move(response));
+    }
+}
+
+void readCountMatrix(ResponseTable& table, const std::vector<CsvRecord>& records) {
+    const CsvRecord& header = records.front();
+    const std::vector<std::string> names(header.fields.begin() + 1, header.fields.end());
+    if (names.size() < 2) throwInput(table.file, where(header.line, ""), "a count matrix needs at least 2 conditions");
+    std::map<std::string, size_t> index;
+    for (size_t k = 0; k < names.size(); ++k) {
+        if (names[k].empty()) throwInput(table.file, where(header.line, std::to_string(k + 2)), "empty condition name");
+        if (!index.emplace(names[k], k).second)
+            throwInput(table.file, where(header.line, names[k]), "condition appears twice in the header");
+    }
+    const size_t m = names.size();
+    table.matrixConditions = names;
+    table.matrixCounts.assign(m * m, 0.0);
+    std::vector<bool> seen(m, false);
+    for (size_t r = 1; r < records.size(); ++r) {
+        const CsvRecord& record = records[r];
+        if (record.fields.size() != m + 1)
+            throwInput(table.file, where(record.line, ""),
+                       "has " + std::to_string(record.fields.size()) + " columns, the header has " +
+                           std::to_string(m + 1));
+        const auto found = index.find(record.fields[0]);
+        if (found == index.end())
+            throwInput(table.file, where(record.line, "condition"),
+                       "unknown condition '" + record.fields[0] + "' (not in the header: " + joined(names) + ")");
+        const size_t row = found->second;
+        if (seen[row]) throwInput(table.file, where(record.line, "condition"), "row '" + names[row] + "' appears twice");
+        seen[row] = true;
+        for (size_t col = 0; col < m; ++col) {
+            const double count = parseNumber(table.file, record.line, names[col], record.fields[col + 1]);
+            if (count < 0)
+                throwInput(table.file, where(record.line, names[col]),
+                           "negative count " + record.fields[col + 1]);
+            if (row == col && count != 0)
+                throwInput(table.file, where(record.line, names[col]),
+                           "condition '" + names[row] + "' is compared with itself (diagonal count " +
+                               record.fields[col + 1] + ", must be 0)");
+            table.matrixCounts[row * m + col] = count;
+        }
+    }
+    for (size_t k = 0; k < m; ++k)
+        if (!seen[k]) throwInput(table.file, "condition " + names[k], "has no row in the count matrix");
+}
+
+ResponseTable readCsv(const std::filesystem::path& path) {
+    ResponseTable table;
+    table.file = path.string();
+    const std::string text = readFile(path);
+    const std::vector<CsvRecord> records = parseCsv(text, table.file);
+    if (records.empty()) throwInput(table.file, "", "empty file (expected a header line and responses)");
+    const std::vector<std::string>& header = records.front().fields;
+    const std::set<std::string> headerSet(header.begin(), header.end());
+    const std::set<std::string> skinlabSet(kSkinlabColumns.begin(), kSkinlabColumns.end());
+    const std::set<std::string> pwcmpSet(kPwcmpColumns.begin(), kPwcmpColumns.end());
+    std::string first = header.front();
+    std::transform(first.begin(), first.end(), first.begin(), [](unsigned char c) { return std::tolower(c); });
+    if (headerSet == skinlabSet && header.size() == skinlabSet.size()) {
+        table.format = ResponseFormat::SkinlabCsv;
+    } else if (headerSet == pwcmpSet && header.size() == pwcmpSet.size()) {
+        table.format = ResponseFormat::PwcmpCsv;
+    } else if (first.empty() || first == "condition") {
+        table.format = ResponseFormat::CountMatrix;
+    } else {
+        // Name the first column that is missing or unexpected, judged against the closer of the two formats.
+        const bool closerToPwcmp = header.size() <= 5;
+        const auto& expected = closerToPwcmp ? pwcmpSet : skinlabSet;
+        for (size_t k = 0; k < header.size(); ++k)
+            if (!expected.count(header[k]))
+                throwInput(table.file, where(records.front().line, std::to_string(k + 1)),
+                           "unexpected column '" + header[k] + "'; expected the columns " +
+                               (closerToPwcmp ? joined(kPwcmpColumns) : joined(kSkinlabColumns)) +
+                               " or a count matrix header 'condition,<names>'");
+        for (const auto& name : expected)
+            if (!headerSet.count(name))
+                throwInput(table.file, where(records.front().line, name), "missing column; expected the columns " +
+                               (closerToPwcmp ? joined(kPwcmpColumns) : joined(kSkinlabColumns)));
+        throwInput(table.file, where(records.front().line, ""), "unrecognised header");
+    }
+    if (records.size() < 2) throwInput(table.file, "", "no responses after the header line");
+    if (table.format == ResponseFormat::CountMatrix)
+        readCountMatrix(table, records);
+    else
+        readLongCsv(table, records);
+    return table;
+}
+
+ResponseTable readDatabase(const std::filesystem::path& path) {
+    ResponseTable table;
+    table.file = path.string();
+    table.format = ResponseFormat::StudyDatabase;
+    sqlite3* database = nullptr;
+    if (sqlite3_open_v2(table.file.c_str(), &database, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) {
+        const std::string message = database ? sqlite3_errmsg(database) : "cannot open";
+        sqlite3_close(database);
+        throwInput(table.file, "", "cannot open the study database: " + message);
+    }
+    struct Closer {
+        sqlite3* database;
+        sqlite3_stmt* statement = nullptr;
+        ~Closer() {
+            sqlite3_finalize(statement);
+            sqlite3_close(database);
+        }
+    } closer{database};
+    sqlite3_busy_timeout(database, 5000);  // the study server may be writing
+    const std::string query =
+        "SELECT observer, scene, condition_A, condition_B, is_A_selected, A_on_left, trial_kind, correct, "
+        "response_ms FROM responses_long";
+    if (sqlite3_prepare_v2(database, query.c_str(), -1, &closer.statement, nullptr) != SQLITE_OK)
+        throwInput(table.file, "responses_long",
+                   std::string("cannot read the responses view: ") + sqlite3_errmsg(database));
+    auto text = [&](int column) -> std::string {
+        const unsigned char* value = sqlite3_column_text(closer.statement, column);
+        return value ? reinterpret_cast<const char*>(value) : std::string();
+    };
+    int row = 0;
+    int status = SQLITE_ROW;
+    while ((status = sqlite3_step(closer.statement)) == SQLITE_ROW) {
+        ++row;
+        Response response;
+        response.line = row;
+        response.observer = text(0);
+        response.block = text(1);
+        response.conditionA = text(2);
+        response.conditionB = text(3);
+        response.aSelected = parseFlag(table.file, row, "is_A_selected", text(4));
+        response.aOnLeft = parseOptionalFlag(table.file, row, "A_on_left", text(5));
+        response.kind = parseKind(table.file, row, text(6));
+        response.correct = parseOptionalFlag(table.file, row, "correct", text(7));
+        if (sqlite3_column_type(closer.statement, 8) != SQLITE_NULL)
+            response.responseMs = sqlite3_column_double(closer.statement, 8);
+        checkResponse(table.file, response);
+        table.responses.push_back(std::move(response));
+    }
+    if (status != SQLITE_DONE)
+        throwInput(table.file, "responses_long", std::string("cannot read: ") + sqlite3_errmsg(database));
+    if (table.responses.empty()) throwInput(table.file, "responses_long", "no responses in the study database");
+    return table;
+}
+
+} // namespace
+
+const char* trialKindName(TrialKind kind) {
+    switch (kind) {
+    case TrialKind::Test: return "test";
+    case TrialKind::Repeat: return "repeat";
+    case TrialKind::Catch: return "catch";
+    case TrialKind::Practice: return "practice";
+    }
+    return "test";
+}
+
+const char* responseFormatName(ResponseFormat format) {
+    switch (format) {
+    case ResponseFormat::StudyDatabase: return "study-database";
+    case ResponseFormat::SkinlabCsv: return "skinlab-csv";
+    case ResponseFormat::PwcmpCsv: return "pwcmp-csv";
+    case ResponseFormat::CountMatrix: return "count-matrix";
+    }
+    return "skinlab-csv";
+}
+
+ResponseTable readResponses(const std::filesystem::path& path) {
+    std::ifstream stream(path, std::ios::binary);
+    if (!stream) throwInput(path.string(), "", "cannot open the responses file");
+    std::string head(16, '\0');
+    stream.read(head.data(), 16);
+    head.resize(static_cast<size_t>(stream.gcount()));
+    // Every SQLite 3 database starts with this 16-byte magic string (sqlite.org/fileformat.html §1.3).
+    if (head == std::string("SQLite format 3\0", 16)) return readDatabase(path);
+    return readCsv(path);
+}
+
+} // namespace skinlab::analysis::scaling

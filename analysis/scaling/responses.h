@@ -1,0 +1,47 @@
+#pragma once
+// Reading 2AFC responses for scaling. Accepted inputs (detected from the file's first bytes / header line):
+//  - a study database (SQLite): the VIEW `responses_long` (contract 3);
+//  - a CSV export of that view (`skinlab study export --format csv`): columns observer, scene, condition_A,
+//    condition_B, is_A_selected, A_on_left, trial_kind, correct, response_ms (any order, all required);
+//  - a pwcmp long-format CSV: observer, scene, condition_A, condition_B, is_A_selected;
+//  - a count matrix CSV: header `condition,<name 1>,...,<name m>`, then one row per condition
+//    `<name i>,D_i1,...,D_im` with D_ij = times i was chosen over j (one block, no observers).
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace skinlab::analysis::scaling {
+
+enum class TrialKind { Test, Repeat, Catch, Practice };
+const char* trialKindName(TrialKind kind);
+
+struct Response {
+    std::string observer;
+    std::string block;  // contract 3's column `scene` (the block name, e.g. "builtin:head/mid")
+    std::string conditionA;
+    std::string conditionB;
+    bool aSelected = false;
+    std::optional<bool> aOnLeft;  // unknown in pwcmp files
+    TrialKind kind = TrialKind::Test;
+    std::optional<bool> correct;  // catch trials only
+    std::optional<double> responseMs;
+    int line = 0;  // 1-based line (CSV) or row (SQLite) it came from, for error messages
+};
+
+enum class ResponseFormat { StudyDatabase, SkinlabCsv, PwcmpCsv, CountMatrix };
+const char* responseFormatName(ResponseFormat format);
+
+struct ResponseTable {
+    std::string file;  // as given, used as the prefix of every error message
+    ResponseFormat format = ResponseFormat::SkinlabCsv;
+    std::vector<Response> responses;
+    // Count-matrix files only: the block's conditions (header order) and the counts D (row-major, m × m).
+    std::vector<std::string> matrixConditions;
+    std::vector<double> matrixCounts;
+};
+
+// Reads any accepted format; throws InputError "FILE: line N: column C: message" on bad input.
+ResponseTable readResponses(const std::filesystem::path& path);
+
+} // namespace skinlab::analysis::scaling

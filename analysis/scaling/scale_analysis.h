@@ -1,0 +1,87 @@
+#pragma once
+// The whole pairwise analysis of a dataset (docs/analysis.md): per block, Thurstone Case V scores in JOD with
+// studentized-bootstrap intervals, Bradley–Terry scores, pairwise tests with a multiple-comparison correction,
+// design flags (disconnected graph, unanimous pairs, existence of the ML estimate), Kendall's ζ and u, side
+// bias; per observer, held-out likelihood screening and catch-trial failures.
+#include "analysis/scaling/bootstrap.h"
+#include "analysis/scaling/comparison_data.h"
+#include "analysis/scaling/consistency.h"
+#include "analysis/scaling/multiple_comparisons.h"
+#include "analysis/scaling/pairwise_model.h"
+#include "analysis/scaling/screening.h"
+
+#include <string>
+#include <vector>
+
+namespace skinlab::analysis::scaling {
+
+struct AnalysisOptions {
+    FitOptions fit;                    // fit.model is ignored: both models are always fitted
+    BootstrapOptions bootstrap;
+    Correction correction = Correction::Holm;
+    double alpha = 0.05;               // significance level after correction
+    double screeningWhisker = 1.5;     // inter-quartile rule factor w
+};
+
+struct PairTest {
+    DifferenceTest test;
+    double comparisons = 0.0;  // trials of this pair in the block (0: never compared directly)
+    double adjustedPValue = 1.0;
+    bool significant = false;
+};
+
+struct ObserverInBlock {
+    double trials = 0.0;
+    double heldOutLogLikelihood = 0.0;  // nats, sum over the observer's trials
+    TriadConsistency consistency;
+    double sideTrials = 0.0;
+    double leftChosen = 0.0;
+};
+
+struct BlockAnalysis {
+    std::string name;
+    std::vector<std::string> conditions;
+    std::vector<std::string> observers;
+    Eigen::MatrixXd counts;  // D(i, j) = times i chosen over j
+    FitResult thurstone;
+    FitResult bradleyTerry;
+    Eigen::VectorXd bradleyTerryStandardError;
+    std::string intervalMethod;         // "studentized-bootstrap" or "fisher-wald" (fewer than 2 observers)
+    int bootstrapSamples = 0;
+    Eigen::VectorXd standardError, low, high;             // Thurstone, JOD
+    Eigen::VectorXd percentileLow, percentileHigh;        // pwcmp-style percentile interval (reference only)
+    std::vector<PairTest> pairs;                           // every i < j
+    std::vector<std::vector<int>> components;              // connected components of the comparison graph
+    bool mleExists = true;  // win graph strongly connected (Ford 1957); otherwise the prior sets some distances
+    std::vector<std::pair<int, int>> unanimousPairs;       // compared pairs where one side never won
+    std::optional<double> kendallU;
+    SideBias sideBias;
+    std::vector<ObserverInBlock> observerStats;
+    std::vector<std::string> warnings;
+};
+
+struct ObserverSummary {
+    std::string observer;
+    double trials = 0.0;
+    double heldOutPerTrial = NAN;  // mean held-out log-likelihood per trial over all blocks (nats)
+    bool flagged = false;          // low outlier by the inter-quartile rule
+    int catchTrials = 0;
+    int catchFailures = 0;
+    double sideTrials = 0.0;
+    double leftChosen = 0.0;
+};
+
+struct Analysis {
+    std::string file;
+    ResponseFormat format = ResponseFormat::SkinlabCsv;
+    AnalysisOptions options;
+    std::vector<BlockAnalysis> blocks;
+    std::vector<ObserverSummary> observers;
+    OutlierRule screeningRule;
+    std::vector<std::string> warnings;  // every block's warnings too, prefixed by the block name
+};
+
+BlockAnalysis analyzeBlock(const BlockData& block, const AnalysisOptions& options);
+Analysis analyzeDataset(const Dataset& dataset, const AnalysisOptions& options);
+
+} // namespace skinlab::analysis::scaling

@@ -1,0 +1,314 @@
+#include "analysis/scaling/scale_report.h"
+
+#include "analysis/scaling/csv_reader.h"
+#include "analysis/scaling/plots.h"
+#include "common/files.h"
+#include "common/version.h"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+namespace skinlab::analysis::scaling {
+namespace {
+
+std::string number(double value, int digits = 6) {
+    if (!std::isfinite(value)) return "";
+    char buffer[64];
+    std::snprintf(buffer, sizeof buffer, "%.*g", digits, value);
+    return buffer;
+}
+
+std::string fixed(double value, int decimals) {
+    if (!std::isfinite(value)) return "–";
+    char buffer[64];
+    std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
+    return buffer;
+}
+
+nlohmann::json finite(double value) { return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(); }
+
+std::string escapeHtml(const std::string& text) {
+    std::string out;
+    for (char c : text) {
+        switch (c) {
+        case '&': out += "&amp;"; break;
+        case '<': out += "&lt;"; break;
+        case '>': out += "&gt;"; break;
+        case '"': out += "&quot;"; break;
+        default: out += c;
+        }
+    }
+    return out;
+}
+
+std::string base64(const std::string& bytes) {
+    static const char* alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    size_t k = 0;
+    for (; k + 2 < bytes.size(); k += 3) {
+        const unsigned v = (static_cast<unsigned char>(bytes[k]) << 16) | (static_cast<unsigned char>(bytes[k + 1]) << 8) |
+                           static_cast<unsigned char>(bytes[k + 2]);
+        out += {alphabet[(v >> 18) & 63], alphabet[(v >> 12) & 63], alphabet[(v >> 6) & 63], alphabet[v & 63]};
+    }
+    if (k + 1 == bytes.size()) {
+        const unsigned v = static_cast<unsigned char>(bytes[k]) << 16;
+        out += {alphabet[(v >> 18) & 63], alphabet[(v >> 12) & 63], '=', '='};
+    } else if (k + 2 == bytes.size()) {
+        const unsigned v = (static_cast<unsigned char>(bytes[k]) << 16) | (static_cast<unsigned char>(bytes[k + 1]) << 8);
+        out += {alphabet[(v >> 18) & 63], alphabet[(v >> 12) & 63], alphabet[(v >> 6) & 63], '='};
+    }
+    return out;
+}
+
+std::string plotName(size_t index, const std::string& kind, const std::string& block) {
+    char prefix[16];
+    std::snprintf(prefix, sizeof prefix, "%02zu-", index + 1);  // the index keeps names unique after slugging
+    return "plots/" + kind + "_" + prefix + blockSlug(block) + ".png";
+}
+
+} // namespace
+
+std::string blockSlug(const std::string& name) {
+    std::string slug;
+    for (unsigned char c : name) {
+        const bool keep = std::isalnum(c) || c == '_' || c == '.';
+        if (keep)
+            slug += static_cast<char>(c);
+        else if (!slug.empty() && slug.back() != '-')
+            slug += '-';
+    }
+    while (!slug.empty() && slug.back() == '-') slug.pop_back();
+    return slug.empty() ? "block" : slug;
+}
+
+nlohmann::json analysisJson(const Analysis& analysis) {
+    const AnalysisOptions& o = analysis.options;
+    nlohmann::json json;
+    json["format"] = "skinlab-scaling";
+    json["version"] = 1;
+    json["skinlab_version"] = skinlab::version();
+    json["input"] = {{"file", analysis.file}, {"format", responseFormatName(analysis.format)}};
+    json["settings"] = {{"model", "thurstone-case-v"},
+                        {"sigma", kThurstoneSigma},
+                        {"unit", "JOD (1 JOD = 75 % preference), mean of each block's scores = 0"},
+                        {"prior_precision", o.fit.priorPrecision},
+                        {"interval", "symmetric studentized bootstrap over observers, cluster-robust SE"},
+                        {"level", o.bootstrap.level},
+                        {"bootstrap_samples", o.bootstrap.samples},
+                        {"seed", o.bootstrap.seed},
+                        {"correction", correctionName(o.correction)},
+                        {"alpha", o.alpha},
+                        {"screening", "leave-one-out held-out log-likelihood per trial, low outliers by Q1 - w*IQR"},
+                        {"screening_whisker", o.screeningWhisker}};
+    for (const BlockAnalysis& block : analysis.blocks) {
+        nlohmann::json b;
+        b["name"] = block.name;
+        b["conditions"] = block.conditions;
+        b["observers"] = static_cast<int>(block.observers.size());
+        nlohmann::json counts = nlohmann::json::array();
+        for (Eigen::Index i = 0; i < block.counts.rows(); ++i) {
+            std::vector<double> row(block.counts.cols());
+            for (Eigen::Index j = 0; j < block.counts.cols(); ++j) row[j] = block.counts(i, j);
+            counts.push_back(row);
+        }
+        b["counts"] = counts;
+        b["interval_method"] = block.intervalMethod;
+        b["bootstrap_samples"] = block.bootstrapSamples;
+        b["fit"] = {{"converged", block.thurstone.converged},
+                    {"iterations", block.thurstone.iterations},
+                    {"log_likelihood", block.thurstone.logLikelihood},
+                    {"bradley_terry_log_likelihood", block.bradleyTerry.logLikelihood}};
+        for (size_t i = 0; i < block.conditions.size(); ++i) {
+            const auto k = static_cast<Eigen::Index>(i);
+            b["scores"].push_back({{"condition", block.conditions[i]},
+                                   {"jod", block.thurstone.scores[k]},
+                                   {"standard_error", finite(block.standardError[k])},
+                                   {"ci_low", finite(block.low[k])},
+                                   {"ci_high", finite(block.high[k])},
+                                   {"percentile_low", finite(block.percentileLow[k])},
+                                   {"percentile_high", finite(block.percentileHigh[k])},
+                                   {"bradley_terry_jod", block.bradleyTerry.scores[k]},
+                                   {"bradley_terry_standard_error", finite(block.bradleyTerryStandardError[k])}});
+        }
+        nlohmann::json components = nlohmann::json::array();
+        for (const auto& component : block.components) {
+            std::vector<std::string> names;
+            for (int c : component) names.push_back(block.conditions[c]);
+            components.push_back(names);
+        }
+        nlohmann::json unanimous = nlohmann::json::array();
+        for (const auto& [i, j] : block.unanimousPairs) unanimous.push_back({block.conditions[i], block.conditions[j]});
+        b["flags"] = {{"connected", block.components.size() == 1},
+                      {"components", components},
+                      {"mle_exists", block.mleExists},
+                      {"unanimous_pairs", unanimous}};
+        b["pairs"] = nlohmann::json::array();
+        for (const PairTest& pair : block.pairs)
+            b["pairs"].push_back({{"condition_A", block.conditions[pair.test.first]},
+                                  {"condition_B", block.conditions[pair.test.second]},
+                                  {"difference_jod", pair.test.difference},
+                                  {"standard_error", finite(pair.test.standardError)},
+                                  {"ci_low", finite(pair.test.low)},
+                                  {"ci_high", finite(pair.test.high)},
+                                  {"comparisons", pair.comparisons},
+                                  {"p_value", pair.test.pValue},
+                                  {"p_adjusted", pair.adjustedPValue},
+                                  {"significant", pair.significant}});
+        b["kendall_u"] = block.kendallU ? nlohmann::json(*block.kendallU) : nlohmann::json();
+        b["side_bias"] = {{"available", block.sideBias.available},
+                          {"trials", block.sideBias.trials},
+                          {"left_rate", block.sideBias.available ? nlohmann::json(block.sideBias.leftRate) : nlohmann::json()},
+                          {"bias_jod", block.sideBias.available ? nlohmann::json(block.sideBias.bias) : nlohmann::json()},
+                          {"standard_error", block.sideBias.available ? finite(block.sideBias.standardError) : nlohmann::json()},
+                          {"p_value", block.sideBias.available ? nlohmann::json(block.sideBias.pValue) : nlohmann::json()}};
+        b["observer_stats"] = nlohmann::json::array();
+        for (size_t k = 0; k < block.observerStats.size(); ++k) {
+            const ObserverInBlock& s = block.observerStats[k];
+            b["observer_stats"].push_back(
+                {{"observer", block.observers[k]},
+                 {"trials", s.trials},
+                 {"held_out_loglik_per_trial", s.trials > 0 && block.observers.size() > 1
+                                                   ? nlohmann::json(s.heldOutLogLikelihood / s.trials)
+                                                   : nlohmann::json()},
+                 {"complete", s.consistency.complete},
+                 {"circular_triads", s.consistency.complete ? nlohmann::json(s.consistency.circularTriads) : nlohmann::json()},
+                 {"zeta", s.consistency.zeta ? nlohmann::json(*s.consistency.zeta) : nlohmann::json()}});
+        }
+        b["warnings"] = block.warnings;
+        json["blocks"].push_back(b);
+    }
+    json["observers"] = nlohmann::json::array();
+    for (const ObserverSummary& s : analysis.observers)
+        json["observers"].push_back({{"observer", s.observer},
+                                     {"trials", s.trials},
+                                     {"held_out_loglik_per_trial", finite(s.heldOutPerTrial)},
+                                     {"flagged", s.flagged},
+                                     {"catch_trials", s.catchTrials},
+                                     {"catch_failures", s.catchFailures},
+                                     {"left_rate", s.sideTrials > 0 ? nlohmann::json(s.leftChosen / s.sideTrials) : nlohmann::json()}});
+    json["screening"] = {{"first_quartile", finite(analysis.screeningRule.firstQuartile)},
+                         {"third_quartile", finite(analysis.screeningRule.thirdQuartile)},
+                         {"threshold", finite(analysis.screeningRule.threshold)},
+                         {"whisker", analysis.screeningRule.whisker}};
+    json["warnings"] = analysis.warnings;
+    return json;
+}
+
+std::string reportSectionHtml(const Analysis& analysis) {
+    const AnalysisOptions& o = analysis.options;
+    std::ostringstream html;
+    html << "<section class=\"skinlab-scaling\">\n<h2>Perceptual scaling (Thurstone Case V, JOD)</h2>\n"
+         << "<p>Input <code>" << escapeHtml(analysis.file) << "</code> (" << responseFormatName(analysis.format)
+         << "). Scores in JOD (1 JOD = 75 % preference, each block's mean = 0); " << fixed(100 * o.bootstrap.level, 0)
+         << " % intervals by a symmetric studentized bootstrap over observers (" << o.bootstrap.samples
+         << " samples, seed " << o.bootstrap.seed << "); pairwise tests with " << correctionName(o.correction)
+         << " correction at α = " << o.alpha << ".</p>\n";
+    for (size_t b = 0; b < analysis.blocks.size(); ++b) {
+        const BlockAnalysis& block = analysis.blocks[b];
+        html << "<h3>" << escapeHtml(block.name) << "</h3>\n<p>" << block.observers.size() << " observer(s), "
+             << block.conditions.size() << " conditions, intervals: " << block.intervalMethod;
+        if (block.kendallU) html << ", Kendall's u = " << fixed(*block.kendallU, 3);
+        if (block.sideBias.available)
+            html << ", side bias " << fixed(block.sideBias.bias, 3) << " JOD toward the left (p = "
+                 << fixed(block.sideBias.pValue, 3) << ", left chosen " << fixed(100 * block.sideBias.leftRate, 1) << " %)";
+        html << ".</p>\n";
+        for (const std::string& warning : block.warnings)
+            html << "<p class=\"warning\"><strong>Warning:</strong> " << escapeHtml(warning) << "</p>\n";
+        html << "<img alt=\"scores of " << escapeHtml(block.name) << "\" src=\"data:image/png;base64,"
+             << base64(encodePng(plotScores(block))) << "\">\n";
+        html << "<img alt=\"preference matrix of " << escapeHtml(block.name) << "\" src=\"data:image/png;base64,"
+             << base64(encodePng(plotPreferenceMatrix(block))) << "\">\n";
+        html << "<table>\n<tr><th>condition</th><th>JOD</th><th>95 % interval</th><th>Bradley–Terry (JOD)</th></tr>\n";
+        for (size_t i = 0; i < block.conditions.size(); ++i) {
+            const auto k = static_cast<Eigen::Index>(i);
+            html << "<tr><td>" << escapeHtml(block.conditions[i]) << "</td><td>" << fixed(block.thurstone.scores[k], 3)
+                 << "</td><td>[" << fixed(block.low[k], 3) << ", " << fixed(block.high[k], 3) << "]</td><td>"
+                 << fixed(block.bradleyTerry.scores[k], 3) << "</td></tr>\n";
+        }
+        html << "</table>\n<table>\n<tr><th>A</th><th>B</th><th>A − B (JOD)</th><th>95 % interval</th><th>p</th>"
+                "<th>p (" << correctionName(o.correction) << ")</th><th>significant</th></tr>\n";
+        for (const PairTest& pair : block.pairs)
+            html << "<tr><td>" << escapeHtml(block.conditions[pair.test.first]) << "</td><td>"
+                 << escapeHtml(block.conditions[pair.test.second]) << "</td><td>" << fixed(pair.test.difference, 3)
+                 << "</td><td>[" << fixed(pair.test.low, 3) << ", " << fixed(pair.test.high, 3) << "]</td><td>"
+                 << number(pair.test.pValue, 3) << "</td><td>" << number(pair.adjustedPValue, 3) << "</td><td>"
+                 << (pair.significant ? "yes" : "no") << "</td></tr>\n";
+        html << "</table>\n";
+    }
+    html << "<h3>Observers</h3>\n<table>\n<tr><th>observer</th><th>trials</th><th>held-out log-likelihood / trial</th>"
+            "<th>outlier</th><th>catch failures</th><th>left chosen</th></tr>\n";
+    for (const ObserverSummary& s : analysis.observers)
+        html << "<tr><td>" << escapeHtml(s.observer) << "</td><td>" << s.trials << "</td><td>"
+             << fixed(s.heldOutPerTrial, 3) << "</td><td>" << (s.flagged ? "<strong>yes</strong>" : "no") << "</td><td>"
+             << s.catchFailures << " / " << s.catchTrials << "</td><td>"
+             << (s.sideTrials > 0 ? fixed(100.0 * s.leftChosen / s.sideTrials, 1) + " %" : std::string("–"))
+             << "</td></tr>\n";
+    html << "</table>\n<p>Outlier rule: held-out log-likelihood per trial below Q1 − " << o.screeningWhisker
+         << "·IQR = " << fixed(analysis.screeningRule.threshold, 3) << ".</p>\n</section>\n";
+    return html.str();
+}
+
+void writeScaleOutputs(const Analysis& analysis, const std::filesystem::path& folder) {
+    ensureDirectory(folder);
+    ensureDirectory(folder / "plots");
+    std::string scores = "block,condition,jod,ci_low,ci_high,standard_error,interval_method,percentile_low,"
+                         "percentile_high,bradley_terry_jod,bradley_terry_standard_error\n";
+    std::string pairs = "block,condition_A,condition_B,difference_jod,ci_low,ci_high,standard_error,comparisons,"
+                        "p_value,p_adjusted,correction,significant\n";
+    std::string counts = "block,condition_row,condition_column,count_row_chosen\n";
+    std::string consistency = "block,observer,trials,held_out_loglik_per_trial,complete,circular_triads,zeta\n";
+    for (size_t b = 0; b < analysis.blocks.size(); ++b) {
+        const BlockAnalysis& block = analysis.blocks[b];
+        const std::string name = csvField(block.name);
+        for (size_t i = 0; i < block.conditions.size(); ++i) {
+            const auto k = static_cast<Eigen::Index>(i);
+            scores += name + "," + csvField(block.conditions[i]) + "," + number(block.thurstone.scores[k], 8) + "," +
+                      number(block.low[k], 8) + "," + number(block.high[k], 8) + "," +
+                      number(block.standardError[k], 8) + "," + block.intervalMethod + "," +
+                      number(block.percentileLow[k], 8) + "," + number(block.percentileHigh[k], 8) + "," +
+                      number(block.bradleyTerry.scores[k], 8) + "," + number(block.bradleyTerryStandardError[k], 8) +
+                      "\n";
+            for (size_t j = 0; j < block.conditions.size(); ++j)
+                if (i != j)
+                    counts += name + "," + csvField(block.conditions[i]) + "," + csvField(block.conditions[j]) + "," +
+                              number(block.counts(k, static_cast<Eigen::Index>(j)), 10) + "\n";
+        }
+        for (const PairTest& pair : block.pairs)
+            pairs += name + "," + csvField(block.conditions[pair.test.first]) + "," +
+                     csvField(block.conditions[pair.test.second]) + "," + number(pair.test.difference, 8) + "," +
+                     number(pair.test.low, 8) + "," + number(pair.test.high, 8) + "," +
+                     number(pair.test.standardError, 8) + "," + number(pair.comparisons, 10) + "," +
+                     number(pair.test.pValue, 6) + "," + number(pair.adjustedPValue, 6) + "," +
+                     correctionName(analysis.options.correction) + "," + (pair.significant ? "1" : "0") + "\n";
+        for (size_t k = 0; k < block.observerStats.size(); ++k) {
+            const ObserverInBlock& s = block.observerStats[k];
+            consistency += name + "," + csvField(block.observers[k]) + "," + number(s.trials, 10) + "," +
+                           (s.trials > 0 && block.observers.size() > 1 ? number(s.heldOutLogLikelihood / s.trials, 8) : "") +
+                           "," + (s.consistency.complete ? "1" : "0") + "," +
+                           (s.consistency.complete ? number(s.consistency.circularTriads, 6) : "") + "," +
+                           (s.consistency.zeta ? number(*s.consistency.zeta, 6) : "") + "\n";
+        }
+        writeFileAtomic(folder / plotName(b, "scores", block.name), encodePng(plotScores(block)));
+        writeFileAtomic(folder / plotName(b, "matrix", block.name), encodePng(plotPreferenceMatrix(block)));
+    }
+    std::string observers = "observer,trials,held_out_loglik_per_trial,flagged,catch_trials,catch_failures,left_rate\n";
+    for (const ObserverSummary& s : analysis.observers)
+        observers += csvField(s.observer) + "," + number(s.trials, 10) + "," + number(s.heldOutPerTrial, 8) + "," +
+                     (s.flagged ? "1" : "0") + "," + std::to_string(s.catchTrials) + "," +
+                     std::to_string(s.catchFailures) + "," +
+                     (s.sideTrials > 0 ? number(s.leftChosen / s.sideTrials, 6) : "") + "\n";
+    writeFileAtomic(folder / "scores.csv", scores);
+    writeFileAtomic(folder / "pairs.csv", pairs);
+    writeFileAtomic(folder / "counts.csv", counts);
+    writeFileAtomic(folder / "consistency.csv", consistency);
+    writeFileAtomic(folder / "observers.csv", observers);
+    writeFileAtomic(folder / "report_section.html", reportSectionHtml(analysis));
+    nlohmann::json json = analysisJson(analysis);
+    for (size_t b = 0; b < analysis.blocks.size(); ++b)
+        json["blocks"][b]["plots"] = {{"scores", plotName(b, "scores", analysis.blocks[b].name)},
+                                      {"matrix", plotName(b, "matrix", analysis.blocks[b].name)}};
+    writeFileAtomic(folder / "scale.json", json.dump(2) + "\n");  // last: marks the folder complete
+}
+
+} // namespace skinlab::analysis::scaling

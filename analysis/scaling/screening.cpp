@@ -1,0 +1,47 @@
+#include "analysis/scaling/screening.h"
+
+#include "analysis/scaling/bootstrap.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace skinlab::analysis::scaling {
+
+HeldOutLikelihood heldOutLikelihood(const BlockData& block, const FitResult& full, const FitOptions& options) {
+    const int n = block.observerCount();
+    HeldOutLikelihood result;
+    result.logLikelihood = Eigen::VectorXd::Zero(n);
+    result.trials = (block.winsFirst + block.winsSecond).rowwise().sum();
+    if (n < 2) return result;
+    Eigen::VectorXd weights = Eigen::VectorXd::Ones(n);
+    for (int k = 0; k < n; ++k) {
+        weights[k] = 0.0;
+        const FitResult without = fitScores(block.weightedCounts(weights), options, &full.scores);
+        weights[k] = 1.0;
+        result.logLikelihood[k] = logLikelihood(options.model, block.pairs, block.winsFirst.row(k).transpose(),
+                                                block.winsSecond.row(k).transpose(), without.scores);
+    }
+    return result;
+}
+
+std::vector<bool> lowOutliers(const std::vector<double>& values, double whisker, OutlierRule* rule) {
+    std::vector<double> sorted;
+    for (double v : values)
+        if (!std::isnan(v)) sorted.push_back(v);
+    std::sort(sorted.begin(), sorted.end());
+    OutlierRule computed;
+    computed.whisker = whisker;
+    std::vector<bool> flags(values.size(), false);
+    if (sorted.size() >= 4) {  // quartiles of fewer than 4 values say nothing about outliers
+        computed.firstQuartile = sortedQuantile(sorted, 0.25);
+        computed.thirdQuartile = sortedQuantile(sorted, 0.75);
+        computed.threshold = computed.firstQuartile - whisker * (computed.thirdQuartile - computed.firstQuartile);
+        for (size_t k = 0; k < values.size(); ++k) flags[k] = !std::isnan(values[k]) && values[k] < computed.threshold;
+    } else {
+        computed.threshold = -INFINITY;
+    }
+    if (rule) *rule = computed;
+    return flags;
+}
+
+} // namespace skinlab::analysis::scaling

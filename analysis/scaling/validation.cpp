@@ -1,0 +1,260 @@
+#include "analysis/scaling/validation.h"
+
+#include "analysis/scaling/bootstrap.h"
+#include "analysis/scaling/screening.h"
+#include "analysis/scaling/simulation.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+#include <thread>
+
+namespace skinlab::analysis::scaling {
+namespace {
+
+// Sums over the intervals/pairs/observers of one experiment; rates are formed at the end.
+struct Tally {
+    double intervals = 0, covered = 0, width = 0, percentileCovered = 0, percentileWidth = 0;
+    double squaredError = 0, rankCorrelation = 0, experiments = 0;
+    double pairs = 0, significantCorrect = 0, significantReversed = 0;
+    double randomObservers = 0, randomFlagged = 0, invertedObservers = 0, invertedFlagged = 0;
+    double genuineObservers = 0, genuineFlagged = 0;
+    void add(const Tally& o) {
+        intervals += o.intervals, covered += o.covered, width += o.width, percentileCovered += o.percentileCovered;
+        percentileWidth += o.percentileWidth, squaredError += o.squaredError, rankCorrelation += o.rankCorrelation;
+        experiments += o.experiments, pairs += o.pairs, significantCorrect += o.significantCorrect;
+        significantReversed += o.significantReversed, randomObservers += o.randomObservers;
+        randomFlagged += o.randomFlagged, invertedObservers += o.invertedObservers;
+        invertedFlagged += o.invertedFlagged, genuineObservers += o.genuineObservers;
+        genuineFlagged += o.genuineFlagged;
+    }
+};
+
+std::vector<double> ranks(const Eigen::VectorXd& values) {
+    std::vector<int> order(values.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(), [&](int a, int b) { return values[a] < values[b]; });
+    std::vector<double> rank(values.size());
+    for (size_t k = 0; k < order.size(); ++k) rank[order[k]] = static_cast<double>(k);
+    return rank;
+}
+
+// Keeps only the observers not flagged.
+BlockData withoutObservers(const BlockData& block, const std::vector<bool>& drop) {
+    BlockData kept = block;
+    std::vector<int> rows;
+    for (int k = 0; k < block.observerCount(); ++k)
+        if (!drop[k]) rows.push_back(k);
+    kept.observers.clear();
+    kept.winsFirst.resize(static_cast<Eigen::Index>(rows.size()), block.winsFirst.cols());
+    kept.winsSecond.resize(static_cast<Eigen::Index>(rows.size()), block.winsSecond.cols());
+    kept.leftChosen.resize(static_cast<Eigen::Index>(rows.size()));
+    kept.sideTrials.resize(static_cast<Eigen::Index>(rows.size()));
+    for (size_t r = 0; r < rows.size(); ++r) {
+        kept.observers.push_back(block.observers[rows[r]]);
+        kept.winsFirst.row(static_cast<Eigen::Index>(r)) = block.winsFirst.row(rows[r]);
+        kept.winsSecond.row(static_cast<Eigen::Index>(r)) = block.winsSecond.row(rows[r]);
+        kept.leftChosen[static_cast<Eigen::Index>(r)] = block.leftChosen[rows[r]];
+        kept.sideTrials[static_cast<Eigen::Index>(r)] = block.sideTrials[rows[r]];
+    }
+    return kept;
+}
+
+Tally runExperiment(const ValidationOptions& options, const std::string& scenario, int observers, int experiment) {
+    SimulationDesign design;
+    design.trueScores = options.trueScores;
+    design.observers = observers;
+    design.trialsPerPair = options.trialsPerPair;
+    if (scenario != "thurstone") {
+        design.lapseRate = options.lapseRate;
+        design.sideBiasStandardDeviation = options.sideBiasStandardDeviation;
+    }
+    const bool screening = scenario == "screening";
+    if (screening) {
+        design.randomObservers = options.randomObservers;
+        design.invertedObservers = options.invertedObservers;
+    }
+    const std::uint64_t scenarioIndex =
+        static_cast<std::uint64_t>(std::find(options.scenarios.begin(), options.scenarios.end(), scenario) -
+                                   options.scenarios.begin());
+    const std::uint64_t stream = (scenarioIndex * 1000 + static_cast<std::uint64_t>(observers)) * 1000000 +
+                                 static_cast<std::uint64_t>(experiment);
+    const std::uint64_t seed = mixSeed(options.seed, stream);
+    const SimulatedBlock simulated = simulateBlock(design, seed);
+    Tally tally;
+    tally.experiments = 1;
+
+    FitOptions fitOptions;
+    BlockData block = simulated.block;
+    if (screening) {
+        const FitResult full = fitScores(block.totalCounts(), fitOptions);
+        const HeldOutLikelihood heldOut = heldOutLikelihood(block, full, fitOptions);
+        std::vector<double> perTrial(observers);
+        for (int k = 0; k < observers; ++k) perTrial[k] = heldOut.logLikelihood[k] / heldOut.trials[k];
+        const std::vector<bool> flags = lowOutliers(perTrial, options.screeningWhisker);
+        for (int k = 0; k < observers; ++k) {
+            switch (simulated.kinds[k]) {
+            case SimulatedObserverKind::Genuine: tally.genuineObservers += 1, tally.genuineFlagged += flags[k]; break;
+            case SimulatedObserverKind::Random: tally.randomObservers += 1, tally.randomFlagged += flags[k]; break;
+            case SimulatedObserverKind::Inverted: tally.invertedObservers += 1, tally.invertedFlagged += flags[k]; break;
+            }
+        }
+        block = withoutObservers(block, flags);  // the intervals below are those of the screened data
+    }
+
+    const FitResult fit = fitScores(block.totalCounts(), fitOptions);
+    BootstrapOptions bootstrapOptions;
+    bootstrapOptions.samples = options.bootstrapSamples;
+    bootstrapOptions.seed = mixSeed(seed, 1);
+    bootstrapOptions.threads = 1;  // experiments already run in parallel
+    const BootstrapResult bootstrap = bootstrapObservers(block, fit, fitOptions, bootstrapOptions);
+
+    const int m = static_cast<int>(options.trueScores.size());
+    Eigen::VectorXd truth = Eigen::Map<const Eigen::VectorXd>(options.trueScores.data(), m);
+    truth.array() -= truth.mean();
+    for (int i = 0; i < m; ++i) {
+        tally.intervals += 1;
+        tally.covered += bootstrap.low[i] <= truth[i] && truth[i] <= bootstrap.high[i];
+        tally.width += bootstrap.high[i] - bootstrap.low[i];
+        tally.percentileCovered += bootstrap.percentileLow[i] <= truth[i] && truth[i] <= bootstrap.percentileHigh[i];
+        tally.percentileWidth += bootstrap.percentileHigh[i] - bootstrap.percentileLow[i];
+        tally.squaredError += (fit.scores[i] - truth[i]) * (fit.scores[i] - truth[i]);
+    }
+    const std::vector<double> estimatedRank = ranks(fit.scores), trueRank = ranks(truth);
+    double rankSquares = 0;
+    for (int i = 0; i < m; ++i) rankSquares += (estimatedRank[i] - trueRank[i]) * (estimatedRank[i] - trueRank[i]);
+    tally.rankCorrelation = 1.0 - 6.0 * rankSquares / (static_cast<double>(m) * (m * m - 1.0));
+
+    std::vector<double> pValues;
+    for (const DifferenceTest& test : bootstrap.differences) pValues.push_back(test.pValue);
+    const std::vector<double> adjusted = adjustPValues(pValues, options.correction);
+    for (size_t k = 0; k < bootstrap.differences.size(); ++k) {
+        const DifferenceTest& test = bootstrap.differences[k];
+        const double trueDifference = truth[test.first] - truth[test.second];
+        tally.pairs += 1;
+        if (adjusted[k] >= options.alpha || trueDifference == 0.0) continue;
+        if ((test.difference > 0) == (trueDifference > 0))
+            tally.significantCorrect += 1;
+        else
+            tally.significantReversed += 1;
+    }
+    return tally;
+}
+
+} // namespace
+
+ValidationReport runValidation(const ValidationOptions& options) {
+    const auto started = std::chrono::steady_clock::now();
+    ValidationReport report;
+    report.options = options;
+    for (const std::string& scenario : options.scenarios) {
+        for (int observers : options.observerCounts) {
+            std::vector<Tally> tallies(options.experiments);
+            std::atomic<int> next{0};
+            auto work = [&] {
+                for (int e = next++; e < options.experiments; e = next++)
+                    tallies[e] = runExperiment(options, scenario, observers, e);
+            };
+            std::vector<std::thread> pool;
+            for (int t = 1; t < std::max(1, options.threads); ++t) pool.emplace_back(work);
+            work();
+            for (auto& thread : pool) thread.join();
+            Tally total;
+            for (const Tally& tally : tallies) total.add(tally);  // fixed order: same sums on any thread count
+
+            ValidationRow row;
+            row.scenario = scenario;
+            row.observers = observers;
+            row.experiments = options.experiments;
+            row.coverage = total.covered / total.intervals;
+            row.meanWidth = total.width / total.intervals;
+            row.percentileCoverage = total.percentileCovered / total.intervals;
+            row.percentileMeanWidth = total.percentileWidth / total.intervals;
+            row.rmse = std::sqrt(total.squaredError / total.intervals);
+            row.rankCorrelation = total.rankCorrelation / total.experiments;
+            row.significantCorrect = total.significantCorrect / total.pairs;
+            row.significantReversed = total.significantReversed / total.pairs;
+            if (total.randomObservers > 0) row.randomHitRate = total.randomFlagged / total.randomObservers;
+            if (total.invertedObservers > 0) row.invertedHitRate = total.invertedFlagged / total.invertedObservers;
+            if (scenario == "screening") row.falseAlarmRate = total.genuineFlagged / total.genuineObservers;
+            report.rows.push_back(row);
+        }
+    }
+    report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    return report;
+}
+
+std::string validationMarkdown(const ValidationReport& report) {
+    const ValidationOptions& o = report.options;
+    std::string scores;
+    for (double s : o.trueScores) scores += (scores.empty() ? "" : ", ") + std::to_string(s).substr(0, 4);
+    char line[512];
+    std::string out;
+    std::snprintf(line, sizeof line,
+                  "True scores [%s] JOD, full design, %d trials per pair per observer (each order %s), %d "
+                  "experiments per row, %d bootstrap samples, %s correction at alpha = %.2f, seed %llu.\n"
+                  "Lapses %.3f and side-bias sd %.2f JOD in the 'lapses+side-bias' and 'screening' scenarios; "
+                  "'screening' adds %d random and %d inverted observer(s) and scores the remaining ones.\n\n",
+                  scores.c_str(), o.trialsPerPair, o.trialsPerPair % 2 == 0 ? "equally often" : "alternating",
+                  o.experiments, o.bootstrapSamples, correctionName(o.correction), o.alpha,
+                  static_cast<unsigned long long>(o.seed), o.lapseRate, o.sideBiasStandardDeviation,
+                  o.randomObservers, o.invertedObservers);
+    out += line;
+    out += "| scenario | observers | coverage (studentized) | mean width | coverage (percentile, pwcmp) | "
+           "mean width | RMSE (JOD) | Spearman | significant & correct | significant & reversed | random caught | "
+           "inverted caught | false alarms |\n";
+    out += "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    auto rate = [](double value) {
+        if (value < 0) return std::string("—");
+        char buffer[32];
+        std::snprintf(buffer, sizeof buffer, "%.3f", value);
+        return std::string(buffer);
+    };
+    for (const ValidationRow& r : report.rows) {
+        std::snprintf(line, sizeof line,
+                      "| %s | %d | %.4f | %.3f | %.4f | %.3f | %.4f | %.4f | %.4f | %.4f | %s | %s | %s |\n",
+                      r.scenario.c_str(), r.observers, r.coverage, r.meanWidth, r.percentileCoverage,
+                      r.percentileMeanWidth, r.rmse, r.rankCorrelation, r.significantCorrect, r.significantReversed,
+                      rate(r.randomHitRate).c_str(), rate(r.invertedHitRate).c_str(), rate(r.falseAlarmRate).c_str());
+        out += line;
+    }
+    return out;
+}
+
+nlohmann::json validationJson(const ValidationReport& report) {
+    const ValidationOptions& o = report.options;
+    nlohmann::json json;
+    json["format"] = "skinlab-scaling-validation";
+    json["version"] = 1;
+    json["options"] = {{"true_scores", o.trueScores},       {"observer_counts", o.observerCounts},
+                       {"experiments", o.experiments},      {"trials_per_pair", o.trialsPerPair},
+                       {"bootstrap_samples", o.bootstrapSamples}, {"seed", o.seed},
+                       {"lapse_rate", o.lapseRate},         {"side_bias_sd", o.sideBiasStandardDeviation},
+                       {"random_observers", o.randomObservers}, {"inverted_observers", o.invertedObservers},
+                       {"correction", correctionName(o.correction)}, {"alpha", o.alpha},
+                       {"screening_whisker", o.screeningWhisker}, {"scenarios", o.scenarios}};
+    json["seconds"] = report.seconds;
+    for (const ValidationRow& r : report.rows) {
+        nlohmann::json row = {{"scenario", r.scenario},
+                              {"observers", r.observers},
+                              {"experiments", r.experiments},
+                              {"coverage", r.coverage},
+                              {"mean_width", r.meanWidth},
+                              {"percentile_coverage", r.percentileCoverage},
+                              {"percentile_mean_width", r.percentileMeanWidth},
+                              {"rmse", r.rmse},
+                              {"rank_correlation", r.rankCorrelation},
+                              {"significant_correct", r.significantCorrect},
+                              {"significant_reversed", r.significantReversed}};
+        if (r.randomHitRate >= 0) row["random_hit_rate"] = r.randomHitRate;
+        if (r.invertedHitRate >= 0) row["inverted_hit_rate"] = r.invertedHitRate;
+        if (r.falseAlarmRate >= 0) row["false_alarm_rate"] = r.falseAlarmRate;
+        json["rows"].push_back(row);
+    }
+    return json;
+}
+
+} // namespace skinlab::analysis::scaling

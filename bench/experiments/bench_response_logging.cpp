@@ -1,0 +1,138 @@
+// Benchmark: response-logging latency of the study server under concurrent simulated participants on loopback
+// (issue 6: p50/p99 and errors at 50 and 200 participants; target p99 < 50 ms, zero errors, zero lost).
+// Each measurement: a fresh study.db (WAL, synchronous=FULL) in a temporary folder, the real HTTP server in this
+// process, N simulated observers (one thread and one connection each) answering every trial. Latency is the
+// client-side round trip of POST /api/response, which includes validation and the fsynced COMMIT.
+//
+// Usage: bench_experiments_response_logging [--observers 50,200] [--think-ms MIN:MAX] [--folder DIR]
+// Prints one Markdown table row per run for docs/benchmarks.md.
+#include "common/files.h"
+#include "common/hash.h"
+#include "experiments/simulated_observers.h"
+#include "experiments/study_creation.h"
+#include "experiments/study_server.h"
+#include "experiments/study_store.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <spdlog/spdlog.h>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <unistd.h>
+#include <vector>
+
+namespace fs = std::filesystem;
+using namespace skinlab::experiments;
+
+namespace {
+
+// Five conditions in one block: 10 pairs × 2 repetitions + 2 catch = 22 responses per participant. The image
+// bytes are not decoded by the server, so placeholder bytes (with their real sha256) stand in for PNGs.
+void writeSet(const fs::path& folder) {
+    fs::create_directories(folder / "png");
+    nlohmann::json manifest{{"format", "skinlab-stimuli"}, {"version", 1}, {"set", "bench"}, {"stimuli", nlohmann::json::array()}};
+    for (int m = 0; m < 5; ++m) {
+        const std::string id = "c" + std::to_string(m);
+        const std::string bytes = "placeholder image " + id;
+        skinlab::writeFileAtomic(folder / "png" / (id + ".png"), bytes);
+        manifest["stimuli"].push_back({{"id", id}, {"files", {{"png", "png/" + id + ".png"}}},
+                                       {"sha256", {{"png", skinlab::sha256Hex(bytes)}}},
+                                       {"factors", {{"method", id}}}, {"block", "bench"}, {"reference", false},
+                                       {"width", 256}, {"height", 256}});
+    }
+    skinlab::writeFileAtomic(folder / "manifest.json", manifest.dump());
+}
+
+struct Run {
+    int observers = 0;
+    double thinkMin = 0, thinkMax = 0;
+    SimulationReport report;
+    std::int64_t stored = 0;
+    std::size_t lost = 0;
+};
+
+Run measure(const fs::path& root, int observers, double thinkMin, double thinkMax, int run) {
+    const fs::path folder = root / ("run-" + std::to_string(run));
+    fs::remove_all(folder);
+    writeSet(folder / "stimuli");
+    skinlab::writeFileAtomic(folder / "design.toml", "seed = 1\nrepetitions = 2\n[practice]\ntrials = 0\n[catch]\nblank = 2\n");
+    createStudy(folder / "stimuli", folder / "design.toml", {}, folder / "study.db");
+    StudyStore store(folder / "study.db");
+    ServerOptions options;
+    options.port = 0;
+    options.threads = 64;
+    StudyServer server(store, options);
+    server.bind();
+    std::thread serving([&] { server.run(); });
+
+    SimulationOptions simulation;
+    simulation.port = server.port();
+    simulation.observers = observers;
+    simulation.thinkMinMs = thinkMin;
+    simulation.thinkMaxMs = thinkMax;
+    simulation.labelPrefix = "bench";
+    Run result;
+    result.observers = observers;
+    result.thinkMin = thinkMin;
+    result.thinkMax = thinkMax;
+    result.report = simulateObservers(store, simulation);
+    server.stop();
+    serving.join();
+    result.stored = store.responseCount();
+    std::map<std::int64_t, bool> stored;
+    for (const ResponseRow& r : store.responses()) stored[r.trialId] = r.aSelected == r.aOnLeft;
+    for (const ObserverResult& o : result.report.observers)
+        for (const auto& [trial, side] : o.acknowledged)
+            if (!stored.count(trial) || stored.at(trial) != (side == "left")) ++result.lost;
+    return result;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    std::vector<int> counts{50, 200};
+    std::vector<std::pair<double, double>> thinks{{0, 0}, {500, 1500}};
+    fs::path root = fs::temp_directory_path() / ("skinlab-bench-experiments-" + std::to_string(::getpid()));
+    for (int i = 1; i + 1 < argc; i += 2) {
+        const std::string key = argv[i], value = argv[i + 1];
+        if (key == "--observers") {
+            counts.clear();
+            std::stringstream ss(value);
+            std::string item;
+            while (std::getline(ss, item, ',')) counts.push_back(std::stoi(item));
+        } else if (key == "--think-ms") {
+            const auto colon = value.find(':');
+            thinks = {{std::stod(value.substr(0, colon)), std::stod(colon == std::string::npos ? value : value.substr(colon + 1))}};
+        } else if (key == "--folder") {
+            root = value;
+        } else {
+            std::fprintf(stderr, "unknown option %s\n", key.c_str());
+            return 2;
+        }
+    }
+    fs::create_directories(root);
+    spdlog::set_level(spdlog::level::warn); // no "participant joined" lines in the table
+    std::printf("| participants | pause before each answer | responses | p50 ms | p99 ms | max ms | rejected | re-sent | lost | responses/s |\n");
+    std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
+    int run = 0;
+    for (const auto& [thinkMin, thinkMax] : thinks)
+        for (int n : counts) {
+            const Run r = measure(root, n, thinkMin, thinkMax, run++);
+            double worst = 0;
+            for (double ms : r.report.latenciesMs) worst = std::max(worst, ms);
+            char pause[64];
+            if (thinkMax > 0) std::snprintf(pause, sizeof pause, "%.0f–%.0f ms", thinkMin, thinkMax);
+            else std::snprintf(pause, sizeof pause, "none (back to back)");
+            std::printf("| %d | %s | %lld | %.2f | %.2f | %.2f | %d | %d | %zu | %.0f |\n", n, pause,
+                        static_cast<long long>(r.stored), r.report.latencyPercentile(50), r.report.latencyPercentile(99),
+                        worst, r.report.rejected(), r.report.transportRetries(), r.lost,
+                        static_cast<double>(r.report.acknowledged()) / r.report.wallSeconds);
+            std::fflush(stdout);
+            if (r.report.completed() != n) std::fprintf(stderr, "only %d of %d observers completed\n", r.report.completed(), n);
+        }
+    fs::remove_all(root);
+    return 0;
+}

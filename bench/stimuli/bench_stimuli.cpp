@@ -1,0 +1,76 @@
+// Stimulus-set throughput: builds a set spec (default stimuli/specs/demo.toml, 1280×720) into a fresh folder
+// and reports stimuli per minute, then rebuilds it unchanged (nothing rendered: the cost of the resume check,
+// which re-hashes every file). Prints a table and writes bench_stimuli.csv into the output folder.
+//   bench_stimuli [--spec SPEC] [--jobs N] [-o DIR] [--assets DIR] [--set key=value ...]
+#include "common/files.h"
+#include "renderer/render_job.h"
+#include "stimuli/build.h"
+
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <spdlog/spdlog.h>
+#include <string>
+#include <thread>
+
+namespace fs = std::filesystem;
+
+int main(int argc, char** argv) {
+    skinlab::stimuli::BuildOptions options;
+    options.spec = fs::path(SKINLAB_SOURCE_DIR) / "stimuli/specs/demo.toml";
+    fs::path out = fs::temp_directory_path() / "skinlab-bench-stimuli";
+    for (int i = 1; i < argc; ++i) {
+        std::string a = argv[i];
+        auto next = [&]() -> std::string {
+            if (i + 1 >= argc) {
+                std::fprintf(stderr, "bench_stimuli: %s needs a value\n", a.c_str());
+                std::exit(2);
+            }
+            return argv[++i];
+        };
+        if (a == "--spec") options.spec = next();
+        else if (a == "--jobs") options.jobs = std::stoi(next());
+        else if (a == "-o") out = next();
+        else if (a == "--assets") options.assetsDir = next();
+        else if (a == "--set") options.specOverrides.push_back(next());
+        else {
+            std::fprintf(stderr, "usage: bench_stimuli [--spec SPEC] [--jobs N] [-o DIR] [--assets DIR] [--set k=v]\n");
+            return 2;
+        }
+    }
+    spdlog::set_level(spdlog::level::warn);
+    try {
+        fs::path setDir = out / "set";
+        fs::remove_all(setDir);
+        options.outputDir = setDir;
+        options.progress = skinlab::stimuli::BuildOptions::ProgressStyle::lines;
+        std::string glRenderer;
+        {
+            skinlab::renderer::Renderer probe;
+            glRenderer = probe.glRenderer();
+        }
+        skinlab::stimuli::BuildSummary cold = skinlab::stimuli::buildSet(options);
+        skinlab::stimuli::BuildSummary warm = skinlab::stimuli::buildSet(options);
+        double perMinute = 60.0 * static_cast<double>(cold.rendered) / cold.wallSeconds;
+        std::printf("spec            %s\n", options.spec.string().c_str());
+        std::printf("GL renderer     %s\n", glRenderer.c_str());
+        std::printf("CPU threads     %u, jobs %d\n", std::thread::hardware_concurrency(), options.jobs);
+        std::printf("stimuli         %zu\n", cold.stimuli);
+        std::printf("cold build      %.1f s  (%.1f stimuli/min, %.2f s per stimulus; incl. spec check, EGL "
+                    "start, contact sheet)\n",
+                    cold.wallSeconds, perMinute, cold.wallSeconds / static_cast<double>(cold.rendered));
+        std::printf("no-op rebuild   %.2f s  (%zu rendered)\n", warm.wallSeconds, warm.rendered);
+        std::string csv = "spec,gl_renderer,cpu_threads,jobs,stimuli,cold_build_s,stimuli_per_minute,noop_rebuild_s\n";
+        csv += "\"" + options.spec.filename().string() + "\",\"" + glRenderer + "\"," +
+               std::to_string(std::thread::hardware_concurrency()) + "," + std::to_string(options.jobs) + "," +
+               std::to_string(cold.stimuli) + "," + std::to_string(cold.wallSeconds) + "," +
+               std::to_string(perMinute) + "," + std::to_string(warm.wallSeconds) + "\n";
+        skinlab::writeFileAtomic(out / "bench_stimuli.csv", csv);
+        std::printf("written         %s\n", (out / "bench_stimuli.csv").string().c_str());
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "bench_stimuli: %s\n", e.what());
+        return 1;
+    }
+    return 0;
+}

@@ -1,0 +1,79 @@
+// `skinlab analyze metrics`: image-difference metrics of renders against a reference (docs/metrics.md).
+#include "analysis/metrics/metrics_run.h"
+#include "cli/commands.h"
+#include "common/error.h"
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <spdlog/spdlog.h>
+
+namespace skinlab::cli {
+namespace {
+
+struct AnalyzeMetricsArguments {
+    std::string reference;
+    std::vector<std::string> tests;
+    std::string stimulusFolder;
+    std::string outputFolder;
+    double exposure = 1.0;
+    std::optional<double> sssRadiusMillimetres;
+    double heatmapMax = 10.0;
+    bool noHeatmaps = false;
+};
+
+void runAnalyzeMetrics(const AnalyzeMetricsArguments& arguments) {
+    metrics::ComparisonPlan plan;
+    if (!arguments.stimulusFolder.empty()) {
+        if (!arguments.tests.empty())
+            throwInput(arguments.tests.front(), "", "test files cannot be combined with --stimuli (the set lists its renders)");
+        std::optional<std::string> referenceId;
+        if (!arguments.reference.empty()) referenceId = arguments.reference;
+        plan = metrics::planStimulusSetComparisons(arguments.stimulusFolder, referenceId);
+    } else {
+        if (arguments.reference.empty()) throwInput("--reference", "", "required: the reference EXR (or use --stimuli DIR)");
+        if (arguments.tests.empty()) throwInput("TEST.exr", "", "required: at least one render to compare with the reference");
+        std::vector<std::filesystem::path> tests(arguments.tests.begin(), arguments.tests.end());
+        plan = metrics::planFileComparisons(arguments.reference, tests);
+    }
+    metrics::MetricsRunOptions options;
+    options.metric.exposure = arguments.exposure;
+    options.metric.sssRadiusMillimetres = arguments.sssRadiusMillimetres;
+    options.heatmapMax = arguments.heatmapMax;
+    options.heatmaps = !arguments.noHeatmaps;
+    auto records = metrics::runMetrics(plan, options, arguments.outputFolder);
+    spdlog::info("metrics: {} comparison(s) written to {}/metrics.csv and metrics.json", records.size(),
+                 arguments.outputFolder);
+}
+
+} // namespace
+
+void registerAnalyzeMetrics(CLI::App& analyze) {
+    auto arguments = std::make_shared<AnalyzeMetricsArguments>();
+    CLI::App* command = analyze.add_subcommand(
+        "metrics",
+        "Compare renders with a reference: PSNR, SSIM, CIEDE2000 on the image and on skin, and halo/bleed/spill/"
+        "interior band scores (docs/metrics.md)");
+    command->add_option("tests", arguments->tests, "Test renders (EXR, contract 1) to compare with --reference");
+    command->add_option("--reference", arguments->reference,
+                        "Reference EXR (with depth.Z, mask.Y and skinlab:f_px/mm_per_unit/sss_radius_mm); with "
+                        "--stimuli: the id of the reference stimulus (default: each block's \"reference\": true)");
+    command->add_option("--stimuli", arguments->stimulusFolder,
+                        "Stimulus set folder (manifest.json): compare every stimulus with its block's reference");
+    command->add_option("-o,--output", arguments->outputFolder,
+                        "Output folder: metrics.csv, metrics.json, heatmaps/<test>.png")
+        ->required();
+    command->add_option("--exposure", arguments->exposure,
+                        "Linear multiplier before the display encoding for dE00/PSNR/SSIM (default 1: the render's "
+                        "own exposure)");
+    command->add_option("--sss-radius-mm", arguments->sssRadiusMillimetres,
+                        "SSS support radius in mm for the bands (default: the reference's skinlab:sss_radius_mm)");
+    command->add_option("--heatmap-max", arguments->heatmapMax, "dE00 at the top of the heat map's colour scale (default 10)");
+    command->add_flag("--no-heatmaps", arguments->noHeatmaps, "Write only metrics.csv and metrics.json");
+    command->callback([arguments] { runAnalyzeMetrics(*arguments); });
+}
+
+} // namespace skinlab::cli

@@ -1,0 +1,209 @@
+// `skinlab analyze scale RESPONSES -o DIR` and `skinlab analyze validate` (docs/analysis.md).
+#include "analysis/scaling/scale_analysis.h"
+#include "analysis/scaling/scale_report.h"
+#include "analysis/scaling/validation.h"
+#include "cli/commands.h"
+#include "common/error.h"
+#include "common/files.h"
+
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+#include <memory>
+
+namespace skinlab::cli {
+namespace {
+
+namespace scaling = skinlab::analysis::scaling;
+
+struct ScaleArguments {
+    std::string responses;
+    std::string output;
+    int bootstrap = 1000;
+    std::uint64_t seed = 1;
+    int threads = 2;
+    double level = 0.95;
+    std::string correction = "holm";
+    double alpha = 0.05;
+    double whisker = 1.5;
+    double priorPrecision = 0.002;
+    std::string block;
+    bool singleBlock = false;
+    std::vector<std::string> conditions;
+};
+
+void runScale(const ScaleArguments& arguments) {
+    scaling::DatasetOptions datasetOptions;
+    datasetOptions.conditionOrder = arguments.conditions;
+    datasetOptions.onlyBlock = arguments.block;
+    datasetOptions.singleBlock = arguments.singleBlock;
+    scaling::AnalysisOptions options;
+    options.fit.priorPrecision = arguments.priorPrecision;
+    options.bootstrap.samples = arguments.bootstrap;
+    options.bootstrap.seed = arguments.seed;
+    options.bootstrap.threads = arguments.threads;
+    options.bootstrap.level = arguments.level;
+    options.correction = scaling::parseCorrection(arguments.correction);
+    options.alpha = arguments.alpha;
+    options.screeningWhisker = arguments.whisker;
+
+    const scaling::ResponseTable table = scaling::readResponses(arguments.responses);
+    const scaling::Dataset dataset = scaling::buildDataset(table, datasetOptions);
+    const scaling::Analysis analysis = scaling::analyzeDataset(dataset, options);
+    for (const std::string& warning : analysis.warnings) spdlog::warn("{}", warning);
+    scaling::writeScaleOutputs(analysis, arguments.output);
+
+    for (const scaling::BlockAnalysis& block : analysis.blocks) {
+        std::printf("%s (%zu observers, %s)\n", block.name.c_str(), block.observers.size(), block.intervalMethod.c_str());
+        for (size_t i = 0; i < block.conditions.size(); ++i) {
+            const auto k = static_cast<Eigen::Index>(i);
+            std::printf("  %-24s %+7.3f JOD  [%+.3f, %+.3f]\n", block.conditions[i].c_str(), block.thurstone.scores[k],
+                        block.low[k], block.high[k]);
+        }
+    }
+    std::printf("wrote %s\n", (std::filesystem::path(arguments.output) / "scale.json").c_str());
+}
+
+struct ValidateArguments {
+    std::string output;
+    scaling::ValidationOptions options;
+    std::string correction = "holm";
+    bool check = false;
+};
+
+// The targets of issue 7 (docs/analysis.md, "Validation"); returns the failed ones.
+std::vector<std::string> failedTargets(const scaling::ValidationReport& report) {
+    std::vector<std::string> failed;
+    char line[256];
+    for (const scaling::ValidationRow& row : report.rows) {
+        auto fail = [&](const char* what, double value) {
+            std::snprintf(line, sizeof line, "%s, %d observers: %s = %.4f", row.scenario.c_str(), row.observers, what,
+                          value);
+            failed.push_back(line);
+        };
+        if (row.scenario == "thurstone") {
+            if (row.coverage < 0.945) fail("coverage < 0.945", row.coverage);
+            if (row.observers == 20 && row.rmse > 0.16) fail("RMSE > 0.16", row.rmse);
+            if (row.significantReversed > 0.002) fail("significant & reversed > 0.002", row.significantReversed);
+        }
+        if (row.scenario == "screening") {
+            if (row.randomHitRate < 0.9) fail("random caught < 0.9", row.randomHitRate);
+            if (row.invertedHitRate >= 0 && row.invertedHitRate < 1.0) fail("inverted caught < 1", row.invertedHitRate);
+            if (row.falseAlarmRate > 0.02) fail("false alarms > 0.02", row.falseAlarmRate);
+        }
+    }
+    return failed;
+}
+
+void runValidate(ValidateArguments& arguments) {
+    arguments.options.correction = scaling::parseCorrection(arguments.correction);
+    for (const std::string& scenario : arguments.options.scenarios)
+        if (scenario != "thurstone" && scenario != "lapses+side-bias" && scenario != "screening")
+            throwInput("--scenarios", "", "'" + scenario + "' is not one of thurstone, lapses+side-bias, screening");
+    if (arguments.options.trueScores.size() < 2) throwInput("--scores", "", "needs at least 2 true scores");
+    for (int observers : arguments.options.observerCounts)
+        if (observers < 2 + arguments.options.randomObservers + arguments.options.invertedObservers)
+            throwInput("--observers", "", std::to_string(observers) + " is too few (at least 2 genuine observers)");
+    const scaling::ValidationReport report = scaling::runValidation(arguments.options);
+    const std::string markdown = scaling::validationMarkdown(report);
+    std::printf("%s", markdown.c_str());
+    std::printf("\n%.1f s\n", report.seconds);
+    if (!arguments.output.empty()) {
+        ensureDirectory(arguments.output);
+        writeFileAtomic(std::filesystem::path(arguments.output) / "validation.md", markdown);
+        writeFileAtomic(std::filesystem::path(arguments.output) / "validation.json",
+                        scaling::validationJson(report).dump(2) + "\n");
+    }
+    if (arguments.check) {
+        const std::vector<std::string> failed = failedTargets(report);
+        for (const std::string& failure : failed) std::fprintf(stderr, "target missed: %s\n", failure.c_str());
+        if (!failed.empty()) throw RuntimeError("validation: " + std::to_string(failed.size()) + " target(s) missed");
+        std::printf("all targets met\n");
+    }
+}
+
+} // namespace
+
+void registerAnalyzeScale(CLI::App& analyze) {
+    auto scaleArguments = std::make_shared<ScaleArguments>();
+    CLI::App* scale = analyze.add_subcommand(
+        "scale", "Scale 2AFC responses to JOD (Thurstone Case V) with bootstrap intervals, tests and screening");
+    scale->add_option("responses", scaleArguments->responses,
+                      "study.db (SQLite, view responses_long), a CSV export, a pwcmp long CSV or a count-matrix CSV")
+        ->required();
+    scale->add_option("-o,--output", scaleArguments->output, "output folder")->required();
+    scale->add_option("--bootstrap", scaleArguments->bootstrap, "bootstrap samples over observers")
+        ->check(CLI::Range(100, 1000000))
+        ->capture_default_str();
+    scale->add_option("--seed", scaleArguments->seed, "bootstrap seed")->capture_default_str();
+    scale->add_option("--threads", scaleArguments->threads, "bootstrap threads")
+        ->check(CLI::Range(1, 256))
+        ->capture_default_str();
+    scale->add_option("--level", scaleArguments->level, "confidence level of the intervals")
+        ->check(CLI::Range(0.5, 0.999))
+        ->capture_default_str();
+    scale->add_option("--correction", scaleArguments->correction, "multiple-comparison correction")
+        ->check(CLI::IsMember({"holm", "bonferroni", "none"}))
+        ->capture_default_str();
+    scale->add_option("--alpha", scaleArguments->alpha, "significance level after correction")
+        ->check(CLI::Range(1e-6, 0.5))
+        ->capture_default_str();
+    scale->add_option("--whisker", scaleArguments->whisker, "inter-quartile rule factor w of the observer screening")
+        ->check(CLI::Range(0.0, 10.0))
+        ->capture_default_str();
+    scale->add_option("--prior-precision", scaleArguments->priorPrecision,
+                      "precision (1/JOD^2) of the Gaussian prior on every pairwise difference")
+        ->check(CLI::Range(1e-6, 10.0))
+        ->capture_default_str();
+    scale->add_option("--block", scaleArguments->block, "analyse only this block (scene)");
+    scale->add_flag("--single-block", scaleArguments->singleBlock, "the file must hold one block only");
+    scale->add_option("--conditions", scaleArguments->conditions,
+                      "the conditions in display order; any other condition in the file is an error")
+        ->delimiter(',');
+    scale->callback([scaleArguments] { runScale(*scaleArguments); });
+
+    auto validateArguments = std::make_shared<ValidateArguments>();
+    scaling::ValidationOptions& o = validateArguments->options;
+    CLI::App* validate = analyze.add_subcommand(
+        "validate", "Simulation study of the scaling: coverage, RMSE, tests and screening against known scores");
+    validate->add_option("-o,--output", validateArguments->output, "folder for validation.md and validation.json");
+    validate->add_option("--experiments", o.experiments, "simulated experiments per scenario and observer count")
+        ->check(CLI::Range(1, 100000))
+        ->capture_default_str();
+    validate->add_option("--observers", o.observerCounts, "observer counts")->delimiter(',')->capture_default_str();
+    validate->add_option("--scores", o.trueScores, "true scores (JOD)")->delimiter(',')->capture_default_str();
+    validate->add_option("--trials-per-pair", o.trialsPerPair, "trials per pair per observer (sides alternate)")
+        ->check(CLI::Range(1, 1000))
+        ->capture_default_str();
+    validate->add_option("--bootstrap", o.bootstrapSamples, "bootstrap samples per experiment")
+        ->check(CLI::Range(100, 100000))
+        ->capture_default_str();
+    validate->add_option("--seed", o.seed, "simulation seed")->capture_default_str();
+    validate->add_option("--threads", o.threads, "worker threads")->check(CLI::Range(1, 256))->capture_default_str();
+    validate->add_option("--lapse", o.lapseRate, "lapse rate of genuine observers (non-ideal scenarios)")
+        ->check(CLI::Range(0.0, 1.0))
+        ->capture_default_str();
+    validate->add_option("--side-bias", o.sideBiasStandardDeviation, "sd of the per-observer side bias (JOD)")
+        ->check(CLI::Range(0.0, 10.0))
+        ->capture_default_str();
+    validate->add_option("--random", o.randomObservers, "random observers in the screening scenario")
+        ->check(CLI::Range(0, 1000))
+        ->capture_default_str();
+    validate->add_option("--inverted", o.invertedObservers, "inverted observers in the screening scenario")
+        ->check(CLI::Range(0, 1000))
+        ->capture_default_str();
+    validate->add_option("--correction", validateArguments->correction, "multiple-comparison correction")
+        ->check(CLI::IsMember({"holm", "bonferroni", "none"}))
+        ->capture_default_str();
+    validate->add_option("--whisker", o.screeningWhisker, "inter-quartile rule factor w")
+        ->check(CLI::Range(0.0, 10.0))
+        ->capture_default_str();
+    validate->add_option("--scenarios", o.scenarios, "thurstone, lapses+side-bias, screening")
+        ->delimiter(',')
+        ->capture_default_str();
+    validate->add_flag("--check", validateArguments->check,
+                       "exit 1 unless issue 7's targets are met (coverage, RMSE, reversals, screening)");
+    validate->callback([validateArguments] { runValidate(*validateArguments); });
+}
+
+} // namespace skinlab::cli

@@ -1,0 +1,303 @@
+#include "experiments/simulated_observers.h"
+
+#include "common/error.h"
+#include "common/files.h"
+#include "experiments/seeded_random.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <httplib.h>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+namespace skinlab::experiments {
+
+using nlohmann::json;
+
+namespace {
+
+// Thurstone Case V scale: σ = 1.4826 makes 1 JOD = 75 % preference (pwcmp).
+constexpr double kSigma = 1.4826;
+
+struct HttpResult {
+    int status = 0; // 0 = no answer (connection refused, reset, timeout)
+    json body;
+    double milliseconds = 0;
+};
+
+class ApiClient {
+public:
+    ApiClient(const SimulationOptions& options) : client_(options.host, options.port), options_(options) {
+        client_.set_connection_timeout(2, 0);
+        client_.set_read_timeout(30, 0);
+        client_.set_write_timeout(30, 0);
+    }
+
+    // Sends until an HTTP answer arrives (bounded by maxAttempts); counts the re-sends.
+    HttpResult send(const std::string& method, const std::string& path, const json& body, int& retries) {
+        for (int attempt = 0; attempt < options_.maxAttempts; ++attempt) {
+            const auto start = std::chrono::steady_clock::now();
+            httplib::Result res = method == "GET" ? client_.Get(path)
+                                                  : client_.Post(path, body.dump(), "application/json");
+            const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+            if (res) {
+                HttpResult out;
+                out.status = res->status;
+                out.milliseconds = ms;
+                try {
+                    out.body = json::parse(res->body);
+                } catch (const json::parse_error&) {
+                    out.body = json{{"error", "not JSON"}};
+                }
+                return out;
+            }
+            ++retries;
+            std::this_thread::sleep_for(std::chrono::milliseconds(options_.retryDelayMs * std::min(attempt + 1, 10)));
+        }
+        return {};
+    }
+
+private:
+    httplib::Client client_;
+    const SimulationOptions& options_;
+};
+
+double normal(SeededRandom& random) {
+    // Box–Muller.
+    double u1 = random.unit();
+    while (u1 <= 0) u1 = random.unit();
+    const double u2 = random.unit();
+    return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
+}
+
+ObserverResult runObserver(StudyStore& store, const SimulationOptions& options, int index, const std::string& kind,
+                           std::vector<double>& latencies) {
+    ObserverResult result;
+    result.kind = kind;
+    char label[96];
+    std::snprintf(label, sizeof label, "%s-%03d%s", options.labelPrefix.c_str(), index + 1,
+                  kind == "thurstone" ? "" : ("-" + kind).c_str());
+    result.label = label;
+    SeededRandom random(combineSeed(options.seed, static_cast<std::uint64_t>(index)));
+    ApiClient api(options);
+
+    HttpResult joined = api.send("POST", "/api/join", json{{"label", result.label}, {"join_key", randomHex(16)}}, result.transportRetries);
+    if (joined.status != 201) {
+        result.failure = "join: " + (joined.status ? joined.body.value("error", std::string("?")) : "no answer");
+        return result;
+    }
+    const std::string token = joined.body["token"].get<std::string>();
+    const json screen{{"viewport_width", 1920}, {"viewport_height", 1080}, {"device_pixel_ratio", 1.0}};
+    json sessionBody = screen;
+    sessionBody["token"] = token;
+    HttpResult state = api.send("POST", "/api/session", sessionBody, result.transportRetries);
+    if (state.status != 200) {
+        result.failure = "session: " + (state.status ? state.body.value("error", std::string("?")) : "no answer");
+        return result;
+    }
+    const std::int64_t session = state.body["session"].get<std::int64_t>();
+
+    // The plan, read from study.db, tells the simulated observer what each trial shows.
+    const ParticipantRecord participant = store.participant(token);
+    std::map<std::int64_t, PlannedTrial> plan;
+    for (const TrialRecord& t : store.trials(participant.id)) plan[t.id] = t.plan;
+    const double invert = kind == "inverted" ? -1.0 : 1.0;
+
+    // Bounded: every iteration either acknowledges a response or counts a rejection.
+    const std::size_t maxSteps = plan.size() * 2 + 10;
+    for (std::size_t step = 0; step < maxSteps; ++step) {
+        const json& body = state.body;
+        if (body.value("completed", false)) {
+            result.completed = true;
+            result.completionCode = body.value("completion_code", std::string());
+            break;
+        }
+        const std::int64_t trialId = body["trial"]["id"].get<std::int64_t>();
+        auto it = plan.find(trialId);
+        if (it == plan.end()) {
+            result.failure = "trial " + std::to_string(trialId) + " is not in this participant's plan";
+            break;
+        }
+        const PlannedTrial& t = it->second;
+        bool chooseA;
+        if (kind == "random" || random.unit() < options.lapseRate) {
+            chooseA = random.coin();
+        } else if (t.kind == TrialKind::catchTrial) {
+            chooseA = (t.expected == 'A') == (kind != "inverted");
+        } else {
+            const double qa = invert * options.truth.quality(t.block, t.conditionA);
+            const double qb = invert * options.truth.quality(t.block, t.conditionB);
+            const double noise = kSigma / std::sqrt(2.0); // ε ~ N(0, σ²/2)
+            const double ua = qa + noise * normal(random) + (t.aOnLeft ? options.sideBias : 0.0);
+            const double ub = qb + noise * normal(random) + (t.aOnLeft ? 0.0 : options.sideBias);
+            chooseA = ua > ub;
+        }
+        const std::string side = chooseA == t.aOnLeft ? "left" : "right";
+        if (options.thinkMaxMs > 0) {
+            const double ms = options.thinkMinMs + random.unit() * (options.thinkMaxMs - options.thinkMinMs);
+            std::this_thread::sleep_for(std::chrono::microseconds(static_cast<long>(ms * 1000)));
+        }
+        json response = screen;
+        response["token"] = token;
+        response["trial"] = trialId;
+        response["side"] = side;
+        response["session"] = session;
+        response["response_ms"] = 800.0 + 400.0 * random.unit();
+        response["client_time"] = utcTimestamp();
+        HttpResult answer = api.send("POST", "/api/response", response, result.transportRetries);
+        if (answer.status == 200) {
+            result.acknowledged.emplace_back(trialId, side);
+            ++result.answered;
+            latencies.push_back(answer.milliseconds);
+            state = std::move(answer);
+            continue;
+        }
+        ++result.rejected;
+        if (answer.status == 0) {
+            result.failure = "server unreachable";
+            break;
+        }
+        // Re-synchronise with the server's view of this participant.
+        state = api.send("GET", "/api/state?token=" + token, json(), result.transportRetries);
+        if (state.status != 200) {
+            result.failure = "state: HTTP " + std::to_string(state.status);
+            break;
+        }
+    }
+    return result;
+}
+
+} // namespace
+
+double SimulationTruth::quality(const std::string& block, const std::string& condition) const {
+    if (auto b = byBlock.find(block); b != byBlock.end()) {
+        if (auto c = b->second.find(condition); c != b->second.end()) return c->second;
+    }
+    if (auto c = byCondition.find(condition); c != byCondition.end()) return c->second;
+    if (byCondition.empty() && byBlock.empty()) return 0.0; // no truth given: all conditions equal
+    throw InputError(source + ": no score for condition \"" + condition + "\" (block \"" + block + "\")");
+}
+
+SimulationTruth readTruthJson(const std::filesystem::path& path) {
+    SimulationTruth truth;
+    truth.source = path.string();
+    json root;
+    try {
+        root = json::parse(readFile(path));
+    } catch (const json::parse_error& e) {
+        throw InputError(path.string() + ": not valid JSON: " + e.what());
+    }
+    if (!root.is_object() || root.empty())
+        throw InputError(path.string() + ": expected an object of scores {\"condition\": JOD, ...}");
+    for (auto it = root.begin(); it != root.end(); ++it) {
+        if (it.value().is_number()) {
+            truth.byCondition[it.key()] = it.value().get<double>();
+        } else if (it.value().is_object()) {
+            for (auto c = it.value().begin(); c != it.value().end(); ++c) {
+                if (!c.value().is_number())
+                    throw InputError(path.string() + ": " + it.key() + "." + c.key() + ": expected a number");
+                truth.byBlock[it.key()][c.key()] = c.value().get<double>();
+            }
+        } else {
+            throw InputError(path.string() + ": " + it.key() + ": expected a number or an object of numbers");
+        }
+    }
+    return truth;
+}
+
+SimulationTruth truthFromFactor(StudyStore& store, const std::string& factor) {
+    SimulationTruth truth;
+    truth.source = "--truth-factor " + factor;
+    const json manifest = json::parse(store.meta("manifest_json"));
+    std::map<std::string, const json*> byId;
+    for (const json& s : manifest["stimuli"]) byId[s["id"].get<std::string>()] = &s;
+    for (const StudyStimulus& s : store.definition().stimuli) {
+        if (s.condition.empty()) continue;
+        const json& entry = *byId.at(s.id);
+        if (!entry.contains("factors") || !entry["factors"].contains(factor))
+            throw InputError("--truth-factor: stimulus \"" + s.id + "\" has no factor \"" + factor + "\"");
+        const json& value = entry["factors"][factor];
+        double q = 0;
+        if (value.is_number()) {
+            q = value.get<double>();
+        } else {
+            try {
+                std::size_t used = 0;
+                const std::string text = value.is_string() ? value.get<std::string>() : value.dump();
+                q = std::stod(text, &used);
+                if (used != text.size()) throw std::invalid_argument(text);
+            } catch (const std::exception&) {
+                throw InputError("--truth-factor: stimulus \"" + s.id + "\": factor \"" + factor + "\" = " + value.dump() +
+                                 " is not a number");
+            }
+        }
+        truth.byBlock[s.block][s.condition] = q;
+    }
+    return truth;
+}
+
+int SimulationReport::completed() const {
+    int n = 0;
+    for (const ObserverResult& o : observers) n += o.completed ? 1 : 0;
+    return n;
+}
+int SimulationReport::rejected() const {
+    int n = 0;
+    for (const ObserverResult& o : observers) n += o.rejected;
+    return n;
+}
+int SimulationReport::transportRetries() const {
+    int n = 0;
+    for (const ObserverResult& o : observers) n += o.transportRetries;
+    return n;
+}
+std::size_t SimulationReport::acknowledged() const {
+    std::size_t n = 0;
+    for (const ObserverResult& o : observers) n += o.acknowledged.size();
+    return n;
+}
+double SimulationReport::latencyPercentile(double p) const {
+    if (latenciesMs.empty()) return std::numeric_limits<double>::quiet_NaN();
+    std::vector<double> sorted = latenciesMs;
+    std::sort(sorted.begin(), sorted.end());
+    // Nearest-rank percentile.
+    const std::size_t rank = static_cast<std::size_t>(std::ceil(p / 100.0 * static_cast<double>(sorted.size())));
+    return sorted[std::min(sorted.size() - 1, rank == 0 ? 0 : rank - 1)];
+}
+
+SimulationReport simulateObservers(StudyStore& store, const SimulationOptions& optionsIn) {
+    SimulationOptions options = optionsIn;
+    if (options.observers < 1) throw InputError("--observers: must be at least 1");
+    if (options.randomObservers + options.invertedObservers > options.observers)
+        throw InputError("--random/--inverted: more special observers than --observers");
+    if (options.labelPrefix.empty()) options.labelPrefix = "sim-" + randomHex(2);
+    // Every compared condition needs a score before any observer starts.
+    for (const StudyBlock& block : store.definition().blocks)
+        for (const std::string& condition : block.conditions) (void)options.truth.quality(block.name, condition);
+    SimulationReport report;
+    report.observers.resize(static_cast<std::size_t>(options.observers));
+    std::vector<std::vector<double>> latencies(static_cast<std::size_t>(options.observers));
+    const auto start = std::chrono::steady_clock::now();
+    std::vector<std::thread> threads;
+    for (int i = 0; i < options.observers; ++i) {
+        const std::string kind = i < options.randomObservers                              ? "random"
+                                 : i < options.randomObservers + options.invertedObservers ? "inverted"
+                                                                                          : "thurstone";
+        threads.emplace_back([&, i, kind] {
+            try {
+                report.observers[static_cast<std::size_t>(i)] =
+                    runObserver(store, options, i, kind, latencies[static_cast<std::size_t>(i)]);
+            } catch (const std::exception& e) {
+                report.observers[static_cast<std::size_t>(i)].failure = e.what();
+            }
+        });
+    }
+    for (std::thread& t : threads) t.join();
+    report.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    for (const auto& l : latencies) report.latenciesMs.insert(report.latenciesMs.end(), l.begin(), l.end());
+    return report;
+}
+
+} // namespace skinlab::experiments

@@ -1,0 +1,141 @@
+#include "experiments/study_design.h"
+
+#include "common/error.h"
+#include "common/spec.h"
+
+#include <limits>
+
+namespace skinlab::experiments {
+
+namespace {
+
+StudyDesign designFromToml(toml::table& root, const std::string& file, const std::vector<std::string>& overrides) {
+    for (const std::string& assignment : overrides) applyOverride(root, assignment, "--set");
+    SpecReader spec(root, file);
+    StudyDesign d;
+    d.sourceName = file;
+    d.title = spec.string("title", d.title);
+    d.question = spec.string("question", d.question);
+    if (d.question.empty()) spec.fail("question", "must not be empty");
+    d.instructions = spec.string("instructions", d.instructions);
+    d.consent = spec.string("consent", d.consent);
+    // Seeds are stored as SQLite integers (signed 64-bit), hence the non-negative int64 range.
+    d.seed = static_cast<std::uint64_t>(spec.integer("seed", 1, 0, std::numeric_limits<std::int64_t>::max()));
+    d.conditionFactor = spec.string("condition_factor", d.conditionFactor);
+    if (d.conditionFactor.empty()) spec.fail("condition_factor", "must not be empty");
+    d.conditions = spec.strings("conditions", {});
+    d.blocks = spec.strings("blocks", {});
+    if (const toml::node* pairs = spec.raw("pairs")) {
+        if (const auto* text = pairs->as_string()) {
+            if (text->get() != "all") spec.fail("pairs", "expected \"all\" or an array of [A, B] condition pairs");
+        } else if (const auto* list = pairs->as_array()) {
+            d.allPairs = false;
+            std::size_t i = 0;
+            for (const toml::node& item : *list) {
+                const std::string key = "pairs[" + std::to_string(i++) + "]";
+                const auto* pair = item.as_array();
+                if (!pair || pair->size() != 2 || !(*pair)[0].is_string() || !(*pair)[1].is_string())
+                    spec.fail(key, "expected a pair of condition names [\"A\", \"B\"], got " + describeNode(item));
+                std::string a = (*pair)[0].as_string()->get();
+                std::string b = (*pair)[1].as_string()->get();
+                if (a == b) spec.fail(key, "a condition cannot be compared with itself (\"" + a + "\")");
+                d.pairs.emplace_back(a, b);
+            }
+            if (d.pairs.empty()) spec.fail("pairs", "an empty list compares nothing");
+        } else {
+            spec.fail("pairs", "expected \"all\" or an array of [A, B] condition pairs, got " + describeNode(*pairs));
+        }
+    }
+    d.repetitions = static_cast<int>(spec.integer("repetitions", d.repetitions, 1, 100));
+    d.blockOrder = spec.choice("block_order", d.blockOrder, {"interleaved", "grouped"});
+    d.breakEvery = static_cast<int>(spec.integer("break_every", d.breakEvery, 0, 100000));
+
+    SpecReader reference = spec.table("reference");
+    d.showReference = reference.boolean("show", false);
+
+    SpecReader practice = spec.table("practice");
+    d.practiceTrials = static_cast<int>(practice.integer("trials", d.practiceTrials, 0, 100));
+
+    SpecReader catchTable = spec.table("catch");
+    d.blankCatchTrials = static_cast<int>(catchTable.integer("blank", d.blankCatchTrials, 0, 1000));
+    for (const SpecReader& pair : catchTable.tables("pairs")) {
+        DeclaredCatchPair c;
+        c.first = pair.requiredString("first");
+        c.second = pair.requiredString("second");
+        c.expected = pair.requiredString("expected");
+        c.repeat = static_cast<int>(pair.integer("repeat", 1, 1, 100));
+        if (c.first == c.second) pair.fail("second", "must differ from first");
+        if (c.expected != c.first && c.expected != c.second)
+            pair.fail("expected", "must be the first or the second stimulus id, got \"" + c.expected + "\"");
+        d.catchPairs.push_back(std::move(c));
+    }
+    spec.finish();
+    return d;
+}
+
+} // namespace
+
+StudyDesign parseStudyDesign(std::string_view tomlText, std::string_view sourceName,
+                             const std::vector<std::string>& overrides) {
+    toml::table root = parseTomlString(tomlText, sourceName);
+    return designFromToml(root, std::string(sourceName), overrides);
+}
+
+StudyDesign readStudyDesign(const std::filesystem::path& path, const std::vector<std::string>& overrides) {
+    toml::table root = parseTomlFile(path);
+    return designFromToml(root, path.string(), overrides);
+}
+
+nlohmann::json StudyDesign::toJson() const {
+    nlohmann::json pairsJson = nlohmann::json::array();
+    for (const auto& [a, b] : pairs) pairsJson.push_back({a, b});
+    nlohmann::json catchJson = nlohmann::json::array();
+    for (const DeclaredCatchPair& c : catchPairs)
+        catchJson.push_back({{"first", c.first}, {"second", c.second}, {"expected", c.expected}, {"repeat", c.repeat}});
+    return {{"title", title},
+            {"question", question},
+            {"instructions", instructions},
+            {"consent", consent},
+            {"seed", seed},
+            {"condition_factor", conditionFactor},
+            {"conditions", conditions},
+            {"blocks", blocks},
+            {"pairs", allPairs ? nlohmann::json("all") : pairsJson},
+            {"repetitions", repetitions},
+            {"block_order", blockOrder},
+            {"break_every", breakEvery},
+            {"reference", {{"show", showReference}}},
+            {"practice", {{"trials", practiceTrials}}},
+            {"catch", {{"blank", blankCatchTrials}, {"pairs", catchJson}}}};
+}
+
+StudyDesign StudyDesign::fromJson(const nlohmann::json& j) {
+    StudyDesign d;
+    d.sourceName = "study.db:design";
+    d.title = j.at("title").get<std::string>();
+    d.question = j.at("question").get<std::string>();
+    d.instructions = j.at("instructions").get<std::string>();
+    d.consent = j.at("consent").get<std::string>();
+    d.seed = j.at("seed").get<std::uint64_t>();
+    d.conditionFactor = j.at("condition_factor").get<std::string>();
+    d.conditions = j.at("conditions").get<std::vector<std::string>>();
+    d.blocks = j.at("blocks").get<std::vector<std::string>>();
+    if (j.at("pairs").is_string()) {
+        d.allPairs = true;
+    } else {
+        d.allPairs = false;
+        for (const auto& p : j.at("pairs")) d.pairs.emplace_back(p.at(0).get<std::string>(), p.at(1).get<std::string>());
+    }
+    d.repetitions = j.at("repetitions").get<int>();
+    d.blockOrder = j.at("block_order").get<std::string>();
+    d.breakEvery = j.at("break_every").get<int>();
+    d.showReference = j.at("reference").at("show").get<bool>();
+    d.practiceTrials = j.at("practice").at("trials").get<int>();
+    d.blankCatchTrials = j.at("catch").at("blank").get<int>();
+    for (const auto& c : j.at("catch").at("pairs"))
+        d.catchPairs.push_back({c.at("first").get<std::string>(), c.at("second").get<std::string>(),
+                                c.at("expected").get<std::string>(), c.at("repeat").get<int>()});
+    return d;
+}
+
+} // namespace skinlab::experiments

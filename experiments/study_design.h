@@ -1,0 +1,51 @@
+#pragma once
+// A study design (D.toml): which conditions are compared, in which blocks, how often, with which practice and
+// catch trials. Reference: docs/experiments.md ("Design file"). Parsed strictly with SpecReader: an unknown key or
+// an out-of-range value is an error naming the file and the key.
+#include <cstdint>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace skinlab::experiments {
+
+// A catch trial declared in the design: two stimuli (by id) and the one an attentive observer must choose.
+struct DeclaredCatchPair {
+    std::string first;
+    std::string second;
+    std::string expected;
+    int repeat = 1; // times per participant
+};
+
+struct StudyDesign {
+    std::string sourceName;    // file name for messages
+    std::string title = "Image comparison";
+    std::string question = "Which image looks more like real skin?";
+    std::string instructions;  // shown before practice; empty = a default text
+    std::string consent;       // shown first; empty = a default text
+    std::uint64_t seed = 1;    // design seed; participant seeds are derived from it and stored
+    std::string conditionFactor = "method"; // manifest factor naming a stimulus's condition ("id" = the stimulus id)
+    std::vector<std::string> conditions;    // empty = every level found
+    std::vector<std::string> blocks;        // empty = every block of the manifest
+    bool allPairs = true;
+    std::vector<std::pair<std::string, std::string>> pairs; // when !allPairs: condition pairs to compare
+    int repetitions = 2;       // times each pair is shown to each participant (alternating sides)
+    std::string blockOrder = "interleaved"; // interleaved | grouped
+    int breakEvery = 40;       // a pause screen every K trials (0 = none)
+    bool showReference = false; // show the block's reference stimulus above the pair (reference-based 2AFC)
+    int practiceTrials = 2;
+    int blankCatchTrials = 2;  // stimulus vs a blank grey panel; the stimulus is the right answer
+    std::vector<DeclaredCatchPair> catchPairs;
+
+    nlohmann::json toJson() const;
+    static StudyDesign fromJson(const nlohmann::json& json);
+};
+
+// Reads D.toml, applies "key=value" overrides (the --set syntax), and checks every key.
+StudyDesign readStudyDesign(const std::filesystem::path& path, const std::vector<std::string>& overrides = {});
+StudyDesign parseStudyDesign(std::string_view tomlText, std::string_view sourceName,
+                             const std::vector<std::string>& overrides = {});
+
+} // namespace skinlab::experiments

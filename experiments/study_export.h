@@ -1,0 +1,24 @@
+#pragma once
+// Exports of a study's responses and its status report.
+//  csv:   contract 3, one row per response: observer,scene,condition_A,condition_B,is_A_selected,A_on_left,
+//         trial_kind,correct,response_ms (correct is 1/0 for catch trials, empty otherwise)
+//  pwcmp: the first five columns, test and repeat trials only (Perez-Ortiz & Mantiuk's pwcmp long format)
+//  json:  every stored field of every response, with the study's metadata
+#include "experiments/study_store.h"
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace skinlab::experiments {
+
+// format: "csv" | "json" | "pwcmp"; anything else throws InputError.
+std::string exportResponses(StudyStore& store, const std::string& format);
+
+nlohmann::json statusJson(StudyStore& store);
+// Human-readable table: one line per participant (progress, catch accuracy), then totals.
+std::string statusText(StudyStore& store);
+
+// CSV field quoting (RFC 4180): quoted when it holds a comma, quote or line break.
+std::string csvField(const std::string& value);
+
+} // namespace skinlab::experiments

@@ -1,0 +1,537 @@
+#include "experiments/study_store.h"
+
+#include "common/error.h"
+#include "common/hash.h"
+#include "common/version.h"
+#include "experiments/request_error.h"
+#include "experiments/sqlite_database.h"
+
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <fcntl.h>
+#include <random>
+#include <unistd.h>
+
+namespace skinlab::experiments {
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kFormat = "skinlab-study";
+constexpr int kFormatVersion = 1;
+
+// The schema. responses.trial_id is the PRIMARY KEY: at most one response per planned trial, whatever the
+// network does. responses_long is contract 3 (read by analysis/scaling).
+constexpr const char* kSchema = R"SQL(
+CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
+CREATE TABLE stimuli (
+  id INTEGER PRIMARY KEY,            -- index in the study definition; URL /stimuli/<id>.png
+  stimulus TEXT NOT NULL UNIQUE,     -- manifest id
+  block TEXT NOT NULL,
+  condition TEXT NOT NULL,
+  png_path TEXT NOT NULL,            -- relative to the stimulus folder
+  sha256 TEXT NOT NULL,
+  width INTEGER NOT NULL,
+  height INTEGER NOT NULL,
+  is_reference INTEGER NOT NULL);
+CREATE TABLE participants (
+  id INTEGER PRIMARY KEY,
+  participant_index INTEGER NOT NULL UNIQUE,
+  label TEXT NOT NULL UNIQUE,
+  token TEXT NOT NULL UNIQUE,
+  join_key TEXT UNIQUE,              -- client-chosen key making a retried join return the same participant
+  seed INTEGER NOT NULL,
+  completion_code TEXT NOT NULL,
+  created_at TEXT NOT NULL);
+CREATE TABLE sessions (
+  id INTEGER PRIMARY KEY,
+  participant_id INTEGER NOT NULL REFERENCES participants(id),
+  started_at TEXT NOT NULL,
+  user_agent TEXT NOT NULL,
+  viewport_width INTEGER NOT NULL,
+  viewport_height INTEGER NOT NULL,
+  device_pixel_ratio REAL NOT NULL);
+CREATE TABLE trials (
+  id INTEGER PRIMARY KEY,
+  participant_id INTEGER NOT NULL REFERENCES participants(id),
+  position INTEGER NOT NULL,
+  kind TEXT NOT NULL CHECK (kind IN ('practice','test','repeat','catch')),
+  block TEXT NOT NULL,
+  condition_a TEXT NOT NULL,
+  condition_b TEXT NOT NULL,
+  stimulus_a INTEGER NOT NULL REFERENCES stimuli(id),
+  stimulus_b INTEGER REFERENCES stimuli(id),      -- NULL: the blank panel of a blank catch trial
+  a_on_left INTEGER NOT NULL,
+  reference_stimulus INTEGER REFERENCES stimuli(id),
+  expected TEXT CHECK (expected IN ('A','B')),
+  UNIQUE (participant_id, position));
+CREATE TABLE responses (
+  trial_id INTEGER PRIMARY KEY REFERENCES trials(id),
+  participant_id INTEGER NOT NULL REFERENCES participants(id),
+  session_id INTEGER NOT NULL REFERENCES sessions(id),
+  chosen TEXT NOT NULL CHECK (chosen IN ('A','B')),
+  side TEXT NOT NULL CHECK (side IN ('left','right')),
+  response_ms REAL NOT NULL,
+  client_time TEXT NOT NULL,
+  server_time TEXT NOT NULL,
+  viewport_width INTEGER NOT NULL,
+  viewport_height INTEGER NOT NULL,
+  device_pixel_ratio REAL NOT NULL,
+  user_agent TEXT NOT NULL);
+CREATE INDEX responses_by_participant ON responses(participant_id);
+CREATE VIEW responses_long AS
+  SELECT p.label AS observer, t.block AS scene, t.condition_a AS condition_A, t.condition_b AS condition_B,
+         CASE r.chosen WHEN 'A' THEN 1 ELSE 0 END AS is_A_selected, t.a_on_left AS A_on_left,
+         t.kind AS trial_kind,
+         CASE WHEN t.kind = 'catch' THEN (CASE WHEN r.chosen = t.expected THEN 1 ELSE 0 END) ELSE NULL END AS correct,
+         r.response_ms AS response_ms
+  FROM responses r JOIN trials t ON t.id = r.trial_id JOIN participants p ON p.id = t.participant_id
+  ORDER BY p.id, t.position;
+)SQL";
+
+void configureConnection(SqliteDatabase& db) {
+    // WAL: readers (status, export) never block the writer; synchronous=FULL: COMMIT fsyncs the WAL, so a
+    // committed response survives a crash or power loss (SQLite docs, "PRAGMA synchronous").
+    db.execute("PRAGMA journal_mode=WAL");
+    db.execute("PRAGMA synchronous=FULL");
+    db.execute("PRAGMA foreign_keys=ON");
+}
+
+std::string makeCompletionCode() {
+    // Unambiguous characters only (no 0/O, 1/I/L), 8 of them.
+    static const char alphabet[] = "ABCDEFGHJKMNPQRSTUVWXYZ23456789";
+    const std::string hex = randomHex(8);
+    std::string code;
+    for (std::size_t i = 0; i < 8; ++i) {
+        const unsigned value = static_cast<unsigned>(std::stoul(hex.substr(i * 2, 2), nullptr, 16));
+        code += alphabet[value % (sizeof(alphabet) - 1)];
+    }
+    return code;
+}
+
+void insertTrials(SqliteDatabase& db, std::int64_t participantId, const std::vector<PlannedTrial>& plan) {
+    SqliteStatement insert = db.prepare(
+        "INSERT INTO trials (participant_id, position, kind, block, condition_a, condition_b, stimulus_a, stimulus_b,"
+        " a_on_left, reference_stimulus, expected) VALUES (?,?,?,?,?,?,?,?,?,?,?)");
+    int position = 0;
+    for (const PlannedTrial& t : plan) {
+        insert.bind(1, participantId).bind(2, position++).bind(3, trialKindName(t.kind)).bind(4, t.block);
+        insert.bind(5, t.conditionA).bind(6, t.conditionB).bind(7, t.stimulusA);
+        if (t.stimulusB == kBlankStimulus) insert.bindNull(8); else insert.bind(8, t.stimulusB);
+        insert.bind(9, t.aOnLeft ? 1 : 0);
+        if (t.referenceStimulus < 0) insert.bindNull(10); else insert.bind(10, t.referenceStimulus);
+        if (t.expected) insert.bind(11, std::string(1, t.expected)); else insert.bindNull(11);
+        insert.run();
+    }
+}
+
+constexpr const char* kTrialColumns =
+    "id, participant_id, position, kind, block, condition_a, condition_b, stimulus_a, stimulus_b, a_on_left,"
+    " reference_stimulus, expected";
+
+TrialRecord readTrial(const SqliteStatement& s) {
+    TrialRecord t;
+    t.id = s.integer(0);
+    t.participantId = s.integer(1);
+    t.position = static_cast<int>(s.integer(2));
+    t.plan.kind = trialKindFromName(s.text(3));
+    t.plan.block = s.text(4);
+    t.plan.conditionA = s.text(5);
+    t.plan.conditionB = s.text(6);
+    t.plan.stimulusA = static_cast<int>(s.integer(7));
+    t.plan.stimulusB = s.isNull(8) ? kBlankStimulus : static_cast<int>(s.integer(8));
+    t.plan.aOnLeft = s.integer(9) != 0;
+    t.plan.referenceStimulus = s.isNull(10) ? -1 : static_cast<int>(s.integer(10));
+    const std::string expected = s.text(11);
+    t.plan.expected = expected.empty() ? 0 : expected[0];
+    return t;
+}
+
+ParticipantRecord readParticipant(const SqliteStatement& s) {
+    ParticipantRecord p;
+    p.id = s.integer(0);
+    p.index = s.integer(1);
+    p.label = s.text(2);
+    p.token = s.text(3);
+    p.seed = static_cast<std::uint64_t>(s.integer(4));
+    p.completionCode = s.text(5);
+    p.createdAt = s.text(6);
+    return p;
+}
+
+constexpr const char* kParticipantColumns = "id, participant_index, label, token, seed, completion_code, created_at";
+
+} // namespace
+
+std::string utcTimestamp() {
+    const auto now = std::chrono::system_clock::now();
+    const std::time_t seconds = std::chrono::system_clock::to_time_t(now);
+    const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000;
+    std::tm tm{};
+    gmtime_r(&seconds, &tm);
+    char buffer[64];
+    std::snprintf(buffer, sizeof buffer, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900, tm.tm_mon + 1,
+                  tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec, static_cast<int>(ms));
+    return buffer;
+}
+
+std::string randomHex(std::size_t bytes) {
+    std::random_device device; // /dev/urandom on Linux (libstdc++)
+    std::string out;
+    static const char digits[] = "0123456789abcdef";
+    for (std::size_t i = 0; i < bytes; ++i) {
+        const unsigned value = device() & 0xFFu;
+        out += digits[value >> 4];
+        out += digits[value & 15u];
+    }
+    return out;
+}
+
+void StudyStore::create(const fs::path& path, const StudyDefinition& definition, const std::string& designText,
+                        const StimulusManifest& manifest) {
+    std::error_code ec;
+    if (fs::exists(path, ec))
+        throw InputError(path.string() + ": already exists; a study file is never overwritten (it may hold "
+                                         "responses) — choose another -o or remove it first");
+    const fs::path temp = path.parent_path() / ("." + path.filename().string() + ".tmp-" + std::to_string(::getpid()));
+    fs::remove(temp, ec);
+    {
+        SqliteDatabase db(temp.string(), true);
+        // Built with a rollback journal; switched to WAL at the end, so the single finished file is renamed.
+        db.execute("PRAGMA foreign_keys=ON");
+        SqliteTransaction tx(db);
+        db.execute(kSchema);
+        SqliteStatement meta = db.prepare("INSERT INTO meta (key, value) VALUES (?, ?)");
+        auto putMeta = [&](const std::string& key, const std::string& value) {
+            meta.bind(1, key).bind(2, value);
+            meta.run();
+        };
+        putMeta("format", kFormat);
+        putMeta("format_version", std::to_string(kFormatVersion));
+        putMeta("skinlab_version", version());
+        putMeta("created_at", utcTimestamp());
+        putMeta("design_toml", designText);
+        putMeta("design_sha256", sha256Hex(designText));
+        putMeta("definition", definition.toJson().dump());
+        putMeta("manifest_json", manifest.text);
+        putMeta("manifest_sha256", manifest.sha256);
+        putMeta("stimuli_dir", manifest.folder.string());
+        putMeta("stimulus_set", manifest.set);
+        SqliteStatement stimulus = db.prepare(
+            "INSERT INTO stimuli (id, stimulus, block, condition, png_path, sha256, width, height, is_reference)"
+            " VALUES (?,?,?,?,?,?,?,?,?)");
+        for (const StudyStimulus& s : definition.stimuli) {
+            stimulus.bind(1, s.index).bind(2, s.id).bind(3, s.block).bind(4, s.condition).bind(5, s.pngPath);
+            stimulus.bind(6, s.sha256).bind(7, s.width).bind(8, s.height).bind(9, s.reference ? 1 : 0);
+            stimulus.run();
+        }
+        tx.commit();
+        db.execute("PRAGMA journal_mode=WAL");
+    }
+    // fsync the finished file, then rename it into place.
+    int fd = ::open(temp.c_str(), O_RDONLY);
+    if (fd >= 0) {
+        ::fsync(fd);
+        ::close(fd);
+    }
+    fs::rename(temp, path, ec);
+    if (ec) {
+        fs::remove(temp, ec);
+        throw InputError(path.string() + ": cannot write the study file: " + ec.message());
+    }
+}
+
+StudyStore::StudyStore(const fs::path& path) : path_(path) {
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec)) throw InputError(path.string() + ": no such study file");
+    db_ = std::make_unique<SqliteDatabase>(path.string(), false);
+    configureConnection(*db_);
+    if (meta("format") != kFormat) throw InputError(path.string() + ": not a skinlab study file");
+    if (meta("format_version") != std::to_string(kFormatVersion))
+        throw InputError(path.string() + ": study file version " + meta("format_version") + " is not supported");
+    definition_ = StudyDefinition::fromJson(nlohmann::json::parse(meta("definition")));
+}
+
+StudyStore::~StudyStore() = default;
+
+std::string StudyStore::meta(const std::string& key) const {
+    SqliteStatement s = db_->prepare("SELECT value FROM meta WHERE key = ?");
+    s.bind(1, key);
+    if (!s.step()) {
+        if (key == "format") return "";
+        throw RuntimeError(path_.string() + ": meta key \"" + key + "\" missing");
+    }
+    return s.text(0);
+}
+
+ParticipantRecord StudyStore::join(const std::string& requestedLabel, const std::string& joinKey) {
+    std::lock_guard lock(mutex_);
+    SqliteTransaction tx(*db_);
+    if (!joinKey.empty()) {
+        SqliteStatement s = db_->prepare(std::string("SELECT ") + kParticipantColumns + " FROM participants WHERE join_key = ?");
+        s.bind(1, joinKey);
+        if (s.step()) {
+            ParticipantRecord existing = readParticipant(s);
+            if (!requestedLabel.empty() && existing.label != requestedLabel)
+                throw RequestError(409, "join_key: already used by another participant");
+            return existing;
+        }
+    }
+    ParticipantRecord p;
+    {
+        SqliteStatement count = db_->prepare("SELECT COALESCE(MAX(participant_index) + 1, 0) FROM participants");
+        count.step();
+        p.index = count.integer(0);
+    }
+    if (!requestedLabel.empty()) {
+        SqliteStatement taken = db_->prepare("SELECT 1 FROM participants WHERE label = ?");
+        taken.bind(1, requestedLabel);
+        if (taken.step())
+            throw RequestError(409, "participant label \"" + requestedLabel +
+                                        "\" is already taken; open that participant's link to resume");
+    }
+    char defaultLabel[32];
+    std::snprintf(defaultLabel, sizeof defaultLabel, "P%03lld", static_cast<long long>(p.index + 1));
+    p.label = requestedLabel.empty() ? defaultLabel : requestedLabel;
+    p.token = randomHex(16);
+    p.seed = participantSeed(definition_.design.seed, p.index);
+    p.completionCode = makeCompletionCode();
+    p.createdAt = utcTimestamp();
+    SqliteStatement insert = db_->prepare(
+        "INSERT INTO participants (participant_index, label, token, join_key, seed, completion_code, created_at)"
+        " VALUES (?,?,?,?,?,?,?)");
+    insert.bind(1, p.index).bind(2, p.label).bind(3, p.token);
+    if (joinKey.empty()) insert.bindNull(4); else insert.bind(4, joinKey);
+    insert.bind(5, static_cast<std::int64_t>(p.seed)).bind(6, p.completionCode).bind(7, p.createdAt);
+    insert.run();
+    p.id = db_->lastInsertId();
+    insertTrials(*db_, p.id, planTrials(definition_, p.index, p.seed));
+    tx.commit();
+    return p;
+}
+
+ParticipantRecord StudyStore::participant(const std::string& token) {
+    std::lock_guard lock(mutex_);
+    SqliteStatement s = db_->prepare(std::string("SELECT ") + kParticipantColumns + " FROM participants WHERE token = ?");
+    s.bind(1, token);
+    if (!s.step()) throw RequestError(404, "unknown participant");
+    return readParticipant(s);
+}
+
+std::int64_t StudyStore::startSession(std::int64_t participantId, const std::string& userAgent, int viewportWidth,
+                                      int viewportHeight, double devicePixelRatio) {
+    std::lock_guard lock(mutex_);
+    SqliteStatement s = db_->prepare(
+        "INSERT INTO sessions (participant_id, started_at, user_agent, viewport_width, viewport_height, device_pixel_ratio)"
+        " VALUES (?,?,?,?,?,?)");
+    s.bind(1, participantId).bind(2, utcTimestamp()).bind(3, userAgent).bind(4, viewportWidth).bind(5, viewportHeight);
+    s.bind(6, devicePixelRatio);
+    s.run();
+    return db_->lastInsertId();
+}
+
+std::optional<TrialRecord> StudyStore::nextTrial(std::int64_t participantId) {
+    std::lock_guard lock(mutex_);
+    SqliteStatement s = db_->prepare(std::string("SELECT ") + kTrialColumns +
+                                     " FROM trials WHERE participant_id = ? AND id NOT IN"
+                                     " (SELECT trial_id FROM responses WHERE participant_id = ?) ORDER BY position LIMIT 1");
+    s.bind(1, participantId).bind(2, participantId);
+    if (!s.step()) return std::nullopt;
+    return readTrial(s);
+}
+
+std::vector<TrialRecord> StudyStore::trials(std::int64_t participantId) {
+    std::lock_guard lock(mutex_);
+    SqliteStatement s = db_->prepare(std::string("SELECT ") + kTrialColumns +
+                                     " FROM trials WHERE participant_id = ? ORDER BY position");
+    s.bind(1, participantId);
+    std::vector<TrialRecord> out;
+    while (s.step()) out.push_back(readTrial(s));
+    return out;
+}
+
+Progress StudyStore::progress(std::int64_t participantId) {
+    std::lock_guard lock(mutex_);
+    SqliteStatement s = db_->prepare("SELECT (SELECT COUNT(*) FROM responses WHERE participant_id = ?1),"
+                                     " (SELECT COUNT(*) FROM trials WHERE participant_id = ?1)");
+    s.bind(1, participantId);
+    s.step();
+    return {static_cast<int>(s.integer(0)), static_cast<int>(s.integer(1))};
+}
+
+ResponseOutcome StudyStore::storeOne(const ResponseInput& in) {
+    std::int64_t participantId = 0;
+    {
+        SqliteStatement s = db_->prepare("SELECT id FROM participants WHERE token = ?");
+        s.bind(1, in.token);
+        if (!s.step()) throw RequestError(404, "unknown participant");
+        participantId = s.integer(0);
+    }
+    TrialRecord trial;
+    {
+        SqliteStatement s = db_->prepare(std::string("SELECT ") + kTrialColumns + " FROM trials WHERE id = ?");
+        s.bind(1, in.trialId);
+        if (!s.step()) throw RequestError(404, "trial " + std::to_string(in.trialId) + ": unknown trial");
+        trial = readTrial(s);
+    }
+    if (trial.participantId != participantId)
+        throw RequestError(403, "trial " + std::to_string(in.trialId) + ": belongs to another participant");
+    {
+        SqliteStatement s = db_->prepare("SELECT participant_id FROM sessions WHERE id = ?");
+        s.bind(1, in.sessionId);
+        if (!s.step()) throw RequestError(404, "session " + std::to_string(in.sessionId) + ": unknown session");
+        if (s.integer(0) != participantId)
+            throw RequestError(403, "session " + std::to_string(in.sessionId) + ": belongs to another participant");
+    }
+    const bool leftIsA = trial.plan.aOnLeft;
+    const std::string chosen = (in.side == "left") == leftIsA ? "A" : "B";
+    {
+        SqliteStatement s = db_->prepare("SELECT chosen FROM responses WHERE trial_id = ?");
+        s.bind(1, in.trialId);
+        if (s.step()) {
+            // A re-send (lost acknowledgement, retry after a restart) is harmless; a different answer is not
+            // allowed to replace the stored one.
+            if (s.text(0) == chosen) return ResponseOutcome::duplicate;
+            throw RequestError(409, "trial " + std::to_string(in.trialId) + ": already answered differently");
+        }
+    }
+    {
+        SqliteStatement s = db_->prepare("SELECT MIN(position) FROM trials WHERE participant_id = ?1 AND id NOT IN"
+                                         " (SELECT trial_id FROM responses WHERE participant_id = ?1)");
+        s.bind(1, participantId);
+        s.step();
+        if (s.isNull(0) || s.integer(0) != trial.position)
+            throw RequestError(409, "trial " + std::to_string(in.trialId) + ": out of order (the next trial is at position " +
+                                        (s.isNull(0) ? std::string("none") : std::to_string(s.integer(0))) + ")");
+    }
+    SqliteStatement insert = db_->prepare(
+        "INSERT INTO responses (trial_id, participant_id, session_id, chosen, side, response_ms, client_time, server_time,"
+        " viewport_width, viewport_height, device_pixel_ratio, user_agent) VALUES (?,?,?,?,?,?,?,?,?,?,?,?)");
+    insert.bind(1, in.trialId).bind(2, participantId).bind(3, in.sessionId).bind(4, chosen).bind(5, in.side);
+    insert.bind(6, in.responseMs).bind(7, in.clientTime).bind(8, utcTimestamp()).bind(9, in.viewportWidth);
+    insert.bind(10, in.viewportHeight).bind(11, in.devicePixelRatio).bind(12, in.userAgent);
+    insert.run();
+    return ResponseOutcome::stored;
+}
+
+ResponseOutcome StudyStore::recordResponse(const ResponseInput& in) {
+    if (in.side != "left" && in.side != "right") throw RequestError(400, "side: expected \"left\" or \"right\"");
+    PendingResponse mine;
+    mine.input = &in;
+    std::unique_lock queueLock(queueMutex_);
+    queue_.push_back(&mine);
+    while (!mine.done) {
+        if (committing_) {
+            queueChanged_.wait(queueLock);
+            continue;
+        }
+        // This thread commits everything queued so far (its own response included).
+        committing_ = true;
+        std::vector<PendingResponse*> batch;
+        batch.swap(queue_);
+        queueLock.unlock();
+        commitBatch(batch);
+        queueLock.lock();
+        committing_ = false;
+        for (PendingResponse* p : batch) p->done = true;
+        queueChanged_.notify_all();
+    }
+    if (mine.error) std::rethrow_exception(mine.error);
+    return mine.outcome;
+}
+
+void StudyStore::commitBatch(const std::vector<PendingResponse*>& batch) {
+    std::lock_guard lock(mutex_);
+    try {
+        SqliteTransaction tx(*db_);
+        for (PendingResponse* p : batch) {
+            // Validation only reads, and the insert is the last step, so a rejected response leaves nothing behind.
+            try {
+                p->outcome = storeOne(*p->input);
+            } catch (const RequestError&) {
+                p->error = std::current_exception();
+            }
+        }
+        tx.commit();
+    } catch (...) {
+        // Nothing of this batch was committed: every response not already rejected fails (and is re-sent).
+        for (PendingResponse* p : batch)
+            if (!p->error) p->error = std::current_exception();
+    }
+}
+
+
+
+std::vector<ParticipantStatus> StudyStore::status() {
+    std::lock_guard lock(mutex_);
+    SqliteTransaction tx(*db_, false); // one consistent snapshot
+    std::vector<ParticipantStatus> out;
+    SqliteStatement s = db_->prepare(std::string("SELECT ") + kParticipantColumns +
+        ", (SELECT COUNT(*) FROM trials t WHERE t.participant_id = p.id)"
+        ", (SELECT COUNT(*) FROM responses r WHERE r.participant_id = p.id)"
+        ", (SELECT COUNT(*) FROM responses r JOIN trials t ON t.id = r.trial_id WHERE r.participant_id = p.id AND t.kind IN ('test','repeat'))"
+        ", (SELECT COUNT(*) FROM responses r JOIN trials t ON t.id = r.trial_id WHERE r.participant_id = p.id AND t.kind = 'catch')"
+        ", (SELECT COUNT(*) FROM responses r JOIN trials t ON t.id = r.trial_id WHERE r.participant_id = p.id AND t.kind = 'catch' AND r.chosen = t.expected)"
+        ", (SELECT COALESCE(MAX(server_time), '') FROM responses r WHERE r.participant_id = p.id)"
+        " FROM participants p ORDER BY p.id");
+    while (s.step()) {
+        ParticipantStatus st;
+        st.participant = readParticipant(s);
+        st.progress.total = static_cast<int>(s.integer(7));
+        st.progress.answered = static_cast<int>(s.integer(8));
+        st.testAnswered = static_cast<int>(s.integer(9));
+        st.catchAnswered = static_cast<int>(s.integer(10));
+        st.catchCorrect = static_cast<int>(s.integer(11));
+        st.lastResponseAt = s.text(12);
+        out.push_back(std::move(st));
+    }
+    return out;
+}
+
+std::vector<ResponseRow> StudyStore::responses() {
+    std::lock_guard lock(mutex_);
+    SqliteStatement s = db_->prepare(
+        "SELECT p.label, p.id, t.id, t.position, t.kind, t.block, t.condition_a, t.condition_b, sa.stimulus,"
+        " COALESCE(sb.stimulus, 'blank'), t.a_on_left, r.chosen, t.expected, r.response_ms, r.client_time,"
+        " r.server_time, r.viewport_width, r.viewport_height, r.device_pixel_ratio, r.user_agent, r.session_id"
+        " FROM responses r JOIN trials t ON t.id = r.trial_id JOIN participants p ON p.id = t.participant_id"
+        " JOIN stimuli sa ON sa.id = t.stimulus_a LEFT JOIN stimuli sb ON sb.id = t.stimulus_b"
+        " ORDER BY p.id, t.position");
+    std::vector<ResponseRow> out;
+    while (s.step()) {
+        ResponseRow r;
+        r.observer = s.text(0);
+        r.participantId = s.integer(1);
+        r.trialId = s.integer(2);
+        r.position = static_cast<int>(s.integer(3));
+        r.kind = trialKindFromName(s.text(4));
+        r.scene = s.text(5);
+        r.conditionA = s.text(6);
+        r.conditionB = s.text(7);
+        r.stimulusA = s.text(8);
+        r.stimulusB = s.text(9);
+        r.aOnLeft = s.integer(10) != 0;
+        r.aSelected = s.text(11) == "A";
+        if (r.kind == TrialKind::catchTrial) r.correct = s.text(11) == s.text(12);
+        r.responseMs = s.real(13);
+        r.clientTime = s.text(14);
+        r.serverTime = s.text(15);
+        r.viewportWidth = static_cast<int>(s.integer(16));
+        r.viewportHeight = static_cast<int>(s.integer(17));
+        r.devicePixelRatio = s.real(18);
+        r.userAgent = s.text(19);
+        r.sessionId = s.integer(20);
+        out.push_back(std::move(r));
+    }
+    return out;
+}
+
+std::int64_t StudyStore::responseCount() {
+    std::lock_guard lock(mutex_);
+    SqliteStatement s = db_->prepare("SELECT COUNT(*) FROM responses");
+    s.step();
+    return s.integer(0);
+}
+
+} // namespace skinlab::experiments

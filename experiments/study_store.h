@@ -1,0 +1,161 @@
+#pragma once
+// study.db: one SQLite file (WAL journal, synchronous=FULL) holding the design, the stimulus manifest and its
+// hash, participants, sessions, planned trials and responses. Schema: docs/experiments.md ("The study file").
+//
+// Crash safety: each response is validated and inserted inside an IMMEDIATE transaction (responses arriving
+// together share one: group commit), and recordResponse() returns only after COMMIT, which with WAL + synchronous=FULL means the WAL frame is fsynced. The server
+// acknowledges after that, so an acknowledged response survives kill -9 and power loss. A response is keyed by
+// its trial (PRIMARY KEY), so a re-sent response can never be stored twice.
+#include "experiments/study_definition.h"
+#include "experiments/trial_plan.h"
+
+#include <cstdint>
+#include <filesystem>
+#include <condition_variable>
+#include <exception>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace skinlab::experiments {
+
+class SqliteDatabase;
+
+struct ParticipantRecord {
+    std::int64_t id = 0;
+    std::int64_t index = 0;   // 0-based order of joining (drives the side mirroring of trial_plan.h)
+    std::string label;        // the observer name in exports
+    std::string token;        // secret in the participant link
+    std::uint64_t seed = 0;
+    std::string completionCode;
+    std::string createdAt;
+};
+
+struct TrialRecord {
+    std::int64_t id = 0;          // global trial id
+    std::int64_t participantId = 0;
+    int position = 0;             // 0-based order within the participant's plan
+    PlannedTrial plan;
+};
+
+struct ResponseInput {
+    std::string token;            // participant token
+    std::int64_t trialId = 0;
+    std::string side;             // "left" | "right"
+    std::int64_t sessionId = 0;
+    double responseMs = 0;        // from stimulus onset to key/click, measured by the page
+    std::string clientTime;       // client's ISO-8601 clock at the response
+    int viewportWidth = 0;        // CSS pixels
+    int viewportHeight = 0;
+    double devicePixelRatio = 1;
+    std::string userAgent;
+};
+
+enum class ResponseOutcome { stored, duplicate };
+
+struct Progress {
+    int answered = 0;
+    int total = 0;
+    bool completed() const { return answered >= total; }
+};
+
+struct ParticipantStatus {
+    ParticipantRecord participant;
+    Progress progress;
+    int testAnswered = 0;   // test + repeat
+    int catchAnswered = 0;
+    int catchCorrect = 0;
+    std::string lastResponseAt;
+};
+
+// One stored response joined with its trial: everything the exports need.
+struct ResponseRow {
+    std::string observer;
+    std::int64_t participantId = 0;
+    std::int64_t trialId = 0;
+    int position = 0;
+    TrialKind kind = TrialKind::test;
+    std::string scene;           // block name
+    std::string conditionA;
+    std::string conditionB;
+    std::string stimulusA;       // manifest ids ("blank" for the panel)
+    std::string stimulusB;
+    bool aOnLeft = true;
+    bool aSelected = true;
+    std::optional<bool> correct; // catch trials only
+    double responseMs = 0;
+    std::string clientTime;
+    std::string serverTime;
+    int viewportWidth = 0;
+    int viewportHeight = 0;
+    double devicePixelRatio = 1;
+    std::string userAgent;
+    std::int64_t sessionId = 0;
+};
+
+class StudyStore {
+public:
+    // Writes a new study file atomically (built under a temporary name, then renamed). Refuses to overwrite an
+    // existing file: a study holds responses that must never be lost by a repeated `create`.
+    static void create(const std::filesystem::path& path, const StudyDefinition& definition,
+                       const std::string& designText, const StimulusManifest& manifest);
+
+    explicit StudyStore(const std::filesystem::path& path);
+    ~StudyStore();
+
+    const StudyDefinition& definition() const { return definition_; }
+    const std::filesystem::path& path() const { return path_; }
+    std::string meta(const std::string& key) const;
+
+    // A new participant with a fresh token, seed and planned trials (one transaction). `label` empty = "P001"...
+    // `joinKey` (chosen by the client, may be empty) makes joining idempotent: a retried join whose first answer
+    // was lost returns the participant it created. Throws RequestError 409 when the label is taken.
+    ParticipantRecord join(const std::string& label, const std::string& joinKey = "");
+    // Throws RequestError 404 for an unknown token.
+    ParticipantRecord participant(const std::string& token);
+    std::int64_t startSession(std::int64_t participantId, const std::string& userAgent, int viewportWidth,
+                              int viewportHeight, double devicePixelRatio);
+    // The first unanswered trial, if any.
+    std::optional<TrialRecord> nextTrial(std::int64_t participantId);
+    Progress progress(std::int64_t participantId);
+    // Validates and commits one response (see the header comment). Rejections throw RequestError:
+    // 404 unknown participant/trial, 403 another participant's trial or session, 409 out of order or a
+    // different answer to an already answered trial.
+    ResponseOutcome recordResponse(const ResponseInput& input);
+
+    std::vector<ParticipantStatus> status();
+    std::vector<ResponseRow> responses();
+    std::vector<TrialRecord> trials(std::int64_t participantId);
+    std::int64_t responseCount();
+
+private:
+    // Group commit: concurrent responses are queued; one waiting thread at a time commits everything queued in one
+    // transaction (one fsync), then wakes the others. Each response is still validated on its own, in arrival
+    // order, inside that transaction, and none is acknowledged before the COMMIT.
+    struct PendingResponse {
+        const ResponseInput* input = nullptr;
+        ResponseOutcome outcome = ResponseOutcome::stored;
+        std::exception_ptr error;
+        bool done = false;
+    };
+    void commitBatch(const std::vector<PendingResponse*>& batch);
+    ResponseOutcome storeOne(const ResponseInput& input); // inside an open transaction, mutex_ held
+
+    std::unique_ptr<SqliteDatabase> db_;
+    std::filesystem::path path_;
+    StudyDefinition definition_;
+    std::mutex mutex_; // one connection shared by the server's threads; SQLite serialises writers anyway
+    std::mutex queueMutex_;
+    std::condition_variable queueChanged_;
+    std::vector<PendingResponse*> queue_;
+    bool committing_ = false;
+};
+
+// Current UTC time as ISO-8601 with milliseconds ("2026-11-23T14:05:31.207Z").
+std::string utcTimestamp();
+// Random lower-case hex string of `bytes` bytes from the OS entropy source (tokens).
+std::string randomHex(std::size_t bytes);
+
+} // namespace skinlab::experiments

@@ -1,0 +1,47 @@
+#pragma once
+// Per-pass timings: a GL_TIME_ELAPSED query around each pass, cross-checked with wall-clock time measured
+// between glFinish() calls.
+//
+// Why both: llvmpipe's first GL_TIME_ELAPSED query of a context can return garbage (hundreds of seconds; see
+// design.md), so the constructor issues one throw-away query; and a GPU time larger than the wall-clock time
+// of the same glFinish-bracketed pass is impossible, so such a value is replaced by the wall-clock time and
+// the pass is named in "timer_check". The glFinish brackets serialise the frame; that costs a little
+// throughput but makes every figure attributable to one pass.
+#include "renderer/gl/gl_resources.h"
+
+#include <chrono>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace skinlab::renderer::gl {
+
+class PassTimer {
+public:
+    PassTimer();  // issues and discards the context's first timer query
+
+    void begin(const std::string& pass);
+    void end();
+    // Clears the recorded passes (a new frame).
+    void reset() { records_.clear(); }
+
+    // {"passes": {name: gpu ms}, "passes_wall": {name: wall ms}, "gpu_total": ms, "wall_total": ms,
+    //  "timer_check": "ok" | "gpu time above wall time, replaced: a, b"}
+    nlohmann::json json() const;
+
+    struct Record {
+        std::string pass;
+        double gpuMs = 0;
+        double wallMs = 0;
+        bool replaced = false;
+    };
+    const std::vector<Record>& records() const { return records_; }
+
+private:
+    Query query_;
+    std::chrono::steady_clock::time_point wallStart_;
+    std::string current_;
+    std::vector<Record> records_;
+};
+
+} // namespace skinlab::renderer::gl

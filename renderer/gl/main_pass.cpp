@@ -1,0 +1,68 @@
+#include "renderer/gl/main_pass.h"
+
+#include <string>
+
+namespace skinlab::renderer::gl {
+
+void MainPass::run(FrameTargets& targets, const GpuScene& scene, GLuint shadowMaps, const MainPassSettings& settings) {
+    targets.clear();
+    const GLuint program = shaders_.program("main_pass.vert", "main_pass.frag");
+    glUseProgram(program);
+    glBindFramebuffer(GL_FRAMEBUFFER, targets.mainFramebuffer.get());
+    glViewport(0, 0, targets.width, targets.height);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_CULL_FACE);  // thin and open surfaces (backdrop, fin) are seen from both sides
+
+    setUniform(program, "view", settings.camera.view);
+    setUniform(program, "projection", settings.camera.projection);
+    setUniform(program, "cameraPosition", settings.camera.position);
+    setUniform(program, "exposure", settings.exposure);
+    setUniform(program, "normalStrength", settings.normalStrength);
+    setUniform(program, "pcfRadius", settings.pcfRadius);
+    setUniform(program, "environmentFromWorld", settings.environmentFromWorld);
+    setUniformArray(program, "irradianceSH", scene.irradianceCoefficients().data(), 9);
+
+    const int lightCount = static_cast<int>(scene.lights.size());
+    setUniform(program, "lightCount", lightCount);
+    for (int i = 0; i < lightCount; ++i) {
+        const GpuLight& light = scene.lights[static_cast<std::size_t>(i)];
+        const std::string index = "[" + std::to_string(i) + "]";
+        setUniform(program, ("lightType" + index).c_str(), light.type);
+        setUniform(program, ("lightDirection" + index).c_str(), light.direction);
+        setUniform(program, ("lightPosition" + index).c_str(), light.position);
+        setUniform(program, ("lightRadiance" + index).c_str(), light.radiance);
+        setUniform(program, ("lightReferenceDistance" + index).c_str(), light.referenceDistance);
+        setUniform(program, ("lightCosInner" + index).c_str(), light.cosInner);
+        setUniform(program, ("lightCosOuter" + index).c_str(), light.cosOuter);
+        setUniform(program, ("lightShadowLayer" + index).c_str(), light.shadowLayer);
+        setUniform(program, ("lightViewProjection" + index).c_str(), light.viewProjection);
+        setUniform(program, ("lightNormalOffset" + index).c_str(), light.normalOffset);
+    }
+
+    const GLuint fallback = scene.fallbackMap();
+    const GLuint maps[] = {scene.albedoMap(), scene.normalMap(), scene.specularMap(), scene.occlusionMap(),
+                           scene.skinMaskMap()};
+    const char* flags[] = {"hasAlbedoMap", "hasNormalMap", "hasSpecularMap", "hasOcclusionMap", "hasSkinMaskMap"};
+    for (GLuint unit = 0; unit < 5; ++unit) {
+        glBindTextureUnit(unit, maps[unit] ? maps[unit] : fallback);
+        setUniform(program, flags[unit], maps[unit] ? 1 : 0);
+    }
+    glBindTextureUnit(5, shadowMaps);
+
+    for (const GpuPart& part : scene.parts()) {
+        setUniform(program, "materialAlbedo", part.material.albedo);
+        setUniform(program, "materialSkin", part.material.skin);
+        setUniform(program, "glossiness", part.material.glossiness);
+        setUniform(program, "specularIntensity", part.material.specularIntensity);
+        scene.drawPart(part);
+    }
+    for (GLuint unit = 0; unit < 6; ++unit) glBindTextureUnit(unit, 0);
+    glDisable(GL_DEPTH_TEST);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glUseProgram(0);
+    checkGl("main pass");
+}
+
+} // namespace skinlab::renderer::gl

@@ -1,0 +1,38 @@
+#pragma once
+// One 1-D screen-space SSS pass (renderer/shaders/sss_blur.frag): reads a colour texture (rgb, a = skin mask) and
+// the linear depth, writes the blurred colour along one axis with one kernel stage's taps (renderer/sss/kernel.h).
+// The CPU mirror is renderer/sss/cpu_blur.cpp (tests compare them).
+#include "renderer/gl/gl_resources.h"
+#include "renderer/sss/kernel.h"
+
+#include <array>
+
+namespace skinlab::renderer::gl {
+
+class ShaderLibrary;
+
+struct SssBlurPassInputs {
+    GLuint source = 0;       // GL_RGBA32F, rgb = colour, a = skin mask 0…1
+    GLuint linearDepth = 0;  // GL_R32F, world units, +inf on background
+    int width = 0;
+    int height = 0;
+    float focalLengthPixels = 0.0f;
+    float mmPerUnit = 1.0f;
+    bool followSurface = true;
+    float followSurfaceK = 0.5f;  // 1/mm
+};
+
+class SssBlurPass {
+public:
+    explicit SssBlurPass(ShaderLibrary& shaders);
+
+    // Draws into `target` (a framebuffer whose attachment 0 receives the result; with `accumulate` its attachment
+    // 1 receives accumulate · result added by blending — the caller clears it once per frame).
+    void run(const SssBlurPassInputs& inputs, const sss::KernelStage& stage, bool horizontal, GLuint target,
+             bool accumulate);
+
+private:
+    ShaderLibrary& shaders_;
+};
+
+} // namespace skinlab::renderer::gl

@@ -1,0 +1,80 @@
+#include "renderer/gl/sss_stage.h"
+
+#include "common/error.h"
+#include "renderer/gl/gl_resources.h"
+#include "renderer/gl/shader_library.h"
+#include "renderer/gl/sss_kernel_method.h"
+#include "renderer/sss/kernel.h"
+#include "renderer/sss/sss_params.h"
+
+namespace skinlab::renderer::gl {
+
+struct SssStage::Impl {
+    explicit Impl(ShaderLibrary& library) : shaders(library), kernelMethod(library) {}
+    ShaderLibrary& shaders;
+    // gaussian-sum, separable, artistic (kernels engineer): the method's kernel run as 1-D passes.
+    SssKernelMethod kernelMethod;
+    // The kernel of the last settings (computing a Burley or file: kernel takes milliseconds; renders repeat).
+    std::string kernelKey;
+    sss::Kernel kernel;
+    sss::SssParams params;
+
+    const sss::Kernel& kernelFor(const SssStageSettings& settings) {
+        const std::string key = settings.sss.dump();
+        if (key != kernelKey) {
+            params = sss::sssParamsFromJson(settings.sss, "sss");
+            kernel = sss::makeKernel(params);
+            kernelKey = key;
+        }
+        return kernel;
+    }
+};
+
+SssStage::SssStage(ShaderLibrary& shaders) : impl_(std::make_unique<Impl>(shaders)) {}
+SssStage::~SssStage() = default;
+
+void SssStage::run(const SssStageInputs& inputs, const SssStageSettings& settings, GLuint output) {
+    if (settings.method != "none" && settings.method != "gaussian-sum" && settings.method != "separable" &&
+        settings.method != "artistic")
+        throw InputError("sss.method: '" + settings.method +
+                         "' is not available in the GL pipeline (available: none, gaussian-sum, separable, artistic)");
+    if (settings.transmittance.value("enabled", false))
+        throw InputError("transmittance.enabled: transmittance is not available in this build");
+    if (output == inputs.diffuse) throw RuntimeError("SSS stage: output texture must differ from the diffuse input");
+    if (settings.method != "none") {
+        const sss::Kernel& kernel = impl_->kernelFor(settings);
+        SssBlurPassInputs passInputs;
+        passInputs.source = inputs.diffuse;
+        passInputs.linearDepth = inputs.linearDepth;
+        passInputs.width = inputs.width;
+        passInputs.height = inputs.height;
+        passInputs.focalLengthPixels = inputs.focalLengthPixels;
+        passInputs.mmPerUnit = inputs.mmPerUnit;
+        passInputs.followSurface = impl_->params.followSurface;
+        passInputs.followSurfaceK = static_cast<float>(impl_->params.followSurfaceK);
+        impl_->kernelMethod.run(passInputs, kernel, output);
+        return;
+    }
+    // A framebuffer per run: texture names are recycled when the frame is resized, so caching one by name
+    // could keep drawing into a deleted texture.
+    const Framebuffer outputFramebuffer = createFramebuffer("SSS stage output", &output, 1);
+    // "none": copy the diffuse buffer through (a draw, not glCopyImageSubData, so the stage's cost is measured
+    // the same way as the methods that will replace it).
+    const GLuint program = impl_->shaders.program("fullscreen.vert", "copy.frag");
+    glUseProgram(program);
+    glBindFramebuffer(GL_FRAMEBUFFER, outputFramebuffer.get());
+    glViewport(0, 0, inputs.width, inputs.height);
+    glBindTextureUnit(0, inputs.diffuse);
+    impl_->shaders.drawFullscreenTriangle();
+    glBindTextureUnit(0, 0);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glUseProgram(0);
+    checkGl("SSS stage (none)");
+}
+
+float SssStage::supportRadiusMm(const SssStageSettings& settings) const {
+    if (settings.method == "none") return 0.0f;
+    return static_cast<float>(impl_->kernelFor(settings).supportRadiusMm());
+}
+
+} // namespace skinlab::renderer::gl

@@ -1,0 +1,337 @@
+#include "renderer/scene/scene_spec.h"
+
+#include "common/error.h"
+#include "common/spec.h"
+#include "renderer/scene/builtin_scenes.h"
+#include "renderer/sss/sss_params.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <glm/gtc/matrix_transform.hpp>
+#include <limits>
+
+namespace skinlab::renderer {
+
+namespace {
+
+glm::vec3 toVec3(const std::array<double, 3>& v) {
+    return {static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2])};
+}
+nlohmann::json jsonVec3(const glm::vec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); }
+
+constexpr double kHuge = 1e30;
+
+// Resolves a path of the spec: "assets:REL" under the assets folder, else relative to the spec's folder.
+// Checks that the file exists (a missing file is bad input, named with its key).
+struct PathResolver {
+    const SpecReader* root;
+    std::filesystem::path specDirectory;
+    std::filesystem::path assetsDirectory;
+
+    std::filesystem::path resolve(const SpecReader& reader, std::string_view key, const std::string& value) const {
+        if (value.empty()) return {};
+        std::filesystem::path path;
+        if (value.rfind("assets:", 0) == 0) {
+            if (assetsDirectory.empty())
+                reader.fail(key, "'" + value + "' needs the assets folder: pass --assets DIR or set SKINLAB_ASSETS");
+            path = assetsDirectory / value.substr(7);
+        } else {
+            path = value;
+            if (path.is_relative()) path = specDirectory / path;
+        }
+        std::error_code error;
+        if (!std::filesystem::is_regular_file(path, error)) reader.fail(key, "file not found: " + path.string());
+        return path;
+    }
+};
+
+void checkDirection(const SpecReader& reader, std::string_view key, const glm::vec3& v) {
+    if (glm::length(v) < 1e-6f) reader.fail(key, "must not be the zero vector");
+}
+
+} // namespace
+
+SceneSpec loadSceneSpec(const std::string& scene, const std::vector<std::string>& overrides,
+                        const std::filesystem::path& assetsDirectoryIn) {
+    SceneSpec spec;
+    spec.source = scene;
+    toml::table table;
+    std::string file;
+    std::filesystem::path specDirectory = std::filesystem::current_path();
+    if (scene.rfind("builtin:", 0) == 0) {
+        const auto text = builtinSceneText(scene.substr(8));
+        if (!text) {
+            std::string names;
+            for (const auto& name : builtinSceneNames()) names += (names.empty() ? "builtin:" : ", builtin:") + name;
+            throw InputError("unknown built-in scene '" + scene + "' (known: " + names + ")");
+        }
+        table = parseTomlString(*text, scene);
+        file = scene;
+    } else {
+        std::error_code error;
+        if (!std::filesystem::is_regular_file(scene, error))
+            throw InputError(scene + ": scene spec not found (give a TOML file or builtin:NAME)");
+        table = parseTomlFile(scene);
+        file = std::filesystem::path(scene).filename().string();
+        specDirectory = std::filesystem::absolute(scene).parent_path();
+    }
+    for (const auto& assignment : overrides) applyOverride(table, assignment, "--set");
+
+    std::filesystem::path assetsDirectory = assetsDirectoryIn;
+    if (assetsDirectory.empty())
+        if (const char* environment = std::getenv("SKINLAB_ASSETS"); environment && *environment)
+            assetsDirectory = environment;
+
+    // Errors name the spec file (or builtin:NAME) the way the user wrote it.
+    SpecReader root(table, scene.rfind("builtin:", 0) == 0 ? scene : scene, "");
+    PathResolver paths{&root, specDirectory, assetsDirectory};
+    nlohmann::json resolved;
+    resolved["scene"] = scene;
+
+    spec.mmPerUnit = root.number("mm_per_unit", 1.0, 1e-6, 1e6);
+    resolved["mm_per_unit"] = spec.mmPerUnit;
+
+    // [model]
+    {
+        const SpecReader model = root.table("model");
+        const std::string source = model.requiredString("source");
+        if (source.rfind("builtin:", 0) == 0) {
+            static const std::vector<std::string> known = {"builtin:halo", "builtin:bleed", "builtin:ear", "builtin:head"};
+            bool found = false;
+            for (const auto& k : known) found = found || k == source;
+            if (!found)
+                model.fail("source", "unknown built-in model '" + source +
+                                         "' (known: builtin:halo, builtin:bleed, builtin:ear, builtin:head)");
+            spec.modelSource = source;
+        } else {
+            spec.modelSource = paths.resolve(model, "source", source).string();
+        }
+        resolved["model"]["source"] = source;
+        if (model.has("depth_gap_mm")) {
+            if (source != "builtin:halo") model.fail("depth_gap_mm", "only applies to builtin:halo");
+        }
+        if (model.has("thickness_mm")) {
+            if (source != "builtin:ear") model.fail("thickness_mm", "only applies to builtin:ear");
+        }
+        if (model.has("flip_v") && source.rfind("builtin:", 0) == 0)
+            model.fail("flip_v", "only applies to model files");
+        spec.flipV = model.boolean("flip_v", false);
+        if (source.rfind("builtin:", 0) != 0) resolved["model"]["flip_v"] = spec.flipV;
+        spec.depthGapMm = model.number("depth_gap_mm", 200.0, 1e-3, 10000.0);
+        spec.thicknessMm = model.number("thickness_mm", 2.5, 0.05, 20.0);
+        if (source == "builtin:halo") resolved["model"]["depth_gap_mm"] = spec.depthGapMm;
+        if (source == "builtin:ear") resolved["model"]["thickness_mm"] = spec.thicknessMm;
+    }
+
+    // [textures]
+    {
+        const SpecReader textures = root.table("textures");
+        const std::string albedo = textures.string("albedo", "");
+        const std::string normal = textures.string("normal", "");
+        const std::string specular = textures.string("specular", "");
+        const std::string occlusion = textures.string("occlusion", "");
+        const std::string skinMask = textures.string("skin_mask", "");
+        spec.textures.albedo = paths.resolve(textures, "albedo", albedo);
+        spec.textures.normal = paths.resolve(textures, "normal", normal);
+        spec.textures.specular = paths.resolve(textures, "specular", specular);
+        spec.textures.occlusion = paths.resolve(textures, "occlusion", occlusion);
+        spec.textures.skinMask = paths.resolve(textures, "skin_mask", skinMask);
+        spec.textures.normalStrength = textures.number("normal_strength", 1.0, 0.0, 4.0);
+        resolved["textures"] = {{"albedo", albedo},     {"normal", normal},        {"specular", specular},
+                                {"occlusion", occlusion}, {"skin_mask", skinMask}, {"normal_strength", spec.textures.normalStrength}};
+    }
+
+    // [[materials]]
+    resolved["materials"] = nlohmann::json::array();
+    for (const SpecReader& material : root.tables("materials")) {
+        MaterialSpec m;
+        m.name = material.requiredString("name");
+        nlohmann::json entry = {{"name", m.name}};
+        if (material.has("albedo")) {
+            m.albedo = toVec3(material.vec3("albedo", {1, 1, 1}, 0.0, 1.0));
+            entry["albedo"] = jsonVec3(*m.albedo);
+        }
+        if (material.has("skin")) entry["skin"] = *(m.skin = material.boolean("skin", true));
+        if (material.has("glossiness")) entry["glossiness"] = *(m.glossiness = material.number("glossiness", 0.6, 0.0, 1.0));
+        if (material.has("specular_intensity"))
+            entry["specular_intensity"] = *(m.specularIntensity = material.number("specular_intensity", 1.0, 0.0, 100.0));
+        spec.materials.push_back(m);
+        resolved["materials"].push_back(entry);
+    }
+
+    // [camera]
+    {
+        const SpecReader camera = root.table("camera");
+        CameraSpec& c = spec.camera;
+        c.view = camera.choice("view", "mid", {"close", "mid", "far", "explicit"});
+        c.fovDeg = camera.number("fov_deg", 30.0, 1.0, 179.0);
+        nlohmann::json& r = resolved["camera"];
+        r = {{"view", c.view}, {"fov_deg", c.fovDeg}};
+        if (c.view == "explicit") {
+            if (!camera.has("position")) camera.fail("position", "missing (camera.view = explicit needs position and target)");
+            if (!camera.has("target")) camera.fail("target", "missing (camera.view = explicit needs position and target)");
+            c.position = toVec3(camera.vec3("position", {0, 0, 1}, -kHuge, kHuge));
+            c.target = toVec3(camera.vec3("target", {0, 0, 0}, -kHuge, kHuge));
+            c.up = toVec3(camera.vec3("up", {0, 1, 0}, -kHuge, kHuge));
+            checkDirection(camera, "up", c.up);
+            if (glm::length(c.position - c.target) < 1e-9f) camera.fail("target", "equals camera.position");
+            if (glm::length(glm::cross(glm::normalize(c.target - c.position), glm::normalize(c.up))) < 1e-4f)
+                camera.fail("up", "is parallel to the viewing direction");
+            for (const char* key : {"yaw_deg", "pitch_deg"})
+                if (camera.has(key)) camera.fail(key, "only applies to the named views close|mid|far");
+            r["position"] = jsonVec3(c.position);
+            r["target"] = jsonVec3(c.target);
+            r["up"] = jsonVec3(c.up);
+        } else {
+            for (const char* key : {"position", "target", "up"})
+                if (camera.has(key)) camera.fail(key, "only applies to camera.view = explicit");
+            c.yawDeg = camera.number("yaw_deg", 0.0, -180.0, 180.0);
+            c.pitchDeg = camera.number("pitch_deg", 0.0, -89.0, 89.0);
+            r["yaw_deg"] = c.yawDeg;
+            r["pitch_deg"] = c.pitchDeg;
+        }
+    }
+
+    // [[lights]]
+    resolved["lights"] = nlohmann::json::array();
+    for (const SpecReader& light : root.tables("lights")) {
+        LightSpec l;
+        l.type = light.choice("type", "directional", {"directional", "spot"});
+        l.color = toVec3(light.vec3("color", {1, 1, 1}, 0.0, 1e6));
+        l.intensity = light.number("intensity", 1.0, 0.0, 1e6);
+        l.shadow = light.boolean("shadow", true);
+        nlohmann::json entry = {{"type", l.type}, {"color", jsonVec3(l.color)}, {"intensity", l.intensity}, {"shadow", l.shadow}};
+        if (l.type == "directional") {
+            for (const char* key : {"position", "target", "inner_angle_deg", "outer_angle_deg"})
+                if (light.has(key)) light.fail(key, "only applies to type = spot");
+            l.direction = toVec3(light.vec3("direction", {0, 0, -1}, -kHuge, kHuge));
+            checkDirection(light, "direction", l.direction);
+            l.direction = glm::normalize(l.direction);
+            entry["direction"] = jsonVec3(l.direction);
+        } else {
+            if (light.has("direction")) light.fail("direction", "does not apply to type = spot (give position and target)");
+            if (!light.has("position")) light.fail("position", "missing (a spot light needs position and target)");
+            l.position = toVec3(light.vec3("position", {0, 0, 1}, -kHuge, kHuge));
+            l.target = toVec3(light.vec3("target", {0, 0, 0}, -kHuge, kHuge));
+            if (glm::length(l.position - l.target) < 1e-9f) light.fail("target", "equals the light's position");
+            l.innerAngleDeg = light.number("inner_angle_deg", 20.0, 0.0, 89.0);
+            l.outerAngleDeg = light.number("outer_angle_deg", 30.0, 0.1, 89.0);
+            if (l.outerAngleDeg <= l.innerAngleDeg)
+                light.fail("outer_angle_deg", "must be larger than inner_angle_deg (" + std::to_string(l.innerAngleDeg) + ")");
+            entry["position"] = jsonVec3(l.position);
+            entry["target"] = jsonVec3(l.target);
+            entry["inner_angle_deg"] = l.innerAngleDeg;
+            entry["outer_angle_deg"] = l.outerAngleDeg;
+        }
+        spec.lights.push_back(l);
+        resolved["lights"].push_back(entry);
+    }
+    if (spec.lights.size() > 4) root.fail("lights", "at most 4 lights, got " + std::to_string(spec.lights.size()));
+
+    // [shadow]
+    {
+        const SpecReader shadow = root.table("shadow");
+        spec.shadowResolution = static_cast<int>(shadow.integer("resolution", 2048, 64, 8192));
+        spec.shadowPcfRadius = static_cast<int>(shadow.integer("pcf_radius", 1, 0, 4));
+        resolved["shadow"] = {{"resolution", spec.shadowResolution}, {"pcf_radius", spec.shadowPcfRadius}};
+    }
+
+    // [environment]
+    {
+        const SpecReader environment = root.table("environment");
+        EnvironmentSpec& e = spec.environment;
+        const std::string environmentFile = environment.string("file", "");
+        e.file = paths.resolve(environment, "file", environmentFile);
+        if (!environmentFile.empty() && environment.has("radiance"))
+            environment.fail("radiance", "only applies without environment.file (a constant environment)");
+        e.radiance = toVec3(environment.vec3("radiance", {0, 0, 0}, 0.0, 1e6));
+        e.intensity = environment.number("intensity", 1.0, 0.0, 1e6);
+        e.rotationDeg = environment.number("rotation_deg", 0.0, -360.0, 360.0);
+        e.background = environment.choice("background", "environment", {"environment", "color"});
+        if (e.background != "color" && environment.has("background_color"))
+            environment.fail("background_color", "only applies to environment.background = color");
+        e.backgroundColor = toVec3(environment.vec3("background_color", {0, 0, 0}, 0.0, 1e6));
+        resolved["environment"] = {{"file", environmentFile},
+                                   {"radiance", jsonVec3(e.radiance)},
+                                   {"intensity", e.intensity},
+                                   {"rotation_deg", e.rotationDeg},
+                                   {"background", e.background},
+                                   {"background_color", jsonVec3(e.backgroundColor)}};
+    }
+
+    // [render]
+    {
+        const SpecReader render = root.table("render");
+        spec.width = static_cast<int>(render.integer("width", 512, 16, 8192));
+        spec.height = static_cast<int>(render.integer("height", 512, 16, 8192));
+        spec.exposureEv = render.number("exposure_ev", 0.0, -30.0, 30.0);
+        resolved["render"] = {{"width", spec.width}, {"height", spec.height}, {"exposure_ev", spec.exposureEv}};
+    }
+
+    // [tone_map]
+    {
+        const SpecReader toneMap = root.table("tone_map");
+        spec.toneMapper = toneMap.choice("operator", "filmic", {"linear", "exponential", "reinhard", "filmic"});
+        spec.exponentialK = toneMap.number("exponential_k", 1.0, 1e-3, 1e3);
+        spec.filmicWhite = toneMap.number("filmic_white", 11.2, 1.0, 1e3);
+        const std::string display = toneMap.choice("display", "srgb", {"srgb"});
+        resolved["tone_map"] = {{"operator", spec.toneMapper},
+                                {"exponential_k", spec.exponentialK},
+                                {"filmic_white", spec.filmicWhite},
+                                {"display", display}};
+    }
+
+    // [sss] and [transmittance]: read by renderer/sss/sss_params (kernels engineer); stored resolved.
+    {
+        const sss::SssParams sssParams = sss::readSssParams(root);
+        const sss::TransmittanceParams transmittanceParams = sss::readTransmittanceParams(root);
+        spec.sssMethod = std::string(sss::methodName(sssParams.method));
+        spec.sss = sssParams.toJson();
+        spec.transmittance = transmittanceParams.toJson();
+        resolved["sss"] = spec.sss;
+        resolved["transmittance"] = spec.transmittance;
+    }
+
+    root.finish();
+    spec.resolved = resolved;
+    return spec;
+}
+
+CameraPose frameCamera(const CameraSpec& camera, const glm::vec3& frameMin, const glm::vec3& frameMax,
+                       const glm::vec3& sceneMin, const glm::vec3& sceneMax, int width, int height) {
+    CameraPose pose;
+    pose.fovYRadians = static_cast<float>(glm::radians(camera.fovDeg));
+    const float tanHalf = std::tan(pose.fovYRadians * 0.5f);
+    const glm::vec3 centre = 0.5f * (frameMin + frameMax);
+    const float radius = std::max(0.5f * glm::length(frameMax - frameMin), 1e-6f);
+    if (camera.view == "explicit") {
+        pose.position = camera.position;
+        pose.target = camera.target;
+        pose.up = glm::normalize(camera.up);
+    } else {
+        // Fraction of the image height the bounding sphere's silhouette fills.
+        const float fill = camera.view == "far" ? 0.4f : camera.view == "mid" ? 0.9f : 1.8f;
+        const float angularRadius = std::atan(fill * tanHalf);
+        const float distance = radius / std::sin(angularRadius);
+        const float yaw = static_cast<float>(glm::radians(camera.yawDeg));
+        const float pitch = static_cast<float>(glm::radians(camera.pitchDeg));
+        const glm::vec3 offset{std::sin(yaw) * std::cos(pitch), std::sin(pitch), std::cos(yaw) * std::cos(pitch)};
+        pose.target = centre;
+        pose.position = centre + distance * offset;
+        pose.up = {0, 1, 0};
+    }
+    pose.view = glm::lookAt(pose.position, pose.target, pose.up);
+    // Near/far enclose the whole scene's bounding sphere (depth along the view axis), the near plane never
+    // closer than 1e-4 of the far plane (depth precision).
+    const glm::vec3 sceneCentre = 0.5f * (sceneMin + sceneMax);
+    const float sceneRadius = std::max(0.5f * glm::length(sceneMax - sceneMin), 1e-6f);
+    const float centreDepth = -(pose.view * glm::vec4(sceneCentre, 1.0f)).z;
+    pose.farPlane = std::max(centreDepth + sceneRadius * 1.05f, 1e-3f);
+    pose.nearPlane = std::max(centreDepth - sceneRadius * 1.05f, pose.farPlane * 1e-4f);
+    const float aspect = static_cast<float>(width) / static_cast<float>(height);
+    pose.projection = glm::perspective(pose.fovYRadians, aspect, pose.nearPlane, pose.farPlane);
+    pose.focalLengthPixels = 0.5f * static_cast<float>(height) / tanHalf;
+    return pose;
+}
+
+} // namespace skinlab::renderer

@@ -1,0 +1,53 @@
+#pragma once
+// CPU reference of the screen-space SSS passes (plain C++, float arithmetic in the same order as the shaders
+// renderer/shaders/sss_*.frag), used by tests to check the GL passes and to test energy and isotropy without GL.
+//
+// One pass along an axis, for a pixel p with skin mask m_p > 0, linear depth z_p (world units):
+//   pixels per mm     k_px = f_px / (mm_per_unit · z_p)          (science.md §2; the same on both axes)
+//   tap i             position u = p + o_i · k_px along the axis, between texels j = floor(u) and j + 1
+//                     (clamped to the image), interpolation fraction f = u − floor(u) (linear filtering, done by
+//                     hand so that every texel is tested on its own)
+//   texel j           s_j = 1 − mask_j (its non-skin share); with follow surface
+//                     s_j = max(s_j, saturate(k · |z_p − z_j| · mm_per_unit)) where mask_j > 0;
+//                     value_j = mix(colour_j, centre, s_j): a non-skin texel or one across a depth step
+//                     contributes the centre colour, so no light comes from background/non-skin pixels and the
+//                     weights still sum to 1 (energy is kept)
+//   tap value         mix(value_j, value_{j+1}, f)
+//   result            mix(centre, Σ w_i · tap value_i, m_p)
+// Pixels with m_p = 0 are copied unchanged. (The shader reads the mask from the colour texture's alpha, which the
+// pipeline sets to the skin mask and every pass carries along; here it is SurfaceBuffers::mask.)
+#include "renderer/sss/kernel.h"
+
+#include <array>
+#include <vector>
+
+namespace skinlab::renderer::sss {
+
+using Rgb = std::array<float, 3>;
+
+struct SurfaceBuffers {
+    int width = 0;
+    int height = 0;
+    std::vector<float> depth;  // linear view depth, world units, +inf on background; row-major, row 0 at the bottom
+    std::vector<float> mask;   // skin mask 0…1
+    float focalLengthPixels = 0.0f;  // f_px = (H/2) / tan(fovY/2)
+    float mmPerUnit = 1.0f;
+};
+
+struct BlurSettings {
+    bool followSurface = true;
+    float followSurfaceK = 0.5f;  // 1/mm
+};
+
+enum class BlurAxis { Horizontal, Vertical };
+
+// One 1-D pass of `stage` along `axis`.
+std::vector<Rgb> blurPass(const SurfaceBuffers& surface, const std::vector<Rgb>& input, const KernelStage& stage,
+                          BlurAxis axis, const BlurSettings& settings);
+
+// A whole method: for each stage a horizontal then a vertical pass on the previous stage's result, accumulated
+// with the stage's weights (kernel.h). An empty kernel (method none) returns the input.
+std::vector<Rgb> applyKernel(const SurfaceBuffers& surface, const std::vector<Rgb>& diffuse, const Kernel& kernel,
+                             const BlurSettings& settings);
+
+} // namespace skinlab::renderer::sss

@@ -1,0 +1,142 @@
+#include "renderer/sss/sss_params.h"
+
+#include "common/error.h"
+#include "common/spec.h"
+#include "renderer/sss/materials.h"
+#include "renderer/sss/tabulated_kernel.h"
+
+namespace skinlab::renderer::sss {
+
+namespace {
+const std::vector<std::string> kMethodNames{"none", "gaussian-sum", "separable", "artistic"};
+const std::vector<std::string> kPlacementNames{"quadratic", "importance"};
+
+// JSON (as written by toJson) → TOML, so that the JSON form goes through the same strict reader.
+toml::table jsonToToml(const nlohmann::json& object, std::string_view source);
+
+void insertJson(toml::table& table, const std::string& key, const nlohmann::json& value, std::string_view source) {
+    if (value.is_boolean()) table.insert_or_assign(key, value.get<bool>());
+    else if (value.is_number_integer()) table.insert_or_assign(key, value.get<std::int64_t>());
+    else if (value.is_number()) table.insert_or_assign(key, value.get<double>());
+    else if (value.is_string()) table.insert_or_assign(key, value.get<std::string>());
+    else if (value.is_object()) table.insert_or_assign(key, jsonToToml(value, source));
+    else if (value.is_array()) {
+        toml::array array;
+        for (const auto& element : value) {
+            if (element.is_number_integer()) array.push_back(element.get<std::int64_t>());
+            else if (element.is_number()) array.push_back(element.get<double>());
+            else if (element.is_string()) array.push_back(element.get<std::string>());
+            else if (element.is_boolean()) array.push_back(element.get<bool>());
+            else throwInput(source, key, "unsupported array element " + element.dump());
+        }
+        table.insert_or_assign(key, std::move(array));
+    } else throwInput(source, key, "unsupported value " + value.dump());
+}
+
+toml::table jsonToToml(const nlohmann::json& object, std::string_view source) {
+    if (!object.is_object()) throwInput(source, "", "expected a JSON object, got " + object.dump());
+    toml::table table;
+    for (const auto& [key, value] : object.items()) insertJson(table, key, value, source);
+    return table;
+}
+
+SssParams readSssTable(const SpecReader& sss) {
+    SssParams p;
+    const std::string method = sss.choice("method", "none", kMethodNames);
+    p.method = method == "gaussian-sum" ? SssMethod::GaussianSum
+               : method == "separable"  ? SssMethod::Separable
+               : method == "artistic"   ? SssMethod::Artistic
+                                        : SssMethod::None;
+    p.samples = static_cast<int>(sss.integer("samples", p.samples, 3, 101));
+    if (p.samples % 2 == 0)
+        sss.fail("samples", std::to_string(p.samples) + " is even; a symmetric kernel needs an odd number of taps (3…101)");
+    p.widthMm = sss.number("width_mm", p.widthMm, 0.01, 100.0);
+    p.placement = sss.choice("sampling", "quadratic", kPlacementNames) == "importance" ? TapPlacement::Importance
+                                                                                        : TapPlacement::Quadratic;
+    p.followSurface = sss.boolean("follow_surface", p.followSurface);
+    p.followSurfaceK = sss.number("follow_surface_k", p.followSurfaceK, 0.0, 1000.0);
+    p.profile = sss.string("profile", p.profile);
+    p.material = sss.choice("material", p.material, materialNames());
+    if (p.profile.rfind("file:", 0) == 0) {
+        if (p.profile.size() == 5) sss.fail("profile", "'file:' needs a path, e.g. file:/path/Skin1_PreInt_DISCSEP.bn");
+        try {
+            readTabulatedKernel(p.profile.substr(5));
+        } catch (const InputError& e) {
+            sss.fail("profile", e.what());
+        }
+    } else if (p.profile != "deon" && p.profile != "burley") {
+        sss.fail("profile", "'" + p.profile + "' is not one of: deon, burley, file:PATH");
+    }
+    if (p.profile == "deon" && p.material != "skin")
+        sss.fail("material", "'" + p.material + "' has no d'Eon profile (only 'skin'); use sss.profile = \"burley\"");
+    p.artisticStrength = sss.vec3("artistic_strength", p.artisticStrength, 0.0, 1.0);
+    p.artisticFalloff = sss.vec3("artistic_falloff", p.artisticFalloff, 0.0, 1.0);
+    return p;
+}
+
+TransmittanceParams readTransmittanceTable(const SpecReader& t) {
+    TransmittanceParams p;
+    p.enabled = t.boolean("enabled", p.enabled);
+    p.translucency = t.number("translucency", p.translucency, 0.0, 1.0);
+    return p;
+}
+} // namespace
+
+std::string_view methodName(SssMethod method) {
+    switch (method) {
+    case SssMethod::None: return "none";
+    case SssMethod::GaussianSum: return "gaussian-sum";
+    case SssMethod::Separable: return "separable";
+    case SssMethod::Artistic: return "artistic";
+    }
+    return "none";
+}
+
+std::string_view placementName(TapPlacement placement) {
+    return placement == TapPlacement::Importance ? "importance" : "quadratic";
+}
+
+nlohmann::json SssParams::toJson() const {
+    return {{"method", std::string(methodName(method))},
+            {"samples", samples},
+            {"width_mm", widthMm},
+            {"sampling", std::string(placementName(placement))},
+            {"follow_surface", followSurface},
+            {"follow_surface_k", followSurfaceK},
+            {"profile", profile},
+            {"material", material},
+            {"artistic_strength", artisticStrength},
+            {"artistic_falloff", artisticFalloff}};
+}
+
+nlohmann::json TransmittanceParams::toJson() const {
+    return {{"enabled", enabled}, {"translucency", translucency}};
+}
+
+SssParams readSssParams(const SpecReader& scene) {
+    const SpecReader sss = scene.table("sss");
+    SssParams p = readSssTable(sss);
+    sss.finish();
+    return p;
+}
+
+TransmittanceParams readTransmittanceParams(const SpecReader& scene) {
+    const SpecReader t = scene.table("transmittance");
+    TransmittanceParams p = readTransmittanceTable(t);
+    t.finish();
+    return p;
+}
+
+SssParams sssParamsFromJson(const nlohmann::json& sss, std::string_view source) {
+    toml::table root;
+    root.insert_or_assign("sss", jsonToToml(sss, source));
+    return readSssParams(SpecReader(root, std::string(source)));
+}
+
+TransmittanceParams transmittanceParamsFromJson(const nlohmann::json& transmittance, std::string_view source) {
+    toml::table root;
+    root.insert_or_assign("transmittance", jsonToToml(transmittance, source));
+    return readTransmittanceParams(SpecReader(root, std::string(source)));
+}
+
+} // namespace skinlab::renderer::sss

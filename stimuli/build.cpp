@@ -1,0 +1,273 @@
+#include "stimuli/build.h"
+
+#include "common/error.h"
+#include "common/files.h"
+#include "common/hash.h"
+#include "common/version.h"
+#include "renderer/render_job.h"
+#include "stimuli/contact_sheet.h"
+#include "stimuli/output_folder.h"
+#include "stimuli/progress.h"
+
+#include <OpenImageIO/imageio.h>
+#include <atomic>
+#include <chrono>
+#include <map>
+#include <mutex>
+#include <spdlog/spdlog.h>
+#include <thread>
+
+namespace skinlab::stimuli {
+
+namespace fs = std::filesystem;
+using renderer::RenderRequest;
+
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+RenderRequest requestFor(const std::string& scene, const std::vector<std::string>& overrides, const fs::path& assets) {
+    RenderRequest request;
+    request.scene = scene;
+    request.overrides = overrides;
+    request.assetsDir = assets;
+    return request;
+}
+
+std::vector<std::string> fixedOverrides(const SetSpec& spec) {
+    std::vector<std::string> out;
+    for (const auto& p : spec.fixed) out.push_back(p.key + "=" + p.level.overrideText);
+    return out;
+}
+
+// Checks the fixed parameters with every scene, then every factor level on its own, so that an unknown factor
+// key, an unknown level or a missing asset is reported naming the factor and level before anything renders.
+void validateLevels(const SetSpec& spec, const fs::path& assets) {
+    const Factor& scenes = spec.factors.front();
+    const std::vector<std::string> fixed = fixedOverrides(spec);
+    for (const auto& scene : scenes.levels) {
+        try {
+            renderer::resolveScene(requestFor(scene.overrideText, fixed, assets));
+        } catch (const InputError& e) {
+            throw InputError(spec.fileName + ": scene '" + scene.value + "': " + e.what());
+        }
+    }
+    const std::string& firstScene = scenes.levels.front().overrideText;
+    for (const auto& factor : spec.factors) {
+        if (factor.name == "scene") continue;
+        for (const auto& level : factor.levels) {
+            std::vector<std::string> overrides = fixed;
+            overrides.push_back(factor.key + "=" + level.overrideText);
+            try {
+                renderer::resolveScene(requestFor(firstScene, overrides, assets));
+            } catch (const InputError& e) {
+                throw InputError(spec.fileName + ": factor '" + factor.name + "': level '" + level.value +
+                                 "': " + e.what());
+            }
+        }
+    }
+}
+
+std::pair<int, int> imageSize(const fs::path& path) {
+    auto input = OIIO::ImageInput::open(path.string());
+    if (!input) throw RuntimeError(path.string() + ": cannot read the rendered image (" + OIIO::geterror() + ")");
+    std::pair<int, int> size{input->spec().width, input->spec().height};
+    input->close();
+    return size;
+}
+
+// Renders one stimulus into temporary files and renames them into place; returns its complete manifest entry.
+nlohmann::json renderStimulus(renderer::Renderer& renderer, const Stimulus& stimulus, const nlohmann::json& resolved,
+                              const fs::path& dir, const fs::path& assets) {
+    auto start = std::chrono::steady_clock::now();
+    AtomicOutput exr(dir / exrRelativePath(stimulus.id));
+    AtomicOutput png(dir / pngRelativePath(stimulus.id));
+    RenderRequest request = requestFor(stimulus.scene, stimulus.overrides, assets);
+    request.exrPath = exr.tempPath();
+    request.pngPath = png.tempPath();
+    renderer::RenderResult result = renderer.render(request);
+    exr.commit();
+    png.commit();
+    if (result.resolved != resolved)
+        spdlog::warn("stimuli: {}: the renderer resolved other parameters than resolveScene(); reruns will "
+                     "re-render it",
+                     stimulus.id);
+
+    nlohmann::json entry = stimulusEntry(stimulus, resolved);
+    entry["sha256"] = {{"exr", sha256File(exr.finalPath())}, {"png", sha256File(png.finalPath())}};
+    auto [width, height] = imageSize(exr.finalPath());
+    entry["width"] = width;
+    entry["height"] = height;
+    nlohmann::json timings = result.timingsMs.is_object() ? result.timingsMs : nlohmann::json{{"render", result.timingsMs}};
+    timings["stimulus_wall"] = secondsSince(start) * 1000.0;  // render + write + hash, ms
+    entry["timings_ms"] = timings;
+    return entry;
+}
+
+// An earlier entry is still valid when its resolved parameters are identical and both files are intact.
+bool entryStillValid(const nlohmann::json& entry, const nlohmann::json& resolved, const fs::path& dir) {
+    if (!entry.contains("resolved") || entry["resolved"] != resolved) return false;
+    try {
+        for (const char* kind : {"exr", "png"}) {
+            fs::path file = dir / entry.at("files").at(kind).get<std::string>();
+            if (!fs::is_regular_file(file)) return false;
+            if (sha256File(file) != entry.at("sha256").at(kind).get<std::string>()) return false;
+        }
+    } catch (const std::exception&) {
+        return false;
+    }
+    return true;
+}
+
+} // namespace
+
+nlohmann::json stimulusEntry(const Stimulus& stimulus, const nlohmann::json& resolved) {
+    nlohmann::json factors = nlohmann::json::object();
+    std::string sceneValue;
+    for (const auto& [name, level] : stimulus.factors) {
+        factors[name] = level.value;
+        if (name == "scene") sceneValue = level.value;
+    }
+    return {{"id", stimulus.id},
+            {"files", {{"exr", exrRelativePath(stimulus.id)}, {"png", pngRelativePath(stimulus.id)}}},
+            {"factors", factors},
+            {"block", stimulus.block},
+            {"reference", stimulus.reference},
+            {"scene", sceneValue},
+            {"overrides", stimulus.overrides},
+            {"resolved", resolved}};
+}
+
+BuildPlan planBuild(const fs::path& specPath, const std::vector<std::string>& specOverrides,
+                    const std::optional<Shard>& shard, const fs::path& assetsDir) {
+    BuildPlan plan;
+    plan.spec = readSetSpec(specPath, specOverrides);
+    plan.all = expand(plan.spec);
+    plan.selected = shard ? selectShard(plan.all, *shard) : plan.all;
+    validateLevels(plan.spec, assetsDir);
+    for (const auto& stimulus : plan.selected) {
+        try {
+            plan.resolved.push_back(renderer::resolveScene(requestFor(stimulus.scene, stimulus.overrides, assetsDir)));
+        } catch (const InputError& e) {
+            throw InputError(plan.spec.fileName + ": stimulus '" + stimulus.id + "': " + e.what());
+        }
+    }
+    return plan;
+}
+
+BuildSummary buildSet(const BuildOptions& options) {
+    auto start = std::chrono::steady_clock::now();
+    if (options.jobs < 1) throwInput("--jobs", "", std::to_string(options.jobs) + " is not a positive number");
+    BuildPlan plan = planBuild(options.spec, options.specOverrides, options.shard, options.assetsDir);
+    const fs::path& dir = options.outputDir;
+    std::optional<Manifest> existing = claimOutputFolder(dir, plan.spec.name, options.shard);
+
+    Manifest manifest = manifestHeader(plan.spec, plan.all, options.shard);
+    std::map<std::string, nlohmann::json> entries;  // id → entry of every stimulus done
+    if (existing && existing->renderer.skinlabVersion == version()) {
+        manifest.renderer = existing->renderer;
+        for (size_t i = 0; i < plan.selected.size(); ++i) {
+            const Stimulus& s = plan.selected[i];
+            for (const auto& old : existing->stimuli) {
+                if (old.value("id", "") != s.id || !entryStillValid(old, plan.resolved[i], dir)) continue;
+                nlohmann::json entry = stimulusEntry(s, plan.resolved[i]);
+                for (const char* field : {"sha256", "width", "height", "timings_ms"}) entry[field] = old[field];
+                entries[s.id] = std::move(entry);
+            }
+        }
+    }
+    std::vector<size_t> toRender;
+    std::vector<std::string> selectedIds;
+    for (size_t i = 0; i < plan.selected.size(); ++i) {
+        selectedIds.push_back(plan.selected[i].id);
+        if (!entries.count(plan.selected[i].id)) toRender.push_back(i);
+    }
+
+    std::mutex manifestMutex;
+    auto writeCurrent = [&] {
+        manifest.stimuli.clear();
+        for (const auto& s : plan.selected)
+            if (auto it = entries.find(s.id); it != entries.end()) manifest.stimuli.push_back(it->second);
+        manifest.complete = manifest.stimuli.size() == plan.selected.size();
+        writeManifest(dir, manifest);
+    };
+    ensureDirectory(dir / "exr");
+    ensureDirectory(dir / "png");
+    tidyOutputFolder(dir, selectedIds);
+    writeCurrent();  // marks the folder as this set's before anything renders
+    spdlog::info("stimuli: set '{}': {} stimuli, {} unchanged, {} to render", plan.spec.name, plan.selected.size(),
+                 entries.size(), toRender.size());
+
+    BuildSummary summary;
+    summary.stimuli = plan.selected.size();
+    if (!toRender.empty()) {
+        auto first = std::make_unique<renderer::Renderer>();
+        RendererInfo current{first->glRenderer(), first->glVersion(), version()};
+        if (!entries.empty() && !(current == manifest.renderer)) {
+            // A set is made by one renderer: images of another GPU/driver are not comparable pixel for pixel.
+            spdlog::warn("stimuli: the set was rendered by '{}', this machine has '{}': re-rendering all of it",
+                         manifest.renderer.glRenderer, current.glRenderer);
+            entries.clear();
+            toRender.clear();
+            for (size_t i = 0; i < plan.selected.size(); ++i) toRender.push_back(i);
+        }
+        manifest.renderer = current;
+        writeCurrent();
+
+        bool terminal = options.progress == BuildOptions::ProgressStyle::bar ||
+                        (options.progress == BuildOptions::ProgressStyle::automatic && Progress::stderrIsTerminal());
+        Progress progress(toRender.size(), terminal);
+        std::atomic<size_t> next{0};
+        std::atomic<bool> stop{false};
+        std::exception_ptr failure;
+        // Every renderer lives until all workers are done: they may share one EGL display, which the first
+        // destroyed renderer would terminate under the others.
+        int jobs = std::min<int>(options.jobs, static_cast<int>(toRender.size()));
+        std::vector<std::unique_ptr<renderer::Renderer>> renderers(static_cast<size_t>(jobs));
+        renderers[0] = std::move(first);
+        auto work = [&](size_t slot) {
+            try {
+                if (!renderers[slot]) renderers[slot] = std::make_unique<renderer::Renderer>();
+                renderer::Renderer* renderer = renderers[slot].get();
+                while (!stop) {
+                    size_t k = next++;
+                    if (k >= toRender.size()) return;
+                    const size_t i = toRender[k];
+                    auto t0 = std::chrono::steady_clock::now();
+                    nlohmann::json entry;
+                    try {
+                        entry = renderStimulus(*renderer, plan.selected[i], plan.resolved[i], dir, options.assetsDir);
+                    } catch (const InputError& e) {
+                        throw InputError(plan.spec.fileName + ": stimulus '" + plan.selected[i].id + "': " + e.what());
+                    } catch (const RuntimeError& e) {
+                        throw RuntimeError("stimulus '" + plan.selected[i].id + "': " + e.what());
+                    }
+                    std::lock_guard lock(manifestMutex);
+                    entries[plan.selected[i].id] = std::move(entry);
+                    writeCurrent();
+                    ++summary.rendered;
+                    progress.finished(plan.selected[i].id, secondsSince(t0));
+                }
+            } catch (...) {
+                std::lock_guard lock(manifestMutex);
+                if (!failure) failure = std::current_exception();
+                stop = true;
+            }
+        };
+        std::vector<std::thread> threads;
+        for (size_t j = 1; j < renderers.size(); ++j) threads.emplace_back(work, j);
+        work(0);
+        for (auto& t : threads) t.join();
+        progress.close();
+        if (failure) std::rethrow_exception(failure);
+    }
+    summary.kept = summary.stimuli - summary.rendered;
+    summary.manifest = dir / kManifestFile;
+    if (options.contactSheet && manifest.complete) summary.contactHtml = writeContactSheet(dir, manifest).html;
+    summary.wallSeconds = secondsSince(start);
+    return summary;
+}
+
+} // namespace skinlab::stimuli

@@ -1,0 +1,207 @@
+#include "stimuli/contact_sheet.h"
+
+#include "common/error.h"
+#include "common/files.h"
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+
+namespace skinlab::stimuli {
+
+namespace fs = std::filesystem;
+
+std::string escapeHtml(std::string_view text) {
+    std::string out;
+    for (char c : text) {
+        switch (c) {
+        case '&': out += "&amp;"; break;
+        case '<': out += "&lt;"; break;
+        case '>': out += "&gt;"; break;
+        case '"': out += "&quot;"; break;
+        default: out += c;
+        }
+    }
+    return out;
+}
+
+namespace {
+
+struct Block {
+    std::string name;
+    std::vector<const nlohmann::json*> stimuli;
+};
+
+std::vector<Block> groupByBlock(const Manifest& manifest) {
+    std::vector<Block> blocks;
+    for (const auto& s : manifest.stimuli) {
+        std::string name = s.at("block").get<std::string>();
+        auto it = std::find_if(blocks.begin(), blocks.end(), [&](const Block& b) { return b.name == name; });
+        if (it == blocks.end()) {
+            blocks.push_back({name, {}});
+            it = blocks.end() - 1;
+        }
+        it->stimuli.push_back(&s);
+    }
+    return blocks;
+}
+
+std::string valueText(const nlohmann::json& value) { return value.is_string() ? value.get<std::string>() : value.dump(); }
+
+// The factor levels that tell the stimuli of one block apart (the caption of a thumbnail).
+std::vector<std::string> varyingFactors(const Block& block) {
+    std::vector<std::string> names;
+    for (const auto* s : block.stimuli)
+        for (auto it = s->at("factors").begin(); it != s->at("factors").end(); ++it)
+            if (std::find(names.begin(), names.end(), it.key()) == names.end()) names.push_back(it.key());
+    std::vector<std::string> varying;
+    for (const auto& name : names) {
+        std::string first;
+        bool differs = false;
+        for (size_t i = 0; i < block.stimuli.size(); ++i) {
+            const auto& f = block.stimuli[i]->at("factors");
+            std::string v = f.contains(name) ? valueText(f[name]) : "";
+            if (i == 0) first = v;
+            else if (v != first) differs = true;
+        }
+        if (differs) varying.push_back(name);
+    }
+    return varying;
+}
+
+std::string caption(const nlohmann::json& stimulus, const std::vector<std::string>& varying) {
+    std::string text;
+    const auto& f = stimulus.at("factors");
+    for (const auto& name : varying)
+        if (f.contains(name)) text += (text.empty() ? "" : " ") + valueText(f[name]);
+    if (stimulus.at("reference").get<bool>()) text += text.empty() ? "reference" : " (ref)";
+    return text.empty() ? stimulus.at("id").get<std::string>() : text;
+}
+
+std::string html(const Manifest& manifest, const std::vector<Block>& blocks) {
+    std::ostringstream out;
+    out << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>" << escapeHtml(manifest.set)
+        << " — skinlab stimulus set</title>\n<style>\n"
+        << "body{font-family:sans-serif;background:#222;color:#ddd;margin:1em}\n"
+        << "h2{border-bottom:1px solid #555;padding-bottom:.2em}\n"
+        << ".grid{display:flex;flex-wrap:wrap;gap:12px}\n"
+        << "figure{margin:0;background:#2c2c2c;padding:6px;border:2px solid transparent}\n"
+        << "figure.reference{border-color:#c90}\n"
+        << "img{display:block;max-width:320px;height:auto}\n"
+        << "figcaption{font-size:12px;margin-top:4px}\n.id{font-family:monospace;color:#aaa}\n"
+        << "table{border-collapse:collapse}td{padding:0 .6em 0 0;vertical-align:top}\n"
+        << "</style>\n</head>\n<body>\n<h1>Stimulus set " << escapeHtml(manifest.set) << "</h1>\n";
+    if (!manifest.description.empty()) out << "<p>" << escapeHtml(manifest.description) << "</p>\n";
+    out << "<p>" << manifest.stimuli.size() << " stimuli in " << blocks.size() << " block(s). Renderer: "
+        << escapeHtml(manifest.renderer.glRenderer) << " (skinlab " << escapeHtml(manifest.renderer.skinlabVersion)
+        << "). Fixed: ";
+    std::string fixed;
+    for (auto it = manifest.fixed.begin(); it != manifest.fixed.end(); ++it)
+        fixed += (fixed.empty() ? "" : ", ") + it.key() + " = " + valueText(it.value());
+    out << escapeHtml(fixed.empty() ? "(scene defaults)" : fixed) << ".</p>\n";
+    for (const auto& block : blocks) {
+        out << "<h2>" << escapeHtml(block.name.empty() ? "(all)" : block.name) << "</h2>\n<div class=\"grid\">\n";
+        for (const auto* s : block.stimuli) {
+            bool reference = s->at("reference").get<bool>();
+            std::string png = s->at("files").at("png").get<std::string>();
+            out << "<figure" << (reference ? " class=\"reference\"" : "") << "><a href=\"" << escapeHtml(png)
+                << "\"><img src=\"" << escapeHtml(png) << "\" alt=\"" << escapeHtml(s->at("id").get<std::string>())
+                << "\" loading=\"lazy\"></a>\n<figcaption><div class=\"id\">" << escapeHtml(s->at("id").get<std::string>())
+                << (reference ? " — reference" : "") << "</div><table>";
+            const auto& f = s->at("factors");
+            for (auto it = f.begin(); it != f.end(); ++it)
+                out << "<tr><td>" << escapeHtml(it.key()) << "</td><td>" << escapeHtml(valueText(it.value()))
+                    << "</td></tr>";
+            out << "</table></figcaption></figure>\n";
+        }
+        out << "</div>\n";
+    }
+    out << "</body>\n</html>\n";
+    return out.str();
+}
+
+OIIO::ImageBuf thumbnail(const fs::path& png, int width, int height) {
+    OIIO::ImageBuf source(png.string());
+    if (!source.read(0, 0, true, OIIO::TypeDesc::FLOAT))
+        throw RuntimeError(png.string() + ": cannot read for the contact sheet (" + source.geterror() + ")");
+    if (source.nchannels() != 3) {
+        int order[3] = {0, std::min(1, source.nchannels() - 1), std::min(2, source.nchannels() - 1)};
+        source = OIIO::ImageBufAlgo::channels(source, 3, order);
+    }
+    return OIIO::ImageBufAlgo::resize(source, "", 0.0f, OIIO::ROI(0, width, 0, height, 0, 1, 0, 3));
+}
+
+void writePng(const fs::path& path, const Manifest& manifest, const std::vector<Block>& blocks, int thumbWidth,
+              const fs::path& dir) {
+    if (manifest.stimuli.empty()) return;
+    const auto& first = manifest.stimuli.front();
+    int imageWidth = std::max(1, first.at("width").get<int>());
+    int imageHeight = std::max(1, first.at("height").get<int>());
+    const int thumbHeight = std::max(1, static_cast<int>(std::lround(double(thumbWidth) * imageHeight / imageWidth)));
+    constexpr int margin = 8, titleHeight = 22, captionHeight = 18, maxColumns = 8;
+    size_t columns = 1;
+    for (const auto& b : blocks) columns = std::max(columns, std::min<size_t>(b.stimuli.size(), maxColumns));
+    int height = margin;
+    for (const auto& b : blocks) {
+        size_t rows = (b.stimuli.size() + maxColumns - 1) / maxColumns;
+        height += titleHeight + static_cast<int>(rows) * (thumbHeight + captionHeight + margin);
+    }
+    const int width = margin + static_cast<int>(columns) * (thumbWidth + margin);
+    OIIO::ImageBuf sheet(OIIO::ImageSpec(width, height, 3, OIIO::TypeDesc::FLOAT));
+    const float background[3] = {0.13f, 0.13f, 0.13f}, text[3] = {0.9f, 0.9f, 0.9f}, accent[3] = {0.8f, 0.55f, 0.0f};
+    OIIO::ImageBufAlgo::fill(sheet, background);
+    // Captions need a TrueType font through FreeType; without one the grid is still written (the HTML page
+    // carries the labels), so a failed render_text is not an error.
+    // OpenImageIO's default font (DroidSans) is not packaged by Debian; DejaVu (fonts-dejavu-core) usually is.
+    std::string font;
+    for (const char* candidate : {"/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
+                                  "/usr/share/fonts/TTF/DejaVuSans.ttf", "/usr/share/fonts/dejavu/DejaVuSans.ttf"})
+        if (fs::exists(candidate)) {
+            font = candidate;
+            break;
+        }
+    auto label = [&](int x, int y, const std::string& s, const float* colour) {
+        if (!OIIO::ImageBufAlgo::render_text(sheet, x, y, s, 13, font, OIIO::cspan<float>(colour, 3)))
+            (void)sheet.geterror();
+    };
+    int y = margin;
+    for (const auto& b : blocks) {
+        label(margin, y + 15, b.name.empty() ? manifest.set : b.name, text);
+        y += titleHeight;
+        std::vector<std::string> varying = varyingFactors(b);
+        for (size_t i = 0; i < b.stimuli.size(); ++i) {
+            const auto& s = *b.stimuli[i];
+            int column = static_cast<int>(i % maxColumns);
+            if (i > 0 && column == 0) y += thumbHeight + captionHeight + margin;
+            int x = margin + column * (thumbWidth + margin);
+            OIIO::ImageBuf thumb = thumbnail(dir / s.at("files").at("png").get<std::string>(), thumbWidth, thumbHeight);
+            OIIO::ImageBufAlgo::paste(sheet, x, y, 0, 0, thumb);
+            bool reference = s.at("reference").get<bool>();
+            label(x, y + thumbHeight + 14, caption(s, varying), reference ? accent : text);
+        }
+        y += thumbHeight + captionHeight + margin;
+    }
+    AtomicOutput out(path);
+    if (!sheet.write(out.tempPath().string(), OIIO::TypeDesc::UINT8))
+        throw RuntimeError(path.string() + ": cannot write (" + sheet.geterror() + ")");
+    out.commit();
+}
+
+} // namespace
+
+ContactSheetFiles writeContactSheet(const fs::path& dir, const Manifest& manifest, int thumbnailWidth) {
+    std::vector<Block> blocks = groupByBlock(manifest);
+    ContactSheetFiles files{dir / "contact.html", dir / "contact.png"};
+    writeFileAtomic(files.html, html(manifest, blocks));
+    if (manifest.stimuli.empty()) {
+        files.png.clear();
+        return files;
+    }
+    writePng(files.png, manifest, blocks, thumbnailWidth, dir);
+    return files;
+}
+
+} // namespace skinlab::stimuli

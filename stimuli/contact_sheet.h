@@ -1,0 +1,23 @@
+#pragma once
+// Contact sheet of a stimulus set, to inspect it at a glance: contact.html (every display PNG, labelled by its
+// factor levels, grouped by block, references marked) and contact.png (a grid of thumbnails, one row per block,
+// each captioned with the levels that vary inside the block).
+#include "stimuli/manifest.h"
+
+#include <filesystem>
+
+namespace skinlab::stimuli {
+
+struct ContactSheetFiles {
+    std::filesystem::path html;
+    std::filesystem::path png;
+};
+
+// Writes DIR/contact.html and DIR/contact.png atomically from the manifest and the PNGs it lists.
+ContactSheetFiles writeContactSheet(const std::filesystem::path& dir, const Manifest& manifest,
+                                    int thumbnailWidth = 256);
+
+// "&lt;" etc. for text inside HTML.
+std::string escapeHtml(std::string_view text);
+
+} // namespace skinlab::stimuli

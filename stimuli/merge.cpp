@@ -1,0 +1,101 @@
+#include "stimuli/merge.h"
+
+#include "common/error.h"
+#include "common/files.h"
+#include "common/hash.h"
+#include "stimuli/contact_sheet.h"
+#include "stimuli/manifest.h"
+#include "stimuli/output_folder.h"
+
+#include <map>
+#include <set>
+
+namespace skinlab::stimuli {
+
+namespace fs = std::filesystem;
+
+namespace {
+std::string shardName(const Shard& s) { return std::to_string(s.index) + "/" + std::to_string(s.count); }
+} // namespace
+
+MergeSummary mergeShards(const std::vector<fs::path>& shardDirs, const fs::path& outputDir, bool contactSheet) {
+    if (shardDirs.empty()) throwInput("merge", "", "no shard folders given");
+    std::vector<Manifest> shards;
+    for (const auto& dir : shardDirs) {
+        if (fs::exists(outputDir) && fs::exists(dir) && fs::equivalent(dir, outputDir))
+            throwInput(dir.string(), "", "is also the output folder; merge into a new folder");
+        std::optional<Manifest> m = readManifest(dir);
+        if (!m) throwInput(dir.string(), "", "holds no stimulus set (no manifest.json)");
+        if (!m->shard) throwInput(dir.string(), "", "is not a shard (built without --shard i/n)");
+        if (!m->complete)
+            throwInput(dir.string(), "", "shard " + shardName(*m->shard) + " is incomplete; rerun its build first");
+        shards.push_back(std::move(*m));
+    }
+    const Manifest& first = shards.front();
+    std::map<int, size_t> byIndex;
+    for (size_t i = 0; i < shards.size(); ++i) {
+        const Manifest& m = shards[i];
+        const std::string where = shardDirs[i].string();
+        if (m.set != first.set) throwInput(where, "", "holds set '" + m.set + "', not '" + first.set + "'");
+        if (m.specSha256 != first.specSha256 || m.setIds != first.setIds)
+            throwInput(where, "", "was built from another version of spec '" + first.specFile + "' (spec_sha256 differs)");
+        if (!m.stimuli.empty() && !first.stimuli.empty() && !(m.renderer == first.renderer))
+            throwInput(where, "", "was rendered by '" + m.renderer.glRenderer + "' (skinlab " + m.renderer.skinlabVersion +
+                                      "), the first shard by '" + first.renderer.glRenderer + "' (skinlab " +
+                                      first.renderer.skinlabVersion + "); a set must come from one renderer");
+        if (m.shard->count != first.shard->count)
+            throwInput(where, "", "is shard " + shardName(*m.shard) + ", the first is shard " + shardName(*first.shard));
+        if (byIndex.count(m.shard->index))
+            throwInput(where, "", "shard " + shardName(*m.shard) + " is given twice");
+        byIndex[m.shard->index] = i;
+    }
+    for (int k = 1; k <= first.shard->count; ++k)
+        if (!byIndex.count(k))
+            throwInput("merge", "", "shard " + std::to_string(k) + "/" + std::to_string(first.shard->count) + " of set '" +
+                                        first.set + "' is missing");
+
+    // Gather the entries in the set's order and check every file against its hash before writing anything.
+    std::map<std::string, std::pair<const nlohmann::json*, size_t>> entries;  // id → entry, shard
+    for (size_t i = 0; i < shards.size(); ++i)
+        for (const auto& s : shards[i].stimuli) entries[s.at("id").get<std::string>()] = {&s, i};
+    Manifest merged = first;
+    merged.shard.reset();
+    merged.stimuli.clear();
+    for (const auto& id : first.setIds) {
+        auto it = entries.find(id);
+        if (it == entries.end()) throwInput("merge", "", "stimulus '" + id + "' is in no shard");
+        merged.stimuli.push_back(*it->second.first);
+        for (const char* kind : {"exr", "png"}) {
+            fs::path file = shardDirs[it->second.second] / it->second.first->at("files").at(kind).get<std::string>();
+            if (!fs::is_regular_file(file)) throwInput(file.string(), "", "missing (listed in its shard's manifest)");
+            if (sha256File(file) != it->second.first->at("sha256").at(kind).get<std::string>())
+                throwInput(file.string(), "", "sha256 does not match its shard's manifest; rebuild that shard");
+        }
+    }
+    for (const auto& m : shards)
+        if (!m.stimuli.empty()) merged.renderer = m.renderer;
+    merged.complete = true;
+
+    std::optional<Manifest> existing = claimOutputFolder(outputDir, merged.set, std::nullopt);
+    (void)existing;
+    ensureDirectory(outputDir / "exr");
+    ensureDirectory(outputDir / "png");
+    for (const auto& s : merged.stimuli) {
+        const auto& source = entries[s.at("id").get<std::string>()];
+        for (const char* kind : {"exr", "png"}) {
+            std::string relative = s.at("files").at(kind).get<std::string>();
+            AtomicOutput out(outputDir / relative);
+            fs::copy_file(shardDirs[source.second] / relative, out.tempPath(), fs::copy_options::overwrite_existing);
+            out.commit();
+        }
+    }
+    tidyOutputFolder(outputDir, first.setIds);
+    writeManifest(outputDir, merged);
+    MergeSummary summary;
+    summary.stimuli = merged.stimuli.size();
+    summary.manifest = outputDir / kManifestFile;
+    if (contactSheet) summary.contactHtml = writeContactSheet(outputDir, merged).html;
+    return summary;
+}
+
+} // namespace skinlab::stimuli

@@ -1,0 +1,99 @@
+// Timing of `skinlab analyze metrics` on one 1280×720 pair (docs/benchmarks.md, "Metrics (issue 4)").
+// Synthetic renders (disc scene, contract-1 EXR with beauty, depth.Z, mask.Y) so the benchmark needs no GL.
+// Run: build/<dir>/tests/analysis/metrics/bench_metrics --benchmark_repetitions=5
+#include "analysis/metrics/error_bands.h"
+#include "analysis/metrics/metrics_run.h"
+#include "analysis/metrics/render_comparison.h"
+
+#include "synthetic_render.h"
+
+#include <benchmark/benchmark.h>
+
+#include <filesystem>
+
+namespace {
+namespace fs = std::filesystem;
+using namespace skinlab::metrics;
+
+constexpr int width = 1280;
+constexpr int height = 720;
+
+struct Fixture {
+    fs::path folder = fs::temp_directory_path() / "skinlab-bench-metrics";
+    fs::path referencePath = folder / "reference.exr";
+    fs::path testPath = folder / "test.exr";
+    Fixture() {
+        fs::remove_all(folder);
+        fs::create_directories(folder);
+        testing::DiscScene scene;
+        scene.size = height;
+        scene.width = width;
+        scene.farPlaneIsSkin = true;
+        scene.stripeHalfWidth = 0.02;
+        testing::SyntheticRender reference = testing::renderDiscScene(scene);
+        testing::SyntheticRender test = reference;
+        test.beauty = cv::Mat(reference.beauty * 1.05);  // every pixel differs: the full ΔE00 cost
+        testing::writeSyntheticExr(referencePath, reference);
+        testing::writeSyntheticExr(testPath, test);
+    }
+};
+
+Fixture& fixture() {
+    static Fixture instance;
+    return instance;
+}
+
+// Reading both EXRs (all channels, float32).
+void loadPair(benchmark::State& state) {
+    for (auto _ : state) {
+        MetricRender reference = loadMetricRender(fixture().referencePath, RenderRole::reference);
+        MetricRender test = loadMetricRender(fixture().testPath, RenderRole::test);
+        benchmark::DoNotOptimize(reference.beauty.data);
+        benchmark::DoNotOptimize(test.beauty.data);
+    }
+}
+
+// Edges, three exact distance transforms and the four bands.
+void buildBands(benchmark::State& state) {
+    MetricRender reference = loadMetricRender(fixture().referencePath, RenderRole::reference);
+    BandGeometry geometry{*reference.sssRadiusMillimetres / *reference.millimetresPerUnit, *reference.focalLengthPixels};
+    for (auto _ : state) {
+        ErrorBands bands = buildErrorBands(reference.depth, reference.mask, geometry);
+        benchmark::DoNotOptimize(bands.masks[0].data);
+    }
+}
+
+// The reference's bands and encodings (done once per reference).
+void prepareTheReference(benchmark::State& state) {
+    MetricRender reference = loadMetricRender(fixture().referencePath, RenderRole::reference);
+    for (auto _ : state) {
+        PreparedReference prepared = prepareReference(reference, {});
+        benchmark::DoNotOptimize(prepared.lab.data);
+    }
+}
+
+// One test against a prepared reference: per-pixel ΔE00, PSNR, SSIM, band scores.
+void compareOneTest(benchmark::State& state) {
+    PreparedReference prepared = prepareReference(loadMetricRender(fixture().referencePath, RenderRole::reference), {});
+    MetricRender test = loadMetricRender(fixture().testPath, RenderRole::test);
+    for (auto _ : state) {
+        ComparisonResult result = compareWithReference(prepared, test, {});
+        benchmark::DoNotOptimize(result.image.ssim);
+    }
+}
+
+// The whole command for one pair: read, prepare, compare, heat map PNG, CSV and JSON.
+void wholeCommand(benchmark::State& state) {
+    ComparisonPlan plan = planFileComparisons(fixture().referencePath, {fixture().testPath});
+    for (auto _ : state) runMetrics(plan, {}, fixture().folder / "out");
+}
+
+BENCHMARK(loadPair)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(buildBands)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(prepareTheReference)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(compareOneTest)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(wholeCommand)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+} // namespace
+
+BENCHMARK_MAIN();

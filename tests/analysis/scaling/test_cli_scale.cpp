@@ -1,0 +1,137 @@
+// `skinlab analyze scale` end to end: a CSV export of simulated observers → every output file, well formed;
+// a bad file → exit 2 and one line naming it; an existing output folder is never left half-written.
+#include "analysis/scaling/simulation.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path scratch() {
+    const fs::path folder = fs::path(SKINLAB_BINARY_DIR) / "test-scratch" / "scaling-cli";
+    fs::create_directories(folder);
+    return folder;
+}
+
+struct Run {
+    int exitCode = -1;
+    std::string output;  // stdout and stderr
+};
+
+Run run(const std::string& arguments) {
+    const std::string command = std::string(SKINLAB_CLI) + " " + arguments + " 2>&1";
+    Run result;
+    FILE* pipe = popen(command.c_str(), "r");
+    char buffer[4096];
+    while (size_t n = fread(buffer, 1, sizeof buffer, pipe)) result.output.append(buffer, n);
+    const int status = pclose(pipe);
+    result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return result;
+}
+
+// Contract-3 CSV from simulated observers, two blocks, with sides, a catch trial per observer.
+std::string simulatedCsv() {
+    using namespace skinlab::analysis::scaling;
+    std::ostringstream csv;
+    csv << "observer,scene,condition_A,condition_B,is_A_selected,A_on_left,trial_kind,correct,response_ms\n";
+    const char* names[] = {"none", "gaussian-sum", "separable", "artistic"};
+    for (int b = 0; b < 2; ++b) {
+        SimulationDesign design;
+        design.trueScores = {0.0, 0.8, 1.2, 1.6};
+        design.observers = 12;
+        design.trialsPerPair = 4;
+        design.randomObservers = b == 0 ? 1 : 0;
+        const SimulatedBlock simulated = simulateBlock(design, 100 + b);
+        const std::string scene = b == 0 ? "builtin:head/mid" : "builtin:head/close";
+        for (int k = 0; k < design.observers; ++k) {
+            for (size_t p = 0; p < simulated.block.pairs.size(); ++p) {
+                const auto [i, j] = simulated.block.pairs[p];
+                const auto pi = static_cast<Eigen::Index>(p);
+                for (int w = 0; w < simulated.block.winsFirst(k, pi); ++w)
+                    csv << "p" << k << "," << scene << "," << names[i] << "," << names[j] << ",1," << (w % 2) << ",test,,900\n";
+                for (int w = 0; w < simulated.block.winsSecond(k, pi); ++w)
+                    csv << "p" << k << "," << scene << "," << names[j] << "," << names[i] << ",1," << (w % 2) << ",test,,900\n";
+            }
+            csv << "p" << k << "," << scene << ",none,artistic,0,1,catch," << (k == 3 ? 0 : 1) << ",400\n";
+        }
+    }
+    return csv.str();
+}
+
+TEST(CliScale, WritesEveryOutput) {
+    const fs::path input = scratch() / "responses.csv";
+    std::ofstream(input) << simulatedCsv();
+    const fs::path output = scratch() / "out";
+    fs::remove_all(output);
+    const Run result = run("analyze scale " + input.string() + " -o " + output.string() + " --bootstrap 300");
+    ASSERT_EQ(result.exitCode, 0) << result.output;
+    for (const char* file : {"scale.json", "scores.csv", "pairs.csv", "observers.csv", "consistency.csv", "counts.csv",
+                             "report_section.html"})
+        EXPECT_TRUE(fs::exists(output / file)) << file;
+    std::ifstream stream(output / "scale.json");
+    const nlohmann::json json = nlohmann::json::parse(stream);
+    ASSERT_EQ(json["blocks"].size(), 2u);
+    const auto& mid = json["blocks"][0];
+    EXPECT_EQ(mid["name"], "builtin:head/mid");
+    EXPECT_EQ(mid["interval_method"], "studentized-bootstrap");
+    // True order none < gaussian-sum < separable < artistic; the extremes are 1.6 JOD apart.
+    EXPECT_LT(mid["scores"][0]["jod"].get<double>(), mid["scores"][3]["jod"].get<double>());
+    EXPECT_TRUE(mid["side_bias"]["available"].get<bool>());
+    for (const char* plot : {"scores", "matrix"}) EXPECT_TRUE(fs::exists(output / mid["plots"][plot].get<std::string>()));
+    // Observer p3 failed its catch trials; p11 answered at random in block 1.
+    bool sawCatch = false;
+    for (const auto& observer : json["observers"])
+        if (observer["observer"] == "p3") sawCatch = observer["catch_failures"] == 2;
+    EXPECT_TRUE(sawCatch);
+    const std::string html = (std::ostringstream() << std::ifstream(output / "report_section.html").rdbuf()).str();
+    EXPECT_EQ(html.rfind("<section class=\"skinlab-scaling\">", 0), 0u);
+    EXPECT_NE(html.find("data:image/png;base64,"), std::string::npos);
+    EXPECT_NE(result.output.find("builtin:head/close"), std::string::npos);
+}
+
+TEST(CliScale, BadInputExitsTwoWithOneLine) {
+    const fs::path input = scratch() / "negative.csv";
+    std::ofstream(input) << "condition,a,b\na,0,-1\nb,3,0\n";
+    const fs::path output = scratch() / "bad-out";
+    fs::remove_all(output);
+    const Run result = run("analyze scale " + input.string() + " -o " + output.string());
+    EXPECT_EQ(result.exitCode, 2);
+    EXPECT_EQ(result.output, "skinlab: error: " + input.string() + ": line 2: column b: negative count -1\n");
+    EXPECT_FALSE(fs::exists(output / "scale.json"));
+}
+
+TEST(CliScale, CountMatrixOracle) {
+    const fs::path input = scratch() / "oracle.csv";
+    std::ofstream(input) << "condition,A,B,C\nA,0,25,0\nB,75,0,25\nC,0,75,0\n";
+    const fs::path output = scratch() / "oracle-out";
+    const Run result = run("analyze scale " + input.string() + " -o " + output.string());
+    ASSERT_EQ(result.exitCode, 0) << result.output;
+    std::ifstream stream(output / "scale.json");
+    const nlohmann::json json = nlohmann::json::parse(stream);
+    const auto& scores = json["blocks"][0]["scores"];
+    EXPECT_NEAR(scores[0]["jod"].get<double>(), -1.0, 1e-3);
+    EXPECT_NEAR(scores[2]["jod"].get<double>(), 1.0, 1e-3);
+    EXPECT_EQ(json["blocks"][0]["interval_method"], "fisher-wald");
+}
+
+TEST(CliValidate, SmallRunMeetsTheScreeningTargets) {
+    const fs::path output = scratch() / "validate";
+    const Run result = run("analyze validate --experiments 20 --observers 20 --bootstrap 200 --scenarios screening -o " +
+                           output.string());
+    ASSERT_EQ(result.exitCode, 0) << result.output;
+    std::ifstream stream(output / "validation.json");
+    const nlohmann::json json = nlohmann::json::parse(stream);
+    ASSERT_EQ(json["rows"].size(), 1u);
+    EXPECT_EQ(json["rows"][0]["inverted_hit_rate"].get<double>(), 1.0);
+    EXPECT_GE(json["rows"][0]["random_hit_rate"].get<double>(), 0.9);
+    EXPECT_LE(json["rows"][0]["false_alarm_rate"].get<double>(), 0.02);
+}
+
+} // namespace

@@ -1,0 +1,191 @@
+// Integration tests through the real `skinlab study ...` executable: create/status/export and their errors,
+// and crash safety — the server is killed with SIGKILL in the middle of a simulated session, restarted, and the
+// session finished: no acknowledged response may be lost or duplicated.
+#include "child_process.h"
+#include "common/files.h"
+#include "common/hash.h"
+#include "experiments/simulated_observers.h"
+#include "experiments/sqlite_database.h"
+#include "experiments/study_store.h"
+#include "stimulus_set_fixture.h"
+
+#include <atomic>
+#include <csignal>
+#include <gtest/gtest.h>
+#include <regex>
+#include <thread>
+
+using namespace skinlab::experiments;
+using namespace skinlab::experiments::test_support;
+namespace fs = std::filesystem;
+
+namespace {
+
+const char* kDesign = R"(
+title = "CLI test"
+seed = 5
+repetitions = 2
+[practice]
+trials = 1
+[catch]
+blank = 2
+)";
+
+struct StudyFiles {
+    TemporaryFolder folder{"cli"};
+    fs::path stimuli = folder.path() / "stimuli";
+    fs::path design;
+    fs::path database = folder.path() / "study.db";
+    StudyFiles() {
+        writeStimulusSet(stimuli);
+        design = writeText(folder.path(), "design.toml", kDesign);
+    }
+};
+
+CommandResult runSkinlab(std::vector<std::string> arguments) {
+    arguments.insert(arguments.begin(), SKINLAB_CLI);
+    return runCommand(arguments);
+}
+
+// Starts `skinlab study serve` and returns the port it printed.
+int startServer(std::unique_ptr<ChildProcess>& child, const fs::path& database, int port) {
+    child = std::make_unique<ChildProcess>(std::vector<std::string>{
+        SKINLAB_CLI, "study", "serve", database.string(), "--port", std::to_string(port), "--token", "t0ken", "--threads", "16"});
+    static const std::regex serving(R"(serving .* on http://127\.0\.0\.1:(\d+)/)");
+    for (int i = 0; i < 10; ++i) {
+        bool ok = false;
+        const std::string line = child->readLine(std::chrono::seconds(20), ok);
+        if (!ok) break;
+        std::smatch m;
+        if (std::regex_search(line, m, serving)) return std::stoi(m[1].str());
+    }
+    return -1;
+}
+
+} // namespace
+
+TEST(StudyCli, CreateStatusExportAndTheirErrors) {
+    StudyFiles files;
+    CommandResult created = runSkinlab({"study", "create", "--stimuli", files.stimuli.string(), "--design",
+                                     files.design.string(), "-o", files.database.string()});
+    ASSERT_EQ(created.exitCode, 0) << created.err;
+    EXPECT_NE(created.out.find("per participant 27 trials (1 practice, 12 test, 12 repeat, 2 catch)"), std::string::npos)
+        << created.out;
+
+    // Never overwrites a study; the existing file is untouched.
+    const std::string before = skinlab::sha256File(files.database);
+    CommandResult again = runSkinlab({"study", "create", "--stimuli", files.stimuli.string(), "--design",
+                                   files.design.string(), "-o", files.database.string()});
+    EXPECT_EQ(again.exitCode, 2);
+    EXPECT_EQ(again.err, "skinlab: error: " + files.database.string() +
+                             ": already exists; a study file is never overwritten (it may hold responses) — choose another "
+                             "-o or remove it first\n");
+    EXPECT_EQ(skinlab::sha256File(files.database), before);
+
+    // Design errors name the file and key, and leave no output behind.
+    const fs::path other = files.folder.path() / "other.db";
+    CommandResult badKey = runSkinlab({"study", "create", "--stimuli", files.stimuli.string(), "--design",
+                                    files.design.string(), "-o", other.string(), "--set", "repetitions=0"});
+    EXPECT_EQ(badKey.exitCode, 2);
+    EXPECT_EQ(badKey.err, "skinlab: error: " + files.design.string() + ": repetitions: 0 is out of range [1, 100]\n");
+    EXPECT_FALSE(fs::exists(other));
+    CommandResult noManifest = runSkinlab({"study", "create", "--stimuli", files.folder.path().string(), "--design",
+                                        files.design.string(), "-o", other.string()});
+    EXPECT_EQ(noManifest.exitCode, 2);
+    EXPECT_EQ(noManifest.err, "skinlab: error: " + (files.folder.path() / "manifest.json").string() +
+                                  ": no manifest.json in the stimulus folder\n");
+    // A stimulus changed after the set was built: its hash no longer matches.
+    skinlab::writeFileAtomic(files.stimuli / "png" / "1-artistic.png", "not a png");
+    CommandResult changed = runSkinlab({"study", "create", "--stimuli", files.stimuli.string(), "--design",
+                                     files.design.string(), "-o", other.string()});
+    EXPECT_EQ(changed.exitCode, 2);
+    EXPECT_NE(changed.err.find("1-artistic.png: sha256 differs from the manifest"), std::string::npos) << changed.err;
+    EXPECT_FALSE(fs::exists(other));
+
+    CommandResult status = runSkinlab({"study", "status", files.database.string()});
+    EXPECT_EQ(status.exitCode, 0);
+    EXPECT_NE(status.out.find("0 participants, 0 completed, 0 responses"), std::string::npos) << status.out;
+    CommandResult csv = runSkinlab({"study", "export", files.database.string(), "--format", "csv"});
+    EXPECT_EQ(csv.out, "observer,scene,condition_A,condition_B,is_A_selected,A_on_left,trial_kind,correct,response_ms\n");
+    CommandResult badFormat = runSkinlab({"study", "export", files.database.string(), "--format", "xls"});
+    EXPECT_NE(badFormat.exitCode, 0);
+    CommandResult missing = runSkinlab({"study", "status", (files.folder.path() / "nope.db").string()});
+    EXPECT_EQ(missing.exitCode, 2);
+    EXPECT_EQ(missing.err, "skinlab: error: " + (files.folder.path() / "nope.db").string() + ": no such study file\n");
+}
+
+TEST(StudyCli, KillNineDuringASessionLosesAndDuplicatesNothing) {
+    StudyFiles files;
+    ASSERT_EQ(runSkinlab({"study", "create", "--stimuli", files.stimuli.string(), "--design", files.design.string(), "-o",
+                       files.database.string()})
+                  .exitCode,
+              0);
+    std::unique_ptr<ChildProcess> server;
+    const int port = startServer(server, files.database, 0);
+    ASSERT_GT(port, 0);
+
+    StudyStore store(files.database);
+    SimulationOptions options;
+    options.port = port;
+    options.observers = 12;
+    options.seed = 3;
+    options.labelPrefix = "crash";
+    options.thinkMinMs = 2; // keeps the session going while the server is killed
+    options.thinkMaxMs = 8;
+    options.truth.byCondition = {{"reference-like", 1}, {"separable", 0.5}, {"artistic", 0}, {"reference", 2}};
+    SimulationReport report;
+    std::thread simulation([&] { report = simulateObservers(store, options); });
+
+    // Kill the server twice in mid-session, each time restarting it on the same port.
+    const std::int64_t total = 12 * 27;
+    int kills = 0;
+    for (std::int64_t threshold : {total / 4, total / 2}) {
+        for (int i = 0; i < 3000 && store.responseCount() < threshold; ++i)
+            std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        ASSERT_LT(store.responseCount(), total) << "the session ended before the kill; make it longer";
+        server->kill(SIGKILL);
+        EXPECT_EQ(server->wait(), 128 + SIGKILL);
+        ++kills;
+        std::this_thread::sleep_for(std::chrono::milliseconds(300)); // requests fail meanwhile and are re-sent
+        ASSERT_EQ(startServer(server, files.database, port), port);
+    }
+    simulation.join();
+    EXPECT_EQ(kills, 2);
+    for (const ObserverResult& o : report.observers) EXPECT_TRUE(o.failure.empty()) << o.label << ": " << o.failure;
+    EXPECT_EQ(report.completed(), 12);
+    EXPECT_GT(report.transportRetries(), 0) << "the kills should have interrupted requests";
+
+    // Exactly one stored response per planned trial, and every acknowledged answer stored as acknowledged.
+    EXPECT_EQ(store.responseCount(), total);
+    std::map<std::int64_t, bool> storedLeft;
+    for (const ResponseRow& r : store.responses()) EXPECT_TRUE(storedLeft.emplace(r.trialId, r.aSelected == r.aOnLeft).second);
+    std::size_t acknowledged = 0;
+    for (const ObserverResult& o : report.observers)
+        for (const auto& [trial, side] : o.acknowledged) {
+            ASSERT_TRUE(storedLeft.count(trial)) << "acknowledged response to trial " << trial << " lost";
+            EXPECT_EQ(storedLeft.at(trial), side == "left");
+            ++acknowledged;
+        }
+    EXPECT_EQ(acknowledged, static_cast<std::size_t>(total));
+    SqliteDatabase db(files.database.string(), false);
+    SqliteStatement check = db.prepare("PRAGMA integrity_check");
+    ASSERT_TRUE(check.step());
+    EXPECT_EQ(check.text(0), "ok");
+
+    // The CLI's own simulate, status and export work against the restarted server.
+    CommandResult simulated = runSkinlab({"study", "simulate", files.database.string(), "--observers", "2", "--url",
+                                       "http://127.0.0.1:" + std::to_string(port), "--truth-factor", "quality",
+                                       "--lapse", "0.1", "--label-prefix", "cli"});
+    EXPECT_EQ(simulated.exitCode, 0) << simulated.out << simulated.err;
+    EXPECT_NE(simulated.out.find("2/2 observers completed, 54 responses acknowledged, 0 rejected"), std::string::npos)
+        << simulated.out;
+    CommandResult status = runSkinlab({"study", "status", files.database.string()});
+    EXPECT_NE(status.out.find("14 participants, 14 completed, 378 responses"), std::string::npos) << status.out;
+    const fs::path exported = files.folder.path() / "responses.csv";
+    ASSERT_EQ(runSkinlab({"study", "export", files.database.string(), "--format", "pwcmp", "-o", exported.string()}).exitCode, 0);
+    const std::string pwcmp = skinlab::readFile(exported);
+    EXPECT_EQ(std::count(pwcmp.begin(), pwcmp.end(), '\n'), 1 + 14 * 24);
+
+    server->kill(SIGTERM);
+    EXPECT_EQ(server->wait(), 0) << "SIGTERM stops the server cleanly";
+}

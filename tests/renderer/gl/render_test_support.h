@@ -1,0 +1,117 @@
+#pragma once
+// Shared helpers of the GL tests: one Renderer per test process (EGL context creation costs ~100 ms), skipping
+// with the EGL failure message when no platform works; EXR reading; temporary folders.
+#include "common/error.h"
+#include "renderer/render_job.h"
+
+#include <OpenImageIO/imageio.h>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <gtest/gtest.h>
+#include <map>
+#include <memory>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+namespace skinlab::renderer::test {
+
+inline std::string& rendererFailure() {
+    static std::string failure;
+    return failure;
+}
+
+// The process-wide renderer, or nullptr (rendererFailure() says why) when no EGL platform works.
+inline Renderer* sharedRenderer() {
+    static std::unique_ptr<Renderer> renderer;
+    static bool tried = false;
+    if (!tried) {
+        tried = true;
+        try {
+            renderer = std::make_unique<Renderer>();
+        } catch (const std::exception& e) {
+            rendererFailure() = e.what();
+        }
+    }
+    return renderer.get();
+}
+
+#define SKINLAB_REQUIRE_RENDERER(name)                                                              \
+    ::skinlab::renderer::Renderer* name = ::skinlab::renderer::test::sharedRenderer();              \
+    if (!name) GTEST_SKIP() << "no EGL/OpenGL 4.5 context: " << ::skinlab::renderer::test::rendererFailure()
+
+struct ExrImage {
+    int width = 0;
+    int height = 0;
+    std::map<std::string, std::vector<float>> channels;  // planar, top row first
+    std::map<std::string, std::string> strings;
+    std::map<std::string, float> floats;
+    std::vector<std::string> channelOrder;
+
+    float at(const std::string& channel, int x, int y) const {
+        return channels.at(channel)[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)];
+    }
+};
+
+inline ExrImage readExr(const std::filesystem::path& path) {
+    auto input = OIIO::ImageInput::open(path.string());
+    if (!input) throw std::runtime_error("cannot open " + path.string() + ": " + OIIO::geterror());
+    const OIIO::ImageSpec& spec = input->spec();
+    ExrImage image;
+    image.width = spec.width;
+    image.height = spec.height;
+    std::vector<float> interleaved(static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height) *
+                                   static_cast<std::size_t>(spec.nchannels));
+    if (!input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, interleaved.data()))
+        throw std::runtime_error("cannot read " + path.string() + ": " + input->geterror());
+    const std::size_t pixels = static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height);
+    for (int c = 0; c < spec.nchannels; ++c) {
+        std::vector<float> plane(pixels);
+        for (std::size_t p = 0; p < pixels; ++p) plane[p] = interleaved[p * static_cast<std::size_t>(spec.nchannels) + static_cast<std::size_t>(c)];
+        image.channels[spec.channelnames[static_cast<std::size_t>(c)]] = std::move(plane);
+        image.channelOrder.push_back(spec.channelnames[static_cast<std::size_t>(c)]);
+    }
+    for (const auto& attribute : spec.extra_attribs) {
+        if (attribute.type() == OIIO::TypeDesc::STRING) image.strings[attribute.name().string()] = attribute.get_string();
+        else if (attribute.type() == OIIO::TypeDesc::FLOAT) image.floats[attribute.name().string()] = attribute.get_float();
+    }
+    return image;
+}
+
+inline std::vector<unsigned char> readPng(const std::filesystem::path& path, int& width, int& height) {
+    auto input = OIIO::ImageInput::open(path.string());
+    if (!input) throw std::runtime_error("cannot open " + path.string());
+    width = input->spec().width;
+    height = input->spec().height;
+    std::vector<unsigned char> rgb(static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 3);
+    input->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, rgb.data());
+    return rgb;
+}
+
+class TempFolder {
+public:
+    explicit TempFolder(const std::string& tag) {
+        static int counter = 0;
+        path_ = std::filesystem::path(SKINLAB_BINARY_DIR) / "test-output" /
+                (tag + "-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+        std::filesystem::remove_all(path_);
+        std::filesystem::create_directories(path_);
+    }
+    ~TempFolder() {
+        if (!keep) std::filesystem::remove_all(path_);
+    }
+    const std::filesystem::path& path() const { return path_; }
+    std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
+    bool keep = false;
+
+private:
+    std::filesystem::path path_;
+};
+
+inline std::string readText(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+} // namespace skinlab::renderer::test

@@ -1,0 +1,172 @@
+// Strict scene specs: defaults, overrides, and every error message word for word (renderer/scene/scene_spec.h).
+#include "common/error.h"
+#include "renderer/scene/builtin_scenes.h"
+#include "renderer/scene/scene_spec.h"
+
+#include <cmath>
+#include <fstream>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+namespace skinlab::renderer {
+namespace {
+
+// The InputError message of loading `scene` with `overrides` ("" when it loads).
+std::string errorOf(const std::string& scene, const std::vector<std::string>& overrides,
+                    const std::filesystem::path& assets = {}) {
+    try {
+        loadSceneSpec(scene, overrides, assets);
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+class TempFolder {
+public:
+    TempFolder() {
+        path_ = std::filesystem::temp_directory_path() / ("skinlab-scene-spec-" + std::to_string(::getpid()) + "-" +
+                                                          std::to_string(counter_++));
+        std::filesystem::create_directories(path_);
+    }
+    ~TempFolder() { std::filesystem::remove_all(path_); }
+    const std::filesystem::path& path() const { return path_; }
+    std::filesystem::path write(const std::string& name, const std::string& text) const {
+        std::ofstream(path_ / name) << text;
+        return path_ / name;
+    }
+
+private:
+    std::filesystem::path path_;
+    static inline int counter_ = 0;
+};
+
+TEST(SceneSpec, EveryBuiltinSceneLoadsWithItsDefaults) {
+    for (const std::string& name : builtinSceneNames()) {
+        const SceneSpec spec = loadSceneSpec("builtin:" + name, {}, {});
+        EXPECT_EQ(spec.modelSource, "builtin:" + name);
+        EXPECT_EQ(spec.mmPerUnit, 1.0) << name;  // built-in models are in millimetres (builtin_geometry.h)
+        EXPECT_FALSE(spec.lights.empty()) << name;
+        EXPECT_EQ(spec.resolved["scene"], "builtin:" + name);
+        EXPECT_EQ(spec.resolved["sss"]["method"], "none");
+        EXPECT_EQ(spec.resolved["render"]["width"], spec.width);
+    }
+}
+
+TEST(SceneSpec, OverridesChangeValuesAndAreRecordedInTheResolvedParameters) {
+    const SceneSpec spec = loadSceneSpec(
+        "builtin:head", {"camera.view=close", "render.width=320", "tone_map.operator=reinhard", "render.exposure_ev=-1.5"},
+        {});
+    EXPECT_EQ(spec.camera.view, "close");
+    EXPECT_EQ(spec.width, 320);
+    EXPECT_EQ(spec.toneMapper, "reinhard");
+    EXPECT_DOUBLE_EQ(spec.exposureEv, -1.5);
+    EXPECT_EQ(spec.resolved["camera"]["view"], "close");
+    EXPECT_EQ(spec.resolved["render"]["width"], 320);
+    EXPECT_EQ(spec.resolved["tone_map"]["operator"], "reinhard");
+    // Later overrides win.
+    EXPECT_EQ(loadSceneSpec("builtin:halo", {"render.height=100", "render.height=64"}, {}).height, 64);
+}
+
+TEST(SceneSpec, ErrorMessagesNameFileKeyAndValue) {
+    EXPECT_EQ(errorOf("builtin:head", {"camera.fvo=3"}), "builtin:head: camera.fvo: unknown key");
+    EXPECT_EQ(errorOf("builtin:head", {"camera.fov_deg=\"wide\""}),
+              "builtin:head: camera.fov_deg: expected a number, got string \"wide\"");
+    EXPECT_EQ(errorOf("builtin:head", {"camera.fov_deg=200"}), "builtin:head: camera.fov_deg: 200 is out of range [1, 179]");
+    EXPECT_EQ(errorOf("builtin:head", {"camera.view=sideways"}),
+              "builtin:head: camera.view: 'sideways' is not one of: close, mid, far, explicit");
+    EXPECT_EQ(errorOf("builtin:head", {"render.width=8"}), "builtin:head: render.width: 8 is out of range [16, 8192]");
+    EXPECT_EQ(errorOf("builtin:head", {"tone_map.operator=aces"}),
+              "builtin:head: tone_map.operator: 'aces' is not one of: linear, exponential, reinhard, filmic");
+    EXPECT_EQ(errorOf("builtin:head", {"lights=3"}), "builtin:head: lights: expected an array of tables, got integer 3");
+    EXPECT_EQ(errorOf("builtin:ear", {"model.depth_gap_mm=10"}),
+              "builtin:ear: model.depth_gap_mm: only applies to builtin:halo");
+    EXPECT_EQ(errorOf("builtin:head", {"camera.position=[0, 0, 1]"}),
+              "builtin:head: camera.position: only applies to camera.view = explicit");
+    EXPECT_EQ(errorOf("builtin:head", {"camera.view=explicit"}),
+              "builtin:head: camera.position: missing (camera.view = explicit needs position and target)");
+    EXPECT_EQ(errorOf("builtin:head", {"model.source=builtin:torso"}),
+              "builtin:head: model.source: unknown built-in model 'builtin:torso' (known: builtin:halo, builtin:bleed, "
+              "builtin:ear, builtin:head)");
+    EXPECT_EQ(errorOf("builtin:head", {"environment.file=assets:envmaps/x.hdr"}, ""),
+              errorOf("builtin:head", {"environment.file=assets:envmaps/x.hdr"}, ""));  // stable
+    EXPECT_EQ(errorOf("builtin:nope", {}),
+              "unknown built-in scene 'builtin:nope' (known: builtin:halo, builtin:bleed, builtin:ear, builtin:head)");
+    EXPECT_EQ(errorOf("/nonexistent/scene.toml", {}),
+              "/nonexistent/scene.toml: scene spec not found (give a TOML file or builtin:NAME)");
+}
+
+TEST(SceneSpec, LightsAreValidatedPerType) {
+    // --set replaces an array of tables as a whole (TOML inline tables).
+    EXPECT_EQ(errorOf("builtin:bleed", {"lights=[{type = \"spot\", direction = [0, 0, -1]}]"}),
+              "builtin:bleed: lights[0].direction: does not apply to type = spot (give position and target)");
+    EXPECT_EQ(errorOf("builtin:bleed", {"lights=[{type = \"spot\", position = [0, 0, 9]}]"}), "");
+    EXPECT_EQ(errorOf("builtin:bleed", {"lights=[{type = \"spot\"}]"}),
+              "builtin:bleed: lights[0].position: missing (a spot light needs position and target)");
+    EXPECT_EQ(errorOf("builtin:bleed", {"lights=[{}, {intensity = -1}]"}),
+              "builtin:bleed: lights[1].intensity: -1 is out of range [0, 1e+06]");
+    EXPECT_EQ(errorOf("builtin:bleed", {"lights=[{direction = [0, 0, 0]}]"}),
+              "builtin:bleed: lights[0].direction: must not be the zero vector");
+    EXPECT_EQ(errorOf("builtin:bleed", {"lights=[{colour = [1, 1, 1]}]"}), "builtin:bleed: lights[0].colour: unknown key");
+    EXPECT_EQ(errorOf("builtin:bleed", {"lights=[{}, {}, {}, {}, {}]"}), "builtin:bleed: lights: at most 4 lights, got 5");
+    EXPECT_EQ(loadSceneSpec("builtin:bleed", {"lights=[]"}, {}).lights.size(), 0u);
+}
+
+TEST(SceneSpec, FilePathsResolveAgainstTheSpecFolderAndTheAssetsFolder) {
+    TempFolder folder;
+    const auto spec = folder.write("scene.toml", "[model]\nsource = \"head.obj\"\n");
+    const std::string path = spec.string();
+    EXPECT_EQ(errorOf(path, {}), path + ": model.source: file not found: " + (folder.path() / "head.obj").string());
+    folder.write("head.obj", "v 0 0 0\n");
+    EXPECT_EQ(errorOf(path, {}), "");
+    EXPECT_EQ(loadSceneSpec(path, {}, {}).modelSource, (folder.path() / "head.obj").string());
+
+    // "assets:" paths need --assets / $SKINLAB_ASSETS.
+    ::unsetenv("SKINLAB_ASSETS");
+    EXPECT_EQ(errorOf(path, {"textures.albedo=assets:skin.jpg"}),
+              path + ": textures.albedo: 'assets:skin.jpg' needs the assets folder: pass --assets DIR or set SKINLAB_ASSETS");
+    EXPECT_EQ(errorOf(path, {"textures.albedo=assets:skin.jpg"}, folder.path()),
+              path + ": textures.albedo: file not found: " + (folder.path() / "skin.jpg").string());
+    folder.write("skin.jpg", "not really a jpeg: checked when rendering");
+    EXPECT_EQ(loadSceneSpec(path, {"textures.albedo=assets:skin.jpg"}, folder.path()).textures.albedo,
+              folder.path() / "skin.jpg");
+}
+
+TEST(SceneSpec, MalformedTomlNamesFileLineAndColumn) {
+    TempFolder folder;
+    const auto spec = folder.write("broken.toml", "[model]\nsource = \n");
+    const std::string message = errorOf(spec.string(), {});
+    EXPECT_EQ(message.rfind(spec.string() + ":2:", 0), 0u) << message;
+}
+
+TEST(CameraFraming, FocalLengthAndNamedViewDistances) {
+    CameraSpec camera;
+    camera.fovDeg = 30.0;
+    const glm::vec3 lo{-1, -1, -1}, hi{1, 1, 1};
+    const float radius = std::sqrt(3.0f);
+    float previous = 0;
+    for (const char* view : {"close", "mid", "far"}) {
+        camera.view = view;
+        const CameraPose pose = frameCamera(camera, lo, hi, lo, hi, 640, 480);
+        // f_px = (H/2) / tan(fovY/2)
+        EXPECT_NEAR(pose.focalLengthPixels, 240.0f / std::tan(glm::radians(15.0f)), 1e-3f);
+        const float distance = glm::length(pose.position);
+        EXPECT_GT(distance, radius) << view;   // never inside the bounding sphere
+        EXPECT_GT(distance, previous) << view; // close < mid < far
+        previous = distance;
+        EXPECT_LT(pose.nearPlane, distance - radius);
+        EXPECT_GT(pose.farPlane, distance + radius);
+        // The sphere's silhouette fills the documented fraction of the image height.
+        const float fill = std::tan(std::asin(radius / distance)) / std::tan(glm::radians(15.0f));
+        const float expected = std::string(view) == "far" ? 0.4f : std::string(view) == "mid" ? 0.9f : 1.8f;
+        EXPECT_NEAR(fill, expected, 1e-4f) << view;
+    }
+    camera.view = "mid";
+    camera.yawDeg = 90.0;  // orbit to +X
+    const CameraPose side = frameCamera(camera, lo, hi, lo, hi, 100, 100);
+    EXPECT_NEAR(side.position.z, 0.0f, 1e-4f);
+    EXPECT_GT(side.position.x, radius);
+}
+
+} // namespace
+} // namespace skinlab::renderer

@@ -1,0 +1,82 @@
+// `skinlab kernel` through the real executable (label integration): JSON and CSV output, normalised taps, errors
+// word for word with exit code 2.
+#include <array>
+#include <cstdio>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+
+namespace {
+
+struct CliRun {
+    int exitCode;
+    std::string out;
+};
+
+// Runs the CLI with `arguments` (shell words), capturing stdout and stderr together.
+CliRun runCli(const std::string& arguments) {
+    const std::string command = std::string(SKINLAB_CLI) + " " + arguments + " 2>&1";
+    FILE* pipe = popen(command.c_str(), "r");
+    if (!pipe) return {-1, "popen failed"};
+    std::string out;
+    std::array<char, 4096> buffer{};
+    size_t n;
+    while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) out.append(buffer.data(), n);
+    const int status = pclose(pipe);
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+} // namespace
+
+TEST(KernelCli, PrintsNormalisedTapsAsJson) {
+    for (const char* method : {"gaussian-sum", "separable", "artistic"}) {
+        const CliRun run = runCli(std::string("kernel --method ") + method + " --samples 11 --stats");
+        ASSERT_EQ(run.exitCode, 0) << run.out;
+        const auto json = nlohmann::json::parse(run.out);
+        EXPECT_EQ(json["params"]["method"], method);
+        EXPECT_EQ(json["params"]["samples"], 11);
+        ASSERT_FALSE(json["kernel"]["stages"].empty());
+        for (const auto& stage : json["kernel"]["stages"]) {
+            ASSERT_EQ(stage["taps"].size(), 11u);
+            for (int c = 0; c < 3; ++c) {
+                double sum = 0.0;
+                for (const auto& tap : stage["taps"]) sum += tap["weight"][c].get<double>();
+                EXPECT_NEAR(sum, 1.0, 1e-9) << method;  // JSON keeps 17 significant digits
+            }
+        }
+        EXPECT_EQ(json["statistics"]["stages"].size(), json["kernel"]["stages"].size());
+    }
+}
+
+TEST(KernelCli, PrintsCsv) {
+    const CliRun run = runCli("kernel --method artistic --samples 7 --format csv");
+    ASSERT_EQ(run.exitCode, 0) << run.out;
+    std::istringstream lines(run.out);
+    std::string line;
+    std::getline(lines, line);
+    EXPECT_EQ(line, "stage,offset_mm,weight_r,weight_g,weight_b,accumulate_r,accumulate_g,accumulate_b");
+    int rows = 0;
+    while (std::getline(lines, line)) ++rows;
+    EXPECT_EQ(rows, 7);
+    EXPECT_NE(run.out.find("\n0,-2,"), std::string::npos) << run.out;  // RANGE = 2 for N ≤ 20
+}
+
+TEST(KernelCli, BadInputIsOneLineWithExitCode2) {
+    CliRun run = runCli("kernel --method separable --samples 20");
+    EXPECT_EQ(run.exitCode, 2);
+    EXPECT_EQ(run.out,
+              "skinlab: error: command line: sss.samples: 20 is even; a symmetric kernel needs an odd number of taps "
+              "(3…101)\n");
+    run = runCli("kernel --method separable --material marble");
+    EXPECT_EQ(run.exitCode, 2);
+    EXPECT_EQ(run.out, "skinlab: error: command line: sss.material: 'marble' has no d'Eon profile (only 'skin'); use "
+                       "sss.profile = \"burley\"\n");
+    run = runCli("kernel --method separable --profile file:/nonexistent/k.bn");
+    EXPECT_EQ(run.exitCode, 2);
+    EXPECT_EQ(run.out, "skinlab: error: command line: sss.profile: /nonexistent/k.bn: kernel file not found\n");
+    run = runCli("kernel --method separable --set camera.view=close");
+    EXPECT_EQ(run.exitCode, 2);
+    EXPECT_EQ(run.out, "skinlab: error: command line: camera: unknown key\n");
+}

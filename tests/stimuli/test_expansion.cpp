@@ -1,0 +1,374 @@
+// Unit tests of stimulus-set specs: parsing, factorial expansion, exclusions, includes, references, naming,
+// shards, the manifest's JSON/CSV, and every spec-level bad-input message word for word. No GL.
+#include "common/error.h"
+#include "stimuli/expansion.h"
+#include "stimuli/manifest.h"
+#include "stimuli/naming.h"
+#include "stimuli/output_folder.h"
+#include "stimuli/set_spec.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <gtest/gtest.h>
+
+namespace fs = std::filesystem;
+using namespace skinlab::stimuli;
+
+namespace {
+
+const fs::path kSpecFile = "set.toml";  // a name for messages; relative scene paths resolve next to it
+
+SetSpec spec(const std::string& text, const std::vector<std::string>& overrides = {}) {
+    return readSetSpecString(text, kSpecFile, overrides);
+}
+
+std::vector<std::string> ids(const std::vector<Stimulus>& stimuli) {
+    std::vector<std::string> out;
+    for (const auto& s : stimuli) out.push_back(s.id);
+    return out;
+}
+
+// The message of the InputError thrown by f, or "" when nothing is thrown.
+template <class F> std::string errorOf(F&& f) {
+    try {
+        f();
+    } catch (const skinlab::InputError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+const std::string kBase = R"(
+[set]
+name = "demo"
+scene = "builtin:head"
+
+[fixed]
+render = { width = 96, height = 64 }
+
+[[factor]]
+name = "view"
+levels = ["close", "mid"]
+
+[[factor]]
+name = "method"
+levels = ["none", "separable", "gaussian-sum"]
+)";
+
+} // namespace
+
+TEST(StimulusExpansion, FullFactorialInOrderWithDefaultNames) {
+    std::vector<Stimulus> all = expand(spec(kBase));
+    EXPECT_EQ(ids(all), (std::vector<std::string>{"head-close-none", "head-close-separable", "head-close-gaussian-sum",
+                                                  "head-mid-none", "head-mid-separable", "head-mid-gaussian-sum"}));
+    const Stimulus& s = all[4];
+    EXPECT_EQ(s.block, "builtin:head/mid");
+    EXPECT_EQ(s.scene, "builtin:head");
+    EXPECT_FALSE(s.reference);
+    EXPECT_EQ(s.index, 4u);
+    EXPECT_EQ(s.overrides, (std::vector<std::string>{"render.height=64", "render.width=96", "camera.view=\"mid\"",
+                                                     "sss.method=\"separable\""}));
+}
+
+TEST(StimulusExpansion, ExclusionsRemoveMatchingCombinations) {
+    std::vector<Stimulus> all = expand(spec(kBase + R"(
+[[exclude]]
+view = "close"
+method = ["separable", "gaussian-sum"]
+)"));
+    EXPECT_EQ(ids(all), (std::vector<std::string>{"head-close-none", "head-mid-none", "head-mid-separable",
+                                                  "head-mid-gaussian-sum"}));
+}
+
+TEST(StimulusExpansion, NumericAndBooleanLevelsGetReadableLabels) {
+    std::vector<Stimulus> all = expand(spec(R"(
+[set]
+name = "sweep"
+scene = "builtin:head"
+[[factor]]
+name = "sss.samples"
+levels = [5, 25]
+[[factor]]
+name = "sss.follow_surface"
+levels = [true, false]
+[[factor]]
+name = "sss.width_mm"
+levels = [0.5]
+)"));
+    EXPECT_EQ(ids(all), (std::vector<std::string>{"head-samples-5-follow_surface-width_mm-0.5",
+                                                  "head-samples-5-no-follow_surface-width_mm-0.5",
+                                                  "head-samples-25-follow_surface-width_mm-0.5",
+                                                  "head-samples-25-no-follow_surface-width_mm-0.5"}));
+    EXPECT_EQ(all[1].overrides,
+              (std::vector<std::string>{"sss.samples=5", "sss.follow_surface=false", "sss.width_mm=0.5"}));
+    EXPECT_EQ(all[1].block, "builtin:head");  // no view factor and no fixed view: the block is the scene
+}
+
+TEST(StimulusExpansion, NamingTemplateAndLabels) {
+    std::vector<Stimulus> all = expand(spec(R"(
+[set]
+name = "t"
+scene = "builtin:halo"
+id = "{method}_{sss.samples}"
+[[factor]]
+name = "method"
+levels = ["separable", "artistic"]
+labels = ["sep", "art"]
+[[factor]]
+name = "sss.samples"
+levels = [9, 17]
+labels = ["n9", "n17"]
+)"));
+    EXPECT_EQ(ids(all), (std::vector<std::string>{"sep_n9", "sep_n17", "art_n9", "art_n17"}));
+}
+
+TEST(StimulusExpansion, IncludesAndReferencesExpandOverBlockFactors) {
+    std::vector<Stimulus> all = expand(spec(kBase + R"(
+[[factor]]
+name = "sss.samples"
+levels = [11, 21]
+
+[[exclude]]
+method = "none"
+"sss.samples" = 21
+
+[[include]]
+method = "separable"
+sss.samples = 63
+view = "mid"
+
+[[reference]]
+method = "reference"
+)"));
+    // 2 views × (none: 1 + separable: 2 + gaussian-sum: 2) = 10, + 1 include, + 1 reference per view.
+    ASSERT_EQ(all.size(), 13u);
+    EXPECT_EQ(all[10].id, "head-mid-separable-samples-63");
+    EXPECT_EQ(all[10].overrides.back(), "sss.samples=63");
+    EXPECT_FALSE(all[10].reference);
+    EXPECT_EQ(all[11].id, "head-close-reference");
+    EXPECT_EQ(all[12].id, "head-mid-reference");
+    EXPECT_TRUE(all[12].reference);
+    EXPECT_EQ(all[12].block, "builtin:head/mid");
+    // A reference leaves non-block factors (samples) at the scene's default.
+    EXPECT_EQ(all[12].overrides, (std::vector<std::string>{"render.height=64", "render.width=96",
+                                                           "camera.view=\"mid\"", "sss.method=\"reference\""}));
+}
+
+TEST(StimulusExpansion, SceneFactorAndFixedView) {
+    std::vector<Stimulus> all = expand(spec(R"(
+[set]
+name = "scenes"
+[fixed]
+camera.view = "far"
+[[factor]]
+name = "scene"
+levels = ["builtin:halo", "builtin:bleed"]
+[[factor]]
+name = "method"
+levels = ["none"]
+)"));
+    EXPECT_EQ(ids(all), (std::vector<std::string>{"halo-none", "bleed-none"}));
+    EXPECT_EQ(all[1].block, "builtin:bleed/far");
+    EXPECT_EQ(all[1].scene, "builtin:bleed");
+}
+
+TEST(StimulusExpansion, OverridesOfTheSpecApply) {
+    std::vector<Stimulus> all = expand(spec(kBase, {"fixed.render.width=128", "set.name=other"}));
+    EXPECT_EQ(all[0].overrides[1], "render.width=128");
+    EXPECT_NE(spec(kBase).sha256, spec(kBase, {"fixed.render.width=128"}).sha256);
+    EXPECT_EQ(spec(kBase).sha256, spec(kBase).sha256);
+}
+
+TEST(StimulusExpansion, ShardsPartitionTheSetRoundRobin) {
+    std::vector<Stimulus> all = expand(spec(kBase));
+    std::vector<std::string> seen;
+    for (int i = 1; i <= 4; ++i)
+        for (const auto& s : selectShard(all, Shard{i, 4})) {
+            EXPECT_EQ(s.index % 4, static_cast<size_t>(i - 1));
+            seen.push_back(s.id);
+        }
+    std::sort(seen.begin(), seen.end());
+    std::vector<std::string> expected = ids(all);
+    std::sort(expected.begin(), expected.end());
+    EXPECT_EQ(seen, expected);
+    EXPECT_EQ(parseShard("3/8").index, 3);
+    EXPECT_EQ(parseShard("3/8").count, 8);
+    EXPECT_EQ(errorOf([] { parseShard("0/4"); }), "--shard: '0/4': i must be in 1..4");
+    EXPECT_EQ(errorOf([] { parseShard("5/4"); }), "--shard: '5/4': i must be in 1..4");
+    EXPECT_EQ(errorOf([] { parseShard("two"); }), "--shard: 'two' is not of the form i/n (e.g. 2/8)");
+}
+
+TEST(StimulusNaming, LabelsAndValues) {
+    EXPECT_EQ(sceneLabel("builtin:head"), "head");
+    EXPECT_EQ(sceneLabel("../../renderer/scenes/lee-perry-smith.toml"), "lee-perry-smith");
+    EXPECT_EQ(sanitizeLabel("Gaussian Sum/2"), "gaussian-sum-2");
+    EXPECT_TRUE(isIdSafe("head-mid-separable"));
+    EXPECT_FALSE(isIdSafe("../x"));
+    EXPECT_FALSE(isIdSafe("Head"));
+    toml::table t = toml::parse("a = 0.1\nb = \"x\\\"y\"\nc = [1, 2.5]\nd = 3.0");
+    EXPECT_EQ(tomlValueText(*t.get("a")), "0.1");
+    EXPECT_EQ(tomlValueText(*t.get("b")), "\"x\\\"y\"");
+    EXPECT_EQ(tomlValueText(*t.get("c")), "[1, 2.5]");
+    EXPECT_EQ(tomlValueText(*t.get("d")), "3.0");
+}
+
+// Every spec-level bad input, word for word (scene-level ones are in test_stimuli_build.cpp: they need the
+// renderer's resolveScene()).
+struct BadSpec {
+    const char* name;
+    std::string text;
+    std::string message;
+};
+
+class StimulusSpecErrors : public ::testing::TestWithParam<BadSpec> {};
+
+TEST_P(StimulusSpecErrors, OneLineNamingFileAndKey) {
+    const BadSpec& c = GetParam();
+    EXPECT_EQ(errorOf([&] { expand(spec(c.text)); }), c.message);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    AllCases, StimulusSpecErrors,
+    ::testing::Values(
+        BadSpec{"EmptyFactorial", kBase + "[[exclude]]\nview = [\"close\", \"mid\"]\n",
+                "set.toml: exclude: the factorial is empty (every combination is excluded)"},
+        BadSpec{"FactorWithoutLevels", kBase + "[[factor]]\nname = \"sss.samples\"\nlevels = []\n",
+                "set.toml: factor[2].levels: factor 'sss.samples' has no levels"},
+        BadSpec{"ConflictWithFixed", kBase + "[[factor]]\nname = \"render.width\"\nlevels = [64, 128]\n",
+                "set.toml: factor[2].name: 'render.width' conflicts with the fixed parameter fixed.render.width "
+                "(held the same for every stimulus of the set)"},
+        BadSpec{"ExposureNeverVaries", kBase + "[[factor]]\nname = \"render.exposure_ev\"\nlevels = [0, 1]\n",
+                "set.toml: factor[2].name: 'render.exposure_ev' is held fixed across every stimulus set (set "
+                "render.exposure_ev in [fixed]); it cannot vary"},
+        BadSpec{"ToneMapperNeverVaries", kBase + "[[factor]]\nname = \"tone_map.operator\"\nlevels = [\"linear\"]\n",
+                "set.toml: factor[2].name: 'tone_map.operator' is held fixed across every stimulus set (set tone_map "
+                "in [fixed]); it cannot vary"},
+        BadSpec{"IncludeConflictsWithFixed", kBase + "[[include]]\nrender.width = 32\n",
+                "set.toml: include[0].render.width: 'render.width' conflicts with the fixed parameter "
+                "fixed.render.width (held the same for every stimulus of the set)"},
+        BadSpec{"UnknownLevelInExclude", kBase + "[[exclude]]\nmethod = \"separabel\"\n",
+                "set.toml: exclude[0].method: 'separabel' is not a level of factor 'method'"},
+        BadSpec{"ExcludeOfUnknownFactor", kBase + "[[exclude]]\nsss.samples = 3\n",
+                "set.toml: exclude[0].sss.samples: 'sss.samples' is not a factor of this set"},
+        BadSpec{"DuplicateLevel", kBase + "[[factor]]\nname = \"sss.samples\"\nlevels = [5, 5]\n",
+                "set.toml: factor[2].levels[1]: '5' is listed twice"},
+        BadSpec{"SameKeyTwice", kBase + "[[factor]]\nname = \"sss.method\"\nlevels = [\"none\"]\n",
+                "set.toml: factor[2].name: 'sss.method' varies the same scene key as factor 'method'"},
+        BadSpec{"UnknownSpecKey", kBase + "[set2]\nx = 1\n", "set.toml: set2: unknown key"},
+        BadSpec{"UnknownFactorField", kBase + "[[factor]]\nname = \"sss.samples\"\nlevels = [5]\nlevel = 3\n",
+                "set.toml: factor[2].level: unknown key"},
+        BadSpec{"MissingScene", "[set]\nname = \"x\"\n[[factor]]\nname = \"method\"\nlevels = [\"none\"]\n",
+                "set.toml: set.scene: missing (a scene \"builtin:NAME\" or scene spec path, or a [[factor]] named "
+                "scene)"},
+        BadSpec{"MissingSceneFile", "[set]\nname = \"x\"\nscene = \"no-such-scene.toml\"\n",
+                "set.toml: set.scene: scene file 'no-such-scene.toml' not found"},
+        BadSpec{"BadSetName", "[set]\nname = \"My Set\"\nscene = \"builtin:head\"\n",
+                "set.toml: set.name: 'My Set' is not a valid set name (use a-z 0-9 . _ -)"},
+        BadSpec{"UnknownSetKey", kBase + "[set.x]\n",
+                "set.toml: set.x: unknown key"},
+        BadSpec{"IdCollision",
+                "[set]\nname = \"x\"\nscene = \"builtin:head\"\nid = \"{scene}\"\n[[factor]]\nname = \"method\"\n"
+                "levels = [\"none\", \"separable\"]\n",
+                "set.toml: set.id: two different stimuli get the id 'head' (add the missing factors to the id "
+                "template or give distinct labels)"},
+        BadSpec{"TemplateUnknownPlaceholder",
+                "[set]\nname = \"x\"\nscene = \"builtin:head\"\nid = \"{scene}-{metod}\"\n",
+                "set.toml: set.id: placeholder {metod} is not a factor of this set"},
+        BadSpec{"DuplicateInclude", kBase + "[[include]]\nview = \"mid\"\nmethod = \"none\"\n",
+                "set.toml: include[0]: duplicates stimulus 'head-mid-none'"},
+        BadSpec{"LabelCountMismatch", kBase + "[[factor]]\nname = \"sss.samples\"\nlevels = [5, 9]\nlabels = [\"a\"]\n",
+                "set.toml: factor[2].labels: 1 labels for 2 levels"},
+        BadSpec{"SceneTwice", kBase + "[[factor]]\nname = \"scene\"\nlevels = [\"builtin:halo\"]\n",
+                "set.toml: factor[2].name: the scene is both fixed (set.scene) and a factor; keep one"},
+        BadSpec{"TableLevel", kBase + "[[factor]]\nname = \"sss.samples\"\nlevels = [{a = 1}]\n",
+                "set.toml: factor[2].levels[0]: a table is not allowed here"}),
+    [](const ::testing::TestParamInfo<BadSpec>& info) { return std::string(info.param.name); });
+
+TEST(StimulusManifest, JsonRoundTripAndCsv) {
+    SetSpec s = spec(kBase);
+    std::vector<Stimulus> all = expand(s);
+    Manifest m = manifestHeader(s, all, Shard{2, 3});
+    m.renderer = {"llvmpipe", "4.5", "0.1.0"};
+    nlohmann::json entry = {{"id", "head-mid-none"},
+                            {"files", {{"exr", "exr/head-mid-none.exr"}, {"png", "png/head-mid-none.png"}}},
+                            {"sha256", {{"exr", "aa"}, {"png", "bb"}}},
+                            {"factors", {{"scene", "builtin:head"}, {"view", "mid"}, {"method", "none"}}},
+                            {"block", "builtin:head/mid"},
+                            {"reference", false},
+                            {"width", 96},
+                            {"height", 64},
+                            {"timings_ms", {{"stimulus_wall", 12.5}}}};
+    m.stimuli.push_back(entry);
+    nlohmann::json j = toJson(m);
+    EXPECT_EQ(j["format"], "skinlab-stimuli");
+    EXPECT_EQ(j["version"], 1);
+    EXPECT_EQ(j["set"], "demo");
+    EXPECT_EQ(j["spec_sha256"], s.sha256);
+    EXPECT_EQ(j["renderer"]["gl_renderer"], "llvmpipe");
+    EXPECT_EQ(j["set_ids"].size(), 6u);
+    Manifest back = manifestFromJson(j, "m.json");
+    EXPECT_EQ(toJson(back), j);
+    EXPECT_EQ(manifestCsv(m),
+              "id,block,reference,scene,view,method,exr,png,sha256_exr,sha256_png,width,height,wall_ms\n"
+              "head-mid-none,builtin:head/mid,0,builtin:head,mid,none,exr/head-mid-none.exr,png/head-mid-none.png,"
+              "aa,bb,96,64,12.5\n");
+    EXPECT_EQ(errorOf([] { manifestFromJson({{"format", "x"}}, "m.json"); }),
+              "m.json: format: not a skinlab stimulus manifest");
+}
+
+TEST(StimulusOutputFolder, RefusesForeignFolders) {
+    fs::path dir = fs::path(SKINLAB_BINARY_DIR) / "tests-tmp" / "stimuli-folder";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    EXPECT_FALSE(claimOutputFolder(dir, "demo", std::nullopt).has_value());  // empty: fine
+    std::ofstream(dir / "notes.txt") << "mine";
+    EXPECT_EQ(errorOf([&] { claimOutputFolder(dir, "demo", std::nullopt); }),
+              dir.string() + ": is not empty and holds no stimulus set (no manifest.json); choose a new or empty folder");
+    fs::remove(dir / "notes.txt");
+    SetSpec s = spec(kBase);
+    writeManifest(dir, manifestHeader(s, expand(s), std::nullopt));
+    EXPECT_TRUE(claimOutputFolder(dir, "demo", std::nullopt).has_value());
+    EXPECT_EQ(errorOf([&] { claimOutputFolder(dir, "other", std::nullopt); }),
+              dir.string() + ": holds stimulus set 'demo', not 'other'; choose another folder");
+    EXPECT_EQ(errorOf([&] { claimOutputFolder(dir, "demo", Shard{1, 2}); }),
+              dir.string() + ": holds the whole set of set 'demo', not shard 1/2; choose another folder");
+    EXPECT_TRUE(fs::exists(dir / "manifest.json"));  // nothing stored is lost
+}
+
+// The shipped specs parse and expand to the documented counts (docs/stimuli.md). The thesis specs' scene is
+// swapped for builtin:head with a --set override so this runs without the scanned head.
+TEST(ShippedSpecs, ExpandToTheDocumentedCounts) {
+    const fs::path dir = fs::path(SKINLAB_SOURCE_DIR) / "stimuli" / "specs";
+    const std::vector<std::pair<std::string, size_t>> expected = {
+        {"demo.toml", 12},
+        {"thesis-fig5.2-methods.toml", 18},
+        {"thesis-fig3.16-halos.toml", 7},
+        {"thesis-fig3.17-bleeding.toml", 7},
+        {"thesis-fig3.19-curvature.toml", 6},
+        {"thesis-fig5.3-materials.toml", 7},
+        {"thesis-fig5.1-samples.toml", 34}};
+    size_t specs = 0;
+    for (const auto& entry : fs::directory_iterator(dir))
+        if (entry.path().extension() == ".toml") ++specs;
+    EXPECT_EQ(specs, expected.size()) << "a spec was added or removed: update this test and docs/stimuli.md";
+    for (const auto& [file, count] : expected) {
+        std::vector<std::string> overrides;
+        if (file != "demo.toml") overrides.push_back("set.scene=builtin:head");
+        SetSpec s = readSetSpec(dir / file, overrides);
+        std::vector<Stimulus> all = expand(s);
+        EXPECT_EQ(all.size(), count) << file;
+        for (const auto& st : all) {
+            EXPECT_TRUE(isIdSafe(st.id)) << st.id;
+            EXPECT_FALSE(st.block.empty()) << st.id;
+        }
+        // Every thesis figure has its fixed resolution, exposure and tone mapper.
+        std::vector<std::string> fixedKeys;
+        for (const auto& p : s.fixed) fixedKeys.push_back(p.key);
+        for (const char* key : {"render.width", "render.height", "render.exposure_ev", "tone_map.operator"})
+            EXPECT_NE(std::find(fixedKeys.begin(), fixedKeys.end(), key), fixedKeys.end()) << file << " " << key;
+    }
+    std::vector<Stimulus> demo = expand(readSetSpec(dir / "demo.toml"));
+    EXPECT_EQ(demo.front().id, "head-close-none");
+    EXPECT_EQ(demo.back().id, "head-mid-gaussian-sum-no-follow_surface");
+}

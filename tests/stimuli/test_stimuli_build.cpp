@@ -1,0 +1,367 @@
+// End-to-end tests of `skinlab stimuli build|merge` through the real CLI and the real renderer (EGL, llvmpipe
+// without a GPU), at 96×64 so the whole file runs in well under a minute on 2 cores:
+//  - a rebuild of an unchanged set renders nothing and keeps every file and hash;
+//  - a changed level re-renders exactly the stimuli whose resolved parameters changed;
+//  - a build killed (SIGKILL) after its first stimulus leaves no corrupt file under a final name, and the rerun
+//    completes it with the same hashes as an uninterrupted build;
+//  - shards 1/2 + 2/2 merged equal the full build (ids, order, hashes);
+//  - bad input that needs the scene spec (unknown factor key or level, missing asset, folder of another set)
+//    fails with one line before anything is rendered.
+// Skips with a message when no EGL platform works.
+#include "common/hash.h"
+#include "renderer/render_job.h"
+#include "stimuli/manifest.h"
+
+#include <OpenImageIO/imageio.h>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <fcntl.h>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <gtest/gtest.h>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <sys/wait.h>
+#include <thread>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Each test works in its own folder (ctest runs the tests of this file as parallel processes).
+fs::path gRoot = fs::path(SKINLAB_BINARY_DIR) / "tests-tmp" / "stimuli-build";
+
+// 3 views × 2 yaw angles of the built-in head, method none (available in every renderer build), tiny renders.
+// The yaw factor has labels so that changing a level keeps the ids (tests "resolved parameters changed").
+std::string smallSpec(const std::string& name, const std::string& secondYaw = "30.0") {
+    std::ostringstream s;
+    s << "[set]\nname = \"" << name << "\"\nscene = \"builtin:head\"\nseed = 7\n\n"
+      << "[fixed]\nrender = { width = 96, height = 64 }\nshadow = { resolution = 256 }\n"
+      << "sss = { method = \"none\" }\n\n"
+      << "[[factor]]\nname = \"view\"\nlevels = [\"close\", \"mid\", \"far\"]\n\n"
+      << "[[factor]]\nname = \"camera.yaw_deg\"\nlevels = [0.0, " << secondYaw << "]\nlabels = [\"front\", \"side\"]\n";
+    return s.str();
+}
+
+fs::path writeSpec(const std::string& fileName, const std::string& text) {
+    fs::create_directories(gRoot);
+    fs::path path = gRoot / fileName;
+    std::ofstream(path) << text;
+    return path;
+}
+
+struct CliRun {
+    int exitCode = -1;
+    std::string output;  // stdout + stderr
+};
+
+// Runs the skinlab CLI with `args`; output to a file so that large outputs cannot block the child.
+CliRun runCli(const std::vector<std::string>& args, const fs::path& log = gRoot / "cli.log",
+           std::function<void(pid_t)> whileRunning = {}) {
+    fs::create_directories(gRoot);
+    pid_t pid = ::fork();
+    if (pid == 0) {
+        int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        ::dup2(fd, 1);
+        ::dup2(fd, 2);
+        std::vector<char*> argv;
+        std::string cli = SKINLAB_CLI;
+        argv.push_back(cli.data());
+        std::vector<std::string> copy = args;
+        for (auto& a : copy) argv.push_back(a.data());
+        argv.push_back(nullptr);
+        ::execv(cli.c_str(), argv.data());
+        ::_exit(127);
+    }
+    if (whileRunning) whileRunning(pid);
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    CliRun run;
+    run.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    std::ifstream in(log);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    run.output = ss.str();
+    return run;
+}
+
+nlohmann::json manifestOf(const fs::path& dir) {
+    std::ifstream in(dir / "manifest.json");
+    return nlohmann::json::parse(in);
+}
+
+// id → (exr sha256, png sha256), from the manifest, after checking every file against its hash.
+std::map<std::string, std::pair<std::string, std::string>> verifiedHashes(const fs::path& dir) {
+    std::map<std::string, std::pair<std::string, std::string>> out;
+    const nlohmann::json manifest = manifestOf(dir);  // kept alive: a range-for over a temporary's member dangles
+    for (const auto& s : manifest["stimuli"]) {
+        std::string exr = s["sha256"]["exr"], png = s["sha256"]["png"];
+        EXPECT_EQ(skinlab::sha256File(dir / s["files"]["exr"].get<std::string>()), exr) << s["id"];
+        EXPECT_EQ(skinlab::sha256File(dir / s["files"]["png"].get<std::string>()), png) << s["id"];
+        out[s["id"].get<std::string>()] = {exr, png};
+    }
+    return out;
+}
+
+std::vector<std::string> idsOf(const fs::path& dir) {
+    std::vector<std::string> ids;
+    const nlohmann::json manifest = manifestOf(dir);
+    for (const auto& s : manifest["stimuli"]) ids.push_back(s["id"]);
+    return ids;
+}
+
+class StimuliBuild : public ::testing::Test {
+protected:
+    static void SetUpTestSuite() {
+        try {
+            skinlab::renderer::Renderer renderer;
+            available_ = true;
+        } catch (const std::exception& e) {
+            reason_ = e.what();
+        }
+    }
+    void SetUp() override {
+        if (!available_) GTEST_SKIP() << "no EGL/OpenGL 4.5 renderer available: " << reason_;
+        gRoot = fs::path(SKINLAB_BINARY_DIR) / "tests-tmp" / "stimuli-build" /
+                ::testing::UnitTest::GetInstance()->current_test_info()->name();
+        fs::remove_all(gRoot);
+        fs::create_directories(gRoot);
+    }
+
+    // The uninterrupted full build the other builds are compared with (built once per test).
+    const fs::path& fullBuild() {
+        if (full_.empty()) {
+            fs::path d = gRoot / "full";
+            CliRun run = runCli({"stimuli", "build", writeSpec("small.toml", smallSpec("small")).string(), "-o", d.string()});
+            EXPECT_EQ(run.exitCode, 0) << run.output;
+            full_ = d;
+        }
+        return full_;
+    }
+    fs::path full_;
+
+    static inline bool available_ = false;
+    static inline std::string reason_;
+};
+
+TEST_F(StimuliBuild, FullBuildDescribesEveryImage) {
+    const fs::path& dir = fullBuild();
+    nlohmann::json m = manifestOf(dir);
+    EXPECT_EQ(m["format"], "skinlab-stimuli");
+    EXPECT_EQ(m["version"], 1);
+    EXPECT_EQ(m["set"], "small");
+    EXPECT_EQ(m["seed"], 7);
+    EXPECT_TRUE(m["complete"].get<bool>());
+    EXPECT_FALSE(m["renderer"]["gl_renderer"].get<std::string>().empty());
+    ASSERT_EQ(m["stimuli"].size(), 6u);
+    const auto& s = m["stimuli"][3];
+    EXPECT_EQ(s["id"], "head-mid-side");
+    EXPECT_EQ(s["block"], "builtin:head/mid");
+    EXPECT_EQ(s["factors"]["view"], "mid");
+    EXPECT_EQ(s["factors"]["camera.yaw_deg"], "30.0");
+    EXPECT_EQ(s["width"], 96);
+    EXPECT_EQ(s["height"], 64);
+    EXPECT_FALSE(s["reference"].get<bool>());
+    EXPECT_TRUE(s["resolved"].is_object());
+    EXPECT_TRUE(s["timings_ms"].contains("stimulus_wall"));
+    verifiedHashes(dir);
+    // The EXR is a real image of the requested size.
+    auto input = OIIO::ImageInput::open((dir / "exr/head-mid-side.exr").string());
+    ASSERT_TRUE(input);
+    EXPECT_EQ(input->spec().width, 96);
+    EXPECT_EQ(input->spec().height, 64);
+    // CSV view and contact sheet.
+    std::ifstream csv(dir / "manifest.csv");
+    std::string header;
+    std::getline(csv, header);
+    EXPECT_EQ(header, "id,block,reference,scene,view,camera.yaw_deg,exr,png,sha256_exr,sha256_png,width,height,wall_ms");
+    EXPECT_TRUE(fs::exists(dir / "contact.html"));
+    auto sheet = OIIO::ImageInput::open((dir / "contact.png").string());
+    ASSERT_TRUE(sheet);
+    EXPECT_GT(sheet->spec().width, 2 * 96);
+}
+
+TEST_F(StimuliBuild, RebuildOfUnchangedSetRendersNothing) {
+    fs::path dir = gRoot / "rebuild";
+    fs::remove_all(dir);
+    fs::copy(fullBuild(), dir, fs::copy_options::recursive);
+    auto before = verifiedHashes(dir);
+    auto mtime = fs::last_write_time(dir / "exr/head-far-front.exr");
+    CliRun run = runCli({"stimuli", "build", (gRoot / "small.toml").string(), "-o", dir.string()});
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    EXPECT_NE(run.output.find("stimuli: 6 stimuli (0 rendered, 6 unchanged)"), std::string::npos) << run.output;
+    EXPECT_EQ(verifiedHashes(dir), before);
+    EXPECT_EQ(fs::last_write_time(dir / "exr/head-far-front.exr"), mtime);
+
+    // Changing one level re-renders exactly the stimuli whose resolved parameters changed (same ids).
+    fs::path changed = writeSpec("small-changed.toml", smallSpec("small", "45.0"));
+    run = runCli({"stimuli", "build", changed.string(), "-o", dir.string()});
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    EXPECT_NE(run.output.find("stimuli: 6 stimuli (3 rendered, 3 unchanged)"), std::string::npos) << run.output;
+    auto after = verifiedHashes(dir);
+    EXPECT_EQ(after["head-mid-front"], before["head-mid-front"]);
+    EXPECT_NE(after["head-mid-side"].first, before["head-mid-side"].first);
+    EXPECT_EQ(manifestOf(dir)["stimuli"][3]["factors"]["camera.yaw_deg"], "45.0");
+}
+
+TEST_F(StimuliBuild, KilledBuildResumesToTheSameHashes) {
+    const fs::path& full = fullBuild();
+    fs::path dir = gRoot / "killed";
+    fs::remove_all(dir);
+    size_t doneAtKill = 0;
+    CliRun killed = runCli({"stimuli", "build", (gRoot / "small.toml").string(), "-o", dir.string()}, gRoot / "killed.log",
+                        [&](pid_t pid) {
+                            // Kill as soon as the manifest records the first stimulus.
+                            auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+                            while (std::chrono::steady_clock::now() < deadline) {
+                                if (fs::exists(dir / "manifest.json")) {
+                                    try {
+                                        doneAtKill = manifestOf(dir)["stimuli"].size();
+                                    } catch (const std::exception&) {
+                                    }
+                                    if (doneAtKill >= 1) break;
+                                }
+                                std::this_thread::sleep_for(std::chrono::milliseconds(2));
+                            }
+                            ::kill(pid, SIGKILL);
+                        });
+    ASSERT_EQ(killed.exitCode, 128 + SIGKILL) << killed.output;
+    nlohmann::json partial = manifestOf(dir);
+    ASSERT_LT(partial["stimuli"].size(), 6u) << "the build finished before it could be killed";
+    EXPECT_FALSE(partial["complete"].get<bool>());
+    // Every file under a final name is complete: listed ones match their hash, the others are readable images.
+    verifiedHashes(dir);
+    for (const char* sub : {"exr", "png"})
+        for (const auto& entry : fs::directory_iterator(dir / sub)) {
+            std::string name = entry.path().filename().string();
+            if (name.front() == '.') continue;  // a temporary name; the rerun removes it
+            auto input = OIIO::ImageInput::open(entry.path().string());
+            EXPECT_TRUE(input) << name << " is corrupt";
+        }
+
+    CliRun rerun = runCli({"stimuli", "build", (gRoot / "small.toml").string(), "-o", dir.string()});
+    ASSERT_EQ(rerun.exitCode, 0) << rerun.output;
+    EXPECT_EQ(idsOf(dir), idsOf(full));
+    EXPECT_EQ(verifiedHashes(dir), verifiedHashes(full));
+    for (const auto& entry : fs::directory_iterator(dir / "exr"))
+        EXPECT_NE(entry.path().filename().string().front(), '.') << "temporary file left: " << entry.path();
+}
+
+TEST_F(StimuliBuild, MergedShardsEqualTheFullBuild) {
+    const fs::path& full = fullBuild();
+    std::vector<std::string> shards;
+    for (int i = 1; i <= 2; ++i) {
+        fs::path dir = gRoot / ("shard" + std::to_string(i));
+        fs::remove_all(dir);
+        CliRun run = runCli({"stimuli", "build", (gRoot / "small.toml").string(), "-o", dir.string(), "--shard",
+                          std::to_string(i) + "/2", "--no-contact-sheet"});
+        ASSERT_EQ(run.exitCode, 0) << run.output;
+        EXPECT_EQ(manifestOf(dir)["stimuli"].size(), 3u);
+        shards.push_back(dir.string());
+    }
+    fs::path merged = gRoot / "merged";
+    fs::remove_all(merged);
+    // A missing shard is refused before anything is written.
+    CliRun incomplete = runCli({"stimuli", "merge", shards[0], "-o", merged.string()});
+    EXPECT_EQ(incomplete.exitCode, 2);
+    EXPECT_EQ(incomplete.output, "skinlab: error: merge: shard 2/2 of set 'small' is missing\n");
+    EXPECT_FALSE(fs::exists(merged));
+
+    CliRun run = runCli({"stimuli", "merge", shards[1], shards[0], "-o", merged.string()});
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    EXPECT_EQ(idsOf(merged), idsOf(full));
+    EXPECT_EQ(verifiedHashes(merged), verifiedHashes(full));
+    nlohmann::json m = manifestOf(merged), f = manifestOf(full);
+    EXPECT_FALSE(m.contains("shard"));
+    EXPECT_TRUE(m["complete"].get<bool>());
+    for (const char* key : {"set", "spec_sha256", "renderer", "fixed", "factors", "set_ids", "seed"})
+        EXPECT_EQ(m[key], f[key]) << key;
+    for (size_t i = 0; i < f["stimuli"].size(); ++i) {
+        nlohmann::json a = m["stimuli"][i], b = f["stimuli"][i];
+        a.erase("timings_ms");
+        b.erase("timings_ms");
+        EXPECT_EQ(a, b) << i;
+    }
+    EXPECT_TRUE(fs::exists(merged / "contact.png"));
+}
+
+TEST_F(StimuliBuild, ParallelJobsGiveTheSameFiles) {
+    const fs::path& full = fullBuild();
+    fs::path dir = gRoot / "jobs2";
+    fs::remove_all(dir);
+    CliRun run = runCli({"stimuli", "build", (gRoot / "small.toml").string(), "-o", dir.string(), "--jobs", "2"});
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    EXPECT_EQ(idsOf(dir), idsOf(full));
+    EXPECT_EQ(verifiedHashes(dir), verifiedHashes(full));
+}
+
+// Bad input that needs the renderer's scene spec: one line, exit 2, nothing rendered, nothing stored lost.
+TEST_F(StimuliBuild, BadInputFailsBeforeRendering) {
+    fs::path out = gRoot / "bad-out";
+    fs::remove_all(out);
+    auto build = [&](const std::string& specText, const fs::path& dir) {
+        fs::path spec = writeSpec("bad.toml", specText);
+        return runCli({"stimuli", "build", spec.string(), "-o", dir.string()});
+    };
+    const std::string spec = (gRoot / "bad.toml").string();
+
+    // Unknown factor key: the scene spec does not know it.
+    CliRun r = build(smallSpec("bad") + "[[factor]]\nname = \"sss.no_such_key\"\nlevels = [1]\n", out);
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_EQ(r.output, "skinlab: error: " + spec + ": factor 'sss.no_such_key': level '1': builtin:head: "
+                        "sss.no_such_key: unknown key\n");
+    EXPECT_FALSE(fs::exists(out));
+
+    // Unknown level of a known factor.
+    r = build(smallSpec("bad") + "[[factor]]\nname = \"sss.profile\"\nlevels = [\"no-such-profile\"]\n", out);
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_EQ(r.output, "skinlab: error: " + spec + ": factor 'sss.profile': level 'no-such-profile': builtin:head: "
+                        "sss.profile: 'no-such-profile' is not one of: deon, burley, file:PATH\n");
+    EXPECT_FALSE(fs::exists(out));
+
+    // Unknown level of the view (its allowed values are fixed by the scene spec).
+    r = build(smallSpec("bad") + "[[include]]\nview = \"overhead\"\n", out);
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_EQ(r.output, "skinlab: error: " + spec + ": stimulus 'head-overhead': builtin:head: camera.view: "
+                        "'overhead' is not one of: close, mid, far, explicit\n");
+    EXPECT_FALSE(fs::exists(out));
+
+    // Missing asset: a scene spec whose model file is absent, named in the message.
+    fs::path scene = writeSpec("missing-asset.toml", "[model]\nsource = \"no-such-head.glb\"\n");
+    std::string text = smallSpec("bad");
+    text.replace(text.find("builtin:head"), 12, scene.filename().string());
+    r = build(text, out);
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_EQ(r.output, "skinlab: error: " + spec + ": scene 'missing-asset.toml': " + scene.string() +
+                            ": model.source: file not found: " + (gRoot / "no-such-head.glb").string() + "\n");
+    EXPECT_FALSE(fs::exists(out));
+
+    // A folder holding another set: refused, and the other set's files are untouched.
+    fs::path other = gRoot / "other-set";
+    fs::remove_all(other);
+    fs::copy(fullBuild(), other, fs::copy_options::recursive);
+    auto before = verifiedHashes(other);
+    r = build(smallSpec("another"), other);
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_EQ(r.output, "skinlab: error: " + other.string() +
+                            ": holds stimulus set 'small', not 'another'; choose another folder\n");
+    EXPECT_EQ(verifiedHashes(other), before);
+    EXPECT_EQ(manifestOf(other)["set"], "small");
+
+    // A shard folder reused for the whole set.
+    fs::path shard = gRoot / "shard1";
+    r = runCli({"stimuli", "build", (gRoot / "small.toml").string(), "-o", shard.string(), "--shard", "1/2"});
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    auto shardHashes = verifiedHashes(shard);
+    r = runCli({"stimuli", "build", (gRoot / "small.toml").string(), "-o", shard.string()});
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_EQ(r.output, "skinlab: error: " + shard.string() +
+                            ": holds shard 1/2 of set 'small', not the whole set; choose another folder\n");
+    EXPECT_EQ(verifiedHashes(shard), shardHashes);
+}
+
+} // namespace
