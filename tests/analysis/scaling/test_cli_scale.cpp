@@ -20,14 +20,14 @@ fs::path scratch() {
     return folder;
 }
 
-struct Run {
+struct CliRun {
     int exitCode = -1;
     std::string output;  // stdout and stderr
 };
 
-Run run(const std::string& arguments) {
+CliRun run(const std::string& arguments) {
     const std::string command = std::string(SKINLAB_CLI) + " " + arguments + " 2>&1";
-    Run result;
+    CliRun result;
     FILE* pipe = popen(command.c_str(), "r");
     char buffer[4096];
     while (size_t n = fread(buffer, 1, sizeof buffer, pipe)) result.output.append(buffer, n);
@@ -70,7 +70,7 @@ TEST(CliScale, WritesEveryOutput) {
     std::ofstream(input) << simulatedCsv();
     const fs::path output = scratch() / "out";
     fs::remove_all(output);
-    const Run result = run("analyze scale " + input.string() + " -o " + output.string() + " --bootstrap 300");
+    const CliRun result = run("analyze scale " + input.string() + " -o " + output.string() + " --bootstrap 300");
     ASSERT_EQ(result.exitCode, 0) << result.output;
     for (const char* file : {"scale.json", "scores.csv", "pairs.csv", "observers.csv", "consistency.csv", "counts.csv",
                              "report_section.html"})
@@ -101,7 +101,7 @@ TEST(CliScale, BadInputExitsTwoWithOneLine) {
     std::ofstream(input) << "condition,a,b\na,0,-1\nb,3,0\n";
     const fs::path output = scratch() / "bad-out";
     fs::remove_all(output);
-    const Run result = run("analyze scale " + input.string() + " -o " + output.string());
+    const CliRun result = run("analyze scale " + input.string() + " -o " + output.string());
     EXPECT_EQ(result.exitCode, 2);
     EXPECT_EQ(result.output, "skinlab: error: " + input.string() + ": line 2: column b: negative count -1\n");
     EXPECT_FALSE(fs::exists(output / "scale.json"));
@@ -111,7 +111,7 @@ TEST(CliScale, CountMatrixOracle) {
     const fs::path input = scratch() / "oracle.csv";
     std::ofstream(input) << "condition,A,B,C\nA,0,25,0\nB,75,0,25\nC,0,75,0\n";
     const fs::path output = scratch() / "oracle-out";
-    const Run result = run("analyze scale " + input.string() + " -o " + output.string());
+    const CliRun result = run("analyze scale " + input.string() + " -o " + output.string());
     ASSERT_EQ(result.exitCode, 0) << result.output;
     std::ifstream stream(output / "scale.json");
     const nlohmann::json json = nlohmann::json::parse(stream);
@@ -123,7 +123,7 @@ TEST(CliScale, CountMatrixOracle) {
 
 TEST(CliValidate, SmallRunMeetsTheScreeningTargets) {
     const fs::path output = scratch() / "validate";
-    const Run result = run("analyze validate --experiments 20 --observers 20 --bootstrap 200 --scenarios screening -o " +
+    const CliRun result = run("analyze validate --experiments 20 --observers 20 --bootstrap 200 --scenarios screening -o " +
                            output.string());
     ASSERT_EQ(result.exitCode, 0) << result.output;
     std::ifstream stream(output / "validation.json");

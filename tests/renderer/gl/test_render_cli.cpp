@@ -11,7 +11,7 @@
 namespace skinlab::renderer {
 namespace {
 
-struct Run {
+struct CliRun {
     int exitCode = -1;
     std::string out;
     std::string err;
@@ -23,14 +23,14 @@ std::string quote(const std::string& s) {
     return q + "'";
 }
 
-Run runCli(const std::vector<std::string>& arguments, const test::TempFolder& folder, const std::string& environment = "") {
+CliRun runCli(const std::vector<std::string>& arguments, const test::TempFolder& folder, const std::string& environment = "") {
     std::string command = environment + " " + quote(SKINLAB_CLI);
     for (const auto& a : arguments) command += " " + quote(a);
     const auto outPath = folder.path().parent_path() / (folder.path().filename().string() + ".stdout");
     const auto errPath = folder.path().parent_path() / (folder.path().filename().string() + ".stderr");
     command += " > " + quote(outPath.string()) + " 2> " + quote(errPath.string());
     const int status = std::system(command.c_str());
-    Run run;
+    CliRun run;
     run.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     run.out = test::readText(outPath);
     run.err = test::readText(errPath);
@@ -41,7 +41,7 @@ Run runCli(const std::vector<std::string>& arguments, const test::TempFolder& fo
 
 // The error line of a failed run: stderr holds exactly one line starting "skinlab: error: " (log lines of
 // spdlog start with "[").
-std::string errorLine(const Run& run) {
+std::string errorLine(const CliRun& run) {
     std::string line;
     int lines = 0;
     std::istringstream in(run.err);
@@ -70,7 +70,7 @@ protected:
 
 TEST_F(RenderCli, RendersExrPngAndTimings) {
     if (!eglAvailable()) GTEST_SKIP() << "no EGL: " << test::rendererFailure();
-    const Run run = runCli({"render", "--scene", "builtin:ear", "--width", "64", "--height", "40", "-o",
+    const CliRun run = runCli({"render", "--scene", "builtin:ear", "--width", "64", "--height", "40", "-o",
                             (out / "ear.exr").string(), "--png", (out / "ear.png").string(), "--timings",
                             (out / "t.json").string()},
                            folder);
@@ -88,7 +88,7 @@ TEST_F(RenderCli, RendersExrPngAndTimings) {
 }
 
 TEST_F(RenderCli, UnknownBuiltinScene) {
-    const Run run = runCli({"render", "--scene", "builtin:torso", "-o", (out / "x.exr").string()}, folder);
+    const CliRun run = runCli({"render", "--scene", "builtin:torso", "-o", (out / "x.exr").string()}, folder);
     EXPECT_EQ(run.exitCode, 2);
     EXPECT_EQ(errorLine(run), "skinlab: error: unknown built-in scene 'builtin:torso' (known: builtin:halo, "
                               "builtin:bleed, builtin:ear, builtin:head)");
@@ -96,7 +96,7 @@ TEST_F(RenderCli, UnknownBuiltinScene) {
 }
 
 TEST_F(RenderCli, BadSpecValueThroughSet) {
-    const Run run = runCli({"render", "--scene", "builtin:head", "--set", "camera.fov_deg=500", "-o", (out / "x.exr").string()}, folder);
+    const CliRun run = runCli({"render", "--scene", "builtin:head", "--set", "camera.fov_deg=500", "-o", (out / "x.exr").string()}, folder);
     EXPECT_EQ(run.exitCode, 2);
     EXPECT_EQ(errorLine(run), "skinlab: error: builtin:head: camera.fov_deg: 500 is out of range [1, 179]");
     EXPECT_TRUE(folderIsEmpty(out.path()));
@@ -104,7 +104,7 @@ TEST_F(RenderCli, BadSpecValueThroughSet) {
 
 TEST_F(RenderCli, UnknownKeyInSpecFile) {
     const auto spec = sceneWith("[model]\nsource = \"builtin:halo\"\n[camera]\nfov = 20\n");
-    const Run run = runCli({"render", "--scene", spec.string(), "-o", (out / "x.exr").string()}, folder);
+    const CliRun run = runCli({"render", "--scene", spec.string(), "-o", (out / "x.exr").string()}, folder);
     EXPECT_EQ(run.exitCode, 2);
     EXPECT_EQ(errorLine(run), "skinlab: error: " + spec.string() + ": camera.fov: unknown key");
     EXPECT_TRUE(folderIsEmpty(out.path()));
@@ -112,7 +112,7 @@ TEST_F(RenderCli, UnknownKeyInSpecFile) {
 
 TEST_F(RenderCli, MissingModelFile) {
     const auto spec = sceneWith("[model]\nsource = \"missing.glb\"\n");
-    const Run run = runCli({"render", "--scene", spec.string(), "-o", (out / "x.exr").string()}, folder);
+    const CliRun run = runCli({"render", "--scene", spec.string(), "-o", (out / "x.exr").string()}, folder);
     EXPECT_EQ(run.exitCode, 2);
     EXPECT_EQ(errorLine(run), "skinlab: error: " + spec.string() + ": model.source: file not found: " +
                                   (folder / "missing.glb").string());
@@ -137,7 +137,7 @@ TEST_F(RenderCli, CorruptModelTextureAndEnvironment) {
     };
     for (const Case& c : cases) {
         const auto spec = sceneWith(c.body);
-        const Run run = runCli({"render", "--scene", spec.string(), "-o", (out / "x.exr").string(), "--png",
+        const CliRun run = runCli({"render", "--scene", spec.string(), "-o", (out / "x.exr").string(), "--png",
                                 (out / "x.png").string()},
                                folder);
         EXPECT_EQ(run.exitCode, 2) << c.body << run.err;
@@ -150,7 +150,7 @@ TEST_F(RenderCli, CorruptModelTextureAndEnvironment) {
 TEST_F(RenderCli, UnwritableOutput) {
     write("a-file", "x");
     const std::string target = (folder / "a-file" / "out.exr").string();
-    const Run run = runCli({"render", "--scene", "builtin:halo", "-o", target}, folder);
+    const CliRun run = runCli({"render", "--scene", "builtin:halo", "-o", target}, folder);
     EXPECT_EQ(run.exitCode, 2);
     EXPECT_EQ(errorLine(run), "skinlab: error: " + target + ": cannot write -o output (folder " +
                                   (folder / "a-file").string() + " does not exist)");
@@ -160,7 +160,7 @@ TEST_F(RenderCli, UnwritableOutputDetectedWhileWritingLeavesNoFile) {
     if (!eglAvailable()) GTEST_SKIP() << "no EGL: " << test::rendererFailure();
     // The EXR's folder exists but the final name is a folder: rename fails after rendering; nothing remains.
     std::filesystem::create_directories(out / "taken.exr");
-    const Run run = runCli({"render", "--scene", "builtin:halo", "--width", "32", "--height", "32", "-o",
+    const CliRun run = runCli({"render", "--scene", "builtin:halo", "--width", "32", "--height", "32", "-o",
                             (out / "taken.exr").string()},
                            folder);
     EXPECT_NE(run.exitCode, 0);
@@ -171,7 +171,7 @@ TEST_F(RenderCli, UnwritableOutputDetectedWhileWritingLeavesNoFile) {
 }
 
 TEST_F(RenderCli, UnknownMethod) {
-    const Run run = runCli({"render", "--scene", "builtin:halo", "--method", "magic", "-o", (out / "x.exr").string()}, folder);
+    const CliRun run = runCli({"render", "--scene", "builtin:halo", "--method", "magic", "-o", (out / "x.exr").string()}, folder);
     EXPECT_EQ(run.exitCode, 2);
     EXPECT_EQ(errorLine(run).rfind("skinlab: error: builtin:halo: sss.method: 'magic' is not one of:", 0), 0u)
         << errorLine(run);
@@ -194,7 +194,7 @@ TEST_F(RenderCli, ShaderFolderOverrideAndShaderErrorsNameTheFile) {
     EXPECT_EQ(test::readText(out / "embedded.exr"), test::readText(out / "folder.exr"));
     // ... and a broken one fails with the file name and the driver's info log (exit 1: not the user's input).
     std::ofstream(shaders / "add_specular.frag", std::ios::app) << "\nthis is not GLSL\n";
-    const Run run = runCli(withOutput("broken.exr"), folder, "SKINLAB_SHADER_DIR=" + quote(shaders.string()));
+    const CliRun run = runCli(withOutput("broken.exr"), folder, "SKINLAB_SHADER_DIR=" + quote(shaders.string()));
     EXPECT_EQ(run.exitCode, 1);
     EXPECT_NE(run.err.find("skinlab: failure: shader add_specular.frag: compile failed: "), std::string::npos) << run.err;
     EXPECT_FALSE(std::filesystem::exists(out / "broken.exr"));
