@@ -1,6 +1,7 @@
 #include "stimuli/contact_sheet.h"
 
 #include "common/error.h"
+#include "common/html.h"
 #include "common/files.h"
 
 #include <OpenImageIO/imagebuf.h>
@@ -14,19 +15,6 @@ namespace skinlab::stimuli {
 
 namespace fs = std::filesystem;
 
-std::string escapeHtml(std::string_view text) {
-    std::string out;
-    for (char c : text) {
-        switch (c) {
-        case '&': out += "&amp;"; break;
-        case '<': out += "&lt;"; break;
-        case '>': out += "&gt;"; break;
-        case '"': out += "&quot;"; break;
-        default: out += c;
-        }
-    }
-    return out;
-}
 
 namespace {
 

@@ -17,7 +17,4 @@ struct ContactSheetFiles {
 ContactSheetFiles writeContactSheet(const std::filesystem::path& dir, const Manifest& manifest,
                                     int thumbnailWidth = 256);
 
-// "&lt;" etc. for text inside HTML.
-std::string escapeHtml(std::string_view text);
-
 } // namespace skinlab::stimuli

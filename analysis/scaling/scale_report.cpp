@@ -1,5 +1,7 @@
 #include "analysis/scaling/scale_report.h"
 
+#include "common/html.h"
+
 #include "analysis/scaling/csv_reader.h"
 #include "analysis/scaling/plots.h"
 #include "common/files.h"
@@ -28,19 +30,6 @@ std::string fixed(double value, int decimals) {
 
 nlohmann::json finite(double value) { return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(); }
 
-std::string escapeHtml(const std::string& text) {
-    std::string out;
-    for (char c : text) {
-        switch (c) {
-        case '&': out += "&amp;"; break;
-        case '<': out += "&lt;"; break;
-        case '>': out += "&gt;"; break;
-        case '"': out += "&quot;"; break;
-        default: out += c;
-        }
-    }
-    return out;
-}
 
 std::string base64(const std::string& bytes) {
     static const char* alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
