@@ -284,6 +284,8 @@ RenderResult Renderer::render(const RenderRequest& request) {
     sssInputs.skinMask = impl.targets.mask.get();
     sssInputs.normal = impl.targets.normal.get();
     sssInputs.geometricNormal = impl.targets.geometricNormal.get();
+    sssInputs.aux = impl.targets.aux.get();
+    sssInputs.curvature = impl.targets.curvature.get();
     sssInputs.width = spec.width;
     sssInputs.height = spec.height;
     sssInputs.focalLengthPixels = camera.focalLengthPixels;
@@ -326,6 +328,9 @@ RenderResult Renderer::render(const RenderRequest& request) {
     const std::vector<float> normal = read(impl.targets.normal.get(), 4);
     const std::vector<float> geometricNormal = read(impl.targets.geometricNormal.get(), 4);
     const std::vector<float> mask = read(impl.targets.mask.get(), 1);
+    const std::vector<float> transmittance = read(impl.targets.transmittance.get(), 4);
+    const std::vector<float> aux = read(impl.targets.aux.get(), 1);
+    const std::vector<float> curvature = read(impl.targets.curvature.get(), 1);
     std::vector<float> display;
     if (!request.pngPath.empty()) {
         const std::vector<float> displayRgba = read(impl.targets.display.get(), 4);
@@ -354,6 +359,9 @@ RenderResult Renderer::render(const RenderRequest& request) {
     addChannels("normal", normal, 4, "XYZ");
     addChannels("geonormal", geometricNormal, 4, "XYZ");
     addChannels("mask", mask, 1, "Y");
+    addChannels("transmittance", transmittance, 4, "RGB");
+    addChannels("aux", aux, 1, "Y");
+    addChannels("curvature", curvature, 1, "Y");
 
     const nlohmann::json cameraJson = {{"position", jsonVec3(camera.position)},
                                        {"target", jsonVec3(camera.target)},

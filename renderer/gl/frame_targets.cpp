@@ -17,13 +17,16 @@ void FrameTargets::resize(int newWidth, int newHeight) {
     normal = createTexture2D(GL_RGBA32F, width, height);
     geometricNormal = createTexture2D(GL_RGBA32F, width, height);
     mask = createTexture2D(GL_R32F, width, height);
+    transmittance = createTexture2D(GL_RGBA32F, width, height);
+    aux = createTexture2D(GL_R32F, width, height);
+    curvature = createTexture2D(GL_R32F, width, height);
     depthBuffer = createTexture2D(GL_DEPTH_COMPONENT32F, width, height);
     scatteredDiffuse = createTexture2D(GL_RGBA32F, width, height);
     beauty = createTexture2D(GL_RGBA32F, width, height);
     display = createTexture2D(GL_RGBA32F, width, height);
     const GLuint mainColours[] = {diffuse.get(), specular.get(), albedo.get(), linearDepth.get(),
-                                  normal.get(),  geometricNormal.get(), mask.get()};
-    mainFramebuffer = createFramebuffer("main pass", mainColours, 7, depthBuffer.get());
+                                  normal.get(),  geometricNormal.get(), mask.get(), transmittance.get()};
+    mainFramebuffer = createFramebuffer("main pass", mainColours, 8, depthBuffer.get());
     const GLuint backgroundColours[] = {diffuse.get()};
     backgroundFramebuffer = createFramebuffer("background pass", backgroundColours, 1, depthBuffer.get());
     const GLuint beautyColours[] = {beauty.get()};
@@ -36,8 +39,10 @@ void FrameTargets::clear() {
     const float zero[4] = {0, 0, 0, 0};
     const float infinite[4] = {std::numeric_limits<float>::infinity(), 0, 0, 0};
     const float far = 1.0f;
-    for (GLint i = 0; i < 7; ++i)
+    for (GLint i = 0; i < 8; ++i)
         glClearNamedFramebufferfv(mainFramebuffer.get(), GL_COLOR, i, i == 3 ? infinite : zero);
+    glClearTexImage(aux.get(), 0, GL_RED, GL_FLOAT, zero);
+    glClearTexImage(curvature.get(), 0, GL_RED, GL_FLOAT, zero);
     glClearNamedFramebufferfv(mainFramebuffer.get(), GL_DEPTH, 0, &far);
     checkGl("clearing the frame");
 }

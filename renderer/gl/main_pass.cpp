@@ -4,17 +4,7 @@
 
 namespace skinlab::renderer::gl {
 
-void MainPass::run(FrameTargets& targets, const GpuScene& scene, GLuint shadowMaps, const MainPassSettings& settings) {
-    targets.clear();
-    const GLuint program = shaders_.program("main_pass.vert", "main_pass.frag");
-    glUseProgram(program);
-    glBindFramebuffer(GL_FRAMEBUFFER, targets.mainFramebuffer.get());
-    glViewport(0, 0, targets.width, targets.height);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    glDepthMask(GL_TRUE);
-    glDisable(GL_CULL_FACE);  // thin and open surfaces (backdrop, fin) are seen from both sides
-
+void MainPass::bindShading(GLuint program, const GpuScene& scene, GLuint shadowMaps, const MainPassSettings& settings) {
     setUniform(program, "view", settings.camera.view);
     setUniform(program, "projection", settings.camera.projection);
     setUniform(program, "cameraPosition", settings.camera.position);
@@ -50,15 +40,39 @@ void MainPass::run(FrameTargets& targets, const GpuScene& scene, GLuint shadowMa
         setUniform(program, flags[unit], maps[unit] ? 1 : 0);
     }
     glBindTextureUnit(5, shadowMaps);
+}
 
+void MainPass::unbindShading() {
+    for (GLuint unit = 0; unit < 8; ++unit) {
+        glBindTextureUnit(unit, 0);
+        glBindSampler(unit, 0);
+    }
+}
+
+void MainPass::setMaterial(GLuint program, const GpuMaterial& material) {
+    setUniform(program, "materialAlbedo", material.albedo);
+    setUniform(program, "materialSkin", material.skin);
+    setUniform(program, "glossiness", material.glossiness);
+    setUniform(program, "specularIntensity", material.specularIntensity);
+}
+
+void MainPass::run(FrameTargets& targets, const GpuScene& scene, GLuint shadowMaps, const MainPassSettings& settings) {
+    targets.clear();
+    const GLuint program = shaders_.program("main_pass.vert", "main_pass.frag");
+    glUseProgram(program);
+    glBindFramebuffer(GL_FRAMEBUFFER, targets.mainFramebuffer.get());
+    glViewport(0, 0, targets.width, targets.height);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_CULL_FACE);  // thin and open surfaces (backdrop, fin) are seen from both sides
+
+    bindShading(program, scene, shadowMaps, settings);
     for (const GpuPart& part : scene.parts()) {
-        setUniform(program, "materialAlbedo", part.material.albedo);
-        setUniform(program, "materialSkin", part.material.skin);
-        setUniform(program, "glossiness", part.material.glossiness);
-        setUniform(program, "specularIntensity", part.material.specularIntensity);
+        setMaterial(program, part.material);
         scene.drawPart(part);
     }
-    for (GLuint unit = 0; unit < 6; ++unit) glBindTextureUnit(unit, 0);
+    unbindShading();
     glDisable(GL_DEPTH_TEST);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glUseProgram(0);

@@ -22,6 +22,15 @@ public:
     // Clears the frame targets and draws every part of the scene into them.
     void run(FrameTargets& targets, const GpuScene& scene, GLuint shadowMaps, const MainPassSettings& settings);
 
+    // Sets every uniform of main_pass.frag except the per-part material ones and binds its textures (units 0–5
+    // and any further ones it needs), for `program` = main_pass.frag linked with any vertex shader that writes
+    // the same outputs as main_pass.vert (the object-space reference bakes the same shading at mesh vertices).
+    // unbindShading() unbinds the units again.
+    static void bindShading(GLuint program, const GpuScene& scene, GLuint shadowMaps, const MainPassSettings& settings);
+    static void unbindShading();
+    // Per-part material uniforms.
+    static void setMaterial(GLuint program, const GpuMaterial& material);
+
 private:
     ShaderLibrary& shaders_;
 };

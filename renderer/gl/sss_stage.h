@@ -31,6 +31,8 @@ struct SssStageInputs {
     GLuint skinMask = 0;         // GL_R32F: 0..1, 0 on background
     GLuint normal = 0;           // GL_RGBA32F: xyz = world-space normal after normal mapping, unit length
     GLuint geometricNormal = 0;  // GL_RGBA32F: xyz = world-space interpolated geometric normal, unit length
+    GLuint aux = 0;              // GL_R32F: Mikkelsen's auxiliary image F (sss.cbf), 0 off skin
+    GLuint curvature = 0;        // GL_R32F: smoothed curvature, 1/world unit, ≥ 0 (sss.curvature)
     int width = 0;               // pixels
     int height = 0;              // pixels
     float focalLengthPixels = 0; // f_px = (height/2) / tan(fovY/2); a kernel offset of o mm at depth z covers

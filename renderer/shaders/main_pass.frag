@@ -24,6 +24,7 @@ layout(location = 3) out float outLinearDepth;     // world units
 layout(location = 4) out vec4 outNormal;           // world-space mapped normal
 layout(location = 5) out vec4 outGeometricNormal;  // world-space geometric normal
 layout(location = 6) out float outMask;            // skin mask 0..1
+layout(location = 7) out vec4 outTransmittance;    // rgb light through thin parts (added to diffuse later), 0 if off
 
 uniform vec3 cameraPosition;
 uniform mat4 view;
@@ -141,4 +142,5 @@ void main() {
     outNormal = vec4(normal, 0.0);
     outGeometricNormal = vec4(geometricNormal, 0.0);
     outMask = mask;
+    outTransmittance = vec4(0.0, 0.0, 0.0, 1.0);
 }

@@ -6,6 +6,7 @@
 #include "renderer/sss/discretisation.h"
 #include "renderer/sss/gaussian_sum_profile.h"
 #include "renderer/sss/materials.h"
+#include "renderer/sss/pscbf_kernel.h"
 #include "renderer/sss/tabulated_kernel.h"
 
 #include <algorithm>
@@ -49,6 +50,19 @@ Kernel makeKernel(const SssParams& params) {
     case SssMethod::None:
         kernel.source = "none";
         break;
+    case SssMethod::Reference:
+        // Computed on the surface (renderer/reference), not with screen-space taps.
+        kernel.source = "object-space reference (" + makeMarginal(params)->description() + ", 3-D distances)";
+        break;
+    case SssMethod::Pscbf: {
+        // Mikkelsen 2010: the broad Gaussian part as one stage whose accumulate weights are 1 − spike; the spike
+        // (the unblurred centre) is added by the pass. Offsets scale with width_mm / 3 like every profile.
+        KernelStage stage = makePscbfKernel(mikkelsenSkinProfile(), params.samples).broadStage();
+        scaleOffsets(stage.taps, scale);
+        kernel.source = "Mikkelsen 2010 pseudo-separable cross-bilateral filter (spike + one Gaussian per channel)";
+        kernel.stages.push_back(std::move(stage));
+        break;
+    }
     case SssMethod::Separable: {
         const auto marginal = makeMarginal(params);
         KernelStage stage;

@@ -8,7 +8,8 @@
 namespace skinlab::renderer::sss {
 
 namespace {
-const std::vector<std::string> kMethodNames{"none", "gaussian-sum", "separable", "artistic"};
+const std::vector<std::string> kMethodNames{"none", "gaussian-sum", "separable", "artistic", "pscbf", "reference"};
+const std::vector<std::string> kCurvatureNames{"off", "increase", "reduce", "reduce-floor"};
 const std::vector<std::string> kPlacementNames{"quadratic", "importance"};
 
 // JSON (as written by toJson) → TOML, so that the JSON form goes through the same strict reader.
@@ -46,6 +47,8 @@ SssParams readSssTable(const SpecReader& sss) {
     p.method = method == "gaussian-sum" ? SssMethod::GaussianSum
                : method == "separable"  ? SssMethod::Separable
                : method == "artistic"   ? SssMethod::Artistic
+               : method == "pscbf"      ? SssMethod::Pscbf
+               : method == "reference"  ? SssMethod::Reference
                                         : SssMethod::None;
     p.samples = static_cast<int>(sss.integer("samples", p.samples, 3, 101));
     if (p.samples % 2 == 0)
@@ -71,6 +74,12 @@ SssParams readSssTable(const SpecReader& sss) {
         sss.fail("material", "'" + p.material + "' has no d'Eon profile (only 'skin'); use sss.profile = \"burley\"");
     p.artisticStrength = sss.vec3("artistic_strength", p.artisticStrength, 0.0, 1.0);
     p.artisticFalloff = sss.vec3("artistic_falloff", p.artisticFalloff, 0.0, 1.0);
+    p.cbf = sss.boolean("cbf", p.cbf);
+    p.cbfLambda = sss.number("cbf_lambda", p.cbfLambda, 0.0, 1000.0);
+    p.labWeight = sss.number("lab_weight", p.labWeight, 0.0, 100.0);
+    p.curvature = sss.choice("curvature", p.curvature, kCurvatureNames);
+    p.curvatureFloor = sss.number("curvature_floor", p.curvatureFloor, 0.0, 1.0);
+    p.referenceEdgeMm = sss.number("reference_edge_mm", p.referenceEdgeMm, 0.05, 50.0);
     return p;
 }
 
@@ -78,6 +87,7 @@ TransmittanceParams readTransmittanceTable(const SpecReader& t) {
     TransmittanceParams p;
     p.enabled = t.boolean("enabled", p.enabled);
     p.translucency = t.number("translucency", p.translucency, 0.0, 1.0);
+    p.curvature = t.boolean("curvature", p.curvature);
     return p;
 }
 } // namespace
@@ -88,6 +98,8 @@ std::string_view methodName(SssMethod method) {
     case SssMethod::GaussianSum: return "gaussian-sum";
     case SssMethod::Separable: return "separable";
     case SssMethod::Artistic: return "artistic";
+    case SssMethod::Pscbf: return "pscbf";
+    case SssMethod::Reference: return "reference";
     }
     return "none";
 }
@@ -106,11 +118,17 @@ nlohmann::json SssParams::toJson() const {
             {"profile", profile},
             {"material", material},
             {"artistic_strength", artisticStrength},
-            {"artistic_falloff", artisticFalloff}};
+            {"artistic_falloff", artisticFalloff},
+            {"cbf", cbf},
+            {"cbf_lambda", cbfLambda},
+            {"lab_weight", labWeight},
+            {"curvature", curvature},
+            {"curvature_floor", curvatureFloor},
+            {"reference_edge_mm", referenceEdgeMm}};
 }
 
 nlohmann::json TransmittanceParams::toJson() const {
-    return {{"enabled", enabled}, {"translucency", translucency}};
+    return {{"enabled", enabled}, {"translucency", translucency}, {"curvature", curvature}};
 }
 
 SssParams readSssParams(const SpecReader& scene) {

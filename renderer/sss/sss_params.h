@@ -18,6 +18,8 @@ enum class SssMethod {
     GaussianSum,  // Jimenez & Gutierrez 2010: six incremental Gaussian blurs, 12 passes
     Separable,    // Jimenez et al. 2015: two passes with the marginal of a physical profile
     Artistic,     // Jimenez's demo kernel (width, strength, falloff), two passes
+    Pscbf,        // Mikkelsen 2010: pseudo-separable cross-bilateral filter, spike + one Gaussian per channel
+    Reference,    // object-space SSS on the tessellated surface (the ground truth of the metrics)
 };
 
 // How a continuous 1-D kernel is discretised into taps (docs/methods.md, "Discretisation").
@@ -54,6 +56,19 @@ struct SssParams {
     std::array<double, 3> artisticStrength{0.48, 0.41, 0.28};
     std::array<double, 3> artisticFalloff{1.0, 0.37, 0.3};
 
+    // --- artifact extensions (thesis §3.3; docs/extensions.md), each a switch on every screen-space method ---
+    // E1: cross-bilateral weights exp(−λ |F_c − F_tap|) on Mikkelsen's auxiliary image (AOV aux.Y), combined
+    // with the follow-surface correction, renormalised, falling back to the unblurred colour where they vanish.
+    bool cbf = false;
+    double cbfLambda = 10.0;  // λ, dimensionless (thesis code: 10)
+    // E2: CIELAB weight exp(−β ΔE*ab) on the albedos of centre and tap; β in 1/ΔE, 0 = off.
+    double labWeight = 0.0;
+    // E3: curvature modulation of the kernel width from the curvature AOV (curvature.Y).
+    std::string curvature = "off";  // off | increase | reduce | reduce-floor
+    double curvatureFloor = 0.5;    // reduce-floor: width share kept on flat skin, [0, 1]
+    // reference method: longest skin edge (mm) after tessellation; irradiance is sampled at the vertices.
+    double referenceEdgeMm = 1.0;
+
     nlohmann::json toJson() const;
 };
 
@@ -62,6 +77,9 @@ struct TransmittanceParams {
     // 0 = opaque, 1 = fully translucent: thickness is scaled by 8.25 (1 − translucency) / width (Jimenez et al.
     // 2010) before T(s) = Σ w_i exp(−s²/v_i) with d'Eon's weights (T(0) = 1 per channel).
     double translucency = 0.5;
+    // transmittance × (1 + c) with c the normalised curvature: the thesis's option, which produces bright
+    // artefacts at nostrils and other tight, thin features (documented as such).
+    bool curvature = false;
 
     nlohmann::json toJson() const;
 };

@@ -181,9 +181,10 @@ TEST(RenderPipeline, ExrLayoutChannelsAndMetadata) {
     const ExrImage image = readExr(request.exrPath);
     for (const char* channel : {"R", "G", "B", "diffuse.R", "diffuse.G", "diffuse.B", "specular.R", "specular.G",
                                 "specular.B", "albedo.R", "albedo.G", "albedo.B", "depth.Z", "normal.X", "normal.Y",
-                                "normal.Z", "geonormal.X", "geonormal.Y", "geonormal.Z", "mask.Y"})
+                                "normal.Z", "geonormal.X", "geonormal.Y", "geonormal.Z", "mask.Y", "transmittance.R",
+                                "transmittance.G", "transmittance.B", "aux.Y", "curvature.Y"})
         EXPECT_TRUE(image.channels.count(channel)) << channel;
-    EXPECT_EQ(image.channels.size(), 20u);
+    EXPECT_EQ(image.channels.size(), 25u);
     EXPECT_EQ(nlohmann::json::parse(image.strings.at("skinlab:resolved")), result.resolved);
     EXPECT_EQ(image.strings.at("skinlab:gl_renderer"), renderer->glRenderer());
     EXPECT_EQ(image.strings.at("skinlab:gl_version"), renderer->glVersion());
