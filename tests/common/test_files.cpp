@@ -4,11 +4,12 @@
 
 #include <filesystem>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 namespace fs = std::filesystem;
 
 TEST(Files, AtomicWriteReplacesAndLeavesNoTemporary) {
-    fs::path dir = fs::temp_directory_path() / "skinlab_test_files";
+    fs::path dir = fs::temp_directory_path() / ("skinlab_test_files-" + std::to_string(::getpid()));
     fs::remove_all(dir);
     skinlab::writeFileAtomic(dir / "a.txt", "first");
     skinlab::writeFileAtomic(dir / "a.txt", "second");
@@ -20,7 +21,7 @@ TEST(Files, AtomicWriteReplacesAndLeavesNoTemporary) {
 }
 
 TEST(Files, UncommittedOutputIsRemoved) {
-    fs::path dir = fs::temp_directory_path() / "skinlab_test_files2";
+    fs::path dir = fs::temp_directory_path() / ("skinlab_test_files2-" + std::to_string(::getpid()));
     fs::remove_all(dir);
     {
         skinlab::AtomicOutput out(dir / "b.bin");

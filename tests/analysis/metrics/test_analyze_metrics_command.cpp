@@ -11,6 +11,7 @@
 #include <sys/wait.h>
 
 #include <nlohmann/json.hpp>
+#include <unistd.h>
 
 namespace skinlab::metrics {
 namespace {
@@ -38,7 +39,7 @@ class AnalyzeMetricsCommand : public ::testing::Test {
 protected:
     void SetUp() override {
         folder = fs::temp_directory_path() /
-                 ("skinlab-metrics-cli-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+                 ("skinlab-metrics-cli-" + std::to_string(::getpid()) + "-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
         fs::remove_all(folder);
         fs::create_directories(folder / "exr");
         scene.size = 128;

@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <unistd.h>
 
 namespace skinlab::metrics {
 namespace {
@@ -23,7 +24,8 @@ class MetricsRun : public ::testing::Test {
 protected:
     void SetUp() override {
         folder = fs::temp_directory_path() /
-                 ("skinlab-metrics-run-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+                 ("skinlab-metrics-run-" + std::to_string(::getpid()) + "-" +
+                  std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
         fs::remove_all(folder);
         fs::create_directories(folder);
         testing::DiscScene scene;

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <unistd.h>
 
 namespace skinlab::metrics {
 namespace {
@@ -18,7 +19,7 @@ using testing::DiscScene;
 using testing::SyntheticRender;
 
 fs::path freshFolder(const std::string& name) {
-    fs::path folder = fs::temp_directory_path() / ("skinlab-metrics-" + name);
+    fs::path folder = fs::temp_directory_path() / ("skinlab-metrics-" + name + "-" + std::to_string(::getpid()));
     fs::remove_all(folder);
     fs::create_directories(folder);
     return folder;

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <unistd.h>
 
 namespace skinlab::metrics {
 namespace {
@@ -17,7 +18,7 @@ namespace fs = std::filesystem;
 class StimulusSetPairs : public ::testing::Test {
 protected:
     void SetUp() override {
-        folder = fs::temp_directory_path() / ("skinlab-metrics-set-" +
+        folder = fs::temp_directory_path() / ("skinlab-metrics-set-" + std::to_string(::getpid()) + "-" +
                                               std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
         fs::remove_all(folder);
         fs::create_directories(folder / "exr");

@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <gtest/gtest.h>
 #include <numbers>
+#include <unistd.h>
 
 using namespace skinlab::renderer::sss;
 namespace fs = std::filesystem;
@@ -207,7 +208,7 @@ TEST(Kernels, InconsistentParametersAreInputErrors) {
 
 namespace {
 fs::path scratchDir() {
-    fs::path dir = fs::temp_directory_path() / "skinlab_test_bn";
+    fs::path dir = fs::temp_directory_path() / ("skinlab_test_bn-" + std::to_string(::getpid()));
     fs::create_directories(dir);
     return dir;
 }
