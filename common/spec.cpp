@@ -82,19 +82,57 @@ void applyOverride(toml::table& root, std::string_view assignment, std::string_v
     }
     if (!value) value = std::make_unique<toml::value<std::string>>(std::string(text));
 
-    toml::table* table = &root;
+    // A component may index an existing array: "lights[0]". Returns the name and the index (npos: none).
+    auto splitIndex = [&](const std::string& part) -> std::pair<std::string, size_t> {
+        const size_t bracket = part.find('[');
+        if (bracket == std::string::npos) return {part, std::string::npos};
+        if (bracket == 0) throwInput(source, quoted, "empty key component");
+        if (part.back() != ']') throwInput(source, quoted, "expected NAME[INDEX] in '" + part + "'");
+        const std::string digits = part.substr(bracket + 1, part.size() - bracket - 2);
+        if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos || digits.size() > 6)
+            throwInput(source, quoted, "index '" + digits + "' is not a non-negative integer");
+        return {part.substr(0, bracket), std::stoul(digits)};
+    };
     std::string path;
+    // The array `name` of `table`, checked to hold element `index`.
+    auto indexedArray = [&](toml::table& table, const std::string& name, size_t index) -> toml::array& {
+        path += (path.empty() ? "" : ".") + name;
+        toml::node* child = table.get(name);
+        if (!child || !child->is_array())
+            throwInput(source, path, "is not an array, cannot index it in '" + std::string(key) + "'");
+        toml::array& array = *child->as_array();
+        if (index >= array.size())
+            throwInput(source, path, "has " + std::to_string(array.size()) + " element(s); index " +
+                                         std::to_string(index) + " is out of range");
+        path += "[" + std::to_string(index) + "]";
+        return array;
+    };
+
+    toml::table* table = &root;
     for (size_t i = 0; i + 1 < parts.size(); ++i) {
-        path += (path.empty() ? "" : ".") + parts[i];
-        toml::node* child = table->get(parts[i]);
-        if (!child) {
-            table->insert(parts[i], toml::table{});
-            child = table->get(parts[i]);
+        const auto [name, index] = splitIndex(parts[i]);
+        toml::node* child = nullptr;
+        if (index == std::string::npos) {
+            path += (path.empty() ? "" : ".") + name;
+            child = table->get(name);
+            if (!child) {
+                table->insert(name, toml::table{});
+                child = table->get(name);
+            }
+        } else {
+            child = indexedArray(*table, name, index).get(index);
         }
         if (!child->is_table()) throwInput(source, path, "is not a table, cannot set '" + std::string(key) + "'");
         table = child->as_table();
     }
-    value->visit([&](auto& concrete) { table->insert_or_assign(parts.back(), concrete); });
+    const auto [leaf, index] = splitIndex(parts.back());
+    if (index == std::string::npos) {
+        value->visit([&](auto& concrete) { table->insert_or_assign(leaf, concrete); });
+        return;
+    }
+    // "name[i]=value": replace one element of an existing array.
+    toml::array& array = indexedArray(*table, leaf, index);
+    value->visit([&](auto& concrete) { array.replace(array.cbegin() + static_cast<std::ptrdiff_t>(index), concrete); });
 }
 
 nlohmann::json tomlToJson(const toml::node& node) {

@@ -26,7 +26,9 @@ toml::table parseTomlString(std::string_view text, std::string_view sourceName);
 
 // Applies one "a.b.c=value" override (the --set syntax). The value is read as a TOML value (number, boolean,
 // "quoted string", [array], {inline table}); anything else is taken as a bare string (so --set camera.view=close
-// works). Intermediate tables are created. `source` names the origin in errors (e.g. "--set").
+// works). Intermediate tables are created. A component may index an existing array: lights[0].intensity=2
+// sets one light's intensity, render.size[1]=720 one element of an array value; an index must exist (arrays are
+// not extended this way; set the whole array for that). `source` names the origin in errors (e.g. "--set").
 void applyOverride(toml::table& root, std::string_view assignment, std::string_view source = "--set");
 
 // TOML → JSON (for "resolved parameters" records). Dates/times become strings.

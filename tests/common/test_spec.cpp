@@ -73,6 +73,30 @@ TEST(Spec, OverridesParseTomlValuesOrBareStrings) {
               "--set: camera.view: is not a table, cannot set 'camera.view.x'");
 }
 
+TEST(Spec, OverridesIndexExistingArrays) {
+    toml::table t = skinlab::parseTomlString(kSpec, "scene.toml");
+    skinlab::applyOverride(t, "lights[0].intensity=2");
+    skinlab::applyOverride(t, "lights[0].shadow=false");
+    skinlab::applyOverride(t, "camera.position=[1, 2, 3]");
+    skinlab::applyOverride(t, "camera.position[2]=30");
+    SpecReader r(t, "scene.toml");
+    auto lights = r.tables("lights");
+    ASSERT_EQ(lights.size(), 1u);
+    EXPECT_DOUBLE_EQ(lights[0].number("intensity", 1, 0, 100), 2.0);
+    EXPECT_FALSE(lights[0].boolean("shadow", true));
+    EXPECT_EQ(lights[0].string("type", ""), "directional");  // the rest of the light is kept
+    EXPECT_EQ(r.table("camera").vec3("position", {0, 0, 0}, -100, 100)[2], 30.0);
+    EXPECT_EQ(r.table("camera").vec3("position", {0, 0, 0}, -100, 100)[0], 1.0);
+    EXPECT_EQ(errorOf([&] { skinlab::applyOverride(t, "lights[1].intensity=2"); }),
+              "--set: lights: has 1 element(s); index 1 is out of range");
+    EXPECT_EQ(errorOf([&] { skinlab::applyOverride(t, "camera[0].view=far"); }),
+              "--set: camera: is not an array, cannot index it in 'camera[0].view'");
+    EXPECT_EQ(errorOf([&] { skinlab::applyOverride(t, "lights[x].intensity=2"); }),
+              "--set: 'lights[x].intensity=2': index 'x' is not a non-negative integer");
+    EXPECT_EQ(errorOf([&] { skinlab::applyOverride(t, "lights[0.intensity=2"); }),
+              "--set: 'lights[0.intensity=2': expected NAME[INDEX] in 'lights[0'");
+}
+
 TEST(Spec, TomlToJson) {
     toml::table t = skinlab::parseTomlString(kSpec, "scene.toml");
     nlohmann::json j = skinlab::tomlToJson(t);
