@@ -1,7 +1,8 @@
 // The renderer's public entry point (render_job.h): scene spec → GL passes → EXR (+ PNG), with timings.
 //
 // Pipeline (docs/rendering.md, "Pipeline"), one class per pass under renderer/gl/:
-//   shadow map → main pass → background → SSS stage → add specular → tone map → read back → EXR / PNG
+//   shadow map → main pass → background → surface AOVs → transmittance → SSS stage → add specular → tone map
+//   → read back → EXR / PNG
 #include "renderer/render_job.h"
 
 #include "common/error.h"
@@ -13,10 +14,13 @@
 #include "renderer/gl/gpu_scene.h"
 #include "renderer/gl/gpu_timer.h"
 #include "renderer/gl/main_pass.h"
+#include "renderer/gl/reference_method.h"
 #include "renderer/gl/shader_library.h"
 #include "renderer/gl/shadow_map_pass.h"
 #include "renderer/gl/sss_stage.h"
+#include "renderer/gl/surface_aov_pass.h"
 #include "renderer/gl/tone_map_pass.h"
+#include "renderer/gl/transmittance_pass.h"
 #include "renderer/output/display_output.h"
 #include "renderer/output/exr_writer.h"
 #include "renderer/scene/builtin_geometry.h"
@@ -24,6 +28,7 @@
 #include "renderer/scene/mesh_loader.h"
 #include "renderer/scene/scene_spec.h"
 #include "renderer/scene/texture.h"
+#include "renderer/sss/sss_params.h"
 
 #include <chrono>
 #include <cmath>
@@ -93,7 +98,10 @@ struct Renderer::Impl {
     gl::ShadowMapPass shadowMapPass{shaders};
     gl::MainPass mainPass{shaders};
     gl::BackgroundPass backgroundPass{shaders};
+    gl::SurfaceAovPass surfaceAovPass{shaders};
+    gl::TransmittancePass transmittancePass{shaders};
     gl::SssStage sssStage{shaders};
+    gl::ReferenceMethod referenceMethod{shaders};  // sss.method = "reference": replaces the SSS stage
     gl::AddSpecularPass addSpecularPass{shaders};
     gl::ToneMapPass toneMapPass{shaders};
 
@@ -247,6 +255,20 @@ RenderResult Renderer::render(const RenderRequest& request) {
     const double uploadMs = millisecondsSince(uploadStart);
 
     // --- passes ------------------------------------------------------------------------------------------
+    // sss.method = "reference": check its parameters and tessellate (cached) before the first pass, so bad input
+    // fails with no pass half done.
+    const bool referenceMethod = spec.sssMethod == "reference";
+    gl::ReferenceInputs referenceInputs;
+    sss::SssParams referenceParams;
+    if (referenceMethod) {
+        referenceParams = sss::sssParamsFromJson(spec.sss, spec.source);
+        referenceInputs.model = model;
+        referenceInputs.partMaterials = partMaterials;
+        referenceInputs.mmPerUnit = static_cast<float>(spec.mmPerUnit);
+        referenceInputs.source = spec.source;
+        impl.referenceMethod.prepare(referenceInputs, referenceParams);
+    }
+
     gl::PassTimer& timer = impl.timer;
     timer.reset();
     timer.begin("shadow");
@@ -260,6 +282,12 @@ RenderResult Renderer::render(const RenderRequest& request) {
     mainSettings.normalStrength = static_cast<float>(spec.textures.normalStrength);
     mainSettings.pcfRadius = spec.shadowPcfRadius;
     mainSettings.environmentFromWorld = environmentFromWorld;
+    const sss::TransmittanceParams transmittanceParams =
+        sss::transmittanceParamsFromJson(spec.transmittance, spec.source);
+    mainSettings.transmittanceEnabled = transmittanceParams.enabled;
+    mainSettings.translucency = static_cast<float>(transmittanceParams.translucency);
+    mainSettings.sssWidthMm = static_cast<float>(sss::sssParamsFromJson(spec.sss, spec.source).widthMm);
+    mainSettings.mmPerUnit = static_cast<float>(spec.mmPerUnit);
     impl.mainPass.run(impl.targets, scene, impl.shadowMapPass.shadowMaps(), mainSettings);
     timer.end();
 
@@ -274,6 +302,20 @@ RenderResult Renderer::render(const RenderRequest& request) {
     backgroundSettings.exposure = exposure;
     backgroundSettings.environmentFromWorld = environmentFromWorld;
     impl.backgroundPass.run(impl.targets, backgroundSettings);
+    timer.end();
+
+    timer.begin("surface_aovs");
+    gl::SurfaceAovSettings surfaceAovSettings;
+    surfaceAovSettings.camera = camera;
+    impl.surfaceAovPass.run(impl.targets, surfaceAovSettings);
+    timer.end();
+
+    timer.begin("transmittance");
+    gl::TransmittanceSettings transmittanceSettings;
+    transmittanceSettings.enabled = transmittanceParams.enabled;
+    transmittanceSettings.curvature = transmittanceParams.curvature;
+    transmittanceSettings.mmPerUnit = static_cast<float>(spec.mmPerUnit);
+    impl.transmittancePass.run(impl.targets, transmittanceSettings);
     timer.end();
 
     timer.begin("sss");
@@ -297,7 +339,17 @@ RenderResult Renderer::render(const RenderRequest& request) {
     sssSettings.method = spec.sssMethod;
     sssSettings.sss = spec.sss;
     sssSettings.transmittance = spec.transmittance;
-    impl.sssStage.run(sssInputs, sssSettings, impl.targets.scatteredDiffuse.get());
+    if (referenceMethod) {
+        // The object-space reference bakes the main pass's shading at the tessellated vertices itself, so it needs
+        // the model, the scene and the main pass's settings rather than the screen-space inputs.
+        referenceInputs.scene = &scene;
+        referenceInputs.shadowMaps = impl.shadowMapPass.shadowMaps();
+        referenceInputs.mainSettings = mainSettings;
+        referenceInputs.targets = &impl.targets;
+        impl.referenceMethod.run(referenceInputs, referenceParams, impl.targets.scatteredDiffuse.get());
+    } else {
+        impl.sssStage.run(sssInputs, sssSettings, impl.targets.scatteredDiffuse.get());
+    }
     timer.end();
 
     timer.begin("add_specular");
@@ -379,7 +431,9 @@ RenderResult Renderer::render(const RenderRequest& request) {
     metadata.strings["skinlab:camera"] = cameraJson.dump();
     metadata.floats["skinlab:f_px"] = camera.focalLengthPixels;
     metadata.floats["skinlab:mm_per_unit"] = static_cast<float>(spec.mmPerUnit);
-    metadata.floats["skinlab:sss_radius_mm"] = impl.sssStage.supportRadiusMm(sssSettings);
+    metadata.floats["skinlab:sss_radius_mm"] =
+        referenceMethod ? gl::ReferenceMethod::supportRadiusMm(referenceParams, spec.source)
+                        : impl.sssStage.supportRadiusMm(sssSettings);
     writeExr(request.exrPath, width, height, channels, metadata);
     if (!request.pngPath.empty()) writePng(request.pngPath, width, height, encodeDisplaySrgb8(display));
     const double writeMs = millisecondsSince(writeStart);
@@ -390,6 +444,7 @@ RenderResult Renderer::render(const RenderRequest& request) {
     result.glVersion = impl.context.version();
     result.timingsMs = timer.json();
     result.timingsMs["cpu"] = {{"load", loadMs}, {"upload", uploadMs}, {"readback", readbackMs}, {"write", writeMs}};
+    if (referenceMethod) result.timingsMs["reference"] = impl.referenceMethod.lastRun();  // CPU parts of "sss"
     result.timingsMs["width"] = width;
     result.timingsMs["height"] = height;
     result.timingsMs["gl_renderer"] = result.glRenderer;

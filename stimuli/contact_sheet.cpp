@@ -7,6 +7,7 @@
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <algorithm>
+#include <cstdlib>
 #include <cmath>
 #include <map>
 #include <sstream>
@@ -60,11 +61,27 @@ std::vector<std::string> varyingFactors(const Block& block) {
     return varying;
 }
 
+// A level as a caption word: words as they are ("separable", "burley"); numbers and booleans with their factor's
+// name, which they do not name themselves ("cbf=true", "lab_weight=0.09", "transmittance.enabled=true").
+// (Manifest factor values are the levels as text: "true", "0.09".)
+std::string levelText(const std::string& factor, const nlohmann::json& value) {
+    const std::string text = valueText(value);
+    bool bare = text == "true" || text == "false" || value.is_number();
+    if (!bare && !text.empty()) {
+        char* end = nullptr;
+        std::strtod(text.c_str(), &end);
+        bare = end && *end == '\0';
+    }
+    if (!bare) return text;
+    const std::string name = factor.rfind("sss.", 0) == 0 ? factor.substr(4) : factor;
+    return name + "=" + text;
+}
+
 std::string caption(const nlohmann::json& stimulus, const std::vector<std::string>& varying) {
     std::string text;
     const auto& f = stimulus.at("factors");
     for (const auto& name : varying)
-        if (f.contains(name)) text += (text.empty() ? "" : " ") + valueText(f[name]);
+        if (f.contains(name)) text += (text.empty() ? "" : " ") + levelText(name, f[name]);
     if (stimulus.at("reference").get<bool>()) text += text.empty() ? "reference" : " (ref)";
     return text.empty() ? stimulus.at("id").get<std::string>() : text;
 }

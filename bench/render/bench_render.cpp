@@ -1,9 +1,10 @@
 // Per-pass milliseconds of the renderer without SSS (docs/benchmarks.md, "Renderer (issue 2)").
-//   bench_render [--frames N] [--width W] [--height H] [--assets DIR] [--csv FILE]
+//   bench_render [--frames N] [--width W] [--height H] [--assets DIR] [--csv FILE] [--set key=value ...]
 // Renders builtin:head and, when the assets folder is known (--assets or $SKINLAB_ASSETS), the scanned head
 // (renderer/scenes/lee-perry-smith.toml) at 1280×720: one warm-up frame (shader compilation, file loading),
 // then N measured frames; prints the median per pass (GPU timer queries, cross-checked with glFinish wall
-// clock) and the wall-clock total of the passes, and writes one CSV row per scene and pass.
+// clock) and the wall-clock total of the passes, and writes one CSV row per scene and pass. --set overrides a
+// scene key for every scene (repeatable), e.g. --set transmittance.enabled=true.
 #include "common/files.h"
 #include "renderer/render_job.h"
 
@@ -31,6 +32,7 @@ int main(int argc, char** argv) {
     int height = 720;
     std::string assets;
     std::string csvPath;
+    std::vector<std::string> overrides;
     for (int i = 1; i + 1 < argc; i += 2) {
         const std::string key = argv[i];
         const std::string value = argv[i + 1];
@@ -39,6 +41,7 @@ int main(int argc, char** argv) {
         else if (key == "--height") height = std::atoi(value.c_str());
         else if (key == "--assets") assets = value;
         else if (key == "--csv") csvPath = value;
+        else if (key == "--set") overrides.push_back(value);
         else {
             std::fprintf(stderr, "bench_render: unknown option %s\n", key.c_str());
             return 2;
@@ -58,10 +61,12 @@ int main(int argc, char** argv) {
     std::string csv = "scene,pass,gpu_ms_median,wall_ms_median,frames,width,height,gl_renderer\n";
     std::printf("GL_RENDERER: %s\nGL_VERSION: %s\n%d×%d, median of %d frames after one warm-up\n\n",
                 renderer.glRenderer().c_str(), renderer.glVersion().c_str(), width, height, frames);
-    const std::vector<std::string> passes = {"shadow", "main", "background", "sss", "add_specular", "tone_map"};
+    const std::vector<std::string> passes = {"shadow",        "main", "background", "surface_aovs",
+                                             "transmittance", "sss",  "add_specular", "tone_map"};
     for (const std::string& scene : scenes) {
         skinlab::renderer::RenderRequest request;
         request.scene = scene;
+        request.overrides = overrides;
         request.width = width;
         request.height = height;
         request.assetsDir = assets;

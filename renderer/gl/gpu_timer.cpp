@@ -16,6 +16,15 @@ PassTimer::PassTimer() {
     checkGl("the first timer query");
 }
 
+void PassTimer::reset() {
+    if (!current_.empty()) {
+        glEndQuery(GL_TIME_ELAPSED);
+        glFinish();
+        current_.clear();
+    }
+    records_.clear();
+}
+
 void PassTimer::begin(const std::string& pass) {
     if (!current_.empty()) throw RuntimeError("PassTimer::begin(" + pass + "): pass " + current_ + " still open");
     glFinish();

@@ -22,8 +22,9 @@ public:
 
     void begin(const std::string& pass);
     void end();
-    // Clears the recorded passes (a new frame).
-    void reset() { records_.clear(); }
+    // Clears the recorded passes (a new frame). A pass left open by a render that threw is closed and dropped,
+    // so that one failed render does not break the next one on the same context.
+    void reset();
 
     // {"passes": {name: gpu ms}, "passes_wall": {name: wall ms}, "gpu_total": ms, "wall_total": ms,
     //  "timer_check": "ok" | "gpu time above wall time, replaced: a, b"}

@@ -1,8 +1,17 @@
 #include "renderer/gl/main_pass.h"
 
+#include <algorithm>
 #include <string>
 
 namespace skinlab::renderer::gl {
+
+namespace {
+// Texture unit of the raw shadow-map depths (main_pass.frag `shadowDepths`).
+constexpr GLuint kShadowDepthUnit = 6;
+// The sampler object that reads the shadow maps with compare mode off (the texture itself compares, for PCF),
+// created by bindShading and deleted by unbindShading in the same context.
+GLuint shadowDepthSampler = 0;
+} // namespace
 
 void MainPass::bindShading(GLuint program, const GpuScene& scene, GLuint shadowMaps, const MainPassSettings& settings) {
     setUniform(program, "view", settings.camera.view);
@@ -29,7 +38,14 @@ void MainPass::bindShading(GLuint program, const GpuScene& scene, GLuint shadowM
         setUniform(program, ("lightShadowLayer" + index).c_str(), light.shadowLayer);
         setUniform(program, ("lightViewProjection" + index).c_str(), light.viewProjection);
         setUniform(program, ("lightNormalOffset" + index).c_str(), light.normalOffset);
+        setUniform(program, ("lightInverseViewProjection" + index).c_str(), glm::inverse(light.viewProjection));
     }
+
+    // Transmittance: thickness (world units) × mm_per_unit × 8.25 (1 − translucency) / width_mm = s (mm).
+    setUniform(program, "transmittanceEnabled", settings.transmittanceEnabled ? 1 : 0);
+    setUniform(program, "transmittanceShrink", kTransmittanceShrinkMm / settings.mmPerUnit);
+    setUniform(program, "transmittanceScale", settings.mmPerUnit * 8.25f * (1.0f - settings.translucency) /
+                                                  std::max(settings.sssWidthMm, 1e-6f));
 
     const GLuint fallback = scene.fallbackMap();
     const GLuint maps[] = {scene.albedoMap(), scene.normalMap(), scene.specularMap(), scene.occlusionMap(),
@@ -40,6 +56,15 @@ void MainPass::bindShading(GLuint program, const GpuScene& scene, GLuint shadowM
         setUniform(program, flags[unit], maps[unit] ? 1 : 0);
     }
     glBindTextureUnit(5, shadowMaps);
+    if (shadowDepthSampler != 0) glDeleteSamplers(1, &shadowDepthSampler);
+    glCreateSamplers(1, &shadowDepthSampler);
+    glSamplerParameteri(shadowDepthSampler, GL_TEXTURE_COMPARE_MODE, GL_NONE);
+    glSamplerParameteri(shadowDepthSampler, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glSamplerParameteri(shadowDepthSampler, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glSamplerParameteri(shadowDepthSampler, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glSamplerParameteri(shadowDepthSampler, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glBindTextureUnit(kShadowDepthUnit, shadowMaps);
+    glBindSampler(kShadowDepthUnit, shadowDepthSampler);
 }
 
 void MainPass::unbindShading() {
@@ -47,6 +72,8 @@ void MainPass::unbindShading() {
         glBindTextureUnit(unit, 0);
         glBindSampler(unit, 0);
     }
+    if (shadowDepthSampler != 0) glDeleteSamplers(1, &shadowDepthSampler);
+    shadowDepthSampler = 0;
 }
 
 void MainPass::setMaterial(GLuint program, const GpuMaterial& material) {

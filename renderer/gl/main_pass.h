@@ -8,12 +8,23 @@
 
 namespace skinlab::renderer::gl {
 
+// Transmittance (Jimenez et al., IEEE CG&A 2010): the shaded point is moved this far inside the surface along its
+// geometric normal before its thickness is read from the shadow map, against depth precision and shadow acne. The
+// thesis used 0.005 units of its scanned head at 47.9 mm per unit = 0.24 mm.
+inline constexpr float kTransmittanceShrinkMm = 0.24f;
+
 struct MainPassSettings {
     CameraPose camera;
     float exposure = 1.0f;             // 2^exposure_ev
     float normalStrength = 1.0f;
     int pcfRadius = 1;
     glm::mat3 environmentFromWorld{1.0f};
+    // Transmittance (docs/rendering.md, "Transmittance"): [transmittance] enabled / translucency, sss.width_mm and
+    // the scene's mm_per_unit. Scaled thickness s = thickness_mm · 8.25 (1 − translucency) / width_mm (mm).
+    bool transmittanceEnabled = false;
+    float translucency = 0.5f;         // 0 opaque … 1 fully translucent (s = 0, T = 1)
+    float sssWidthMm = 3.0f;           // mm, > 0
+    float mmPerUnit = 1.0f;            // millimetres per world unit
 };
 
 class MainPass {
@@ -22,10 +33,11 @@ public:
     // Clears the frame targets and draws every part of the scene into them.
     void run(FrameTargets& targets, const GpuScene& scene, GLuint shadowMaps, const MainPassSettings& settings);
 
-    // Sets every uniform of main_pass.frag except the per-part material ones and binds its textures (units 0–5
-    // and any further ones it needs), for `program` = main_pass.frag linked with any vertex shader that writes
-    // the same outputs as main_pass.vert (the object-space reference bakes the same shading at mesh vertices).
-    // unbindShading() unbinds the units again.
+    // Sets every uniform of main_pass.frag except the per-part material ones and binds its textures (units 0–5,
+    // and unit 6: the shadow maps again through a sampler object without depth comparison, for transmittance),
+    // for `program` = main_pass.frag linked with any vertex shader that writes the same outputs as main_pass.vert
+    // (the object-space reference bakes the same shading at mesh vertices).
+    // unbindShading() unbinds the units again and deletes that sampler object; call it before the next bindShading.
     static void bindShading(GLuint program, const GpuScene& scene, GLuint shadowMaps, const MainPassSettings& settings);
     static void unbindShading();
     // Per-part material uniforms.

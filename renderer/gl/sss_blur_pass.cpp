@@ -8,13 +8,20 @@
 
 namespace skinlab::renderer::gl {
 
+namespace {
+// Units 0 and 1 are the source colour and the linear depth (layout(binding) in sss_blur.frag); the extension
+// textures take 2, 3, 4.
+constexpr GLuint kFirstExtensionTextureUnit = 2;
+} // namespace
+
 SssBlurPass::SssBlurPass(ShaderLibrary& shaders) : shaders_(shaders) {}
 
 void SssBlurPass::run(const SssBlurPassInputs& inputs, const sss::KernelStage& stage, bool horizontal,
                       GLuint target, bool accumulate) {
     if (stage.taps.empty() || stage.taps.size() > 101)
         throw RuntimeError("SSS blur pass: " + std::to_string(stage.taps.size()) + " taps (supported: 1…101)");
-    const ShaderDefines defines = accumulate ? ShaderDefines{{"SSS_ACCUMULATE", "1"}} : ShaderDefines{};
+    ShaderDefines defines = inputs.extensions.defines();
+    if (accumulate) defines.emplace_back("SSS_ACCUMULATE", "1");
     const GLuint program = shaders_.program("fullscreen.vert", "sss_blur.frag", defines);
     std::vector<glm::vec4> taps;
     taps.reserve(stage.taps.size());
@@ -33,6 +40,9 @@ void SssBlurPass::run(const SssBlurPassInputs& inputs, const sss::KernelStage& s
                glm::vec3(static_cast<float>(stage.accumulate[0]), static_cast<float>(stage.accumulate[1]),
                          static_cast<float>(stage.accumulate[2])));
 
+    // First of the state changes: it throws (a pipeline bug) before touching any GL state when a switched-on
+    // extension has no texture.
+    inputs.extensions.bind(program, kFirstExtensionTextureUnit);
     glUseProgram(program);
     glBindFramebuffer(GL_FRAMEBUFFER, target);
     glViewport(0, 0, inputs.width, inputs.height);
@@ -46,6 +56,7 @@ void SssBlurPass::run(const SssBlurPassInputs& inputs, const sss::KernelStage& s
     shaders_.drawFullscreenTriangle();
     glBindTextureUnit(0, 0);
     glBindTextureUnit(1, 0);
+    inputs.extensions.unbind(kFirstExtensionTextureUnit);
     if (accumulate) {
         glDisablei(GL_BLEND, 1);
         glBlendFuncSeparatei(1, GL_ONE, GL_ZERO, GL_ONE, GL_ZERO);

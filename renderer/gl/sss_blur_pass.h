@@ -1,8 +1,10 @@
 #pragma once
 // One 1-D screen-space SSS pass (renderer/shaders/sss_blur.frag): reads a colour texture (rgb, a = skin mask) and
-// the linear depth, writes the blurred colour along one axis with one kernel stage's taps (renderer/sss/kernel.h).
-// The CPU mirror is renderer/sss/cpu_blur.cpp (tests compare them).
+// the linear depth, writes the blurred colour along one axis with one kernel stage's taps (renderer/sss/kernel.h),
+// with the artifact extensions of `extensions` (docs/extensions.md). The CPU mirror is renderer/sss/cpu_blur.cpp
+// (tests compare them).
 #include "renderer/gl/gl_resources.h"
+#include "renderer/gl/sss_extension_settings.h"
 #include "renderer/sss/kernel.h"
 
 #include <array>
@@ -20,6 +22,7 @@ struct SssBlurPassInputs {
     float mmPerUnit = 1.0f;
     bool followSurface = true;
     float followSurfaceK = 0.5f;  // 1/mm
+    SssExtensionSettings extensions;  // sss.cbf, sss.lab_weight, sss.curvature and their textures (default: all off)
 };
 
 class SssBlurPass {

@@ -2,6 +2,7 @@
 
 #include "common/error.h"
 #include "renderer/gl/gl_resources.h"
+#include "renderer/gl/pscbf_method.h"  // pscbf (Mikkelsen 2010)
 #include "renderer/gl/shader_library.h"
 #include "renderer/gl/sss_kernel_method.h"
 #include "renderer/sss/kernel.h"
@@ -18,6 +19,8 @@ struct SssStage::Impl {
     std::string kernelKey;
     sss::Kernel kernel;
     sss::SssParams params;
+    // pscbf (Mikkelsen 2010; renderer/gl/pscbf_method.h), created on first use.
+    std::unique_ptr<PscbfMethod> pscbfMethod;
 
     const sss::Kernel& kernelFor(const SssStageSettings& settings) {
         const std::string key = settings.sss.dump();
@@ -34,12 +37,18 @@ SssStage::SssStage(ShaderLibrary& shaders) : impl_(std::make_unique<Impl>(shader
 SssStage::~SssStage() = default;
 
 void SssStage::run(const SssStageInputs& inputs, const SssStageSettings& settings, GLuint output) {
+    // --- pscbf (Mikkelsen 2010; pscbf engineer): its own two passes, renderer/gl/pscbf_method.h ---------------
+    if (settings.method == "pscbf") {
+        const sss::Kernel& kernel = impl_->kernelFor(settings);
+        if (!impl_->pscbfMethod) impl_->pscbfMethod = std::make_unique<PscbfMethod>(impl_->shaders);
+        impl_->pscbfMethod->run(inputs, impl_->params, kernel, output);
+        return;
+    }
+    // --- end pscbf -------------------------------------------------------------------------------------------
     if (settings.method != "none" && settings.method != "gaussian-sum" && settings.method != "separable" &&
         settings.method != "artistic")
         throw InputError("sss.method: '" + settings.method +
                          "' is not available in the GL pipeline (available: none, gaussian-sum, separable, artistic)");
-    if (settings.transmittance.value("enabled", false))
-        throw InputError("transmittance.enabled: transmittance is not available in this build");
     if (output == inputs.diffuse) throw RuntimeError("SSS stage: output texture must differ from the diffuse input");
     if (settings.method != "none") {
         const sss::Kernel& kernel = impl_->kernelFor(settings);
@@ -52,6 +61,10 @@ void SssStage::run(const SssStageInputs& inputs, const SssStageSettings& setting
         passInputs.mmPerUnit = inputs.mmPerUnit;
         passInputs.followSurface = impl_->params.followSurface;
         passInputs.followSurfaceK = static_cast<float>(impl_->params.followSurfaceK);
+        passInputs.extensions = SssExtensionSettings::fromParams(impl_->params);
+        passInputs.extensions.albedoTexture = inputs.albedo;
+        passInputs.extensions.auxTexture = inputs.aux;
+        passInputs.extensions.curvatureTexture = inputs.curvature;
         impl_->kernelMethod.run(passInputs, kernel, output);
         return;
     }
@@ -74,6 +87,10 @@ void SssStage::run(const SssStageInputs& inputs, const SssStageSettings& setting
 
 float SssStage::supportRadiusMm(const SssStageSettings& settings) const {
     if (settings.method == "none") return 0.0f;
+    if (settings.method == "pscbf") {  // pscbf: the filter disc's radius r_max × width_mm / 3 (pscbf_method.h)
+        impl_->kernelFor(settings);
+        return static_cast<float>(PscbfMethod::supportRadiusMm(impl_->params));
+    }
     return static_cast<float>(impl_->kernelFor(settings).supportRadiusMm());
 }
 

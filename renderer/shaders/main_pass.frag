@@ -6,7 +6,10 @@
 // plus the AOVs the SSS stage and the EXR need: albedo, linear depth (world units along the view axis),
 // mapped and geometric normals (world space), skin mask. All linear Rec.709. Light "L_c" is the radiance of a
 // white Lambertian surface facing the light, so diffuse = albedo * L_c * (n.l) needs no 1/pi (thesis).
+// Transmittance (Jimenez et al., IEEE CG&A 2010; docs/rendering.md "Transmittance") is written to its own output
+// (location 7); the transmittance pass adds it to the diffuse buffer before the SSS stage.
 #include "specular_brdf.glsl"
+#include "transmittance_profile.glsl"
 
 #define MAX_LIGHTS 4
 
@@ -60,6 +63,14 @@ uniform mat4 lightViewProjection[MAX_LIGHTS];
 uniform float lightNormalOffset[MAX_LIGHTS];     // world units: receiver offset along the normal (acne)
 uniform int pcfRadius;
 
+// Transmittance (MainPassSettings, set in MainPass::bindShading). The shadow maps again, through a sampler object
+// with compare mode off, to read the raw stored depth (window depth 0..1 of the light's clip space).
+layout(binding = 6) uniform sampler2DArray shadowDepths;
+uniform mat4 lightInverseViewProjection[MAX_LIGHTS];  // light clip space -> world
+uniform int transmittanceEnabled;
+uniform float transmittanceShrink;  // world units: the point is moved this far inside along the geometric normal
+uniform float transmittanceScale;   // scaled thickness s (mm) per world unit of thickness
+
 uniform vec3 irradianceSH[9];        // A_l * L_lm (renderer/scene/environment.h), environment frame
 uniform mat3 environmentFromWorld;   // inverse of the environment's rotation about +Y
 
@@ -89,6 +100,34 @@ float shadowVisibility(int light, vec3 position, vec3 geometricNormal) {
     return sum / taps;
 }
 
+// Thickness of the object between `position` and the light (world units), from the light's shadow map (Jimenez
+// et al. 2010): the point, shrunk inside along the normal against shadow-map precision and acne, is projected into
+// the light's clip space; the depth stored there (the surface nearest the light) is unprojected with the inverse
+// light view-projection, which serves orthographic and perspective lights alike, and its distance to the shrunk
+// point (whose unprojection is the point itself) is the thickness along the light ray. Negative: the point lies
+// outside the shadow map (no transmittance).
+float thicknessToLight(int light, vec3 position, vec3 geometricNormal) {
+    vec3 inside = position - geometricNormal * transmittanceShrink;
+    vec4 clip = lightViewProjection[light] * vec4(inside, 1.0);
+    vec3 ndc = clip.xyz / clip.w;
+    vec2 coordinate = ndc.xy * 0.5 + 0.5;
+    if (any(lessThan(coordinate, vec2(0.0))) || any(greaterThan(coordinate, vec2(1.0))) || abs(ndc.z) > 1.0)
+        return -1.0;
+    // Averaged over the same (2r+1)^2 taps as the shadow's PCF: a single tap aliases into dotted lines along the
+    // terminator, where the thickness grows from 0 within a shadow texel or two.
+    vec2 texel = 1.0 / vec2(textureSize(shadowDepths, 0).xy);
+    float sum = 0.0;
+    for (int y = -pcfRadius; y <= pcfRadius; ++y)
+        for (int x = -pcfRadius; x <= pcfRadius; ++x) {
+            vec2 offset = vec2(x, y) * texel;
+            float storedDepth = texture(shadowDepths, vec3(coordinate + offset, float(lightShadowLayer[light]))).r;
+            // On the point's own light ray: the taps filter the stored depth, not the position.
+            vec4 nearest = lightInverseViewProjection[light] * vec4(ndc.xy, storedDepth * 2.0 - 1.0, 1.0);
+            sum += distance(nearest.xyz / nearest.w, inside);
+        }
+    return sum / float((2 * pcfRadius + 1) * (2 * pcfRadius + 1));
+}
+
 void main() {
     vec3 geometricNormal = normalize(worldNormal);
     vec3 tangent = normalize(worldTangent.xyz);
@@ -116,6 +155,7 @@ void main() {
     vec3 toViewer = normalize(cameraPosition - worldPosition);
     vec3 lightSum = vec3(0.0);
     vec3 specularSum = vec3(0.0);
+    vec3 transmittedSum = vec3(0.0);
     for (int i = 0; i < lightCount; ++i) {
         vec3 toLight;
         vec3 radiance = lightRadiance[i];
@@ -132,6 +172,14 @@ void main() {
         float visibility = shadowVisibility(i, worldPosition, geometricNormal);
         lightSum += radiance * max(dot(normal, toLight), 0.0) * visibility;
         specularSum += radiance * specularEq45(normal, toLight, toViewer, glossiness, kSkinF0) * visibility;
+        // Light through the object (Jimenez et al. 2010): L_c T(s) saturate(0.3 + L.(-N)), only lights with a
+        // shadow map; not shadowed (the light travels through the occluder the thickness describes).
+        // The shadow-map taps are read only where the facing term is not 0 (most of the lit side skips them).
+        float facing = clamp(0.3 + dot(toLight, -geometricNormal), 0.0, 1.0);
+        if (transmittanceEnabled != 0 && lightShadowLayer[i] >= 0 && mask > 0.0 && facing > 0.0) {
+            float thickness = thicknessToLight(i, worldPosition, geometricNormal);
+            if (thickness >= 0.0) transmittedSum += radiance * deonTransmittance(thickness * transmittanceScale) * facing;
+        }
     }
     vec3 ambient = max(irradiance(environmentFromWorld * normal), vec3(0.0)) / 3.14159265358979 * occlusion;
 
@@ -142,5 +190,6 @@ void main() {
     outNormal = vec4(normal, 0.0);
     outGeometricNormal = vec4(geometricNormal, 0.0);
     outMask = mask;
-    outTransmittance = vec4(0.0, 0.0, 0.0, 1.0);
+    // Skin only, weighted by the mask like the SSS stage's inputs; alpha 0 (the pass adds rgb only).
+    outTransmittance = vec4(exposure * transmittedSum * albedo * mask, 0.0);
 }

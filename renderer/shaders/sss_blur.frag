@@ -1,13 +1,20 @@
 #version 450 core
+#extension GL_GOOGLE_include_directive : require
 // One 1-D screen-space subsurface-scattering pass (horizontal or vertical) with a tabulated kernel: the pass of the
 // separable and artistic methods (two passes) and of the gaussian-sum method (12 passes, SSS_ACCUMULATE on the
 // vertical ones). Mirrors renderer/sss/cpu_blur.cpp operation for operation (docs/methods.md):
-//   pixels per mm = f_px / (mm_per_unit · z_centre), the same on both axes (science.md §2);
+//   pixels per mm = f_px / (mm_per_unit · z_centre), the same on both axes (science.md §2), × the curvature width
+//   scale of sss.curvature (E3; exactly 1 when off);
 //   each tap linearly interpolates the two texels it falls between, each texel first replaced by the centre colour
 //   in proportion to its non-skin share (1 − mask) and, with follow-surface, saturate(k · |Δz| · mm_per_unit);
 //   skin pixels get mix(centre, Σ w·tap, mask); non-skin pixels are copied.
+// With SSS_EXTENSION_WEIGHTS (sss.cbf and/or sss.lab_weight on; docs/extensions.md) each of the two texels of a tap
+// weighs w_i · (its interpolation share) · labWeight · auxiliaryWeight, and the sum is renormalised per channel by
+// the summed weights, falling back to the centre where they vanish.
 // Inputs: source rgb = linear diffuse colour, a = skin mask; linearDepth r = view depth in world units (+inf on
-// background).
+// background); the extension textures of sss_extension_inputs.glsl.
+#include "sss_extensions.glsl"
+#include "sss_extension_inputs.glsl"
 
 #ifndef SSS_MAX_TAPS
 #define SSS_MAX_TAPS 101  // sss.samples ≤ 101
@@ -40,9 +47,15 @@ void main() {
     if (centreMask > 0.0) {
         float centreDepth = texelFetch(linearDepth, p, 0).r;
         float pixelsPerMm = focalLengthPixels / (mmPerUnit * centreDepth);
+        if (extensionCurvatureStrategy != kCurvatureOff) pixelsPerMm *= extensionWidthScale(p, mmPerUnit);
         int along = horizontal != 0 ? p.x : p.y;
         int lastTexel = (horizontal != 0 ? size.x : size.y) - 1;
         vec3 sum = vec3(0.0);
+#ifdef SSS_EXTENSION_WEIGHTS
+        ExtensionCentre extension = extensionCentre(p);
+        vec3 weightSum = vec3(0.0);
+        float texelWeights[2];
+#endif
         for (int i = 0; i < tapCount; ++i) {
             float position = float(along) + taps[i].w * pixelsPerMm;
             float first = floor(position);
@@ -58,9 +71,22 @@ void main() {
                     s = max(s, clamp(followSurfaceK * abs(centreDepth - texelFetch(linearDepth, q, 0).r) * mmPerUnit,
                                      0.0, 1.0));
                 values[t] = mix(texel.rgb, centre, s);
+#ifdef SSS_EXTENSION_WEIGHTS
+                texelWeights[t] = extensionTexelWeight(extension, q);
+#endif
             }
+#ifdef SSS_EXTENSION_WEIGHTS
+            vec3 weight0 = taps[i].xyz * ((1.0 - fraction) * texelWeights[0]);
+            vec3 weight1 = taps[i].xyz * (fraction * texelWeights[1]);
+            sum += weight0 * values[0] + weight1 * values[1];
+            weightSum += weight0 + weight1;
+#else
             sum += taps[i].xyz * mix(values[0], values[1], fraction);
+#endif
         }
+#ifdef SSS_EXTENSION_WEIGHTS
+        sum = resolveWeightedSumPerChannel(sum, weightSum, centre);
+#endif
         result = mix(centre, sum, centreMask);
     }
     outColor = vec4(result, centreMask);

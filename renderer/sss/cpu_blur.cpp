@@ -8,6 +8,7 @@ namespace skinlab::renderer::sss {
 
 namespace {
 float mix(float x, float y, float a) { return x * (1.0f - a) + y * a; }
+glm::vec3 toVec3(const Rgb& rgb) { return glm::vec3(rgb[0], rgb[1], rgb[2]); }
 
 } // namespace
 
@@ -16,6 +17,9 @@ std::vector<Rgb> blurPass(const SurfaceBuffers& surface, const std::vector<Rgb>&
     const int width = surface.width;
     const int height = surface.height;
     assert(input.size() == size_t(width) * height);
+    assert(settings.labWeight <= 0.0f || surface.albedo.size() == input.size());
+    assert(!settings.cbf || surface.aux.size() == input.size());
+    assert(settings.curvature == CurvatureStrategy::Off || surface.curvature.size() == input.size());
     std::vector<Rgb> output(input.size());
     const bool horizontal = axis == BlurAxis::Horizontal;
     for (int y = 0; y < height; ++y) {
@@ -28,8 +32,27 @@ std::vector<Rgb> blurPass(const SurfaceBuffers& surface, const std::vector<Rgb>&
                 continue;
             }
             const float centreDepth = surface.depth[index];
-            const float pixelsPerMm = surface.focalLengthPixels / (surface.mmPerUnit * centreDepth);
+            float pixelsPerMm = surface.focalLengthPixels / (surface.mmPerUnit * centreDepth);
+            if (settings.curvature != CurvatureStrategy::Off)
+                pixelsPerMm *= curvatureWidthScale(
+                    settings.curvature,
+                    normalisedCurvature(surface.curvature[index], surface.mmPerUnit, kCurvatureReferenceRadiusMm),
+                    settings.curvatureFloor);
             Rgb sum{0.0f, 0.0f, 0.0f};
+            // E1/E2: the centre's CIELAB albedo and auxiliary value, and the per-channel weight sum.
+            const bool weighsTaps = settings.weighsTaps();
+            const glm::vec3 labCentre = weighsTaps && settings.labWeight > 0.0f
+                                            ? linearRec709ToLab(toVec3(surface.albedo[index]))
+                                            : glm::vec3(0.0f);
+            const float auxCentre = weighsTaps && settings.cbf ? surface.aux[index] : 0.0f;
+            auto texelWeight = [&](size_t texel) {
+                float weight = 1.0f;
+                if (settings.labWeight > 0.0f)
+                    weight *= labWeight(labCentre, linearRec709ToLab(toVec3(surface.albedo[texel])), settings.labWeight);
+                if (settings.cbf) weight *= auxiliaryWeight(auxCentre, surface.aux[texel], settings.cbfLambda);
+                return weight;
+            };
+            Rgb weightSum{0.0f, 0.0f, 0.0f};
             const int along = horizontal ? x : y;
             const int length = horizontal ? width : height;
             auto texelIndex = [&](int j) {
@@ -53,13 +76,39 @@ std::vector<Rgb> blurPass(const SurfaceBuffers& surface, const std::vector<Rgb>&
                                                    0.0f, 1.0f));
                     for (int c = 0; c < 3; ++c) values[t][c] = mix(input[texels[t]][c], centre[c], s);
                 }
-                for (int c = 0; c < 3; ++c)
-                    sum[c] += static_cast<float>(tap.weight[c]) * mix(values[0][c], values[1][c], fraction);
+                if (!weighsTaps) {
+                    for (int c = 0; c < 3; ++c)
+                        sum[c] += static_cast<float>(tap.weight[c]) * mix(values[0][c], values[1][c], fraction);
+                    continue;
+                }
+                const float share0 = (1.0f - fraction) * texelWeight(texels[0]);
+                const float share1 = fraction * texelWeight(texels[1]);
+                for (int c = 0; c < 3; ++c) {
+                    const float weight0 = static_cast<float>(tap.weight[c]) * share0;
+                    const float weight1 = static_cast<float>(tap.weight[c]) * share1;
+                    sum[c] += weight0 * values[0][c] + weight1 * values[1][c];
+                    weightSum[c] += weight0 + weight1;
+                }
             }
+            if (weighsTaps)
+                for (int c = 0; c < 3; ++c)
+                    sum[c] = resolveWeightedSum(glm::vec3(sum[c]), weightSum[c], glm::vec3(centre[c])).x;
             for (int c = 0; c < 3; ++c) output[index][c] = mix(centre[c], sum[c], centreMask);
         }
     }
     return output;
+}
+
+BlurSettings blurSettingsFromParams(const SssParams& params) {
+    BlurSettings settings;
+    settings.followSurface = params.followSurface;
+    settings.followSurfaceK = static_cast<float>(params.followSurfaceK);
+    settings.cbf = params.cbf;
+    settings.cbfLambda = static_cast<float>(params.cbfLambda);
+    settings.labWeight = static_cast<float>(params.labWeight);
+    settings.curvature = curvatureStrategyFromName(params.curvature, "sss");
+    settings.curvatureFloor = static_cast<float>(params.curvatureFloor);
+    return settings;
 }
 
 std::vector<Rgb> applyKernel(const SurfaceBuffers& surface, const std::vector<Rgb>& diffuse, const Kernel& kernel,

@@ -16,7 +16,18 @@
 //   result            mix(centre, Σ w_i · tap value_i, m_p)
 // Pixels with m_p = 0 are copied unchanged. (The shader reads the mask from the colour texture's alpha, which the
 // pipeline sets to the skin mask and every pass carries along; here it is SurfaceBuffers::mask.)
+//
+// The artifact extensions (docs/extensions.md; renderer/sss/extension_weights.h), as in
+// renderer/shaders/sss_extension_inputs.glsl:
+//   E3 sss.curvature   k_px × curvatureWidthScale(strategy, normalisedCurvature(κ_p, mm_per_unit), floor)
+//   E1/E2 (cbf, lab)   each texel j of tap i weighs w_i · (1 − f or f) · e_j with
+//                      e_j = labWeight(Lab(albedo_p), Lab(albedo_j), β) · auxiliaryWeight(F_p, F_j, λ);
+//                      Σ (weight · value_j) / Σ weight per channel, or the centre where Σ weight < 1e-4
+//                      (resolveWeightedSum), then mix(centre, ·, m_p) as above.
+// With both cbf and lab_weight off the tap loop is the one above, unchanged.
+#include "renderer/sss/extension_weights.h"
 #include "renderer/sss/kernel.h"
+#include "renderer/sss/sss_params.h"
 
 #include <array>
 #include <vector>
@@ -32,12 +43,26 @@ struct SurfaceBuffers {
     std::vector<float> mask;   // skin mask 0…1
     float focalLengthPixels = 0.0f;  // f_px = (H/2) / tan(fovY/2)
     float mmPerUnit = 1.0f;
+    // Extension inputs, read only while the matching switch of BlurSettings is on (may stay empty otherwise):
+    std::vector<Rgb> albedo;       // linear albedo (sss.lab_weight; the albedo AOV)
+    std::vector<float> aux;        // Mikkelsen's auxiliary image F (sss.cbf; the aux.Y AOV)
+    std::vector<float> curvature;  // curvature κ, 1/world unit, ≥ 0 (sss.curvature; the curvature.Y AOV)
 };
 
 struct BlurSettings {
     bool followSurface = true;
     float followSurfaceK = 0.5f;  // 1/mm
+    bool cbf = false;             // E1
+    float cbfLambda = 10.0f;      // λ, dimensionless
+    float labWeight = 0.0f;       // E2: β in 1/ΔE*ab, 0 = off
+    CurvatureStrategy curvature = CurvatureStrategy::Off;  // E3
+    float curvatureFloor = 0.5f;  // [0, 1]
+
+    bool weighsTaps() const { return cbf || labWeight > 0.0f; }
 };
+
+// Follow-surface and extension settings of resolved [sss] parameters.
+BlurSettings blurSettingsFromParams(const SssParams& params);
 
 enum class BlurAxis { Horizontal, Vertical };
 

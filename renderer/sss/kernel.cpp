@@ -60,6 +60,7 @@ Kernel makeKernel(const SssParams& params) {
         KernelStage stage = makePscbfKernel(mikkelsenSkinProfile(), params.samples).broadStage();
         scaleOffsets(stage.taps, scale);
         kernel.source = "Mikkelsen 2010 pseudo-separable cross-bilateral filter (spike + one Gaussian per channel)";
+        kernel.declaredSupportMm = mikkelsenSkinProfile().maxRadiusMm * scale;
         kernel.stages.push_back(std::move(stage));
         break;
     }
@@ -106,6 +107,7 @@ Kernel makeKernel(const SssParams& params) {
 }
 
 double Kernel::supportRadiusMm() const {
+    if (declaredSupportMm > 0.0) return declaredSupportMm;
     // Cascaded stages (gaussian-sum) blur the previous stage's result: their reaches combine as a root sum of
     // squares, exact for Gaussians truncated at the same number of standard deviations (variances add).
     double reachSquared = 0.0;

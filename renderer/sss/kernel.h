@@ -37,6 +37,9 @@ struct Kernel {
     // stages the root sum of squares of the stages' reaches (exact for Gaussians).
     double supportRadiusMm() const;
     nlohmann::json toJson() const;
+    // Set where the method's filter reaches further than its outermost tap (pscbf: the disc of radius r_max that
+    // bounds the filter, 4.5 mm × width_mm / 3, while its 13 taps sit at cell medians inside it); 0: from the taps.
+    double declaredSupportMm = 0.0;
 };
 
 // Share of a discretised channel's energy the taps leave outside the truncation radius of quadratic placement

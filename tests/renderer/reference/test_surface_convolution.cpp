@@ -172,15 +172,18 @@ TEST(SurfaceConvolution, ConvergesAsSampleDensityGrows) {
             irradiance[i] = glm::vec3(std::max(0.0f, glm::dot(samples.normal[i], light)));
         results.push_back(convolveSurface(samples, irradiance, *profile, {}, &receivers));
     }
+    // The adaptive tessellation refines each triangle only as far as the edge length asks, so successive densities
+    // are not nested 1 → 4 everywhere; convergence is measured against the finest result (0.5 mm): the difference
+    // must shrink at every refinement.
     std::vector<double> rms, worst;
-    for (std::size_t k = 1; k < results.size(); ++k) {
-        rms.push_back(rmsDifference(results[k - 1], results[k], receivers));
-        worst.push_back(maxDifference(results[k - 1], results[k], receivers));
-        std::printf("convergence: edge %.2g → %.2g mm: RMS difference %.6f, max %.6f\n", 8.0 / (1 << k), 4.0 / (1 << k),
-                    rms.back(), worst.back());
+    for (std::size_t k = 0; k + 1 < results.size(); ++k) {
+        rms.push_back(rmsDifference(results[k], results.back(), receivers));
+        worst.push_back(maxDifference(results[k], results.back(), receivers));
+        std::printf("convergence: edge %.2g mm vs 0.5 mm: RMS difference %.6f, max %.6f; vs the next density: RMS %.6f\n",
+                    4.0 / (1 << k), rms.back(), worst.back(), rmsDifference(results[k], results[k + 1], receivers));
     }
     for (std::size_t k = 1; k < rms.size(); ++k) EXPECT_LT(rms[k], rms[k - 1]) << k;
-    EXPECT_LT(worst.back(), 0.01);  // radiance ≤ albedo < 1: the last refinement changes < 1 % of white
+    EXPECT_LT(worst.back(), 0.01);  // radiance ≤ albedo < 1: 1 mm is within 1 % of white of 0.5 mm
 }
 
 TEST(SurfaceConvolution, OnlySkinScattersAndReceives) {

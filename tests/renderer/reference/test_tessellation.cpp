@@ -7,7 +7,10 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cstdio>
 #include <map>
+#include <set>
 
 using namespace skinlab::renderer;
 using namespace skinlab::renderer::reference;
@@ -22,6 +25,50 @@ std::map<std::pair<std::uint32_t, std::uint32_t>, int> edgeUses(const Model& mod
             ++uses[{std::min(a, b), std::max(a, b)}];
         }
     return uses;
+}
+
+// Vertex count the former uniform scheme (every skin triangle 1 → 4 each round until the longest skin edge fits)
+// reaches: V' = V + E, E' = 2E + 3T, T' = 4T per round, each round halving every edge.
+std::size_t uniformSchemeVertices(const Model& model, float targetEdgeMm, float mmPerUnit) {
+    std::size_t vertices = model.vertices.size(), edges = 0, triangles = 0;
+    std::map<std::pair<std::uint32_t, std::uint32_t>, int> allEdges;
+    for (const auto& part : model.parts) {
+        if (!model.materials[part.material].skin) continue;
+        for (const auto& [edge, count] : edgeUses(model, part)) allEdges[edge] += count;
+        triangles += part.indexCount / 3;
+    }
+    edges = allEdges.size();
+    for (float longest = longestSkinEdgeMm(model, mmPerUnit); longest > targetEdgeMm; longest *= 0.5f) {
+        vertices += edges;
+        edges = 2 * edges + 3 * triangles;
+        triangles *= 4;
+    }
+    return vertices;
+}
+
+// One skin part made of two disconnected pieces: a 5 mm square as a 10 × 10 grid of 0.5 mm cells (200 small
+// triangles) at x ∈ [-30, -25], and a 20 mm square of two triangles at x ∈ [0, 20].
+Model makeMixedSizes() {
+    Model model;
+    const auto addVertex = [&](float x, float y) {
+        Vertex v;
+        v.position = glm::vec3(x, y, 0.0f);
+        model.vertices.push_back(v);
+        return static_cast<std::uint32_t>(model.vertices.size() - 1);
+    };
+    for (int j = 0; j <= 10; ++j)
+        for (int i = 0; i <= 10; ++i) addVertex(-30.0f + 0.5f * float(i), 0.5f * float(j));
+    for (int j = 0; j < 10; ++j)
+        for (int i = 0; i < 10; ++i) {
+            const std::uint32_t v = static_cast<std::uint32_t>(j * 11 + i);
+            model.indices.insert(model.indices.end(), {v, v + 1, v + 12, v, v + 12, v + 11});
+        }
+    const std::uint32_t a = addVertex(0, 0), b = addVertex(20, 0), c = addVertex(20, 20), d = addVertex(0, 20);
+    model.indices.insert(model.indices.end(), {a, b, c, a, c, d});
+    model.parts.push_back({0, static_cast<std::uint32_t>(model.indices.size()), 0});
+    model.materials.push_back({"skin", glm::vec3(1.0f), true, 0.6f, 1.0f});
+    model.computeBounds();
+    return model;
 }
 
 double skinArea(const SurfaceSamples& samples) {
@@ -50,6 +97,49 @@ TEST(Tessellation, SplitsUntilTheTargetEdgeAndStaysConforming) {
         if (count == 1) ++boundary;
     }
     EXPECT_EQ(boundary, 4 * 16);  // only the square's outline is open
+}
+
+TEST(Tessellation, SplitsOnlyLongTrianglesOfAMixedMesh) {
+    const Model mixed = makeMixedSizes();
+    TessellationStatistics statistics;
+    const Model fine = tessellateSkin(mixed, 2.0f, 1.0f, &statistics);
+    EXPECT_LE(longestSkinEdgeMm(fine, 1.0f), 2.0f);
+    // The 200 small triangles (0.71 mm diagonals) are in the output unchanged, with the same vertex indices.
+    std::set<std::array<std::uint32_t, 3>> triangles;
+    for (std::size_t i = 0; i + 2 < fine.indices.size(); i += 3)
+        triangles.insert({fine.indices[i], fine.indices[i + 1], fine.indices[i + 2]});
+    for (std::size_t i = 0; i < 600; i += 3)
+        EXPECT_TRUE(triangles.count({mixed.indices[i], mixed.indices[i + 1], mixed.indices[i + 2]})) << "triangle " << i / 3;
+    for (std::size_t i = 0; i < mixed.vertices.size(); ++i) EXPECT_EQ(fine.vertices[i].position, mixed.vertices[i].position);
+    // Conforming: every edge used at most twice; the open edges are the two outlines (40 small + 4 × 2^k large).
+    int boundary = 0;
+    for (const auto& [edge, count] : edgeUses(fine, fine.parts[0])) {
+        EXPECT_LE(count, 2);
+        if (count == 1) ++boundary;
+    }
+    const std::size_t uniform = uniformSchemeVertices(mixed, 2.0f, 1.0f);
+    std::printf("mixed mesh at 2 mm: %zu vertices (%d rounds, %zu boundary edges); uniform scheme: %zu\n",
+                fine.vertices.size(), statistics.rounds, std::size_t(boundary), uniform);
+    EXPECT_EQ(boundary, 40 + 4 * 16);  // the 20 mm square's sides end at 1.25 mm, like the uniform scheme's
+    EXPECT_LT(fine.vertices.size() * 20, uniform);  // far below: only the large square is refined
+    // The 20 mm square is refined like the uniform scheme does it (17 × 17 grid), the small grid not at all.
+    EXPECT_EQ(fine.vertices.size(), 121u + 17u * 17u);
+}
+
+TEST(Tessellation, BuiltinHeadNeedsFarFewerVerticesThanUniformRounds) {
+    const Model head = makeHeadScene();
+    TessellationStatistics statistics;
+    const Model fine = tessellateSkin(head, 2.0f, 1.0f, &statistics);
+    const std::size_t uniform = uniformSchemeVertices(head, 2.0f, 1.0f);
+    std::printf("builtin:head at 2 mm: %zu -> %zu vertices in %d rounds (longest skin edge %.3f mm); uniform "
+                "scheme: %zu\n", head.vertices.size(), fine.vertices.size(), statistics.rounds,
+                statistics.longestSkinEdgeMm, uniform);
+    EXPECT_LE(statistics.longestSkinEdgeMm, 2.0f);
+    EXPECT_LT(fine.vertices.size() * 5, uniform);
+    for (const auto& part : fine.parts) {
+        if (!fine.materials[part.material].skin) continue;
+        for (const auto& [edge, count] : edgeUses(fine, part)) ASSERT_LE(count, 2);
+    }
 }
 
 TEST(Tessellation, ScalesWithMillimetresPerUnitAndKeepsNonSkinParts) {
