@@ -40,13 +40,14 @@ double luminance(const ExrImage& image, int x, int y) {
 } // namespace
 
 namespace {
-// Renders `scene` with none and every method at 64×48 and checks finite output, untouched non-skin pixels and that
-// the SSS changed the skin.
-void renderEveryMethod(Renderer& renderer, const std::string& scene) {
+// Renders `scene` with none and every method at 64×48 (both with `overrides`) and checks finite output, untouched
+// non-skin pixels and that the SSS changed the skin.
+void renderEveryMethod(Renderer& renderer, const std::string& scene, const std::vector<std::string>& overrides = {},
+                       const std::vector<std::string>& methods = kMethods) {
     TempFolder folder("sss-every-scene");
-    const ExrImage none = render(renderer, folder, scene, "none", {}, 64, 48);
-    for (const auto& method : kMethods) {
-        const ExrImage image = render(renderer, folder, scene, method, {}, 64, 48);
+    const ExrImage none = render(renderer, folder, scene, "none", overrides, 64, 48);
+    for (const auto& method : methods) {
+        const ExrImage image = render(renderer, folder, scene, method, overrides, 64, 48);
         double changed = 0.0;
         for (int y = 0; y < image.height; ++y)
             for (int x = 0; x < image.width; ++x) {
@@ -79,6 +80,22 @@ TEST(SssRender, EveryMethodRendersTheScannedHead) {
     if (!assets || !*assets) GTEST_SKIP() << "$SKINLAB_ASSETS unset: the scanned head is not available";
     renderEveryMethod(*renderer,
                       (std::filesystem::path(SKINLAB_SOURCE_DIR) / "renderer/scenes/lee-perry-smith.toml").string());
+}
+
+// Every screen-space method with every extension switched on at once (and transmittance with its curvature
+// option) on every built-in scene and the scanned head.
+TEST(SssRender, EveryMethodWithEveryExtensionRendersEveryScene) {
+    SKINLAB_REQUIRE_RENDERER(renderer);
+    const std::vector<std::string> all{"sss.cbf=true", "sss.lab_weight=0.09", "sss.curvature=reduce-floor",
+                                       "transmittance.enabled=true", "transmittance.curvature=true"};
+    const std::vector<std::string> methods{"gaussian-sum", "separable", "artistic", "pscbf"};
+    std::vector<std::string> scenes{"builtin:halo", "builtin:bleed", "builtin:ear", "builtin:head"};
+    const char* assets = std::getenv("SKINLAB_ASSETS");
+    if (assets && *assets)
+        scenes.push_back((std::filesystem::path(SKINLAB_SOURCE_DIR) / "renderer/scenes/lee-perry-smith.toml").string());
+    else
+        std::printf("  $SKINLAB_ASSETS unset: the scanned head is skipped\n");
+    for (const auto& scene : scenes) renderEveryMethod(*renderer, scene, all, methods);
 }
 
 TEST(SssRender, UniformlyLitSkinPlaneKeepsItsMean) {
