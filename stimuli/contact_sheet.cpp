@@ -86,6 +86,38 @@ std::string caption(const nlohmann::json& stimulus, const std::vector<std::strin
     return text.empty() ? stimulus.at("id").get<std::string>() : text;
 }
 
+// Splits a caption into lines no wider than `width` pixels at 13 px (OpenImageIO's text_size with `font`), at
+// spaces; a word wider than a line is cut. At most `maxLines` lines; "…" marks text left out.
+std::vector<std::string> wrapCaption(const std::string& caption, int width, int maxLines, const std::string& font) {
+    auto fits = [&](const std::string& text) {
+        const OIIO::ROI box = OIIO::ImageBufAlgo::text_size(text, 13, font);
+        return !box.defined() || box.width() <= width;  // no font: nothing is drawn anyway
+    };
+    std::vector<std::string> words;
+    std::istringstream in(caption);
+    for (std::string word; in >> word;) words.push_back(word);
+    std::vector<std::string> lines;
+    std::string current;
+    for (std::string word : words) {
+        while (!fits(word) && word.size() > 1) word.pop_back();
+        const std::string joined = current.empty() ? word : current + " " + word;
+        if (fits(joined)) {
+            current = joined;
+            continue;
+        }
+        lines.push_back(current);
+        current = word;
+    }
+    if (!current.empty()) lines.push_back(current);
+    if (static_cast<int>(lines.size()) > maxLines) {
+        lines.resize(static_cast<size_t>(maxLines));
+        std::string& last = lines.back();
+        while (!last.empty() && !fits(last + "…")) last.pop_back();
+        last += "…";
+    }
+    return lines;
+}
+
 std::string html(const Manifest& manifest, const std::vector<Block>& blocks) {
     std::ostringstream out;
     out << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>" << escapeHtml(manifest.set)
@@ -146,7 +178,9 @@ void writePng(const fs::path& path, const Manifest& manifest, const std::vector<
     int imageWidth = std::max(1, first.at("width").get<int>());
     int imageHeight = std::max(1, first.at("height").get<int>());
     const int thumbHeight = std::max(1, static_cast<int>(std::lround(double(thumbWidth) * imageHeight / imageWidth)));
-    constexpr int margin = 8, titleHeight = 22, captionHeight = 18, maxColumns = 8;
+    // Captions wrap at word boundaries to the thumbnail's width, up to kCaptionLines lines (the last one cut).
+    constexpr int margin = 8, titleHeight = 22, lineHeight = 16, kCaptionLines = 3, maxColumns = 8;
+    constexpr int captionHeight = lineHeight * kCaptionLines + 2;
     size_t columns = 1;
     for (const auto& b : blocks) columns = std::max(columns, std::min<size_t>(b.stimuli.size(), maxColumns));
     int height = margin;
@@ -185,7 +219,10 @@ void writePng(const fs::path& path, const Manifest& manifest, const std::vector<
             OIIO::ImageBuf thumb = thumbnail(dir / s.at("files").at("png").get<std::string>(), thumbWidth, thumbHeight);
             OIIO::ImageBufAlgo::paste(sheet, x, y, 0, 0, thumb);
             bool reference = s.at("reference").get<bool>();
-            label(x, y + thumbHeight + 14, caption(s, varying), reference ? accent : text);
+            const std::vector<std::string> lines = wrapCaption(caption(s, varying), thumbWidth, kCaptionLines, font);
+            for (size_t line = 0; line < lines.size(); ++line)
+                label(x, y + thumbHeight + 14 + static_cast<int>(line) * lineHeight, lines[line],
+                      reference ? accent : text);
         }
         y += thumbHeight + captionHeight + margin;
     }
