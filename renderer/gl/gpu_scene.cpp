@@ -8,20 +8,11 @@
 
 namespace skinlab::renderer::gl {
 
-void GpuScene::uploadModel(const Model& model, const std::vector<GpuMaterial>& partMaterials) {
-    GLuint name = 0;
-    glCreateBuffers(1, &name);
-    vertexBuffer_ = Buffer(name);
-    glNamedBufferStorage(name, static_cast<GLsizeiptr>(model.vertices.size() * sizeof(Vertex)), model.vertices.data(), 0);
-    glCreateBuffers(1, &name);
-    indexBuffer_ = Buffer(name);
-    glNamedBufferStorage(name, static_cast<GLsizeiptr>(model.indices.size() * sizeof(std::uint32_t)),
-                         model.indices.data(), 0);
-    glCreateVertexArrays(1, &name);
-    vertexArray_ = VertexArray(name);
-    const GLuint vao = name;
-    glVertexArrayVertexBuffer(vao, 0, vertexBuffer_.get(), 0, sizeof(Vertex));
-    glVertexArrayElementBuffer(vao, indexBuffer_.get());
+VertexArray createModelVertexArray(GLuint vertexBuffer, GLuint indexBuffer) {
+    GLuint vao = 0;
+    glCreateVertexArrays(1, &vao);
+    glVertexArrayVertexBuffer(vao, 0, vertexBuffer, 0, sizeof(Vertex));
+    glVertexArrayElementBuffer(vao, indexBuffer);
     struct Attribute {
         GLuint index;
         GLint size;
@@ -35,6 +26,19 @@ void GpuScene::uploadModel(const Model& model, const std::vector<GpuMaterial>& p
         glVertexArrayAttribFormat(vao, a.index, a.size, GL_FLOAT, GL_FALSE, static_cast<GLuint>(a.offset));
         glVertexArrayAttribBinding(vao, a.index, 0);
     }
+    return VertexArray(vao);
+}
+
+void GpuScene::uploadModel(const Model& model, const std::vector<GpuMaterial>& partMaterials) {
+    GLuint name = 0;
+    glCreateBuffers(1, &name);
+    vertexBuffer_ = Buffer(name);
+    glNamedBufferStorage(name, static_cast<GLsizeiptr>(model.vertices.size() * sizeof(Vertex)), model.vertices.data(), 0);
+    glCreateBuffers(1, &name);
+    indexBuffer_ = Buffer(name);
+    glNamedBufferStorage(name, static_cast<GLsizeiptr>(model.indices.size() * sizeof(std::uint32_t)),
+                         model.indices.data(), 0);
+    vertexArray_ = createModelVertexArray(vertexBuffer_.get(), indexBuffer_.get());
     parts_.clear();
     for (std::size_t i = 0; i < model.parts.size(); ++i)
         parts_.push_back({model.parts[i].firstIndex, model.parts[i].indexCount, partMaterials.at(i)});

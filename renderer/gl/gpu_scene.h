@@ -43,6 +43,10 @@ struct GpuLight {
     float normalOffset = 0.0f;       // world units
 };
 
+// A vertex array over a buffer of renderer::Vertex with the attribute layout main_pass.vert reads (locations 0–5:
+// position, normal, uv, tangent, colour, skin) and `indexBuffer` as its element buffer.
+VertexArray createModelVertexArray(GLuint vertexBuffer, GLuint indexBuffer);
+
 class GpuScene {
 public:
     // Uploads the model (positions in world units) and its parts' materials.

@@ -143,30 +143,10 @@ struct ReferenceMethod::Impl {
         entry->pointIndexBuffer = Buffer(name);
         glNamedBufferStorage(name, static_cast<GLsizeiptr>(std::max<std::size_t>(points.size(), 1) * sizeof(std::uint32_t)),
                              points.empty() ? nullptr : points.data(), 0);
-        // Two vertex arrays over the same vertices, with the same layout as GpuScene::uploadModel (main_pass.vert's
-        // attributes 0–5): triangles for the draw, points for the bake.
-        const auto makeVertexArray = [&](GLuint elements) {
-            GLuint vao = 0;
-            glCreateVertexArrays(1, &vao);
-            glVertexArrayVertexBuffer(vao, 0, entry->vertexBuffer.get(), 0, sizeof(Vertex));
-            glVertexArrayElementBuffer(vao, elements);
-            struct Attribute {
-                GLuint index;
-                GLint size;
-                std::size_t offset;
-            };
-            const Attribute attributes[] = {{0, 3, offsetof(Vertex, position)}, {1, 3, offsetof(Vertex, normal)},
-                                            {2, 2, offsetof(Vertex, uv)},       {3, 4, offsetof(Vertex, tangent)},
-                                            {4, 3, offsetof(Vertex, color)},    {5, 1, offsetof(Vertex, skin)}};
-            for (const Attribute& a : attributes) {
-                glEnableVertexArrayAttrib(vao, a.index);
-                glVertexArrayAttribFormat(vao, a.index, a.size, GL_FLOAT, GL_FALSE, static_cast<GLuint>(a.offset));
-                glVertexArrayAttribBinding(vao, a.index, 0);
-            }
-            return VertexArray(vao);
-        };
-        entry->vertexArray = makeVertexArray(entry->indexBuffer.get());
-        entry->pointVertexArray = makeVertexArray(entry->pointIndexBuffer.get());
+        // Two vertex arrays over the same vertices, with main_pass.vert's layout: triangles for the draw, points
+        // for the bake.
+        entry->vertexArray = createModelVertexArray(entry->vertexBuffer.get(), entry->indexBuffer.get());
+        entry->pointVertexArray = createModelVertexArray(entry->vertexBuffer.get(), entry->pointIndexBuffer.get());
         checkGl("reference: uploading the tessellated model");
         entry->tessellateMs = millisecondsSince(start);
         // A few entries: one stimulus set renders one or two models at one edge length.
