@@ -336,7 +336,6 @@ RenderResult Renderer::render(const RenderRequest& request) {
     sssInputs.projection = camera.projection;
     sssInputs.cameraPosition = camera.position;
     gl::SssStageSettings sssSettings;
-    sssSettings.method = spec.sssMethod;
     sssSettings.sss = spec.sss;
     sssSettings.transmittance = spec.transmittance;
     if (referenceMethod) {

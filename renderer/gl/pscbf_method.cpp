@@ -2,6 +2,7 @@
 
 #include "common/error.h"
 #include "renderer/gl/shader_library.h"
+#include "renderer/gl/sss_blur_pass.h"
 #include "renderer/gl/sss_extension_settings.h"
 #include "renderer/sss/pscbf_kernel.h"
 
@@ -21,10 +22,6 @@ constexpr int kMaxTaps = 101;  // PSCBF_MAX_TAPS of the shader (sss.samples ≤ 
 } // namespace
 
 PscbfMethod::PscbfMethod(ShaderLibrary& shaders) : shaders_(shaders) {}
-
-double PscbfMethod::supportRadiusMm(const sss::SssParams& params) {
-    return sss::mikkelsenSkinProfile().maxRadiusMm * params.widthMm / 3.0;
-}
 
 glm::dvec3 PscbfMethod::depthSigmaMm(const sss::SssParams& params) {
     const auto& variance = sss::mikkelsenSkinProfile().varianceMm2;
@@ -49,16 +46,8 @@ void PscbfMethod::run(const SssStageInputs& inputs, const sss::SssParams& params
     if (output == inputs.diffuse) throw RuntimeError("pscbf method: output texture must differ from the diffuse input");
     ensureScratch(inputs.width, inputs.height);
 
-    SssExtensionSettings extensions = SssExtensionSettings::fromParams(params);
-    extensions.albedoTexture = inputs.albedo;
-    extensions.auxTexture = inputs.aux;
-    extensions.curvatureTexture = inputs.curvature;
-
-    std::vector<glm::vec4> taps;
-    taps.reserve(stage.taps.size());
-    for (const auto& tap : stage.taps)
-        taps.emplace_back(static_cast<float>(tap.weight[0]), static_cast<float>(tap.weight[1]),
-                          static_cast<float>(tap.weight[2]), static_cast<float>(tap.offsetMm));
+    const SssExtensionSettings extensions =
+        SssExtensionSettings::fromParams(params, inputs.albedo, inputs.aux, inputs.curvature);
     // The spike is what the broad stage's accumulate weights leave (kernel.cpp: accumulate = 1 − spike).
     const glm::vec3 spike(static_cast<float>(1.0 - stage.accumulate[0]), static_cast<float>(1.0 - stage.accumulate[1]),
                           static_cast<float>(1.0 - stage.accumulate[2]));
@@ -73,9 +62,7 @@ void PscbfMethod::run(const SssStageInputs& inputs, const sss::SssParams& params
         ShaderDefines defines = extensions.defines();
         if (!horizontal) defines.emplace_back("PSCBF_FINAL_PASS", "1");
         const GLuint program = shaders_.program("fullscreen.vert", "pscbf_blur.frag", defines);
-        glProgramUniform4fv(program, glGetUniformLocation(program, "taps"), static_cast<GLsizei>(taps.size()),
-                            &taps[0].x);
-        setUniform(program, "tapCount", static_cast<int>(taps.size()));
+        setTapUniforms(program, stage);
         setUniform(program, "horizontal", horizontal ? 1 : 0);
         setUniform(program, "focalLengthPixels", inputs.focalLengthPixels);
         setUniform(program, "mmPerUnit", inputs.mmPerUnit);

@@ -25,9 +25,6 @@ public:
     // no tilt correction, no tangent-plane depth prediction).
     void run(const SssStageInputs& inputs, const sss::SssParams& params, const sss::Kernel& kernel, GLuint output);
 
-    // Radius of the filter disc on the surface, mm: r_max (4.5 mm, Mikkelsen's Table 1) × width_mm / 3, like the
-    // taps. The EXR attribute skinlab:sss_radius_mm for pscbf.
-    static double supportRadiusMm(const sss::SssParams& params);
     // σ_c of the depth range weight per channel, mm: √v_c × width_mm / 3 (the profile's own Gaussian; see the shader).
     static glm::dvec3 depthSigmaMm(const sss::SssParams& params);
 

@@ -14,6 +14,17 @@ namespace {
 constexpr GLuint kFirstExtensionTextureUnit = 2;
 } // namespace
 
+void setTapUniforms(GLuint program, const sss::KernelStage& stage) {
+    std::vector<glm::vec4> taps;
+    taps.reserve(stage.taps.size());
+    for (const auto& tap : stage.taps)
+        taps.emplace_back(static_cast<float>(tap.weight[0]), static_cast<float>(tap.weight[1]),
+                          static_cast<float>(tap.weight[2]), static_cast<float>(tap.offsetMm));
+    glProgramUniform4fv(program, glGetUniformLocation(program, "taps"), static_cast<GLsizei>(taps.size()),
+                        &taps[0].x);
+    setUniform(program, "tapCount", static_cast<int>(taps.size()));
+}
+
 SssBlurPass::SssBlurPass(ShaderLibrary& shaders) : shaders_(shaders) {}
 
 void SssBlurPass::run(const SssBlurPassInputs& inputs, const sss::KernelStage& stage, bool horizontal,
@@ -23,14 +34,7 @@ void SssBlurPass::run(const SssBlurPassInputs& inputs, const sss::KernelStage& s
     ShaderDefines defines = inputs.extensions.defines();
     if (accumulate) defines.emplace_back("SSS_ACCUMULATE", "1");
     const GLuint program = shaders_.program("fullscreen.vert", "sss_blur.frag", defines);
-    std::vector<glm::vec4> taps;
-    taps.reserve(stage.taps.size());
-    for (const auto& tap : stage.taps)
-        taps.emplace_back(static_cast<float>(tap.weight[0]), static_cast<float>(tap.weight[1]),
-                          static_cast<float>(tap.weight[2]), static_cast<float>(tap.offsetMm));
-    glProgramUniform4fv(program, glGetUniformLocation(program, "taps"), static_cast<GLsizei>(taps.size()),
-                        &taps[0].x);
-    setUniform(program, "tapCount", static_cast<int>(taps.size()));
+    setTapUniforms(program, stage);
     setUniform(program, "horizontal", horizontal ? 1 : 0);
     setUniform(program, "focalLengthPixels", inputs.focalLengthPixels);
     setUniform(program, "mmPerUnit", inputs.mmPerUnit);

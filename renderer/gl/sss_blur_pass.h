@@ -25,6 +25,10 @@ struct SssBlurPassInputs {
     SssExtensionSettings extensions;  // sss.cbf, sss.lab_weight, sss.curvature and their textures (default: all off)
 };
 
+// Uploads a stage's taps to the `taps` (vec4: xyz = RGB weight, w = offset in mm) and `tapCount` uniforms of a
+// blur program (sss_blur.frag, pscbf_blur.frag).
+void setTapUniforms(GLuint program, const sss::KernelStage& stage);
+
 class SssBlurPass {
 public:
     explicit SssBlurPass(ShaderLibrary& shaders);

@@ -4,6 +4,15 @@
 
 namespace skinlab::renderer::gl {
 
+SssExtensionSettings SssExtensionSettings::fromParams(const sss::SssParams& params, GLuint albedoTexture,
+                                                      GLuint auxTexture, GLuint curvatureTexture) {
+    SssExtensionSettings settings = fromParams(params);
+    settings.albedoTexture = albedoTexture;
+    settings.auxTexture = auxTexture;
+    settings.curvatureTexture = curvatureTexture;
+    return settings;
+}
+
 SssExtensionSettings SssExtensionSettings::fromParams(const sss::SssParams& params) {
     SssExtensionSettings settings;
     settings.cbf = params.cbf;

@@ -30,6 +30,9 @@ struct SssExtensionSettings {
 
     // The switches of resolved [sss] parameters (textures left 0: set them from SssStageInputs).
     static SssExtensionSettings fromParams(const sss::SssParams& params);
+    // The same with the three AOV textures (SssStageInputs::albedo, ::aux, ::curvature).
+    static SssExtensionSettings fromParams(const sss::SssParams& params, GLuint albedoTexture, GLuint auxTexture,
+                                           GLuint curvatureTexture);
 
     // True where E1 or E2 weigh the taps (the program then needs the SSS_EXTENSION_WEIGHTS variant).
     bool weighsTaps() const { return cbf || labWeight > 0.0f; }

@@ -37,21 +37,22 @@ SssStage::SssStage(ShaderLibrary& shaders) : impl_(std::make_unique<Impl>(shader
 SssStage::~SssStage() = default;
 
 void SssStage::run(const SssStageInputs& inputs, const SssStageSettings& settings, GLuint output) {
-    // --- pscbf (Mikkelsen 2010; pscbf engineer): its own two passes, renderer/gl/pscbf_method.h ---------------
-    if (settings.method == "pscbf") {
-        const sss::Kernel& kernel = impl_->kernelFor(settings);
+    if (output == inputs.diffuse) throw RuntimeError("SSS stage: output texture must differ from the diffuse input");
+    const sss::Kernel& kernel = impl_->kernelFor(settings);
+    const sss::SssParams& params = impl_->params;
+    switch (params.method) {
+    case sss::SssMethod::Reference:
+        // Computed on the surface, not on the screen: render_job.cpp runs ReferenceMethod instead of this stage.
+        throw RuntimeError("SSS stage: method reference is run by ReferenceMethod, not by the screen-space stage");
+    case sss::SssMethod::Pscbf: {
+        // Mikkelsen 2010: its own two passes (renderer/gl/pscbf_method.h).
         if (!impl_->pscbfMethod) impl_->pscbfMethod = std::make_unique<PscbfMethod>(impl_->shaders);
-        impl_->pscbfMethod->run(inputs, impl_->params, kernel, output);
+        impl_->pscbfMethod->run(inputs, params, kernel, output);
         return;
     }
-    // --- end pscbf -------------------------------------------------------------------------------------------
-    if (settings.method != "none" && settings.method != "gaussian-sum" && settings.method != "separable" &&
-        settings.method != "artistic")
-        throw InputError("sss.method: '" + settings.method +
-                         "' is not available in the GL pipeline (available: none, gaussian-sum, separable, artistic)");
-    if (output == inputs.diffuse) throw RuntimeError("SSS stage: output texture must differ from the diffuse input");
-    if (settings.method != "none") {
-        const sss::Kernel& kernel = impl_->kernelFor(settings);
+    case sss::SssMethod::GaussianSum:
+    case sss::SssMethod::Separable:
+    case sss::SssMethod::Artistic: {
         SssBlurPassInputs passInputs;
         passInputs.source = inputs.diffuse;
         passInputs.linearDepth = inputs.linearDepth;
@@ -59,14 +60,14 @@ void SssStage::run(const SssStageInputs& inputs, const SssStageSettings& setting
         passInputs.height = inputs.height;
         passInputs.focalLengthPixels = inputs.focalLengthPixels;
         passInputs.mmPerUnit = inputs.mmPerUnit;
-        passInputs.followSurface = impl_->params.followSurface;
-        passInputs.followSurfaceK = static_cast<float>(impl_->params.followSurfaceK);
-        passInputs.extensions = SssExtensionSettings::fromParams(impl_->params);
-        passInputs.extensions.albedoTexture = inputs.albedo;
-        passInputs.extensions.auxTexture = inputs.aux;
-        passInputs.extensions.curvatureTexture = inputs.curvature;
+        passInputs.followSurface = params.followSurface;
+        passInputs.followSurfaceK = static_cast<float>(params.followSurfaceK);
+        passInputs.extensions = SssExtensionSettings::fromParams(params, inputs.albedo, inputs.aux, inputs.curvature);
         impl_->kernelMethod.run(passInputs, kernel, output);
         return;
+    }
+    case sss::SssMethod::None:
+        break;
     }
     // A framebuffer per run: texture names are recycled when the frame is resized, so caching one by name
     // could keep drawing into a deleted texture.
@@ -86,11 +87,7 @@ void SssStage::run(const SssStageInputs& inputs, const SssStageSettings& setting
 }
 
 float SssStage::supportRadiusMm(const SssStageSettings& settings) const {
-    if (settings.method == "none") return 0.0f;
-    if (settings.method == "pscbf") {  // pscbf: the filter disc's radius r_max × width_mm / 3 (pscbf_method.h)
-        impl_->kernelFor(settings);
-        return static_cast<float>(PscbfMethod::supportRadiusMm(impl_->params));
-    }
+    // 0 for none; pscbf's kernel declares its filter disc r_max × width_mm / 3 (renderer/sss/kernel.h).
     return static_cast<float>(impl_->kernelFor(settings).supportRadiusMm());
 }
 

@@ -44,9 +44,8 @@ struct SssStageInputs {
 };
 
 // The resolved [sss] and [transmittance] tables of the scene (as in the EXR's skinlab:resolved metadata,
-// e.g. {"method":"none", ...}); parsed into typed parameters by renderer/sss/sss_params.h.
+// e.g. {"method":"none", ...}); parsed into typed parameters by renderer/sss/sss_params.h. The method is sss.method.
 struct SssStageSettings {
-    std::string method = "none";
     nlohmann::json sss = nlohmann::json::object();
     nlohmann::json transmittance = nlohmann::json::object();
 };

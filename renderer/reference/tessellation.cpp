@@ -155,19 +155,21 @@ void splitMarked(Model& model, std::unordered_map<std::uint64_t, std::uint32_t>&
     }
     model.indices = std::move(indices);
 }
+// Calls visit(a, b, c) with the corner positions (world units) of every triangle of the skin parts.
+template <class Visit>
+void forEachSkinTrianglePositions(const Model& model, Visit&& visit) {
+    forEachSkinTriangle(model, [&](const std::uint32_t* corner) {
+        visit(model.vertices[corner[0]].position, model.vertices[corner[1]].position,
+              model.vertices[corner[2]].position);
+    });
+}
 } // namespace
 
 float longestSkinEdgeMm(const Model& model, float mmPerUnit) {
     float longest = 0.0f;
-    for (const auto& part : model.parts) {
-        if (!isSkinPart(model, part)) continue;
-        for (std::uint32_t i = part.firstIndex; i + 2 < part.firstIndex + part.indexCount; i += 3) {
-            const glm::vec3& a = model.vertices[model.indices[i]].position;
-            const glm::vec3& b = model.vertices[model.indices[i + 1]].position;
-            const glm::vec3& c = model.vertices[model.indices[i + 2]].position;
-            longest = std::max({longest, glm::length(a - b), glm::length(b - c), glm::length(c - a)});
-        }
-    }
+    forEachSkinTrianglePositions(model, [&](const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
+        longest = std::max({longest, glm::length(a - b), glm::length(b - c), glm::length(c - a)});
+    });
     return longest * mmPerUnit;
 }
 
@@ -178,15 +180,9 @@ Model tessellateSkin(const Model& model, float targetEdgeMm, float mmPerUnit, Te
     // Refuse at once what cannot fit: every final skin triangle has edges ≤ the target, so area ≤ (√3/4)·edge²,
     // and a triangle mesh has at least half as many vertices as triangles (Euler, up to its boundary and genus).
     double skinAreaMm2 = 0.0;
-    for (const auto& part : model.parts) {
-        if (!isSkinPart(model, part)) continue;
-        for (std::uint32_t i = part.firstIndex; i + 2 < part.firstIndex + part.indexCount; i += 3) {
-            const glm::vec3& a = model.vertices[model.indices[i]].position;
-            const glm::vec3& b = model.vertices[model.indices[i + 1]].position;
-            const glm::vec3& c = model.vertices[model.indices[i + 2]].position;
-            skinAreaMm2 += 0.5 * double(glm::length(glm::cross(b - a, c - a))) * double(mmPerUnit) * double(mmPerUnit);
-        }
-    }
+    forEachSkinTrianglePositions(model, [&](const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
+        skinAreaMm2 += 0.5 * double(glm::length(glm::cross(b - a, c - a))) * double(mmPerUnit) * double(mmPerUnit);
+    });
     const double fewestVertices = 0.5 * skinAreaMm2 / (0.25 * std::sqrt(3.0) * double(targetEdgeMm) * double(targetEdgeMm));
     if (fewestVertices > double(maxVertices))
         throwInput("reference", "edge_mm",

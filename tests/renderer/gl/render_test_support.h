@@ -109,6 +109,27 @@ private:
     std::filesystem::path path_;
 };
 
+// Renders `scene` with `method` (and the `overrides`, as --set) at width × height into `exrPath`; the assets come
+// from $SKINLAB_ASSETS (the renderer's default).
+inline RenderResult renderToExr(Renderer& renderer, const std::string& scene, const std::string& method,
+                                std::vector<std::string> overrides, int width, int height,
+                                const std::filesystem::path& exrPath) {
+    RenderRequest request;
+    request.scene = scene;
+    request.method = method;
+    request.overrides = std::move(overrides);
+    request.width = width;
+    request.height = height;
+    request.exrPath = exrPath;
+    return renderer.render(request);
+}
+
+// Rec. 709 luminance of the diffuse AOV (after SSS) at a pixel.
+inline double diffuseLuminance(const ExrImage& image, int x, int y) {
+    return 0.2126 * image.at("diffuse.R", x, y) + 0.7152 * image.at("diffuse.G", x, y) +
+           0.0722 * image.at("diffuse.B", x, y);
+}
+
 inline std::string readText(const std::filesystem::path& path) {
     std::ifstream in(path, std::ios::binary);
     return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());

@@ -63,7 +63,9 @@ TEST(SurfaceAovs, SphereCurvatureIsOneOverItsRadius) {
         for (int y = 0; y < image.height; ++y)
             for (int x = 0; x < image.width; ++x) {
                 ASSERT_GE(image.at("curvature.Y", x, y), 0.0f);
-                if (image.at("mask.Y", x, y) == 0.0f) ASSERT_EQ(image.at("curvature.Y", x, y), 0.0f) << x << "," << y;
+                if (image.at("mask.Y", x, y) == 0.0f) {
+                    ASSERT_EQ(image.at("curvature.Y", x, y), 0.0f) << x << "," << y;
+                }
             }
     }
 }

@@ -110,7 +110,9 @@ TEST(Transmittance, ThickerFinsTransmitLess) {
         const double mean = skinMean(image, "transmittance.R");
         std::printf("builtin:ear thickness %.1f mm, translucency 0.8: skin transmittance.R mean %.5f\n", thicknessMm, mean);
         EXPECT_GT(mean, 0.0);
-        if (!first) EXPECT_LT(mean, previous * 0.8) << thicknessMm << " mm";
+        if (!first) {
+            EXPECT_LT(mean, previous * 0.8) << thicknessMm << " mm";
+        }
         previous = mean;
         first = false;
     }

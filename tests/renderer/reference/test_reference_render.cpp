@@ -24,17 +24,10 @@ struct Rendered {
 
 Rendered renderScene(Renderer& renderer, const TempFolder& folder, const std::string& name, const std::string& scene,
                      const std::string& method, std::vector<std::string> overrides, int size = 96) {
-    RenderRequest request;
-    request.scene = scene;
-    request.overrides = std::move(overrides);
-    request.method = method;
-    request.width = size;
-    request.height = size;
-    request.exrPath = folder / (name + ".exr");
-    if (const char* assets = std::getenv("SKINLAB_ASSETS")) request.assetsDir = assets;
     Rendered out;
-    out.timings = renderer.render(request).timingsMs;
-    out.image = readExr(request.exrPath);
+    out.timings = test::renderToExr(renderer, scene, method, std::move(overrides), size, size, folder / (name + ".exr"))
+                      .timingsMs;
+    out.image = readExr(folder / (name + ".exr"));
     return out;
 }
 

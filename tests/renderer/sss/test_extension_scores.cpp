@@ -35,15 +35,8 @@ const std::vector<std::string> kScreenSpaceMethods{"gaussian-sum", "separable", 
 std::filesystem::path renderExr(Renderer& renderer, const TempFolder& folder, const std::string& name,
                                 const std::string& scene, const std::string& method,
                                 std::vector<std::string> overrides) {
-    RenderRequest request;
-    request.scene = scene;
-    request.method = method;
-    request.overrides = std::move(overrides);
-    request.width = kSize;
-    request.height = kSize;
-    request.exrPath = folder / (name + ".exr");
-    renderer.render(request);
-    return request.exrPath;
+    test::renderToExr(renderer, scene, method, std::move(overrides), kSize, kSize, folder / (name + ".exr"));
+    return folder / (name + ".exr");
 }
 
 metrics::PreparedReference prepare(const std::filesystem::path& referenceExr) {

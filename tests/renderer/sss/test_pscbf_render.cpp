@@ -37,21 +37,11 @@ using test::TempFolder;
 
 ExrImage render(Renderer& renderer, const TempFolder& folder, const std::string& scene, const std::string& method,
                 std::vector<std::string> overrides, int width, int height) {
-    RenderRequest request;
-    request.scene = scene;
-    request.method = method;
-    request.overrides = std::move(overrides);
-    request.width = width;
-    request.height = height;
-    request.exrPath = folder / (method + ".exr");
-    renderer.render(request);
-    return readExr(request.exrPath);
+    test::renderToExr(renderer, scene, method, std::move(overrides), width, height, folder / (method + ".exr"));
+    return readExr(folder / (method + ".exr"));
 }
 
-double luminance(const ExrImage& image, int x, int y) {
-    return 0.2126 * image.at("diffuse.R", x, y) + 0.7152 * image.at("diffuse.G", x, y) +
-           0.0722 * image.at("diffuse.B", x, y);
-}
+double luminance(const ExrImage& image, int x, int y) { return test::diffuseLuminance(image, x, y); }
 
 // Renders `scene` with none and pscbf at 64×48: finite output, non-skin pixels untouched, skin changed, support
 // radius r_max = 4.5 mm at the default width.
@@ -171,7 +161,6 @@ std::vector<std::array<float, 4>> runStage(const SyntheticFrame& frame, const ss
     inputs.focalLengthPixels = frame.focalLengthPixels;
     inputs.mmPerUnit = frame.mmPerUnit;
     gl::SssStageSettings settings;
-    settings.method = "pscbf";
     settings.sss = params.toJson();
     stageFixture().stage->run(inputs, settings, output.get());
     std::vector<std::array<float, 4>> out(frame.diffuse.size());

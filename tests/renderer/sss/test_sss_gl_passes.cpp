@@ -87,7 +87,6 @@ std::vector<Rgb> runOnGpu(const sss::SurfaceBuffers& surface, const std::vector<
     inputs.focalLengthPixels = surface.focalLengthPixels;
     inputs.mmPerUnit = surface.mmPerUnit;
     gl::SssStageSettings settings;
-    settings.method = std::string(sss::methodName(params.method));
     settings.sss = params.toJson();
     fixture().stage->run(inputs, settings, output.get());
     std::vector<float> out(rgba.size());
