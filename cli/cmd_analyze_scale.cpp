@@ -8,6 +8,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 
@@ -71,7 +72,7 @@ struct ValidateArguments {
     bool check = false;
 };
 
-// The targets of issue 7 (docs/analysis.md, "Validation"); returns the failed ones.
+// The validation targets (docs/analysis.md, "Validation"); returns the failed ones.
 std::vector<std::string> failedTargets(const scaling::ValidationReport& report) {
     std::vector<std::string> failed;
     char line[256];
@@ -97,10 +98,16 @@ std::vector<std::string> failedTargets(const scaling::ValidationReport& report) 
 
 void runValidate(ValidateArguments& arguments) {
     arguments.options.correction = scaling::parseCorrection(arguments.correction);
+    const std::vector<std::string>& known = scaling::validationScenarios();
+    std::string names;
+    for (const std::string& name : known) names += (names.empty() ? "" : ", ") + name;
     for (const std::string& scenario : arguments.options.scenarios)
-        if (scenario != "thurstone" && scenario != "lapses+side-bias" && scenario != "screening")
-            throwInput("--scenarios", "", "'" + scenario + "' is not one of thurstone, lapses+side-bias, screening");
+        if (std::find(known.begin(), known.end(), scenario) == known.end())
+            throwInput("--scenarios", "", "'" + scenario + "' is not one of " + names);
     if (arguments.options.trueScores.size() < 2) throwInput("--scores", "", "needs at least 2 true scores");
+    if (2 * static_cast<size_t>(arguments.options.disconnectedGroups) > arguments.options.trueScores.size())
+        throwInput("--groups", "", std::to_string(arguments.options.disconnectedGroups) +
+                                       " groups need at least 2 true scores each");
     for (int observers : arguments.options.observerCounts)
         if (observers < 2 + arguments.options.randomObservers + arguments.options.invertedObservers)
             throwInput("--observers", "", std::to_string(observers) + " is too few (at least 2 genuine observers)");
@@ -198,11 +205,22 @@ void registerAnalyzeScale(CLI::App& analyze) {
     validate->add_option("--whisker", o.screeningWhisker, "inter-quartile rule factor w")
         ->check(CLI::Range(0.0, 10.0))
         ->capture_default_str();
-    validate->add_option("--scenarios", o.scenarios, "thurstone, lapses+side-bias, screening")
+    validate->add_option("--pair-fraction", o.sparsePairFraction, "share of the pairs each observer judges (sparse)")
+        ->check(CLI::Range(0.05, 1.0))
+        ->capture_default_str();
+    validate->add_option("--groups", o.disconnectedGroups, "groups of conditions never compared (disconnected)")
+        ->check(CLI::Range(2, 100))
+        ->capture_default_str();
+    validate->add_option("--stretch", o.nearUnanimousStretch, "factor on the true scores (near-unanimous)")
+        ->check(CLI::Range(1.0, 100.0))
+        ->capture_default_str();
+    validate->add_option("--scenarios", o.scenarios,
+                         "thurstone, lapses+side-bias, screening, sparse, disconnected, near-unanimous")
         ->delimiter(',')
         ->capture_default_str();
     validate->add_flag("--check", validateArguments->check,
-                       "exit 1 unless issue 7's targets are met (coverage, RMSE, reversals, screening)");
+                       "exit 1 unless the validation targets are met (coverage, RMSE, reversals, screening, "
+                       "finite intervals)");
     validate->callback([validateArguments] { runValidate(*validateArguments); });
 }
 

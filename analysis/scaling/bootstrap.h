@@ -12,12 +12,19 @@
 // 16:927), which reached 95 % coverage at 10 observers in simulation where the equal-tailed
 // [q̂ − t*_(0.975)·se, q̂ − t*_(0.025)·se] stopped at 94.8 %. Differences q_i − q_j are handled the same way;
 // their p-value is 2Φ(−|t_obs|·1.95996/|t|*_(0.95)), so p < 0.05 exactly when the 95 % interval excludes 0.
+//
+// Studentization needs a spread to divide by. Where it is degenerate — observers who all answer alike (se ≈ 0),
+// resamples without spread (se* ≈ 0), extreme |t*|, a disconnected comparison graph, unanimous pairs (the win
+// graph not strongly connected, Ford 1957) — a score or difference falls back, with its reasons recorded, to the
+// hull of the percentile interval and the profile-posterior interval (profile_likelihood.h), and a difference's
+// p-value to the score test. docs/analysis.md, "When the bootstrap is degenerate".
 #include "analysis/scaling/comparison_data.h"
 #include "analysis/scaling/pairwise_model.h"
 
 #include <Eigen/Dense>
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace skinlab::analysis::scaling {
@@ -34,18 +41,38 @@ struct BootstrapOptions {
 Eigen::MatrixXd robustCovariance(const BlockData& block, const Eigen::VectorXd& weights, const FitResult& fit,
                                  Model model);
 
+// Why an interval is not the studentized one (empty: it is). Names as written to scale.json.
+struct IntervalDiagnosis {
+    bool fallback = false;
+    std::vector<std::string> reasons;  // "disconnected", "unanimous", "observers-agree", "zero-spread-resamples",
+                                       // "extreme-t", "bound-at-search-cap"
+};
+
 struct DifferenceTest {
     int first = 0, second = 0;  // condition indices, first < second
     double difference = 0.0;    // q_first − q_second (JOD)
     double standardError = 0.0;
-    double low = 0.0, high = 0.0;  // studentized interval of the difference
-    double pValue = 1.0;           // two-sided, unadjusted
+    double low = 0.0, high = 0.0;  // studentized interval of the difference (or the fallback, see diagnosis)
+    double pValue = 1.0;           // two-sided, unadjusted (studentized, or the score test for a fallback)
+    IntervalDiagnosis diagnosis;
 };
+
+// Structure of a block's comparison graph: connected components (pairs compared at least once) and strongly
+// connected components of the win graph ("i beat j at least once"). Within a strongly connected component every
+// difference has a finite ML estimate; across two, the data bound it on one side only.
+struct DesignStructure {
+    std::vector<int> component;          // per condition
+    std::vector<int> stronglyConnected;  // per condition
+    int components = 0, stronglyConnectedComponents = 0;
+};
+DesignStructure designStructure(const BlockData& block);
 
 struct BootstrapResult {
     int samples = 0;
     Eigen::VectorXd standardError;      // robust (sandwich) SE of each score
-    Eigen::VectorXd low, high;          // studentized bootstrap interval
+    Eigen::VectorXd low, high;          // studentized bootstrap interval, or the fallback (see scoreDiagnoses)
+    Eigen::VectorXd modelStandardError; // from the posterior information (Fisher), for the diagnosis
+    std::vector<IntervalDiagnosis> scoreDiagnoses;  // per condition
     Eigen::VectorXd percentileLow, percentileHigh;  // pwcmp's construction, for comparison only
     Eigen::VectorXd bootstrapMean;
     Eigen::MatrixXd bootstrapCovariance;

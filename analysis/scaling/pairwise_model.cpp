@@ -70,6 +70,48 @@ double logLikelihood(Model model, const std::vector<std::pair<int, int>>& pairs,
     return total;
 }
 
+namespace {
+
+// Gradient and negative Hessian (plus 1 1ᵀ for the mean penalty) of the log posterior at q.
+void assemble(const PairCounts& counts, const FitOptions& options, const Eigen::VectorXd& q, Eigen::VectorXd& gradient,
+              Eigen::MatrixXd& information) {
+    const int m = counts.conditions;
+    const double md = static_cast<double>(m);
+    const double sum = q.sum();
+    // prior: −τ/2 Σ_{i<j}(q_i − q_j)²  ⇒  gradient −τ(m q − Σq), negative Hessian τ(m I − 1 1ᵀ);
+    // mean penalty −½(Σq)²  ⇒  gradient −Σq, negative Hessian 1 1ᵀ.
+    gradient = -options.priorPrecision * (md * q - Eigen::VectorXd::Constant(m, sum)) - Eigen::VectorXd::Constant(m, sum);
+    information.setConstant(m, m, 1.0 - options.priorPrecision);
+    information.diagonal().array() += options.priorPrecision * md;
+    for (size_t p = 0; p < counts.pairs.size(); ++p) {
+        const auto [i, j] = counts.pairs[p];
+        const double d = q[i] - q[j];
+        double slope = 0.0, weight = 0.0;
+        if (counts.first[p] > 0) {
+            const LinkValues v = linkValues(options.model, d);
+            slope += counts.first[p] * v.slope;
+            weight -= counts.first[p] * v.curvature;
+        }
+        if (counts.second[p] > 0) {
+            const LinkValues v = linkValues(options.model, -d);
+            slope -= counts.second[p] * v.slope;
+            weight -= counts.second[p] * v.curvature;
+        }
+        gradient[i] += slope;
+        gradient[j] -= slope;
+        information(i, i) += weight;
+        information(j, j) += weight;
+        information(i, j) -= weight;
+        information(j, i) -= weight;
+    }
+}
+
+} // namespace
+
+double logPosterior(const PairCounts& counts, const FitOptions& options, const Eigen::VectorXd& scores) {
+    return objective(counts, options, scores, nullptr);
+}
+
 FitResult fitScores(const PairCounts& counts, const FitOptions& options, const Eigen::VectorXd* start) {
     const int m = counts.conditions;
     FitResult result;
@@ -79,39 +121,8 @@ FitResult fitScores(const PairCounts& counts, const FitOptions& options, const E
     double current = objective(counts, options, result.scores, nullptr);
     const double md = static_cast<double>(m);
 
-    auto assemble = [&](const Eigen::VectorXd& q) {
-        const double sum = q.sum();
-        // prior: −τ/2 Σ_{i<j}(q_i − q_j)²  ⇒  gradient −τ(m q − Σq), negative Hessian τ(m I − 1 1ᵀ);
-        // mean penalty −½(Σq)²  ⇒  gradient −Σq, negative Hessian 1 1ᵀ.
-        gradient = -options.priorPrecision * (md * q - Eigen::VectorXd::Constant(m, sum)) -
-                   Eigen::VectorXd::Constant(m, sum);
-        information.setConstant(1.0 - options.priorPrecision);
-        information.diagonal().array() += options.priorPrecision * md;
-        for (size_t p = 0; p < counts.pairs.size(); ++p) {
-            const auto [i, j] = counts.pairs[p];
-            const double d = q[i] - q[j];
-            double slope = 0.0, weight = 0.0;
-            if (counts.first[p] > 0) {
-                const LinkValues v = linkValues(options.model, d);
-                slope += counts.first[p] * v.slope;
-                weight -= counts.first[p] * v.curvature;
-            }
-            if (counts.second[p] > 0) {
-                const LinkValues v = linkValues(options.model, -d);
-                slope -= counts.second[p] * v.slope;
-                weight -= counts.second[p] * v.curvature;
-            }
-            gradient[i] += slope;
-            gradient[j] -= slope;
-            information(i, i) += weight;
-            information(j, j) += weight;
-            information(i, j) -= weight;
-            information(j, i) -= weight;
-        }
-    };
-
     for (result.iterations = 0; result.iterations < options.maxIterations; ++result.iterations) {
-        assemble(result.scores);
+        assemble(counts, options, result.scores, gradient, information);
         const Eigen::LDLT<Eigen::MatrixXd> solver(information);
         Eigen::VectorXd step = solver.solve(gradient);
         // Backtracking: the log posterior is concave, so a full Newton step is accepted except far from the
@@ -132,12 +143,51 @@ FitResult fitScores(const PairCounts& counts, const FitOptions& options, const E
             break;
         }
     }
-    assemble(result.scores);
+    assemble(counts, options, result.scores, gradient, information);
     result.inverseInformation = information.ldlt().solve(Eigen::MatrixXd::Identity(m, m));
     // `information` has eigenvalue m along 1/√m (the mean penalty); remove that direction so the matrix is the
     // covariance of the mean-zero scores.
     result.inverseInformation.array() -= 1.0 / (md * md);
     objective(counts, options, result.scores, &result.logLikelihood);
+    return result;
+}
+
+ConstrainedFit fitConstrained(const PairCounts& counts, const FitOptions& options, const Eigen::VectorXd& contrast,
+                              double value, const Eigen::VectorXd& start) {
+    const int m = counts.conditions;
+    ConstrainedFit result;
+    result.scores = start + contrast * ((value - contrast.dot(start)) / contrast.squaredNorm());
+    Eigen::VectorXd gradient(m);
+    Eigen::MatrixXd information(m, m);
+    double current = objective(counts, options, result.scores, nullptr);
+    for (int iteration = 0; iteration < options.maxIterations; ++iteration) {
+        assemble(counts, options, result.scores, gradient, information);
+        // Newton step of the Lagrangian: maximise along the directions that keep aᵀq fixed,
+        // step = I⁻¹(g − μ a) with μ chosen so that aᵀ step = 0.
+        const Eigen::LDLT<Eigen::MatrixXd> solver(information);
+        const Eigen::VectorXd towardOptimum = solver.solve(gradient);
+        const Eigen::VectorXd alongContrast = solver.solve(contrast);
+        const Eigen::VectorXd step =
+            towardOptimum - alongContrast * (contrast.dot(towardOptimum) / contrast.dot(alongContrast));
+        double scale = 1.0;
+        Eigen::VectorXd candidate = result.scores + step;
+        double candidateValue = objective(counts, options, candidate, nullptr);
+        while (candidateValue < current - 1e-12 * std::abs(current) && scale > 1e-6) {
+            scale *= 0.5;
+            candidate = result.scores + scale * step;
+            candidateValue = objective(counts, options, candidate, nullptr);
+        }
+        result.scores = candidate;
+        current = candidateValue;
+        if ((scale * step).cwiseAbs().maxCoeff() < options.tolerance) {
+            result.converged = true;
+            break;
+        }
+    }
+    assemble(counts, options, result.scores, gradient, information);
+    result.logPosterior = current;
+    result.gradient = gradient;
+    result.information = information;
     return result;
 }
 

@@ -44,7 +44,7 @@ struct FitOptions {
     Model model = Model::Thurstone;
     // Precision (1/JOD²) of the zero-mean Gaussian prior put on every difference q_i − q_j, compared or not.
     // 0.002 moves the pwcmp oracle (100 trials per compared pair) by 2.5e-4 JOD (0.01 would move it by 1.2e-3),
-    // yet bounds a unanimous 10:0 pair near 5.5 JOD and ties the components of a disconnected design together.
+    // yet bounds a unanimous 10:0 pair (at 4.96 JOD) and ties the components of a disconnected design together.
     double priorPrecision = 0.002;
     int maxIterations = 100;
     double tolerance = 1e-10;  // stop when the largest Newton step is below this (JOD)
@@ -61,6 +61,21 @@ struct FitResult {
 
 // Maximum a posteriori scores. `start` (optional) warm-starts Newton's method (used by the bootstrap).
 FitResult fitScores(const PairCounts& counts, const FitOptions& options, const Eigen::VectorXd* start = nullptr);
+
+// The log posterior that fitScores maximises (data term − prior − mean penalty) at given scores.
+double logPosterior(const PairCounts& counts, const FitOptions& options, const Eigen::VectorXd& scores);
+
+// Maximum of the log posterior subject to aᵀq = value, for a contrast a orthogonal to 1 (so the scale's mean stays
+// 0): the profile of the posterior along aᵀq. Newton's method on the Lagrangian, warm-started at `start`.
+struct ConstrainedFit {
+    Eigen::VectorXd scores;
+    double logPosterior = 0.0;
+    Eigen::VectorXd gradient;      // of the log posterior at `scores` (parallel to a at the optimum)
+    Eigen::MatrixXd information;   // negative Hessian of the log posterior plus 1 1ᵀ, at `scores`
+    bool converged = false;
+};
+ConstrainedFit fitConstrained(const PairCounts& counts, const FitOptions& options, const Eigen::VectorXd& contrast,
+                              double value, const Eigen::VectorXd& start);
 
 // Log-likelihood of counts (per pair first/second) under given scores.
 double logLikelihood(Model model, const std::vector<std::pair<int, int>>& pairs, const Eigen::VectorXd& first,

@@ -13,7 +13,7 @@ namespace skinlab::analysis::scaling {
 namespace {
 
 const cv::Scalar kBlack(0, 0, 0), kGrey(150, 150, 150), kLightGrey(225, 225, 225), kWhite(255, 255, 255);
-const cv::Scalar kBlue(180, 90, 30);  // BGR
+const cv::Scalar kBlue(180, 90, 30), kOrange(0, 120, 230);  // BGR
 constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 
 // OpenCV's Hershey fonts draw ASCII only; other bytes become '?'. Long labels are shortened with "..".
@@ -55,13 +55,31 @@ std::string format(const char* pattern, double value) {
 
 cv::Mat plotScores(const BlockAnalysis& block) {
     const int m = static_cast<int>(block.conditions.size());
-    const int left = 80, right = 30, top = 60, bottom = 110, slot = 90;
-    const int width = std::max(520, left + right + slot * m), height = 460;
+    const int left = 80, right = 30, top = 60, bottom = 130, slot = 90;
+    const int width = std::max(560, left + right + slot * m), height = 480;
     cv::Mat image(height, width, CV_8UC3, kWhite);
-    double low = 0.0, high = 0.0;
+    // The axis never depends on the size of a bound: it spans the scores plus a margin (half their range, at least
+    // 1.5 JOD); bounds beyond it are clipped and drawn as arrows (the table and scale.json hold their values).
+    double scoreLow = 0.0, scoreHigh = 0.0;
     for (int i = 0; i < m; ++i) {
-        low = std::min({low, block.low[i], block.thurstone.scores[i]});
-        high = std::max({high, block.high[i], block.thurstone.scores[i]});
+        const double q = block.thurstone.scores[i];
+        if (!std::isfinite(q)) continue;
+        scoreLow = std::min(scoreLow, q);
+        scoreHigh = std::max(scoreHigh, q);
+    }
+    const double margin = std::max(1.5, 0.5 * (scoreHigh - scoreLow));
+    const double windowLow = scoreLow - margin, windowHigh = scoreHigh + margin;
+    auto clipped = [&](double value) { return !std::isfinite(value) || value < windowLow || value > windowHigh; };
+    auto clip = [&](double value, double fallback) {
+        return std::isfinite(value) ? std::clamp(value, windowLow, windowHigh) : fallback;
+    };
+    double low = scoreLow, high = scoreHigh;
+    bool anyClipped = false, anyFallback = false;
+    for (int i = 0; i < m; ++i) {
+        low = std::min(low, clip(block.low[i], windowLow));
+        high = std::max(high, clip(block.high[i], windowHigh));
+        anyClipped = anyClipped || clipped(block.low[i]) || clipped(block.high[i]);
+        anyFallback = anyFallback || (static_cast<size_t>(i) < block.intervalFlags.size() && block.intervalFlags[i].fallback);
     }
     const double range = std::max(high - low, 0.5);
     low -= 0.08 * range;
@@ -70,11 +88,14 @@ cv::Mat plotScores(const BlockAnalysis& block) {
     auto y = [&](double value) {
         return static_cast<int>(std::lround(plotBottom - (value - low) / (high - low) * (plotBottom - plotTop)));
     };
-    // Grid every 0.5 JOD (every 1 JOD when the range is wide), labelled.
-    const double step = (high - low) > 6 ? 1.0 : 0.5;
-    for (double g = std::ceil(low / step) * step; g <= high; g += step) {
-        cv::line(image, {left, y(g)}, {width - right, y(g)}, std::abs(g) < 1e-9 ? kGrey : kLightGrey, 1);
-        text(image, format("%.1f", g), {left - 8, y(g) + 5}, 0.45, kBlack, 2);
+    // Grid: the smallest of 0.1, 0.2, 0.5, 1, 2, 5, 10, … JOD that gives at most 12 lines, labelled.
+    double step = 0.1;
+    for (int k = 0; (high - low) / step > 12.0 && k < 40; ++k) step *= (k % 3 == 1) ? 2.5 : 2.0;
+    const double first = std::ceil(low / step);
+    for (int g = 0; g <= 13 && (first + g) * step <= high; ++g) {
+        const double value = (first + g) * step;
+        cv::line(image, {left, y(value)}, {width - right, y(value)}, std::abs(value) < 0.5 * step ? kGrey : kLightGrey, 1);
+        text(image, format(step < 1.0 ? "%.1f" : "%.0f", value), {left - 8, y(value) + 5}, 0.45, kBlack, 2);
     }
     cv::rectangle(image, {left, plotTop}, {width - right, plotBottom}, kBlack, 1);
     text(image, "JOD", {12, plotTop - 12}, 0.5, kBlack);
@@ -82,14 +103,32 @@ cv::Mat plotScores(const BlockAnalysis& block) {
     const double columnWidth = static_cast<double>(width - left - right) / m;
     for (int i = 0; i < m; ++i) {
         const int x = static_cast<int>(std::lround(left + (i + 0.5) * columnWidth));
-        cv::line(image, {x, y(block.low[i])}, {x, y(block.high[i])}, kBlue, 2, cv::LINE_AA);
-        cv::line(image, {x - 8, y(block.low[i])}, {x + 8, y(block.low[i])}, kBlue, 2, cv::LINE_AA);
-        cv::line(image, {x - 8, y(block.high[i])}, {x + 8, y(block.high[i])}, kBlue, 2, cv::LINE_AA);
-        cv::circle(image, {x, y(block.thurstone.scores[i])}, 5, kBlack, cv::FILLED, cv::LINE_AA);
+        const bool fallback = static_cast<size_t>(i) < block.intervalFlags.size() && block.intervalFlags[i].fallback;
+        const cv::Scalar colour = fallback ? kOrange : kBlue;
+        const int yLow = y(clip(block.low[i], windowLow)), yHigh = y(clip(block.high[i], windowHigh));
+        cv::line(image, {x, yLow}, {x, yHigh}, colour, 2, cv::LINE_AA);
+        // A bound inside the axis ends in a cap; a clipped one in an arrow head pointing off the axis.
+        if (clipped(block.low[i]))
+            cv::fillConvexPoly(image, std::vector<cv::Point>{{x - 7, yLow - 10}, {x + 7, yLow - 10}, {x, yLow}}, colour, cv::LINE_AA);
+        else
+            cv::line(image, {x - 8, yLow}, {x + 8, yLow}, colour, 2, cv::LINE_AA);
+        if (clipped(block.high[i]))
+            cv::fillConvexPoly(image, std::vector<cv::Point>{{x - 7, yHigh + 10}, {x + 7, yHigh + 10}, {x, yHigh}}, colour, cv::LINE_AA);
+        else
+            cv::line(image, {x - 8, yHigh}, {x + 8, yHigh}, colour, 2, cv::LINE_AA);
+        if (std::isfinite(block.thurstone.scores[i]))
+            cv::circle(image, {x, y(block.thurstone.scores[i])}, 5, kBlack, cv::FILLED, cv::LINE_AA);
         // Alternate label rows so long names of neighbours do not overlap.
         text(image, label(block.conditions[i], 14), {x, plotBottom + 22 + (i % 2) * 20}, 0.45, kBlack, 1);
-        text(image, format("%+.2f", block.thurstone.scores[i]), {x, plotBottom + 68 + (i % 2) * 0}, 0.4, kGrey, 1);
+        text(image, format("%+.2f", block.thurstone.scores[i]), {x, plotBottom + 68}, 0.4, kGrey, 1);
     }
+    int legend = plotBottom + 92;
+    if (anyFallback) {
+        text(image, "orange: percentile+profile interval (studentized bootstrap degenerate here)", {left, legend}, 0.4,
+             kOrange);
+        legend += 18;
+    }
+    if (anyClipped) text(image, "arrow: the interval continues beyond the axis (values in the table)", {left, legend}, 0.4, kBlack);
     return image;
 }
 

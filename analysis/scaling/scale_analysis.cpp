@@ -1,5 +1,7 @@
 #include "analysis/scaling/scale_analysis.h"
 
+#include "analysis/scaling/profile_likelihood.h"
+
 #include <spdlog/spdlog.h>
 
 #include <cmath>
@@ -71,8 +73,6 @@ bool winGraphStronglyConnected(const BlockData& block, const PairCounts& totals)
     return m < 2 || (reachesAll(true) && reachesAll(false));
 }
 
-constexpr double kNormalQuantile975 = 1.959963984540054;  // Φ⁻¹(0.975)
-
 } // namespace
 
 BlockAnalysis analyzeBlock(const BlockData& block, const AnalysisOptions& options) {
@@ -122,6 +122,7 @@ BlockAnalysis analyzeBlock(const BlockData& block, const AnalysisOptions& option
         result.high = bootstrap.high;
         result.percentileLow = bootstrap.percentileLow;
         result.percentileHigh = bootstrap.percentileHigh;
+        result.intervalFlags = bootstrap.scoreDiagnoses;
         for (const DifferenceTest& test : bootstrap.differences) result.pairs.push_back({test});
         result.bradleyTerryStandardError =
             robustCovariance(block, Eigen::VectorXd::Ones(n), result.bradleyTerry, Model::BradleyTerry)
@@ -131,15 +132,39 @@ BlockAnalysis analyzeBlock(const BlockData& block, const AnalysisOptions& option
         if (n < 5)
             result.warnings.push_back("only " + std::to_string(n) +
                                       " observers: bootstrap intervals are unreliable below about 10");
+        std::map<std::string, int> reasons;
+        int fallbacks = 0;
+        for (const IntervalDiagnosis& diagnosis : result.intervalFlags) {
+            fallbacks += diagnosis.fallback;
+            for (const std::string& reason : diagnosis.reasons) ++reasons[reason];
+        }
+        if (fallbacks > 0) {
+            std::string why;
+            for (const auto& [reason, count] : reasons) why += (why.empty() ? "" : ", ") + reason;
+            result.warnings.push_back(std::to_string(fallbacks) + " of " + std::to_string(m) +
+                                      " score intervals are percentile+profile intervals instead of studentized "
+                                      "ones (" + why + ")");
+        }
     } else {
-        // One observer or a bare count matrix: nothing to resample; Wald intervals from the Fisher information.
-        result.intervalMethod = "fisher-wald";
+        // One observer or a bare count matrix: nothing to resample. Profile-posterior intervals (asymmetric where
+        // the data are, finite under the prior) and score tests, both model-based.
+        result.intervalMethod = "profile-likelihood";
         const Eigen::MatrixXd& v = result.thurstone.inverseInformation;
         result.standardError = v.diagonal().cwiseMax(0.0).cwiseSqrt();
-        result.low = result.thurstone.scores - kNormalQuantile975 * result.standardError;
-        result.high = result.thurstone.scores + kNormalQuantile975 * result.standardError;
-        result.percentileLow = result.low;
-        result.percentileHigh = result.high;
+        result.low.resize(m);
+        result.high.resize(m);
+        result.intervalFlags.assign(m, {});
+        for (int i = 0; i < m; ++i) {
+            Eigen::VectorXd contrast = Eigen::VectorXd::Constant(m, -1.0 / m);
+            contrast[i] += 1.0;
+            const ProfileInterval profile =
+                profileInterval(totals, thurstoneOptions, result.thurstone, contrast, options.bootstrap.level);
+            result.low[i] = profile.low;
+            result.high[i] = profile.high;
+            if (profile.lowAtCap || profile.highAtCap) result.intervalFlags[i].reasons.emplace_back("bound-at-search-cap");
+        }
+        result.percentileLow = Eigen::VectorXd::Constant(m, NAN);
+        result.percentileHigh = Eigen::VectorXd::Constant(m, NAN);
         result.bradleyTerryStandardError = result.bradleyTerry.inverseInformation.diagonal().cwiseMax(0.0).cwiseSqrt();
         for (int i = 0; i < m; ++i)
             for (int j = i + 1; j < m; ++j) {
@@ -148,15 +173,19 @@ BlockAnalysis analyzeBlock(const BlockData& block, const AnalysisOptions& option
                 test.second = j;
                 test.difference = result.thurstone.scores[i] - result.thurstone.scores[j];
                 test.standardError = std::sqrt(std::max(v(i, i) + v(j, j) - 2.0 * v(i, j), 0.0));
-                test.low = test.difference - kNormalQuantile975 * test.standardError;
-                test.high = test.difference + kNormalQuantile975 * test.standardError;
-                test.pValue = test.standardError > 0
-                                  ? std::erfc(std::abs(test.difference / test.standardError) / std::sqrt(2.0))
-                                  : 1.0;
+                Eigen::VectorXd contrast = Eigen::VectorXd::Zero(m);
+                contrast[i] = 1.0;
+                contrast[j] = -1.0;
+                const ProfileInterval profile =
+                    profileInterval(totals, thurstoneOptions, result.thurstone, contrast, options.bootstrap.level);
+                test.low = profile.low;
+                test.high = profile.high;
+                if (profile.lowAtCap || profile.highAtCap) test.diagnosis.reasons.emplace_back("bound-at-search-cap");
+                test.pValue = scoreTestPValue(nullptr, totals, thurstoneOptions, result.thurstone, i, j);
                 result.pairs.push_back({test});
             }
         if (block.hasObservers)
-            result.warnings.push_back("a single observer: intervals are Fisher-information (Wald) intervals");
+            result.warnings.push_back("a single observer: intervals are profile-likelihood intervals");
     }
     for (PairTest& pair : result.pairs) {
         pair.comparisons = result.counts(pair.test.first, pair.test.second) + result.counts(pair.test.second, pair.test.first);

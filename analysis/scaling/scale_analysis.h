@@ -1,7 +1,7 @@
 #pragma once
 // The whole pairwise analysis of a dataset (docs/analysis.md): per block, Thurstone Case V scores in JOD with
 // studentized-bootstrap intervals, Bradley–Terry scores, pairwise tests with a multiple-comparison correction,
-// design flags (disconnected graph, unanimous pairs, existence of the ML estimate), Kendall's ζ and u, side
+// design flags (disconnected graph, unanimous pairs, existence of the ML estimate), per-interval fallback flags, Kendall's ζ and u, side
 // bias; per observer, held-out likelihood screening and catch-trial failures.
 #include "analysis/scaling/bootstrap.h"
 #include "analysis/scaling/comparison_data.h"
@@ -46,7 +46,8 @@ struct BlockAnalysis {
     FitResult thurstone;
     FitResult bradleyTerry;
     Eigen::VectorXd bradleyTerryStandardError;
-    std::string intervalMethod;         // "studentized-bootstrap" or "fisher-wald" (fewer than 2 observers)
+    std::string intervalMethod;         // "studentized-bootstrap", or "profile-likelihood" (fewer than 2 observers)
+    std::vector<IntervalDiagnosis> intervalFlags;  // per condition: fell back to percentile+profile, and why
     int bootstrapSamples = 0;
     Eigen::VectorXd standardError, low, high;             // Thurstone, JOD
     Eigen::VectorXd percentileLow, percentileHigh;        // pwcmp-style percentile interval (reference only)

@@ -50,6 +50,22 @@ std::string base64(const std::string& bytes) {
     return out;
 }
 
+// Per-interval method: the block's method unless the interval fell back (bootstrap.h).
+std::string scoreMethod(const BlockAnalysis& block, size_t i) {
+    return i < block.intervalFlags.size() && block.intervalFlags[i].fallback ? "percentile+profile" : block.intervalMethod;
+}
+std::string pairMethod(const BlockAnalysis& block, const PairTest& pair) {
+    return pair.test.diagnosis.fallback ? "percentile+profile" : block.intervalMethod;
+}
+std::string joined(const std::vector<std::string>& values, const char* separator) {
+    std::string out;
+    for (const std::string& value : values) out += (out.empty() ? "" : separator) + value;
+    return out;
+}
+std::vector<std::string> scoreReasons(const BlockAnalysis& block, size_t i) {
+    return i < block.intervalFlags.size() ? block.intervalFlags[i].reasons : std::vector<std::string>{};
+}
+
 std::string plotName(size_t index, const std::string& kind, const std::string& block) {
     char prefix[16];
     std::snprintf(prefix, sizeof prefix, "%02zu-", index + 1);  // the index keeps names unique after slugging
@@ -82,7 +98,9 @@ nlohmann::json analysisJson(const Analysis& analysis) {
                         {"sigma", kThurstoneSigma},
                         {"unit", "JOD (1 JOD = 75 % preference), mean of each block's scores = 0"},
                         {"prior_precision", o.fit.priorPrecision},
-                        {"interval", "symmetric studentized bootstrap over observers, cluster-robust SE"},
+                        {"interval", "symmetric studentized bootstrap over observers, cluster-robust SE; where the "
+                                     "studentization is degenerate (flagged per interval) the hull of the percentile "
+                                     "and the profile-posterior intervals, with a score test"},
                         {"level", o.bootstrap.level},
                         {"bootstrap_samples", o.bootstrap.samples},
                         {"seed", o.bootstrap.seed},
@@ -115,6 +133,8 @@ nlohmann::json analysisJson(const Analysis& analysis) {
                                    {"standard_error", finite(block.standardError[k])},
                                    {"ci_low", finite(block.low[k])},
                                    {"ci_high", finite(block.high[k])},
+                                   {"interval_method", scoreMethod(block, i)},
+                                   {"fallback_reasons", scoreReasons(block, i)},
                                    {"percentile_low", finite(block.percentileLow[k])},
                                    {"percentile_high", finite(block.percentileHigh[k])},
                                    {"bradley_terry_jod", block.bradleyTerry.scores[k]},
@@ -141,6 +161,8 @@ nlohmann::json analysisJson(const Analysis& analysis) {
                                   {"ci_low", finite(pair.test.low)},
                                   {"ci_high", finite(pair.test.high)},
                                   {"comparisons", pair.comparisons},
+                                  {"interval_method", pairMethod(block, pair)},
+                                  {"fallback_reasons", pair.test.diagnosis.reasons},
                                   {"p_value", pair.test.pValue},
                                   {"p_adjusted", pair.adjustedPValue},
                                   {"significant", pair.significant}});
@@ -191,8 +213,9 @@ std::string reportSectionHtml(const Analysis& analysis) {
          << "<p>Input <code>" << escapeHtml(analysis.file) << "</code> (" << responseFormatName(analysis.format)
          << "). Scores in JOD (1 JOD = 75 % preference, each block's mean = 0); " << fixed(100 * o.bootstrap.level, 0)
          << " % intervals by a symmetric studentized bootstrap over observers (" << o.bootstrap.samples
-         << " samples, seed " << o.bootstrap.seed << "); pairwise tests with " << correctionName(o.correction)
-         << " correction at α = " << o.alpha << ".</p>\n";
+         << " samples, seed " << o.bootstrap.seed << "); where studentization is degenerate (marked †) the hull of "
+            "the percentile and profile-posterior intervals, and a score test; pairwise tests with "
+         << correctionName(o.correction) << " correction at α = " << o.alpha << ".</p>\n";
     for (size_t b = 0; b < analysis.blocks.size(); ++b) {
         const BlockAnalysis& block = analysis.blocks[b];
         html << "<h3>" << escapeHtml(block.name) << "</h3>\n<p>" << block.observers.size() << " observer(s), "
@@ -208,20 +231,28 @@ std::string reportSectionHtml(const Analysis& analysis) {
              << base64(encodePng(plotScores(block))) << "\">\n";
         html << "<img alt=\"preference matrix of " << escapeHtml(block.name) << "\" src=\"data:image/png;base64,"
              << base64(encodePng(plotPreferenceMatrix(block))) << "\">\n";
-        html << "<table>\n<tr><th>condition</th><th>JOD</th><th>95 % interval</th><th>Bradley–Terry (JOD)</th></tr>\n";
+        html << "<table>\n<tr><th>condition</th><th>JOD</th><th>95 % interval</th><th>interval method</th>"
+                "<th>Bradley–Terry (JOD)</th></tr>\n";
         for (size_t i = 0; i < block.conditions.size(); ++i) {
             const auto k = static_cast<Eigen::Index>(i);
             html << "<tr><td>" << escapeHtml(block.conditions[i]) << "</td><td>" << fixed(block.thurstone.scores[k], 3)
                  << "</td><td>[" << fixed(block.low[k], 3) << ", " << fixed(block.high[k], 3) << "]</td><td>"
-                 << fixed(block.bradleyTerry.scores[k], 3) << "</td></tr>\n";
+                 << escapeHtml(scoreMethod(block, i))
+                 << (scoreReasons(block, i).empty() ? std::string()
+                                                    : " † (" + escapeHtml(joined(scoreReasons(block, i), ", ")) + ")")
+                 << "</td><td>" << fixed(block.bradleyTerry.scores[k], 3) << "</td></tr>\n";
         }
-        html << "</table>\n<table>\n<tr><th>A</th><th>B</th><th>A − B (JOD)</th><th>95 % interval</th><th>p</th>"
+        html << "</table>\n<table>\n<tr><th>A</th><th>B</th><th>A − B (JOD)</th><th>95 % interval</th><th>method</th><th>p</th>"
                 "<th>p (" << correctionName(o.correction) << ")</th><th>significant</th></tr>\n";
         for (const PairTest& pair : block.pairs)
             html << "<tr><td>" << escapeHtml(block.conditions[pair.test.first]) << "</td><td>"
                  << escapeHtml(block.conditions[pair.test.second]) << "</td><td>" << fixed(pair.test.difference, 3)
                  << "</td><td>[" << fixed(pair.test.low, 3) << ", " << fixed(pair.test.high, 3) << "]</td><td>"
-                 << number(pair.test.pValue, 3) << "</td><td>" << number(pair.adjustedPValue, 3) << "</td><td>"
+                 << escapeHtml(pairMethod(block, pair))
+                 << (pair.test.diagnosis.reasons.empty()
+                         ? std::string()
+                         : " † (" + escapeHtml(joined(pair.test.diagnosis.reasons, ", ")) + ")")
+                 << "</td><td>" << number(pair.test.pValue, 3) << "</td><td>" << number(pair.adjustedPValue, 3) << "</td><td>"
                  << (pair.significant ? "yes" : "no") << "</td></tr>\n";
         html << "</table>\n";
     }
@@ -242,9 +273,9 @@ void writeScaleOutputs(const Analysis& analysis, const std::filesystem::path& fo
     ensureDirectory(folder);
     ensureDirectory(folder / "plots");
     std::string scores = "block,condition,jod,ci_low,ci_high,standard_error,interval_method,percentile_low,"
-                         "percentile_high,bradley_terry_jod,bradley_terry_standard_error\n";
+                         "percentile_high,bradley_terry_jod,bradley_terry_standard_error,fallback_reasons\n";
     std::string pairs = "block,condition_A,condition_B,difference_jod,ci_low,ci_high,standard_error,comparisons,"
-                        "p_value,p_adjusted,correction,significant\n";
+                        "p_value,p_adjusted,correction,significant,interval_method,fallback_reasons\n";
     std::string counts = "block,condition_row,condition_column,count_row_chosen\n";
     std::string consistency = "block,observer,trials,held_out_loglik_per_trial,complete,circular_triads,zeta\n";
     for (size_t b = 0; b < analysis.blocks.size(); ++b) {
@@ -254,10 +285,10 @@ void writeScaleOutputs(const Analysis& analysis, const std::filesystem::path& fo
             const auto k = static_cast<Eigen::Index>(i);
             scores += name + "," + csvField(block.conditions[i]) + "," + number(block.thurstone.scores[k], 8) + "," +
                       number(block.low[k], 8) + "," + number(block.high[k], 8) + "," +
-                      number(block.standardError[k], 8) + "," + block.intervalMethod + "," +
+                      number(block.standardError[k], 8) + "," + scoreMethod(block, i) + "," +
                       number(block.percentileLow[k], 8) + "," + number(block.percentileHigh[k], 8) + "," +
                       number(block.bradleyTerry.scores[k], 8) + "," + number(block.bradleyTerryStandardError[k], 8) +
-                      "\n";
+                      "," + csvField(joined(scoreReasons(block, i), ";")) + "\n";
             for (size_t j = 0; j < block.conditions.size(); ++j)
                 if (i != j)
                     counts += name + "," + csvField(block.conditions[i]) + "," + csvField(block.conditions[j]) + "," +
@@ -269,7 +300,8 @@ void writeScaleOutputs(const Analysis& analysis, const std::filesystem::path& fo
                      number(pair.test.low, 8) + "," + number(pair.test.high, 8) + "," +
                      number(pair.test.standardError, 8) + "," + number(pair.comparisons, 10) + "," +
                      number(pair.test.pValue, 6) + "," + number(pair.adjustedPValue, 6) + "," +
-                     correctionName(analysis.options.correction) + "," + (pair.significant ? "1" : "0") + "\n";
+                     correctionName(analysis.options.correction) + "," + (pair.significant ? "1" : "0") + "," +
+                     pairMethod(block, pair) + "," + csvField(joined(pair.test.diagnosis.reasons, ";")) + "\n";
         for (size_t k = 0; k < block.observerStats.size(); ++k) {
             const ObserverInBlock& s = block.observerStats[k];
             consistency += name + "," + csvField(block.observers[k]) + "," + number(s.trials, 10) + "," +

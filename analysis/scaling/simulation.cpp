@@ -2,6 +2,7 @@
 
 #include "analysis/scaling/pairwise_model.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -20,8 +21,10 @@ SimulatedBlock simulateBlock(const SimulationDesign& design, std::uint64_t seed)
         std::snprintf(name, sizeof name, "o%03d", k + 1);
         block.observers.push_back(name);
     }
+    const int groups = std::max(1, design.groups);
     for (int i = 0; i < m; ++i)
-        for (int j = i + 1; j < m; ++j) block.pairs.emplace_back(i, j);
+        for (int j = i + 1; j < m; ++j)
+            if (i * groups / m == j * groups / m) block.pairs.emplace_back(i, j);
     const auto pairCount = static_cast<Eigen::Index>(block.pairs.size());
     block.winsFirst = Eigen::MatrixXd::Zero(n, pairCount);
     block.winsSecond = Eigen::MatrixXd::Zero(n, pairCount);
@@ -44,6 +47,8 @@ SimulatedBlock simulateBlock(const SimulationDesign& design, std::uint64_t seed)
         const double sign = kind == SimulatedObserverKind::Inverted ? -1.0 : 1.0;
         for (Eigen::Index p = 0; p < pairCount; ++p) {
             const auto [i, j] = block.pairs[p];
+            // Drawn only for incomplete designs, so complete ones keep their random stream.
+            if (design.pairFraction < 1.0 && uniform(random) >= design.pairFraction) continue;
             for (int t = 0; t < design.trialsPerPair; ++t) {
                 const bool firstOnLeft = t % 2 == 0;
                 bool firstChosen;

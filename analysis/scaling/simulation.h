@@ -21,6 +21,10 @@ struct SimulationDesign {
     double sideBiasStandardDeviation = 0.0;  // JOD; each genuine observer draws b ~ N(0, sd²)
     int randomObservers = 0;             // of `observers`
     int invertedObservers = 0;           // of `observers`
+    // Incomplete designs: each observer judges each pair with this probability (1: every pair), and the
+    // conditions fall into `groups` contiguous groups never compared with each other (1: connected).
+    double pairFraction = 1.0;
+    int groups = 1;
 };
 
 struct SimulatedBlock {
@@ -28,7 +32,7 @@ struct SimulatedBlock {
     std::vector<SimulatedObserverKind> kinds;  // per observer
 };
 
-// Full design: every pair, every observer. Deterministic for a given seed.
+// Every within-group pair, each observer judging it with probability pairFraction (the full design by default). Deterministic for a given seed.
 SimulatedBlock simulateBlock(const SimulationDesign& design, std::uint64_t seed);
 
 } // namespace skinlab::analysis::scaling

@@ -17,13 +17,15 @@ namespace {
 
 // Sums over the intervals/pairs/observers of one experiment; rates are formed at the end.
 struct Tally {
-    double intervals = 0, covered = 0, width = 0, percentileCovered = 0, percentileWidth = 0;
+    double intervals = 0, covered = 0, width = 0, percentileCovered = 0, percentileWidth = 0, fallbacks = 0;
+    double maximumHalfWidth = 0;
     double squaredError = 0, rankCorrelation = 0, experiments = 0;
     double pairs = 0, significantCorrect = 0, significantReversed = 0;
     double randomObservers = 0, randomFlagged = 0, invertedObservers = 0, invertedFlagged = 0;
     double genuineObservers = 0, genuineFlagged = 0;
     void add(const Tally& o) {
         intervals += o.intervals, covered += o.covered, width += o.width, percentileCovered += o.percentileCovered;
+        fallbacks += o.fallbacks, maximumHalfWidth = std::max(maximumHalfWidth, o.maximumHalfWidth);
         percentileWidth += o.percentileWidth, squaredError += o.squaredError, rankCorrelation += o.rankCorrelation;
         experiments += o.experiments, pairs += o.pairs, significantCorrect += o.significantCorrect;
         significantReversed += o.significantReversed, randomObservers += o.randomObservers;
@@ -68,7 +70,24 @@ Tally runExperiment(const ValidationOptions& options, const std::string& scenari
     design.trueScores = options.trueScores;
     design.observers = observers;
     design.trialsPerPair = options.trialsPerPair;
-    if (scenario != "thurstone") {
+    const int m = static_cast<int>(options.trueScores.size());
+    if (scenario == "sparse") design.pairFraction = options.sparsePairFraction;
+    if (scenario == "near-unanimous")
+        for (double& score : design.trueScores) score *= options.nearUnanimousStretch;
+    if (scenario == "disconnected") {
+        // The distance between groups is not measured; the prior anchors the groups at equal means, so the
+        // scores the intervals are for are the truth with each group centred.
+        design.groups = options.disconnectedGroups;
+        for (int g = 0; g < design.groups; ++g) {
+            double sum = 0.0;
+            int members = 0;
+            for (int i = 0; i < m; ++i)
+                if (i * design.groups / m == g) sum += design.trueScores[i], ++members;
+            for (int i = 0; i < m; ++i)
+                if (i * design.groups / m == g) design.trueScores[i] -= sum / members;
+        }
+    }
+    if (scenario == "lapses+side-bias" || scenario == "screening") {
         design.lapseRate = options.lapseRate;
         design.sideBiasStandardDeviation = options.sideBiasStandardDeviation;
     }
@@ -112,13 +131,15 @@ Tally runExperiment(const ValidationOptions& options, const std::string& scenari
     bootstrapOptions.threads = 1;  // experiments already run in parallel
     const BootstrapResult bootstrap = bootstrapObservers(block, fit, fitOptions, bootstrapOptions);
 
-    const int m = static_cast<int>(options.trueScores.size());
-    Eigen::VectorXd truth = Eigen::Map<const Eigen::VectorXd>(options.trueScores.data(), m);
+    Eigen::VectorXd truth = Eigen::Map<const Eigen::VectorXd>(design.trueScores.data(), m);
     truth.array() -= truth.mean();
     for (int i = 0; i < m; ++i) {
         tally.intervals += 1;
         tally.covered += bootstrap.low[i] <= truth[i] && truth[i] <= bootstrap.high[i];
         tally.width += bootstrap.high[i] - bootstrap.low[i];
+        tally.fallbacks += bootstrap.scoreDiagnoses[i].fallback;
+        tally.maximumHalfWidth =
+            std::max({tally.maximumHalfWidth, fit.scores[i] - bootstrap.low[i], bootstrap.high[i] - fit.scores[i]});
         tally.percentileCovered += bootstrap.percentileLow[i] <= truth[i] && truth[i] <= bootstrap.percentileHigh[i];
         tally.percentileWidth += bootstrap.percentileHigh[i] - bootstrap.percentileLow[i];
         tally.squaredError += (fit.scores[i] - truth[i]) * (fit.scores[i] - truth[i]);
@@ -146,6 +167,12 @@ Tally runExperiment(const ValidationOptions& options, const std::string& scenari
 
 } // namespace
 
+const std::vector<std::string>& validationScenarios() {
+    static const std::vector<std::string> names = {"thurstone",    "lapses+side-bias", "screening",
+                                                   "sparse",       "disconnected",     "near-unanimous"};
+    return names;
+}
+
 ValidationReport runValidation(const ValidationOptions& options) {
     const auto started = std::chrono::steady_clock::now();
     ValidationReport report;
@@ -171,6 +198,8 @@ ValidationReport runValidation(const ValidationOptions& options) {
             row.experiments = options.experiments;
             row.coverage = total.covered / total.intervals;
             row.meanWidth = total.width / total.intervals;
+            row.fallbackShare = total.fallbacks / total.intervals;
+            row.maximumHalfWidth = total.maximumHalfWidth;
             row.percentileCoverage = total.percentileCovered / total.intervals;
             row.percentileMeanWidth = total.percentileWidth / total.intervals;
             row.rmse = std::sqrt(total.squaredError / total.intervals);
@@ -197,16 +226,20 @@ std::string validationMarkdown(const ValidationReport& report) {
                   "True scores [%s] JOD, full design, %d trials per pair per observer (each order %s), %d "
                   "experiments per row, %d bootstrap samples, %s correction at alpha = %.2f, seed %llu.\n"
                   "Lapses %.3f and side-bias sd %.2f JOD in the 'lapses+side-bias' and 'screening' scenarios; "
-                  "'screening' adds %d random and %d inverted observer(s) and scores the remaining ones.\n\n",
+                  "'screening' adds %d random and %d inverted observer(s) and scores the remaining ones. "
+                  "'sparse': each observer judges %.0f %% of the pairs; 'disconnected': %d groups never compared "
+                  "(truth centred per group); 'near-unanimous': true scores x %.1f.\n\n",
                   scores.c_str(), o.trialsPerPair, o.trialsPerPair % 2 == 0 ? "equally often" : "alternating",
                   o.experiments, o.bootstrapSamples, correctionName(o.correction), o.alpha,
                   static_cast<unsigned long long>(o.seed), o.lapseRate, o.sideBiasStandardDeviation,
-                  o.randomObservers, o.invertedObservers);
+                  o.randomObservers, o.invertedObservers, 100.0 * o.sparsePairFraction, o.disconnectedGroups,
+                  o.nearUnanimousStretch);
     out += line;
-    out += "| scenario | observers | coverage (studentized) | mean width | coverage (percentile, pwcmp) | "
+    out += "| scenario | observers | coverage | mean width | fallback share | largest half-width | "
+           "coverage (percentile, pwcmp) | "
            "mean width | RMSE (JOD) | Spearman | significant & correct | significant & reversed | random caught | "
            "inverted caught | false alarms |\n";
-    out += "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    out += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     auto rate = [](double value) {
         if (value < 0) return std::string("—");
         char buffer[32];
@@ -215,8 +248,9 @@ std::string validationMarkdown(const ValidationReport& report) {
     };
     for (const ValidationRow& r : report.rows) {
         std::snprintf(line, sizeof line,
-                      "| %s | %d | %.4f | %.3f | %.4f | %.3f | %.4f | %.4f | %.4f | %.4f | %s | %s | %s |\n",
-                      r.scenario.c_str(), r.observers, r.coverage, r.meanWidth, r.percentileCoverage,
+                      "| %s | %d | %.4f | %.3f | %.3f | %.2f | %.4f | %.3f | %.4f | %.4f | %.4f | %.4f | %s | %s | %s |\n",
+                      r.scenario.c_str(), r.observers, r.coverage, r.meanWidth, r.fallbackShare, r.maximumHalfWidth,
+                      r.percentileCoverage,
                       r.percentileMeanWidth, r.rmse, r.rankCorrelation, r.significantCorrect, r.significantReversed,
                       rate(r.randomHitRate).c_str(), rate(r.invertedHitRate).c_str(), rate(r.falseAlarmRate).c_str());
         out += line;
@@ -235,7 +269,9 @@ nlohmann::json validationJson(const ValidationReport& report) {
                        {"lapse_rate", o.lapseRate},         {"side_bias_sd", o.sideBiasStandardDeviation},
                        {"random_observers", o.randomObservers}, {"inverted_observers", o.invertedObservers},
                        {"correction", correctionName(o.correction)}, {"alpha", o.alpha},
-                       {"screening_whisker", o.screeningWhisker}, {"scenarios", o.scenarios}};
+                       {"screening_whisker", o.screeningWhisker}, {"scenarios", o.scenarios},
+                       {"sparse_pair_fraction", o.sparsePairFraction}, {"disconnected_groups", o.disconnectedGroups},
+                       {"near_unanimous_stretch", o.nearUnanimousStretch}};
     json["seconds"] = report.seconds;
     for (const ValidationRow& r : report.rows) {
         nlohmann::json row = {{"scenario", r.scenario},
@@ -243,6 +279,8 @@ nlohmann::json validationJson(const ValidationReport& report) {
                               {"experiments", r.experiments},
                               {"coverage", r.coverage},
                               {"mean_width", r.meanWidth},
+                              {"fallback_share", r.fallbackShare},
+                              {"maximum_half_width", r.maximumHalfWidth},
                               {"percentile_coverage", r.percentileCoverage},
                               {"percentile_mean_width", r.percentileMeanWidth},
                               {"rmse", r.rmse},

@@ -4,7 +4,10 @@
 //  - "thurstone": every observer follows the Case V model exactly (the model the intervals promise 95 % for);
 //  - "lapses+side-bias": genuine observers with lapses and a per-observer side bias (model misspecification);
 //  - "screening": the same genuine observers plus one random and one inverted observer; screening hit and
-//    false-alarm rates, and the intervals after removing the flagged observers.
+//    false-alarm rates, and the intervals after removing the flagged observers;
+//  - "sparse": Case V observers who each judge only a random share of the pairs;
+//  - "disconnected": Case V observers, the conditions in groups never compared with each other;
+//  - "near-unanimous": Case V observers on a scale stretched so far pairs are (nearly) always unanimous.
 #include "analysis/scaling/multiple_comparisons.h"
 
 #include <nlohmann/json.hpp>
@@ -32,15 +35,24 @@ struct ValidationOptions {
     Correction correction = Correction::Holm;
     double alpha = 0.05;
     double screeningWhisker = 1.5;
-    std::vector<std::string> scenarios = {"thurstone", "lapses+side-bias", "screening"};
+    double sparsePairFraction = 0.3;   // "sparse": share of the pairs each observer judges
+    int disconnectedGroups = 2;        // "disconnected": groups of conditions, never compared across
+    double nearUnanimousStretch = 3.0; // "near-unanimous": true scores multiplied by this
+    std::vector<std::string> scenarios = {"thurstone", "lapses+side-bias", "screening",
+                                          "sparse", "disconnected", "near-unanimous"};
 };
+
+// Every scenario runValidation knows.
+const std::vector<std::string>& validationScenarios();
 
 struct ValidationRow {
     std::string scenario;
     int observers = 0;
     int experiments = 0;
-    double coverage = 0.0;            // studentized bootstrap, 95 % nominal
+    double coverage = 0.0;            // the reported intervals (studentized, or the flagged fallback), 95 % nominal
     double meanWidth = 0.0;           // JOD
+    double fallbackShare = 0.0;       // share of score intervals that fell back to percentile+profile
+    double maximumHalfWidth = 0.0;    // JOD, largest distance from a score to one of its bounds
     double percentileCoverage = 0.0;  // pwcmp's percentile bootstrap on the same resamples
     double percentileMeanWidth = 0.0;
     double rmse = 0.0;                // JOD, mean-zero scores against mean-zero truth

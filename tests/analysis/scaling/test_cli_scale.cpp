@@ -118,7 +118,7 @@ TEST(CliScale, CountMatrixOracle) {
     const auto& scores = json["blocks"][0]["scores"];
     EXPECT_NEAR(scores[0]["jod"].get<double>(), -1.0, 1e-3);
     EXPECT_NEAR(scores[2]["jod"].get<double>(), 1.0, 1e-3);
-    EXPECT_EQ(json["blocks"][0]["interval_method"], "fisher-wald");
+    EXPECT_EQ(json["blocks"][0]["interval_method"], "profile-likelihood");
 }
 
 TEST(CliValidate, SmallRunMeetsTheScreeningTargets) {
