@@ -87,6 +87,10 @@ std::vector<std::string> failedTargets(const scaling::ValidationReport& report) 
             if (row.observers == 20 && row.rmse > 0.16) fail("RMSE > 0.16", row.rmse);
             if (row.significantReversed > 0.002) fail("significant & reversed > 0.002", row.significantReversed);
         }
+        if (row.scenario == "sparse" || row.scenario == "disconnected" || row.scenario == "near-unanimous") {
+            if (row.coverage < 0.93) fail("coverage < 0.93", row.coverage);
+        }
+        if (!(row.maximumHalfWidth <= 250.0)) fail("an interval wider than the prior allows", row.maximumHalfWidth);
         if (row.scenario == "screening") {
             if (row.randomHitRate < 0.9) fail("random caught < 0.9", row.randomHitRate);
             if (row.invertedHitRate >= 0 && row.invertedHitRate < 1.0) fail("inverted caught < 1", row.invertedHitRate);
