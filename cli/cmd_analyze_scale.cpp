@@ -58,8 +58,13 @@ void runScale(const ScaleArguments& arguments) {
         std::printf("%s (%zu observers, %s)\n", block.name.c_str(), block.observers.size(), block.intervalMethod.c_str());
         for (size_t i = 0; i < block.conditions.size(); ++i) {
             const auto k = static_cast<Eigen::Index>(i);
-            std::printf("  %-24s %+7.3f JOD  [%+.3f, %+.3f]\n", block.conditions[i].c_str(), block.thurstone.scores[k],
-                        block.low[k], block.high[k]);
+            std::string note;
+            if (i < block.intervalFlags.size() && block.intervalFlags[i].fallback) {
+                for (const std::string& reason : block.intervalFlags[i].reasons) note += (note.empty() ? "" : ", ") + reason;
+                note = "  percentile+profile (" + note + ")";
+            }
+            std::printf("  %-24s %+7.3f JOD  [%+.3f, %+.3f]%s\n", block.conditions[i].c_str(), block.thurstone.scores[k],
+                        block.low[k], block.high[k], note.c_str());
         }
     }
     std::printf("wrote %s\n", (std::filesystem::path(arguments.output) / "scale.json").c_str());

@@ -172,6 +172,9 @@ BootstrapResult bootstrapObservers(const BlockData& block, const FitResult& fit,
             diagnosis.fallback = true;
             diagnosis.reasons.emplace_back(name);
         };
+        // A structural reason (disconnected, unanimous) already decides, and there the model-based SE is inflated
+        // by the prior, so the comparison with it would only add a misleading "observers-agree".
+        if (diagnosis.fallback) return t;
         if (!(standardError >= 0.25 * modelError) || !(standardError > 0.0)) reason("observers-agree");
         else if (degenerate > 0.01 * samples) reason("zero-spread-resamples");
         else if (!(sortedQuantile(t, options.level) <= 2.0 * z)) reason("extreme-t");

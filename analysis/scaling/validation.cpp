@@ -220,7 +220,7 @@ std::string validationMarkdown(const ValidationReport& report) {
     const ValidationOptions& o = report.options;
     std::string scores;
     for (double s : o.trueScores) scores += (scores.empty() ? "" : ", ") + std::to_string(s).substr(0, 4);
-    char line[512];
+    char line[1536];
     std::string out;
     std::snprintf(line, sizeof line,
                   "True scores [%s] JOD, full design, %d trials per pair per observer (each order %s), %d "

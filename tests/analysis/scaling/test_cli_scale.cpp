@@ -134,4 +134,23 @@ TEST(CliValidate, SmallRunMeetsTheScreeningTargets) {
     EXPECT_LE(json["rows"][0]["false_alarm_rate"].get<double>(), 0.02);
 }
 
+TEST(CliValidate, DegenerateScenariosGiveFiniteIntervals) {
+    const fs::path output = scratch() / "validate-degenerate";
+    const CliRun result = run("analyze validate --experiments 6 --observers 10 --bootstrap 200 --trials-per-pair 2 "
+                              "--scenarios sparse,disconnected,near-unanimous -o " + output.string());
+    ASSERT_EQ(result.exitCode, 0) << result.output;
+    std::ifstream stream(output / "validation.json");
+    const nlohmann::json json = nlohmann::json::parse(stream);
+    ASSERT_EQ(json["rows"].size(), 3u);
+    for (const auto& row : json["rows"]) {
+        EXPECT_TRUE(row["coverage"].is_number()) << row.dump();
+        EXPECT_LT(row["maximum_half_width"].get<double>(), 250.0) << row.dump();
+        EXPECT_GT(row["mean_width"].get<double>(), 0.0) << row.dump();
+    }
+    EXPECT_EQ(json["rows"][1]["fallback_share"].get<double>(), 1.0) << "disconnected designs always fall back";
+    const CliRun bad = run("analyze validate --scenarios sparse,unknown");
+    EXPECT_EQ(bad.exitCode, 2);
+    EXPECT_NE(bad.output.find("'unknown' is not one of"), std::string::npos) << bad.output;
+}
+
 } // namespace
