@@ -145,7 +145,7 @@ void runSlurm(const StimuliOptions& o) {
         return;
     }
     if (!submission.cancelledMergeJob.empty())
-        std::printf("stimuli: cancelled the earlier merge job %s (it waited on the failed shard)\n",
+        std::printf("stimuli: cancelled the earlier merge job %s (this submission merges the set)\n",
                     submission.cancelledMergeJob.c_str());
     std::printf("stimuli: set '%s': array job %s (%zu shard task(s)), merge job %s (afterok:%s)\n", scripts.set.c_str(),
                 submission.arrayJob.c_str(), scripts.shards.size(), submission.mergeJob.c_str(),

@@ -253,6 +253,7 @@ SlurmScripts slurmScripts(const SlurmOptions& o) {
     const fs::path spec = absoluteNormal(o.spec);
     SlurmScripts s;
     s.set = plan.spec.name;
+    s.stimuli = plan.all.size();
     s.buildPath = slurmFolder(out) / "build.sbatch";
     s.mergePath = slurmFolder(out) / "merge.sbatch";
     if (o.onlyShard) s.shards = {*o.onlyShard};
@@ -336,9 +337,10 @@ SlurmSubmission submitSlurm(const SlurmOptions& o) {
     nlohmann::json jobs = readJobs(out);
     if (jobs.is_null())
         jobs = {{"format", kJobsFormat}, {"version", 1}, {"set", submission.scripts.set}, {"spec", absoluteNormal(o.spec).string()},
-                {"shards", o.shards}, {"submissions", nlohmann::json::array()}};
-    // A resubmitted shard makes the earlier merge job's dependency unsatisfiable: cancel it if it still waits.
-    if (o.onlyShard && !jobs["submissions"].empty()) {
+                {"shards", o.shards}, {"stimuli", submission.scripts.stimuli}, {"submissions", nlohmann::json::array()}};
+    // The new submission has its own merge job; an earlier one still waiting (on a failed shard, whose afterok
+    // can never be satisfied, or on tasks now submitted again) is cancelled so that the set is merged once.
+    if (!jobs["submissions"].empty()) {
         std::string oldMerge = jobs["submissions"].back().value("merge_job", "");
         fs::path scancel = findOnPath("scancel");
         fs::path squeue = findOnPath("squeue");
@@ -380,6 +382,7 @@ namespace {
 struct JobState {
     std::string state;  // Slurm's word, e.g. RUNNING, PENDING, FAILED
     std::string exitCode;
+    std::string reason;  // squeue's reason of a pending job, e.g. Dependency, DependencyNeverSatisfied
 };
 
 // Slurm's view of the given job ids ("12_3", "13"): squeue for queued and recent jobs, then sacct (accounting),
@@ -397,13 +400,16 @@ std::map<std::string, JobState> queryJobs(const std::vector<std::string>& arrayJ
         queried = true;
         // One id at a time: squeue fails for the whole list when one id is unknown to the controller.
         for (const auto& id : all) {
-            ProgramRun run = runProgram({squeue.string(), "-h", "-r", "-j", id, "-o", "%i|%T"});
+            ProgramRun run = runProgram({squeue.string(), "-h", "-r", "-j", id, "-o", "%i|%T|%r"});
             if (run.exitCode != 0) continue;
             std::istringstream lines(run.out);
             std::string line;
             while (std::getline(lines, line)) {
-                auto bar = line.find('|');
-                if (bar != std::string::npos) states[trim(line.substr(0, bar))] = {trim(line.substr(bar + 1)), ""};
+                std::vector<std::string> f;
+                std::stringstream fields(line);
+                std::string field;
+                while (std::getline(fields, field, '|')) f.push_back(trim(field));
+                if (f.size() >= 2) states[f[0]] = {f[1], "", f.size() >= 3 && f[2] != "None" ? f[2] : ""};
             }
         }
     }
@@ -509,10 +515,12 @@ SlurmStatus slurmStatus(const fs::path& outArg) {
             manifest = readManifest(shardFolder(out, i));
         } catch (const InputError&) {
         }
+        // Shard i holds the stimuli whose index k has k mod n == i - 1.
+        const size_t all = manifest ? manifest->setIds.size() : jobs.value("stimuli", size_t{0});
+        const size_t n = static_cast<size_t>(status.shards);
+        s.total = all / n + (static_cast<size_t>(i) <= all % n ? 1 : 0);
         if (manifest) {
             s.done = manifest->stimuli.size();
-            s.total = manifest->setIds.size() / static_cast<size_t>(status.shards) +
-                      (static_cast<size_t>(i) <= manifest->setIds.size() % static_cast<size_t>(status.shards) ? 1 : 0);
             complete = manifest->complete;
         }
         if (auto it = latestJob.find(i); it != latestJob.end()) {
@@ -547,7 +555,12 @@ SlurmStatus slurmStatus(const fs::path& outArg) {
         status.mergeLog = slurmFolder(out) / "logs" / ("merge-" + status.mergeJob + ".log");
         auto state = slurm.find(status.mergeJob);
         std::string queued = state == slurm.end() ? "" : shardStateOf(state->second.state);
-        if (!queued.empty()) status.mergeState = queued;
+        if (!queued.empty()) {
+            status.mergeState = queued;
+            if (state->second.reason == "DependencyNeverSatisfied")
+                status.mergeState += " (never runs: a shard failed; resubmit it)";
+            else if (!state->second.reason.empty()) status.mergeState += " (" + state->second.reason + ")";
+        }
         else if (merged && merged->complete) status.mergeState = "done";
         else if (state != slurm.end()) status.mergeState = "failed (" + state->second.state + ")";
         else status.mergeState = fs::exists(status.mergeLog) ? "failed" : "unknown";

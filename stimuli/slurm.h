@@ -30,6 +30,7 @@ struct SlurmOptions {
     int cpusPerTask = 0;
     std::vector<std::string> sbatchArgs;      // further #SBATCH lines, e.g. --qos=high, --constraint=a100
     std::optional<int> onlyShard;             // resubmit this shard alone (and a new merge job)
+    // Any resubmission cancels the previous submission's merge job if it is still pending.
     bool dryRun = false;
     std::filesystem::path skinlab;            // the executable the tasks run; empty: this process's own
     std::string command;                      // the command line, recorded for `status`
@@ -42,6 +43,7 @@ std::filesystem::path mergedSetFolder(const std::filesystem::path& out);
 
 struct SlurmScripts {
     std::string set;
+    size_t stimuli = 0;       // in the whole set
     std::filesystem::path buildPath, mergePath;
     std::string build, merge;
     std::vector<int> shards;  // the shards the array runs (1-based)
@@ -55,7 +57,7 @@ struct SlurmSubmission {
     SlurmScripts scripts;
     std::string arrayJob;  // empty in a dry run
     std::string mergeJob;
-    std::string cancelledMergeJob;  // an earlier merge job that waited for a resubmitted shard and was cancelled
+    std::string cancelledMergeJob;  // an earlier merge job still waiting, cancelled (the new submission merges)
 };
 
 // Writes the scripts into OUT/slurm and submits them with `sbatch --parsable` (the merge with

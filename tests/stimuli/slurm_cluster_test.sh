@@ -166,6 +166,7 @@ grep -q "^shard $requeued/4  done " "$WORK/B.status" || fail "status of B: the r
   fail "the requeued task's log does not show two starts"
 grep -q -E "stimuli: set 'cluster-small': 3 stimuli, [12] unchanged, [12] to render" \
   "$WORK/B/slurm/logs/build-${arrayB}_$((requeued - 1)).log" || fail "the requeued task did not resume its shard"
+grep -q "^merge  pending .*job $mergeB" "$WORK/B.status" || fail "status of B: the merge is not reported pending"
 [ -f "$WORK/B/set/manifest.json" ] && fail "the merge ran although a shard failed"
 
 "$SKINLAB" stimuli slurm "$SPEC" -o "$WORK/B" --shards 4 --time 10:00 --only-shard "$killed" >"$WORK/B.resubmit" 2>&1 ||
