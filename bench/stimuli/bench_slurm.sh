@@ -23,8 +23,11 @@ trap 'slurm_cluster_stop; rm -rf "$WORK"' EXIT
 
 echo "machine: $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg) at the start, $(date -u +%Y-%m-%dT%H:%M:%SZ)"
 t0=$(date +%s.%N)
-"$SKINLAB" stimuli build "$SPEC" -o "$WORK/local" --no-contact-sheet --progress lines "${EXTRA[@]}" >"$WORK/local.log" 2>&1
+TIMEFORMAT='%U %S'
+cpu=$({ time "$SKINLAB" stimuli build "$SPEC" -o "$WORK/local" --no-contact-sheet --progress lines "${EXTRA[@]}" \
+  >"$WORK/local.log" 2>&1; } 2>&1)
 t1=$(date +%s.%N)
+echo "local build CPU time (user + system, all threads): $(echo "$cpu" | awk '{printf "%.1f", $1 + $2}') s"
 jq -r '.renderer.gl_renderer' "$WORK/local/manifest.json" | sed 's/^/renderer: /'
 jq -r --arg wall "$(awk -v a="$t0" -v b="$t1" 'BEGIN {print b - a}')" '
   [.stimuli[].timings_ms.stimulus_wall / 1000] as $t | ($t | sort) as $s |
