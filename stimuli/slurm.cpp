@@ -352,6 +352,8 @@ SlurmSubmission submitSlurm(const SlurmOptions& o) {
             }
         }
     }
+    // The folder is this set's from now on, even if sbatch refuses the scripts (a corrected command may retry).
+    writeFileAtomic(slurmFolder(out) / kJobsFile, jobs.dump(2) + "\n");
     nlohmann::json record = {{"submitted", utcNow()}, {"shards", submission.scripts.shards}, {"command", o.command}};
 
     ProgramRun array = runProgram({sbatch.string(), "--parsable", submission.scripts.buildPath.string()});
@@ -392,6 +394,7 @@ std::map<std::string, JobState> queryJobs(const std::vector<std::string>& arrayJ
     std::map<std::string, JobState> states;
     std::vector<std::string> all = arrayJobs;
     all.insert(all.end(), plainJobs.begin(), plainJobs.end());
+    queried = !findOnPath("squeue").empty() || !findOnPath("sacct").empty() || !findOnPath("scontrol").empty();
     if (all.empty()) return states;
     std::string list;
     for (const auto& id : all) list += (list.empty() ? "" : ",") + id;

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # A stimulus set built through a real Slurm: brings up a single-node cluster on this machine (munged, slurmctld
 # and slurmd on free loopback ports, every file in a temporary folder; tests/stimuli/slurm_cluster.sh), then
-#  1. `skinlab stimuli slurm SPEC -o A --shards 4`: a 4-task array and a merge job (afterok); the merged set must
+#  1. `skinlab stimuli slurm SPEC -o A --shards 4` (after one refused by sbatch for an unknown partition): a
+#     4-task array and a merge job (afterok); the merged set must
 #     equal a local build (ids, order, manifest entries, every image's sha256) and `stimuli status` must say done;
 #  2. the same into B, where one running task is requeued midway (`scontrol requeue`, as on preemption) and
 #     another one's renderer is killed midway (SIGKILL, as on a crash): the requeued task resumes its shard, the killed one
@@ -92,6 +93,12 @@ wait_jobs() {
 job_ids() { sed -n "s/^stimuli: set '[^']*': array job \([0-9]*\) .*merge job \([0-9]*\) .*/\1 \2/p" "$1"; }
 
 # ---- 1. a clean run ----------------------------------------------------------------------------------------------
+# sbatch's own refusal is one line naming the script; the corrected command may then use the same folder.
+if "$SKINLAB" stimuli slurm "$SPEC" -o "$WORK/A" --shards 4 --partition nope >"$WORK/A.refused" 2>&1; then
+  fail "a submission to an unknown partition succeeded"
+fi
+grep -q "^skinlab: failure: sbatch $WORK/A/slurm/build.sbatch failed (exit 1): sbatch: error: .*partition" "$WORK/A.refused" &&
+  [ "$(wc -l <"$WORK/A.refused")" = 1 ] || { cat "$WORK/A.refused"; fail "sbatch's refusal is not one clear line"; }
 t0=$SECONDS
 "$SKINLAB" stimuli slurm "$SPEC" -o "$WORK/A" --shards 4 --time 10:00 >"$WORK/A.submit" 2>&1 || { cat "$WORK/A.submit"; fail "submission A failed"; }
 cat "$WORK/A.submit"
