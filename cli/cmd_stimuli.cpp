@@ -1,10 +1,11 @@
-// `skinlab stimuli build|list|merge|contact`: stimulus sets (docs/stimuli.md).
+// `skinlab stimuli build|list|merge|contact|slurm|status`: stimulus sets (docs/stimuli.md).
 #include "cli/commands.h"
 #include "common/error.h"
 #include "stimuli/build.h"
 #include "stimuli/contact_sheet.h"
 #include "stimuli/merge.h"
 #include "stimuli/output_folder.h"
+#include "stimuli/slurm.h"
 
 #include <cstdio>
 #include <iostream>
@@ -25,7 +26,37 @@ struct StimuliOptions {
     std::string progress = "auto";
     std::vector<std::string> shardDirs;
     std::string format = "text";
+    // slurm
+    int shards = 4;
+    std::string partition, time, account, mem;
+    int gpusPerTask = 0;
+    int cpusPerTask = 0;
+    std::vector<std::string> sbatchArgs;
+    int onlyShard = 0;
+    bool dryRun = false;
+    std::string skinlab;
 };
+
+// The submission as one command line (absolute paths, without --only-shard and --dry-run), recorded so that
+// `stimuli status` can say how to resubmit a failed shard.
+std::string slurmCommandLine(const StimuliOptions& o) {
+    namespace fs = std::filesystem;
+    auto q = [](const std::string& v) { return stimuli::shellQuote(v); };
+    auto abs = [&](const std::string& p) { return q(fs::absolute(p).lexically_normal().string()); };
+    std::string c = "skinlab stimuli slurm " + abs(o.spec) + " -o " + abs(o.output) + " --shards " + std::to_string(o.shards);
+    if (!o.assets.empty()) c += " --assets " + abs(o.assets);
+    for (const auto& v : o.overrides) c += " --set " + q(v);
+    if (!o.partition.empty()) c += " --partition " + q(o.partition);
+    if (!o.time.empty()) c += " --time " + q(o.time);
+    if (!o.account.empty()) c += " --account " + q(o.account);
+    if (o.gpusPerTask > 0) c += " --gpus-per-task " + std::to_string(o.gpusPerTask);
+    if (o.cpusPerTask > 0) c += " --cpus-per-task " + std::to_string(o.cpusPerTask);
+    if (!o.mem.empty()) c += " --mem " + q(o.mem);
+    if (o.jobs > 1) c += " --jobs " + std::to_string(o.jobs);
+    for (const auto& a : o.sbatchArgs) c += " --sbatch=" + q(a);
+    if (!o.skinlab.empty()) c += " --skinlab " + abs(o.skinlab);
+    return c;
+}
 
 std::optional<stimuli::Shard> shardOption(const std::string& text) {
     if (text.empty()) return std::nullopt;
@@ -84,6 +115,80 @@ void runContact(const StimuliOptions& o) {
     std::printf("contact sheet: %s\n", files.html.string().c_str());
 }
 
+void runSlurm(const StimuliOptions& o) {
+    stimuli::SlurmOptions options;
+    options.spec = o.spec;
+    options.specOverrides = o.overrides;
+    options.outputDir = o.output;
+    options.assetsDir = o.assets;
+    options.shards = o.shards;
+    options.jobsPerTask = o.jobs;
+    options.partition = o.partition;
+    options.time = o.time;
+    options.account = o.account;
+    options.mem = o.mem;
+    options.gpusPerTask = o.gpusPerTask;
+    options.cpusPerTask = o.cpusPerTask;
+    options.sbatchArgs = o.sbatchArgs;
+    if (o.onlyShard > 0) options.onlyShard = o.onlyShard;
+    options.dryRun = o.dryRun;
+    options.skinlab = o.skinlab;
+    options.command = slurmCommandLine(o);
+    stimuli::SlurmSubmission submission = stimuli::submitSlurm(options);
+    const auto& scripts = submission.scripts;
+    if (o.dryRun) {
+        std::printf("# %s\n%s\n# %s\n%s\n", scripts.buildPath.string().c_str(), scripts.build.c_str(),
+                    scripts.mergePath.string().c_str(), scripts.merge.c_str());
+        std::printf("# dry run, nothing written or submitted; without --dry-run:\n#   sbatch --parsable %s\n"
+                    "#   sbatch --parsable --dependency=afterok:ARRAY_JOB_ID %s\n",
+                    scripts.buildPath.string().c_str(), scripts.mergePath.string().c_str());
+        return;
+    }
+    if (!submission.cancelledMergeJob.empty())
+        std::printf("stimuli: cancelled the earlier merge job %s (this submission merges the set)\n",
+                    submission.cancelledMergeJob.c_str());
+    std::printf("stimuli: set '%s': array job %s (%zu shard task(s)), merge job %s (afterok:%s)\n", scripts.set.c_str(),
+                submission.arrayJob.c_str(), scripts.shards.size(), submission.mergeJob.c_str(),
+                submission.arrayJob.c_str());
+    std::printf("scripts: %s, %s; logs: %s\n", scripts.buildPath.string().c_str(), scripts.mergePath.string().c_str(),
+                (scripts.buildPath.parent_path() / "logs").string().c_str());
+    std::printf("progress: skinlab stimuli status %s\n", o.output.c_str());
+}
+
+void runStatus(const StimuliOptions& o) {
+    stimuli::SlurmStatus status = stimuli::slurmStatus(o.output);
+    if (o.format == "json") {
+        nlohmann::json out = {{"set", status.set}, {"shards", nlohmann::json::array()},
+                              {"merge", {{"job", status.mergeJob}, {"state", status.mergeState},
+                                         {"log", status.mergeLog.string()}}}};
+        for (const auto& s : status.shard)
+            out["shards"].push_back({{"shard", s.index}, {"state", s.state}, {"done", s.done}, {"total", s.total},
+                                     {"job", s.job}, {"slurm_state", s.slurmState}, {"log", s.log.string()},
+                                     {"error", s.lastError}});
+        std::cout << out.dump(2) << "\n";
+        return;
+    }
+    std::printf("set %s: %d shards%s\n", status.set.c_str(), status.shards,
+                status.slurmQueried ? "" : " (no Slurm commands on PATH: states from the shard folders only)");
+    std::vector<int> failed;
+    for (const auto& s : status.shard) {
+        std::printf("shard %d/%d  %-13s %zu/%zu stimuli  job %s%s%s\n", s.index, status.shards, s.state.c_str(), s.done,
+                    s.total, s.job.empty() ? "-" : s.job.c_str(), s.slurmState.empty() ? "" : "  ",
+                    s.slurmState.c_str());
+        if (s.state == "failed") {
+            failed.push_back(s.index);
+            std::printf("    log: %s\n", s.log.string().c_str());
+            if (!s.lastError.empty()) std::printf("    %s\n", s.lastError.c_str());
+        }
+    }
+    if (!status.mergeJob.empty())
+        std::printf("merge  %s  job %s  log: %s\n", status.mergeState.c_str(), status.mergeJob.c_str(),
+                    status.mergeLog.string().c_str());
+    for (int i : failed)
+        std::printf("resubmit shard %d: %s --only-shard %d\n", i,
+                    status.resubmit.empty() ? "skinlab stimuli slurm SPEC -o OUT ..." : status.resubmit.c_str(), i);
+}
+
 } // namespace
 
 void registerStimuli(CLI::App& app) {
@@ -122,6 +227,34 @@ void registerStimuli(CLI::App& app) {
     CLI::App* contact = stimuli->add_subcommand("contact", "Rewrite the contact sheet of a set folder");
     contact->add_option("dir", options->output, "Set folder")->required();
     contact->callback([options] { runContact(*options); });
+
+    CLI::App* slurm = stimuli->add_subcommand(
+        "slurm", "Build a set on a Slurm cluster: a job array (one task per shard) and a merge job (afterok)");
+    specOptions(slurm);
+    slurm->add_option("-o,--output", options->output,
+                      "Folder on the shared file system: shards/I, set (the merged set), slurm (scripts, logs, job ids)")
+        ->required();
+    slurm->add_option("--shards", options->shards, "Number of shards = array tasks (default 4)")->check(CLI::Range(1, 100000));
+    slurm->add_option("--partition", options->partition, "sbatch --partition");
+    slurm->add_option("--time", options->time, "sbatch --time of each task and of the merge, e.g. 1:00:00");
+    slurm->add_option("--account", options->account, "sbatch --account");
+    slurm->add_option("--gpus-per-task", options->gpusPerTask, "sbatch --gpus-per-task (GPU through the EGL device platform)")
+        ->check(CLI::Range(0, 64));
+    slurm->add_option("--cpus-per-task", options->cpusPerTask, "sbatch --cpus-per-task")->check(CLI::Range(0, 4096));
+    slurm->add_option("--mem", options->mem, "sbatch --mem of each task, e.g. 8G");
+    slurm->add_option("--jobs", options->jobs, "Renderers per task (build --jobs, default 1)")->check(CLI::Range(1, 64));
+    slurm->add_option("--sbatch", options->sbatchArgs, "Another sbatch option for both jobs, e.g. --sbatch=--qos=high (repeatable)")
+        ->allow_extra_args(false);
+    slurm->add_option("--only-shard", options->onlyShard, "Resubmit shard I alone (and a new merge job)")
+        ->check(CLI::Range(1, 100000));
+    slurm->add_flag("--dry-run", options->dryRun, "Print the sbatch scripts; write and submit nothing");
+    slurm->add_option("--skinlab", options->skinlab, "The skinlab executable the tasks run (default: this one)");
+    slurm->callback([options] { runSlurm(*options); });
+
+    CLI::App* status = stimuli->add_subcommand("status", "Per shard of a Slurm build: done, running, pending or failed");
+    status->add_option("dir", options->output, "The folder given to `stimuli slurm -o`")->required();
+    status->add_option("--format", options->format, "text or json")->check(CLI::IsMember({"text", "json"}));
+    status->callback([options] { runStatus(*options); });
 }
 
 } // namespace skinlab::cli

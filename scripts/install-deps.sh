@@ -21,6 +21,7 @@ PACKAGES=(
   # browser test of the participant page
   chromium nodejs   # npm ships with the machine's Node.js (nodesource); Debian's npm conflicts with it
   fonts-dejavu-core   # stimuli: captions of contact.png (OpenImageIO render_text needs a TrueType font)
+  slurm-wlm munge jq   # stimuli: the single-node Slurm cluster test (slurmctld, slurmd, sbatch; munged; jq reads manifests)
 )
 
 missing=()

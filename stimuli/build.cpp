@@ -163,6 +163,9 @@ BuildSummary buildSet(const BuildOptions& options) {
     BuildPlan plan = planBuild(options.spec, options.specOverrides, options.shard, options.assetsDir);
     const fs::path& dir = options.outputDir;
     std::optional<Manifest> existing = claimOutputFolder(dir, plan.spec.name, options.shard);
+    ensureDirectory(dir);
+    OutputFolderLock folderLock(dir);  // one build per folder at a time (a requeued task whose first run still lives)
+    existing = claimOutputFolder(dir, plan.spec.name, options.shard);  // re-read: a build may have ended meanwhile
 
     Manifest manifest = manifestHeader(plan.spec, plan.all, options.shard);
     std::map<std::string, nlohmann::json> entries;  // id → entry of every stimulus done
@@ -193,10 +196,10 @@ BuildSummary buildSet(const BuildOptions& options) {
         manifest.complete = manifest.stimuli.size() == plan.selected.size();
         writeManifest(dir, manifest);
     };
+    writeCurrent();  // marks the folder as this set's before anything renders (or creates a subfolder)
     ensureDirectory(dir / "exr");
     ensureDirectory(dir / "png");
     tidyOutputFolder(dir, selectedIds);
-    writeCurrent();  // marks the folder as this set's before anything renders
     spdlog::info("stimuli: set '{}': {} stimuli, {} unchanged, {} to render", plan.spec.name, plan.selected.size(),
                  entries.size(), toRender.size());
 

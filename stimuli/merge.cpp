@@ -32,6 +32,21 @@ MergeSummary mergeShards(const std::vector<fs::path>& shardDirs, const fs::path&
         shards.push_back(std::move(*m));
     }
     const Manifest& first = shards.front();
+    // Shards that disagree about the set or the spec (another spec file, another version of it, other --set
+    // overrides): name every shard of each version, so the odd ones can be rebuilt.
+    std::map<std::string, std::vector<size_t>> bySpec;  // set + spec_sha256 → shards
+    for (size_t i = 0; i < shards.size(); ++i) bySpec[shards[i].set + "\n" + shards[i].specSha256].push_back(i);
+    if (bySpec.size() > 1) {
+        std::string versions;
+        for (const auto& [key, members] : bySpec) {
+            const Manifest& m = shards[members.front()];
+            versions += (versions.empty() ? "" : "; ") + std::string("set '") + m.set + "' spec '" + m.specFile +
+                        "' sha256 " + m.specSha256.substr(0, 12) + " in";
+            for (size_t i : members) versions += " " + shardDirs[i].string() + " (shard " + shardName(*shards[i].shard) + ")";
+        }
+        throwInput("merge", "", "the shards disagree about the spec: " + versions +
+                                    "; rebuild the odd shards from the same spec and --set values");
+    }
     std::map<int, size_t> byIndex;
     for (size_t i = 0; i < shards.size(); ++i) {
         const Manifest& m = shards[i];

@@ -20,6 +20,22 @@ std::optional<Manifest> claimOutputFolder(const std::filesystem::path& dir, cons
 // are no longer part of the selection (`keepIds`).
 void tidyOutputFolder(const std::filesystem::path& dir, const std::vector<std::string>& keepIds);
 
+// An exclusive lock on a set folder for the length of a build (flock(2) on DIR/.skinlab-build.lock, which works on
+// local file systems and NFSv4). A second build of the same folder — a requeued cluster task whose earlier run is
+// still alive on an unreachable node, or two shells — is refused instead of interleaving its writes:
+// "DIR: another skinlab build is writing this folder (pid P on HOST); wait for it or stop it, then rebuild".
+class OutputFolderLock {
+public:
+    explicit OutputFolderLock(const std::filesystem::path& dir);
+    ~OutputFolderLock();
+    OutputFolderLock(const OutputFolderLock&) = delete;
+    OutputFolderLock& operator=(const OutputFolderLock&) = delete;
+
+private:
+    int fd_ = -1;
+};
+inline constexpr const char* kBuildLockFile = ".skinlab-build.lock";
+
 // "exr/ID.exr" and "png/ID.png": paths relative to the set folder.
 std::string exrRelativePath(const std::string& id);
 std::string pngRelativePath(const std::string& id);

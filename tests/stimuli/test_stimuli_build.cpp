@@ -13,7 +13,9 @@
 #include "stimuli/manifest.h"
 
 #include <OpenImageIO/imageio.h>
+#include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <csignal>
 #include <cstdio>
 #include <fcntl.h>
@@ -287,6 +289,50 @@ TEST_F(StimuliBuild, MergedShardsEqualTheFullBuild) {
         EXPECT_EQ(a, b) << i;
     }
     EXPECT_TRUE(fs::exists(merged / "contact.png"));
+
+    // A shard built from another version of the spec (here other --set values) is refused, naming the shards of
+    // each version, before anything is written.
+    fs::path odd = gRoot / "shard2-odd";
+    CliRun oddRun = runCli({"stimuli", "build", (gRoot / "small.toml").string(), "-o", odd.string(), "--shard", "2/2",
+                            "--no-contact-sheet", "--set", "set.seed=8"});
+    ASSERT_EQ(oddRun.exitCode, 0) << oddRun.output;
+    fs::path refused = gRoot / "merged-refused";
+    CliRun disagree = runCli({"stimuli", "merge", shards[0], odd.string(), "-o", refused.string()});
+    EXPECT_EQ(disagree.exitCode, 2);
+    EXPECT_NE(disagree.output.find("skinlab: error: merge: the shards disagree about the spec: "), std::string::npos)
+        << disagree.output;
+    EXPECT_NE(disagree.output.find(shards[0] + " (shard 1/2)"), std::string::npos) << disagree.output;
+    EXPECT_NE(disagree.output.find(odd.string() + " (shard 2/2)"), std::string::npos) << disagree.output;
+    EXPECT_EQ(std::count(disagree.output.begin(), disagree.output.end(), '\n'), 1) << disagree.output;
+    EXPECT_FALSE(fs::exists(refused));
+}
+
+// A second build of a folder that a live build is writing (a requeued cluster task whose first run is still
+// alive) is refused with one line; the first build is unaffected.
+TEST_F(StimuliBuild, SecondBuildOfABusyFolderIsRefused) {
+    const fs::path& full = fullBuild();
+    fs::path dir = gRoot / "busy";
+    CliRun second;
+    CliRun first = runCli({"stimuli", "build", (gRoot / "small.toml").string(), "-o", dir.string()}, gRoot / "first.log",
+                          [&](pid_t pid) {
+                              // Freeze the first build once it has marked the folder, run the second, thaw the first.
+                              auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+                              while (!fs::exists(dir / "manifest.json") && std::chrono::steady_clock::now() < deadline)
+                                  std::this_thread::sleep_for(std::chrono::milliseconds(2));
+                              ::kill(pid, SIGSTOP);
+                              second = runCli({"stimuli", "build", (gRoot / "small.toml").string(), "-o", dir.string()},
+                                              gRoot / "second.log");
+                              ::kill(pid, SIGCONT);
+                          });
+    ASSERT_EQ(first.exitCode, 0) << first.output;
+    EXPECT_EQ(second.exitCode, 2) << second.output;
+    EXPECT_EQ(second.output.rfind("skinlab: error: " + dir.string() + ": another skinlab build is writing this folder (pid ",
+                                  0),
+              0u)
+        << second.output;
+    EXPECT_NE(second.output.find("); wait for it or stop it, then rebuild\n"), std::string::npos) << second.output;
+    EXPECT_EQ(std::count(second.output.begin(), second.output.end(), '\n'), 1) << second.output;
+    EXPECT_EQ(verifiedHashes(dir), verifiedHashes(full));
 }
 
 TEST_F(StimuliBuild, ParallelJobsGiveTheSameFiles) {
@@ -365,3 +411,54 @@ TEST_F(StimuliBuild, BadInputFailsBeforeRendering) {
 }
 
 } // namespace
+
+// `stimuli slurm --dry-run` prints the two sbatch scripts (a job array, one task per shard, and a merge job) and
+// writes nothing; the bad-input cases fail with one line. The real cluster run is tests/stimuli/slurm_cluster_test.sh.
+TEST_F(StimuliBuild, SlurmDryRunPrintsTheScripts) {
+    fs::path spec = writeSpec("small.toml", smallSpec("small"));
+    fs::path out = gRoot / "cluster";
+    CliRun run = runCli({"stimuli", "slurm", spec.string(), "-o", out.string(), "--shards", "3", "--partition", "gpu",
+                         "--time", "0:30:00", "--gpus-per-task", "1", "--account", "lab", "--dry-run"});
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    for (const std::string& line : std::vector<std::string>
+         {"#SBATCH --array=0-2\n", "#SBATCH --requeue\n", "#SBATCH --partition=gpu\n", "#SBATCH --time=0:30:00\n",
+          "#SBATCH --gpus-per-task=1\n", "#SBATCH --account=lab\n", "n=3\n", "i=$((SLURM_ARRAY_TASK_ID + 1))\n",
+          "#SBATCH --output=" + (out / "slurm" / "logs" / "build-%A_%a.log").string() + "\n",
+          " -o \"$dir\" --shard \"$i/$n\" --progress lines --no-contact-sheet || status=$?\n",
+          "--dependency=afterok:ARRAY_JOB_ID", "'" + (out / "set").string() + "'"})
+        EXPECT_NE(run.output.find(line), std::string::npos) << line << "\n" << run.output;
+    EXPECT_EQ(run.output.find("#SBATCH --gpus-per-task=1", run.output.find("merge.sbatch")), std::string::npos)
+        << "the merge job asks for no GPU";
+    EXPECT_FALSE(fs::exists(out));
+
+    CliRun one = runCli({"stimuli", "slurm", spec.string(), "-o", out.string(), "--shards", "3", "--only-shard", "2",
+                         "--dry-run"});
+    ASSERT_EQ(one.exitCode, 0) << one.output;
+    EXPECT_NE(one.output.find("#SBATCH --array=1\n"), std::string::npos) << one.output;
+
+    CliRun tooMany = runCli({"stimuli", "slurm", spec.string(), "-o", out.string(), "--shards", "7", "--dry-run"});
+    EXPECT_EQ(tooMany.exitCode, 2);
+    EXPECT_EQ(tooMany.output, "skinlab: error: --shards: 7 is more than the 6 stimuli of set 'small'\n");
+
+    CliRun badShard = runCli({"stimuli", "slurm", spec.string(), "-o", out.string(), "--shards", "3", "--only-shard",
+                              "4", "--dry-run"});
+    EXPECT_EQ(badShard.exitCode, 2);
+    EXPECT_EQ(badShard.output, "skinlab: error: --only-shard: '4' is not a shard of 1..3\n");
+
+    // Without sbatch on PATH: one line saying what to install; nothing written.
+    const char* oldPath = std::getenv("PATH");
+    std::string saved = oldPath ? oldPath : "";
+    fs::create_directories(gRoot / "empty-bin");
+    ::setenv("PATH", (gRoot / "empty-bin").c_str(), 1);
+    CliRun noSbatch = runCli({"stimuli", "slurm", spec.string(), "-o", out.string(), "--shards", "3"});
+    ::setenv("PATH", saved.c_str(), 1);
+    EXPECT_EQ(noSbatch.exitCode, 1);
+    EXPECT_EQ(noSbatch.output.rfind("skinlab: failure: sbatch not found: install slurm-client", 0), 0u) << noSbatch.output;
+    EXPECT_EQ(std::count(noSbatch.output.begin(), noSbatch.output.end(), '\n'), 1) << noSbatch.output;
+    EXPECT_FALSE(fs::exists(out));
+
+    CliRun noBuild = runCli({"stimuli", "status", gRoot.string()});
+    EXPECT_EQ(noBuild.exitCode, 2);
+    EXPECT_EQ(noBuild.output, "skinlab: error: " + gRoot.string() +
+                                  ": holds no Slurm build (no slurm/jobs.json); submit one with `skinlab stimuli slurm`\n");
+}
