@@ -35,8 +35,12 @@ struct Comparison {
 };
 
 struct PosteriorOptions {
-    // Prior N(0, v₀) on every score. sd 2 JOD: a study's conditions rarely span more than ±4 JOD (98 % preference).
-    double priorVariance = 4.0;
+    // Prior N(0, v₀) on every score. sd 1 JOD. The prior steers the first batches: a prior much wider than the
+    // true spread spreads the early posterior means too far apart, and the gain then favours near neighbours, which
+    // chains the comparison graph (measured in the benchmark: with sd 2 JOD against true scores of sd 1 JOD the
+    // active design needed ~25 % more comparisons than a random one for the same RMSE at m = 30; with sd 1 JOD it
+    // matches or beats it, also for true scores of sd 2 JOD).
+    double priorVariance = 1.0;
     // Sweeps stop when no mean or standard deviation moved more than `tolerance` JOD in a sweep.
     int maxSweeps = 50;
     double tolerance = 1e-6;
