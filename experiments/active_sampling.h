@@ -4,10 +4,12 @@
 //
 // Model: Thurstone Case V in JOD units, P(i ≻ j) = Φ((q_i − q_j)/σ) with σ = 1.4826 (1 JOD = 75 % preference),
 // the model `analyze scale` fits. The scores have a joint Gaussian posterior N(μ, Σ) starting from the prior
-// N(0, v₀ I). Every answer is one probit factor on q_winner − q_loser; the factors are folded in by expectation
-// propagation (Minka 2001): each answer keeps its own Gaussian site message (a function of its difference d),
-// and sweeps over all answers (in a canonical order) replace a site by the moment-matched one — a rank-one update
-// of Σ — until the posterior no longer moves. The full covariance matters: a fully factorised (TrueSkill-style)
+// N(0, v₀ I). Every answer is a probit factor on q_winner − q_loser; all answers to one pair form one factor
+// Φ(d/σ)^a Φ(−d/σ)^b on its difference d, folded in by expectation propagation (Minka 2001): each compared pair
+// keeps a Gaussian site message in d, and sweeps over the pairs (in a canonical order) replace a site by the
+// moment-matched one (moments of the one-dimensional tilted distribution by quadrature) — a rank-one update of Σ
+// — until the posterior no longer moves. Cost per sweep: O(p m²) for p compared pairs, independent of the number
+// of answers. The full covariance matters: a fully factorised (TrueSkill-style)
 // posterior treats every difference as equally well known once each score is, so the planner would keep
 // comparing neighbours along a chain and the scale's ends would drift apart (measured: 3× the full design's RMSE
 // at m = 30). The result depends only on the multiset of answers, never on their arrival order, so a posterior

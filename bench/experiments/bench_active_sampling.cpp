@@ -165,7 +165,15 @@ double reachedAt(const std::vector<double>& x, const std::vector<double>& y, dou
 }
 
 struct CoverageCell {
-    double covered = 0, total = 0, width = 0;
+    double covered = 0, total = 0;
+    std::vector<double> widths;
+    // Median width: a mean is dominated by the few experiments whose ML estimate does not exist (a condition that
+    // always won or always lost) at small budgets, where the interval is as wide as the prior lets it be.
+    double medianWidth() const {
+        std::vector<double> sorted = widths;
+        std::sort(sorted.begin(), sorted.end());
+        return sorted.empty() ? 0.0 : sorted[sorted.size() / 2];
+    }
 };
 
 void drawPlot(const std::string& file, const std::vector<int>& ms, const std::vector<std::vector<std::vector<double>>>& curves,
@@ -289,7 +297,7 @@ int main(int argc, char** argv) {
                         CoverageCell& cell = coverage[{d, static_cast<int>(b)}];
                         for (int i = 0; i < m; ++i) {
                             cell.covered += (boot.low[i] <= truth[static_cast<std::size_t>(i)] && truth[static_cast<std::size_t>(i)] <= boot.high[i]) ? 1 : 0;
-                            cell.width += boot.high[i] - boot.low[i];
+                            cell.widths.push_back(boot.high[i] - boot.low[i]);
                             cell.total += 1;
                         }
                     }
@@ -319,15 +327,15 @@ int main(int argc, char** argv) {
             const CoverageCell& r = coverage[{1, static_cast<int>(b)}];
             const CoverageCell& a = coverage[{2, static_cast<int>(b)}];
             std::snprintf(line, sizeof line, "| %d | %zu (%.1f rounds, %zu observers) | %.3f (%.2f) | %.3f (%.2f) | %.3f (%.2f) |", m, count,
-                          coverageRounds[b], count / static_cast<std::size_t>(step), f.covered / f.total, f.width / f.total,
-                          r.covered / r.total, r.width / r.total, a.covered / a.total, a.width / a.total);
+                          coverageRounds[b], count / static_cast<std::size_t>(step), f.covered / f.total, f.medianWidth(),
+                          r.covered / r.total, r.medianWidth(), a.covered / a.total, a.medianWidth());
             coverageLines.push_back(line);
         }
         std::fflush(stdout);
         allCurves.push_back(curves);
         allX.push_back(x);
     }
-    std::printf("\nCoverage of the 95 %% studentized bootstrap intervals (mean width, JOD):\n\n"
+    std::printf("\nCoverage of the 95 %% studentized bootstrap intervals (median width, JOD):\n\n"
                 "| m | comparisons | full | random | active |\n|---|---|---|---|---|\n");
     for (const std::string& line : coverageLines) std::printf("%s\n", line.c_str());
 
