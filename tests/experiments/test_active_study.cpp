@@ -157,8 +157,8 @@ TEST(ActiveStudy, RunsEndToEndOverHttpAndItsPlanSurvivesKillNine) {
     options.observers = 10;
     options.seed = 4;
     options.labelPrefix = "active";
-    options.thinkMinMs = 2;
-    options.thinkMaxMs = 8;
+    options.thinkMinMs = 5; // keeps the session going while the server is killed
+    options.thinkMaxMs = 15;
     options.truth.byCondition = kTruth;
     SimulationReport report;
     std::thread simulation([&] { report = simulateObservers(store, options); });
@@ -209,7 +209,17 @@ TEST(ActiveStudy, RunsEndToEndOverHttpAndItsPlanSurvivesKillNine) {
         EXPECT_EQ(p.catchCorrect, 2);
     }
 
-    // The analysis is unchanged: the export scales like any other, the best condition on top in each block.
+    // The CLI's own simulate runs further observers through the restarted server.
+    const CommandResult simulated = runSkinlab({"study", "simulate", files.database.string(), "--observers", "2", "--url",
+                                                "http://127.0.0.1:" + std::to_string(port), "--truth-factor", "quality",
+                                                "--label-prefix", "cli"});
+    EXPECT_EQ(simulated.exitCode, 0) << simulated.out << simulated.err;
+    EXPECT_NE(simulated.out.find("2/2 observers completed, 30 responses acknowledged, 0 rejected"), std::string::npos)
+        << simulated.out;
+    const CommandResult status = runSkinlab({"study", "status", files.database.string()});
+    EXPECT_NE(status.out.find("12 participants, 12 completed, 180 responses"), std::string::npos) << status.out;
+
+    // The analysis is unchanged: the export scales like any other.
     const fs::path exported = files.folder.path() / "responses.csv";
     ASSERT_EQ(runSkinlab({"study", "export", files.database.string(), "--format", "csv", "-o", exported.string()}).exitCode, 0);
     const fs::path analysis = files.folder.path() / "scale";
