@@ -356,20 +356,24 @@ std::vector<PlannedTrial> StudyStore::activeTrials(std::int64_t participantIndex
                                                    const std::vector<PlannedTrial>& stored) {
     return nextActiveTrials(definition_, participantIndex, seed, stored, [this](std::size_t b) {
         const StudyBlock& block = definition_.blocks[b];
-        // Every stored answer to a test trial of the block, of every participant.
-        SqliteStatement s = db_->prepare("SELECT t.kind, t.condition_a, t.condition_b, r.chosen FROM responses r"
-                                         " JOIN trials t ON t.id = r.trial_id WHERE t.block = ? AND t.kind IN ('test','repeat')");
+        // Every stored answer to a test trial of the block, of every participant, counted per ordered pair.
+        SqliteStatement s = db_->prepare(
+            "SELECT t.condition_a, t.condition_b, SUM(r.chosen = 'A'), SUM(r.chosen = 'B') FROM responses r"
+            " JOIN trials t ON t.id = r.trial_id WHERE t.block = ? AND t.kind IN ('test','repeat')"
+            " GROUP BY t.condition_a, t.condition_b");
         s.bind(1, block.name);
         std::vector<PlannedTrial> trials;
         std::vector<bool> aSelected;
         while (s.step()) {
             PlannedTrial t;
-            t.kind = trialKindFromName(s.text(0));
+            t.kind = TrialKind::test;
             t.block = block.name;
-            t.conditionA = s.text(1);
-            t.conditionB = s.text(2);
-            trials.push_back(std::move(t));
-            aSelected.push_back(s.text(3) == "A");
+            t.conditionA = s.text(0);
+            t.conditionB = s.text(1);
+            for (std::int64_t k = 0; k < s.integer(2) + s.integer(3); ++k) {
+                trials.push_back(t);
+                aSelected.push_back(k < s.integer(2));
+            }
         }
         return active::fitPosterior(static_cast<int>(block.conditions.size()), blockComparisons(block, trials, aSelected));
     });

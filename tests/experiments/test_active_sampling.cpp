@@ -23,7 +23,7 @@ using skinlab::experiments::test_support::TemporaryFolder;
 
 namespace {
 
-// Thurstone observer (science of docs/analysis.md): i beats j iff q_i + ε_i > q_j + ε_j, ε ~ N(0, σ²/2).
+// Thurstone observer (docs/analysis.md): i beats j iff q_i + ε_i > q_j + ε_j, ε ~ N(0, σ²/2).
 std::vector<Comparison> simulate(const std::vector<double>& truth, int perPair, std::uint64_t seed) {
     std::mt19937_64 random(seed);
     std::normal_distribution<double> noise(0.0, kThurstoneSigma / std::sqrt(2.0));
