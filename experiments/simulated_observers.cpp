@@ -105,8 +105,11 @@ ObserverResult runObserver(StudyStore& store, const SimulationOptions& options, 
     for (const TrialRecord& t : store.trials(participant.id)) plan[t.id] = t.plan;
     const double invert = kind == "inverted" ? -1.0 : 1.0;
 
-    // Bounded: every iteration either acknowledges a response or counts a rejection.
-    const std::size_t maxSteps = plan.size() * 2 + 10;
+    // Bounded: every iteration either acknowledges a response or counts a rejection. (An active design stores its
+    // plan batch by batch: the length comes from the server's progress.)
+    const std::size_t planned = std::max<std::size_t>(
+        plan.size(), static_cast<std::size_t>(state.body.value("total", 0) + state.body.value("practice_total", 0)));
+    const std::size_t maxSteps = planned * 2 + 10;
     for (std::size_t step = 0; step < maxSteps; ++step) {
         const json& body = state.body;
         if (body.value("completed", false)) {
@@ -116,6 +119,10 @@ ObserverResult runObserver(StudyStore& store, const SimulationOptions& options, 
         }
         const std::int64_t trialId = body["trial"]["id"].get<std::int64_t>();
         auto it = plan.find(trialId);
+        if (it == plan.end()) { // an active design's next batch, stored since the plan was read
+            for (const TrialRecord& t : store.trials(participant.id)) plan[t.id] = t.plan;
+            it = plan.find(trialId);
+        }
         if (it == plan.end()) {
             result.failure = "trial " + std::to_string(trialId) + " is not in this participant's plan";
             break;

@@ -145,6 +145,7 @@ StudyDefinition resolveStudy(const StudyDesign& design, const StimulusManifest& 
 }
 
 int StudyDefinition::testTrialCount() const {
+    if (design.activePairs) return design.trialsPerParticipant;
     int n = 0;
     for (const StudyBlock& b : blocks) n += static_cast<int>(b.pairs.size());
     return n;

@@ -27,7 +27,10 @@ StudyDesign designFromToml(toml::table& root, const std::string& file, const std
     d.blocks = spec.strings("blocks", {});
     if (const toml::node* pairs = spec.raw("pairs")) {
         if (const auto* text = pairs->as_string()) {
-            if (text->get() != "all") spec.fail("pairs", "expected \"all\" or an array of [A, B] condition pairs");
+            if (text->get() == "active") d.activePairs = true;
+            else if (text->get() != "all")
+                spec.fail("pairs", "expected \"all\", \"active\" or an array of [A, B] condition pairs, got \"" +
+                                       text->get() + "\"");
         } else if (const auto* list = pairs->as_array()) {
             d.allPairs = false;
             std::size_t i = 0;
@@ -45,6 +48,21 @@ StudyDesign designFromToml(toml::table& root, const std::string& file, const std
         } else {
             spec.fail("pairs", "expected \"all\" or an array of [A, B] condition pairs, got " + describeNode(*pairs));
         }
+    }
+    // Active designs (pairs = "active"): trials_per_participant is required, and the keys that only shape a fixed
+    // design (repetitions, block_order) are errors rather than silently ignored.
+    if (d.activePairs) {
+        if (!spec.has("trials_per_participant"))
+            spec.fail("trials_per_participant", "required with pairs = \"active\" (test trials per participant)");
+        if (spec.has("repetitions"))
+            spec.fail("repetitions", "not used with pairs = \"active\" (the planner chooses every test trial; "
+                                     "set trials_per_participant)");
+        if (spec.has("block_order"))
+            spec.fail("block_order", "not used with pairs = \"active\" (each batch is planned for one block)");
+        d.trialsPerParticipant = static_cast<int>(spec.integer("trials_per_participant", 0, 1, 10000));
+        d.repetitions = 1;
+    } else if (spec.has("trials_per_participant")) {
+        spec.fail("trials_per_participant", "only used with pairs = \"active\"");
     }
     d.repetitions = static_cast<int>(spec.integer("repetitions", d.repetitions, 1, 100));
     d.blockOrder = spec.choice("block_order", d.blockOrder, {"interleaved", "grouped"});
@@ -100,7 +118,8 @@ nlohmann::json StudyDesign::toJson() const {
             {"condition_factor", conditionFactor},
             {"conditions", conditions},
             {"blocks", blocks},
-            {"pairs", allPairs ? nlohmann::json("all") : pairsJson},
+            {"pairs", activePairs ? nlohmann::json("active") : allPairs ? nlohmann::json("all") : pairsJson},
+            {"trials_per_participant", trialsPerParticipant},
             {"repetitions", repetitions},
             {"block_order", blockOrder},
             {"break_every", breakEvery},
@@ -122,6 +141,8 @@ StudyDesign StudyDesign::fromJson(const nlohmann::json& j) {
     d.blocks = j.at("blocks").get<std::vector<std::string>>();
     if (j.at("pairs").is_string()) {
         d.allPairs = true;
+        d.activePairs = j.at("pairs").get<std::string>() == "active";
+        d.trialsPerParticipant = j.value("trials_per_participant", 0);
     } else {
         d.allPairs = false;
         for (const auto& p : j.at("pairs")) d.pairs.emplace_back(p.at(0).get<std::string>(), p.at(1).get<std::string>());

@@ -31,6 +31,11 @@ struct StudyDesign {
     std::vector<std::string> blocks;        // empty = every block of the manifest
     bool allPairs = true;
     std::vector<std::pair<std::string, std::string>> pairs; // when !allPairs: condition pairs to compare
+    // pairs = "active": each participant's test trials are planned batch by batch from the answers so far
+    // (experiments/active_sampling.h); `trialsPerParticipant` of them, no repetitions. allPairs stays true
+    // (every pair of a block is a candidate).
+    bool activePairs = false;
+    int trialsPerParticipant = 0;
     int repetitions = 2;       // times each pair is shown to each participant (alternating sides)
     std::string blockOrder = "interleaved"; // interleaved | grouped
     int breakEvery = 40;       // a pause screen every K trials (0 = none)

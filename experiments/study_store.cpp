@@ -3,6 +3,7 @@
 #include "common/error.h"
 #include "common/hash.h"
 #include "common/version.h"
+#include "experiments/active_plan.h"
 #include "experiments/request_error.h"
 #include "experiments/sqlite_database.h"
 
@@ -110,11 +111,12 @@ std::string makeCompletionCode() {
     return code;
 }
 
-void insertTrials(SqliteDatabase& db, std::int64_t participantId, const std::vector<PlannedTrial>& plan) {
+void insertTrials(SqliteDatabase& db, std::int64_t participantId, const std::vector<PlannedTrial>& plan,
+                  int firstPosition = 0) {
     SqliteStatement insert = db.prepare(
         "INSERT INTO trials (participant_id, position, kind, block, condition_a, condition_b, stimulus_a, stimulus_b,"
         " a_on_left, reference_stimulus, expected) VALUES (?,?,?,?,?,?,?,?,?,?,?)");
-    int position = 0;
+    int position = firstPosition;
     for (const PlannedTrial& t : plan) {
         insert.bind(1, participantId).bind(2, position++).bind(3, trialKindName(t.kind)).bind(4, t.block);
         insert.bind(5, t.conditionA).bind(6, t.conditionB).bind(7, t.stimulusA);
@@ -306,7 +308,8 @@ ParticipantRecord StudyStore::join(const std::string& requestedLabel, const std:
     insert.bind(5, static_cast<std::int64_t>(p.seed)).bind(6, p.completionCode).bind(7, p.createdAt);
     insert.run();
     p.id = db_->lastInsertId();
-    insertTrials(*db_, p.id, planTrials(definition_, p.index, p.seed));
+    if (definition_.design.activePairs) insertTrials(*db_, p.id, activeTrials(p.index, p.seed, {}));
+    else insertTrials(*db_, p.id, planTrials(definition_, p.index, p.seed));
     tx.commit();
     return p;
 }
@@ -333,12 +336,77 @@ std::int64_t StudyStore::startSession(std::int64_t participantId, const std::str
 
 std::optional<TrialRecord> StudyStore::nextTrial(std::int64_t participantId) {
     std::lock_guard lock(mutex_);
-    SqliteStatement s = db_->prepare(std::string("SELECT ") + kTrialColumns +
-                                     " FROM trials WHERE participant_id = ? AND id NOT IN"
-                                     " (SELECT trial_id FROM responses WHERE participant_id = ?) ORDER BY position LIMIT 1");
-    s.bind(1, participantId).bind(2, participantId);
-    if (!s.step()) return std::nullopt;
-    return readTrial(s);
+    auto first = [&]() -> std::optional<TrialRecord> {
+        SqliteStatement s = db_->prepare(std::string("SELECT ") + kTrialColumns +
+                                         " FROM trials WHERE participant_id = ? AND id NOT IN"
+                                         " (SELECT trial_id FROM responses WHERE participant_id = ?) ORDER BY position LIMIT 1");
+        s.bind(1, participantId).bind(2, participantId);
+        if (!s.step()) return std::nullopt;
+        return readTrial(s);
+    };
+    std::optional<TrialRecord> next = first();
+    // Active design: every stored trial answered, so the next batch is planned and stored now (before it is shown).
+    if (!next && definition_.design.activePairs && extendActivePlan(participantId)) next = first();
+    return next;
+}
+
+// ---- Active designs (experiments/active_plan.h) ----
+
+std::vector<PlannedTrial> StudyStore::activeTrials(std::int64_t participantIndex, std::uint64_t seed,
+                                                   const std::vector<PlannedTrial>& stored) {
+    return nextActiveTrials(definition_, participantIndex, seed, stored, [this](std::size_t b) {
+        const StudyBlock& block = definition_.blocks[b];
+        // Every stored answer to a test trial of the block, of every participant, counted per ordered pair.
+        SqliteStatement s = db_->prepare(
+            "SELECT t.condition_a, t.condition_b, SUM(r.chosen = 'A'), SUM(r.chosen = 'B') FROM responses r"
+            " JOIN trials t ON t.id = r.trial_id WHERE t.block = ? AND t.kind IN ('test','repeat')"
+            " GROUP BY t.condition_a, t.condition_b");
+        s.bind(1, block.name);
+        std::vector<PlannedTrial> trials;
+        std::vector<bool> aSelected;
+        while (s.step()) {
+            PlannedTrial t;
+            t.kind = TrialKind::test;
+            t.block = block.name;
+            t.conditionA = s.text(0);
+            t.conditionB = s.text(1);
+            for (std::int64_t k = 0; k < s.integer(2) + s.integer(3); ++k) {
+                trials.push_back(t);
+                aSelected.push_back(k < s.integer(2));
+            }
+        }
+        return active::fitPosterior(static_cast<int>(block.conditions.size()), blockComparisons(block, trials, aSelected));
+    });
+}
+
+bool StudyStore::extendActivePlan(std::int64_t participantId) {
+    SqliteTransaction tx(*db_);
+    std::int64_t index = 0;
+    std::uint64_t seed = 0;
+    {
+        SqliteStatement s = db_->prepare("SELECT participant_index, seed FROM participants WHERE id = ?");
+        s.bind(1, participantId);
+        if (!s.step()) return false;
+        index = s.integer(0);
+        seed = static_cast<std::uint64_t>(s.integer(1));
+    }
+    std::vector<PlannedTrial> stored;
+    {
+        SqliteStatement s = db_->prepare(std::string("SELECT ") + kTrialColumns +
+                                         " FROM trials WHERE participant_id = ? ORDER BY position");
+        s.bind(1, participantId);
+        while (s.step()) stored.push_back(readTrial(s).plan);
+    }
+    const std::vector<PlannedTrial> next = activeTrials(index, seed, stored);
+    if (next.empty()) return false;
+    insertTrials(*db_, participantId, next, static_cast<int>(stored.size()));
+    tx.commit();
+    return true;
+}
+
+int StudyStore::plannedTrialCount() const {
+    const StudyDefinition& d = definition_;
+    return d.design.practiceTrials + d.testTrialCount() + d.repeatTrialCount() + d.catchTrialCount();
 }
 
 std::vector<TrialRecord> StudyStore::trials(std::int64_t participantId) {
@@ -357,7 +425,9 @@ Progress StudyStore::progress(std::int64_t participantId) {
                                      " (SELECT COUNT(*) FROM trials WHERE participant_id = ?1)");
     s.bind(1, participantId);
     s.step();
-    return {static_cast<int>(s.integer(0)), static_cast<int>(s.integer(1))};
+    // An active design stores its test trials batch by batch; its length is known from the design.
+    const int total = definition_.design.activePairs ? plannedTrialCount() : static_cast<int>(s.integer(1));
+    return {static_cast<int>(s.integer(0)), total};
 }
 
 ResponseOutcome StudyStore::storeOne(const ResponseInput& in) {
@@ -478,7 +548,7 @@ std::vector<ParticipantStatus> StudyStore::status() {
     while (s.step()) {
         ParticipantStatus st;
         st.participant = readParticipant(s);
-        st.progress.total = static_cast<int>(s.integer(7));
+        st.progress.total = definition_.design.activePairs ? plannedTrialCount() : static_cast<int>(s.integer(7));
         st.progress.answered = static_cast<int>(s.integer(8));
         st.testAnswered = static_cast<int>(s.integer(9));
         st.catchAnswered = static_cast<int>(s.integer(10));

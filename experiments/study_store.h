@@ -117,7 +117,8 @@ public:
     ParticipantRecord participant(const std::string& token);
     std::int64_t startSession(std::int64_t participantId, const std::string& userAgent, int viewportWidth,
                               int viewportHeight, double devicePixelRatio);
-    // The first unanswered trial, if any.
+    // The first unanswered trial, if any. For an active design whose stored trials are all answered, the next
+    // batch is planned from the current answers and stored first (see experiments/active_plan.h).
     std::optional<TrialRecord> nextTrial(std::int64_t participantId);
     Progress progress(std::int64_t participantId);
     // Validates and commits one response (see the header comment). Rejections throw RequestError:
@@ -142,6 +143,12 @@ private:
     };
     void commitBatch(const std::vector<PendingResponse*>& batch);
     ResponseOutcome storeOne(const ResponseInput& input); // inside an open transaction, mutex_ held
+    // Active designs (experiments/active_plan.h), mutex_ held: the next stretch of a plan from the posterior of
+    // the stored answers; storing it (one transaction) returns false when the plan is already complete.
+    std::vector<PlannedTrial> activeTrials(std::int64_t participantIndex, std::uint64_t seed,
+                                           const std::vector<PlannedTrial>& stored);
+    bool extendActivePlan(std::int64_t participantId);
+    int plannedTrialCount() const; // per participant
 
     std::unique_ptr<SqliteDatabase> db_;
     std::filesystem::path path_;

@@ -110,7 +110,9 @@ std::vector<PlannedTrial> planTrials(const StudyDefinition& study, std::int64_t 
     }
 
     std::vector<PlannedTrial> main;
-    if (design.blockOrder == "grouped") {
+    if (design.activePairs) {
+        main.assign(static_cast<std::size_t>(design.trialsPerParticipant), PlannedTrial{}); // open slots
+    } else if (design.blockOrder == "grouped") {
         std::vector<std::size_t> order(perBlock.size());
         for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
         random.shuffle(order);

@@ -38,6 +38,12 @@ struct PlannedTrial {
 // Seed of participant number `participantIndex` (0, 1, 2, ... in order of joining) under the design seed.
 std::uint64_t participantSeed(std::uint64_t designSeed, std::int64_t participantIndex);
 
+// The participant's whole plan. For an active design (pairs = "active") the test trials are not known in advance:
+// the plan holds `trials_per_participant` open slots (isActiveSlot) where the test trials go, with the practice
+// and catch trials placed around them exactly as for a fixed design; experiments/active_plan.h fills the slots.
 std::vector<PlannedTrial> planTrials(const StudyDefinition& study, std::int64_t participantIndex, std::uint64_t seed);
+
+// An open test-trial slot of an active design's plan (empty block name; never stored).
+inline bool isActiveSlot(const PlannedTrial& trial) { return trial.kind == TrialKind::test && trial.block.empty(); }
 
 } // namespace skinlab::experiments

@@ -4,7 +4,9 @@
 // process, N simulated observers (one thread and one connection each) answering every trial. Latency is the
 // client-side round trip of POST /api/response, which includes validation and the fsynced COMMIT.
 //
-// Usage: bench_experiments_response_logging [--observers 50,200] [--think-ms MIN:MAX] [--folder DIR]
+// With --active M: M conditions and an active design (pairs = "active", 2(M − 1) test trials per participant), so
+// the measured round trips include planning a batch from the posterior whenever a participant's batch runs out.
+// Usage: bench_experiments_response_logging [--observers 50,200] [--think-ms MIN:MAX] [--folder DIR] [--active M]
 // Prints one Markdown table row per run for docs/benchmarks.md.
 #include "common/files.h"
 #include "common/hash.h"
@@ -31,10 +33,12 @@ namespace {
 
 // Five conditions in one block: 10 pairs × 2 repetitions + 2 catch = 22 responses per participant. The image
 // bytes are not decoded by the server, so placeholder bytes (with their real sha256) stand in for PNGs.
+int activeConditions = 0; // --active M (0: the fixed five-condition design)
+
 void writeSet(const fs::path& folder) {
     fs::create_directories(folder / "png");
     nlohmann::json manifest{{"format", "skinlab-stimuli"}, {"version", 1}, {"set", "bench"}, {"stimuli", nlohmann::json::array()}};
-    for (int m = 0; m < 5; ++m) {
+    for (int m = 0; m < (activeConditions > 0 ? activeConditions : 5); ++m) {
         const std::string id = "c" + std::to_string(m);
         const std::string bytes = "placeholder image " + id;
         skinlab::writeFileAtomic(folder / "png" / (id + ".png"), bytes);
@@ -58,7 +62,10 @@ Run measure(const fs::path& root, int observers, double thinkMin, double thinkMa
     const fs::path folder = root / ("run-" + std::to_string(run));
     fs::remove_all(folder);
     writeSet(folder / "stimuli");
-    skinlab::writeFileAtomic(folder / "design.toml", "seed = 1\nrepetitions = 2\n[practice]\ntrials = 0\n[catch]\nblank = 2\n");
+    const std::string pairs = activeConditions > 0 ? "pairs = \"active\"\ntrials_per_participant = " +
+                                                         std::to_string(2 * (activeConditions - 1)) + "\n"
+                                                   : "repetitions = 2\n";
+    skinlab::writeFileAtomic(folder / "design.toml", "seed = 1\n" + pairs + "[practice]\ntrials = 0\n[catch]\nblank = 2\n");
     createStudy(folder / "stimuli", folder / "design.toml", {}, folder / "study.db");
     StudyStore store(folder / "study.db");
     ServerOptions options;
@@ -106,6 +113,8 @@ int main(int argc, char** argv) {
         } else if (key == "--think-ms") {
             const auto colon = value.find(':');
             thinks = {{std::stod(value.substr(0, colon)), std::stod(colon == std::string::npos ? value : value.substr(colon + 1))}};
+        } else if (key == "--active") {
+            activeConditions = std::stoi(value);
         } else if (key == "--folder") {
             root = value;
         } else {

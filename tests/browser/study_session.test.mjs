@@ -2,7 +2,9 @@
 // sessions with the keyboard (one at devicePixelRatio 1 in a window first too small, one with
 // --force-device-scale-factor=2), checks that every image is shown at one image pixel per device pixel (layout
 // and screenshot pixels), resumes after a reload, and checks the stored rows.
-// Usage: node study_session.test.mjs /path/to/skinlab     Exit 0 pass, 1 fail, 77 skip.
+// With "active" as second argument the study is an active design (pairs = "active", test trials planned batch by
+// batch while the session runs); the same checks apply.
+// Usage: node study_session.test.mjs /path/to/skinlab [active]     Exit 0 pass, 1 fail, 77 skip.
 import { spawn, spawnSync } from 'node:child_process';
 import { createHash } from 'node:crypto';
 import fs from 'node:fs';
@@ -15,6 +17,7 @@ import { fileURLToPath } from 'node:url';
 const SKIP = 77;
 const here = path.dirname(fileURLToPath(import.meta.url));
 const cli = process.argv[2];
+const active = process.argv[3] === 'active';
 const CHROMIUM = '/usr/bin/chromium';
 if (!cli || !fs.existsSync(cli)) { console.error('usage: node study_session.test.mjs SKINLAB_CLI'); process.exit(1); }
 if (!fs.existsSync(CHROMIUM)) { console.log('SKIP: /usr/bin/chromium not installed'); process.exit(SKIP); }
@@ -124,13 +127,14 @@ methods.forEach((method, m) => {
 });
 fs.writeFileSync(path.join(work, 'stimuli/manifest.json'), JSON.stringify(manifest, null, 2));
 fs.writeFileSync(path.join(work, 'design.toml'),
-  'title = "Browser test"\nquestion = "Which looks more like real skin?"\nseed = 3\nrepetitions = 1\nbreak_every = 2\n' +
+  'title = "Browser test"\nquestion = "Which looks more like real skin?"\nseed = 3\nbreak_every = 2\n' +
+  (active ? 'pairs = "active"\ntrials_per_participant = 3\n' : 'repetitions = 1\n') +
   '[practice]\ntrials = 1\n[catch]\nblank = 1\n');
 const database = path.join(work, 'study.db');
 const created = spawnSync(cli, ['study', 'create', '--stimuli', path.join(work, 'stimuli'), '--design',
   path.join(work, 'design.toml'), '-o', database], { encoding: 'utf8' });
 if (created.status !== 0) { console.error(created.stderr); process.exit(1); }
-const TRIALS = 5; // 1 practice + 3 pairs + 1 catch
+const TRIALS = 5; // 1 practice + 3 pairs (active: 3 planned test trials, batches of 2) + 1 catch
 
 // --- the real server ---
 const server = spawn(cli, ['study', 'serve', database, '--port', '0', '--token', 'browser-token'],
@@ -283,6 +287,7 @@ try {
     }
     check(mine.filter((r) => r.trial_kind === 'practice').length === 1, `${observer}: one practice row`);
     check(mine.filter((r) => r.trial_kind === 'catch').length === 1, `${observer}: one catch row`);
+    check(mine.filter((r) => r.trial_kind === 'test').length === 3, `${observer}: three test rows`);
   });
   exitCode = failures === 0 ? 0 : 1;
 } catch (e) {
@@ -291,5 +296,5 @@ try {
   server.kill('SIGTERM');
   fs.rmSync(work, { recursive: true, force: true });
 }
-console.log(exitCode === 0 ? 'PASS: browser study session' : `FAILED (${failures} checks)`);
+console.log(exitCode === 0 ? `PASS: browser study session${active ? ' (active design)' : ''}` : `FAILED (${failures} checks)`);
 process.exit(exitCode);

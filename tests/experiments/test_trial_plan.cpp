@@ -188,7 +188,8 @@ TEST(TrialPlan, DesignErrorsNameFileKeyAndValue) {
               "artistic, reference)");
     EXPECT_EQ(expectInputError("pairs = [[\"separable\", \"separable\"]]\n"),
               "D.toml: pairs[0]: a condition cannot be compared with itself (\"separable\")");
-    EXPECT_EQ(expectInputError("pairs = \"some\"\n"), "D.toml: pairs: expected \"all\" or an array of [A, B] condition pairs");
+    EXPECT_EQ(expectInputError("pairs = \"some\"\n"),
+              "D.toml: pairs: expected \"all\", \"active\" or an array of [A, B] condition pairs, got \"some\"");
     EXPECT_EQ(expectInputError("blocks = [\"scene:c\"]\n"),
               "D.toml: blocks: \"scene:c\" is not a block of the stimulus set (blocks: scene:a/mid, scene:b/close)");
     EXPECT_EQ(expectInputError("condition_factor = \"scene\"\n"),

@@ -1,0 +1,379 @@
+// Active sampling against the alternatives (docs/benchmarks.md, "Active sampling"; docs/analysis.md,
+// "Validation of active designs"). For m = 10, 20, 30 conditions with known true scores, simulated Thurstone
+// observers answer three designs of the same length:
+//  - full:   every pair once per round, rounds repeated (each round in a random order);
+//  - random: each comparison a uniformly random pair (an incomplete random design);
+//  - active: batches of m − 1 pairs, each the minimum spanning tree over 1/information gain of the posterior
+//            built from every answer so far (experiments/active_sampling.h, as the study server plans them).
+// Each observer answers m − 1 consecutive comparisons (one active batch). After every m − 1 comparisons the
+// scale is fitted exactly as `analyze scale` fits it (Thurstone Case V MAP, analysis/scaling) and its RMSE
+// against the truth (both mean-zero) recorded; at a few budgets the 95 % studentized bootstrap interval over
+// observers is computed and its coverage of the true scores counted.
+// Also times the planning of one batch at m = 30 with 200 participants' answers (the server's request path).
+//
+// Usage: bench_active_sampling [--experiments E] [--coverage-experiments C] [--bootstrap B] [--spread S]
+//                              [--rounds R] [--threads T] [--seed N] [--plot FILE.png]
+#include "analysis/scaling/bootstrap.h"
+#include "analysis/scaling/pairwise_model.h"
+#include "experiments/active_sampling.h"
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <map>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+using namespace skinlab;
+namespace sc = skinlab::analysis::scaling;
+namespace ac = skinlab::experiments::active;
+
+namespace {
+
+struct Trial {
+    int first = 0, second = 0; // first < second
+    bool firstWins = true;
+};
+
+struct Settings {
+    int experiments = 60;
+    int coverageExperiments = 30;
+    int bootstrap = 200;
+    double spread = 1.0; // true scores ~ N(0, spread²) JOD
+    int rounds = 4;      // longest design, in full-design rounds m(m−1)/2
+    int threads = 2;
+    std::uint64_t seed = 1;
+    std::string plot;
+};
+
+const char* kDesigns[] = {"full", "random", "active"};
+
+bool answer(std::mt19937_64& random, const std::vector<double>& truth, int i, int j) {
+    std::normal_distribution<double> noise(0.0, ac::kThurstoneSigma / std::sqrt(2.0));
+    return truth[static_cast<std::size_t>(i)] + noise(random) > truth[static_cast<std::size_t>(j)] + noise(random);
+}
+
+Trial make(std::mt19937_64& random, const std::vector<double>& truth, int i, int j) {
+    if (i > j) std::swap(i, j);
+    return {i, j, answer(random, truth, i, j)};
+}
+
+// The block as the analysis sees it: observers of `perObserver` consecutive trials, compared pairs only.
+sc::BlockData blockOf(const std::vector<Trial>& trials, std::size_t count, int m, int perObserver) {
+    sc::BlockData block;
+    block.name = "simulated";
+    for (int i = 0; i < m; ++i) block.conditions.push_back("c" + std::to_string(i));
+    const int observers = static_cast<int>((count + static_cast<std::size_t>(perObserver) - 1) / static_cast<std::size_t>(perObserver));
+    for (int k = 0; k < observers; ++k) block.observers.push_back("o" + std::to_string(k));
+    std::map<std::pair<int, int>, int> column;
+    for (std::size_t t = 0; t < count; ++t) {
+        const auto key = std::make_pair(trials[t].first, trials[t].second);
+        if (!column.count(key)) {
+            column.emplace(key, static_cast<int>(block.pairs.size()));
+            block.pairs.push_back(key);
+        }
+    }
+    const auto pairs = static_cast<Eigen::Index>(block.pairs.size());
+    block.winsFirst = Eigen::MatrixXd::Zero(observers, pairs);
+    block.winsSecond = Eigen::MatrixXd::Zero(observers, pairs);
+    block.sideCounts.assign(block.pairs.size(), {0, 0, 0, 0});
+    block.leftChosen = Eigen::VectorXd::Zero(observers);
+    block.sideTrials = Eigen::VectorXd::Zero(observers);
+    for (std::size_t t = 0; t < count; ++t) {
+        const int k = static_cast<int>(t / static_cast<std::size_t>(perObserver));
+        const int p = column.at({trials[t].first, trials[t].second});
+        (trials[t].firstWins ? block.winsFirst : block.winsSecond)(k, p) += 1.0;
+    }
+    return block;
+}
+
+std::vector<Trial> simulateDesign(int design, const std::vector<double>& truth, std::size_t length, std::uint64_t seed) {
+    const int m = static_cast<int>(truth.size());
+    std::mt19937_64 random(seed);
+    std::vector<Trial> trials;
+    trials.reserve(length);
+    if (design == 0) {
+        std::vector<std::pair<int, int>> pairs;
+        for (int i = 0; i < m; ++i)
+            for (int j = i + 1; j < m; ++j) pairs.emplace_back(i, j);
+        while (trials.size() < length) {
+            std::shuffle(pairs.begin(), pairs.end(), random);
+            for (const auto& [i, j] : pairs)
+                if (trials.size() < length) trials.push_back(make(random, truth, i, j));
+        }
+    } else if (design == 1) {
+        std::uniform_int_distribution<int> pick(0, m - 1);
+        while (trials.size() < length) {
+            const int i = pick(random);
+            int j = pick(random);
+            while (j == i) j = pick(random);
+            trials.push_back(make(random, truth, i, j));
+        }
+    } else {
+        std::vector<ac::Comparison> answers;
+        std::uint64_t batch = 0;
+        while (trials.size() < length) {
+            const ac::ScorePosterior posterior = ac::fitPosterior(m, answers);
+            for (const auto& [i, j] : ac::spanningTreeBatch(posterior, seed * 1000003u + batch++)) {
+                if (trials.size() >= length) break;
+                const Trial t = make(random, truth, i, j);
+                trials.push_back(t);
+                answers.push_back(t.firstWins ? ac::Comparison{t.first, t.second} : ac::Comparison{t.second, t.first});
+            }
+        }
+    }
+    return trials;
+}
+
+double rmse(const Eigen::VectorXd& scores, const std::vector<double>& truth) {
+    double sum = 0.0;
+    for (Eigen::Index i = 0; i < scores.size(); ++i) {
+        const double d = scores[i] - truth[static_cast<std::size_t>(i)];
+        sum += d * d;
+    }
+    return std::sqrt(sum / static_cast<double>(scores.size()));
+}
+
+struct Curve {
+    std::vector<double> comparisons;
+    std::vector<double> sumSquared; // Σ over experiments of the mean squared error
+    std::vector<double> rmse() const {
+        std::vector<double> out;
+        for (double s : sumSquared) out.push_back(s);
+        return out;
+    }
+};
+
+// Interpolated number of comparisons at which `curve` first reaches `target` (−1 if never).
+double reachedAt(const std::vector<double>& x, const std::vector<double>& y, double target) {
+    for (std::size_t k = 0; k < y.size(); ++k) {
+        if (y[k] <= target) {
+            if (k == 0) return x[0];
+            const double f = (y[k - 1] - target) / (y[k - 1] - y[k]);
+            return x[k - 1] + f * (x[k] - x[k - 1]);
+        }
+    }
+    return -1.0;
+}
+
+struct CoverageCell {
+    double covered = 0, total = 0;
+    std::vector<double> widths;
+    // Median width: a mean is dominated by the few experiments whose ML estimate does not exist (a condition that
+    // always won or always lost) at small budgets, where the interval is as wide as the prior lets it be.
+    double medianWidth() const {
+        std::vector<double> sorted = widths;
+        std::sort(sorted.begin(), sorted.end());
+        return sorted.empty() ? 0.0 : sorted[sorted.size() / 2];
+    }
+};
+
+void drawPlot(const std::string& file, const std::vector<int>& ms, const std::vector<std::vector<std::vector<double>>>& curves,
+              const std::vector<std::vector<double>>& xs, const Settings& settings) {
+    const int panelW = 420, panelH = 340, left = 70, top = 50, bottom = 60;
+    cv::Mat image(panelH + top + bottom, static_cast<int>(ms.size()) * panelW + 20, CV_8UC3, cv::Scalar(255, 255, 255));
+    const cv::Scalar colours[] = {cv::Scalar(40, 40, 40), cv::Scalar(30, 140, 230), cv::Scalar(180, 90, 30)};
+    const int font = cv::FONT_HERSHEY_SIMPLEX;
+    char buf[128];
+    std::snprintf(buf, sizeof buf, "Scale RMSE (JOD) vs comparisons; true scores ~ N(0, %.1f^2) JOD, %d experiments",
+                  settings.spread, settings.experiments);
+    cv::putText(image, buf, {20, 22}, font, 0.5, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+    for (std::size_t p = 0; p < ms.size(); ++p) {
+        const int x0 = static_cast<int>(p) * panelW + left, y0 = top, w = panelW - left - 20, h = panelH - 20;
+        double ymax = 0;
+        for (const auto& c : curves[p])
+            for (std::size_t k = 0; k < c.size(); ++k) ymax = std::max(ymax, c[k]);
+        ymax = std::min(ymax, 1.5);
+        const double xmax = xs[p].back();
+        auto px = [&](double x) { return x0 + static_cast<int>(std::lround(w * x / xmax)); };
+        auto py = [&](double y) { return y0 + h - static_cast<int>(std::lround(h * std::min(y, ymax) / ymax)); };
+        cv::rectangle(image, {x0, y0}, {x0 + w, y0 + h}, cv::Scalar(150, 150, 150));
+        const int M = ms[p] * (ms[p] - 1) / 2;
+        for (int r = 1; r <= settings.rounds; ++r) {
+            const int gx = px(static_cast<double>(r * M));
+            cv::line(image, {gx, y0}, {gx, y0 + h}, cv::Scalar(225, 225, 225));
+            std::snprintf(buf, sizeof buf, "%d", r * M);
+            cv::putText(image, buf, {gx - 14, y0 + h + 18}, font, 0.4, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+        }
+        for (int t = 0; t <= 4; ++t) {
+            const double y = ymax * t / 4.0;
+            std::snprintf(buf, sizeof buf, "%.2f", y);
+            cv::putText(image, buf, {x0 - 42, py(y) + 4}, font, 0.4, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+            cv::line(image, {x0, py(y)}, {x0 + w, py(y)}, cv::Scalar(235, 235, 235));
+        }
+        for (std::size_t d = 0; d < 3; ++d) {
+            const auto& c = curves[p][d];
+            for (std::size_t k = 1; k < c.size(); ++k)
+                cv::line(image, {px(xs[p][k - 1]), py(c[k - 1])}, {px(xs[p][k]), py(c[k])}, colours[d], 2, cv::LINE_AA);
+            cv::line(image, {x0 + w - 110, y0 + 18 + 18 * static_cast<int>(d)}, {x0 + w - 85, y0 + 18 + 18 * static_cast<int>(d)},
+                     colours[d], 2, cv::LINE_AA);
+            cv::putText(image, kDesigns[d], {x0 + w - 78, y0 + 22 + 18 * static_cast<int>(d)}, font, 0.45, colours[d], 1,
+                        cv::LINE_AA);
+        }
+        std::snprintf(buf, sizeof buf, "m = %d (grid: full rounds)", ms[p]);
+        cv::putText(image, buf, {x0 + 10, y0 + h + 42}, font, 0.5, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+    }
+    cv::imwrite(file, image);
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    Settings s;
+    for (int k = 1; k + 1 < argc; k += 2) {
+        const std::string key = argv[k];
+        const char* value = argv[k + 1];
+        if (key == "--experiments") s.experiments = std::atoi(value);
+        else if (key == "--coverage-experiments") s.coverageExperiments = std::atoi(value);
+        else if (key == "--bootstrap") s.bootstrap = std::atoi(value);
+        else if (key == "--spread") s.spread = std::atof(value);
+        else if (key == "--rounds") s.rounds = std::atoi(value);
+        else if (key == "--threads") s.threads = std::atoi(value);
+        else if (key == "--seed") s.seed = static_cast<std::uint64_t>(std::atoll(value));
+        else if (key == "--plot") s.plot = value;
+        else {
+            std::fprintf(stderr, "bench_active_sampling: unknown option %s\n", key.c_str());
+            return 2;
+        }
+    }
+    const auto start = std::chrono::steady_clock::now();
+    std::printf("hardware threads %u; %d experiments per m (coverage: %d, %d bootstrap samples); true scores ~ "
+                "N(0, %.2f^2) JOD; designs up to %d full rounds; observers answer m-1 trials each\n\n",
+                std::thread::hardware_concurrency(), s.experiments, s.coverageExperiments, s.bootstrap, s.spread,
+                s.rounds);
+    const std::vector<int> ms = {10, 20, 30};
+    // Coverage budgets, in full rounds.
+    const std::vector<double> coverageRounds = {0.6, 1.0, 1.2, 2.0, 2.4};
+    std::vector<std::vector<std::vector<double>>> allCurves;
+    std::vector<std::vector<double>> allX;
+    std::printf("| m | full rounds | comparisons (full) | RMSE full | RMSE random | RMSE active | active reaches full's RMSE at | "
+                "saving | random reaches it at |\n|---|---|---|---|---|---|---|---|---|\n");
+    std::vector<std::string> coverageLines;
+    for (const int m : ms) {
+        const int M = m * (m - 1) / 2;
+        const int step = m - 1;
+        const std::size_t length = static_cast<std::size_t>(s.rounds * M);
+        std::vector<double> x;
+        for (std::size_t c = static_cast<std::size_t>(step); c <= length; c += static_cast<std::size_t>(step)) x.push_back(static_cast<double>(c));
+        std::vector<std::vector<double>> sumSquared(3, std::vector<double>(x.size(), 0.0));
+        std::map<std::pair<int, int>, CoverageCell> coverage; // (design, budget index)
+        sc::FitOptions fitOptions;
+        sc::BootstrapOptions bootOptions;
+        bootOptions.samples = s.bootstrap;
+        bootOptions.threads = s.threads;
+        for (int e = 0; e < s.experiments; ++e) {
+            std::mt19937_64 truthRandom(sc::mixSeed(s.seed, static_cast<std::uint64_t>(m * 100000 + e)));
+            std::normal_distribution<double> draw(0.0, s.spread);
+            std::vector<double> truth(static_cast<std::size_t>(m));
+            double mean = 0;
+            for (double& q : truth) mean += (q = draw(truthRandom));
+            mean /= m;
+            for (double& q : truth) q -= mean;
+            for (int d = 0; d < 3; ++d) {
+                const std::vector<Trial> trials =
+                    simulateDesign(d, truth, length, sc::mixSeed(s.seed + 17, static_cast<std::uint64_t>(m * 100000 + e * 3 + d)));
+                for (std::size_t k = 0; k < x.size(); ++k) {
+                    const sc::BlockData block = blockOf(trials, static_cast<std::size_t>(x[k]), m, step);
+                    const sc::FitResult fit = sc::fitScores(block.totalCounts(), fitOptions);
+                    const double r = rmse(fit.scores, truth);
+                    sumSquared[static_cast<std::size_t>(d)][k] += r * r;
+                }
+                if (e < s.coverageExperiments) {
+                    for (std::size_t b = 0; b < coverageRounds.size(); ++b) {
+                        // Budget rounded to whole observers.
+                        const std::size_t count = static_cast<std::size_t>(std::lround(coverageRounds[b] * M / step)) * static_cast<std::size_t>(step);
+                        const sc::BlockData block = blockOf(trials, count, m, step);
+                        const sc::FitResult fit = sc::fitScores(block.totalCounts(), fitOptions);
+                        bootOptions.seed = sc::mixSeed(s.seed, static_cast<std::uint64_t>(e * 7 + d));
+                        const sc::BootstrapResult boot = sc::bootstrapObservers(block, fit, fitOptions, bootOptions);
+                        CoverageCell& cell = coverage[{d, static_cast<int>(b)}];
+                        for (int i = 0; i < m; ++i) {
+                            cell.covered += (boot.low[i] <= truth[static_cast<std::size_t>(i)] && truth[static_cast<std::size_t>(i)] <= boot.high[i]) ? 1 : 0;
+                            cell.widths.push_back(boot.high[i] - boot.low[i]);
+                            cell.total += 1;
+                        }
+                    }
+                }
+            }
+        }
+        std::vector<std::vector<double>> curves(3, std::vector<double>(x.size()));
+        for (int d = 0; d < 3; ++d)
+            for (std::size_t k = 0; k < x.size(); ++k)
+                curves[static_cast<std::size_t>(d)][k] = std::sqrt(sumSquared[static_cast<std::size_t>(d)][k] / s.experiments);
+        for (int r = 1; r <= s.rounds; ++r) {
+            const std::size_t k = static_cast<std::size_t>(r * M / step) - 1; // x[k] = r·M
+            const double target = curves[0][k];
+            const double active = reachedAt(x, curves[2], target);
+            const double random = reachedAt(x, curves[1], target);
+            char activeText[64], randomText[64], saving[32];
+            if (active > 0) std::snprintf(activeText, sizeof activeText, "%.0f", active); else std::snprintf(activeText, sizeof activeText, "> %zu", length);
+            if (random > 0) std::snprintf(randomText, sizeof randomText, "%.0f", random); else std::snprintf(randomText, sizeof randomText, "> %zu", length);
+            if (active > 0) std::snprintf(saving, sizeof saving, "%.0f %%", 100.0 * (1.0 - active / (r * M))); else std::snprintf(saving, sizeof saving, "n/a");
+            std::printf("| %d | %d | %d | %.3f | %.3f | %.3f | %s | %s | %s |\n", m, r, r * M, target, curves[1][k], curves[2][k],
+                        activeText, saving, randomText);
+        }
+        for (std::size_t b = 0; b < coverageRounds.size(); ++b) {
+            const std::size_t count = static_cast<std::size_t>(std::lround(coverageRounds[b] * M / step)) * static_cast<std::size_t>(step);
+            char line[256];
+            const CoverageCell& f = coverage[{0, static_cast<int>(b)}];
+            const CoverageCell& r = coverage[{1, static_cast<int>(b)}];
+            const CoverageCell& a = coverage[{2, static_cast<int>(b)}];
+            std::snprintf(line, sizeof line, "| %d | %zu (%.1f rounds, %zu observers) | %.3f (%.2f) | %.3f (%.2f) | %.3f (%.2f) |", m, count,
+                          coverageRounds[b], count / static_cast<std::size_t>(step), f.covered / f.total, f.medianWidth(),
+                          r.covered / r.total, r.medianWidth(), a.covered / a.total, a.medianWidth());
+            coverageLines.push_back(line);
+        }
+        std::fflush(stdout);
+        allCurves.push_back(curves);
+        allX.push_back(x);
+    }
+    std::printf("\nCoverage of the 95 %% studentized bootstrap intervals (median width, JOD):\n\n"
+                "| m | comparisons | full | random | active |\n|---|---|---|---|---|\n");
+    for (const std::string& line : coverageLines) std::printf("%s\n", line.c_str());
+
+    // Planning time of one batch at m = 30 with 200 participants' answers (as the server plans it).
+    std::printf("\nPlanning one batch (posterior from every answer, gains, spanning tree), m = 30:\n\n"
+                "| participants | answers | EP sweeps | plan median (ms) | plan min (ms) |\n|---|---|---|---|---|\n");
+    for (const int perParticipant : {29, 58, 100}) {
+        const int m = 30;
+        std::mt19937_64 random(7);
+        std::vector<double> truth(m);
+        std::normal_distribution<double> draw(0.0, s.spread);
+        for (double& q : truth) q = draw(random);
+        std::vector<ac::Comparison> answers;
+        std::uniform_int_distribution<int> pick(0, m - 1);
+        const int participants = 200;
+        for (int t = 0; t < participants * perParticipant; ++t) {
+            const int i = pick(random);
+            int j = pick(random);
+            while (j == i) j = pick(random);
+            answers.push_back(answer(random, truth, i, j) ? ac::Comparison{i, j} : ac::Comparison{j, i});
+        }
+        std::vector<double> times;
+        int sweeps = 0;
+        for (int r = 0; r < 7; ++r) {
+            const auto t0 = std::chrono::steady_clock::now();
+            const ac::ScorePosterior posterior = ac::fitPosterior(m, answers);
+            const auto batch = ac::spanningTreeBatch(posterior, static_cast<std::uint64_t>(r));
+            times.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+            sweeps = posterior.sweeps;
+            if (batch.size() != static_cast<std::size_t>(m - 1)) return 1;
+        }
+        std::sort(times.begin(), times.end());
+        std::printf("| %d | %zu | %d | %.1f | %.1f |\n", participants, answers.size(), sweeps, times[times.size() / 2], times.front());
+    }
+    if (!s.plot.empty()) {
+        drawPlot(s.plot, ms, allCurves, allX, s);
+        std::printf("\nplot: %s\n", s.plot.c_str());
+    }
+    std::printf("\ntotal %.1f s\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    return 0;
+}

@@ -1,0 +1,268 @@
+// Unit tests of active sampling (experiments/active_sampling.h, experiments/active_plan.h): the EP posterior
+// recovers known scores from simulated answers and does not depend on the answers' order; the information gain
+// prefers close, uncertain pairs; a batch is a spanning tree (connected, m − 1 pairs) and reproducible from its
+// seed; the `pairs = "active"` design keys are checked strictly; an active plan keeps practice and catch trials
+// in place and fills its open slots batch by batch.
+#include "common/error.h"
+#include "experiments/active_plan.h"
+#include "experiments/active_sampling.h"
+#include "experiments/study_definition.h"
+#include "stimulus_set_fixture.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <random>
+#include <set>
+
+using namespace skinlab::experiments;
+using namespace skinlab::experiments::active;
+using skinlab::experiments::test_support::TemporaryFolder;
+
+namespace {
+
+// Thurstone observer (docs/analysis.md): i beats j iff q_i + ε_i > q_j + ε_j, ε ~ N(0, σ²/2).
+std::vector<Comparison> simulate(const std::vector<double>& truth, int perPair, std::uint64_t seed) {
+    std::mt19937_64 random(seed);
+    std::normal_distribution<double> noise(0.0, kThurstoneSigma / std::sqrt(2.0));
+    std::vector<Comparison> out;
+    const int m = static_cast<int>(truth.size());
+    for (int r = 0; r < perPair; ++r)
+        for (int i = 0; i < m; ++i)
+            for (int j = i + 1; j < m; ++j) {
+                const bool iWins = truth[static_cast<std::size_t>(i)] + noise(random) > truth[static_cast<std::size_t>(j)] + noise(random);
+                out.push_back(iWins ? Comparison{i, j} : Comparison{j, i});
+            }
+    return out;
+}
+
+bool connected(int m, const std::vector<std::pair<int, int>>& edges) {
+    std::vector<int> parent(static_cast<std::size_t>(m));
+    std::iota(parent.begin(), parent.end(), 0);
+    auto find = [&](int x) {
+        while (parent[static_cast<std::size_t>(x)] != x) x = parent[static_cast<std::size_t>(x)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
+        return x;
+    };
+    for (const auto& [a, b] : edges) parent[static_cast<std::size_t>(find(a))] = find(b);
+    for (int i = 1; i < m; ++i)
+        if (find(i) != find(0)) return false;
+    return true;
+}
+
+StudyDefinition makeStudy(const std::string& designToml) {
+    TemporaryFolder folder("active");
+    test_support::writeStimulusSet(folder.path(), {});
+    return resolveStudy(parseStudyDesign(designToml, "D.toml"), readStimulusManifest(folder.path()));
+}
+
+std::string designError(const std::string& designToml) {
+    try {
+        parseStudyDesign(designToml, "D.toml");
+    } catch (const skinlab::InputError& e) {
+        return e.what();
+    }
+    return "(no error)";
+}
+
+} // namespace
+
+TEST(ActiveSampling, PosteriorConvergesToTheTrueScores) {
+    const std::vector<double> truth = {-1.5, -0.8, 0.0, 0.3, 0.9, 1.1};
+    double previousError = 1e9, previousSd = 1e9;
+    for (const int perPair : {5, 40, 300}) {
+        const ScorePosterior p = fitPosterior(6, simulate(truth, perPair, 42));
+        EXPECT_TRUE(p.converged) << perPair;
+        const double meanOfMeans = std::accumulate(p.mean.begin(), p.mean.end(), 0.0) / 6.0;
+        double squared = 0.0, sd = 0.0;
+        for (std::size_t i = 0; i < 6; ++i) {
+            squared += std::pow(p.mean[i] - meanOfMeans - truth[i], 2);
+            // sd of the centred score q_i − q̄ (the common offset is left to the prior: answers say nothing on it)
+            double centred = p.variance(static_cast<int>(i));
+            for (int j = 0; j < 6; ++j) {
+                centred -= 2.0 / 6.0 * p.cov(static_cast<int>(i), j);
+                for (int k = 0; k < 6; ++k) centred += p.cov(j, k) / 36.0;
+            }
+            sd += std::sqrt(centred) / 6.0;
+        }
+        const double rmse = std::sqrt(squared / 6.0);
+        EXPECT_LT(rmse, previousError * 1.05) << perPair << " answers per pair";
+        EXPECT_LT(sd, previousSd) << "more answers, narrower posterior";
+        previousError = rmse;
+        previousSd = sd;
+    }
+    EXPECT_LT(previousError, 0.1) << "4500 answers pin the scores to a few hundredths of a JOD";
+    EXPECT_LT(previousError, 2 * previousSd) << "the error is of the order of the posterior sd";
+    // The posterior sd at 300 answers per pair is the order of the ML standard error (~0.05 JOD).
+    EXPECT_LT(previousSd, 0.1);
+    EXPECT_GT(previousSd, 0.01);
+}
+
+TEST(ActiveSampling, PosteriorDependsOnlyOnTheAnswersNotTheirOrder) {
+    const std::vector<double> truth = {0.0, 0.4, 1.0, 2.2, -0.7};
+    std::vector<Comparison> answers = simulate(truth, 7, 3);
+    const ScorePosterior a = fitPosterior(5, answers);
+    std::mt19937_64 random(9);
+    std::shuffle(answers.begin(), answers.end(), random);
+    const ScorePosterior b = fitPosterior(5, answers);
+    const ScorePosterior c = fitPosterior(5, answers); // rebuilt again (a restart)
+    for (std::size_t i = 0; i < 5; ++i) {
+        EXPECT_EQ(a.mean[i], b.mean[i]);
+        EXPECT_EQ(b.mean[i], c.mean[i]);
+    }
+    EXPECT_EQ(a.covariance, b.covariance);
+    EXPECT_EQ(b.covariance, c.covariance);
+    EXPECT_EQ(spanningTreeBatch(a, 77), spanningTreeBatch(c, 77));
+    // Before any answer: the prior.
+    const ScorePosterior prior = fitPosterior(3, {});
+    EXPECT_EQ(prior.mean, std::vector<double>(3, 0.0));
+    EXPECT_EQ(prior.covariance, ScorePosterior::independent({0, 0, 0}, std::vector<double>(3, PosteriorOptions{}.priorVariance)).covariance);
+    EXPECT_THROW(fitPosterior(3, {{0, 3}}), skinlab::RuntimeError);
+}
+
+TEST(ActiveSampling, GainIsHighestForCloseUncertainPairs) {
+    const ScorePosterior p = ScorePosterior::independent({0.0, 0.2, 3.0, 0.2}, {1.0, 1.0, 1.0, 0.01});
+    // Close beats far at equal uncertainty.
+    EXPECT_GT(expectedInformationGain(p, 0, 1), expectedInformationGain(p, 0, 2));
+    // Uncertain beats certain at equal distance.
+    EXPECT_GT(expectedInformationGain(p, 0, 1), expectedInformationGain(p, 0, 3));
+    // Symmetric and positive.
+    EXPECT_NEAR(expectedInformationGain(p, 0, 1), expectedInformationGain(p, 1, 0), 1e-12);
+    EXPECT_GT(expectedInformationGain(p, 0, 2), 0.0);
+    // What counts is the uncertainty of the difference: two scores known only together (strongly correlated) make
+    // a pair with little to teach, although each score alone is uncertain.
+    ScorePosterior correlated = ScorePosterior::independent({0.0, 0.1, 0.0}, {1.0, 1.0, 1.0});
+    correlated.covariance[1] = correlated.covariance[3] = 0.95; // cov(0, 1)
+    EXPECT_LT(expectedInformationGain(correlated, 0, 1), 0.2 * expectedInformationGain(correlated, 0, 2));
+    // A chain of answers 0–1–2–…–5 ties neighbours closer than the chain's ends: the ends' difference is the most
+    // uncertain, so at equal estimated distance the gain prefers the shortcut.
+    std::vector<Comparison> chain;
+    for (int r = 0; r < 10; ++r)
+        for (int i = 0; i < 5; ++i) {
+            chain.push_back({i, i + 1});
+            chain.push_back({i + 1, i});
+        }
+    const ScorePosterior chained = fitPosterior(6, chain);
+    EXPECT_GT(chained.cov(0, 0) + chained.cov(5, 5) - 2 * chained.cov(0, 5),
+              2 * (chained.cov(0, 0) + chained.cov(1, 1) - 2 * chained.cov(0, 1)));
+    EXPECT_GT(expectedInformationGain(chained, 0, 5), expectedInformationGain(chained, 0, 1));
+    // After data: a close pair teaches more than a far one.
+    const ScorePosterior fitted = fitPosterior(5, simulate({-2.0, 0.0, 0.1, 2.0, 4.0}, 6, 1));
+    const auto gains = informationGains(fitted);
+    EXPECT_GT(gains[1][2], gains[0][4]);
+    EXPECT_GT(gains[1][2], gains[1][4]);
+    std::pair<int, int> best{0, 1};
+    for (int i = 0; i < 5; ++i)
+        for (int j = i + 1; j < 5; ++j)
+            if (gains[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)] >
+                gains[static_cast<std::size_t>(best.first)][static_cast<std::size_t>(best.second)])
+                best = {i, j};
+    // A minimum spanning tree always holds the lightest edge (the highest gain) — first, as batches are sorted.
+    EXPECT_EQ(spanningTreeBatch(fitted, 5).front(), best);
+}
+
+TEST(ActiveSampling, BatchIsAConnectedSpanningTreeReproducibleFromItsSeed) {
+    for (const int m : {2, 3, 10, 30}) {
+        std::vector<double> truth;
+        for (int i = 0; i < m; ++i) truth.push_back(0.2 * i);
+        for (const bool withData : {false, true}) {
+            const ScorePosterior p = fitPosterior(m, withData ? simulate(truth, 2, 4) : std::vector<Comparison>{});
+            const auto batch = spanningTreeBatch(p, 11);
+            ASSERT_EQ(batch.size(), static_cast<std::size_t>(m - 1)) << m;
+            EXPECT_TRUE(connected(m, batch)) << m;
+            std::set<std::pair<int, int>> unique(batch.begin(), batch.end());
+            EXPECT_EQ(unique.size(), batch.size());
+            for (const auto& [a, b] : batch) EXPECT_LT(a, b);
+            EXPECT_EQ(batch, spanningTreeBatch(p, 11));
+        }
+    }
+    // Before any answer every gain is equal: the seed picks the tree, so participants starting together differ.
+    const ScorePosterior prior = fitPosterior(12, {});
+    EXPECT_NE(spanningTreeBatch(prior, 1), spanningTreeBatch(prior, 2));
+    EXPECT_TRUE(spanningTreeBatch(fitPosterior(1, {}), 1).empty());
+}
+
+TEST(ActiveSampling, DesignKeysAreCheckedStrictly) {
+    const StudyDesign d = parseStudyDesign("pairs = \"active\"\ntrials_per_participant = 30\n", "D.toml");
+    EXPECT_TRUE(d.activePairs);
+    EXPECT_TRUE(d.allPairs);
+    EXPECT_EQ(d.trialsPerParticipant, 30);
+    const StudyDesign back = StudyDesign::fromJson(d.toJson());
+    EXPECT_TRUE(back.activePairs);
+    EXPECT_EQ(back.trialsPerParticipant, 30);
+    EXPECT_FALSE(StudyDesign::fromJson(parseStudyDesign("", "D.toml").toJson()).activePairs);
+
+    EXPECT_EQ(designError("pairs = \"active\"\n"),
+              "D.toml: trials_per_participant: required with pairs = \"active\" (test trials per participant)");
+    EXPECT_EQ(designError("pairs = \"active\"\ntrials_per_participant = 0\n"),
+              "D.toml: trials_per_participant: 0 is out of range [1, 10000]");
+    EXPECT_EQ(designError("pairs = \"active\"\ntrials_per_participant = 10\nrepetitions = 2\n"),
+              "D.toml: repetitions: not used with pairs = \"active\" (the planner chooses every test trial; set "
+              "trials_per_participant)");
+    EXPECT_EQ(designError("pairs = \"active\"\ntrials_per_participant = 10\nblock_order = \"grouped\"\n"),
+              "D.toml: block_order: not used with pairs = \"active\" (each batch is planned for one block)");
+    EXPECT_EQ(designError("trials_per_participant = 10\n"), "D.toml: trials_per_participant: only used with pairs = \"active\"");
+    EXPECT_EQ(designError("pairs = \"activ\"\n"),
+              "D.toml: pairs: expected \"all\", \"active\" or an array of [A, B] condition pairs, got \"activ\"");
+}
+
+TEST(ActiveSampling, PlanFillsOpenSlotsBatchByBatchAroundPracticeAndCatchTrials) {
+    const StudyDefinition study =
+        makeStudy("seed = 3\npairs = \"active\"\ntrials_per_participant = 10\n[practice]\ntrials = 2\n[catch]\nblank = 2\n");
+    ASSERT_EQ(study.blocks.size(), 2u);
+    ASSERT_EQ(study.blocks[0].conditions.size(), 4u); // batches of 3 pairs
+    EXPECT_EQ(study.testTrialCount(), 10);
+    EXPECT_EQ(study.repeatTrialCount(), 0);
+    const std::uint64_t seed = participantSeed(study.design.seed, 1);
+    const std::vector<PlannedTrial> skeleton = planTrials(study, 1, seed);
+    ASSERT_EQ(skeleton.size(), 14u);
+    EXPECT_EQ(std::count_if(skeleton.begin(), skeleton.end(), isActiveSlot), 10);
+
+    int posteriorCalls = 0;
+    auto prior = [&](std::size_t b) {
+        ++posteriorCalls;
+        return fitPosterior(static_cast<int>(study.blocks[b].conditions.size()), {});
+    };
+    std::vector<PlannedTrial> stored;
+    std::vector<std::size_t> stretches;
+    for (int guard = 0; guard < 20; ++guard) {
+        const std::vector<PlannedTrial> next = nextActiveTrials(study, 1, seed, stored, prior);
+        if (next.empty()) break;
+        stretches.push_back(next.size());
+        stored.insert(stored.end(), next.begin(), next.end());
+    }
+    ASSERT_EQ(stored.size(), skeleton.size());
+    EXPECT_EQ(posteriorCalls, 4) << "10 test trials in batches of 3: 3 + 3 + 3 + 1";
+    std::map<std::string, int> perBlock;
+    int left = 0;
+    for (std::size_t k = 0; k < stored.size(); ++k) {
+        EXPECT_FALSE(isActiveSlot(stored[k]));
+        EXPECT_EQ(stored[k].kind, skeleton[k].kind) << k;
+        if (skeleton[k].kind != TrialKind::test) {
+            EXPECT_EQ(stored[k].conditionA, skeleton[k].conditionA) << "practice/catch trial " << k << " kept";
+            EXPECT_EQ(stored[k].stimulusB, skeleton[k].stimulusB);
+        } else {
+            ++perBlock[stored[k].block];
+            left += stored[k].aOnLeft ? 1 : 0;
+            EXPECT_NE(stored[k].conditionA, stored[k].conditionB);
+        }
+        if (k > 0 && stored[k].kind == TrialKind::test && stored[k - 1].kind == TrialKind::test) {
+            EXPECT_FALSE(stored[k].block == stored[k - 1].block && stored[k].conditionA == stored[k - 1].conditionA &&
+                         stored[k].conditionB == stored[k - 1].conditionB);
+        }
+    }
+    EXPECT_EQ(left, 5) << "A on the left in exactly half of the test trials";
+    EXPECT_EQ(perBlock.size(), 2u) << "batches alternate between the blocks";
+    // Reproducible: the same answers (here none) give the same plan.
+    std::vector<PlannedTrial> again;
+    for (std::size_t s : stretches) {
+        const auto next = nextActiveTrials(study, 1, seed, again, prior);
+        ASSERT_EQ(next.size(), s);
+        again.insert(again.end(), next.begin(), next.end());
+    }
+    for (std::size_t k = 0; k < stored.size(); ++k) {
+        EXPECT_EQ(again[k].conditionA, stored[k].conditionA);
+        EXPECT_EQ(again[k].aOnLeft, stored[k].aOnLeft);
+    }
+}
