@@ -71,7 +71,7 @@ struct ValidateArguments {
     bool check = false;
 };
 
-// The targets of issue 7 (docs/analysis.md, "Validation"); returns the failed ones.
+// The validation targets (docs/analysis.md, "Validation"); returns the failed ones.
 std::vector<std::string> failedTargets(const scaling::ValidationReport& report) {
     std::vector<std::string> failed;
     char line[256];
@@ -202,7 +202,7 @@ void registerAnalyzeScale(CLI::App& analyze) {
         ->delimiter(',')
         ->capture_default_str();
     validate->add_flag("--check", validateArguments->check,
-                       "exit 1 unless issue 7's targets are met (coverage, RMSE, reversals, screening)");
+                       "exit 1 unless the validation targets are met (coverage, RMSE, reversals, screening)");
     validate->callback([validateArguments] { runValidate(*validateArguments); });
 }
 

@@ -1,4 +1,4 @@
-// Wall-clock time of the scaling of one block with 1000 bootstrap samples over observers (issue 7 targets:
+// Wall-clock time of the scaling of one block with 1000 bootstrap samples over observers (targets:
 // 6 conditions × 30 observers < 1 s, 20 × 30 < 10 s on 2 cores). Simulated full designs; each case runs
 // `--repeat` times (default 5) and prints the median and the minimum, for the bootstrap alone and for the whole
 // block analysis (Thurstone and Bradley–Terry fits, bootstrap, tests, leave-one-out screening, consistency).

@@ -39,7 +39,7 @@ BlockData matrixBlock(const std::vector<std::vector<double>>& counts) {
 
 TEST(PairwiseModel, PwcmpOracleGivesMinusOneZeroOne) {
     // pwcmp's own example: D = [[0,25,0],[75,0,25],[0,75,0]] ⇒ q = [−1, 0, 1] JOD. The prior (precision 0.002)
-    // moves the answer by 2.5e-4; the tolerance 1e-3 is the issue's.
+    // moves the answer by 2.5e-4; the tolerance is 1e-3.
     const BlockData block = matrixBlock({{0, 25, 0}, {75, 0, 25}, {0, 75, 0}});
     const FitResult fit = fitScores(block.totalCounts(), FitOptions{});
     ASSERT_TRUE(fit.converged);
