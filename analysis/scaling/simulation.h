@@ -1,5 +1,5 @@
 #pragma once
-// Simulated 2AFC observers with known true scores (science.md §6): a Thurstone observer picks the left
+// Simulated 2AFC observers with known true scores (docs/analysis.md): a Thurstone observer picks the left
 // stimulus L over the right R iff q_L + ε_L + b > q_R + ε_R, ε ~ N(0, σ²/2) with σ = 1.4826 JOD (so the
 // difference of the two noises has standard deviation σ: P(i ≻ j) = Φ((q_i − q_j)/σ)), b the observer's side
 // bias in JOD. With probability `lapseRate` the answer is a coin flip instead. Deliberately bad observers: a

@@ -1,5 +1,5 @@
 #pragma once
-// Typed parameters of the scene spec tables [sss] and [transmittance] (contracts.md §4), their strict reader and
+// Typed parameters of the scene spec tables [sss] and [transmittance], their strict reader and
 // their JSON form (the "resolved" record stored in EXR metadata and manifests). Every key, unit and default is
 // documented in docs/methods.md; the readers throw InputError naming file and key for bad values.
 #include <array>
