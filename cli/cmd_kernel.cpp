@@ -119,7 +119,7 @@ void registerKernel(CLI::App& app) {
                        "none | gaussian-sum | separable | artistic | pscbf (its broad Gaussian stage; the pass adds "
                        "the spike) | reference (no taps: computed on the surface)")
         ->required();
-    kernel->add_option("--samples", options->samples, "Taps per 1-D pass, odd, 3…101 (sss.samples; default 21)");
+    kernel->add_option("--samples", options->samples, "Taps per 1-D pass, odd, 3…101 (sss.samples; default 21, pscbf 13)");
     kernel->add_option("--profile", options->profile, "deon | burley | file:PATH.bn (sss.profile; default deon)");
     kernel->add_option("--material", options->material,
                        "skin | skin1 | skin2 | marble | apple | ketchup | wholemilk (sss.material; default skin)");

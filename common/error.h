@@ -3,7 +3,8 @@
 //  - bad input (spec, asset, request, command-line value): throw InputError with a one-line message that names
 //    the file, key and value at fault; the CLI prints it and exits 2, the server answers 4xx JSON;
 //  - driver / EGL / GL / I/O failures outside the user's control: throw RuntimeError (CLI exit 1);
-//  - bugs: assert (SKINLAB_ASSERT prints both sides).
+//  - bugs: SKINLAB_CHECK / SKINLAB_CHECK_EQ … of common/check.h (always on, also in release builds; prints
+//    the expression and both values, then aborts).
 // Never print and carry on.
 #include <stdexcept>
 #include <string>

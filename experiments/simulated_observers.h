@@ -1,6 +1,6 @@
 #pragma once
 // Simulated observers that take part in a study through the real HTTP API, many at once — for demos, load tests
-// and validating the analysis (science.md §6). Observer k picks i over j iff q_i + ε_i > q_j + ε_j with
+// and validating the analysis (docs/analysis.md). Observer k picks i over j iff q_i + ε_i > q_j + ε_j with
 // ε ~ N(0, σ²/2), σ = 1.4826, so P(i ≻ j) = Φ((q_i − q_j)/σ) and 1 JOD = 75 % preference (Thurstone Case V as
 // scaled by pwcmp, Perez-Ortiz & Mantiuk 2017). Options add a lapse rate (a random answer), a side bias (JOD added
 // to the left image) and deliberately random or inverted (q → −q) observers to exercise observer screening.

@@ -1,6 +1,6 @@
 #pragma once
 // Per-participant trial plans. Order and sides come from a seeded generator (the seed is stored with the
-// participant), following the design hygiene of science.md §6 (ITU-T P.910 practice):
+// participant), following the design hygiene of docs/analysis.md (ITU-T P.910 practice):
 //  - each pair appears in both orders (A left / A right): repetition k of a pair flips the side of repetition
 //    k−1, and participant n+1 gets the mirror image of participant n's sides, so an even number of repetitions
 //    balances sides within a participant and any two consecutive participants balance them exactly;

@@ -28,6 +28,7 @@
 #include "renderer/scene/mesh_loader.h"
 #include "renderer/scene/scene_spec.h"
 #include "renderer/scene/texture.h"
+#include "renderer/shading/tone_mappers.h"
 #include "renderer/sss/sss_params.h"
 
 #include <chrono>
@@ -286,7 +287,11 @@ RenderResult Renderer::render(const RenderRequest& request) {
         sss::transmittanceParamsFromJson(spec.transmittance, spec.source);
     mainSettings.transmittanceEnabled = transmittanceParams.enabled;
     mainSettings.translucency = static_cast<float>(transmittanceParams.translucency);
-    mainSettings.sssWidthMm = static_cast<float>(sss::sssParamsFromJson(spec.sss, spec.source).widthMm);
+    const sss::SssParams sssParams = sss::sssParamsFromJson(spec.sss, spec.source);
+    mainSettings.sssWidthMm = static_cast<float>(sssParams.widthMm);
+    mainSettings.transmittanceThesisCurvature =
+        transmittanceParams.curvature && transmittanceParams.curvatureForm == "thesis";
+    mainSettings.curvatureReferenceMm = static_cast<float>(sssParams.curvatureReferenceMm);
     mainSettings.mmPerUnit = static_cast<float>(spec.mmPerUnit);
     impl.mainPass.run(impl.targets, scene, impl.shadowMapPass.shadowMaps(), mainSettings);
     timer.end();
@@ -307,6 +312,7 @@ RenderResult Renderer::render(const RenderRequest& request) {
     timer.begin("surface_aovs");
     gl::SurfaceAovSettings surfaceAovSettings;
     surfaceAovSettings.camera = camera;
+    surfaceAovSettings.screenCurvature = sssParams.curvatureMeasure == "screen";
     impl.surfaceAovPass.run(impl.targets, surfaceAovSettings);
     timer.end();
 
@@ -315,6 +321,8 @@ RenderResult Renderer::render(const RenderRequest& request) {
     transmittanceSettings.enabled = transmittanceParams.enabled;
     transmittanceSettings.curvature = transmittanceParams.curvature;
     transmittanceSettings.mmPerUnit = static_cast<float>(spec.mmPerUnit);
+    transmittanceSettings.thesisForm = transmittanceParams.curvatureForm == "thesis";
+    transmittanceSettings.curvatureReferenceMm = static_cast<float>(sssParams.curvatureReferenceMm);
     impl.transmittancePass.run(impl.targets, transmittanceSettings);
     timer.end();
 
@@ -356,8 +364,16 @@ RenderResult Renderer::render(const RenderRequest& request) {
     timer.end();
 
     timer.begin("tone_map");
+    float reinhardScale = 1.0f;
+    if (spec.toneMapper == "reinhard") {
+        // Reinhard et al. 2002, Eq. 1: the log-average luminance of the beauty (read back once, on the CPU).
+        std::vector<float> linear(static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height) * 4);
+        gl::readTexture(impl.targets.beauty.get(), spec.width, spec.height, 4, linear.data());
+        const double logAverage = reinhardLogAverage(linear.data(), linear.size() / 4, 4);
+        reinhardScale = static_cast<float>(spec.reinhardKey / logAverage);
+    }
     impl.toneMapPass.run(impl.targets, spec.toneMapper, static_cast<float>(spec.exponentialK),
-                         static_cast<float>(spec.filmicWhite));
+                         static_cast<float>(spec.filmicWhite), reinhardScale);
     timer.end();
 
     // --- read back and write -----------------------------------------------------------------------------

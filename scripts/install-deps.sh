@@ -19,7 +19,7 @@ PACKAGES=(
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
   # browser test of the participant page
-  chromium nodejs   # npm ships with the machine's Node.js (nodesource); Debian's npm conflicts with it
+  chromium nodejs   # npm: see below
   fonts-dejavu-core   # stimuli: captions of contact.png (OpenImageIO render_text needs a TrueType font)
   slurm-wlm munge jq   # stimuli: the single-node Slurm cluster test (slurmctld, slurmd, sbatch; munged; jq reads manifests)
 )
@@ -30,6 +30,12 @@ for p in "${PACKAGES[@]}"; do
     missing+=("$p")
   fi
 done
+
+# npm: Debian 12's nodejs package has none, so Debian's npm is installed then; a Node.js from elsewhere (e.g.
+# nodesource) brings its own npm, which Debian's npm package conflicts with, so it is installed only when absent.
+if ! command -v npm >/dev/null 2>&1; then
+  missing+=(npm)
+fi
 
 if [ ${#missing[@]} -eq 0 ]; then
   echo "install-deps: all ${#PACKAGES[@]} packages present"

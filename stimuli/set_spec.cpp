@@ -24,7 +24,7 @@ std::string sceneKeyOf(const std::string& factorName) {
 
 const std::vector<std::string>& alwaysFixedKeys() {
     // Resolution, exposure and tone mapping change how every pixel is displayed: varying them inside a set would
-    // favour some conditions by brightness or sharpness rather than by the factor under test (issue 5).
+    // favour some conditions by brightness or sharpness rather than by the factor under test.
     static const std::vector<std::string> keys = {"render.width", "render.height", "render.exposure_ev",
                                                   "tone_map"};
     return keys;

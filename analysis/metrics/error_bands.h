@@ -1,5 +1,5 @@
 #pragma once
-// The halo, bleed, spill and interior bands of science.md §5 (docs/metrics.md, "Bands"). The construction
+// The halo, bleed, spill and interior bands (docs/metrics.md, "Bands"). The construction
 // follows Middlebury's depth-discontinuity regions (Scharstein & Szeliski 2002) and Boundary IoU's
 // resolution-relative bands (Cheng et al. 2021): every width is the projected SSS support radius
 // ρ(p) = r_w · f_px / D(p) in pixels, never a fixed number of pixels, so band areas scale with the resolution.

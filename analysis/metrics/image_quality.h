@@ -1,5 +1,5 @@
 #pragma once
-// PSNR and SSIM through OpenCV's quality module (opencv_contrib), with its traps handled (science.md §5):
+// PSNR and SSIM through OpenCV's quality module (opencv_contrib), with its traps handled (docs/metrics.md):
 // QualitySSIM hard-codes C1 = (0.01·255)² = 6.5025 and C2 = (0.03·255)² = 58.5225, so its inputs must be on a
 // 0–255 scale; QualityPSNR's default peak is 255. Both functions here take CV_64F images in [0, 255].
 #include <opencv2/core.hpp>

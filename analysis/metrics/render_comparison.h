@@ -1,6 +1,6 @@
 #pragma once
 // One comparison of a test render with a reference: per-pixel ΔE00, global and skin PSNR/SSIM/ΔE00, and the
-// band scores of science.md §5 (docs/metrics.md lists every field).
+// band scores (docs/metrics.md lists every field).
 #include "analysis/metrics/error_bands.h"
 #include "analysis/metrics/metric_render.h"
 

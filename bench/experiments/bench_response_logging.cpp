@@ -1,5 +1,5 @@
 // Benchmark: response-logging latency of the study server under concurrent simulated participants on loopback
-// (issue 6: p50/p99 and errors at 50 and 200 participants; target p99 < 50 ms, zero errors, zero lost).
+// (p50/p99 and errors at 50 and 200 participants; target p99 < 50 ms, zero errors, zero lost).
 // Each measurement: a fresh study.db (WAL, synchronous=FULL) in a temporary folder, the real HTTP server in this
 // process, N simulated observers (one thread and one connection each) answering every trial. Latency is the
 // client-side round trip of POST /api/response, which includes validation and the fsynced COMMIT.

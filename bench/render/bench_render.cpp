@@ -1,4 +1,4 @@
-// Per-pass milliseconds of the renderer without SSS (docs/benchmarks.md, "Renderer (issue 2)").
+// Per-pass milliseconds of the renderer without SSS (docs/benchmarks.md, "Renderer").
 //   bench_render [--frames N] [--width W] [--height H] [--assets DIR] [--csv FILE] [--set key=value ...]
 // Renders builtin:head and, when the assets folder is known (--assets or $SKINLAB_ASSETS), the scanned head
 // (renderer/scenes/lee-perry-smith.toml) at 1280×720: one warm-up frame (shader compilation, file loading),

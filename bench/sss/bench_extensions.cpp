@@ -1,4 +1,4 @@
-// Cost of the artifact extensions (issue 4; docs/benchmarks.md, "Artifact extensions (issue 4)"): SSS-stage
+// Cost of the artifact extensions (docs/benchmarks.md, "Artifact extensions"): SSS-stage
 // milliseconds of every screen-space method with each extension set, at one scene, view and size.
 //   bench_extensions [--scene S] [--view close|mid|far] [--width W] [--height H] [--frames N] [--assets DIR]
 //                    [--methods gaussian-sum,separable,artistic,pscbf]

@@ -1,5 +1,5 @@
 // SSS milliseconds per method against samples per pass and close/mid/far views (thesis Fig. 5.1 and Table 5.2;
-// docs/benchmarks.md, "SSS methods (issue 3)").
+// docs/benchmarks.md, "SSS methods").
 //   bench_sss [--scene S] [--width W] [--height H] [--samples 5,11,21,51,101] [--views close,mid,far]
 //             [--methods gaussian-sum,separable,artistic,pscbf] [--frames N] [--assets DIR] [--out DIR]
 // For every view, method and sample count: one warm-up render (kernel construction, shader compilation), then N

@@ -1,4 +1,4 @@
-// The SSS stage alone on frozen frames, methods interleaved (docs/benchmarks.md, "Mikkelsen's pscbf (issue 4)").
+// The SSS stage alone on frozen frames, methods interleaved (docs/benchmarks.md, "Mikkelsen's pscbf").
 //   bench_sss_stage [--scene S] [--width W] [--height H] [--views close,mid,far] [--methods separable,pscbf]
 //                   [--samples 13,21] [--repeats N] [--assets DIR] [--out DIR]
 // Why beside bench_sss: bench_sss measures each method in a run of whole renders, so on a machine shared with other

@@ -1,5 +1,7 @@
 #include "renderer/gl/main_pass.h"
 
+#include "renderer/sss/sss_params.h"
+
 #include <algorithm>
 #include <string>
 
@@ -41,11 +43,16 @@ void MainPass::bindShading(GLuint program, const GpuScene& scene, GLuint shadowM
         setUniform(program, ("lightInverseViewProjection" + index).c_str(), glm::inverse(light.viewProjection));
     }
 
-    // Transmittance: thickness (world units) × mm_per_unit × 8.25 (1 − translucency) / width_mm = s (mm).
+    // Transmittance: s = thickness (world units) × 8.25 (1 − translucency) / sssWidth, the demo's sssWidth being
+    // width_mm / (2 mm_per_unit): s = thickness × mm_per_unit × 16.5 (1 − translucency) / width_mm.
     setUniform(program, "transmittanceEnabled", settings.transmittanceEnabled ? 1 : 0);
     setUniform(program, "transmittanceShrink", kTransmittanceShrinkMm / settings.mmPerUnit);
-    setUniform(program, "transmittanceScale", settings.mmPerUnit * 8.25f * (1.0f - settings.translucency) /
-                                                  std::max(settings.sssWidthMm, 1e-6f));
+    setUniform(program, "transmittanceThesisCurvature", settings.transmittanceThesisCurvature ? 1 : 0);
+    setUniform(program, "transmittanceCurvatureScale",
+               settings.camera.focalLengthPixels / 8.0f * settings.curvatureReferenceMm / settings.mmPerUnit);
+    setUniform(program, "transmittanceScale",
+               static_cast<float>(sss::transmittanceScalePerUnit(settings.translucency,
+                                                                 std::max(settings.sssWidthMm, 1e-6f), settings.mmPerUnit)));
 
     const GLuint fallback = scene.fallbackMap();
     const GLuint maps[] = {scene.albedoMap(), scene.normalMap(), scene.specularMap(), scene.occlusionMap(),

@@ -24,7 +24,7 @@ constexpr int kMaxTaps = 101;  // PSCBF_MAX_TAPS of the shader (sss.samples ≤ 
 PscbfMethod::PscbfMethod(ShaderLibrary& shaders) : shaders_(shaders) {}
 
 glm::dvec3 PscbfMethod::depthSigmaMm(const sss::SssParams& params) {
-    const auto& variance = sss::mikkelsenSkinProfile().varianceMm2;
+    const auto& variance = sss::mikkelsenSkinProfile(params.pscbfSigma).varianceMm2;
     const double scale = params.widthMm / 3.0;
     return {std::sqrt(variance[0]) * scale, std::sqrt(variance[1]) * scale, std::sqrt(variance[2]) * scale};
 }
@@ -46,8 +46,7 @@ void PscbfMethod::run(const SssStageInputs& inputs, const sss::SssParams& params
     if (output == inputs.diffuse) throw RuntimeError("pscbf method: output texture must differ from the diffuse input");
     ensureScratch(inputs.width, inputs.height);
 
-    const SssExtensionSettings extensions =
-        SssExtensionSettings::fromParams(params, inputs.albedo, inputs.aux, inputs.curvature);
+    SssExtensionSettings extensions = SssExtensionSettings::fromParams(params, inputs.albedo, inputs.aux, inputs.curvature);
     // The spike is what the broad stage's accumulate weights leave (kernel.cpp: accumulate = 1 − spike).
     const glm::vec3 spike(static_cast<float>(1.0 - stage.accumulate[0]), static_cast<float>(1.0 - stage.accumulate[1]),
                           static_cast<float>(1.0 - stage.accumulate[2]));
@@ -80,6 +79,7 @@ void PscbfMethod::run(const SssStageInputs& inputs, const sss::SssParams& params
         glBindTextureUnit(kDepthUnit, inputs.linearDepth);
         glBindTextureUnit(kNormalUnit, inputs.geometricNormal);
         glBindTextureUnit(kUnblurredUnit, inputs.diffuse);
+        extensions.litTexture = horizontal ? inputs.diffuse : scratch;  // sss.extension_input = "lit"
         extensions.bind(program, kFirstExtensionUnit);
         shaders_.drawFullscreenTriangle();
         extensions.unbind(kFirstExtensionUnit);

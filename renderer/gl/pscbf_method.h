@@ -1,6 +1,6 @@
 #pragma once
 // Mikkelsen's pseudo-separable cross-bilateral filter as a GL method (sss.method = "pscbf"; M. S. Mikkelsen,
-// "Skin Rendering by Pseudo-Separable Cross Bilateral Filtering", 2010; science.md §2b; docs/extensions.md).
+// "Skin Rendering by Pseudo-Separable Cross Bilateral Filtering", 2010; docs/extensions.md).
 // Two 1-D passes of renderer/shaders/pscbf_blur.frag: diffuse → scratch (horizontal) → output (vertical, plus the
 // spike: output = spike · diffuse + (1 − spike) · blurred). The taps are the broad Gaussian part of the profile
 // (renderer/sss/pscbf_kernel.h, built by makeKernel), scaled by width_mm / 3. What differs from the kernel methods

@@ -10,7 +10,7 @@ namespace skinlab::renderer::gl {
 
 namespace {
 // Units 0 and 1 are the source colour and the linear depth (layout(binding) in sss_blur.frag); the extension
-// textures take 2, 3, 4.
+// textures take 2, 3, 4, 5.
 constexpr GLuint kFirstExtensionTextureUnit = 2;
 } // namespace
 
@@ -46,7 +46,9 @@ void SssBlurPass::run(const SssBlurPassInputs& inputs, const sss::KernelStage& s
 
     // First of the state changes: it throws (a pipeline bug) before touching any GL state when a switched-on
     // extension has no texture.
-    inputs.extensions.bind(program, kFirstExtensionTextureUnit);
+    SssExtensionSettings extensions = inputs.extensions;
+    extensions.litTexture = inputs.source;  // sss.extension_input = "lit": the colour this pass blurs
+    extensions.bind(program, kFirstExtensionTextureUnit);
     glUseProgram(program);
     glBindFramebuffer(GL_FRAMEBUFFER, target);
     glViewport(0, 0, inputs.width, inputs.height);

@@ -19,7 +19,9 @@ SssExtensionSettings SssExtensionSettings::fromParams(const sss::SssParams& para
     settings.cbfLambda = static_cast<float>(params.cbfLambda);
     settings.labWeight = static_cast<float>(params.labWeight);
     settings.curvature = sss::curvatureStrategyFromName(params.curvature, "sss");
+    settings.input = sss::extensionInputFromName(params.extensionInput, "sss");
     settings.curvatureFloor = static_cast<float>(params.curvatureFloor);
+    settings.curvatureReferenceMm = static_cast<float>(params.curvatureReferenceMm);
     return settings;
 }
 
@@ -31,7 +33,8 @@ ShaderDefines SssExtensionSettings::defines() const {
 void SssExtensionSettings::bind(GLuint program, GLuint firstTextureUnit) const {
     // A switch that is on without its texture would silently read texture 0 (all zeros in GL): a pipeline bug.
     if ((labWeight > 0.0f && albedoTexture == 0) || (cbf && auxTexture == 0) ||
-        (curvature != sss::CurvatureStrategy::Off && curvatureTexture == 0))
+        (curvature != sss::CurvatureStrategy::Off && curvatureTexture == 0) ||
+        (weighsTaps() && input == sss::ExtensionInput::Lit && (litTexture == 0 || albedoTexture == 0)))
         throw RuntimeError("SSS extensions: an extension is on but its input texture is missing");
     setUniform(program, "extensionLabBeta", labWeight);
     setUniform(program, "extensionCbf", cbf ? 1 : 0);
@@ -39,16 +42,20 @@ void SssExtensionSettings::bind(GLuint program, GLuint firstTextureUnit) const {
     // The GLSL constants kCurvatureOff … kCurvatureReduceFloor follow the enum's order (sss_extensions.glsl).
     setUniform(program, "extensionCurvatureStrategy", static_cast<int>(curvature));
     setUniform(program, "extensionCurvatureFloor", curvatureFloor);
+    setUniform(program, "extensionCurvatureReferenceMm", curvatureReferenceMm);
     setUniform(program, "extensionAlbedo", static_cast<int>(firstTextureUnit));
     setUniform(program, "extensionAux", static_cast<int>(firstTextureUnit + 1));
     setUniform(program, "extensionCurvature", static_cast<int>(firstTextureUnit + 2));
+    setUniform(program, "extensionLit", static_cast<int>(firstTextureUnit + 3));
+    setUniform(program, "extensionInputLit", input == sss::ExtensionInput::Lit ? 1 : 0);
     glBindTextureUnit(firstTextureUnit, albedoTexture);
     glBindTextureUnit(firstTextureUnit + 1, auxTexture);
     glBindTextureUnit(firstTextureUnit + 2, curvatureTexture);
+    glBindTextureUnit(firstTextureUnit + 3, litTexture);
 }
 
 void SssExtensionSettings::unbind(GLuint firstTextureUnit) const {
-    for (GLuint unit = firstTextureUnit; unit < firstTextureUnit + 3; ++unit) glBindTextureUnit(unit, 0);
+    for (GLuint unit = firstTextureUnit; unit < firstTextureUnit + 4; ++unit) glBindTextureUnit(unit, 0);
 }
 
 } // namespace skinlab::renderer::gl

@@ -23,10 +23,13 @@ struct SssExtensionSettings {
     float labWeight = 0.0f;   // β, 1/ΔE*ab; 0 = off
     sss::CurvatureStrategy curvature = sss::CurvatureStrategy::Off;
     float curvatureFloor = 0.5f;  // [0, 1], reduce-floor only
+    float curvatureReferenceMm = sss::kCurvatureReferenceRadiusMm;  // sss.curvature_reference_mm
+    sss::ExtensionInput input = sss::ExtensionInput::Albedo;  // sss.extension_input (E1/E2)
 
     GLuint albedoTexture = 0;     // GL_RGBA32F, rgb = linear albedo (SssStageInputs::albedo)
     GLuint auxTexture = 0;        // GL_R32F, F (SssStageInputs::aux)
     GLuint curvatureTexture = 0;  // GL_R32F, κ in 1/world unit (SssStageInputs::curvature)
+    GLuint litTexture = 0;        // the colour the pass blurs (its source), read with input = lit; set per pass
 
     // The switches of resolved [sss] parameters (textures left 0: set them from SssStageInputs).
     static SssExtensionSettings fromParams(const sss::SssParams& params);
@@ -40,11 +43,11 @@ struct SssExtensionSettings {
     // exactly its extension-free shader.
     ShaderDefines defines() const;
 
-    // Sets the extension* uniforms of `program` and binds the three textures to units firstTextureUnit,
-    // firstTextureUnit + 1, firstTextureUnit + 2. A texture that is 0 while its extension is on is a pipeline bug:
+    // Sets the extension* uniforms of `program` and binds the four textures to units firstTextureUnit,
+    // firstTextureUnit + 1, firstTextureUnit + 2 and firstTextureUnit + 3 (the lit colour). A texture that is 0 while its extension is on is a pipeline bug:
     // RuntimeError, thrown before any GL state is changed.
     void bind(GLuint program, GLuint firstTextureUnit) const;
-    // Unbinds the three units bind() used.
+    // Unbinds the four units bind() used.
     void unbind(GLuint firstTextureUnit) const;
 };
 

@@ -13,7 +13,7 @@ namespace skinlab::renderer::gl {
 struct SssStage::Impl {
     explicit Impl(ShaderLibrary& library) : shaders(library), kernelMethod(library) {}
     ShaderLibrary& shaders;
-    // gaussian-sum, separable, artistic (kernels engineer): the method's kernel run as 1-D passes.
+    // gaussian-sum, separable, artistic: the method's kernel run as 1-D passes.
     SssKernelMethod kernelMethod;
     // The kernel of the last settings (computing a Burley or file: kernel takes milliseconds; renders repeat).
     std::string kernelKey;

@@ -1,9 +1,9 @@
 #pragma once
-// The SSS stage slot of the pipeline (science.md §2): between the main pass, which writes the diffuse
+// The SSS stage slot of the pipeline (docs/methods.md): between the main pass, which writes the diffuse
 // (irradiance × albedo) buffer and the AOVs, and add_specular. It reads the diffuse buffer and writes the
 // scattered diffuse buffer; every method of renderer/sss plugs in behind run().
 //
-// Contract for the methods (kernels engineer):
+// Contract for the methods:
 //  - all textures are GL_TEXTURE_2D, width × height, sampled with texelFetch (no filtering, no mipmaps);
 //  - colours are linear Rec.709, scene-referred, exposure already applied (the main pass scales by
 //    2^exposure_ev; every method is linear in the colour, so this commutes), specular NOT included;
@@ -36,7 +36,7 @@ struct SssStageInputs {
     int width = 0;               // pixels
     int height = 0;              // pixels
     float focalLengthPixels = 0; // f_px = (height/2) / tan(fovY/2); a kernel offset of o mm at depth z covers
-                                 // o / mmPerUnit * f_px / z pixels (science.md §2, same scale on both axes)
+                                 // o / mmPerUnit * f_px / z pixels (docs/methods.md, same scale on both axes)
     float mmPerUnit = 1;         // millimetres per world unit of the scene
     glm::mat4 view{1.0f};        // world → view (camera looks down -Z)
     glm::mat4 projection{1.0f};  // view → clip (OpenGL convention)

@@ -31,6 +31,7 @@ void SurfaceAovPass::run(FrameTargets& targets, const SurfaceAovSettings& settin
     setUniform(program, "focalLengthPixels", settings.camera.focalLengthPixels);
     setUniform(program, "depthStepPixels", kSurfaceDepthStepPixels);
     setUniform(program, "axisCount", 2);
+    setUniform(program, "screenCurvature", settings.screenCurvature ? 1 : 0);
     glBindTextureUnit(0, targets.linearDepth.get());
     glBindTextureUnit(1, targets.geometricNormal.get());
     glBindTextureUnit(2, targets.albedo.get());

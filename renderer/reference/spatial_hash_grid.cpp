@@ -1,7 +1,8 @@
 #include "renderer/reference/spatial_hash_grid.h"
 
+#include "common/check.h"
+
 #include <algorithm>
-#include <cassert>
 #include <cmath>
 
 namespace skinlab::renderer::reference {
@@ -9,7 +10,7 @@ namespace skinlab::renderer::reference {
 SpatialHashGrid::SpatialHashGrid(const std::vector<glm::vec3>& points, const std::vector<std::uint32_t>& members,
                                  float cellSizeMm)
     : points_(&points), cellSize_(cellSizeMm) {
-    assert(cellSizeMm > 0.0f);
+    SKINLAB_CHECK_GT(cellSizeMm, 0.0f);
     std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed;
     keyed.reserve(members.size());
     for (const std::uint32_t index : members) keyed.emplace_back(key(cellOf(points[index])), index);

@@ -1,10 +1,10 @@
 #include "renderer/reference/surface_convolution.h"
 
+#include "common/check.h"
 #include "renderer/reference/spatial_hash_grid.h"
 
 #include <algorithm>
 #include <atomic>
-#include <cassert>
 #include <cmath>
 #include <numbers>
 #include <thread>
@@ -14,7 +14,7 @@ namespace skinlab::renderer::reference {
 std::vector<glm::vec3> convolveSurface(const SurfaceSamples& samples, const std::vector<glm::vec3>& irradiance,
                                        const RadialProfile& profile, const ConvolutionSettings& settings,
                                        const std::vector<std::uint32_t>* receivers, ConvolutionReport* report) {
-    assert(irradiance.size() == samples.size());
+    SKINLAB_CHECK_EQ(irradiance.size(), samples.size());
     const std::size_t count = samples.size();
     std::vector<glm::vec3> output(count);
     for (std::size_t i = 0; i < count; ++i) output[i] = irradiance[i] * samples.albedo[i];

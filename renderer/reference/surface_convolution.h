@@ -1,5 +1,5 @@
 #pragma once
-// The object-space reference SSS (issue 4, part 2): convolution of per-sample diffuse irradiance × albedo over the
+// The object-space reference SSS : convolution of per-sample diffuse irradiance × albedo over the
 // surface with a radial diffusion profile at true 3-D distances, among skin samples only.
 //
 // For a skin receiver p and skin sources q within the cutoff radius r_c (3-D distance |p − q| in mm):

@@ -1,6 +1,6 @@
 #pragma once
 // Procedural, physically scaled models of the built-in scenes (builtin:halo, builtin:bleed, builtin:ear,
-// builtin:head). They need no files; the render engineer's builtin scene specs add lights, camera and
+// builtin:head). They need no files; the builtin scene specs (renderer/scenes/builtin) add lights, camera and
 // materials on top by material name.
 //
 // Conventions shared by every built-in model (docs/assets.md, "Built-in geometry"):

@@ -271,17 +271,20 @@ SceneSpec loadSceneSpec(const std::string& scene, const std::vector<std::string>
     // [tone_map]
     {
         const SpecReader toneMap = root.table("tone_map");
-        spec.toneMapper = toneMap.choice("operator", "filmic", {"linear", "exponential", "reinhard", "filmic"});
+        spec.toneMapper =
+            toneMap.choice("operator", "filmic", {"linear", "exponential", "reinhard", "reinhard-rgb", "filmic"});
         spec.exponentialK = toneMap.number("exponential_k", 1.0, 1e-3, 1e3);
         spec.filmicWhite = toneMap.number("filmic_white", 11.2, 1.0, 1e3);
+        spec.reinhardKey = toneMap.number("reinhard_key", 0.18, 1e-3, 10.0);
         const std::string display = toneMap.choice("display", "srgb", {"srgb"});
         resolved["tone_map"] = {{"operator", spec.toneMapper},
                                 {"exponential_k", spec.exponentialK},
                                 {"filmic_white", spec.filmicWhite},
+                                {"reinhard_key", spec.reinhardKey},
                                 {"display", display}};
     }
 
-    // [sss] and [transmittance]: read by renderer/sss/sss_params (kernels engineer); stored resolved.
+    // [sss] and [transmittance]: read by renderer/sss/sss_params; stored resolved.
     {
         const sss::SssParams sssParams = sss::readSssParams(root);
         const sss::TransmittanceParams transmittanceParams = sss::readTransmittanceParams(root);

@@ -83,9 +83,10 @@ struct SceneSpec {
     int width = 512;
     int height = 512;
     double exposureEv = 0.0;           // beauty and AOVs are scaled by 2^exposure_ev
-    std::string toneMapper = "filmic"; // linear | exponential | reinhard | filmic
+    std::string toneMapper = "filmic"; // linear | exponential | reinhard | reinhard-rgb | filmic
     double exponentialK = 1.0;         // exponential: 1 - exp(-k x)
     double filmicWhite = 11.2;         // filmic (Hable 2010): linear value mapped to display white
+    double reinhardKey = 0.18;         // reinhard (Reinhard et al. 2002, Eq. 2): the key a
     std::string sssMethod = "none";
     nlohmann::json sss = nlohmann::json::object();           // resolved [sss] table
     nlohmann::json transmittance = nlohmann::json::object(); // resolved [transmittance] table

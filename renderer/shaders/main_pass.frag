@@ -1,6 +1,6 @@
 #version 450 core
 #extension GL_GOOGLE_include_directive : require
-// Main pass (science.md §4): per pixel
+// Main pass (thesis ch. 4): per pixel
 //   diffuse  = exposure * (sum_lights L_c (n.l) shadow + E_SH(n) / pi * AO) * albedo
 //   specular = exposure * sum_lights L_c * Eq. 4.5 * shadow * specular intensity
 // plus the AOVs the SSS stage and the EXR need: albedo, linear depth (world units along the view axis),
@@ -70,6 +70,8 @@ uniform mat4 lightInverseViewProjection[MAX_LIGHTS];  // light clip space -> wor
 uniform int transmittanceEnabled;
 uniform float transmittanceShrink;  // world units: the point is moved this far inside along the geometric normal
 uniform float transmittanceScale;   // scaled thickness s (mm) per world unit of thickness
+uniform int transmittanceThesisCurvature;   // transmittance.curvature_form = "thesis": s / (1 + 2c)
+uniform float transmittanceCurvatureScale;  // c per unit of the thesis' raw measure: f_px / 8 · reference mm / mm_per_unit
 
 uniform vec3 irradianceSH[9];        // A_l * L_lm (renderer/scene/environment.h), environment frame
 uniform mat3 environmentFromWorld;   // inverse of the environment's rotation about +Y
@@ -152,6 +154,21 @@ void main() {
     float mask = clamp(materialSkin * vertexSkin, 0.0, 1.0);
     if (hasSkinMaskMap != 0) mask *= clamp(texture(skinMaskMap, textureCoordinate).r, 0.0, 1.0);
 
+    // The thesis' curvature-modulated transmittance (its main-pass shader): the profile widened inside the exponent,
+    // sssWidth × (1 + 2c), i.e. s / (1 + 2c), with its screen-space curvature (cross(n − dx, n + dx).y −
+    // cross(n − dy, n + dy).x) · 2 / distance, dx, dy = dFdx, dFdy of the view-space geometric normal, clamped ≥ 0,
+    // normalised like the curvature AOV but not capped at 1. Derivatives in uniform control flow, before the loop.
+    vec3 viewGeometricNormal = normalize(mat3(view) * geometricNormal);
+    vec3 normalDx = dFdx(viewGeometricNormal);
+    vec3 normalDy = dFdy(viewGeometricNormal);
+    float transmittanceWidening = 1.0;
+    if (transmittanceThesisCurvature != 0) {
+        float raw = (cross(viewGeometricNormal - normalDx, viewGeometricNormal + normalDx).y -
+                     cross(viewGeometricNormal - normalDy, viewGeometricNormal + normalDy).x) *
+                    2.0 / length((view * vec4(worldPosition, 1.0)).xyz);
+        transmittanceWidening = 1.0 + 2.0 * max(raw, 0.0) * transmittanceCurvatureScale;
+    }
+
     vec3 toViewer = normalize(cameraPosition - worldPosition);
     vec3 lightSum = vec3(0.0);
     vec3 specularSum = vec3(0.0);
@@ -178,7 +195,7 @@ void main() {
         float facing = clamp(0.3 + dot(toLight, -geometricNormal), 0.0, 1.0);
         if (transmittanceEnabled != 0 && lightShadowLayer[i] >= 0 && mask > 0.0 && facing > 0.0) {
             float thickness = thicknessToLight(i, worldPosition, geometricNormal);
-            if (thickness >= 0.0) transmittedSum += radiance * deonTransmittance(thickness * transmittanceScale) * facing;
+            if (thickness >= 0.0) transmittedSum += radiance * deonTransmittance(thickness * transmittanceScale / transmittanceWidening) * facing;
         }
     }
     vec3 ambient = max(irradiance(environmentFromWorld * normal), vec3(0.0)) / 3.14159265358979 * occlusion;

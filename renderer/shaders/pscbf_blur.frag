@@ -1,7 +1,7 @@
 #version 450 core
 #extension GL_GOOGLE_include_directive : require
 // One 1-D pass of Mikkelsen's pseudo-separable cross-bilateral filter (method pscbf; M. S. Mikkelsen, "Skin
-// Rendering by Pseudo-Separable Cross Bilateral Filtering", 2010; science.md §2b; docs/extensions.md). The method
+// Rendering by Pseudo-Separable Cross Bilateral Filtering", 2010; docs/extensions.md). The method
 // runs it twice (renderer/gl/pscbf_method.cpp): horizontally on the diffuse buffer, then vertically on that result
 // with PSCBF_FINAL_PASS, which adds the spike: output = spike · unblurred + (1 − spike) · blurred, per channel.
 //

@@ -3,7 +3,7 @@
 // One 1-D screen-space subsurface-scattering pass (horizontal or vertical) with a tabulated kernel: the pass of the
 // separable and artistic methods (two passes) and of the gaussian-sum method (12 passes, SSS_ACCUMULATE on the
 // vertical ones). Mirrors renderer/sss/cpu_blur.cpp operation for operation (docs/methods.md):
-//   pixels per mm = f_px / (mm_per_unit · z_centre), the same on both axes (science.md §2), × the curvature width
+//   pixels per mm = f_px / (mm_per_unit · z_centre), the same on both axes (docs/methods.md), × the curvature width
 //   scale of sss.curvature (E3; exactly 1 when off);
 //   each tap linearly interpolates the two texels it falls between, each texel first replaced by the centre colour
 //   in proportion to its non-skin share (1 − mask) and, with follow-surface, saturate(k · |Δz| · mm_per_unit);

@@ -1,4 +1,4 @@
-// The artifact extensions of the thesis (§3.3; science.md §3) for any screen-space SSS pass, one pixel at a time.
+// The artifact extensions of the thesis (§3.3) for any screen-space SSS pass, one pixel at a time.
 // Mirrors renderer/sss/extension_weights.h function by function (same names, same float arithmetic); tests compare
 // the two. docs/extensions.md describes each function and how a blur pass combines them:
 //

@@ -9,6 +9,12 @@
 // background or across a depth step (|depth difference| > depthStepPixels pixel footprints) is rejected. Where
 // neither axis has a neighbour the curvature is -1 (unmeasured; the smoothing skips it). Off skin: aux 0,
 // curvature -2. The curvature output carries the linear depth beside it for the smoothing (curvature_smooth.frag).
+// With screenCurvature = 1 (sss.curvature_measure = "screen") the curvature is instead the thesis' screen-space
+// measure (its §3.3.3 and main-pass shader), from the per-pixel change of the view-space geometric normal
+// (dx, dy: central differences of the same-surface neighbours, one-sided where only one is usable, standing in for
+// dFdx / dFdy): (cross(n − dx, n + dx).y − cross(n − dy, n + dy).x) · 2 / distance to the camera, clamped ≥ 0, then
+// × f_px / 8 so that a sphere of radius r seen face-on reads 1/r at its centre, like the 3-D measure. It grows
+// towards silhouettes, where the normal turns fast per pixel.
 #include "sss_extensions.glsl"
 
 layout(location = 0) out float outAux;
@@ -27,6 +33,7 @@ uniform float depthStepPixels;   // depth-step threshold in pixel footprints
 // only while one of its pixels is active, whereas unrolled code runs for background pixels too (the pass then
 // costs 3× more on the CPU; measured, docs/benchmarks.md).
 uniform int axisCount;
+uniform int screenCurvature;     // 0: 3-D normal curvature; 1: the thesis' screen-space measure
 
 // View-space position of the surface seen through the centre of `pixel` at linear depth `depth` (view z = -depth):
 // a perspective projection maps x to ndc.x = (P00 x + P20 z) / -z, so x = depth (ndc.x / P00 + P20 / P00).
@@ -83,6 +90,30 @@ void main() {
     vec3 normal = normalize(viewFromWorld * texelFetch(geometricNormal, pixel, 0).xyz);
     vec3 rgb = texelFetch(albedo, pixel, 0).rgb;
     outAux = auxiliaryValue(position, normal, (rgb.r + rgb.g + rgb.b) / 3.0);
+
+    if (screenCurvature != 0) {
+        vec3 dn[2];
+        bool measuredAxis[2];
+        for (int axis = 0; axis < 2; ++axis) {
+            ivec2 step = axis == 0 ? ivec2(1, 0) : ivec2(0, 1);
+            vec3 plusPosition, plusNormal, minusPosition, minusNormal;
+            bool plus = sameSurface(pixel + step, depth, plusPosition, plusNormal);
+            bool minus = sameSurface(pixel - step, depth, minusPosition, minusNormal);
+            measuredAxis[axis] = plus || minus;
+            if (plus && minus) dn[axis] = 0.5 * (normalize(plusNormal) - normalize(minusNormal));
+            else if (plus) dn[axis] = normalize(plusNormal) - normal;
+            else if (minus) dn[axis] = normal - normalize(minusNormal);
+            else dn[axis] = vec3(0.0);
+        }
+        if (!measuredAxis[0] && !measuredAxis[1]) {
+            outCurvature = vec2(-1.0, depth);
+            return;
+        }
+        float thesis = (cross(normal - dn[0], normal + dn[0]).y - cross(normal - dn[1], normal + dn[1]).x) * 2.0 /
+                       length(position);
+        outCurvature = vec2(max(thesis, 0.0) * focalLengthPixels / 8.0, depth);
+        return;
+    }
 
     // Mean over the axes that could be measured, clamped at 0; -1 where none could.
     float sum = 0.0;

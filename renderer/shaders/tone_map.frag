@@ -9,8 +9,9 @@ layout(binding = 0) uniform sampler2D beauty;
 uniform int operatorIndex;
 uniform float exponentialK;
 uniform float filmicWhite;
+uniform float reinhardScale;  // a / L̄ (Reinhard et al. 2002, Eq. 2)
 
 void main() {
     vec3 x = texelFetch(beauty, ivec2(gl_FragCoord.xy), 0).rgb;
-    outDisplay = vec4(toneMap(x, operatorIndex, exponentialK, filmicWhite), 1.0);
+    outDisplay = vec4(toneMap(x, operatorIndex, exponentialK, filmicWhite, reinhardScale), 1.0);
 }

@@ -1,6 +1,6 @@
 // Transmittance through a slab of skin (Jimenez, Whelan, Sundstedt & Gutierrez, "Real-Time Realistic Skin
 // Translucency", IEEE CG&A 2010): T(s) = sum_i w_i exp(-s^2 / v_i) with d'Eon & Luebke's six-Gaussian skin profile
-// (GPU Gems 3 ch. 14, Table 14-1; science.md §1): v_i in mm^2, s the scaled thickness in mm.
+// (d'Eon & Luebke, GPU Gems 3 ch. 14, Table 14-1): v_i in mm^2, s the scaled thickness in mm.
 // Mirrors deonTransmittance() in renderer/sss/gaussian_sum_profile.cpp lobe by lobe (the same table, blue weight
 // 0.649 as published); tests/renderer/gl/test_transmittance_glsl.cpp compares the two. Each channel's weights sum
 // to 1, so T(0) = 1 per channel. (The thesis code used other weights and got T(0) = (2.23, 1.64, 1.35): not here.)

@@ -1,9 +1,9 @@
 #include "renderer/sss/artistic_kernel.h"
 
+#include "common/check.h"
 #include "renderer/sss/discretisation.h"
 #include "renderer/sss/gaussian_sum_profile.h"
 
-#include <cassert>
 #include <cmath>
 
 namespace skinlab::renderer::sss {
@@ -21,7 +21,8 @@ double artisticProfile(double r, double falloff) {
 
 std::vector<KernelTap> artisticTaps(int samples, const std::array<double, 3>& strength,
                                     const std::array<double, 3>& falloff) {
-    assert(samples >= 3 && samples % 2 == 1);
+    SKINLAB_CHECK_GE(samples, 3);
+    SKINLAB_CHECK_EQ(samples % 2, 1);
     const double range = samples > 20 ? 3.0 : 2.0;
     const double step = 2.0 * range / double(samples - 1);
     std::vector<KernelTap> taps(static_cast<size_t>(samples));

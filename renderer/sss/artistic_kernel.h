@@ -1,6 +1,6 @@
 #pragma once
 // The "artistic" separable kernel of Jimenez's Separable SSS demo (2012/2015), as described in the thesis §3.1.3
-// (method M3 of science.md §2): RANGE = 3 if N > 20 else 2; offsets o_i = RANGE·sign(t)·t²/RANGE² for t evenly
+// (method M3 of docs/methods.md): RANGE = 3 if N > 20 else 2; offsets o_i = RANGE·sign(t)·t²/RANGE² for t evenly
 // spaced in [−RANGE, RANGE]; weight_i = trapezoid area × profile(o_i) with profile(r) = Σ_{i≥2} w_i^red G(v_i,
 // r/(0.001 + falloff_c)) (d'Eon's red weights without the narrowest lobe, evaluated along a line, i.e. a slice of
 // the radial profile, not its marginal); each channel normalised; then the centre weight becomes

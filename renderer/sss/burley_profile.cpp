@@ -1,9 +1,9 @@
 #include "renderer/sss/burley_profile.h"
 
+#include "common/check.h"
 #include "renderer/sss/radial_marginal.h"
 
 #include <algorithm>
-#include <cassert>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -14,7 +14,7 @@ namespace skinlab::renderer::sss {
 BurleyProfile::BurleyProfile(std::array<double, 3> shapeMm, std::string description)
     : d_(shapeMm), description_(std::move(description)) {
     for (double d : d_) {
-        assert(d > 0.0);
+        SKINLAB_CHECK_GT(d, 0.0);
         (void)d;
     }
 }

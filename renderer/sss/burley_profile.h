@@ -34,7 +34,7 @@ private:
     std::string description_;
 };
 
-// Slab transmittance T(t) = (A/4)(e^{−t/d} + 3 e^{−t/(3d)}) with A = 1 (science.md §1).
+// Slab transmittance T(t) = (A/4)(e^{−t/d} + 3 e^{−t/(3d)}) with A = 1 (d'Eon & Luebke, GPU Gems 3 ch. 14).
 double burleyTransmittance(double shapeMm, double thicknessMm);
 
 } // namespace skinlab::renderer::sss

@@ -1,7 +1,8 @@
 #include "renderer/sss/cpu_blur.h"
 
+#include "common/check.h"
+
 #include <algorithm>
-#include <cassert>
 #include <cmath>
 
 namespace skinlab::renderer::sss {
@@ -16,10 +17,10 @@ std::vector<Rgb> blurPass(const SurfaceBuffers& surface, const std::vector<Rgb>&
                           BlurAxis axis, const BlurSettings& settings) {
     const int width = surface.width;
     const int height = surface.height;
-    assert(input.size() == size_t(width) * height);
-    assert(settings.labWeight <= 0.0f || surface.albedo.size() == input.size());
-    assert(!settings.cbf || surface.aux.size() == input.size());
-    assert(settings.curvature == CurvatureStrategy::Off || surface.curvature.size() == input.size());
+    SKINLAB_CHECK_EQ(input.size(), size_t(width) * height);
+    SKINLAB_CHECK(settings.labWeight <= 0.0f || surface.albedo.size() == input.size());
+    SKINLAB_CHECK(!settings.cbf || surface.aux.size() == input.size());
+    SKINLAB_CHECK(settings.curvature == CurvatureStrategy::Off || surface.curvature.size() == input.size());
     std::vector<Rgb> output(input.size());
     const bool horizontal = axis == BlurAxis::Horizontal;
     for (int y = 0; y < height; ++y) {
@@ -36,20 +37,23 @@ std::vector<Rgb> blurPass(const SurfaceBuffers& surface, const std::vector<Rgb>&
             if (settings.curvature != CurvatureStrategy::Off)
                 pixelsPerMm *= curvatureWidthScale(
                     settings.curvature,
-                    normalisedCurvature(surface.curvature[index], surface.mmPerUnit, kCurvatureReferenceRadiusMm),
+                    normalisedCurvature(surface.curvature[index], surface.mmPerUnit, settings.curvatureReferenceMm),
                     settings.curvatureFloor);
             Rgb sum{0.0f, 0.0f, 0.0f};
             // E1/E2: the centre's CIELAB albedo and auxiliary value, and the per-channel weight sum.
             const bool weighsTaps = settings.weighsTaps();
             const glm::vec3 labCentre = weighsTaps && settings.labWeight > 0.0f
-                                            ? linearRec709ToLab(toVec3(surface.albedo[index]))
+                                            ? linearRec709ToLab(extensionColour(surface, input, index, settings))
                                             : glm::vec3(0.0f);
-            const float auxCentre = weighsTaps && settings.cbf ? surface.aux[index] : 0.0f;
+            const float auxCentre = weighsTaps && settings.cbf ? extensionAuxiliary(surface, input, index, settings) : 0.0f;
             auto texelWeight = [&](size_t texel) {
                 float weight = 1.0f;
                 if (settings.labWeight > 0.0f)
-                    weight *= labWeight(labCentre, linearRec709ToLab(toVec3(surface.albedo[texel])), settings.labWeight);
-                if (settings.cbf) weight *= auxiliaryWeight(auxCentre, surface.aux[texel], settings.cbfLambda);
+                    weight *= labWeight(labCentre, linearRec709ToLab(extensionColour(surface, input, texel, settings)),
+                                        settings.labWeight);
+                if (settings.cbf)
+                    weight *= auxiliaryWeight(auxCentre, extensionAuxiliary(surface, input, texel, settings),
+                                              settings.cbfLambda);
                 return weight;
             };
             Rgb weightSum{0.0f, 0.0f, 0.0f};
@@ -99,6 +103,17 @@ std::vector<Rgb> blurPass(const SurfaceBuffers& surface, const std::vector<Rgb>&
     return output;
 }
 
+glm::vec3 extensionColour(const SurfaceBuffers& surface, const std::vector<Rgb>& input, std::size_t i,
+                          const BlurSettings& settings) {
+    return settings.input == ExtensionInput::Lit ? toVec3(input[i]) : toVec3(surface.albedo[i]);
+}
+
+float extensionAuxiliary(const SurfaceBuffers& surface, const std::vector<Rgb>& input, std::size_t i,
+                         const BlurSettings& settings) {
+    if (settings.input != ExtensionInput::Lit) return surface.aux[i];
+    return litAuxiliaryValue(surface.aux[i], toVec3(surface.albedo[i]), toVec3(input[i]));
+}
+
 BlurSettings blurSettingsFromParams(const SssParams& params) {
     BlurSettings settings;
     settings.followSurface = params.followSurface;
@@ -106,8 +121,10 @@ BlurSettings blurSettingsFromParams(const SssParams& params) {
     settings.cbf = params.cbf;
     settings.cbfLambda = static_cast<float>(params.cbfLambda);
     settings.labWeight = static_cast<float>(params.labWeight);
+    settings.input = extensionInputFromName(params.extensionInput, "sss");
     settings.curvature = curvatureStrategyFromName(params.curvature, "sss");
     settings.curvatureFloor = static_cast<float>(params.curvatureFloor);
+    settings.curvatureReferenceMm = static_cast<float>(params.curvatureReferenceMm);
     return settings;
 }
 

@@ -3,7 +3,7 @@
 // renderer/shaders/sss_*.frag), used by tests to check the GL passes and to test energy and isotropy without GL.
 //
 // One pass along an axis, for a pixel p with skin mask m_p > 0, linear depth z_p (world units):
-//   pixels per mm     k_px = f_px / (mm_per_unit · z_p)          (science.md §2; the same on both axes)
+//   pixels per mm     k_px = f_px / (mm_per_unit · z_p)          (docs/methods.md; the same on both axes)
 //   tap i             position u = p + o_i · k_px along the axis, between texels j = floor(u) and j + 1
 //                     (clamped to the image), interpolation fraction f = u − floor(u) (linear filtering, done by
 //                     hand so that every texel is tested on its own)
@@ -22,6 +22,8 @@
 //   E3 sss.curvature   k_px × curvatureWidthScale(strategy, normalisedCurvature(κ_p, mm_per_unit), floor)
 //   E1/E2 (cbf, lab)   each texel j of tap i weighs w_i · (1 − f or f) · e_j with
 //                      e_j = labWeight(Lab(albedo_p), Lab(albedo_j), β) · auxiliaryWeight(F_p, F_j, λ);
+//                      with sss.extension_input = "lit" the pass's input colour replaces the albedo in Lab and
+//                      F_j = litAuxiliaryValue(F_j, albedo_j, input_j) (extensionColour / extensionAuxiliary);
 //                      Σ (weight · value_j) / Σ weight per channel, or the centre where Σ weight < 1e-4
 //                      (resolveWeightedSum), then mix(centre, ·, m_p) as above.
 // With both cbf and lab_weight off the tap loop is the one above, unchanged.
@@ -55,11 +57,19 @@ struct BlurSettings {
     bool cbf = false;             // E1
     float cbfLambda = 10.0f;      // λ, dimensionless
     float labWeight = 0.0f;       // E2: β in 1/ΔE*ab, 0 = off
+    ExtensionInput input = ExtensionInput::Albedo;  // E1/E2: albedo AOV or the colour this pass blurs
     CurvatureStrategy curvature = CurvatureStrategy::Off;  // E3
     float curvatureFloor = 0.5f;  // [0, 1]
+    float curvatureReferenceMm = kCurvatureReferenceRadiusMm;  // sss.curvature_reference_mm
 
     bool weighsTaps() const { return cbf || labWeight > 0.0f; }
 };
+
+// E1/E2 inputs of texel i for a pass whose input colour is `input` (albedo or lit, as `settings.input` says).
+glm::vec3 extensionColour(const SurfaceBuffers& surface, const std::vector<Rgb>& input, std::size_t i,
+                          const BlurSettings& settings);
+float extensionAuxiliary(const SurfaceBuffers& surface, const std::vector<Rgb>& input, std::size_t i,
+                         const BlurSettings& settings);
 
 // Follow-surface and extension settings of resolved [sss] parameters.
 BlurSettings blurSettingsFromParams(const SssParams& params);

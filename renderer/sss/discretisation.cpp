@@ -1,6 +1,7 @@
 #include "renderer/sss/discretisation.h"
 
-#include <cassert>
+#include "common/check.h"
+
 #include <cmath>
 
 namespace skinlab::renderer::sss {
@@ -9,13 +10,14 @@ void normaliseChannels(std::vector<KernelTap>& taps) {
     for (int c = 0; c < kChannels; ++c) {
         double sum = 0.0;
         for (const auto& tap : taps) sum += tap.weight[c];
-        assert(sum > 0.0);
+        SKINLAB_CHECK_GT(sum, 0.0);
         for (auto& tap : taps) tap.weight[c] /= sum;
     }
 }
 
 std::vector<KernelTap> quadraticTaps(const Marginal& marginal, int samples) {
-    assert(samples >= 3 && samples % 2 == 1);
+    SKINLAB_CHECK_GE(samples, 3);
+    SKINLAB_CHECK_EQ(samples % 2, 1);
     const double range = marginal.truncationRadiusMm(kTruncatedTail);
     std::vector<KernelTap> taps(static_cast<size_t>(samples));
     const int half = samples / 2;
@@ -40,7 +42,8 @@ std::vector<KernelTap> quadraticTaps(const Marginal& marginal, int samples) {
 }
 
 std::vector<KernelTap> importanceTaps(const Marginal& marginal, int samples) {
-    assert(samples >= 3 && samples % 2 == 1);
+    SKINLAB_CHECK_GE(samples, 3);
+    SKINLAB_CHECK_EQ(samples % 2, 1);
     const int widest = marginal.widestChannel();
     std::vector<double> bounds(static_cast<size_t>(samples) + 1);
     const double far = marginal.searchRadiusMm();

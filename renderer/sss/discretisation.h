@@ -1,6 +1,6 @@
 #pragma once
 // Discretisation of a 1-D marginal into N taps (N odd, 3…101), every channel normalised to sum 1
-// (science.md §2, M2; docs/methods.md, "Discretisation").
+// (docs/methods.md, "Discretisation").
 #include "renderer/sss/kernel.h"
 #include "renderer/sss/marginal.h"
 

@@ -71,6 +71,20 @@ std::string_view curvatureStrategyName(CurvatureStrategy strategy) {
 
 const std::vector<std::string>& curvatureStrategyNames() { return kCurvatureNames; }
 
+std::string_view extensionInputName(ExtensionInput input) { return input == ExtensionInput::Lit ? "lit" : "albedo"; }
+
+ExtensionInput extensionInputFromName(std::string_view name, std::string_view source) {
+    if (name == "albedo") return ExtensionInput::Albedo;
+    if (name == "lit") return ExtensionInput::Lit;
+    throwInput(source, "extension_input", "'" + std::string(name) + "' is not one of: albedo, lit");
+}
+
+float litAuxiliaryValue(float storedAux, const glm::vec3& albedo, const glm::vec3& lit) {
+    const float albedoGrey = (albedo.r + albedo.g + albedo.b) / 3.0f;
+    const float litGrey = (lit.r + lit.g + lit.b) / 3.0f;
+    return albedoGrey > 1e-6f ? storedAux / albedoGrey * litGrey : 0.0f;
+}
+
 CurvatureStrategy curvatureStrategyFromName(std::string_view name, std::string_view source) {
     if (name == "off") return CurvatureStrategy::Off;
     if (name == "increase") return CurvatureStrategy::Increase;

@@ -1,5 +1,5 @@
 #pragma once
-// The three artifact extensions of the thesis (§3.3; science.md §3) as plain functions on one pixel, in float
+// The three artifact extensions of the thesis (§3.3) as plain functions on one pixel, in float
 // arithmetic: the reference that renderer/shaders/sss_extensions.glsl mirrors and tests check it against.
 // docs/extensions.md explains each one, its parameters and what it fixes.
 //
@@ -26,6 +26,18 @@ glm::vec3 linearRec709ToLab(const glm::vec3& rgb);
 // E2 weight of a tap: exp(−β ‖Lab_centre − Lab_tap‖) (ΔE*ab, CIE76). β in 1/ΔE; β = 0 switches it off (weight 1).
 // Thesis: β = 0.09 for the separable methods, 0.5 for the sum of Gaussians.
 float labWeight(const glm::vec3& labCentre, const glm::vec3& labTap, float beta);
+
+// --- E1/E2 input (sss.extension_input) ----------------------------------------------------------------------
+// What the CIELAB weight compares and what grey modulates F: the albedo (the thesis' final separable shader; the
+// default) or the lit colour being blurred, i.e. the input of each pass (the thesis text, Eq. 3.13, "the lab color
+// of the image I", its sum-of-Gaussians passes and earlier separable shaders). They differ at shadow terminators,
+// where the lit form also cuts the blur.
+enum class ExtensionInput { Albedo, Lit };
+std::string_view extensionInputName(ExtensionInput input);
+ExtensionInput extensionInputFromName(std::string_view name, std::string_view source);
+// F with the lit colour's grey: the stored F (modulated by the albedo grey, surface_aovs.frag) divided by the albedo
+// grey and multiplied by the lit colour's grey (mean of R, G, B); 0 where the albedo grey is below 1e-6.
+float litAuxiliaryValue(float storedAux, const glm::vec3& albedo, const glm::vec3& lit);
 
 // --- E1: Mikkelsen's auxiliary image -------------------------------------------------------------------------
 
@@ -67,7 +79,7 @@ CurvatureStrategy curvatureStrategyFromName(std::string_view name, std::string_v
 
 // A surface of radius kCurvatureReferenceRadiusMm or tighter counts as fully curved (c = 1). 20 mm: the radius
 // of the nose tip, ears and lips is below it, the cheeks and forehead (60–100 mm) give c = 0.2–0.33.
-inline constexpr float kCurvatureReferenceRadiusMm = 20.0f;
+inline constexpr float kCurvatureReferenceRadiusMm = 20.0f;  // the default of sss.curvature_reference_mm
 
 // Normalised curvature c = saturate(κ · mm-per-unit⁻¹ · reference radius): κ is the curvature AOV (1/world unit,
 // ≈ 1/radius, ≥ 0).

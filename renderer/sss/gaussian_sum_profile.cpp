@@ -1,7 +1,8 @@
 #include "renderer/sss/gaussian_sum_profile.h"
 
+#include "common/check.h"
+
 #include <algorithm>
-#include <cassert>
 #include <cmath>
 #include <numbers>
 
@@ -41,10 +42,10 @@ GaussianSumProfile::GaussianSumProfile(std::vector<GaussianLobe> lobes, std::str
     std::sort(lobes_.begin(), lobes_.end(),
               [](const GaussianLobe& a, const GaussianLobe& b) { return a.varianceMm2 < b.varianceMm2; });
     for (const auto& lobe : lobes_) {
-        assert(lobe.varianceMm2 > 0.0);
+        SKINLAB_CHECK_GT(lobe.varianceMm2, 0.0);
         for (int c = 0; c < 3; ++c) totals_[c] += lobe.weight[c];
     }
-    for (int c = 0; c < 3; ++c) assert(totals_[c] > 0.0);
+    for (int c = 0; c < 3; ++c) SKINLAB_CHECK_GT(totals_[c], 0.0);
 }
 
 double GaussianSumProfile::radial(int channel, double rMm) const {

@@ -1,6 +1,6 @@
 #pragma once
 // Sum-of-Gaussians diffusion profile R(r) = Σ w_i G(v_i, r), G(v, r) = exp(−r²/(2v)) / (2πv) (unit integral over the
-// plane; v in mm²). Its marginal is exact: ∫ G(v, √(x²+y²)) dy = exp(−x²/(2v)) / √(2πv) (science.md §1).
+// plane; v in mm²). Its marginal is exact: ∫ G(v, √(x²+y²)) dy = exp(−x²/(2v)) / √(2πv) (d'Eon & Luebke, GPU Gems 3 ch. 14).
 // d'Eon & Luebke, "Advanced Techniques for Realistic Real-Time Skin Rendering", GPU Gems 3 ch. 14, 2007, Table 14-1.
 #include "renderer/sss/marginal.h"
 

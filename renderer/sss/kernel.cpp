@@ -16,7 +16,8 @@
 namespace skinlab::renderer::sss {
 
 namespace {
-// Profile millimetres → surface millimetres (sss.width_mm spans the kernel range ±3, as the demo's sssWidth).
+// Profile millimetres → surface millimetres: sss.width_mm is where the kernel edge (±3 profile-mm) lands on the
+// surface; the demo's kernel edge lies at 2 · sssWidth world units (widthMmFromDemoSssWidth).
 double widthScale(const SssParams& params) { return params.widthMm / 3.0; }
 
 void scaleOffsets(std::vector<KernelTap>& taps, double scale) {
@@ -57,10 +58,11 @@ Kernel makeKernel(const SssParams& params) {
     case SssMethod::Pscbf: {
         // Mikkelsen 2010: the broad Gaussian part as one stage whose accumulate weights are 1 − spike; the spike
         // (the unblurred centre) is added by the pass. Offsets scale with width_mm / 3 like every profile.
-        KernelStage stage = makePscbfKernel(mikkelsenSkinProfile(), params.samples).broadStage();
+        const PscbfProfile& profile = mikkelsenSkinProfile(params.pscbfSigma);
+        KernelStage stage = makePscbfKernel(profile, params.samples).broadStage();
         scaleOffsets(stage.taps, scale);
         kernel.source = "Mikkelsen 2010 pseudo-separable cross-bilateral filter (spike + one Gaussian per channel)";
-        kernel.declaredSupportMm = mikkelsenSkinProfile().maxRadiusMm * scale;
+        kernel.declaredSupportMm = profile.maxRadiusMm * scale;
         kernel.stages.push_back(std::move(stage));
         break;
     }

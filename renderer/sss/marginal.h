@@ -1,6 +1,6 @@
 #pragma once
 // A 1-D kernel density per colour channel: the marginal (pre-integrated kernel) a(x) of a radial diffusion profile,
-// a(x) = ∫ R(√(x²+y²)) dy (science.md §1), or a tabulated kernel. Distances in millimetres on the surface;
+// a(x) = ∫ R(√(x²+y²)) dy (d'Eon & Luebke, GPU Gems 3 ch. 14), or a tabulated kernel. Distances in millimetres on the surface;
 // each channel integrates to 1 over the real line. This is what the discretisation turns into taps.
 #include <string>
 

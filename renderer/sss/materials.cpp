@@ -1,8 +1,8 @@
 #include "renderer/sss/materials.h"
 
+#include "common/check.h"
 #include "renderer/sss/gaussian_sum_profile.h"
 
-#include <cassert>
 #include <cmath>
 
 namespace skinlab::renderer::sss {
@@ -54,7 +54,7 @@ std::array<double, 3> burleyShapeMm(const std::string& material) {
         return d;
     }
     const MeasuredMedium* medium = findMeasuredMedium(material);
-    assert(medium != nullptr);
+    SKINLAB_CHECK(medium != nullptr);
     for (int c = 0; c < 3; ++c) {
         const double sigmaA = medium->absorption[c];
         const double sigmaTPrime = sigmaA + medium->reducedScattering[c];

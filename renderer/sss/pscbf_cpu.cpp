@@ -1,9 +1,9 @@
 #include "renderer/sss/pscbf_cpu.h"
 
+#include "common/check.h"
 #include "renderer/sss/extension_weights.h"
 
 #include <algorithm>
-#include <cassert>
 #include <cmath>
 
 namespace skinlab::renderer::sss {
@@ -20,8 +20,9 @@ std::vector<Rgb> pscbfPass(const PscbfCpuInputs& inputs, const std::vector<Rgb>&
     const BlurSettings& extensions = inputs.extensions;
     const int width = surface.width;
     const int height = surface.height;
-    assert(input.size() == size_t(width) * height && unblurred.size() == input.size());
-    assert(inputs.viewNormal.empty() || inputs.viewNormal.size() == input.size());
+    SKINLAB_CHECK_EQ(input.size(), size_t(width) * height);
+    SKINLAB_CHECK_EQ(unblurred.size(), input.size());
+    SKINLAB_CHECK(inputs.viewNormal.empty() || inputs.viewNormal.size() == input.size());
     const bool horizontal = axis == BlurAxis::Horizontal;
     const bool hasNormal = !inputs.viewNormal.empty();
     const float f = surface.focalLengthPixels;
@@ -57,7 +58,7 @@ std::vector<Rgb> pscbfPass(const PscbfCpuInputs& inputs, const std::vector<Rgb>&
             if (extensions.curvature != CurvatureStrategy::Off)
                 pixelsPerMm *= curvatureWidthScale(
                     extensions.curvature,
-                    normalisedCurvature(surface.curvature[index], surface.mmPerUnit, kCurvatureReferenceRadiusMm),
+                    normalisedCurvature(surface.curvature[index], surface.mmPerUnit, extensions.curvatureReferenceMm),
                     extensions.curvatureFloor);
             const float nw = glm::dot(n, w);
             const float nAxis = horizontal ? n.x : n.y;
@@ -67,9 +68,10 @@ std::vector<Rgb> pscbfPass(const PscbfCpuInputs& inputs, const std::vector<Rgb>&
                 inverseTwoSigmaSquared[c] = 1.0f / (2.0f * inputs.depthSigmaMm[c] * inputs.depthSigmaMm[c]);
             const bool weighsTaps = extensions.weighsTaps();
             const glm::vec3 labCentre = weighsTaps && extensions.labWeight > 0.0f
-                                            ? linearRec709ToLab(toVec3(surface.albedo[index]))
+                                            ? linearRec709ToLab(extensionColour(surface, input, index, extensions))
                                             : glm::vec3(0.0f);
-            const float auxCentre = weighsTaps && extensions.cbf ? surface.aux[index] : 0.0f;
+            const float auxCentre =
+                weighsTaps && extensions.cbf ? extensionAuxiliary(surface, input, index, extensions) : 0.0f;
             const int along = horizontal ? x : y;
             const int lastTexel = (horizontal ? width : height) - 1;
             Rgb sum{0.0f, 0.0f, 0.0f};
@@ -102,10 +104,12 @@ std::vector<Rgb> pscbfPass(const PscbfCpuInputs& inputs, const std::vector<Rgb>&
                     if (weighsTaps) {
                         float extension = 1.0f;
                         if (extensions.labWeight > 0.0f)
-                            extension *= labWeight(labCentre, linearRec709ToLab(toVec3(surface.albedo[texel])),
-                                                   extensions.labWeight);
+                            extension *= labWeight(
+                                labCentre, linearRec709ToLab(extensionColour(surface, input, texel, extensions)),
+                                extensions.labWeight);
                         if (extensions.cbf)
-                            extension *= auxiliaryWeight(auxCentre, surface.aux[texel], extensions.cbfLambda);
+                            extension *= auxiliaryWeight(
+                                auxCentre, extensionAuxiliary(surface, input, texel, extensions), extensions.cbfLambda);
                         for (int c = 0; c < 3; ++c) weight[c] *= extension;
                     }
                     for (int c = 0; c < 3; ++c) {
@@ -131,7 +135,8 @@ std::vector<Rgb> pscbfPass(const PscbfCpuInputs& inputs, const std::vector<Rgb>&
 }
 
 std::vector<Rgb> applyPscbf(const PscbfCpuInputs& inputs, const std::vector<Rgb>& diffuse, const Kernel& kernel) {
-    assert(kernel.method == SssMethod::Pscbf && kernel.stages.size() == 1);
+    SKINLAB_CHECK(kernel.method == SssMethod::Pscbf);
+    SKINLAB_CHECK_EQ(kernel.stages.size(), 1u);
     const KernelStage& stage = kernel.stages[0];
     const std::vector<Rgb> horizontal = pscbfPass(inputs, diffuse, diffuse, stage, BlurAxis::Horizontal);
     return pscbfPass(inputs, horizontal, diffuse, stage, BlurAxis::Vertical);

@@ -1,9 +1,9 @@
 #include "renderer/sss/pscbf_kernel.h"
 
+#include "common/check.h"
 #include "renderer/sss/discretisation.h"
 #include "renderer/sss/gaussian_sum_profile.h"
 
-#include <cassert>
 #include <cmath>
 
 namespace skinlab::renderer::sss {
@@ -29,9 +29,10 @@ double truncatedQuantile(const PscbfProfile& profile, int channel, double probab
 }
 } // namespace
 
-const PscbfProfile& mikkelsenSkinProfile() {
-    static const PscbfProfile profile{{0.15, 0.18, 0.20}, {2.3, 1.4, 1.1}, 4.5};
-    return profile;
+const PscbfProfile& mikkelsenSkinProfile(PscbfSigma reading) {
+    static const PscbfProfile variance{{0.15, 0.18, 0.20}, {2.3, 1.4, 1.1}, 4.5};
+    static const PscbfProfile standardDeviation{{0.15, 0.18, 0.20}, {2.3 * 2.3, 1.4 * 1.4, 1.1 * 1.1}, 4.5};
+    return reading == PscbfSigma::StdDev ? standardDeviation : variance;
 }
 
 double pscbfBroadRadial(const PscbfProfile& profile, int channel, double rMm) {
@@ -49,9 +50,15 @@ double pscbfTruncatedCumulative(const PscbfProfile& profile, int channel, double
 }
 
 PscbfKernel makePscbfKernel(const PscbfProfile& profile, int samples) {
-    assert(samples >= 3 && samples <= 101 && samples % 2 == 1);
-    assert(profile.maxRadiusMm > 0.0);
-    for (int c = 0; c < kChannels; ++c) assert(profile.varianceMm2[c] > 0.0 && profile.spike[c] >= 0.0 && profile.spike[c] < 1.0);
+    SKINLAB_CHECK_GE(samples, 3);
+    SKINLAB_CHECK_LE(samples, 101);
+    SKINLAB_CHECK_EQ(samples % 2, 1);
+    SKINLAB_CHECK_GT(profile.maxRadiusMm, 0.0);
+    for (int c = 0; c < kChannels; ++c) {
+        SKINLAB_CHECK_GT(profile.varianceMm2[c], 0.0);
+        SKINLAB_CHECK_GE(profile.spike[c], 0.0);
+        SKINLAB_CHECK_LT(profile.spike[c], 1.0);
+    }
     constexpr int red = 0;  // Mikkelsen places the taps on the red (widest) channel's distribution
     const int half = samples / 2;
     std::vector<double> bounds(static_cast<size_t>(samples) + 1);

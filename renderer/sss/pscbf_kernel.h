@@ -1,7 +1,7 @@
 #pragma once
 // Mikkelsen's pseudo-separable cross-bilateral filter ("pscbf"): profile and taps (GL-free).
 // Source: M. S. Mikkelsen, "Skin Rendering by Pseudo-Separable Cross Bilateral Filtering", Naughty Dog / DTU
-// technical report, 2010, Table 1 and §3 (science.md §2b). docs/extensions.md describes the method.
+// technical report, 2010, Table 1 and §3. docs/extensions.md describes the method.
 //
 // Profile: a spike (the unblurred irradiance, a Dirac delta) plus one broad 2-D Gaussian per channel,
 //   R_c(r) = spike_c · δ(r) + (1 − spike_c) · G(v_c, r),   G(v, r) = exp(−r²/(2v)) / (2πv)
@@ -29,8 +29,9 @@ struct PscbfProfile {
     double maxRadiusMm;                 // r_max: radius of the filter disc on the surface, mm
 };
 
-// Mikkelsen 2010, Table 1, for skin: spike (0.15, 0.18, 0.20), v (2.3, 1.4, 1.1) mm², r_max 4.5 mm.
-const PscbfProfile& mikkelsenSkinProfile();
+// Mikkelsen 2010, Table 1, for skin: spike (0.15, 0.18, 0.20), r_max 4.5 mm, and 2.3 / 1.4 / 1.1 read as the
+// variance v in mm² (PscbfSigma::Variance, the default) or as the standard deviation in mm (v = 5.29 / 1.96 / 1.21).
+const PscbfProfile& mikkelsenSkinProfile(PscbfSigma reading = PscbfSigma::Variance);
 inline constexpr int kPscbfSamples = 13;  // taps per axis in the paper
 
 // The broad part's radial density G(v_c, r) in 1/mm² (unit integral; the spike excluded).

@@ -1,5 +1,5 @@
 #pragma once
-// Numerical 1-D marginal of any radial profile (science.md §1): a(x) = ∫ R(√(x²+y²)) dy = 2 ∫_0^∞ R(√(x²+u²)) du.
+// Numerical 1-D marginal of any radial profile (d'Eon & Luebke, GPU Gems 3 ch. 14): a(x) = ∫ R(√(x²+y²)) dy = 2 ∫_0^∞ R(√(x²+u²)) du.
 // Used for profiles without a closed form and to check the closed forms (Gaussian, Burley/K0) in tests.
 #include <functional>
 

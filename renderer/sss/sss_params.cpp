@@ -11,6 +11,9 @@ namespace {
 const std::vector<std::string> kMethodNames{"none", "gaussian-sum", "separable", "artistic", "pscbf", "reference"};
 const std::vector<std::string> kCurvatureNames{"off", "increase", "reduce", "reduce-floor"};
 const std::vector<std::string> kPlacementNames{"quadratic", "importance"};
+const std::vector<std::string> kPscbfSigmaNames{"variance", "std-dev"};
+const std::vector<std::string> kExtensionInputNames{"albedo", "lit"};
+const std::vector<std::string> kCurvatureMeasureNames{"normal", "screen"};
 
 // JSON (as written by toJson) → TOML, so that the JSON form goes through the same strict reader.
 toml::table jsonToToml(const nlohmann::json& object, std::string_view source);
@@ -50,6 +53,7 @@ SssParams readSssTable(const SpecReader& sss) {
                : method == "pscbf"      ? SssMethod::Pscbf
                : method == "reference"  ? SssMethod::Reference
                                         : SssMethod::None;
+    if (p.method == SssMethod::Pscbf) p.samples = SssParams::kDefaultPscbfSamples;
     p.samples = static_cast<int>(sss.integer("samples", p.samples, 3, 101));
     if (p.samples % 2 == 0)
         sss.fail("samples", std::to_string(p.samples) + " is even; a symmetric kernel needs an odd number of taps (3…101)");
@@ -77,8 +81,13 @@ SssParams readSssTable(const SpecReader& sss) {
     p.cbf = sss.boolean("cbf", p.cbf);
     p.cbfLambda = sss.number("cbf_lambda", p.cbfLambda, 0.0, 1000.0);
     p.labWeight = sss.number("lab_weight", p.labWeight, 0.0, 100.0);
+    p.extensionInput = sss.choice("extension_input", p.extensionInput, kExtensionInputNames);
     p.curvature = sss.choice("curvature", p.curvature, kCurvatureNames);
     p.curvatureFloor = sss.number("curvature_floor", p.curvatureFloor, 0.0, 1.0);
+    p.curvatureMeasure = sss.choice("curvature_measure", p.curvatureMeasure, kCurvatureMeasureNames);
+    p.curvatureReferenceMm = sss.number("curvature_reference_mm", p.curvatureReferenceMm, 0.1, 1000.0);
+    p.pscbfSigma = sss.choice("pscbf_sigma", "variance", kPscbfSigmaNames) == "std-dev" ? PscbfSigma::StdDev
+                                                                                      : PscbfSigma::Variance;
     p.referenceEdgeMm = sss.number("reference_edge_mm", p.referenceEdgeMm, 0.05, 50.0);
     return p;
 }
@@ -88,6 +97,7 @@ TransmittanceParams readTransmittanceTable(const SpecReader& t) {
     p.enabled = t.boolean("enabled", p.enabled);
     p.translucency = t.number("translucency", p.translucency, 0.0, 1.0);
     p.curvature = t.boolean("curvature", p.curvature);
+    p.curvatureForm = t.choice("curvature_form", p.curvatureForm, {"scale", "thesis"});
     return p;
 }
 } // namespace
@@ -102,6 +112,10 @@ std::string_view methodName(SssMethod method) {
     case SssMethod::Reference: return "reference";
     }
     return "none";
+}
+
+std::string_view pscbfSigmaName(PscbfSigma reading) {
+    return reading == PscbfSigma::StdDev ? "std-dev" : "variance";
 }
 
 std::string_view placementName(TapPlacement placement) {
@@ -122,13 +136,20 @@ nlohmann::json SssParams::toJson() const {
             {"cbf", cbf},
             {"cbf_lambda", cbfLambda},
             {"lab_weight", labWeight},
+            {"extension_input", extensionInput},
             {"curvature", curvature},
             {"curvature_floor", curvatureFloor},
+            {"curvature_measure", curvatureMeasure},
+            {"curvature_reference_mm", curvatureReferenceMm},
+            {"pscbf_sigma", std::string(pscbfSigmaName(pscbfSigma))},
             {"reference_edge_mm", referenceEdgeMm}};
 }
 
 nlohmann::json TransmittanceParams::toJson() const {
-    return {{"enabled", enabled}, {"translucency", translucency}, {"curvature", curvature}};
+    return {{"enabled", enabled},
+            {"translucency", translucency},
+            {"curvature", curvature},
+            {"curvature_form", curvatureForm}};
 }
 
 SssParams readSssParams(const SpecReader& scene) {
@@ -155,6 +176,13 @@ TransmittanceParams transmittanceParamsFromJson(const nlohmann::json& transmitta
     toml::table root;
     root.insert_or_assign("transmittance", jsonToToml(transmittance, source));
     return readTransmittanceParams(SpecReader(root, std::string(source)));
+}
+
+double widthMmFromDemoSssWidth(double sssWidth, double mmPerUnit) { return 2.0 * sssWidth * mmPerUnit; }
+
+double transmittanceScalePerUnit(double translucency, double widthMm, double mmPerUnit) {
+    const double demoSssWidth = widthMm / (2.0 * mmPerUnit);  // world units
+    return 8.25 * (1.0 - translucency) / demoSssWidth;
 }
 
 } // namespace skinlab::renderer::sss

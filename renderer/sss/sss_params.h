@@ -1,5 +1,5 @@
 #pragma once
-// Typed parameters of the scene spec tables [sss] and [transmittance] (contracts.md §4), their strict reader and
+// Typed parameters of the scene spec tables [sss] and [transmittance], their strict reader and
 // their JSON form (the "resolved" record stored in EXR metadata and manifests). Every key, unit and default is
 // documented in docs/methods.md; the readers throw InputError naming file and key for bad values.
 #include <array>
@@ -28,17 +28,30 @@ enum class TapPlacement {
     Importance,  // equal-probability cells of the widest channel (Mikkelsen 2010), other channels re-weighted
 };
 
+// Mikkelsen 2010, Table 1 lists 2.3 / 1.4 / 1.1 for the broad Gaussian and calls the value a "variance" (Eq. 7:
+// "variance σ/K and σ"), so the numbers may be the variance v (mm²) or, as the symbol σ suggests, the standard
+// deviation (mm). Default: variance, the reading the paper's own filter extent r_max = 4.5 mm supports (3 standard
+// deviations of the red Gaussian, 3·√2.3 = 4.55 mm; under the other reading r_max would cut the red Gaussian at 1.96 σ).
+enum class PscbfSigma {
+    Variance,  // v_c = 2.3 / 1.4 / 1.1 mm²
+    StdDev,    // σ_c = 2.3 / 1.4 / 1.1 mm, v_c = σ_c²
+};
+
 std::string_view methodName(SssMethod method);
+std::string_view pscbfSigmaName(PscbfSigma reading);
 std::string_view placementName(TapPlacement placement);
 
 struct SssParams {
     SssMethod method = SssMethod::None;
-    // Taps per 1-D pass (odd, 3…101). gaussian-sum uses it for each of its 12 passes.
-    int samples = 21;
+    // Taps per 1-D pass (odd, 3…101). gaussian-sum uses it for each of its 12 passes. Default 21; for pscbf 13,
+    // the paper's count (kDefaultSamples, kDefaultPscbfSamples; the reader picks by method when the key is absent).
+    static constexpr int kDefaultSamples = 21;
+    static constexpr int kDefaultPscbfSamples = 13;
+    int samples = kDefaultSamples;
     // Physical width of the blur in millimetres on the surface: a kernel offset of o profile-millimetres is placed
     // at o · width_mm / 3 mm on the surface. 3 is the profile's own physical scale (d'Eon, Burley and the tabulated
-    // kernels are measured in mm). Same convention as the demo's sssWidth, which spans the kernel range ±3:
-    // width_mm = sssWidth × mm_per_unit.
+    // kernels are measured in mm). Jimenez's demo places its kernel edge (±3) at 2 · sssWidth world units, so
+    // width_mm = 2 × sssWidth × mm_per_unit (widthMmFromDemoSssWidth below).
     double widthMm = 3.0;
     TapPlacement placement = TapPlacement::Quadratic;
     // Follow-surface correction (Jimenez): per tap s = saturate(k · |Δz| · mm_per_unit), colour = lerp(tap, centre,
@@ -63,9 +76,21 @@ struct SssParams {
     double cbfLambda = 10.0;  // λ, dimensionless (thesis code: 10)
     // E2: CIELAB weight exp(−β ΔE*ab) on the albedos of centre and tap; β in 1/ΔE, 0 = off.
     double labWeight = 0.0;
+    // E1/E2 input: "albedo" (the albedo AOV; the thesis' final separable shader) or "lit" (the colour each pass
+    // blurs; the thesis text, Eq. 3.13, its sum-of-Gaussians passes and earlier separable shaders).
+    std::string extensionInput = "albedo";
     // E3: curvature modulation of the kernel width from the curvature AOV (curvature.Y).
     std::string curvature = "off";  // off | increase | reduce | reduce-floor
     double curvatureFloor = 0.5;    // reduce-floor: width share kept on flat skin, [0, 1]
+    // How the curvature AOV is measured: "normal" (3-D normal curvature, ≈ 1/radius) or "screen" (the thesis'
+    // screen-space measure from the per-pixel change of the view normal; grows at silhouettes).
+    std::string curvatureMeasure = "normal";
+    // Radius (mm) at or below which a surface counts as fully curved: c = saturate(κ · curvature_reference_mm).
+    // The thesis gives no such scale; 20 mm is the radius of the tightest broad facial features (nose tip, ear
+    // rims, lips), so those reach c = 1 while cheeks and forehead (60–100 mm) stay at c = 0.2–0.33.
+    double curvatureReferenceMm = 20.0;
+    // pscbf: how Table 1's 2.3 / 1.4 / 1.1 are read (PscbfSigma above).
+    PscbfSigma pscbfSigma = PscbfSigma::Variance;
     // reference method: longest skin edge (mm) after tessellation; irradiance is sampled at the vertices.
     double referenceEdgeMm = 1.0;
 
@@ -74,15 +99,30 @@ struct SssParams {
 
 struct TransmittanceParams {
     bool enabled = false;
-    // 0 = opaque, 1 = fully translucent: thickness is scaled by 8.25 (1 − translucency) / width (Jimenez et al.
-    // 2010) before T(s) = Σ w_i exp(−s²/v_i) with d'Eon's weights (T(0) = 1 per channel).
+    // 0 = opaque, 1 = fully translucent: thickness is scaled by 8.25 (1 − translucency) / sssWidth (Jimenez et al.
+    // 2010; transmittanceScalePerUnit below) before T(s) = Σ w_i exp(−s²/v_i) with d'Eon's weights (T(0) = 1 per channel).
     double translucency = 0.5;
-    // transmittance × (1 + c) with c the normalised curvature: the thesis's option, which produces bright
-    // artefacts at nostrils and other tight, thin features (documented as such).
+    // Curvature modulation, the thesis's option, which produces bright artefacts at nostrils and other tight, thin
+    // features (documented as such). curvatureForm "scale": transmittance × (1 + c), c the normalised curvature
+    // capped at 1; "thesis": the profile widened inside the exponent as the thesis' main-pass shader does,
+    // s / (1 + 2c) (its sssWidth × (1 + 2κ)), c uncapped, from the thesis' screen-space curvature.
     bool curvature = false;
+    std::string curvatureForm = "scale";
 
     nlohmann::json toJson() const;
 };
+
+// Jimenez's separable SSS demo steps `sssWidth · (cot(fovY/2) / z) · dir / 3` in UV per kernel unit (its kernel
+// spans ±3), and one UV unit spans 2 · z · tan(fovY/2) world units at linear depth z (vertically), so its kernel edge
+// lands at 2 · sssWidth world units. In skinlab the edge lies at width_mm, hence width_mm = 2 · sssWidth · mm_per_unit.
+// (The demo steps the same UV length horizontally, so there its edge lies at 2 · aspect · sssWidth; skinlab uses the
+// vertical, aspect-free scale on both axes.)
+double widthMmFromDemoSssWidth(double sssWidth, double mmPerUnit);
+
+// Transmittance thickness scale, per world unit of thickness: the demo's 8.25 (1 − translucency) / sssWidth with
+// sssWidth = width_mm / (2 · mm_per_unit), i.e. mm_per_unit · 16.5 (1 − translucency) / width_mm. The scaled
+// thickness s goes into T(s) = Σ w_i exp(−s²/v_i) (v_i in mm²).
+double transmittanceScalePerUnit(double translucency, double widthMm, double mmPerUnit);
 
 // Reads the [sss] table of a scene spec (through the scene's reader: `scene.table("sss")` is read and finished
 // here). Defaults for absent keys; InputError naming file and key for bad ones.

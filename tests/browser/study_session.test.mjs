@@ -294,7 +294,13 @@ try {
   console.error(e);
 } finally {
   server.kill('SIGTERM');
-  fs.rmSync(work, { recursive: true, force: true });
+  // Chromium's helper processes may still be writing into a profile for a moment after context.close(): retry
+  // (Node.js 18's rmSync does not by default), and never let the clean-up decide the test's result.
+  try {
+    fs.rmSync(work, { recursive: true, force: true, maxRetries: 10, retryDelay: 200 });
+  } catch (e) {
+    console.error(`warning: could not remove ${work}: ${e.message}`);
+  }
 }
 console.log(exitCode === 0 ? `PASS: browser study session${active ? ' (active design)' : ''}` : `FAILED (${failures} checks)`);
 process.exit(exitCode);

@@ -1,4 +1,4 @@
-// Timing of `skinlab analyze metrics` on one 1280×720 pair (docs/benchmarks.md, "Metrics (issue 4)").
+// Timing of `skinlab analyze metrics` on one 1280×720 pair (docs/benchmarks.md, "Metrics").
 // Synthetic renders (disc scene, contract-1 EXR with beauty, depth.Z, mask.Y) so the benchmark needs no GL.
 // Run: build/<dir>/tests/analysis/metrics/bench_metrics --benchmark_repetitions=5
 #include "analysis/metrics/error_bands.h"

@@ -55,8 +55,8 @@ constexpr std::array<SharmaPair, 34> sharmaTable1 = {{
     {{2.0776, 0.0795, -1.1350}, {0.9033, -0.0636, -0.5514}, 0.9082},
 }};
 
-// The table prints 4 decimals, so a correct implementation is within 0.5e-4 of every entry; 1e-4 is the
-// tolerance the issue asks for. Both argument orders: the formula is symmetric. One test for the 34 pairs (each
+// The table prints 4 decimals, so a correct implementation is within 0.5e-4 of every entry; the tolerance is
+// 1e-4. Both argument orders: the formula is symmetric. One test for the 34 pairs (each
 // test is a process under ctest); a failure names the pair.
 TEST(Ciede2000, MatchesAll34PairsOfSharmaTable1InBothOrders) {
     for (size_t i = 0; i < sharmaTable1.size(); ++i) {

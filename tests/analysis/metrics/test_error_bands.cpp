@@ -1,4 +1,4 @@
-// Band construction (science.md §5) on analytic scenes whose bands are known in closed form.
+// Band construction (docs/metrics.md) on analytic scenes whose bands are known in closed form.
 #include "analysis/metrics/error_bands.h"
 
 #include "synthetic_render.h"

@@ -1,4 +1,4 @@
-// PSNR and SSIM through OpenCV's quality module, checked against values computed by hand (science.md §5).
+// PSNR and SSIM through OpenCV's quality module, checked against values computed by hand (docs/metrics.md).
 #include "analysis/metrics/image_quality.h"
 
 #include <gtest/gtest.h>

@@ -132,7 +132,7 @@ SyntheticRender withEdgeErrors(const DiscScene& scene, const SyntheticRender& re
     return test;
 }
 
-// science.md §5: energy scores agree within 5% between 512² and 1024² renders of the same scene.
+// docs/metrics.md: energy scores agree within 5% between 512² and 1024² renders of the same scene.
 TEST(RenderComparison, LeakEnergiesAreResolutionIndependent) {
     fs::path folder = freshFolder("resolution");
     const double errorWidth = 0.8 * 0.008;  // 80% of r_w = 8 mm, so the error lies inside the bands

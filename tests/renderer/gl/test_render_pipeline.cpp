@@ -235,7 +235,7 @@ TEST(RenderPipeline, BackgroundPixelsHaveInfiniteDepthAndZeroMask) {
 TEST(RenderPipeline, ToneMappersAndSrgbEncodingMatchTheirCppMirrors) {
     SKINLAB_REQUIRE_RENDERER(renderer);
     TempFolder folder("tonemap");
-    for (const char* toneMapper : {"linear", "exponential", "reinhard", "filmic"}) {
+    for (const char* toneMapper : {"linear", "exponential", "reinhard", "reinhard-rgb", "filmic"}) {
         RenderRequest request;
         request.scene = "builtin:head";
         request.width = 48;
@@ -249,8 +249,21 @@ TEST(RenderPipeline, ToneMappersAndSrgbEncodingMatchTheirCppMirrors) {
         const std::vector<unsigned char> png = test::readPng(request.pngPath, width, height);
         ASSERT_EQ(width, 48);
         std::vector<float> display;
-        for (std::size_t p = 0; p < image.channels.at("R").size(); ++p)
-            for (const char* c : {"R", "G", "B"}) display.push_back(toneMap(image.channels.at(c)[p], toneMapper, 1.7f));
+        const std::size_t pixels = image.channels.at("R").size();
+        std::vector<float> rgb;
+        for (std::size_t p = 0; p < pixels; ++p)
+            for (const char* c : {"R", "G", "B"}) rgb.push_back(image.channels.at(c)[p]);
+        // reinhard: the key 0.18 over the log-average luminance of the beauty (the EXR's R, G, B).
+        const float scale = static_cast<float>(kReinhardDefaultKey / reinhardLogAverage(rgb.data(), pixels, 3));
+        for (std::size_t p = 0; p < pixels; ++p) {
+            if (std::string(toneMapper) == "reinhard") {
+                float y[3];
+                toneMapReinhard(&rgb[p * 3], scale, y);
+                display.insert(display.end(), y, y + 3);
+            } else {
+                for (int c = 0; c < 3; ++c) display.push_back(toneMap(rgb[p * 3 + c], toneMapper, 1.7f));
+            }
+        }
         const std::vector<std::uint8_t> expected = encodeDisplaySrgb8(display);
         int maxDifference = 0;
         for (std::size_t i = 0; i < png.size(); ++i)
@@ -274,7 +287,29 @@ TEST(DisplayTransform, SrgbThroughOpenColorIOAgainstKnownValues) {
 TEST(ToneMappers, KnownValues) {
     EXPECT_FLOAT_EQ(toneMap(0.25f, "linear"), 0.25f);
     EXPECT_FLOAT_EQ(toneMap(3.0f, "linear"), 1.0f);
-    EXPECT_FLOAT_EQ(toneMap(1.0f, "reinhard"), 0.5f);
+    EXPECT_FLOAT_EQ(toneMap(1.0f, "reinhard-rgb"), 0.5f);
+    // Reinhard et al. 2002, Eqs. 1–3 on luminance. Eq. 1: the log-average of luminances 1 and 4 is
+    // √((1 + δ)(4 + δ)) ≈ 2 (δ = 1e-4).
+    const float two[6] = {1.0f, 1.0f, 1.0f, 4.0f, 4.0f, 4.0f};
+    EXPECT_NEAR(reinhardLogAverage(two, 2, 3), std::sqrt((1.0 + 1e-4) * (4.0 + 1e-4)), 1e-6);
+    // Eqs. 2–3 with a / L̄ = 1: grey 1 → L = 1 → 0.5, as per channel; saturated red (1, 0, 0) has L_w = 0.2126, so
+    // it maps to 1 / 1.2126 = 0.8247 and stays pure red, where the per-channel form gives 0.5 (darker).
+    float y[3];
+    const float grey[3] = {1.0f, 1.0f, 1.0f}, red[3] = {1.0f, 0.0f, 0.0f}, skin[3] = {2.0f, 1.0f, 0.6f};
+    toneMapReinhard(grey, 1.0f, y);
+    EXPECT_NEAR(y[0], 0.5f, 1e-6f);
+    EXPECT_NEAR(y[2], 0.5f, 1e-6f);
+    toneMapReinhard(red, 1.0f, y);
+    EXPECT_NEAR(y[0], 1.0f / 1.2126f, 1e-6f);
+    EXPECT_EQ(y[1], 0.0f);
+    // A bright skin colour keeps its channel ratios (2 : 1 : 0.6) under the luminance form; per channel it does not.
+    toneMapReinhard(skin, 0.5f, y);
+    EXPECT_NEAR(y[0] / y[1], 2.0f, 1e-5f);
+    EXPECT_NEAR(y[2] / y[1], 0.6f, 1e-5f);
+    EXPECT_LT(toneMap(2.0f, "reinhard-rgb") / toneMap(1.0f, "reinhard-rgb"), 1.34f);  // (2/3) / (1/2)
+    // The key a scales the image before the curve: a = 0.36 on L̄ = 0.18 doubles the scaled luminance.
+    toneMapReinhard(grey, 0.36f / 0.18f, y);
+    EXPECT_NEAR(y[0], 2.0f / 3.0f, 1e-6f);
     EXPECT_NEAR(toneMap(1.0f, "exponential", 2.0f), 1.0f - std::exp(-2.0f), 1e-7f);
     EXPECT_NEAR(toneMap(5.6f, "filmic"), 1.0f, 1e-6f);  // hable(2 * W / 2) / hable(W): white maps to 1
     EXPECT_NEAR(toneMap(0.0f, "filmic"), 0.0f, 1e-7f);  // hable(0) = DE/DF - E/F = 0 up to float rounding

@@ -131,5 +131,35 @@ TEST(SurfaceAovs, AuxiliaryImageMatchesTheCppMirrorAndGrowsTowardsTheSilhouette)
     }
 }
 
+// sss.curvature_measure = "screen": the thesis' screen-space measure, scaled so that a sphere seen face-on reads 1/r
+// at its centre. For a sphere it grows towards the silhouette as (1/cos θ + cos θ) / 2 along the row through the
+// centre (θ the angle of the normal from the view axis): × 1.36 at 90 % of the radius. The 3-D measure stays 1/r.
+TEST(SurfaceAovs, ScreenSpaceCurvatureGrowsTowardsTheSilhouette) {
+    SKINLAB_REQUIRE_RENDERER(renderer);
+    TempFolder folder("curvature-screen");
+    const ExrImage normal = renderScene(*renderer, folder, "builtin:halo", 160);
+    const ExrImage screen = renderScene(*renderer, folder, "builtin:halo", 160, {"sss.curvature_measure=screen"});
+    const test::ExrCamera camera = test::exrCamera(screen);
+    const glm::vec4 clip = camera.projection * camera.view * glm::vec4(0, 0, 0, 1);
+    const int centreX = static_cast<int>(std::floor((clip.x / clip.w * 0.5f + 0.5f) * static_cast<float>(screen.width)));
+    const int centreY = static_cast<int>(std::floor((0.5f - clip.y / clip.w * 0.5f) * static_cast<float>(screen.height)));
+    int edge = centreX;
+    while (edge + 1 < screen.width && screen.at("mask.Y", edge + 1, centreY) > 0.0f) ++edge;
+    const int radiusPixels = edge - centreX;
+    ASSERT_GT(radiusPixels, 20);
+    const double inverseRadius = 1.0 / kHaloSphereRadiusMm;
+    const double screenCentre = screen.at("curvature.Y", centreX, centreY) / inverseRadius;
+    const double normalCentre = normal.at("curvature.Y", centreX, centreY) / inverseRadius;
+    const int outer = centreX + static_cast<int>(0.9f * static_cast<float>(radiusPixels));
+    const double screenOuter = screen.at("curvature.Y", outer, centreY) / inverseRadius;
+    const double normalOuter = normal.at("curvature.Y", outer, centreY) / inverseRadius;
+    std::printf("builtin:halo sphere, 160 px, curvature × r: centre screen %.3f / normal %.3f; at 90 %% of the radius "
+                "screen %.3f / normal %.3f\n", screenCentre, normalCentre, screenOuter, normalOuter);
+    EXPECT_NEAR(screenCentre, 1.0, 0.1);
+    EXPECT_NEAR(normalOuter, 1.0, 0.1);
+    EXPECT_GT(screenOuter, 1.2 * screenCentre);
+    EXPECT_GT(screenOuter, 1.2 * normalOuter);
+}
+
 } // namespace
 } // namespace skinlab::renderer

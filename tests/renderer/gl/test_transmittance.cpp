@@ -58,13 +58,16 @@ TEST(Transmittance, BackLitFinIsBrighterWithItOnAndTheDiffuseGainsExactlyTheAov)
     SKINLAB_REQUIRE_RENDERER(renderer);
     TempFolder folder("transmittance-on-off");
     const ExrImage off = renderEar(*renderer, folder, "off", {});
-    const ExrImage on = renderEar(*renderer, folder, "on", {"transmittance.enabled=true"});
+    // Translucency 0.75: s = 2.5 mm × 16.5 (1 − 0.75) / 3 = 3.4 (the demo's scale, docs/methods.md), where d'Eon's
+    // red tail still transmits a few per cent.
+    const ExrImage on =
+        renderEar(*renderer, folder, "on", {"transmittance.enabled=true", "transmittance.translucency=0.75"});
     for (const char* c : kRgb) EXPECT_EQ(maxAbs(off, std::string("transmittance.") + c), 0.0f) << c;
 
     const double offMean = skinMean(off, "diffuse.R");
     const double onMean = skinMean(on, "diffuse.R");
     const double transmittedMean = skinMean(on, "transmittance.R");
-    std::printf("builtin:ear (2.5 mm, translucency 0.5): skin diffuse.R mean %.5f off, %.5f on (+%.1f %%); "
+    std::printf("builtin:ear (2.5 mm, translucency 0.75): skin diffuse.R mean %.5f off, %.5f on (+%.1f %%); "
                 "transmittance.R mean %.5f\n",
                 offMean, onMean, 100.0 * (onMean / offMean - 1.0), transmittedMean);
     EXPECT_GT(onMean, offMean * 1.05);  // the back light reaches the front of the thin fin
@@ -184,6 +187,34 @@ TEST(Transmittance, CurvatureOptionScalesTheAddedLightByOnePlusNormalisedCurvatu
         }
     std::printf("transmittance.curvature: %d transmitting pixels with normalised curvature > 0.1 (the fin's rim)\n", curved);
     EXPECT_GT(curved, 20);  // the rounded rim of the fin is tightly curved
+}
+
+// transmittance.curvature_form = "thesis": the profile widened inside the exponent, s / (1 + 2c), in the main pass
+// (c uncapped, from the thesis' screen-space curvature). T(s) falls with s, so every pixel transmits at least as
+// much as without the curvature term, more on the fin's curved rim, and the diffuse gains exactly the AOV (no
+// × (1 + c) afterwards).
+TEST(Transmittance, ThesisCurvatureFormWidensTheProfileInsideTheExponent) {
+    SKINLAB_REQUIRE_RENDERER(renderer);
+    TempFolder folder("transmittance-curvature-thesis");
+    const ExrImage off = renderEar(*renderer, folder, "off", {});
+    const ExrImage plain =
+        renderEar(*renderer, folder, "plain", {"transmittance.enabled=true", "transmittance.translucency=0.75"});
+    const ExrImage thesis = renderEar(*renderer, folder, "thesis",
+                                      {"transmittance.enabled=true", "transmittance.translucency=0.75",
+                                       "transmittance.curvature=true", "transmittance.curvature_form=thesis"});
+    int brighter = 0;
+    for (int y = 0; y < thesis.height; ++y)
+        for (int x = 0; x < thesis.width; ++x)
+            for (const char* channel : kRgb) {
+                const std::string t = std::string("transmittance.") + channel;
+                ASSERT_GE(thesis.at(t, x, y), plain.at(t, x, y) * (1.0f - 1e-5f)) << channel << " at " << x << "," << y;
+                if (std::string(channel) == "R" && thesis.at(t, x, y) > plain.at(t, x, y) * 1.01f) ++brighter;
+                const std::string d = std::string("diffuse.") + channel;
+                ASSERT_NEAR(thesis.at(d, x, y) - off.at(d, x, y), thesis.at(t, x, y), 1e-6f + 1e-5f * thesis.at(d, x, y));
+            }
+    std::printf("transmittance.curvature_form = thesis: %d pixels transmit > 1 %% more red than without curvature\n",
+                brighter);
+    EXPECT_GT(brighter, 20);
 }
 
 } // namespace

@@ -3,6 +3,11 @@
 #include "renderer/sss/cpu_blur.h"
 #include "renderer/sss/pscbf_kernel.h"
 
+#include "common/error.h"
+#include "common/spec.h"
+#include "renderer/sss/kernel.h"
+#include "renderer/sss/sss_params.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -115,4 +120,55 @@ TEST(PscbfKernel, JsonRecordsTheParameters) {
     EXPECT_EQ(json.at("method"), "pscbf");
     EXPECT_EQ(json.at("taps").size(), 13u);
     EXPECT_DOUBLE_EQ(json.at("max_radius_mm").get<double>(), 4.5);
+}
+
+// The paper runs 13 taps per axis: an [sss] table that selects pscbf and names no count gets 13, the other methods
+// keep 21, and an explicit count wins.
+TEST(PscbfKernel, ThirteenTapsByDefaultFromTheSceneTable) {
+    auto read = [](std::string_view text) {
+        const toml::table root = skinlab::parseTomlString(text, "scene.toml");
+        return readSssParams(skinlab::SpecReader(root, "scene.toml"));
+    };
+    EXPECT_EQ(read("[sss]\nmethod = \"pscbf\"\n").samples, 13);
+    EXPECT_EQ(read("[sss]\nmethod = \"separable\"\n").samples, 21);
+    EXPECT_EQ(read("[sss]\nmethod = \"pscbf\"\nsamples = 21\n").samples, 21);
+    SssParams pscbf = read("[sss]\nmethod = \"pscbf\"\n");
+    EXPECT_EQ(makeKernel(pscbf).stages.at(0).taps.size(), 13u);
+    EXPECT_EQ(sssParamsFromJson(pscbf.toJson()).samples, 13);
+}
+
+// Table 1's 2.3 / 1.4 / 1.1 read as standard deviations (mm): variances 5.29 / 1.96 / 1.21 mm², the same spike and
+// r_max. Under that reading r_max cuts the red Gaussian at 4.5 / 2.3 = 1.96 σ, so the red taps spread wider (RMS
+// width closer to r_max). The reading is a key of [sss] and travels through the JSON form.
+TEST(PscbfKernel, StandardDeviationReading) {
+    const PscbfProfile& sd = mikkelsenSkinProfile(PscbfSigma::StdDev);
+    EXPECT_DOUBLE_EQ(sd.varianceMm2[0], 2.3 * 2.3);
+    EXPECT_DOUBLE_EQ(sd.varianceMm2[1], 1.4 * 1.4);
+    EXPECT_DOUBLE_EQ(sd.varianceMm2[2], 1.1 * 1.1);
+    EXPECT_EQ(sd.spike, mikkelsenSkinProfile().spike);
+    EXPECT_DOUBLE_EQ(sd.maxRadiusMm, 4.5);
+
+    const toml::table root = skinlab::parseTomlString("[sss]\nmethod = \"pscbf\"\npscbf_sigma = \"std-dev\"\n", "s.toml");
+    const SssParams params = readSssParams(skinlab::SpecReader(root, "s.toml"));
+    EXPECT_EQ(params.pscbfSigma, PscbfSigma::StdDev);
+    EXPECT_EQ(sssParamsFromJson(params.toJson()).pscbfSigma, PscbfSigma::StdDev);
+    SssParams variance = params;
+    variance.pscbfSigma = PscbfSigma::Variance;
+    const double wide = tapStatistics(makeKernel(params).stages.at(0).taps, 10.0).rmsWidthMm[0];
+    const double narrow = tapStatistics(makeKernel(variance).stages.at(0).taps, 10.0).rmsWidthMm[0];
+    // Truncated to ±4.5 mm the variance reading keeps an RMS near √2.3 = 1.52 mm; the other near 2.0 mm.
+    EXPECT_NEAR(narrow, std::sqrt(2.3), 0.1);
+    EXPECT_GT(wide, narrow + 0.3);
+    EXPECT_LT(wide, 2.3);
+
+    const toml::table bad = skinlab::parseTomlString("[sss]\npscbf_sigma = \"sigma\"\n", "s.toml");
+    EXPECT_THROW(readSssParams(skinlab::SpecReader(bad, "s.toml")), skinlab::InputError);
+}
+
+// Bugs are caught in the builds that run: the kernel's preconditions are checked in the release preset too (they
+// were `assert`s, compiled out there), and the message names the expression and both values.
+TEST(PscbfKernelDeathTest, PreconditionsAreCheckedInEveryBuild) {
+    GTEST_FLAG_SET(death_test_style, "threadsafe");
+    EXPECT_DEATH(makePscbfKernel(mikkelsenSkinProfile(), 4), R"(check failed at .*pscbf_kernel\.cpp:[0-9]+: samples % 2 == 1 \(0 vs 1\))");
+    EXPECT_DEATH(makePscbfKernel(mikkelsenSkinProfile(), 103), R"(samples <= 101 \(103 vs 101\))");
 }

@@ -98,7 +98,7 @@ TEST(RadialProfile, TabulatedProfilesAreRejected) {
 }
 
 // On a flat plane a step irradiance convolves to the marginal's CDF across the step: out(x) = ∫_{x'>0} a(x − x')
-// dx' = P(X < x) = cumulative(x) of the 1-D marginal (science.md §1).
+// dx' = P(X < x) = cumulative(x) of the 1-D marginal (d'Eon & Luebke, GPU Gems 3 ch. 14).
 class StepResponse : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(StepResponse, EqualsTheMarginalCdf) {

@@ -77,7 +77,7 @@ TEST(SceneSpec, ErrorMessagesNameFileKeyAndValue) {
               "builtin:head: camera.view: 'sideways' is not one of: close, mid, far, explicit");
     EXPECT_EQ(errorOf("builtin:head", {"render.width=8"}), "builtin:head: render.width: 8 is out of range [16, 8192]");
     EXPECT_EQ(errorOf("builtin:head", {"tone_map.operator=aces"}),
-              "builtin:head: tone_map.operator: 'aces' is not one of: linear, exponential, reinhard, filmic");
+              "builtin:head: tone_map.operator: 'aces' is not one of: linear, exponential, reinhard, reinhard-rgb, filmic");
     EXPECT_EQ(errorOf("builtin:head", {"lights=3"}), "builtin:head: lights: expected an array of tables, got integer 3");
     EXPECT_EQ(errorOf("builtin:ear", {"model.depth_gap_mm=10"}),
               "builtin:ear: model.depth_gap_mm: only applies to builtin:halo");

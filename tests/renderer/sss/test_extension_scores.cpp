@@ -1,4 +1,4 @@
-// Halo and bleed scores of the screen-space methods and the artifact extensions (issue 4 "Tests"; docs/extensions.md,
+// Halo and bleed scores of the screen-space methods and the artifact extensions (docs/extensions.md,
 // "Scores on renders"), on real renders through the renderer's public API, scored by analysis/metrics against the
 // object-space `reference` method of the same scene, camera and size (label gl; llvmpipe in CI; 128² renders).
 //
@@ -44,7 +44,7 @@ metrics::PreparedReference prepare(const std::filesystem::path& referenceExr) {
                                      metrics::MetricOptions{});
 }
 
-// The leak energy Σ_band |Y_T − Y_R| / Σ_skin Y_R of one band (science.md §5).
+// The leak energy Σ_band |Y_T − Y_R| / Σ_skin Y_R of one band (docs/metrics.md).
 double leakEnergy(const metrics::PreparedReference& reference, const std::filesystem::path& testExr,
                   metrics::Band band) {
     const metrics::MetricRender test = metrics::loadMetricRender(testExr, metrics::RenderRole::test);

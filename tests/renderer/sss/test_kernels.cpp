@@ -1,5 +1,5 @@
 // Discretised kernels: normalisation, symmetry, the artistic kernel against hand-computed taps, importance sampling,
-// the gaussian-sum cascade, tabulated .bn kernels (science.md §2).
+// the gaussian-sum cascade, tabulated .bn kernels (docs/methods.md).
 #include "reference_data.h"
 #include "renderer/sss/artistic_kernel.h"
 #include "renderer/sss/burley_profile.h"

@@ -1,4 +1,4 @@
-// Diffusion profiles and their marginals against closed forms and numerical integration (science.md §1).
+// Diffusion profiles and their marginals against closed forms and numerical integration (d'Eon & Luebke, GPU Gems 3 ch. 14).
 #include "renderer/sss/burley_profile.h"
 #include "renderer/sss/gaussian_sum_profile.h"
 #include "renderer/sss/materials.h"

@@ -162,7 +162,7 @@ TEST(SssGlPasses, MatchTheCpuReferenceOnATestImage) {
         float maxDiff = 0.0f;
         for (size_t i = 0; i < cpu.size(); ++i)
             for (int c = 0; c < 3; ++c) maxDiff = std::max(maxDiff, std::abs(cpu[i][c] - gpu[i][c]));
-        // 1e-3 (issue 3): both sides compute in float32 in the same order; differences come from fused
+        // 1e-3: both sides compute in float32 in the same order; differences come from fused
         // multiply-adds and the driver's mix(), i.e. a few ulps per tap.
         EXPECT_LE(maxDiff, 1e-3f) << v.name;
         std::printf("  %-32s max |GL - CPU| = %.3g\n", v.name, double(maxDiff));
@@ -287,6 +287,8 @@ TEST(SssGlPasses, ExtensionsMatchTheCpuReference) {
         double lambda;
         double beta;
         const char* curvature;
+        const char* input = "albedo";
+        double referenceMm = 20.0;
     };
     const std::vector<Extensions> extensions{
         {"cbf", true, 10.0, 0.0, "off"},
@@ -296,7 +298,13 @@ TEST(SssGlPasses, ExtensionsMatchTheCpuReference) {
         {"curvature increase", false, 10.0, 0.0, "increase"},
         {"curvature reduce", false, 10.0, 0.0, "reduce"},
         {"curvature reduce-floor", false, 10.0, 0.0, "reduce-floor"},
-        {"cbf + lab + reduce-floor", true, 10.0, 0.09, "reduce-floor"}};
+        {"cbf + lab + reduce-floor", true, 10.0, 0.09, "reduce-floor"},
+        // sss.extension_input = "lit": the colour each pass blurs replaces the albedo (Lab, and F's grey).
+        {"cbf lit", true, 10.0, 0.0, "off", "lit"},
+        {"lab_weight 0.09 lit", false, 10.0, 0.09, "off", "lit"},
+        {"lab_weight 0.5 lit", false, 10.0, 0.5, "off", "lit"},
+        // sss.curvature_reference_mm: c = saturate(κ · 60 mm), every pixel past κ = 1/60 mm counts as fully curved.
+        {"reduce-floor reference 60 mm", false, 10.0, 0.0, "reduce-floor", "albedo", 60.0}};
     for (sss::SssMethod method : kMethods) {
         const sss::SssParams off = params(method);
         const auto gpuOff = runOnGpu(image.surface, image.diffuse, off);
@@ -306,6 +314,8 @@ TEST(SssGlPasses, ExtensionsMatchTheCpuReference) {
             p.cbfLambda = e.lambda;
             p.labWeight = e.beta;
             p.curvature = e.curvature;
+            p.extensionInput = e.input;
+            p.curvatureReferenceMm = e.referenceMm;
             const auto cpu = sss::applyKernel(image.surface, image.diffuse, sss::makeKernel(p),
                                               sss::blurSettingsFromParams(p));
             const auto gpu = runOnGpu(image.surface, image.diffuse, p);
@@ -322,6 +332,39 @@ TEST(SssGlPasses, ExtensionsMatchTheCpuReference) {
                         std::string(sss::methodName(method)).c_str(), e.name, double(difference), double(changed));
         }
     }
+}
+
+// The two inputs differ where the lit colour does and the albedo does not: a skin plane of one albedo with a shadow
+// terminator (the light drops to 5 % at x = 48). With the albedo input the CIELAB weight is 1 everywhere (one albedo),
+// so the blur is the unweighted one; with the lit input it cuts the blur at the terminator (thesis Eq. 3.13's "lab
+// color of the image I"), leaving the shadowed side darker next to the edge.
+TEST(SssGlPasses, LitExtensionInputCutsAtAShadowTerminator) {
+    SKINLAB_REQUIRE_GL();
+    const int w = 96, h = 32;
+    sss::SurfaceBuffers surface = flatPlane(w, h, 2.5f);
+    surface.albedo.assign(size_t(w) * h, Rgb{0.6f, 0.4f, 0.3f});
+    surface.aux.assign(size_t(w) * h, 1.0f);
+    std::vector<Rgb> diffuse(size_t(w) * h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const float light = x < 48 ? 1.0f : 0.05f;
+            for (int c = 0; c < 3; ++c) diffuse[size_t(y) * w + x][c] = light * surface.albedo[0][c];
+        }
+    sss::SssParams off = params(sss::SssMethod::Separable);
+    off.followSurface = false;
+    sss::SssParams albedo = off, lit = off;
+    albedo.labWeight = lit.labWeight = 0.09;
+    lit.extensionInput = "lit";
+    const auto gpuOff = runOnGpu(surface, diffuse, off);
+    const auto gpuAlbedo = runOnGpu(surface, diffuse, albedo);
+    const auto gpuLit = runOnGpu(surface, diffuse, lit);
+    EXPECT_LE(maxAbsDifference(gpuAlbedo, gpuOff), 1e-5f) << "one albedo: the albedo input must not weigh any tap";
+    const size_t shadowed = size_t(h / 2) * w + 50;  // 2 pixels into the shadow
+    EXPECT_GT(gpuOff[shadowed][0], 0.05f * 0.6f + 0.02f) << "the unweighted blur carries light across the terminator";
+    EXPECT_LT(gpuLit[shadowed][0], 0.5f * (gpuOff[shadowed][0] + 0.05f * 0.6f))
+        << "the lit input should keep most of the light on its side";
+    const auto cpuLit = sss::applyKernel(surface, diffuse, sss::makeKernel(lit), sss::blurSettingsFromParams(lit));
+    EXPECT_LE(maxAbsDifference(cpuLit, gpuLit), 1e-3f);
 }
 
 namespace {

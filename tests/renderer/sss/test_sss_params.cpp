@@ -3,6 +3,9 @@
 
 #include "common/error.h"
 #include "common/spec.h"
+#include "renderer/sss/kernel.h"
+
+#include <cmath>
 
 #include <gtest/gtest.h>
 
@@ -110,4 +113,73 @@ TEST(TransmittanceParams, ReadsAndValidates) {
     } catch (const skinlab::InputError& e) {
         EXPECT_STREQ(e.what(), "scene.toml: transmittance.translucency: 1.5 is out of range [0, 1]");
     }
+}
+
+// Jimenez's demo (SSSSBlurPS): finalStep = sssWidth · (1 / tan(fovY/2)) / z · dir / 3 in texture coordinates per
+// kernel unit, offsets of its artistic kernel in [−3, 3] (RANGE = 3 for more than 20 taps). Replays that step for a
+// few views and compares where the outermost tap lands, in pixels, with skinlab's artistic kernel at the converted
+// width (pixels per mm = f_px / (mm_per_unit · z), f_px = (H/2) / tan(fovY/2)). The old reading width_mm = sssWidth ×
+// mm_per_unit lands at half the demo's distance.
+TEST(SssParams, DemoSssWidthConversion) {
+    constexpr double kPi = 3.14159265358979323846;
+    struct View {
+        double sssWidth, mmPerUnit, fovDeg, z, height;
+    };
+    for (const View v : {View{0.012, 47.9, 20.0, 2.5, 720.0}, View{1.5, 1.0, 30.0, 300.0, 512.0},
+                         View{0.05, 10.0, 45.0, 7.0, 1080.0}}) {
+        const double t = std::tan(0.5 * v.fovDeg * kPi / 180.0);
+        const double demoStepUv = v.sssWidth * (1.0 / t) / v.z / 3.0;  // per kernel unit
+        const double demoEdgePixels = 3.0 * demoStepUv * v.height;     // vertical pass, offset 3
+
+        SssParams params;
+        params.method = SssMethod::Artistic;
+        params.samples = 25;
+        params.widthMm = widthMmFromDemoSssWidth(v.sssWidth, v.mmPerUnit);
+        const Kernel kernel = makeKernel(params);
+        ASSERT_EQ(kernel.stages.size(), 1u);
+        const double edgeMm = kernel.stages[0].taps.back().offsetMm;
+        const double fPx = 0.5 * v.height / t;
+        const double edgePixels = edgeMm * fPx / (v.mmPerUnit * v.z);
+        EXPECT_NEAR(edgePixels, demoEdgePixels, 1e-9 * demoEdgePixels) << "sssWidth " << v.sssWidth;
+    }
+    EXPECT_DOUBLE_EQ(widthMmFromDemoSssWidth(0.012, 47.9), 2.0 * 0.012 * 47.9);
+}
+
+// The demo's transmittance scale (SSSSTransmittance): s = 8.25 (1 − translucency) / sssWidth × thickness in world
+// units. At the converted width, skinlab's per-unit scale is the same number; independent of mm_per_unit in mm.
+TEST(TransmittanceParams, ThicknessScaleFollowsTheDemo) {
+    for (const double translucency : {0.0, 0.5, 0.83}) {
+        for (const double sssWidth : {0.012, 1.5}) {
+            for (const double mmPerUnit : {1.0, 47.9}) {
+                const double widthMm = widthMmFromDemoSssWidth(sssWidth, mmPerUnit);
+                const double demo = 8.25 * (1.0 - translucency) / sssWidth;
+                EXPECT_NEAR(transmittanceScalePerUnit(translucency, widthMm, mmPerUnit), demo, 1e-9 * (1.0 + demo));
+            }
+        }
+    }
+    // Per mm of thickness at width_mm = 3: 16.5 (1 − 0.5) / 3 = 2.75 / mm.
+    EXPECT_NEAR(transmittanceScalePerUnit(0.5, 3.0, 1.0), 2.75, 1e-12);
+}
+
+// The keys of the thesis' variants: extension input, curvature measure and reference radius, transmittance form.
+TEST(SssParams, ThesisVariantKeys) {
+    const SssParams defaults = readSss("");
+    EXPECT_EQ(defaults.extensionInput, "albedo");
+    EXPECT_EQ(defaults.curvatureMeasure, "normal");
+    EXPECT_DOUBLE_EQ(defaults.curvatureReferenceMm, 20.0);
+    const SssParams p = readSss("[sss]\nextension_input = \"lit\"\ncurvature_measure = \"screen\"\n"
+                                "curvature_reference_mm = 40.0\n");
+    EXPECT_EQ(p.extensionInput, "lit");
+    EXPECT_EQ(p.curvatureMeasure, "screen");
+    EXPECT_DOUBLE_EQ(p.curvatureReferenceMm, 40.0);
+    EXPECT_EQ(sssParamsFromJson(p.toJson()).toJson(), p.toJson());
+    EXPECT_EQ(sssError("[sss]\nextension_input = \"image\""),
+              "scene.toml: sss.extension_input: 'image' is not one of: albedo, lit");
+    EXPECT_EQ(sssError("[sss]\ncurvature_measure = \"gauss\""),
+              "scene.toml: sss.curvature_measure: 'gauss' is not one of: normal, screen");
+
+    const toml::table root = skinlab::parseTomlString("[transmittance]\ncurvature_form = \"thesis\"\n", "scene.toml");
+    EXPECT_EQ(readTransmittanceParams(skinlab::SpecReader(root, "scene.toml")).curvatureForm, "thesis");
+    const toml::table bad = skinlab::parseTomlString("[transmittance]\ncurvature_form = \"both\"\n", "scene.toml");
+    EXPECT_THROW(readTransmittanceParams(skinlab::SpecReader(bad, "scene.toml")), skinlab::InputError);
 }
