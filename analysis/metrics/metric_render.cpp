@@ -125,7 +125,9 @@ OpenedRender openMetricRender(const std::filesystem::path& path, RenderRole role
     render.focalLengthPixels = floatAttribute(spec, file, "skinlab:f_px", reference);
     render.millimetresPerUnit = floatAttribute(spec, file, "skinlab:mm_per_unit", reference);
     // Not required here: `--sss-radius-mm` may stand in for it (prepareReference checks).
-    render.sssRadiusMillimetres = floatAttribute(spec, file, "skinlab:sss_radius_mm", false);
+    // A test render's radius is never used (a render without SSS stores 0), so only a reference's is checked.
+    if (reference)
+        render.sssRadiusMillimetres = floatAttribute(spec, file, "skinlab:sss_radius_mm", false);
     return opened;
 }
 
