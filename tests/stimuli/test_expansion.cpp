@@ -381,7 +381,7 @@ TEST(ShippedSpecs, ExpandToTheDocumentedCounts) {
     }
     std::vector<Stimulus> demo = expand(readSetSpec(dir / "demo.toml"));
     EXPECT_EQ(demo.front().id, "head-close-none");
-    EXPECT_EQ(demo.back().id, "head-mid-reference");  // the references come last
+    EXPECT_EQ(demo.back().id, "head-mid-reference-reference_edge_mm-2.0");  // the references come last
 }
 
 // Every stimulus of every shipped spec resolves against the renderer's scene reader (methods, extension switches
