@@ -17,4 +17,5 @@ namespace skinlab::cli {
 // `skinlab analyze` sub-subcommands, registered by cmd_analyze.cpp on the `analyze` subcommand.
 void registerAnalyzeScale(CLI::App& analyze);    // scale, validate
 void registerAnalyzeMetrics(CLI::App& analyze);  // metrics
+void registerAnalyzeAgreement(CLI::App& analyze);  // agreement
 } // namespace skinlab::cli

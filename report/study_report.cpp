@@ -256,6 +256,21 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
         }
         cropOfBlock[block.name] = cropWhereTheyDiffer(images, names, out, slug(block.name));
     }
+    // The set's reference render of each block ("reference": true in the manifest), shown beside the conditions.
+    std::map<std::string, ConditionImages> referenceOfBlock;
+    try {
+        const nlohmann::json manifest = nlohmann::json::parse(readFile(stimuliFolder / "manifest.json"));
+        for (const nlohmann::json& s : manifest.value("stimuli", nlohmann::json::array())) {
+            if (!s.value("reference", false) || !s.contains("files") || !s["files"].contains("png")) continue;
+            std::string block = s.value("block", ""), id = s.value("id", "");
+            if (!imagesOfBlock.count(block) || referenceOfBlock.count(block)) continue;
+            std::string file = "stimuli/" + slug(id) + ".png";
+            copyFileAtomic(stimuliFolder / s["files"]["png"].get<std::string>(), out / file);
+            referenceOfBlock[block] = {"reference", id, file};
+        }
+    } catch (const nlohmann::json::exception& e) {
+        throwInput((stimuliFolder / "manifest.json").string(), "", std::string("not valid JSON (") + e.what() + ")");
+    }
 
     // --- Metrics against the set's references (given, or computed here for the study's stimuli). ---
     nlohmann::json metricsJson;
@@ -454,6 +469,14 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
             "Crops: the window where the conditions differ most, enlarged 2× without smoothing.</p>\n";
     for (const experiments::StudyBlock& block : definition.blocks) {
         html << "<h3>" << h(block.name) << "</h3><div class=\"thumbs\">";
+        if (referenceOfBlock.count(block.name)) {
+            const ConditionImages& image = referenceOfBlock[block.name];
+            html << "<figure><a href=\"" << h(image.png) << "\"><img src=\"" << h(image.png)
+                 << "\" alt=\"reference\" loading=\"eager\"></a><figcaption><strong>reference</strong> ("
+                 << (design.showReference ? "shown above each pair" : "not shown to observers") << ") · "
+                 << h(image.stimulus)
+                 << "</figcaption></figure>";
+        }
         for (const ConditionImages& image : imagesOfBlock[block.name])
             html << "<figure><a href=\"" << h(image.png) << "\"><img src=\"" << h(image.png) << "\" alt=\""
                  << h(image.condition) << "\" loading=\"eager\"></a><figcaption><strong>" << h(image.condition)

@@ -94,6 +94,22 @@ for (const file of ['scale.json', 'agreement.json', 'agreement.csv', 'metrics/me
 const agreement = JSON.parse(fs.readFileSync(path.join(reportDir, 'agreement.json'), 'utf8'));
 check(agreement.agreement.some((row) => row.metric === 'image.flip_mean' && row.conditions === 4),
   'agreement.json has FLIP over the 4 conditions');
+// The same agreement tables without a report, from the report's metrics folder.
+run(['analyze', 'agreement', database, '--metrics', path.join(reportDir, 'metrics'), '-o', path.join(work, 'agreement'),
+  '--bootstrap', '200']);
+const standalone = JSON.parse(fs.readFileSync(path.join(work, 'agreement', 'agreement.json'), 'utf8'));
+check(standalone.agreement.length === agreement.agreement.length, 'analyze agreement writes the same rows');
+// Plain images on the command line: two stimulus PNGs (sRGB) get the image-wide scores; a bad --encoding is named.
+const pngs = fs.readdirSync(path.join(reportDir, 'stimuli')).filter((f) => f.endsWith('.png')).sort();
+run(['analyze', 'metrics', '--reference', path.join(reportDir, 'stimuli', pngs[0]), path.join(reportDir, 'stimuli', pngs[1]),
+  '-o', path.join(work, 'plain'), '--ppd', '40']);
+const plain = JSON.parse(fs.readFileSync(path.join(work, 'plain', 'metrics.json'), 'utf8'));
+check(plain.comparisons[0].bands_measured === false && plain.comparisons[0].image.flip_mean > 0 &&
+  plain.settings.flip.pixels_per_degree === 40, 'plain PNGs: image-wide scores, no bands, --ppd recorded');
+const bad = spawnSync(cli, ['analyze', 'metrics', '--reference', path.join(reportDir, 'stimuli', pngs[0]),
+  path.join(reportDir, 'stimuli', pngs[1]), '-o', path.join(work, 'bad'), '--encoding', 'gamma'], { encoding: 'utf8' });
+check(bad.status === 2 && bad.stderr.includes('--encoding: "gamma" is not one of auto, srgb, linear'),
+  'bad --encoding: exit 2 and a message naming it');
 const html = fs.readFileSync(path.join(reportDir, 'index.html'), 'utf8');
 check(!/(file:|\/tmp\/)/.test(html.replace(/<code>[^<]*<\/code>/g, '')), 'no absolute paths in links');
 
