@@ -6,5 +6,6 @@ void registerAnalyze(CLI::App& app) {
     analyze->require_subcommand(1);
     registerAnalyzeScale(*analyze);
     registerAnalyzeMetrics(*analyze);
+    registerAnalyzeAgreement(*analyze);
 }
 } // namespace skinlab::cli

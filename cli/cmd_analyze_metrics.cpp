@@ -23,6 +23,8 @@ struct AnalyzeMetricsArguments {
     std::optional<double> sssRadiusMillimetres;
     double heatmapMax = 10.0;
     bool noHeatmaps = false;
+    double pixelsPerDegree = metrics::flipDefaultPixelsPerDegree;
+    std::string encoding = "auto";
 };
 
 void runAnalyzeMetrics(const AnalyzeMetricsArguments& arguments) {
@@ -42,6 +44,8 @@ void runAnalyzeMetrics(const AnalyzeMetricsArguments& arguments) {
     metrics::MetricsRunOptions options;
     options.metric.exposure = arguments.exposure;
     options.metric.sssRadiusMillimetres = arguments.sssRadiusMillimetres;
+    options.metric.pixelsPerDegree = arguments.pixelsPerDegree;
+    options.metric.encoding = metrics::parseImageEncoding(arguments.encoding);
     options.heatmapMax = arguments.heatmapMax;
     options.heatmaps = !arguments.noHeatmaps;
     auto records = metrics::runMetrics(plan, options, arguments.outputFolder);
@@ -55,9 +59,10 @@ void registerAnalyzeMetrics(CLI::App& analyze) {
     auto arguments = std::make_shared<AnalyzeMetricsArguments>();
     CLI::App* command = analyze.add_subcommand(
         "metrics",
-        "Compare renders with a reference: PSNR, SSIM, CIEDE2000 on the image and on skin, and halo/bleed/spill/"
-        "interior band scores (docs/metrics.md)");
-    command->add_option("tests", arguments->tests, "Test renders (EXR, contract 1) to compare with --reference");
+        "Compare renders with a reference: PSNR, SSIM, CIEDE2000 and LDR-FLIP on the image and on skin, and halo/bleed/"
+        "spill/interior band scores; plain images (PNG, JPEG, RGB-only EXR) get the image-wide scores (docs/metrics.md)");
+    command->add_option("tests", arguments->tests,
+                        "Test renders (EXR, contract 1) or plain images (PNG, JPEG, EXR, ...) to compare with --reference");
     command->add_option("--reference", arguments->reference,
                         "Reference EXR (with depth.Z, mask.Y and skinlab:f_px/mm_per_unit/sss_radius_mm); with "
                         "--stimuli: the id of the reference stimulus (default: each block's \"reference\": true)");
@@ -73,6 +78,12 @@ void registerAnalyzeMetrics(CLI::App& analyze) {
                         "SSS support radius in mm for the bands (default: the reference's skinlab:sss_radius_mm)");
     command->add_option("--heatmap-max", arguments->heatmapMax, "dE00 at the top of the heat map's colour scale (default 10)");
     command->add_flag("--no-heatmaps", arguments->noHeatmaps, "Write only metrics.csv and metrics.json");
+    command->add_option("--ppd", arguments->pixelsPerDegree,
+                        "FLIP's pixels per degree of visual angle (default 67.0206: 0.7 m from a 0.7 m wide 3840-pixel "
+                        "monitor)");
+    command->add_option("--encoding", arguments->encoding,
+                        "How pixel values map to linear light: auto (default: float files linear, 8/16-bit sRGB unless "
+                        "the file says linear), srgb, linear");
     command->callback([arguments] { runAnalyzeMetrics(*arguments); });
 }
 

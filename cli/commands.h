@@ -10,10 +10,12 @@ void registerStimuli(CLI::App& app);
 void registerStudy(CLI::App& app);
 void registerAnalyze(CLI::App& app);
 void registerBench(CLI::App& app);
+void registerReport(CLI::App& app);
 } // namespace skinlab::cli
 
 namespace skinlab::cli {
 // `skinlab analyze` sub-subcommands, registered by cmd_analyze.cpp on the `analyze` subcommand.
 void registerAnalyzeScale(CLI::App& analyze);    // scale, validate
 void registerAnalyzeMetrics(CLI::App& analyze);  // metrics
+void registerAnalyzeAgreement(CLI::App& analyze);  // agreement
 } // namespace skinlab::cli

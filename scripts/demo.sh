@@ -5,6 +5,8 @@
 #   3. creates a 2AFC study from it, serves it on loopback and runs 20 simulated observers through the real
 #      HTTP API (true scores in experiments/designs/demo-truth.json);
 #   4. scales the answers to JOD with confidence intervals;
+#   5. writes the study report (HTML + PDF): stimuli, scale, objective errors against the object-space reference,
+#      metrics against the scale, findings;
 # and prints where everything is, and the command for a session with a real participant.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -37,6 +39,7 @@ trap - EXIT
 
 "$skinlab" study export "$out/study.db" --format csv -o "$out/responses.csv"
 "$skinlab" analyze scale "$out/study.db" -o "$out/scale"
+"$skinlab" report "$out/study.db" -o "$out/report"
 
 cat <<TXT
 
@@ -45,6 +48,7 @@ demo: done
   stimuli:         $(pwd)/$out/stimuli/manifest.json
   study database:  $(pwd)/$out/study.db  (20 simulated observers; responses in $out/responses.csv)
   JOD scale:       $(pwd)/$out/scale/report_section.html  (scale.json, scores.csv, plots)
+  study report:    $(pwd)/$out/report/index.html  (and report.pdf)
   a session with a real participant:
     $skinlab study serve $out/study.db        # then open the printed participant link in a browser
 TXT

@@ -38,7 +38,7 @@ std::string formatScale(double value) {
     return text;
 }
 
-cv::Mat colourise(const cv::Mat& values, double scaleMax) {
+cv::Mat colourise(const cv::Mat& values, double scaleMax, cv::ColormapTypes map = cv::COLORMAP_INFERNO) {
     cv::Mat scaled(values.size(), CV_8UC1);
     for (int y = 0; y < values.rows; ++y) {
         const auto* in = values.ptr<float>(y);
@@ -49,7 +49,7 @@ cv::Mat colourise(const cv::Mat& values, double scaleMax) {
         }
     }
     cv::Mat coloured;
-    cv::applyColorMap(scaled, coloured, cv::COLORMAP_INFERNO);
+    cv::applyColorMap(scaled, coloured, map);
     return coloured;
 }
 
@@ -98,9 +98,9 @@ cv::Mat renderErrorHeatmap(const cv::Mat& deltaE00, const ErrorBands& bands, dou
     return canvas;
 }
 
-void writeErrorHeatmap(const std::filesystem::path& path, const cv::Mat& deltaE00, const ErrorBands& bands,
-                       double scaleMax) {
-    cv::Mat picture = renderErrorHeatmap(deltaE00, bands, scaleMax);
+namespace {
+
+void writePng(const std::filesystem::path& path, const cv::Mat& picture) {
     AtomicOutput output(path);
     bool written = false;
     try {
@@ -111,5 +111,40 @@ void writeErrorHeatmap(const std::filesystem::path& path, const cv::Mat& deltaE0
     if (!written) throwInput(path.string(), "", "cannot write PNG");
     output.commit();
 }
+
+} // namespace
+
+void writeErrorHeatmap(const std::filesystem::path& path, const cv::Mat& deltaE00, const ErrorBands& bands,
+                       double scaleMax) {
+    writePng(path, renderErrorHeatmap(deltaE00, bands, scaleMax));
+}
+
+cv::Mat renderFlipHeatmap(const cv::Mat& flip) {
+    CV_Assert(flip.type() == CV_64FC1 || flip.type() == CV_32FC1);
+    cv::Mat values;
+    flip.convertTo(values, CV_32FC1);
+    cv::Mat heat = colourise(values, 1.0, cv::COLORMAP_MAGMA);
+    const int height = std::max(heat.rows, legendMinimumHeight);
+    cv::Mat canvas(height, heat.cols + legendWidth, CV_8UC3, legendBackground);
+    heat.copyTo(canvas(cv::Rect(0, 0, heat.cols, heat.rows)));
+    const int left = heat.cols + 12;
+    cv::putText(canvas, "LDR-FLIP", {left, 18}, cv::FONT_HERSHEY_SIMPLEX, fontScale, textColour, 1, cv::LINE_AA);
+    const int barTop = 30, barHeight = 120, barWidth = 18;
+    cv::Mat ramp(barHeight, 1, CV_32FC1);
+    for (int i = 0; i < barHeight; ++i) ramp.at<float>(i) = static_cast<float>(1.0 - double(i) / double(barHeight - 1));
+    cv::Mat rampColour;
+    cv::resize(colourise(ramp, 1.0, cv::COLORMAP_MAGMA), rampColour, {barWidth, barHeight}, 0, 0, cv::INTER_NEAREST);
+    rampColour.copyTo(canvas(cv::Rect(left, barTop, barWidth, barHeight)));
+    const double ticks[3] = {1.0, 0.5, 0.0};
+    for (int i = 0; i < 3; ++i) {
+        int y = barTop + static_cast<int>(std::lround(i * (barHeight - 1) / 2.0));
+        cv::line(canvas, {left + barWidth, y}, {left + barWidth + 4, y}, textColour, 1);
+        cv::putText(canvas, formatScale(ticks[i]), {left + barWidth + 8, y + 5}, cv::FONT_HERSHEY_SIMPLEX, fontScale,
+                    textColour, 1, cv::LINE_AA);
+    }
+    return canvas;
+}
+
+void writeFlipHeatmap(const std::filesystem::path& path, const cv::Mat& flip) { writePng(path, renderFlipHeatmap(flip)); }
 
 } // namespace skinlab::metrics

@@ -17,4 +17,8 @@ cv::Mat renderErrorHeatmap(const cv::Mat& deltaE00, const ErrorBands& bands, dou
 void writeErrorHeatmap(const std::filesystem::path& path, const cv::Mat& deltaE00, const ErrorBands& bands,
                        double scaleMax);
 
+// The per-pixel LDR-FLIP map (0..1) through the magma colour map (the paper's choice) with a legend panel.
+cv::Mat renderFlipHeatmap(const cv::Mat& flip);
+void writeFlipHeatmap(const std::filesystem::path& path, const cv::Mat& flip);
+
 } // namespace skinlab::metrics

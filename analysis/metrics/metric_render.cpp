@@ -4,6 +4,7 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <vector>
@@ -45,7 +46,40 @@ void extractChannel(const std::vector<float>& pixels, int channels, int index, c
     for (size_t i = 0; i < count; ++i) out[i] = pixels[i * static_cast<size_t>(channels) + static_cast<size_t>(index)];
 }
 
+// The encoding a file states or implies (ImageEncoding::automatic's rule).
+ImageEncoding impliedEncoding(const OIIO::ImageSpec& spec) {
+    std::string colourSpace = spec.get_string_attribute("oiio:ColorSpace");
+    std::string lower = colourSpace;
+    std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
+    if (lower.find("srgb") != std::string::npos) return ImageEncoding::srgb;
+    if (lower.find("linear") != std::string::npos) return ImageEncoding::linear;
+    bool floating = spec.format.basetype == OIIO::TypeDesc::FLOAT || spec.format.basetype == OIIO::TypeDesc::HALF ||
+                    spec.format.basetype == OIIO::TypeDesc::DOUBLE;
+    return floating ? ImageEncoding::linear : ImageEncoding::srgb;
+}
+
+// The sRGB EOTF (IEC 61966-2-1).
+float decodeSrgb(float encoded) {
+    return encoded <= 0.04045f ? encoded / 12.92f : std::pow((encoded + 0.055f) / 1.055f, 2.4f);
+}
+
 } // namespace
+
+ImageEncoding parseImageEncoding(const std::string& text) {
+    if (text == "auto") return ImageEncoding::automatic;
+    if (text == "srgb") return ImageEncoding::srgb;
+    if (text == "linear") return ImageEncoding::linear;
+    throwInput("--encoding", "", "\"" + text + "\" is not one of auto, srgb, linear");
+}
+
+const char* imageEncodingName(ImageEncoding encoding) {
+    switch (encoding) {
+    case ImageEncoding::automatic: return "auto";
+    case ImageEncoding::srgb: return "srgb";
+    case ImageEncoding::linear: return "linear";
+    }
+    return "?";
+}
 
 namespace {
 
@@ -55,7 +89,7 @@ struct OpenedRender {
     int channels[5] = {-1, -1, -1, -1, -1};  // R, G, B, depth.Z, mask.Y
 };
 
-OpenedRender openMetricRender(const std::filesystem::path& path, RenderRole role) {
+OpenedRender openMetricRender(const std::filesystem::path& path, RenderRole role, ImageEncoding encoding) {
     const std::string file = path.string();
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path, ec)) throwInput(file, "", "file not found");
@@ -70,6 +104,11 @@ OpenedRender openMetricRender(const std::filesystem::path& path, RenderRole role
     if (spec.depth != 1) throwInput(file, "", "volume images are not supported");
 
     bool reference = role == RenderRole::reference;
+    // A reference without any of skinlab's AOVs and metadata is a plain image (photograph, PNG, another
+    // engine's render); one with some of them is a skinlab render with something missing, an error below.
+    bool plain = channelIndex(spec, "depth.Z") < 0 && channelIndex(spec, "mask.Y") < 0 &&
+                 !spec.find_attribute("skinlab:f_px") && !spec.find_attribute("skinlab:mm_per_unit");
+    if (plain) reference = false;
     opened.channels[0] = requireChannel(spec, file, "R");
     opened.channels[1] = requireChannel(spec, file, "G");
     opened.channels[2] = requireChannel(spec, file, "B");
@@ -79,23 +118,27 @@ OpenedRender openMetricRender(const std::filesystem::path& path, RenderRole role
     }
     MetricRender& render = opened.render;
     render.path = path;
+    render.plain = plain;
+    render.encoding = encoding == ImageEncoding::automatic ? impliedEncoding(spec) : encoding;
     render.width = spec.width;
     render.height = spec.height;
     render.focalLengthPixels = floatAttribute(spec, file, "skinlab:f_px", reference);
     render.millimetresPerUnit = floatAttribute(spec, file, "skinlab:mm_per_unit", reference);
     // Not required here: `--sss-radius-mm` may stand in for it (prepareReference checks).
-    render.sssRadiusMillimetres = floatAttribute(spec, file, "skinlab:sss_radius_mm", false);
+    // A test render's radius is never used (a render without SSS stores 0), so only a reference's is checked.
+    if (reference)
+        render.sssRadiusMillimetres = floatAttribute(spec, file, "skinlab:sss_radius_mm", false);
     return opened;
 }
 
 } // namespace
 
-MetricRender inspectMetricRender(const std::filesystem::path& path, RenderRole role) {
-    return openMetricRender(path, role).render;
+MetricRender inspectMetricRender(const std::filesystem::path& path, RenderRole role, ImageEncoding encoding) {
+    return openMetricRender(path, role, encoding).render;
 }
 
-MetricRender loadMetricRender(const std::filesystem::path& path, RenderRole role) {
-    OpenedRender opened = openMetricRender(path, role);
+MetricRender loadMetricRender(const std::filesystem::path& path, RenderRole role, ImageEncoding encoding) {
+    OpenedRender opened = openMetricRender(path, role, encoding);
     const std::string file = path.string();
     const OIIO::ImageSpec& spec = opened.input->spec();
     MetricRender render = std::move(opened.render);
@@ -114,6 +157,8 @@ MetricRender loadMetricRender(const std::filesystem::path& path, RenderRole role
     for (int c = 0; c < 3; ++c) {
         planes[c].create(spec.height, spec.width, CV_32FC1);
         extractChannel(pixels, spec.nchannels, opened.channels[c], planes[c]);
+        if (render.encoding == ImageEncoding::srgb)
+            for (auto it = planes[c].begin<float>(); it != planes[c].end<float>(); ++it) *it = decodeSrgb(*it);
     }
     cv::merge(planes, 3, render.beauty);
     if (opened.channels[3] >= 0) {

@@ -38,7 +38,8 @@ nlohmann::json regionJson(const RegionScores& scores) {
             {"psnr_db", jsonNumber(scores.psnrDecibels)},
             {"ssim", jsonNumber(scores.ssim)},
             {"delta_e00_mean", jsonNumber(scores.deltaE00Mean)},
-            {"delta_e00_p95", jsonNumber(scores.deltaE00P95)}};
+            {"delta_e00_p95", jsonNumber(scores.deltaE00P95)},
+            {"flip_mean", jsonNumber(scores.flipMean)}};
 }
 
 nlohmann::json bandJson(const BandScores& scores) {
@@ -47,6 +48,7 @@ nlohmann::json bandJson(const BandScores& scores) {
             {"fraction_of_skin", jsonNumber(scores.fractionOfSkin)},
             {"delta_e00_mean", jsonNumber(scores.deltaE00Mean)},
             {"delta_e00_p95", jsonNumber(scores.deltaE00P95)},
+            {"flip_mean", jsonNumber(scores.flipMean)},
             {"excess", jsonNumber(scores.excess)},
             {"leak_energy", jsonNumber(scores.leakEnergy)}};
 }
@@ -56,13 +58,14 @@ nlohmann::json bandJson(const BandScores& scores) {
 std::string metricsCsv(const std::vector<ComparisonRecord>& records) {
     std::string out = "reference,test,block,width,height,sss_radius_mm,mm_per_unit,support_radius_world,f_px";
     for (const char* region : {"image", "skin"})
-        for (const char* field : {"pixels", "psnr_db", "ssim", "delta_e00_mean", "delta_e00_p95"})
+        for (const char* field : {"pixels", "psnr_db", "ssim", "delta_e00_mean", "delta_e00_p95", "flip_mean"})
             out += std::string(",") + region + "_" + field;
     for (Band band : allBands)
         for (const char* field :
-             {"pixels", "fraction_of_image", "fraction_of_skin", "delta_e00_mean", "delta_e00_p95", "excess", "leak_energy"})
+             {"pixels", "fraction_of_image", "fraction_of_skin", "delta_e00_mean", "delta_e00_p95", "flip_mean", "excess",
+              "leak_energy"})
             out += "," + std::string(bandName(band)) + "_" + field;
-    out += ",heatmap\n";
+    out += ",heatmap,flip_heatmap,bands_measured\n";
     for (const ComparisonRecord& record : records) {
         out += csvText(record.job.referenceName) + "," + csvText(record.job.testName) + "," + csvText(record.job.block);
         out += "," + std::to_string(record.width) + "," + std::to_string(record.height);
@@ -71,16 +74,17 @@ std::string metricsCsv(const std::vector<ComparisonRecord>& records) {
             out += "," + csvNumber(v);
         for (const RegionScores* region : {&record.image, &record.skin}) {
             out += "," + std::to_string(region->pixels);
-            for (double v : {region->psnrDecibels, region->ssim, region->deltaE00Mean, region->deltaE00P95})
+            for (double v : {region->psnrDecibels, region->ssim, region->deltaE00Mean, region->deltaE00P95, region->flipMean})
                 out += "," + csvNumber(v);
         }
         for (const BandScores& band : record.bands) {
             out += "," + std::to_string(band.pixels);
-            for (double v : {band.fractionOfImage, band.fractionOfSkin, band.deltaE00Mean, band.deltaE00P95, band.excess,
-                             band.leakEnergy})
+            for (double v : {band.fractionOfImage, band.fractionOfSkin, band.deltaE00Mean, band.deltaE00P95, band.flipMean,
+                             band.excess, band.leakEnergy})
                 out += "," + csvNumber(v);
         }
-        out += "," + csvText(record.heatmap) + "\n";
+        out += "," + csvText(record.heatmap) + "," + csvText(record.flipHeatmap) + "," +
+               (record.bandsMeasured ? "1" : "0") + "\n";
     }
     return out;
 }
@@ -103,9 +107,11 @@ nlohmann::json metricsJson(const std::vector<ComparisonRecord>& records, const R
             {"support_radius_world", record.geometry.supportRadiusWorld},
             {"f_px", record.geometry.focalLengthPixels},
             {"image", regionJson(record.image)},
-            {"skin", regionJson(record.skin)},
-            {"bands", bands},
+            {"bands_measured", record.bandsMeasured},
+            {"skin", record.bandsMeasured ? regionJson(record.skin) : nlohmann::json()},
+            {"bands", record.bandsMeasured ? bands : nlohmann::json()},
             {"heatmap", record.heatmap.empty() ? nlohmann::json() : nlohmann::json(record.heatmap)},
+            {"flip_heatmap", record.flipHeatmap.empty() ? nlohmann::json() : nlohmann::json(record.flipHeatmap)},
         });
     }
     return {{"format", "skinlab-metrics"},
@@ -116,7 +122,11 @@ nlohmann::json metricsJson(const std::vector<ComparisonRecord>& records, const R
               {"display_encoding", displayEncodingDescription},
               {"skin_mask_threshold", 0.5},
               {"percentile", "p95 with linear interpolation between order statistics"},
-              {"heatmap_max_delta_e00", settings.heatmapMax}}},
+              {"heatmap_max_delta_e00", settings.heatmapMax},
+              {"flip", {{"variant", "LDR-FLIP (Andersson et al. 2020)"},
+                        {"pixels_per_degree", settings.pixelsPerDegree},
+                        {"input", "linear RGB x exposure, clamped to [0,1]"}}},
+              {"encoding", imageEncodingName(settings.encoding)}}},
             {"blocks_without_reference", blocksWithoutReference},
             {"comparisons", comparisons}};
 }

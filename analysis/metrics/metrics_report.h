@@ -23,11 +23,15 @@ struct ComparisonRecord {
     RegionScores skin;
     std::array<BandScores, 4> bands;
     std::string heatmap;  // path relative to the output folder; "" when heat maps are off
+    std::string flipHeatmap;  // the FLIP map, likewise
+    bool bandsMeasured = true;  // false: plain reference, skin and band scores undefined (null / empty cells)
 };
 
 struct ReportSettings {
     double exposure = 1.0;
     double heatmapMax = 10.0;
+    double pixelsPerDegree = flipDefaultPixelsPerDegree;
+    ImageEncoding encoding = ImageEncoding::automatic;
 };
 
 // CSV with a header row; NaN (undefined: empty band, no skin) is an empty cell, +inf (PSNR of identical

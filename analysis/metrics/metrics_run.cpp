@@ -5,6 +5,7 @@
 #include "common/files.h"
 
 #include <cmath>
+#include <limits>
 #include <map>
 #include <memory>
 
@@ -12,6 +13,9 @@
 
 namespace skinlab::metrics {
 namespace fs = std::filesystem;
+namespace {
+constexpr double notANumber = std::numeric_limits<double>::quiet_NaN();
+}
 
 std::vector<ComparisonRecord> runMetrics(const ComparisonPlan& plan, const MetricsRunOptions& options,
                                          const fs::path& outputFolder) {
@@ -25,14 +29,21 @@ std::vector<ComparisonRecord> runMetrics(const ComparisonPlan& plan, const Metri
     for (const ComparisonJob& job : plan.jobs) {
         auto found = referenceHeaders.find(job.referencePath);
         if (found == referenceHeaders.end())
-            found = referenceHeaders.emplace(job.referencePath, inspectMetricRender(job.referencePath, RenderRole::reference))
+            found = referenceHeaders
+                        .emplace(job.referencePath,
+                                 inspectMetricRender(job.referencePath, RenderRole::reference, options.metric.encoding))
                         .first;
         const MetricRender& reference = found->second;
-        if (!options.metric.sssRadiusMillimetres && !reference.sssRadiusMillimetres)
+        if (!reference.plain && !options.metric.sssRadiusMillimetres && !reference.sssRadiusMillimetres)
             throwInput(job.referencePath.string(), "skinlab:sss_radius_mm",
                        "metadata attribute is missing (or give --sss-radius-mm)");
-        checkComparable(reference, inspectMetricRender(job.testPath, RenderRole::test));
+        checkComparable(reference, inspectMetricRender(job.testPath, RenderRole::test, options.metric.encoding));
     }
+    for (const auto& [path, reference] : referenceHeaders)
+        if (reference.plain)
+            spdlog::info("metrics: {} is a plain image (no depth.Z, mask.Y or skinlab metadata, read as {}): skin and "
+                         "band metrics (halo, bleed, spill, interior) skipped",
+                         path.string(), imageEncodingName(reference.encoding));
 
     // 2. Compare, one reference prepared once for all its tests.
     ensureDirectory(outputFolder);
@@ -43,20 +54,23 @@ std::vector<ComparisonRecord> runMetrics(const ComparisonPlan& plan, const Metri
         if (found == prepared.end()) {
             prepared.clear();  // jobs are grouped by reference; keep one in memory at a time
             auto reference = std::make_shared<const PreparedReference>(
-                prepareReference(loadMetricRender(job.referencePath, RenderRole::reference), options.metric));
+                prepareReference(loadMetricRender(job.referencePath, RenderRole::reference, options.metric.encoding),
+                                 options.metric));
             found = prepared.emplace(job.referencePath, reference).first;
         }
         const PreparedReference& reference = *found->second;
         spdlog::info("metrics: {} vs {}", job.testName, job.referenceName);
         ComparisonResult result =
-            compareWithReference(reference, loadMetricRender(job.testPath, RenderRole::test), options.metric);
+            compareWithReference(reference, loadMetricRender(job.testPath, RenderRole::test, options.metric.encoding),
+                                 options.metric);
 
         ComparisonRecord record;
         record.job = job;
         record.width = reference.render.width;
         record.height = reference.render.height;
         record.sssRadiusMillimetres = reference.sssRadiusMillimetres;
-        record.millimetresPerUnit = *reference.render.millimetresPerUnit;
+        record.millimetresPerUnit = reference.render.millimetresPerUnit.value_or(notANumber);
+        record.bandsMeasured = result.bandsMeasured;
         record.geometry = reference.geometry;
         record.image = result.image;
         record.skin = result.skin;
@@ -64,13 +78,16 @@ std::vector<ComparisonRecord> runMetrics(const ComparisonPlan& plan, const Metri
         if (options.heatmaps) {
             record.heatmap = "heatmaps/" + job.testName + ".png";
             writeErrorHeatmap(outputFolder / record.heatmap, result.deltaE00, reference.bands, options.heatmapMax);
+            record.flipHeatmap = "heatmaps/" + job.testName + ".flip.png";
+            writeFlipHeatmap(outputFolder / record.flipHeatmap, result.flip);
         }
         records.push_back(std::move(record));
     }
 
     // 3. Tables last.
     writeFileAtomic(outputFolder / "metrics.csv", metricsCsv(records));
-    ReportSettings settings{options.metric.exposure, options.heatmapMax};
+    ReportSettings settings{options.metric.exposure, options.heatmapMax, options.metric.pixelsPerDegree,
+                            options.metric.encoding};
     writeFileAtomic(outputFolder / "metrics.json", metricsJson(records, settings, plan.blocksWithoutReference).dump(2) + "\n");
     return records;
 }

@@ -107,11 +107,24 @@ void validateMetricOptions(const MetricOptions& options) {
     if (options.sssRadiusMillimetres &&
         (!(*options.sssRadiusMillimetres > 0.0) || !std::isfinite(*options.sssRadiusMillimetres)))
         throwInput("--sss-radius-mm", "", formatNumber(*options.sssRadiusMillimetres) + " must be a positive number");
+    if (!(options.pixelsPerDegree > 0.0) || !std::isfinite(options.pixelsPerDegree))
+        throwInput("--ppd", "", formatNumber(options.pixelsPerDegree) + " must be a positive number");
 }
 
 PreparedReference prepareReference(MetricRender reference, const MetricOptions& options) {
     const std::string file = reference.path.string();
     validateMetricOptions(options);
+    if (reference.plain) {
+        PreparedReference prepared;
+        for (cv::Mat& mask : prepared.bands.masks) mask = cv::Mat::zeros(reference.height, reference.width, CV_8UC1);
+        prepared.bands.skin = cv::Mat::zeros(reference.height, reference.width, CV_8UC1);
+        EncodedImage encoded = encode(reference.beauty, options.exposure);
+        prepared.lab = std::move(encoded.lab);
+        prepared.luminance = std::move(encoded.luminance);
+        prepared.display = std::move(encoded.display);
+        prepared.render = std::move(reference);
+        return prepared;
+    }
     if (reference.depth.empty() || reference.mask.empty() || !reference.focalLengthPixels ||
         !reference.millimetresPerUnit)
         throw std::logic_error("prepareReference(): " + file + " was not loaded as a reference");
@@ -174,6 +187,7 @@ ComparisonResult compareWithReference(const PreparedReference& reference, const 
     }
 
     cv::Mat ssimMap = structuralSimilarityMap(reference.display, encoded.display);
+    result.flip = flipErrorMap(ref.beauty, test.beauty, options.pixelsPerDegree, options.exposure);
     const cv::Mat& skin = reference.bands.skin;
     const auto totalPixels = static_cast<std::size_t>(ref.width) * static_cast<std::size_t>(ref.height);
     const auto skinPixels = static_cast<std::size_t>(cv::countNonZero(skin));
@@ -186,9 +200,18 @@ ComparisonResult compareWithReference(const PreparedReference& reference, const 
         scores.ssim = structuralSimilarity(ssimMap, mask);
         scores.deltaE00Mean = mean(values);
         scores.deltaE00P95 = percentile95(std::move(values));
+        scores.flipMean = flipMean(result.flip, mask);
         return scores;
     };
     result.image = regionScores(cv::Mat());
+    if (ref.plain) {
+        // No skin mask and no depth: the skin region and the bands are undefined.
+        result.bandsMeasured = false;
+        result.skin = {0, notANumber, notANumber, notANumber, notANumber, notANumber};
+        for (auto& scores : result.bands)
+            scores = {0, notANumber, notANumber, notANumber, notANumber, notANumber, notANumber, notANumber};
+        return result;
+    }
     result.skin = regionScores(skin);
 
     for (Band band : allBands) {
@@ -201,6 +224,7 @@ ComparisonResult compareWithReference(const PreparedReference& reference, const 
             skinPixels ? static_cast<double>(scores.pixels) / static_cast<double>(skinPixels) : notANumber;
         scores.deltaE00Mean = mean(values);
         scores.deltaE00P95 = percentile95(std::move(values));
+        scores.flipMean = flipMean(result.flip, mask);
         double leakSum = maskedSum(absoluteLuminance, mask);
         scores.leakEnergy = reference.skinLuminanceSum > 0.0 ? leakSum / reference.skinLuminanceSum : notANumber;
     }

@@ -2,6 +2,7 @@
 // One comparison of a test render with a reference: per-pixel ΔE00, global and skin PSNR/SSIM/ΔE00, and the
 // band scores (docs/metrics.md lists every field).
 #include "analysis/metrics/error_bands.h"
+#include "analysis/metrics/flip.h"
 #include "analysis/metrics/metric_render.h"
 
 #include <array>
@@ -18,9 +19,14 @@ struct MetricOptions {
     double exposure = 1.0;
     // Overrides the reference's skinlab:sss_radius_mm (millimetres) when set.
     std::optional<double> sssRadiusMillimetres;
+    // Viewing set-up of FLIP: pixels per degree of visual angle (default: the paper's 67.0206).
+    double pixelsPerDegree = flipDefaultPixelsPerDegree;
+    // How 8/16-bit and EXR inputs are decoded to linear RGB (plain images; skinlab renders are linear EXRs).
+    ImageEncoding encoding = ImageEncoding::automatic;
 };
 
-// The reference with everything that does not depend on the test render computed once.
+// The reference with everything that does not depend on the test render computed once. For a plain reference
+// (render.plain) `bands` holds empty masks and `skinLuminanceSum` is 0: only the image-wide scores are defined.
 struct PreparedReference {
     MetricRender render;
     BandGeometry geometry;
@@ -35,7 +41,7 @@ struct PreparedReference {
 // Throws InputError "--exposure: V must be a positive number" (or --sss-radius-mm) for a bad option.
 void validateMetricOptions(const MetricOptions& options);
 
-// Requires a render loaded with RenderRole::reference. Throws InputError for a non-positive exposure or radius.
+// Requires a render loaded with RenderRole::reference (a skinlab render or a plain image). Throws InputError for a non-positive exposure or radius.
 PreparedReference prepareReference(MetricRender reference, const MetricOptions& options);
 
 struct RegionScores {
@@ -44,6 +50,7 @@ struct RegionScores {
     double ssim = 0.0;           // mean SSIM over the region
     double deltaE00Mean = 0.0;
     double deltaE00P95 = 0.0;    // 95th percentile, linear interpolation between order statistics
+    double flipMean = 0.0;       // mean LDR-FLIP over the region (pooled in double)
 };
 
 struct BandScores {
@@ -52,15 +59,18 @@ struct BandScores {
     double fractionOfSkin = 0.0;  // band pixels / skin pixels (NaN without skin)
     double deltaE00Mean = 0.0;    // NaN for an empty band
     double deltaE00P95 = 0.0;     // NaN for an empty band
+    double flipMean = 0.0;        // mean LDR-FLIP over the band; NaN for an empty band
     double excess = 0.0;          // band mean − interior mean; NaN if either is empty
     double leakEnergy = 0.0;      // Σ_band |Y_T − Y_R| / Σ_skin Y_R; NaN without skin luminance
 };
 
 struct ComparisonResult {
+    bool bandsMeasured = true;        // false for a plain reference: `skin` and `bands` are all NaN (0 pixels)
     RegionScores image;
     RegionScores skin;
     std::array<BandScores, 4> bands;  // indexed by Band
     cv::Mat deltaE00;                 // CV_32FC1 per-pixel ΔE00
+    cv::Mat flip;                     // CV_64FC1 per-pixel LDR-FLIP
     const BandScores& band(Band b) const { return bands[static_cast<std::size_t>(b)]; }
 };
 

@@ -349,7 +349,7 @@ bool needsHead(const std::string& file) { return file.rfind("thesis-", 0) == 0 |
 TEST(ShippedSpecs, ExpandToTheDocumentedCounts) {
     const fs::path dir = fs::path(SKINLAB_SOURCE_DIR) / "stimuli" / "specs";
     const std::vector<std::pair<std::string, size_t>> expected = {
-        {"demo.toml", 17},
+        {"demo.toml", 19},
         {"thesis-fig5.2-methods.toml", 18},
         {"thesis-fig3.16-halos.toml", 7},
         {"thesis-fig3.17-bleeding.toml", 7},
@@ -381,7 +381,7 @@ TEST(ShippedSpecs, ExpandToTheDocumentedCounts) {
     }
     std::vector<Stimulus> demo = expand(readSetSpec(dir / "demo.toml"));
     EXPECT_EQ(demo.front().id, "head-close-none");
-    EXPECT_EQ(demo.back().id, "head-mid-gaussian-sum-no-follow_surface");
+    EXPECT_EQ(demo.back().id, "head-mid-reference-reference_edge_mm-2.0");  // the references come last
 }
 
 // Every stimulus of every shipped spec resolves against the renderer's scene reader (methods, extension switches

@@ -2,6 +2,7 @@
 // Synthetic renders (disc scene, contract-1 EXR with beauty, depth.Z, mask.Y) so the benchmark needs no GL.
 // Run: build/<dir>/tests/analysis/metrics/bench_metrics --benchmark_repetitions=5
 #include "analysis/metrics/error_bands.h"
+#include "analysis/metrics/flip.h"
 #include "analysis/metrics/metrics_run.h"
 #include "analysis/metrics/render_comparison.h"
 
@@ -82,6 +83,17 @@ void compareOneTest(benchmark::State& state) {
     }
 }
 
+// LDR-FLIP alone on the 1280×720 pair (both images through the CSF and feature filters, the per-pixel map, the
+// mean), at the paper's 67.02 pixels per degree.
+void flipOnePair(benchmark::State& state) {
+    MetricRender reference = loadMetricRender(fixture().referencePath, RenderRole::reference);
+    MetricRender test = loadMetricRender(fixture().testPath, RenderRole::test);
+    for (auto _ : state) {
+        cv::Mat map = flipErrorMap(reference.beauty, test.beauty, flipDefaultPixelsPerDegree);
+        benchmark::DoNotOptimize(flipMean(map));
+    }
+}
+
 // The whole command for one pair: read, prepare, compare, heat map PNG, CSV and JSON.
 void wholeCommand(benchmark::State& state) {
     ComparisonPlan plan = planFileComparisons(fixture().referencePath, {fixture().testPath});
@@ -92,6 +104,7 @@ BENCHMARK(loadPair)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(buildBands)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(prepareTheReference)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(compareOneTest)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(flipOnePair)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(wholeCommand)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 } // namespace

@@ -188,3 +188,26 @@ TEST_F(MetricsRun, RepeatedTestNamesAreRejected) {
 
 } // namespace
 } // namespace skinlab::metrics
+
+namespace skinlab::metrics {
+namespace {
+// A render without SSS (method "none") stores skinlab:sss_radius_mm = 0; as a test render its radius is never
+// used, so it is compared like any other.
+TEST(MetricsRunTestRender, ZeroRadiusOfATestRenderIsIgnored) {
+    fs::path folder = fs::temp_directory_path() / ("skinlab-metrics-zero-radius-" + std::to_string(::getpid()));
+    fs::remove_all(folder);
+    fs::create_directories(folder);
+    testing::DiscScene scene;
+    scene.size = 48;
+    SyntheticRender reference = testing::renderDiscScene(scene);
+    SyntheticRender none = reference;
+    none.sssRadiusMillimetres = 0.0f;
+    testing::writeSyntheticExr(folder / "ref.exr", reference);
+    testing::writeSyntheticExr(folder / "none.exr", none);
+    auto records = runMetrics(planFileComparisons(folder / "ref.exr", {folder / "none.exr"}), {}, folder / "out");
+    ASSERT_EQ(records.size(), 1u);
+    EXPECT_EQ(records[0].image.flipMean, 0.0);
+    fs::remove_all(folder);
+}
+} // namespace
+} // namespace skinlab::metrics

@@ -1,0 +1,298 @@
+#include "analysis/agreement/metric_agreement.h"
+
+#include "analysis/scaling/bootstrap.h"
+#include "common/error.h"
+#include "common/version.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numeric>
+#include <random>
+
+namespace skinlab::analysis::agreement {
+namespace {
+
+constexpr double notANumber = std::numeric_limits<double>::quiet_NaN();
+
+nlohmann::json jsonNumber(double value) { return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(); }
+
+std::string csvNumber(double value) {
+    if (!std::isfinite(value)) return "";
+    char text[40];
+    std::snprintf(text, sizeof text, "%.9g", value);
+    return text;
+}
+
+std::string csvText(const std::string& text) {
+    if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
+    std::string quoted = "\"";
+    for (char c : text) {
+        if (c == '"') quoted += '"';
+        quoted += c;
+    }
+    return quoted + "\"";
+}
+
+std::vector<double> ranks(const std::vector<double>& values) {
+    std::vector<std::size_t> order(values.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return values[a] < values[b]; });
+    std::vector<double> rank(values.size());
+    for (std::size_t i = 0; i < order.size();) {
+        std::size_t j = i;
+        while (j + 1 < order.size() && values[order[j + 1]] == values[order[i]]) ++j;
+        double mean = 0.5 * static_cast<double>(i + j) + 1.0;
+        for (std::size_t k = i; k <= j; ++k) rank[order[k]] = mean;
+        i = j + 1;
+    }
+    return rank;
+}
+
+// A value found by a dotted path in a comparison object ("bands.halo.flip_mean"); NaN for null or absent.
+double lookUp(const nlohmann::json& object, const std::string& key) {
+    const nlohmann::json* node = &object;
+    std::size_t start = 0;
+    while (true) {
+        std::size_t dot = key.find('.', start);
+        std::string part = key.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
+        if (!node->is_object() || !node->contains(part)) return notANumber;
+        node = &(*node)[part];
+        if (dot == std::string::npos) break;
+        start = dot + 1;
+    }
+    return node->is_number() ? node->get<double>() : notANumber;
+}
+
+} // namespace
+
+const std::vector<MetricDefinition>& metricDefinitions() {
+    static const std::vector<MetricDefinition> definitions = [] {
+        std::vector<MetricDefinition> list;
+        for (const char* region : {"image", "skin"}) {
+            std::string r = region;
+            list.push_back({r + ".psnr_db", "PSNR (" + r + ")", true});
+            list.push_back({r + ".ssim", "SSIM (" + r + ")", true});
+            list.push_back({r + ".delta_e00_mean", "mean ΔE00 (" + r + ")", false});
+            list.push_back({r + ".delta_e00_p95", "p95 ΔE00 (" + r + ")", false});
+            list.push_back({r + ".flip_mean", "mean FLIP (" + r + ")", false});
+        }
+        for (const char* band : {"halo", "bleed", "spill", "interior"}) {
+            std::string b = band;
+            list.push_back({"bands." + b + ".delta_e00_mean", "mean ΔE00 (" + b + ")", false});
+            list.push_back({"bands." + b + ".flip_mean", "mean FLIP (" + b + ")", false});
+            if (b != "interior") list.push_back({"bands." + b + ".leak_energy", "leak energy (" + b + ")", false});
+        }
+        return list;
+    }();
+    return definitions;
+}
+
+std::vector<ConditionMetrics> conditionMetricsFromJson(
+    const nlohmann::json& metrics, const std::string& file,
+    const std::map<std::string, std::pair<std::string, std::string>>& conditionOfStimulus) {
+    if (!metrics.is_object() || metrics.value("format", "") != "skinlab-metrics" || !metrics.contains("comparisons") ||
+        !metrics["comparisons"].is_array())
+        throwInput(file, "format", "not a metrics.json written by `skinlab analyze metrics`");
+    std::vector<ConditionMetrics> out;
+    for (const nlohmann::json& comparison : metrics["comparisons"]) {
+        if (!comparison.contains("test") || !comparison["test"].contains("name")) continue;
+        std::string name = comparison["test"]["name"].get<std::string>();
+        auto found = conditionOfStimulus.find(name);
+        if (found == conditionOfStimulus.end()) continue;
+        ConditionMetrics row{found->second.first, found->second.second, name, {}};
+        for (const MetricDefinition& metric : metricDefinitions()) row.values[metric.key] = lookUp(comparison, metric.key);
+        out.push_back(std::move(row));
+    }
+    return out;
+}
+
+double pearsonCorrelation(const std::vector<double>& x, const std::vector<double>& y) {
+    const std::size_t n = x.size();
+    if (n < 3 || y.size() != n) return notANumber;
+    double mx = std::accumulate(x.begin(), x.end(), 0.0) / double(n);
+    double my = std::accumulate(y.begin(), y.end(), 0.0) / double(n);
+    double sxy = 0.0, sxx = 0.0, syy = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+        sxy += (x[i] - mx) * (y[i] - my);
+        sxx += (x[i] - mx) * (x[i] - mx);
+        syy += (y[i] - my) * (y[i] - my);
+    }
+    if (!(sxx > 0.0) || !(syy > 0.0)) return notANumber;
+    return std::clamp(sxy / std::sqrt(sxx * syy), -1.0, 1.0);
+}
+
+double spearmanCorrelation(const std::vector<double>& x, const std::vector<double>& y) {
+    if (x.size() < 3 || y.size() != x.size()) return notANumber;
+    return pearsonCorrelation(ranks(x), ranks(y));
+}
+
+AgreementResult computeAgreement(const scaling::Dataset& dataset, const scaling::Analysis& analysis,
+                                 const std::vector<ConditionMetrics>& metrics, const scaling::FitOptions& fit,
+                                 const AgreementOptions& options) {
+    AgreementResult result;
+    result.options = options;
+    const auto& definitions = metricDefinitions();
+    for (const scaling::BlockAnalysis& block : analysis.blocks) {
+        auto data = std::find_if(dataset.blocks.begin(), dataset.blocks.end(),
+                                 [&](const scaling::BlockData& b) { return b.name == block.name; });
+        if (data == dataset.blocks.end()) continue;
+        const int m = static_cast<int>(block.conditions.size());
+        BlockScale scale{block.name, block.conditions, {}};
+        for (int i = 0; i < m; ++i) scale.jod.push_back(block.thurstone.scores[i]);
+        result.scales.push_back(scale);
+
+        // Metric values per condition of this block (NaN where a condition has none).
+        std::vector<const ConditionMetrics*> byCondition(static_cast<std::size_t>(m), nullptr);
+        for (const ConditionMetrics& row : metrics) {
+            if (row.block != block.name) continue;
+            auto it = std::find(block.conditions.begin(), block.conditions.end(), row.condition);
+            if (it != block.conditions.end()) byCondition[static_cast<std::size_t>(it - block.conditions.begin())] = &row;
+        }
+        int withMetrics = 0;
+        for (int i = 0; i < m; ++i) {
+            if (byCondition[static_cast<std::size_t>(i)]) ++withMetrics;
+            else if (std::any_of(metrics.begin(), metrics.end(), [&](const auto& r) { return r.block == block.name; }))
+                result.warnings.push_back(block.name + ": condition \"" + block.conditions[static_cast<std::size_t>(i)] +
+                                          "\" has no metric values (not compared with a reference)");
+        }
+        if (withMetrics == 0) {
+            result.warnings.push_back(block.name + ": no condition has metric values; no agreement computed");
+            continue;
+        }
+        auto value = [&](int condition, const std::string& key) {
+            const ConditionMetrics* row = byCondition[static_cast<std::size_t>(condition)];
+            if (!row) return notANumber;
+            auto found = row->values.find(key);
+            return found == row->values.end() ? notANumber : found->second;
+        };
+
+        // Bootstrap over observers: resample, re-fit the scale, recompute every correlation.
+        const int observers = data->observerCount();
+        std::vector<Eigen::VectorXd> resampledScores;
+        if (observers >= 2 && data->hasObservers) {
+            for (int b = 0; b < options.samples; ++b) {
+                std::mt19937_64 random(scaling::mixSeed(options.seed, static_cast<std::uint64_t>(b)));
+                std::uniform_int_distribution<int> pick(0, observers - 1);
+                Eigen::VectorXd weights = Eigen::VectorXd::Zero(observers);
+                for (int k = 0; k < observers; ++k) weights[pick(random)] += 1.0;
+                scaling::FitOptions options1 = fit;
+                options1.model = scaling::Model::Thurstone;
+                resampledScores.push_back(
+                    scaling::fitScores(data->weightedCounts(weights), options1, &block.thurstone.scores).scores);
+            }
+        }
+
+        for (const MetricDefinition& definition : definitions) {
+            MetricAgreement row;
+            row.block = block.name;
+            row.metric = definition;
+            std::vector<int> used;
+            for (int i = 0; i < m; ++i)
+                if (std::isfinite(value(i, definition.key))) used.push_back(i);
+            row.conditions = static_cast<int>(used.size());
+            std::vector<double> x, y;
+            for (int i : used) {
+                x.push_back(value(i, definition.key));
+                y.push_back(block.thurstone.scores[i]);
+            }
+            row.pearson = pearsonCorrelation(x, y);
+            row.spearman = spearmanCorrelation(x, y);
+            std::vector<double> pearsons, spearmans;
+            for (const Eigen::VectorXd& scores : resampledScores) {
+                std::vector<double> yb;
+                for (int i : used) yb.push_back(scores[i]);
+                double p = pearsonCorrelation(x, yb), s = spearmanCorrelation(x, yb);
+                if (std::isfinite(p)) pearsons.push_back(p);
+                if (std::isfinite(s)) spearmans.push_back(s);
+            }
+            row.bootstrapSamples = static_cast<int>(pearsons.size());
+            const double tail = 0.5 * (1.0 - options.level);
+            auto interval = [&](std::vector<double>& samples, double& low, double& high) {
+                if (samples.size() < 2 || !std::isfinite(row.pearson)) {
+                    low = high = notANumber;
+                    return;
+                }
+                std::sort(samples.begin(), samples.end());
+                low = scaling::sortedQuantile(samples, tail);
+                high = scaling::sortedQuantile(samples, 1.0 - tail);
+            };
+            interval(pearsons, row.pearsonLow, row.pearsonHigh);
+            interval(spearmans, row.spearmanLow, row.spearmanHigh);
+            if (!std::isfinite(row.spearman)) row.spearmanLow = row.spearmanHigh = notANumber;
+
+            // Pairs the observers separated significantly: does the metric order them the same way?
+            for (const scaling::PairTest& pair : block.pairs) {
+                if (!pair.significant) continue;
+                int i = pair.test.first, j = pair.test.second;
+                double vi = value(i, definition.key), vj = value(j, definition.key);
+                if (!std::isfinite(vi) || !std::isfinite(vj)) continue;
+                ++row.significantPairs;
+                double perceived = block.thurstone.scores[i] - block.thurstone.scores[j];
+                double predicted = (definition.higherIsBetter ? 1.0 : -1.0) * (vi - vj);
+                if (predicted != 0.0 && (predicted > 0.0) == (perceived > 0.0)) ++row.predictedPairs;
+            }
+            row.predictedShare =
+                row.significantPairs ? double(row.predictedPairs) / double(row.significantPairs) : notANumber;
+            result.rows.push_back(row);
+        }
+    }
+    return result;
+}
+
+nlohmann::json agreementJson(const AgreementResult& result) {
+    nlohmann::json scales = nlohmann::json::array();
+    for (const BlockScale& scale : result.scales) {
+        nlohmann::json jod = nlohmann::json::object();
+        for (std::size_t i = 0; i < scale.conditions.size(); ++i) jod[scale.conditions[i]] = scale.jod[i];
+        scales.push_back({{"block", scale.block}, {"jod", jod}});
+    }
+    nlohmann::json rows = nlohmann::json::array();
+    for (const MetricAgreement& row : result.rows)
+        rows.push_back({{"block", row.block},
+                        {"metric", row.metric.key},
+                        {"label", row.metric.label},
+                        {"higher_is_better", row.metric.higherIsBetter},
+                        {"conditions", row.conditions},
+                        {"pearson", jsonNumber(row.pearson)},
+                        {"pearson_low", jsonNumber(row.pearsonLow)},
+                        {"pearson_high", jsonNumber(row.pearsonHigh)},
+                        {"spearman", jsonNumber(row.spearman)},
+                        {"spearman_low", jsonNumber(row.spearmanLow)},
+                        {"spearman_high", jsonNumber(row.spearmanHigh)},
+                        {"significant_pairs", row.significantPairs},
+                        {"predicted_pairs", row.predictedPairs},
+                        {"predicted_share", jsonNumber(row.predictedShare)},
+                        {"bootstrap_samples", row.bootstrapSamples}});
+    return {{"format", "skinlab-agreement"},
+            {"version", 1},
+            {"skinlab_version", version()},
+            {"settings",
+             {{"bootstrap_samples", result.options.samples},
+              {"seed", result.options.seed},
+              {"level", result.options.level},
+              {"interval", "percentile, observers resampled with replacement, Thurstone scale re-fitted per resample"},
+              {"correlation_sign", "raw: metric against JOD (an error metric that agrees with observers correlates "
+                                   "negatively)"},
+              {"pairs", "pairs significant in the scale analysis; a tie in the metric counts as not predicted"}}},
+            {"scales", scales},
+            {"agreement", rows},
+            {"warnings", result.warnings}};
+}
+
+std::string agreementCsv(const AgreementResult& result) {
+    std::string out = "block,metric,higher_is_better,conditions,pearson,pearson_low,pearson_high,spearman,spearman_low,"
+                      "spearman_high,significant_pairs,predicted_pairs,predicted_share\n";
+    for (const MetricAgreement& row : result.rows) {
+        out += csvText(row.block) + "," + row.metric.key + "," + (row.metric.higherIsBetter ? "1" : "0") + "," +
+               std::to_string(row.conditions);
+        for (double v : {row.pearson, row.pearsonLow, row.pearsonHigh, row.spearman, row.spearmanLow, row.spearmanHigh})
+            out += "," + csvNumber(v);
+        out += "," + std::to_string(row.significantPairs) + "," + std::to_string(row.predictedPairs) + "," +
+               csvNumber(row.predictedShare) + "\n";
+    }
+    return out;
+}
+
+} // namespace skinlab::analysis::agreement

@@ -1,0 +1,87 @@
+#pragma once
+// Image metrics against perception (docs/metrics.md, "Metrics against perception"): for each block of a study
+// whose stimuli were scored against a reference, the Pearson and Spearman correlations between every metric and
+// the JOD scale across the block's conditions, with percentile intervals from a bootstrap over observers (each
+// resample re-fits the scale), and the share of the pairs that observers separated significantly whose order the
+// metric predicts.
+#include "analysis/scaling/scale_analysis.h"
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace skinlab::analysis::agreement {
+
+// A metric as `analyze metrics` writes it: the JSON path inside one comparison ("image.flip_mean",
+// "bands.halo.delta_e00_mean"), and whether a larger value means closer to the reference.
+struct MetricDefinition {
+    std::string key;
+    std::string label;
+    bool higherIsBetter = false;
+};
+const std::vector<MetricDefinition>& metricDefinitions();
+
+// The metric values of one condition of one block (NaN where undefined).
+struct ConditionMetrics {
+    std::string block;
+    std::string condition;
+    std::string stimulus;
+    std::map<std::string, double> values;  // by MetricDefinition::key
+};
+
+// Reads the comparisons of a metrics.json (format "skinlab-metrics"), keeping those whose test name is a key of
+// `conditionOfStimulus` (stimulus id → (block, condition)). Throws InputError naming `file` for a file that is
+// not a metrics.json.
+std::vector<ConditionMetrics> conditionMetricsFromJson(
+    const nlohmann::json& metrics, const std::string& file,
+    const std::map<std::string, std::pair<std::string, std::string>>& conditionOfStimulus);
+
+struct AgreementOptions {
+    int samples = 1000;      // bootstrap resamples of the observers
+    std::uint64_t seed = 1;
+    double level = 0.95;     // two-sided percentile interval
+};
+
+struct MetricAgreement {
+    std::string block;
+    MetricDefinition metric;
+    int conditions = 0;            // conditions with a finite value of the metric (and a JOD score)
+    double pearson = 0.0, pearsonLow = 0.0, pearsonHigh = 0.0;     // metric vs JOD; NaN when undefined
+    double spearman = 0.0, spearmanLow = 0.0, spearmanHigh = 0.0;
+    int significantPairs = 0;      // pairs of these conditions separated significantly (scale analysis)
+    int predictedPairs = 0;        // of them, pairs the metric orders as the observers did (ties: not predicted)
+    double predictedShare = 0.0;   // predicted / significant; NaN without a significant pair
+    int bootstrapSamples = 0;      // resamples with a defined correlation
+};
+
+struct BlockScale {
+    std::string block;
+    std::vector<std::string> conditions;
+    std::vector<double> jod;  // per condition
+};
+
+struct AgreementResult {
+    AgreementOptions options;
+    std::vector<BlockScale> scales;
+    std::vector<MetricAgreement> rows;  // per block, per metric in metricDefinitions() order
+    std::vector<std::string> warnings;
+};
+
+// `analysis` must come from analyzeDataset(dataset, ...) with `fit`; conditions of a block without metric values
+// are left out of that block's correlations (with a warning).
+AgreementResult computeAgreement(const scaling::Dataset& dataset, const scaling::Analysis& analysis,
+                                 const std::vector<ConditionMetrics>& metrics, const scaling::FitOptions& fit,
+                                 const AgreementOptions& options);
+
+// Pearson correlation; NaN for fewer than 3 values or a constant variable.
+double pearsonCorrelation(const std::vector<double>& x, const std::vector<double>& y);
+// Spearman's ρ: Pearson of the ranks, ties sharing their mean rank.
+double spearmanCorrelation(const std::vector<double>& x, const std::vector<double>& y);
+
+nlohmann::json agreementJson(const AgreementResult& result);  // format "skinlab-agreement", version 1
+std::string agreementCsv(const AgreementResult& result);      // one row per block and metric
+
+} // namespace skinlab::analysis::agreement

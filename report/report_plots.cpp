@@ -1,0 +1,158 @@
+#include "report/report_plots.h"
+
+#include "common/html.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace skinlab::report {
+namespace {
+
+std::string px(double value) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.1f", value);
+    return text;
+}
+
+struct Range {
+    double low = 0.0, high = 1.0;
+    double map(double v, double from, double to) const { return from + (v - low) / (high - low) * (to - from); }
+};
+
+// Range of the finite values, padded; at least `minimumSpan` wide.
+Range rangeOf(const std::vector<double>& values, double pad, double minimumSpan) {
+    Range range{INFINITY, -INFINITY};
+    for (double v : values)
+        if (std::isfinite(v)) {
+            range.low = std::min(range.low, v);
+            range.high = std::max(range.high, v);
+        }
+    if (!std::isfinite(range.low)) return {0.0, 1.0};
+    double span = std::max(range.high - range.low, minimumSpan);
+    double centre = 0.5 * (range.low + range.high);
+    return {centre - 0.5 * span - pad * span, centre + 0.5 * span + pad * span};
+}
+
+// Up to ~6 round tick values inside the range.
+std::vector<double> ticks(const Range& range) {
+    double span = range.high - range.low;
+    double step = std::pow(10.0, std::floor(std::log10(span / 5.0)));
+    for (double factor : {1.0, 2.0, 5.0, 10.0})
+        if (span / (step * factor) <= 6.0) {
+            step *= factor;
+            break;
+        }
+    std::vector<double> out;
+    for (double t = std::ceil(range.low / step) * step; t <= range.high + 1e-12 && out.size() < 12; t += step)
+        out.push_back(std::fabs(t) < 1e-12 * step ? 0.0 : t);
+    return out;
+}
+
+std::string tickLabel(double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", v);
+    std::string s = text;
+    if (!s.empty() && s[0] == '-') s = "\u2212" + s.substr(1);
+    return s;
+}
+
+} // namespace
+
+std::string formatNumber(double value, int digits) {
+    if (!std::isfinite(value)) return "\u2014";
+    char text[48];
+    std::snprintf(text, sizeof text, "%.*f", digits, value);
+    std::string s = text;
+    if (s.rfind("-", 0) == 0) {
+        // "-0.00" is zero.
+        bool zero = s.find_first_not_of("-0.") == std::string::npos;
+        s = zero ? s.substr(1) : "\u2212" + s.substr(1);
+    }
+    return s;
+}
+
+std::string scaleSvg(const std::vector<IntervalPoint>& points) {
+    const double left = 150.0, right = 620.0, rowHeight = 26.0, top = 20.0;
+    const double height = top + rowHeight * static_cast<double>(points.size()) + 36.0;
+    std::vector<double> values;
+    for (const auto& p : points) values.push_back(p.value);
+    // The axis spans the estimates with 1.5 JOD to spare on each side; longer bars are clipped (arrow).
+    Range range = rangeOf(values, 0.0, 1.0);
+    range.low -= 1.5;
+    range.high += 1.5;
+    std::string svg = "<svg class=\"plot\" xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"0 0 640 " + px(height) +
+                      "\" width=\"640\" height=\"" + px(height) + "\" role=\"img\">";
+    const double axisY = top + rowHeight * static_cast<double>(points.size()) + 4.0;
+    for (double t : ticks(range)) {
+        double x = range.map(t, left, right);
+        svg += "<line x1=\"" + px(x) + "\" y1=\"" + px(top - 6) + "\" x2=\"" + px(x) + "\" y2=\"" + px(axisY) +
+               "\" class=\"grid\"/><text x=\"" + px(x) + "\" y=\"" + px(axisY + 16) + "\" class=\"tick\">" +
+               tickLabel(t) + "</text>";
+    }
+    svg += "<text x=\"" + px(0.5 * (left + right)) + "\" y=\"" + px(axisY + 32) + "\" class=\"axis\">JOD</text>";
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        const IntervalPoint& p = points[i];
+        double y = top + rowHeight * (static_cast<double>(i) + 0.5);
+        svg += "<text x=\"" + px(left - 8) + "\" y=\"" + px(y + 4) + "\" class=\"label\">" + escapeHtml(p.label) + "</text>";
+        if (!std::isfinite(p.value)) continue;
+        double low = std::isfinite(p.low) ? p.low : range.low - 1.0;
+        double high = std::isfinite(p.high) ? p.high : range.high + 1.0;
+        bool clippedLow = low < range.low, clippedHigh = high > range.high;
+        double x0 = range.map(std::max(low, range.low), left, right);
+        double x1 = range.map(std::min(high, range.high), left, right);
+        double xv = range.map(p.value, left, right);
+        svg += "<line x1=\"" + px(x0) + "\" y1=\"" + px(y) + "\" x2=\"" + px(x1) + "\" y2=\"" + px(y) + "\" class=\"bar\"/>";
+        if (clippedLow)
+            svg += "<path d=\"M" + px(x0) + " " + px(y) + " l8 -5 v10 z\" class=\"clip\"><title>interval continues to " +
+                   formatNumber(p.low, 2) + "</title></path>";
+        if (clippedHigh)
+            svg += "<path d=\"M" + px(x1) + " " + px(y) + " l-8 -5 v10 z\" class=\"clip\"><title>interval continues to " +
+                   formatNumber(p.high, 2) + "</title></path>";
+        svg += "<circle cx=\"" + px(xv) + "\" cy=\"" + px(y) + "\" r=\"4.5\" class=\"dot\"/>";
+    }
+    return svg + "</svg>";
+}
+
+std::string scatterSvg(const std::vector<ScatterPoint>& points, const std::string& xLabel) {
+    const double left = 52.0, right = 330.0, top = 14.0, bottom = 212.0;
+    std::vector<double> xs, ys;
+    for (const auto& p : points) {
+        xs.push_back(p.x);
+        ys.push_back(p.y);
+    }
+    Range rx = rangeOf(xs, 0.08, 1e-6);
+    Range ry = rangeOf(ys, 0.15, 1.0);
+    std::string svg = "<svg class=\"plot scatter\" xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"0 0 350 256\" "
+                      "width=\"350\" height=\"256\" role=\"img\">";
+    for (double t : ticks(rx)) {
+        double x = rx.map(t, left, right);
+        svg += "<line x1=\"" + px(x) + "\" y1=\"" + px(top) + "\" x2=\"" + px(x) + "\" y2=\"" + px(bottom) +
+               "\" class=\"grid\"/><text x=\"" + px(x) + "\" y=\"" + px(bottom + 14) + "\" class=\"tick\">" +
+               tickLabel(t) + "</text>";
+    }
+    for (double t : ticks(ry)) {
+        double y = ry.map(t, bottom, top);
+        svg += "<line x1=\"" + px(left) + "\" y1=\"" + px(y) + "\" x2=\"" + px(right) + "\" y2=\"" + px(y) +
+               "\" class=\"grid\"/><text x=\"" + px(left - 6) + "\" y=\"" + px(y + 4) + "\" class=\"tick ytick\">" +
+               tickLabel(t) + "</text>";
+    }
+    svg += "<text x=\"" + px(0.5 * (left + right)) + "\" y=\"250\" class=\"axis\">" + escapeHtml(xLabel) + "</text>";
+    svg += "<text x=\"12\" y=\"" + px(0.5 * (top + bottom)) + "\" class=\"axis\" transform=\"rotate(-90 12 " +
+           px(0.5 * (top + bottom)) + ")\">JOD</text>";
+    for (const auto& p : points) {
+        if (!std::isfinite(p.x) || !std::isfinite(p.y)) continue;
+        double x = rx.map(p.x, left, right);
+        double lowValue = std::isfinite(p.low) ? std::max(p.low, ry.low) : ry.low;
+        double highValue = std::isfinite(p.high) ? std::min(p.high, ry.high) : ry.high;
+        svg += "<line x1=\"" + px(x) + "\" y1=\"" + px(ry.map(lowValue, bottom, top)) + "\" x2=\"" + px(x) + "\" y2=\"" +
+               px(ry.map(highValue, bottom, top)) + "\" class=\"bar\"/>";
+        double y = ry.map(p.y, bottom, top);
+        svg += "<circle cx=\"" + px(x) + "\" cy=\"" + px(y) + "\" r=\"4\" class=\"dot\"><title>" + escapeHtml(p.label) +
+               "</title></circle><text x=\"" + px(x + 6) + "\" y=\"" + px(y - 6) + "\" class=\"point\">" +
+               escapeHtml(p.label) + "</text>";
+    }
+    return svg + "</svg>";
+}
+
+} // namespace skinlab::report

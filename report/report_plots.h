@@ -1,0 +1,29 @@
+#pragma once
+// Inline SVG plots of the study report: a JOD scale with intervals and metric-versus-JOD scatter plots. Axis
+// ranges come from the point estimates, never from the size of an interval: bounds beyond the range are clipped
+// and marked with an arrow, so any input draws in bounded time.
+#include <string>
+#include <vector>
+
+namespace skinlab::report {
+
+struct IntervalPoint {
+    std::string label;
+    double value = 0.0, low = 0.0, high = 0.0;
+};
+
+// One row per point, in the given order: a dot at `value` and a bar from `low` to `high` (JOD).
+std::string scaleSvg(const std::vector<IntervalPoint>& points);
+
+struct ScatterPoint {
+    std::string label;
+    double x = 0.0;                     // metric value
+    double y = 0.0, low = 0.0, high = 0.0;  // JOD and its interval
+};
+
+std::string scatterSvg(const std::vector<ScatterPoint>& points, const std::string& xLabel);
+
+// A number for the page: `digits` after the point, "−" for minus, "—" for a non-finite value.
+std::string formatNumber(double value, int digits);
+
+} // namespace skinlab::report

@@ -1,0 +1,693 @@
+#include "report/study_report.h"
+
+#include "analysis/agreement/metric_agreement.h"
+#include "analysis/metrics/metrics_run.h"
+#include "analysis/scaling/scale_analysis.h"
+#include "analysis/scaling/scale_report.h"
+#include "common/error.h"
+#include "common/files.h"
+#include "common/html.h"
+#include "common/version.h"
+#include "experiments/study_store.h"
+#include "report/report_plots.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <map>
+#include <numeric>
+#include <set>
+#include <sstream>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <spdlog/spdlog.h>
+
+namespace skinlab::report {
+namespace fs = std::filesystem;
+namespace scaling = skinlab::analysis::scaling;
+namespace agreement = skinlab::analysis::agreement;
+namespace experiments = skinlab::experiments;
+
+namespace {
+
+std::string h(const std::string& text) { return escapeHtml(text); }
+std::string num(double value, int digits = 2) { return formatNumber(value, digits); }
+std::string slug(const std::string& block) { return scaling::blockSlug(block); }
+
+// A number on the page that links to the table it comes from.
+std::string linked(const std::string& anchor, const std::string& text) {
+    return "<a class=\"num\" href=\"#" + anchor + "\">" + text + "</a>";
+}
+
+void copyFileAtomic(const fs::path& from, const fs::path& to) {
+    if (!fs::is_regular_file(from)) throwInput(from.string(), "", "file not found");
+    ensureDirectory(to.parent_path());
+    AtomicOutput output(to);
+    fs::copy_file(from, output.tempPath(), fs::copy_options::overwrite_existing);
+    output.commit();
+}
+
+void writePngAtomic(const fs::path& path, const cv::Mat& image) {
+    ensureDirectory(path.parent_path());
+    AtomicOutput output(path);
+    if (!cv::imwrite(output.tempPath().string() + ".png", image))
+        throw RuntimeError(path.string() + ": cannot write PNG");
+    fs::rename(output.tempPath().string() + ".png", output.tempPath());
+    output.commit();
+}
+
+struct Observer {
+    std::string label;
+    int answered = 0, total = 0, catchAnswered = 0, catchCorrect = 0;
+    bool excluded = false;
+    std::string reason;
+    bool screeningFlag = false;
+    double heldOutPerTrial = NAN;
+};
+
+struct ConditionImages {
+    std::string condition, stimulus, png;  // png relative to the report folder
+};
+
+struct Crop {
+    cv::Rect window;
+    std::map<std::string, std::string> files;  // condition → crop PNG relative to the report folder
+};
+
+// The window (a square about a fifth of the image height) where the conditions differ most: the largest box mean
+// of the per-pixel range (max − min over conditions, summed over channels).
+Crop cropWhereTheyDiffer(const std::vector<cv::Mat>& images, const std::vector<std::string>& names,
+                         const fs::path& folder, const std::string& prefix) {
+    Crop crop;
+    if (images.size() < 2) return crop;
+    cv::Mat low, high;
+    images[0].convertTo(low, CV_32FC3);
+    high = low.clone();
+    for (std::size_t i = 1; i < images.size(); ++i) {
+        cv::Mat f;
+        images[i].convertTo(f, CV_32FC3);
+        low = cv::min(low, f);
+        high = cv::max(high, f);
+    }
+    cv::Mat range;
+    cv::transform(high - low, range, cv::Matx13f(1.f, 1.f, 1.f));
+    const int side = std::max(8, std::min(images[0].rows, images[0].cols) / 5);
+    cv::Mat boxed;
+    cv::boxFilter(range, boxed, CV_32F, {side, side}, {-1, -1}, true, cv::BORDER_CONSTANT);
+    // Keep the window inside the image.
+    cv::Rect inner(side / 2, side / 2, std::max(1, images[0].cols - side), std::max(1, images[0].rows - side));
+    cv::Point best;
+    cv::minMaxLoc(boxed(inner), nullptr, nullptr, nullptr, &best);
+    crop.window = cv::Rect(best.x, best.y, side, side) & cv::Rect(0, 0, images[0].cols, images[0].rows);
+    for (std::size_t i = 0; i < images.size(); ++i) {
+        cv::Mat enlarged;
+        cv::resize(images[i](crop.window), enlarged, {}, 2.0, 2.0, cv::INTER_NEAREST);
+        std::string file = "crops/" + prefix + "-" + slug(names[i]) + ".png";
+        writePngAtomic(folder / file, enlarged);
+        crop.files[names[i]] = file;
+    }
+    return crop;
+}
+
+const char* const styleSheet = R"CSS(
+:root { --ink:#1d2330; --muted:#5b6475; --line:#d9dee7; --accent:#2f5fb3; --sig:#dcefdc; --ns:#f6f7f9; }
+* { box-sizing: border-box; }
+body { font: 15px/1.5 "DejaVu Sans", "Liberation Sans", Arial, sans-serif; color: var(--ink); margin: 0; background:#fff; }
+main { max-width: 1100px; margin: 0 auto; padding: 28px 32px 60px; }
+h1 { font-size: 26px; margin: 0 0 4px; } h2 { font-size: 20px; margin: 34px 0 10px; border-bottom: 2px solid var(--line); padding-bottom: 4px; }
+h3 { font-size: 16px; margin: 22px 0 8px; }
+.sub { color: var(--muted); margin: 0 0 18px; }
+.question { font-size: 18px; background: #eef3fb; border-left: 4px solid var(--accent); padding: 10px 14px; margin: 12px 0 18px; }
+table { border-collapse: collapse; margin: 8px 0 14px; font-size: 13.5px; }
+th, td { border: 1px solid var(--line); padding: 4px 8px; text-align: right; vertical-align: middle; }
+th { background: #f1f3f7; } td.l, th.l { text-align: left; }
+td.sig { background: var(--sig); font-weight: 600; } td.ns { background: var(--ns); color: var(--muted); } td.diag { background: #e9ebef; }
+.findings li { margin: 6px 0; } a.num { color: var(--accent); text-decoration: none; border-bottom: 1px dotted var(--accent); }
+.thumbs { display: flex; flex-wrap: wrap; gap: 12px; }
+.thumbs figure { margin: 0; width: 250px; } .thumbs img { width: 250px; border: 1px solid var(--line); display: block; }
+.crops figure { width: 170px; } .crops img { width: 170px; image-rendering: pixelated; }
+figcaption { font-size: 12.5px; color: var(--muted); margin-top: 3px; }
+.heat img { width: 330px; }
+.scatters { display: flex; flex-wrap: wrap; gap: 16px; } .scatters figure { margin: 0; width: 350px; }
+svg.plot { font-size: 11px; } svg .grid { stroke: #e3e6ec; } svg .bar { stroke: var(--accent); stroke-width: 2.5; }
+svg .dot { fill: var(--accent); } svg .clip { fill: #c0392b; } svg .tick { text-anchor: middle; fill: var(--muted); }
+svg .ytick { text-anchor: end; } svg .label { text-anchor: end; fill: var(--ink); font-size: 12px; }
+svg .axis { text-anchor: middle; fill: var(--ink); font-size: 12px; } svg .point { fill: var(--muted); font-size: 10px; }
+.note { color: var(--muted); font-size: 13px; }
+@media print { main { padding: 0; max-width: none; } h2 { break-after: avoid; } figure, table, svg { break-inside: avoid; } }
+)CSS";
+
+} // namespace
+
+ReportSummary writeStudyReport(const ReportOptions& options) {
+    const auto started = std::chrono::steady_clock::now();
+    if (!fs::is_regular_file(options.study)) throwInput(options.study.string(), "", "file not found");
+    if (options.output.empty()) throwInput("-o", "", "required: the report folder");
+    experiments::StudyStore store(options.study);
+    const experiments::StudyDefinition& definition = store.definition();
+    const experiments::StudyDesign& design = definition.design;
+    const fs::path stimuliFolder = options.stimuli.empty() ? fs::path(store.meta("stimuli_dir")) : options.stimuli;
+    if (!fs::is_regular_file(stimuliFolder / "manifest.json"))
+        throwInput((stimuliFolder / "manifest.json").string(), "",
+                   "file not found (the study's stimulus folder; give --stimuli DIR if it moved)");
+    if (!options.metrics.empty() && !fs::is_regular_file(options.metrics / "metrics.json"))
+        throwInput((options.metrics / "metrics.json").string(), "", "file not found (run `skinlab analyze metrics` first)");
+    for (const experiments::StudyStimulus& s : definition.stimuli)
+        if (!fs::is_regular_file(stimuliFolder / s.pngPath))
+            throwInput((stimuliFolder / s.pngPath).string(), "", "file not found (stimulus " + s.id + ")");
+
+    const fs::path out = options.output;
+    ensureDirectory(out);
+
+    // --- Participants and exclusions (catch trials: more than one failure in four excludes; protocol rule). ---
+    std::vector<Observer> observers;
+    std::map<std::string, std::size_t> observerIndex;
+    for (const experiments::ParticipantStatus& status : store.status()) {
+        Observer o;
+        o.label = status.participant.label;
+        o.answered = status.progress.answered;
+        o.total = status.progress.total;
+        o.catchAnswered = status.catchAnswered;
+        o.catchCorrect = status.catchCorrect;
+        int failures = o.catchAnswered - o.catchCorrect;
+        if (o.answered == 0) {
+            o.excluded = true;
+            o.reason = "no answers";
+        } else if (o.catchAnswered > 0 && 4 * failures > o.catchAnswered) {
+            o.excluded = true;
+            o.reason = "failed " + std::to_string(failures) + " of " + std::to_string(o.catchAnswered) + " catch trials";
+        }
+        observerIndex[o.label] = observers.size();
+        observers.push_back(o);
+    }
+    const std::vector<experiments::ResponseRow> rows = store.responses();
+    std::set<std::pair<int, int>> viewports;
+    std::set<double> pixelRatios;
+    scaling::ResponseTable table;
+    table.file = options.study.string();
+    table.format = scaling::ResponseFormat::StudyDatabase;
+    int line = 0;
+    for (const experiments::ResponseRow& row : rows) {
+        ++line;
+        viewports.insert({row.viewportWidth, row.viewportHeight});
+        pixelRatios.insert(row.devicePixelRatio);
+        auto found = observerIndex.find(row.observer);
+        if (found != observerIndex.end() && observers[found->second].excluded) continue;
+        scaling::Response r;
+        r.observer = row.observer;
+        r.block = row.scene;
+        r.conditionA = row.conditionA;
+        r.conditionB = row.conditionB;
+        r.aSelected = row.aSelected;
+        r.aOnLeft = row.aOnLeft;
+        r.correct = row.correct;
+        r.responseMs = row.responseMs;
+        r.line = line;
+        switch (row.kind) {
+        case experiments::TrialKind::practice: r.kind = scaling::TrialKind::Practice; break;
+        case experiments::TrialKind::test: r.kind = scaling::TrialKind::Test; break;
+        case experiments::TrialKind::repeat: r.kind = scaling::TrialKind::Repeat; break;
+        case experiments::TrialKind::catchTrial: r.kind = scaling::TrialKind::Catch; break;
+        }
+        table.responses.push_back(r);
+    }
+    const int included = static_cast<int>(std::count_if(observers.begin(), observers.end(), [](const Observer& o) {
+        return !o.excluded;
+    }));
+    if (included < 2) throwInput(options.study.string(), "", "fewer than 2 observers with answers to analyse (" +
+                                                                  std::to_string(included) + ")");
+
+    // --- The scale (existing analysis). ---
+    scaling::AnalysisOptions analysisOptions;
+    analysisOptions.bootstrap.samples = options.bootstrapSamples;
+    analysisOptions.bootstrap.seed = options.seed;
+    analysisOptions.bootstrap.threads = options.threads;
+    spdlog::info("report: scaling {} responses of {} observers", table.responses.size(), included);
+    const scaling::Dataset dataset = scaling::buildDataset(table, {});
+    const scaling::Analysis analysis = scaling::analyzeDataset(dataset, analysisOptions);
+    writeFileAtomic(out / "scale.json", scaling::analysisJson(analysis).dump(2) + "\n");
+    for (const scaling::ObserverSummary& summary : analysis.observers) {
+        auto found = observerIndex.find(summary.observer);
+        if (found == observerIndex.end()) continue;
+        observers[found->second].screeningFlag = summary.flagged;
+        observers[found->second].heldOutPerTrial = summary.heldOutPerTrial;
+    }
+
+    // --- Stimuli: copies, and crops where the conditions differ most. ---
+    std::map<std::string, std::vector<ConditionImages>> imagesOfBlock;
+    std::map<std::string, std::pair<std::string, std::string>> conditionOfStimulus;
+    std::map<std::string, Crop> cropOfBlock;
+    std::map<std::string, std::string> referencePng;
+    for (const experiments::StudyBlock& block : definition.blocks) {
+        std::vector<cv::Mat> images;
+        std::vector<std::string> names;
+        for (std::size_t c = 0; c < block.conditions.size(); ++c) {
+            const experiments::StudyStimulus& s = definition.stimuli[static_cast<std::size_t>(block.conditionStimulus[c])];
+            std::string file = "stimuli/" + slug(s.id) + ".png";
+            copyFileAtomic(stimuliFolder / s.pngPath, out / file);
+            imagesOfBlock[block.name].push_back({block.conditions[c], s.id, file});
+            conditionOfStimulus[s.id] = {block.name, block.conditions[c]};
+            images.push_back(cv::imread((stimuliFolder / s.pngPath).string(), cv::IMREAD_COLOR));
+            names.push_back(block.conditions[c]);
+        }
+        cropOfBlock[block.name] = cropWhereTheyDiffer(images, names, out, slug(block.name));
+    }
+    // The set's reference render of each block ("reference": true in the manifest), shown beside the conditions.
+    std::map<std::string, ConditionImages> referenceOfBlock;
+    try {
+        const nlohmann::json manifest = nlohmann::json::parse(readFile(stimuliFolder / "manifest.json"));
+        for (const nlohmann::json& s : manifest.value("stimuli", nlohmann::json::array())) {
+            if (!s.value("reference", false) || !s.contains("files") || !s["files"].contains("png")) continue;
+            std::string block = s.value("block", ""), id = s.value("id", "");
+            if (!imagesOfBlock.count(block) || referenceOfBlock.count(block)) continue;
+            std::string file = "stimuli/" + slug(id) + ".png";
+            copyFileAtomic(stimuliFolder / s["files"]["png"].get<std::string>(), out / file);
+            referenceOfBlock[block] = {"reference", id, file};
+        }
+    } catch (const nlohmann::json::exception& e) {
+        throwInput((stimuliFolder / "manifest.json").string(), "", std::string("not valid JSON (") + e.what() + ")");
+    }
+
+    // --- Metrics against the set's references (given, or computed here for the study's stimuli). ---
+    nlohmann::json metricsJson;
+    fs::path metricsFolder = options.metrics;
+    if (metricsFolder.empty()) {
+        metrics::ComparisonPlan plan;
+        try {
+            plan = metrics::planStimulusSetComparisons(stimuliFolder, std::nullopt);
+        } catch (const InputError& e) {
+            spdlog::warn("report: no image metrics ({})", e.what());
+        }
+        std::erase_if(plan.jobs, [&](const metrics::ComparisonJob& job) { return !conditionOfStimulus.count(job.testName); });
+        if (!plan.jobs.empty()) {
+            metricsFolder = out / "metrics";
+            metrics::MetricsRunOptions metricOptions;
+            metricOptions.metric.pixelsPerDegree = options.pixelsPerDegree;
+            spdlog::info("report: image metrics of {} stimuli against their block's reference", plan.jobs.size());
+            metrics::runMetrics(plan, metricOptions, metricsFolder);
+            // The references, for the stimulus section.
+            for (const auto& job : plan.jobs) referencePng[job.block] = job.referenceName;
+        }
+    }
+    std::vector<agreement::ConditionMetrics> conditionMetrics;
+    std::map<std::string, std::string> heatmapOf, flipHeatmapOf;  // stimulus → copied heat map
+    if (!metricsFolder.empty()) {
+        const fs::path file = metricsFolder / "metrics.json";
+        try {
+            metricsJson = nlohmann::json::parse(readFile(file));
+        } catch (const nlohmann::json::exception& e) {
+            throwInput(file.string(), "", std::string("not valid JSON (") + e.what() + ")");
+        }
+        conditionMetrics = agreement::conditionMetricsFromJson(metricsJson, file.string(), conditionOfStimulus);
+        for (const nlohmann::json& comparison : metricsJson["comparisons"]) {
+            std::string name = comparison["test"].value("name", "");
+            if (!conditionOfStimulus.count(name)) continue;
+            for (const char* key : {"heatmap", "flip_heatmap"}) {
+                if (!comparison.contains(key) || !comparison[key].is_string()) continue;
+                std::string copied = "heatmaps/" + slug(name) + (std::string(key) == "heatmap" ? ".png" : ".flip.png");
+                copyFileAtomic(metricsFolder / comparison[key].get<std::string>(), out / copied);
+                (std::string(key) == "heatmap" ? heatmapOf : flipHeatmapOf)[name] = copied;
+            }
+        }
+    }
+    agreement::AgreementOptions agreementOptions;
+    agreementOptions.samples = options.bootstrapSamples;
+    agreementOptions.seed = options.seed;
+    const agreement::AgreementResult agreementResult =
+        agreement::computeAgreement(dataset, analysis, conditionMetrics, analysisOptions.fit, agreementOptions);
+    if (!conditionMetrics.empty()) {
+        writeFileAtomic(out / "agreement.json", agreement::agreementJson(agreementResult).dump(2) + "\n");
+        writeFileAtomic(out / "agreement.csv", agreement::agreementCsv(agreementResult));
+    }
+
+    // ================= The page =================
+    std::ostringstream html;
+    const int excluded = static_cast<int>(observers.size()) - included;
+    html << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" << h(design.title)
+         << " — study report</title><style>" << styleSheet << "</style></head><body><main>\n";
+    html << "<h1>" << h(design.title) << "</h1><p class=\"sub\">Study report · " << h(options.study.filename().string())
+         << " · stimulus set " << h(store.meta("stimulus_set")) << " · skinlab " << h(version()) << "</p>\n";
+    html << "<p class=\"question\">Question put to observers: <strong>" << h(design.question) << "</strong></p>\n";
+    html << "<nav class=\"note\">Contents: <a href=\"#findings\">Findings</a> · <a href=\"#design\">Design</a> · "
+            "<a href=\"#participants\">Participants</a> · <a href=\"#stimuli\">Stimuli</a> · <a href=\"#scale\">Scale</a>"
+            " · <a href=\"#metrics\">Objective errors</a> · <a href=\"#agreement\">Metrics vs. perception</a></nav>\n";
+
+    // --- Findings (generated). ---
+    html << "<h2 id=\"findings\">Findings</h2><ul class=\"findings\">\n";
+    html << "<li>" << linked("participants", std::to_string(included)) << " observers analysed";
+    if (excluded > 0) html << "; " << linked("participants", std::to_string(excluded)) << " excluded (reasons in the table)";
+    html << ".</li>\n";
+    for (const scaling::BlockAnalysis& block : analysis.blocks) {
+        const std::string anchor = "scale-" + slug(block.name);
+        std::vector<int> order(block.conditions.size());
+        std::iota(order.begin(), order.end(), 0);
+        std::sort(order.begin(), order.end(),
+                  [&](int a, int b) { return block.thurstone.scores[a] > block.thurstone.scores[b]; });
+        int best = order.front(), worst = order.back();
+        int significant = 0;
+        std::vector<std::string> beaten;
+        for (const scaling::PairTest& pair : block.pairs) {
+            if (!pair.significant) continue;
+            ++significant;
+            int other = pair.test.first == best ? pair.test.second : pair.test.second == best ? pair.test.first : -1;
+            if (other >= 0 && block.thurstone.scores[best] > block.thurstone.scores[other])
+                beaten.push_back(block.conditions[static_cast<std::size_t>(other)]);
+        }
+        const std::size_t pairCount = block.pairs.size();
+        html << "<li><strong>" << h(block.name) << "</strong>: <em>" << h(block.conditions[static_cast<std::size_t>(best)])
+             << "</em> scored highest, " << linked(anchor, num(block.thurstone.scores[best]) + " JOD") << " ["
+             << linked(anchor, num(block.low[best])) << ", " << linked(anchor, num(block.high[best])) << "]; <em>"
+             << h(block.conditions[static_cast<std::size_t>(worst)]) << "</em> lowest, "
+             << linked(anchor, num(block.thurstone.scores[worst]) + " JOD") << ". "
+             << linked("pairs-" + slug(block.name), std::to_string(significant)) << " of " << pairCount
+             << " pairs are separated significantly (" << h(scaling::correctionName(analysis.options.correction))
+             << "-corrected, α = " << num(analysis.options.alpha, 2) << ")";
+        if (!beaten.empty()) {
+            html << "; the best is significantly above ";
+            for (std::size_t i = 0; i < beaten.size(); ++i) html << (i ? ", " : "") << "<em>" << h(beaten[i]) << "</em>";
+        } else if (block.conditions.size() > 1) {
+            html << "; the best is not significantly above any other condition";
+        }
+        html << ".</li>\n";
+        // The metric that predicts this block's scale best: highest Spearman oriented so that + means agreement.
+        const agreement::MetricAgreement* bestMetric = nullptr;
+        auto oriented = [](const agreement::MetricAgreement& row) {
+            return (row.metric.higherIsBetter ? 1.0 : -1.0) * row.spearman;
+        };
+        auto orientedPearson = [](const agreement::MetricAgreement& row) {
+            return (row.metric.higherIsBetter ? 1.0 : -1.0) * row.pearson;
+        };
+        for (const agreement::MetricAgreement& row : agreementResult.rows) {
+            if (row.block != block.name || row.conditions < 3 || !std::isfinite(row.spearman) || !std::isfinite(row.pearson))
+                continue;
+            if (!bestMetric || oriented(row) > oriented(*bestMetric) ||
+                (oriented(row) == oriented(*bestMetric) && orientedPearson(row) > orientedPearson(*bestMetric)))
+                bestMetric = &row;
+        }
+        if (bestMetric) {
+            const std::string a = "agreement-" + slug(block.name);
+            html << "<li>In <strong>" << h(block.name) << "</strong> the metric that predicts the scale best is <em>"
+                 << h(bestMetric->metric.label) << "</em> (" << (bestMetric->metric.higherIsBetter ? "higher" : "lower")
+                 << " is better): Spearman ρ = " << linked(a, num(bestMetric->spearman)) << " ["
+                 << linked(a, num(bestMetric->spearmanLow)) << ", " << linked(a, num(bestMetric->spearmanHigh))
+                 << "], Pearson r = " << linked(a, num(bestMetric->pearson)) << " over " << bestMetric->conditions
+                 << " conditions";
+            if (bestMetric->significantPairs > 0)
+                html << "; it orders " << linked(a, std::to_string(bestMetric->predictedPairs)) << " of "
+                     << linked(a, std::to_string(bestMetric->significantPairs)) << " significantly separated pairs as the observers did";
+            html << ".</li>\n";
+        } else if (!conditionMetrics.empty()) {
+            html << "<li>" << h(block.name) << ": too few conditions with metric values for a correlation.</li>\n";
+        }
+    }
+    if (conditionMetrics.empty())
+        html << "<li>No image metrics: the stimulus set has no reference render for the study's blocks (add a "
+                "<code>[[reference]]</code> to the set's spec, or give <code>--metrics DIR</code>).</li>\n";
+    html << "</ul>\n";
+
+    // --- Design. ---
+    html << "<h2 id=\"design\">Design</h2><table><tbody>"
+         << "<tr><th class=\"l\">Task</th><td class=\"l\">two-alternative forced choice, side by side"
+         << (design.showReference ? ", with the reference shown above the pair" : "") << "</td></tr>"
+         << "<tr><th class=\"l\">Condition factor</th><td class=\"l\">" << h(design.conditionFactor) << "</td></tr>"
+         << "<tr><th class=\"l\">Blocks</th><td class=\"l\">";
+    for (std::size_t b = 0; b < definition.blocks.size(); ++b)
+        html << (b ? "; " : "") << h(definition.blocks[b].name) << " (" << definition.blocks[b].conditions.size()
+             << " conditions, " << definition.blocks[b].pairs.size() << " pairs)";
+    html << "</td></tr><tr><th class=\"l\">Repetitions per pair</th><td class=\"l\">" << design.repetitions
+         << " (both left/right orders)</td></tr>"
+         << "<tr><th class=\"l\">Trials per participant</th><td class=\"l\">" << definition.testTrialCount() << " test, "
+         << definition.repeatTrialCount() << " repeat, " << definition.catchTrialCount() << " catch, "
+         << design.practiceTrials << " practice (not analysed)</td></tr>"
+         << "<tr><th class=\"l\">Seed</th><td class=\"l\">" << design.seed << "</td></tr>"
+         << "<tr><th class=\"l\">Design / manifest sha256</th><td class=\"l\"><code>" << h(store.meta("design_sha256").substr(0, 16))
+         << "…</code> / <code>" << h(store.meta("manifest_sha256").substr(0, 16)) << "…</code></td></tr>"
+         << "<tr><th class=\"l\">Analysis</th><td class=\"l\">Thurstone Case V in JOD (1 JOD = 75 % preference), "
+         << h(analysis.blocks.empty() ? std::string("—") : analysis.blocks.front().intervalMethod) << " intervals ("
+         << options.bootstrapSamples << " resamples, " << num(100.0 * analysisOptions.bootstrap.level, 0)
+         << " %), pairwise tests " << h(scaling::correctionName(analysis.options.correction)) << "-corrected</td></tr>"
+         << "</tbody></table>\n";
+
+    // --- Participants. ---
+    html << "<h2 id=\"participants\">Participants</h2><p>" << observers.size() << " joined, " << included
+         << " analysed, " << excluded << " excluded. Exclusion rule (decided before the study, "
+         << "as the protocol recommends): more than one failed catch trial in four, or no answers. Screening "
+         << "(held-out log-likelihood per trial, low outliers by the inter-quartile rule) is reported, not used to "
+         << "exclude.</p>\n<table><thead><tr><th class=\"l\">observer</th><th>answered</th><th>catch correct</th>"
+            "<th>held-out log-lik./trial</th><th class=\"l\">screening</th><th class=\"l\">status</th></tr></thead><tbody>\n";
+    for (const Observer& o : observers)
+        html << "<tr><td class=\"l\">" << h(o.label) << "</td><td>" << o.answered << " / " << o.total << "</td><td>"
+             << o.catchCorrect << " / " << o.catchAnswered << "</td><td>" << num(o.heldOutPerTrial, 3)
+             << "</td><td class=\"l\">" << (o.excluded ? "—" : o.screeningFlag ? "low outlier (flagged)" : "ok")
+             << "</td><td class=\"l\">" << (o.excluded ? "excluded: " + h(o.reason) : std::string("included"))
+             << "</td></tr>\n";
+    html << "</tbody></table>\n<p><strong>Viewing conditions.</strong> Recorded per answer by the browser: viewports ";
+    {
+        int shown = 0;
+        for (const auto& [w, hgt] : viewports) {
+            if (shown++ == 6) {
+                html << ", …";
+                break;
+            }
+            html << (shown > 1 ? ", " : "") << w << "×" << hgt;
+        }
+        if (viewports.empty()) html << "—";
+        html << "; device pixel ratio ";
+        shown = 0;
+        for (double r : pixelRatios) html << (shown++ ? ", " : "") << num(r, 2);
+        if (pixelRatios.empty()) html << "—";
+    }
+    html << ". Images are shown at one image pixel per device pixel. Display, room lighting and viewing distance are "
+            "not stored in the study file; see the lab notes.</p>\n";
+
+    // --- Stimuli. ---
+    html << "<h2 id=\"stimuli\">Stimuli</h2><p class=\"note\">Click a thumbnail for the image at full size (1:1). "
+            "Crops: the window where the conditions differ most, enlarged 2× without smoothing.</p>\n";
+    for (const experiments::StudyBlock& block : definition.blocks) {
+        html << "<h3>" << h(block.name) << "</h3><div class=\"thumbs\">";
+        if (referenceOfBlock.count(block.name)) {
+            const ConditionImages& image = referenceOfBlock[block.name];
+            html << "<figure><a href=\"" << h(image.png) << "\"><img src=\"" << h(image.png)
+                 << "\" alt=\"reference\" loading=\"eager\"></a><figcaption><strong>reference</strong> ("
+                 << (design.showReference ? "shown above each pair" : "not shown to observers") << ") · "
+                 << h(image.stimulus)
+                 << "</figcaption></figure>";
+        }
+        for (const ConditionImages& image : imagesOfBlock[block.name])
+            html << "<figure><a href=\"" << h(image.png) << "\"><img src=\"" << h(image.png) << "\" alt=\""
+                 << h(image.condition) << "\" loading=\"eager\"></a><figcaption><strong>" << h(image.condition)
+                 << "</strong> · " << h(image.stimulus) << "</figcaption></figure>";
+        html << "</div>\n";
+        const Crop& crop = cropOfBlock[block.name];
+        if (!crop.files.empty()) {
+            html << "<p class=\"note\">Window " << crop.window.width << "×" << crop.window.height << " at ("
+                 << crop.window.x << ", " << crop.window.y << ").</p><div class=\"thumbs crops\">";
+            for (const ConditionImages& image : imagesOfBlock[block.name])
+                html << "<figure><img src=\"" << h(crop.files.at(image.condition)) << "\" alt=\"crop of "
+                     << h(image.condition) << "\"><figcaption>" << h(image.condition) << "</figcaption></figure>";
+            html << "</div>\n";
+        }
+    }
+
+    // --- Scale. ---
+    html << "<h2 id=\"scale\">Perceptual scale (JOD)</h2><p class=\"note\">Higher = chosen more often. Bars: "
+         << num(100.0 * analysisOptions.bootstrap.level, 0) << " % confidence intervals; bars running off the axis end "
+         << "in a red arrow. Matrix: row − column in JOD; green = significant after correction, grey = not; n/c = "
+            "never compared directly.</p>\n";
+    for (const scaling::BlockAnalysis& block : analysis.blocks) {
+        std::vector<int> order(block.conditions.size());
+        std::iota(order.begin(), order.end(), 0);
+        std::sort(order.begin(), order.end(),
+                  [&](int a, int b) { return block.thurstone.scores[a] > block.thurstone.scores[b]; });
+        std::vector<IntervalPoint> points;
+        for (int i : order)
+            points.push_back({block.conditions[static_cast<std::size_t>(i)], block.thurstone.scores[i], block.low[i], block.high[i]});
+        html << "<h3 id=\"scale-" << slug(block.name) << "\">" << h(block.name) << " (" << block.observers.size()
+             << " observers)</h3>" << scaleSvg(points);
+        html << "<table><thead><tr><th class=\"l\">condition</th><th>JOD</th><th>low</th><th>high</th><th>SE</th></tr>"
+                "</thead><tbody>";
+        for (int i : order)
+            html << "<tr><td class=\"l\">" << h(block.conditions[static_cast<std::size_t>(i)]) << "</td><td>"
+                 << num(block.thurstone.scores[i]) << "</td><td>" << num(block.low[i]) << "</td><td>" << num(block.high[i])
+                 << "</td><td>" << num(block.standardError[i]) << "</td></tr>";
+        html << "</tbody></table>";
+        for (const std::string& warning : block.warnings) html << "<p class=\"note\">Note: " << h(warning) << "</p>";
+        // Pairwise significance matrix.
+        std::map<std::pair<int, int>, const scaling::PairTest*> pairOf;
+        for (const scaling::PairTest& pair : block.pairs) pairOf[{pair.test.first, pair.test.second}] = &pair;
+        html << "<table id=\"pairs-" << slug(block.name) << "\"><thead><tr><th class=\"l\">row − column</th>";
+        for (int j : order) html << "<th>" << h(block.conditions[static_cast<std::size_t>(j)]) << "</th>";
+        html << "</tr></thead><tbody>";
+        for (int i : order) {
+            html << "<tr><th class=\"l\">" << h(block.conditions[static_cast<std::size_t>(i)]) << "</th>";
+            for (int j : order) {
+                if (i == j) {
+                    html << "<td class=\"diag\"></td>";
+                    continue;
+                }
+                auto found = pairOf.find({std::min(i, j), std::max(i, j)});
+                if (found == pairOf.end()) {
+                    html << "<td class=\"ns\">—</td>";
+                    continue;
+                }
+                const scaling::PairTest& pair = *found->second;
+                double difference = block.thurstone.scores[i] - block.thurstone.scores[j];
+                html << "<td class=\"" << (pair.significant ? "sig" : "ns") << "\" title=\"adjusted p = "
+                     << num(pair.adjustedPValue, 4) << "\">" << num(difference) << "<br><span class=\"note\">p="
+                     << num(pair.adjustedPValue, 3) << (pair.comparisons > 0 ? "" : " n/c") << "</span></td>";
+            }
+            html << "</tr>";
+        }
+        html << "</tbody></table>\n";
+    }
+
+    // --- Objective errors. ---
+    html << "<h2 id=\"metrics\">Objective errors against the reference</h2>\n";
+    if (conditionMetrics.empty()) {
+        html << "<p>Not available: the stimulus set has no reference render for the study's blocks.</p>\n";
+    } else {
+        html << "<p class=\"note\">Each stimulus against its block's reference render";
+        if (!referencePng.empty()) {
+            html << " (";
+            int k = 0;
+            for (const auto& [block, reference] : referencePng) html << (k++ ? ", " : "") << h(block) << ": " << h(reference);
+            html << ")";
+        }
+        html << ". ΔE00 and FLIP: lower is better; PSNR and SSIM: higher is better. Bands: mean ΔE00 in the halo, "
+                "bleed, spill and interior bands (docs/metrics.md). FLIP at "
+             << num(metricsJson.contains("settings") && metricsJson["settings"].contains("flip")
+                        ? metricsJson["settings"]["flip"].value("pixels_per_degree", NAN)
+                        : NAN,
+                    1)
+             << " pixels per degree.</p>\n";
+        for (const experiments::StudyBlock& block : definition.blocks) {
+            html << "<h3 id=\"metrics-" << slug(block.name) << "\">" << h(block.name) << "</h3><table><thead><tr>"
+                 << "<th class=\"l\">condition</th><th>PSNR (dB)</th><th>SSIM</th><th>mean ΔE00</th><th>p95 ΔE00</th>"
+                    "<th>mean FLIP</th><th>skin FLIP</th><th>halo ΔE00</th><th>bleed ΔE00</th><th>spill ΔE00</th>"
+                    "<th>interior ΔE00</th></tr></thead><tbody>";
+            for (const agreement::ConditionMetrics& row : conditionMetrics) {
+                if (row.block != block.name) continue;
+                auto v = [&](const char* key) { return row.values.at(key); };
+                html << "<tr><td class=\"l\">" << h(row.condition) << "</td><td>" << num(v("image.psnr_db")) << "</td><td>"
+                     << num(v("image.ssim"), 4) << "</td><td>" << num(v("image.delta_e00_mean"), 3) << "</td><td>"
+                     << num(v("image.delta_e00_p95"), 3) << "</td><td>" << num(v("image.flip_mean"), 4) << "</td><td>"
+                     << num(v("skin.flip_mean"), 4) << "</td><td>" << num(v("bands.halo.delta_e00_mean"), 3) << "</td><td>"
+                     << num(v("bands.bleed.delta_e00_mean"), 3) << "</td><td>" << num(v("bands.spill.delta_e00_mean"), 3)
+                     << "</td><td>" << num(v("bands.interior.delta_e00_mean"), 3) << "</td></tr>";
+            }
+            html << "</tbody></table><div class=\"thumbs heat\">";
+            for (const ConditionImages& image : imagesOfBlock[block.name]) {
+                if (heatmapOf.count(image.stimulus))
+                    html << "<figure><a href=\"" << h(heatmapOf[image.stimulus]) << "\"><img src=\""
+                         << h(heatmapOf[image.stimulus]) << "\" alt=\"ΔE00 of " << h(image.condition)
+                         << "\"></a><figcaption>ΔE00, " << h(image.condition) << "</figcaption></figure>";
+                if (flipHeatmapOf.count(image.stimulus))
+                    html << "<figure><a href=\"" << h(flipHeatmapOf[image.stimulus]) << "\"><img src=\""
+                         << h(flipHeatmapOf[image.stimulus]) << "\" alt=\"FLIP of " << h(image.condition)
+                         << "\"></a><figcaption>FLIP, " << h(image.condition) << "</figcaption></figure>";
+            }
+            html << "</div>\n";
+        }
+    }
+
+    // --- Metrics against perception. ---
+    html << "<h2 id=\"agreement\">Metrics against perception</h2>\n";
+    if (conditionMetrics.empty()) {
+        html << "<p>Not available without image metrics.</p>\n";
+    } else {
+        html << "<p class=\"note\">Correlation of each metric with the JOD scale over the block's conditions (raw sign: "
+                "an error metric that agrees with the observers correlates negatively). Intervals: "
+             << num(100.0 * agreementOptions.level, 0) << " % percentile bootstrap over observers ("
+             << agreementOptions.samples << " resamples, the scale re-fitted each time). Pairs: of the pairs the "
+                "observers separated significantly, how many the metric orders the same way (ties count as not). "
+                "Also in agreement.csv and agreement.json.</p>\n";
+        static const std::vector<std::string> plotted = {"image.psnr_db", "image.ssim", "image.delta_e00_mean",
+                                                         "image.flip_mean", "skin.flip_mean", "bands.halo.delta_e00_mean"};
+        for (const scaling::BlockAnalysis& block : analysis.blocks) {
+            html << "<h3 id=\"agreement-" << slug(block.name) << "\">" << h(block.name) << "</h3><table><thead><tr>"
+                 << "<th class=\"l\">metric</th><th>better</th><th>n</th><th>Pearson r</th><th>95 % interval</th>"
+                    "<th>Spearman ρ</th><th>95 % interval</th><th>pairs ordered</th></tr></thead><tbody>";
+            std::vector<const agreement::MetricAgreement*> shown;
+            for (const agreement::MetricAgreement& row : agreementResult.rows) {
+                if (row.block != block.name || row.conditions == 0) continue;
+                shown.push_back(&row);
+                html << "<tr><td class=\"l\">" << h(row.metric.label) << "</td><td>"
+                     << (row.metric.higherIsBetter ? "higher" : "lower") << "</td><td>" << row.conditions << "</td><td>"
+                     << num(row.pearson) << "</td><td>[" << num(row.pearsonLow) << ", " << num(row.pearsonHigh)
+                     << "]</td><td>" << num(row.spearman) << "</td><td>[" << num(row.spearmanLow) << ", "
+                     << num(row.spearmanHigh) << "]</td><td>"
+                     << (row.significantPairs ? std::to_string(row.predictedPairs) + " / " +
+                                                    std::to_string(row.significantPairs)
+                                              : std::string("—"))
+                     << "</td></tr>";
+            }
+            html << "</tbody></table><div class=\"scatters\">";
+            for (const agreement::MetricAgreement* row : shown) {
+                if (std::find(plotted.begin(), plotted.end(), row->metric.key) == plotted.end()) continue;
+                std::vector<ScatterPoint> points;
+                for (const agreement::ConditionMetrics& metricRow : conditionMetrics) {
+                    if (metricRow.block != block.name) continue;
+                    auto it = std::find(block.conditions.begin(), block.conditions.end(), metricRow.condition);
+                    if (it == block.conditions.end()) continue;
+                    auto i = static_cast<Eigen::Index>(it - block.conditions.begin());
+                    points.push_back({metricRow.condition, metricRow.values.at(row->metric.key), block.thurstone.scores[i],
+                                      block.low[i], block.high[i]});
+                }
+                html << "<figure>" << scatterSvg(points, row->metric.label) << "<figcaption>" << h(row->metric.label)
+                     << ": r = " << num(row->pearson) << " [" << num(row->pearsonLow) << ", " << num(row->pearsonHigh)
+                     << "], ρ = " << num(row->spearman) << "</figcaption></figure>";
+            }
+            html << "</div>\n";
+        }
+        for (const std::string& warning : agreementResult.warnings) html << "<p class=\"note\">Note: " << h(warning) << "</p>";
+    }
+    html << "<p class=\"note\">Written by <code>skinlab report</code> from " << h(options.study.filename().string())
+         << ". Tables: scale.json" << (conditionMetrics.empty() ? "" : ", agreement.csv, agreement.json")
+         << (options.metrics.empty() && !metricsFolder.empty() ? ", metrics/" : "") << ".</p>\n</main></body></html>\n";
+    writeFileAtomic(out / "index.html", html.str());
+
+    ReportSummary summary;
+    summary.html = out / "index.html";
+    summary.observers = included;
+    summary.excluded = excluded;
+    summary.metrics = !conditionMetrics.empty();
+
+    // --- PDF through headless Chromium (a fresh profile in a temporary folder). ---
+    if (options.pdf) {
+        const fs::path profile = fs::temp_directory_path() / ("skinlab-report-chromium-" + std::to_string(::getpid()));
+        fs::remove_all(profile);
+        const fs::path pdf = out / "report.pdf";
+        const fs::path temp = out / (".report.pdf.tmp-" + std::to_string(::getpid()));
+        auto quote = [](const std::string& s) {
+            std::string q = "'";
+            for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+            return q + "'";
+        };
+        std::string command = "timeout 180 " + quote(options.chromium) +
+                              " --headless --no-sandbox --disable-gpu --disable-quic --no-first-run "
+                              "--disable-background-networking --disable-component-update --disable-sync "
+                              "--no-pdf-header-footer --user-data-dir=" + quote(profile.string()) +
+                              " --print-to-pdf=" + quote(temp.string()) + " " +
+                              quote("file://" + fs::absolute(out / "index.html").string()) + " >/dev/null 2>&1";
+        int status = std::system(command.c_str());
+        fs::remove_all(profile);
+        std::error_code ec;
+        if (status == 0 && fs::is_regular_file(temp, ec) && fs::file_size(temp, ec) > 0) {
+            fs::rename(temp, pdf);
+            summary.pdf = pdf;
+        } else {
+            fs::remove(temp, ec);
+            spdlog::warn("report: no PDF ({} failed or is not installed; give --chromium PATH or --no-pdf)",
+                         options.chromium);
+        }
+    }
+    double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    spdlog::info("report: written in {:.1f} s", seconds);
+    return summary;
+}
+
+} // namespace skinlab::report

@@ -1,0 +1,49 @@
+// The report's SVG plots and number formatting: bounded output whatever the intervals (±1e9 JOD, infinite,
+// NaN), clipped bars marked, and no "nan"/"inf" text.
+#include "report/report_plots.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+namespace skinlab::report {
+namespace {
+
+int count(const std::string& text, const std::string& what) {
+    int n = 0;
+    for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+    return n;
+}
+
+TEST(ReportPlots, HugeAndUndefinedIntervalsAreClippedAndMarked) {
+    const double inf = std::numeric_limits<double>::infinity();
+    std::vector<IntervalPoint> points = {{"a", 1.0, -1e9, 1e9}, {"b", 0.0, -0.5, 0.5}, {"c", -1.0, NAN, inf}};
+    std::string svg = scaleSvg(points);
+    EXPECT_LT(svg.size(), 20000u) << "the plot's size must not depend on the bounds";
+    EXPECT_EQ(count(svg, "class=\"clip\""), 4);  // a: both ends; c: both ends (undefined and infinite)
+    EXPECT_EQ(count(svg, "<circle"), 3);
+    EXPECT_EQ(count(svg, "class=\"grid\""), count(svg, "class=\"tick\""));
+    EXPECT_LE(count(svg, "class=\"grid\""), 12);
+    EXPECT_EQ(svg.find("nan"), std::string::npos);
+    EXPECT_EQ(svg.find("inf"), std::string::npos);
+}
+
+TEST(ReportPlots, ScatterSkipsUndefinedPoints) {
+    std::vector<ScatterPoint> points = {{"a", 0.1, 1.0, 0.5, 1.5}, {"b", NAN, 0.0, -0.5, 0.5}, {"c", 0.3, -1.0, -1e9, 1e9}};
+    std::string svg = scatterSvg(points, "mean FLIP");
+    EXPECT_EQ(count(svg, "<circle"), 2);
+    EXPECT_LT(svg.size(), 20000u);
+    EXPECT_EQ(svg.find("nan"), std::string::npos);
+}
+
+TEST(ReportPlots, NumbersNeverShowNan) {
+    EXPECT_EQ(formatNumber(NAN, 2), "\u2014");
+    EXPECT_EQ(formatNumber(std::numeric_limits<double>::infinity(), 2), "\u2014");
+    EXPECT_EQ(formatNumber(-0.001, 2), "0.00");
+    EXPECT_EQ(formatNumber(-1.234, 2), "\u22121.23");
+    EXPECT_EQ(formatNumber(0.5, 3), "0.500");
+}
+
+} // namespace
+} // namespace skinlab::report
