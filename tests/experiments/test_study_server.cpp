@@ -331,3 +331,41 @@ TEST(StudyServer, FiftySimulatedParticipantsAtOnce) {
     EXPECT_GT(catchByKind["inverted"].second, 0);
     EXPECT_LT(report.latencyPercentile(50), 1000.0);
 }
+
+TEST(StudyServer, SimulateRunAgainWithTheSamePrefixContinuesItsObservers) {
+    RunningStudy study(kDesign);
+    // An interrupted run: observer "resume-001" joined (with the simulator's join key) and answered 3 trials.
+    HttpClient client = study.client();
+    JsonAnswer joined = postJson(client, "/api/join", {{"label", "resume-001"}, {"join_key", simulatedJoinKey("resume-001")}});
+    ASSERT_EQ(joined.status, 201) << joined.raw;
+    Participant p;
+    p.token = joined.body["token"];
+    json start = screen();
+    start["token"] = p.token;
+    JsonAnswer session = postJson(client, "/api/session", start);
+    p.session = session.body["session"];
+    p.state = session.body;
+    for (int i = 0; i < 3; ++i) {
+        JsonAnswer ack = postJson(client, "/api/response", responseBody(p, p.state["trial"]["id"], "left"));
+        ASSERT_EQ(ack.status, 200);
+        p.state = ack.body;
+    }
+    SimulationOptions options;
+    options.port = study.port();
+    options.observers = 2;
+    options.labelPrefix = "resume";
+    const SimulationReport first = simulateObservers(study.store(), options);
+    for (const ObserverResult& o : first.observers) EXPECT_TRUE(o.failure.empty()) << o.label << ": " << o.failure;
+    EXPECT_EQ(first.completed(), 2);
+    EXPECT_EQ(first.rejected(), 0);
+    EXPECT_EQ(first.acknowledged(), 16u - 3u + 16u) << "resume-001 continued after its 3 answers";
+    EXPECT_EQ(study.store().responseCount(), 32);
+    // The same command again: both observers are found complete; nothing is stored twice, nothing refused (no 409).
+    const SimulationReport again = simulateObservers(study.store(), options);
+    for (const ObserverResult& o : again.observers) EXPECT_TRUE(o.failure.empty()) << o.label << ": " << o.failure;
+    EXPECT_EQ(again.completed(), 2);
+    EXPECT_EQ(again.rejected(), 0);
+    EXPECT_EQ(again.acknowledged(), 0u);
+    EXPECT_EQ(study.store().status().size(), 2u);
+    EXPECT_EQ(study.store().responseCount(), 32);
+}
