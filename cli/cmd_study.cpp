@@ -27,7 +27,10 @@ struct StudyOptions {
     std::string study;
     std::string host = "127.0.0.1";
     int port = 8080;
-    int threads = 64;
+    int threads = 8;
+    int connectionsPerClient = 64;
+    double joinsPerMinute = 60;
+    std::string publicHost;
     std::string token;
     std::string url = "http://127.0.0.1:8080";
     int observers = 0;
@@ -40,6 +43,7 @@ struct StudyOptions {
     std::uint64_t seed = 1;
     std::string think;
     std::string labelPrefix;
+    bool apiOnly = false;
     std::string format;
 };
 
@@ -65,6 +69,10 @@ void runServe(const StudyOptions& o) {
     options.host = o.host;
     options.port = o.port;
     options.threads = o.threads;
+    options.connectionsPerClient = o.connectionsPerClient;
+    options.joinsPerMinute = o.joinsPerMinute;
+    options.joinBurst = o.joinsPerMinute;
+    options.publicHost = o.publicHost;
     options.researcherToken = o.token;
     options.stimuliDir = o.stimuli;
     ex::StudyServer server(store, options);
@@ -106,6 +114,7 @@ void runSimulate(const StudyOptions& o) {
     options.invertedObservers = o.invertedObservers;
     options.seed = o.seed;
     options.labelPrefix = o.labelPrefix;
+    options.browserLike = !o.apiOnly;
     if (!o.think.empty()) {
         static const std::regex thinkPattern(R"((\d+(?:\.\d+)?)(?::(\d+(?:\.\d+)?))?)");
         if (!std::regex_match(o.think, m, thinkPattern)) throw InputError("--think-ms: \"" + o.think + "\" is not MS or MIN:MAX");
@@ -155,7 +164,15 @@ void registerStudy(CLI::App& app) {
     serve->add_option("study", options->study, "study.db")->required();
     serve->add_option("--host", options->host, "Address to bind (default loopback only)")->capture_default_str();
     serve->add_option("--port", options->port, "Port (0 = any free port)")->capture_default_str()->check(CLI::Range(0, 65535));
-    serve->add_option("--threads", options->threads, "Worker threads")->capture_default_str()->check(CLI::Range(2, 1024));
+    serve->add_option("--threads", options->threads, "Worker threads running the requests (connections need none)")
+        ->capture_default_str()->check(CLI::Range(2, 1024));
+    serve->add_option("--public-host", options->publicHost,
+                      "Name the server is reached by (checked against the Host header; default: its address only)");
+    serve->add_option("--max-connections-per-client", options->connectionsPerClient,
+                      "Open connections allowed per client address")->capture_default_str()->check(CLI::Range(1, 100000));
+    serve->add_option("--joins-per-minute", options->joinsPerMinute,
+                      "New participants per client address per minute (also the burst)")->capture_default_str()
+        ->check(CLI::Range(1.0, 1e6));
     serve->add_option("--token", options->token, "Researcher token (default: random, printed at start)");
     serve->add_option("--stimuli", options->stimuli, "Stimulus folder, if it moved since `study create`");
     serve->callback([options] { runServe(*options); });
@@ -172,7 +189,11 @@ void registerStudy(CLI::App& app) {
     simulate->add_option("--inverted", options->invertedObservers, "Observers with inverted scores")->check(CLI::Range(0, 5000));
     simulate->add_option("--seed", options->seed, "Seed of the simulated answers")->capture_default_str();
     simulate->add_option("--think-ms", options->think, "Pause before each answer: MS or MIN:MAX");
-    simulate->add_option("--label-prefix", options->labelPrefix, "Observer label prefix (default sim-XXXX)");
+    simulate->add_option("--label-prefix", options->labelPrefix,
+                         "Observer label prefix (default sim-XXXX); run again with the same prefix to continue");
+    simulate->add_flag("--api-only", options->apiOnly,
+                       "Only the API calls, each on a new connection (default: like a browser — one kept-alive "
+                       "connection, the page, the study and each image once)");
     simulate->callback([options] { runSimulate(*options); });
 
     CLI::App* status = study->add_subcommand("status", "Per-participant progress and catch-trial accuracy");

@@ -7,9 +7,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <httplib.h>
+#include "experiments/http_client.h"
+#include "common/hash.h"
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <thread>
 
 namespace skinlab::experiments {
@@ -30,24 +32,29 @@ struct HttpResult {
 class ApiClient {
 public:
     ApiClient(const SimulationOptions& options) : client_(options.host, options.port), options_(options) {
-        client_.set_connection_timeout(2, 0);
-        client_.set_read_timeout(30, 0);
-        client_.set_write_timeout(30, 0);
+        client_.setTimeout(std::chrono::seconds(30));
+        client_.setKeepAlive(options.browserLike); // browsers keep their connection open between requests
+        client_.setUserAgent("skinlab-simulate");
     }
 
-    // Sends until an HTTP answer arrives (bounded by maxAttempts); counts the re-sends.
+    // Sends until an HTTP answer arrives (bounded by maxAttempts); counts the re-sends. A 429 (too many joins or
+    // connections from this address) is waited out as its Retry-After says.
     HttpResult send(const std::string& method, const std::string& path, const json& body, int& retries) {
         for (int attempt = 0; attempt < options_.maxAttempts; ++attempt) {
             const auto start = std::chrono::steady_clock::now();
-            httplib::Result res = method == "GET" ? client_.Get(path)
-                                                  : client_.Post(path, body.dump(), "application/json");
+            HttpAnswer res = method == "GET" ? client_.get(path) : client_.post(path, body.dump());
             const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-            if (res) {
+            if (res.status == 429) {
+                const int wait = std::clamp(std::atoi(res.header("Retry-After").c_str()), 1, 10);
+                std::this_thread::sleep_for(std::chrono::seconds(wait));
+                continue;
+            }
+            if (res.status != 0) {
                 HttpResult out;
-                out.status = res->status;
+                out.status = res.status;
                 out.milliseconds = ms;
                 try {
-                    out.body = json::parse(res->body);
+                    out.body = json::parse(res.body);
                 } catch (const json::parse_error&) {
                     out.body = json{{"error", "not JSON"}};
                 }
@@ -59,9 +66,20 @@ public:
         return {};
     }
 
+    // A static resource, as a browser with a cache fetches it: once per participant (bounded retries).
+    void fetchOnce(const std::string& path, int& retries) {
+        if (!options_.browserLike || !fetched_.insert(path).second) return;
+        for (int attempt = 0; attempt < options_.maxAttempts; ++attempt) {
+            if (client_.get(path).status != 0) return;
+            ++retries;
+            std::this_thread::sleep_for(std::chrono::milliseconds(options_.retryDelayMs * std::min(attempt + 1, 10)));
+        }
+    }
+
 private:
-    httplib::Client client_;
+    HttpClient client_;
     const SimulationOptions& options_;
+    std::set<std::string> fetched_;
 };
 
 double normal(SeededRandom& random) {
@@ -83,7 +101,12 @@ ObserverResult runObserver(StudyStore& store, const SimulationOptions& options, 
     SeededRandom random(combineSeed(options.seed, static_cast<std::uint64_t>(index)));
     ApiClient api(options);
 
-    HttpResult joined = api.send("POST", "/api/join", json{{"label", result.label}, {"join_key", randomHex(16)}}, result.transportRetries);
+    // The page's own sequence: the page and its script and style, the study, then join (the join key follows from
+    // the label, so a second run with the same --label-prefix continues these observers instead of failing).
+    for (const char* asset : {"/", "/app.js", "/style.css"}) api.fetchOnce(asset, result.transportRetries);
+    if (options.browserLike) api.send("GET", "/api/study", json(), result.transportRetries);
+    HttpResult joined = api.send("POST", "/api/join", json{{"label", result.label}, {"join_key", simulatedJoinKey(result.label)}},
+                                 result.transportRetries);
     if (joined.status != 201) {
         result.failure = "join: " + (joined.status ? joined.body.value("error", std::string("?")) : "no answer");
         return result;
@@ -101,8 +124,8 @@ ObserverResult runObserver(StudyStore& store, const SimulationOptions& options, 
 
     // The plan, read from study.db, tells the simulated observer what each trial shows.
     const ParticipantRecord participant = store.participant(token);
-    std::map<std::int64_t, PlannedTrial> plan;
-    for (const TrialRecord& t : store.trials(participant.id)) plan[t.id] = t.plan;
+    std::map<std::int64_t, std::pair<std::int64_t, PlannedTrial>> plan; // by reference: (row id, trial)
+    for (const TrialRecord& t : store.trials(participant.id)) plan[trialReference(token, t.id)] = {t.id, t.plan};
     const double invert = kind == "inverted" ? -1.0 : 1.0;
 
     // Bounded: every iteration either acknowledges a response or counts a rejection. (An active design stores its
@@ -127,7 +150,12 @@ ObserverResult runObserver(StudyStore& store, const SimulationOptions& options, 
             result.failure = "trial " + std::to_string(trialId) + " is not in this participant's plan";
             break;
         }
-        const PlannedTrial& t = it->second;
+        const PlannedTrial& t = it->second.second;
+        // Both images (and the reference), each once: the browser's cache keeps them (immutable, ETag).
+        for (const char* side : {"left", "right", "reference"}) {
+            const json& shown = body["trial"][side];
+            if (shown.is_object() && shown.contains("url")) api.fetchOnce(shown["url"].get<std::string>(), result.transportRetries);
+        }
         bool chooseA;
         if (kind == "random" || random.unit() < options.lapseRate) {
             chooseA = random.coin();
@@ -155,7 +183,7 @@ ObserverResult runObserver(StudyStore& store, const SimulationOptions& options, 
         response["client_time"] = utcTimestamp();
         HttpResult answer = api.send("POST", "/api/response", response, result.transportRetries);
         if (answer.status == 200) {
-            result.acknowledged.emplace_back(trialId, side);
+            result.acknowledged.emplace_back(it->second.first, side);
             ++result.answered;
             latencies.push_back(answer.milliseconds);
             state = std::move(answer);
@@ -177,6 +205,8 @@ ObserverResult runObserver(StudyStore& store, const SimulationOptions& options, 
 }
 
 } // namespace
+
+std::string simulatedJoinKey(const std::string& label) { return "sim-" + skinlab::sha256Hex("skinlab-simulate:" + label).substr(0, 40); }
 
 double SimulationTruth::quality(const std::string& block, const std::string& condition) const {
     if (auto b = byBlock.find(block); b != byBlock.end()) {

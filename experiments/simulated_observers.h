@@ -42,6 +42,9 @@ struct SimulationOptions {
     double thinkMinMs = 0;    // pause before each answer, uniform in [min, max]
     double thinkMaxMs = 0;
     std::string labelPrefix;  // observer labels "<prefix>-001[-random|-inverted]"; empty = "sim-<random>"
+    bool browserLike = true;  // as the participant page does: kept-alive connection, page + study + images (each
+                              // once: the browser caches them) around the API calls; false = API calls only, each
+                              // on a new connection
     int maxAttempts = 300;    // per request, when the server cannot be reached (restarts); bounded
     int retryDelayMs = 50;
 };
@@ -53,7 +56,7 @@ struct ObserverResult {
     int answered = 0;          // acknowledged responses (stored or duplicate)
     int rejected = 0;          // 4xx/5xx answers
     int transportRetries = 0;  // re-sends after a failed connection
-    std::vector<std::pair<std::int64_t, std::string>> acknowledged; // (trial id, side) in order
+    std::vector<std::pair<std::int64_t, std::string>> acknowledged; // (trial row id, side) in order
     std::string completionCode;
     std::string failure;       // why it stopped early, if it did
 };
@@ -68,6 +71,10 @@ struct SimulationReport {
     std::size_t acknowledged() const;
     double latencyPercentile(double p) const; // p in [0, 100]
 };
+
+// The join key of the simulated observer labelled `label`: the same label joins as the same participant, so an
+// interrupted simulation run again with the same --label-prefix continues where it stopped.
+std::string simulatedJoinKey(const std::string& label);
 
 // Runs the observers concurrently (one thread each) against a server serving `store`'s study.
 SimulationReport simulateObservers(StudyStore& store, const SimulationOptions& options);

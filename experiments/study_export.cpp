@@ -7,7 +7,10 @@
 namespace skinlab::experiments {
 
 std::string csvField(const std::string& value) {
-    if (value.find_first_of(",\"\r\n") == std::string::npos) return value;
+    // Quoted also when it starts or ends with a blank, which readers trim from unquoted fields.
+    const bool blankEdge = !value.empty() && (value.front() == ' ' || value.front() == '\t' || value.back() == ' ' ||
+                                              value.back() == '\t');
+    if (!blankEdge && value.find_first_of(",\"\r\n") == std::string::npos) return value;
     std::string out = "\"";
     for (char c : value) {
         if (c == '"') out += '"';
@@ -58,7 +61,9 @@ std::string exportResponses(StudyStore& store, const std::string& format) {
                                         {"server_time", r.serverTime}, {"viewport_width", r.viewportWidth},
                                         {"viewport_height", r.viewportHeight},
                                         {"device_pixel_ratio", r.devicePixelRatio}, {"user_agent", r.userAgent}});
-        return out.dump(2) + "\n";
+        // Stored text is well-formed UTF-8 (validUtf8), but a study file written by an older version may hold raw
+        // header bytes: those are replaced (U+FFFD) rather than failing the whole export.
+        return out.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
     }
     const bool pwcmp = format == "pwcmp";
     std::string out = pwcmp ? "observer,scene,condition_A,condition_B,is_A_selected\n"

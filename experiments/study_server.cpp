@@ -6,8 +6,9 @@
 #include "experiments/request_error.h"
 #include "experiments/study_export.h"
 
-#include <httplib.h>
-#include <sys/socket.h>
+#include <boost/asio/ip/address.hpp>
+#include <algorithm>
+#include <cmath>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <spdlog/spdlog.h>
@@ -28,42 +29,26 @@ namespace {
 constexpr std::size_t kMaxTokenLength = 64;
 constexpr std::size_t kMaxTextLength = 512;
 
-void sendJson(httplib::Response& res, int status, const json& body) {
+HttpResponse jsonResponse(int status, const json& body) {
+    HttpResponse res;
     res.status = status;
-    res.set_header("Cache-Control", "no-store");
-    res.set_content(body.dump(), "application/json");
+    res.contentType = "application/json";
+    res.headers.emplace_back("Cache-Control", "no-store");
+    res.body = body.dump(-1, ' ', false, json::error_handler_t::replace);
+    return res;
 }
 
-void sendError(httplib::Response& res, int status, const std::string& message) {
-    sendJson(res, status, json{{"error", message}});
-}
+HttpResponse errorResponse(int status, const std::string& message) { return jsonResponse(status, json{{"error", message}}); }
 
-// Runs a handler, turning every failure into a JSON error response.
-template <class Handler> auto guarded(Handler handler) {
-    return [handler](const httplib::Request& req, httplib::Response& res) {
-        try {
-            handler(req, res);
-        } catch (const RequestError& e) {
-            spdlog::debug("{} {}: {} {}", req.method, req.path, e.status(), e.what());
-            sendError(res, e.status(), e.what());
-        } catch (const InputError& e) {
-            spdlog::debug("{} {}: 400 {}", req.method, req.path, e.what());
-            sendError(res, 400, e.what());
-        } catch (const std::exception& e) {
-            spdlog::error("{} {}: {}", req.method, req.path, e.what());
-            sendError(res, 500, "internal error");
-        }
-    };
-}
-
-json parseBody(const httplib::Request& req) {
-    const std::string type = req.get_header_value("Content-Type");
+json parseBody(const HttpRequest& req) {
+    const std::string type = req.header("Content-Type");
     // Requiring JSON also keeps cross-site HTML forms (which cannot send it without a CORS preflight) out.
     if (type.rfind("application/json", 0) != 0) throw RequestError(415, "expected Content-Type: application/json");
     json body;
     try {
         body = json::parse(req.body);
-    } catch (const json::parse_error&) {
+    } catch (const json::exception&) {
+        // parse_error, and out_of_range for numbers no double holds (1e400).
         throw RequestError(400, "request body is not valid JSON");
     }
     if (!body.is_object()) throw RequestError(400, "request body must be a JSON object");
@@ -86,6 +71,8 @@ std::int64_t integerField(const json& body, const char* name, std::int64_t min, 
     if (!body.contains(name)) throw RequestError(400, std::string(name) + ": missing");
     const json& v = body[name];
     if (!v.is_number_integer()) throw RequestError(400, std::string(name) + ": expected an integer");
+    if (v.is_number_unsigned() && v.get<std::uint64_t>() > static_cast<std::uint64_t>(INT64_MAX))
+        throw RequestError(400, std::string(name) + ": out of range");
     const std::int64_t value = v.get<std::int64_t>();
     if (value < min || value > max)
         throw RequestError(400, std::string(name) + ": " + std::to_string(value) + " is out of range [" +
@@ -103,11 +90,7 @@ double numberField(const json& body, const char* name, double min, double max) {
     return value;
 }
 
-std::string userAgentOf(const httplib::Request& req) {
-    std::string agent = req.get_header_value("User-Agent");
-    if (agent.size() > kMaxTextLength) agent.resize(kMaxTextLength);
-    return agent;
-}
+std::string userAgentOf(const HttpRequest& req) { return validUtf8(req.header("User-Agent"), kMaxTextLength); }
 
 bool constantTimeEqual(const std::string& a, const std::string& b) {
     if (a.size() != b.size()) return false;
@@ -116,112 +99,199 @@ bool constantTimeEqual(const std::string& a, const std::string& b) {
     return diff == 0;
 }
 
+std::string lowerCase(std::string s) {
+    for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return s;
+}
+
+// "/stimuli/<digits>.png" (1 to 6 digits) → the number.
+std::optional<std::size_t> stimulusNumber(const std::string& path) {
+    static const std::string prefix = "/stimuli/", suffix = ".png";
+    if (path.size() <= prefix.size() + suffix.size() || path.rfind(prefix, 0) != 0 ||
+        path.compare(path.size() - suffix.size(), suffix.size(), suffix) != 0)
+        return std::nullopt;
+    const std::string digits = path.substr(prefix.size(), path.size() - prefix.size() - suffix.size());
+    if (digits.empty() || digits.size() > 6) return std::nullopt;
+    for (char c : digits)
+        if (c < '0' || c > '9') return std::nullopt;
+    return std::stoul(digits);
+}
+
+bool etagMatches(const std::string& ifNoneMatch, const std::string& etag) {
+    if (ifNoneMatch.empty()) return false;
+    if (ifNoneMatch.find('*') != std::string::npos) return true;
+    // A list of (possibly weak, W/"...") tags; the comparison is weak (RFC 9110 §13.1.2).
+    return ifNoneMatch.find(etag) != std::string::npos;
+}
+
 } // namespace
 
 StudyServer::StudyServer(StudyStore& store, ServerOptions options) : store_(store), options_(std::move(options)) {
     if (options_.researcherToken.empty()) options_.researcherToken = randomHex(16);
     if (options_.stimuliDir.empty()) options_.stimuliDir = store_.meta("stimuli_dir");
+    std::error_code ec;
+    const fs::path folder = fs::weakly_canonical(options_.stimuliDir, ec);
     for (const StudyStimulus& s : store_.definition().stimuli) {
         const fs::path file = options_.stimuliDir / s.pngPath;
         if (!fs::is_regular_file(file))
             throw InputError(file.string() + ": stimulus image missing (stimulus \"" + s.id +
                              "\"); pass --stimuli DIR if the set moved");
-        if (sha256File(file) != s.sha256)
+        // A link may point within the set, never out of it.
+        const fs::path resolved = fs::weakly_canonical(file, ec);
+        const auto [end, unused] = std::mismatch(folder.begin(), folder.end(), resolved.begin(), resolved.end());
+        if (ec || end != folder.end())
+            throw InputError(file.string() + ": resolves to " + resolved.string() + ", outside the stimulus folder " +
+                             folder.string() + " (stimulus \"" + s.id + "\")");
+        // The bytes checked are the bytes served: read once, verified, held in memory.
+        Stimulus stimulus;
+        stimulus.bytes = std::make_shared<const std::string>(readFile(resolved));
+        if (sha256Hex(*stimulus.bytes) != s.sha256)
             throw InputError(file.string() + ": sha256 differs from the study's manifest (stimulus \"" + s.id +
                              "\"); the stimulus set changed after `study create`");
-        stimulusFiles_.push_back(file);
+        stimulus.etag = "\"" + s.sha256 + "\"";
+        stimuli_.push_back(std::move(stimulus));
     }
-    server_ = std::make_unique<httplib::Server>();
-    const int threads = options_.threads;
-    server_->new_task_queue = [threads] { return new httplib::ThreadPool(static_cast<std::size_t>(threads)); };
-    server_->set_payload_max_length(options_.maxBodyBytes);
-    server_->set_keep_alive_timeout(2);  // seconds; an idle browser connection frees its worker soon
-    server_->set_read_timeout(10, 0);
-    server_->set_write_timeout(10, 0);
-    server_->set_tcp_nodelay(true);
-    // Remember the listening socket: Debian's libcpp-httplib is built with a listen backlog of 5
-    // (CPPHTTPLIB_LISTEN_BACKLOG), so a burst of participants connecting at once overflows it and their SYNs are
-    // retried by the kernel after 1 s. bind() raises the backlog on this socket.
-    server_->set_socket_options([this](int sock) {
-        int yes = 1;
-        ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
-        listeningSocket_ = sock;
-    });
-    server_->set_error_handler(httplib::Server::HandlerWithResponse([](const httplib::Request&, httplib::Response& res) {
-        // Statuses httplib sets itself (404 no route, 413 body too large, 400 malformed request line) get a JSON
-        // body too; responses that already carry one keep it.
-        if (res.body.empty()) {
-            const char* reason = res.status == 404 ? "not found"
-                                 : res.status == 413 ? "request body too large"
-                                 : res.status == 405 ? "method not allowed"
-                                                     : "bad request";
-            sendError(res, res.status, reason);
-        }
-        return httplib::Server::HandlerResponse::Handled;
-    }));
-    registerRoutes();
+    HttpLimits limits;
+    limits.bodyBytes = options_.maxBodyBytes;
+    limits.headerBytes = options_.maxHeaderBytes;
+    limits.connectionsPerClient = options_.connectionsPerClient;
+    limits.workerThreads = options_.threads;
+    limits.ioThreads = options_.ioThreads;
+    limits.requestTimeout = options_.requestTimeout;
+    http_ = std::make_unique<HttpServer>([this](const HttpRequest& request) { return handle(request); }, limits);
 }
 
-StudyServer::~StudyServer() { stop(); }
+StudyServer::~StudyServer() {
+    stop();
+    http_.reset(); // joins the workers before the members their handlers use are destroyed
+}
 
 std::string StudyServer::url() const {
     const std::string host = options_.host == "0.0.0.0" ? "127.0.0.1" : options_.host;
-    return "http://" + host + ":" + std::to_string(port_) + "/";
+    return "http://" + (host.find(':') != std::string::npos ? "[" + host + "]" : host) + ":" + std::to_string(port_) + "/";
 }
 
 int StudyServer::bind() {
-    if (options_.port == 0) {
-        port_ = server_->bind_to_any_port(options_.host);
-    } else {
-        port_ = server_->bind_to_port(options_.host, options_.port) ? options_.port : -1;
-    }
-    if (port_ <= 0)
-        throw InputError("--host/--port: cannot listen on " + options_.host + ":" + std::to_string(options_.port) +
-                         " (address in use or not available)");
-    // Calling listen() again on a listening socket updates its backlog (Linux); SOMAXCONN caps it.
-    if (listeningSocket_ >= 0) ::listen(listeningSocket_, SOMAXCONN);
+    port_ = http_->bind(options_.host, options_.port);
     return port_;
 }
 
-void StudyServer::run() { server_->listen_after_bind(); }
+void StudyServer::run() { http_->run(); }
 void StudyServer::stop() {
-    if (server_) server_->stop();
+    if (http_) http_->stop();
 }
-bool StudyServer::running() const { return server_ && server_->is_running(); }
+bool StudyServer::running() const { return http_ && http_->running(); }
 
-void StudyServer::registerRoutes() {
-    httplib::Server& server = *server_;
+bool StudyServer::hostAllowed(const std::string& hostHeader) const {
+    // Host = name-or-address [":" port]. A browser sends the name it resolved; a DNS-rebinding page sends its own
+    // name, so only the bound address, a loopback name for a loopback server, or --public-host NAME are accepted.
+    std::string name = lowerCase(hostHeader), portText;
+    if (!name.empty() && name.front() == '[') {
+        const std::size_t close = name.find(']');
+        if (close == std::string::npos) return false;
+        portText = close + 1 < name.size() && name[close + 1] == ':' ? name.substr(close + 2) : "";
+        if (close + 1 < name.size() && name[close + 1] != ':') return false;
+        name = name.substr(1, close - 1);
+    } else if (const std::size_t colon = name.rfind(':'); colon != std::string::npos) {
+        portText = name.substr(colon + 1);
+        name = name.substr(0, colon);
+    }
+    if (name.empty()) return false;
+    if (!options_.publicHost.empty() && name == lowerCase(options_.publicHost)) return true; // any port (a proxy)
+    if (portText != std::to_string(port_)) return false;
+    boost::system::error_code ec;
+    const auto bound = boost::asio::ip::make_address(options_.host, ec);
+    if (ec) return false;
+    if (name == "localhost") return bound.is_loopback() || bound.is_unspecified();
+    const auto address = boost::asio::ip::make_address(name, ec);
+    if (ec) return false; // any other name
+    return bound.is_unspecified() || address == bound;
+}
+
+bool StudyServer::allowJoin(const std::string& clientAddress, double& retryAfterSeconds) {
+    // A token bucket per client address: joinBurst joins at once, then joinsPerMinute.
+    std::lock_guard lock(joinMutex_);
+    const auto now = std::chrono::steady_clock::now();
+    if (joinBuckets_.size() > 100000) joinBuckets_.clear(); // bounded memory under an address-spraying flood
+    auto [it, fresh] = joinBuckets_.try_emplace(clientAddress);
+    JoinBucket& bucket = it->second;
+    const double perSecond = options_.joinsPerMinute / 60.0;
+    if (fresh) bucket.tokens = options_.joinBurst;
+    else bucket.tokens = std::min(options_.joinBurst, bucket.tokens + perSecond * std::chrono::duration<double>(now - bucket.updated).count());
+    bucket.updated = now;
+    if (bucket.tokens >= 1) {
+        bucket.tokens -= 1;
+        return true;
+    }
+    retryAfterSeconds = perSecond > 0 ? (1 - bucket.tokens) / perSecond : 60;
+    return false;
+}
+
+HttpResponse StudyServer::handle(const HttpRequest& req) {
+    try {
+        if (req.headerCount("Host") != 1) throw RequestError(400, "Host: exactly one Host header is required");
+        if (!hostAllowed(req.header("Host")))
+            throw RequestError(421, "Host: \"" + validUtf8(req.header("Host"), 64) +
+                                        "\" is not this server (serve with --public-host NAME to be reached by a name)");
+        return route(req);
+    } catch (const RequestError& e) {
+        spdlog::debug("{} {}: {} {}", req.method, validUtf8(req.path, 128), e.status(), e.what());
+        HttpResponse res = errorResponse(e.status(), e.what());
+        if (e.status() == 429) res.headers.emplace_back("Retry-After", "5");
+        return res;
+    } catch (const InputError& e) {
+        spdlog::debug("{} {}: 400 {}", req.method, validUtf8(req.path, 128), e.what());
+        return errorResponse(400, e.what());
+    } catch (const std::exception& e) {
+        spdlog::error("{} {}: {}", req.method, validUtf8(req.path, 128), e.what());
+        return errorResponse(500, "internal error");
+    }
+}
+
+HttpResponse StudyServer::route(const HttpRequest& req) {
     const StudyDefinition& definition = store_.definition();
+    const std::string& path = req.path;
+    const bool get = req.method == "GET", post = req.method == "POST";
 
-    auto serveWebFile = [](const std::string& name, const char* type) {
-        return [name, type](const httplib::Request&, httplib::Response& res) {
-            const auto file = web::embeddedFile(name);
-            if (!file) return sendError(res, 404, "not found");
-            res.set_header("Cache-Control", "no-cache");
-            res.set_header("X-Content-Type-Options", "nosniff");
-            res.set_header("Content-Security-Policy", "default-src 'self'; img-src 'self'; style-src 'self'; script-src 'self'");
-            res.set_content(std::string(*file), type);
-        };
+    auto webFile = [](const std::string& name, const char* type) {
+        const auto file = web::embeddedFile(name);
+        if (!file) return errorResponse(404, "not found");
+        HttpResponse res;
+        res.contentType = type;
+        res.headers = {{"Cache-Control", "no-cache"},
+                       {"X-Content-Type-Options", "nosniff"},
+                       {"Content-Security-Policy", "default-src 'self'; img-src 'self'; style-src 'self'; script-src 'self'"}};
+        res.body = std::string(*file);
+        return res;
     };
-    server.Get("/", serveWebFile("index.html", "text/html; charset=utf-8"));
-    server.Get("/index.html", serveWebFile("index.html", "text/html; charset=utf-8"));
-    server.Get("/app.js", serveWebFile("app.js", "text/javascript; charset=utf-8"));
-    server.Get("/style.css", serveWebFile("style.css", "text/css; charset=utf-8"));
+    if (get && (path == "/" || path == "/index.html")) return webFile("index.html", "text/html; charset=utf-8");
+    if (get && path == "/app.js") return webFile("app.js", "text/javascript; charset=utf-8");
+    if (get && path == "/style.css") return webFile("style.css", "text/css; charset=utf-8");
 
     // Stimuli by number only: the number indexes the study's own list, so no request can name another file.
-    server.Get(R"(/stimuli/(\d{1,6})\.png)", guarded([this](const httplib::Request& req, httplib::Response& res) {
-        const std::size_t index = std::stoul(req.matches[1].str());
-        if (index >= stimulusFiles_.size()) throw RequestError(404, "no such stimulus");
-        res.set_header("Cache-Control", "private, max-age=3600");
-        res.set_header("X-Content-Type-Options", "nosniff");
-        res.set_content(readFile(stimulusFiles_[index]), "image/png");
-    }));
+    // The bytes never change while the study runs (content-addressed by sha256): cached for good by the browser.
+    if (get && path.rfind("/stimuli/", 0) == 0) {
+        const auto index = stimulusNumber(path);
+        if (!index || *index >= stimuli_.size()) throw RequestError(404, "no such stimulus");
+        const Stimulus& stimulus = stimuli_[*index];
+        HttpResponse res;
+        res.headers = {{"Cache-Control", "private, max-age=31536000, immutable"},
+                       {"ETag", stimulus.etag},
+                       {"X-Content-Type-Options", "nosniff"}};
+        if (etagMatches(req.header("If-None-Match"), stimulus.etag)) {
+            res.status = 304;
+            return res;
+        }
+        res.contentType = "image/png";
+        res.sharedBody = stimulus.bytes;
+        return res;
+    }
 
     auto stimulusJson = [&definition](int index) {
         const StudyStimulus& s = definition.stimuli[static_cast<std::size_t>(index)];
         return json{{"url", "/stimuli/" + std::to_string(index) + ".png"}, {"width", s.width}, {"height", s.height}};
     };
-    auto trialJson = [&definition, stimulusJson](const TrialRecord& t) {
+    auto trialJson = [&definition, stimulusJson](const TrialRecord& t, const std::string& token) {
         const PlannedTrial& p = t.plan;
         const StudyStimulus& a = definition.stimuli[static_cast<std::size_t>(p.stimulusA)];
         json sideA = stimulusJson(p.stimulusA);
@@ -229,7 +299,7 @@ void StudyServer::registerRoutes() {
         json sideB = p.stimulusB == kBlankStimulus ? json{{"blank", true}, {"width", a.width}, {"height", a.height}}
                                                    : stimulusJson(p.stimulusB);
         // Catch trials look like any other trial to the participant; only practice is announced.
-        return json{{"id", t.id},
+        return json{{"id", trialReference(token, t.id)},
                     {"position", t.position},
                     {"practice", p.kind == TrialKind::practice},
                     {"left", p.aOnLeft ? sideA : sideB},
@@ -249,19 +319,19 @@ void StudyServer::registerRoutes() {
                    {"total", progress.total - practiceTotal},
                    {"practice_answered", practiceAnswered},
                    {"practice_total", practiceTotal},
-                   {"trial", next ? trialJson(*next) : json()},
+                   {"trial", next ? trialJson(*next, p.token) : json()},
                    {"completed", !next.has_value()}};
         if (!next) state["completion_code"] = p.completionCode;
         return state;
     };
 
-    server.Get("/api/study", guarded([&definition](const httplib::Request&, httplib::Response& res) {
+    if (get && path == "/api/study") {
         const StudyDesign& d = definition.design;
-        sendJson(res, 200, {{"title", d.title}, {"question", d.question}, {"instructions", d.instructions},
-                            {"consent", d.consent}, {"break_every", d.breakEvery}});
-    }));
+        return jsonResponse(200, {{"title", d.title}, {"question", d.question}, {"instructions", d.instructions},
+                                  {"consent", d.consent}, {"break_every", d.breakEvery}});
+    }
 
-    server.Post("/api/join", guarded([this](const httplib::Request& req, httplib::Response& res) {
+    if (post && path == "/api/join") {
         const json body = parseBody(req);
         const std::string label = stringField(body, "label", kMaxTokenLength, false);
         for (char c : label)
@@ -271,12 +341,18 @@ void StudyServer::registerRoutes() {
         for (char c : joinKey)
             if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_'))
                 throw RequestError(400, "join_key: only letters, digits, '-' and '_' are allowed");
+        double retryAfter = 0;
+        if (!allowJoin(req.clientAddress, retryAfter)) {
+            HttpResponse res = errorResponse(429, "too many new participants from this address; retry later");
+            res.headers.emplace_back("Retry-After", std::to_string(static_cast<int>(std::ceil(retryAfter))));
+            return res;
+        }
         const ParticipantRecord p = store_.join(label, joinKey);
         spdlog::info("participant {} joined", p.label);
-        sendJson(res, 201, {{"token", p.token}, {"observer", p.label}});
-    }));
+        return jsonResponse(201, {{"token", p.token}, {"observer", p.label}});
+    }
 
-    server.Post("/api/session", guarded([this, stateJson](const httplib::Request& req, httplib::Response& res) {
+    if (post && path == "/api/session") {
         const json body = parseBody(req);
         const ParticipantRecord p = store_.participant(stringField(body, "token", kMaxTokenLength));
         const int width = static_cast<int>(integerField(body, "viewport_width", 0, 100000));
@@ -285,16 +361,16 @@ void StudyServer::registerRoutes() {
         const std::int64_t session = store_.startSession(p.id, userAgentOf(req), width, height, dpr);
         json state = stateJson(p);
         state["session"] = session;
-        sendJson(res, 200, state);
-    }));
+        return jsonResponse(200, state);
+    }
 
-    server.Get("/api/state", guarded([this, stateJson](const httplib::Request& req, httplib::Response& res) {
-        const std::string token = req.get_param_value("token");
+    if (get && path == "/api/state") {
+        const std::string token = req.queryParameter("token").value_or("");
         if (token.empty() || token.size() > kMaxTokenLength) throw RequestError(400, "token: missing");
-        sendJson(res, 200, stateJson(store_.participant(token)));
-    }));
+        return jsonResponse(200, stateJson(store_.participant(token)));
+    }
 
-    server.Post("/api/response", guarded([this, stateJson](const httplib::Request& req, httplib::Response& res) {
+    if (post && path == "/api/response") {
         const json body = parseBody(req);
         ResponseInput in;
         in.token = stringField(body, "token", kMaxTokenLength);
@@ -313,29 +389,32 @@ void StudyServer::registerRoutes() {
         json state = stateJson(store_.participant(in.token));
         state["stored"] = outcome == ResponseOutcome::stored;
         state["duplicate"] = outcome == ResponseOutcome::duplicate;
-        sendJson(res, 200, state);
-    }));
+        return jsonResponse(200, state);
+    }
 
-    auto requireResearcher = [this](const httplib::Request& req) {
-        std::string token;
-        const std::string authorization = req.get_header_value("Authorization");
-        if (authorization.rfind("Bearer ", 0) == 0) token = authorization.substr(7);
-        else if (req.has_param("token")) token = req.get_param_value("token");
-        if (token.empty()) throw RequestError(401, "researcher token required (Authorization: Bearer TOKEN)");
-        if (!constantTimeEqual(token, options_.researcherToken)) throw RequestError(403, "wrong researcher token");
-    };
-    server.Get("/api/researcher/status", guarded([this, requireResearcher](const httplib::Request& req, httplib::Response& res) {
-        requireResearcher(req);
-        sendJson(res, 200, statusJson(store_));
-    }));
-    server.Get("/api/researcher/export", guarded([this, requireResearcher](const httplib::Request& req, httplib::Response& res) {
-        requireResearcher(req);
-        const std::string format = req.has_param("format") ? req.get_param_value("format") : "csv";
-        if (format != "csv" && format != "json" && format != "pwcmp")
-            throw RequestError(400, "format: \"" + format.substr(0, 16) + "\" is not one of csv, json, pwcmp");
-        res.set_header("Cache-Control", "no-store");
-        res.set_content(exportResponses(store_, format), format == "json" ? "application/json" : "text/csv");
-    }));
+    if (get && path.rfind("/api/researcher/", 0) == 0) {
+        // The token travels in a header only: a URL ends up in logs, proxies and the browser's history.
+        const std::string authorization = req.header("Authorization");
+        if (authorization.rfind("Bearer ", 0) != 0) {
+            if (req.queryParameter("token"))
+                throw RequestError(401, "researcher token: send it as Authorization: Bearer TOKEN, never in the URL");
+            throw RequestError(401, "researcher token required (Authorization: Bearer TOKEN)");
+        }
+        if (!constantTimeEqual(authorization.substr(7), options_.researcherToken))
+            throw RequestError(403, "wrong researcher token");
+        if (path == "/api/researcher/status") return jsonResponse(200, statusJson(store_));
+        if (path == "/api/researcher/export") {
+            const std::string format = req.queryParameter("format").value_or("csv");
+            if (format != "csv" && format != "json" && format != "pwcmp")
+                throw RequestError(400, "format: \"" + validUtf8(format, 16) + "\" is not one of csv, json, pwcmp");
+            HttpResponse res;
+            res.contentType = format == "json" ? "application/json" : "text/csv";
+            res.headers.emplace_back("Cache-Control", "no-store");
+            res.body = exportResponses(store_, format);
+            return res;
+        }
+    }
+    throw RequestError(404, "not found");
 }
 
 } // namespace skinlab::experiments

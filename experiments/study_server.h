@@ -1,35 +1,44 @@
 #pragma once
-// The study's HTTP server (cpp-httplib): the participant page (embedded HTML/CSS/JS), the participant API,
-// the study's own stimulus images, and researcher endpoints behind a token. API reference: docs/experiments.md.
+// The study's HTTP server: the participant page (embedded HTML/CSS/JS), the participant API, the study's own
+// stimulus images, and researcher endpoints behind a token. API reference and limits: docs/experiments.md.
+// Transport: HttpServer (event-driven, Boost.Beast; docs/architecture.md, "Study server: threading model").
 //
 // Every rejected request is answered with a 4xx status and JSON {"error": "..."} and changes nothing.
-// Only the stimuli listed in the study are served, by number (/stimuli/<n>.png); no request path is ever mapped
-// onto the file system.
+// Only the stimuli listed in the study are served, by number (/stimuli/<n>.png), from the bytes verified against
+// their sha256 when the server started (held in memory); no request path is ever mapped onto the file system.
+#include "experiments/http_server.h"
 #include "experiments/study_store.h"
 
+#include <chrono>
 #include <filesystem>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
-
-namespace httplib {
-class Server;
-}
 
 namespace skinlab::experiments {
 
 struct ServerOptions {
     std::string host = "127.0.0.1"; // loopback unless the researcher says otherwise
     int port = 8080;                 // 0 = any free port
-    int threads = 64;                // worker threads (each holds one connection while it is open)
+    int threads = 8;                 // worker threads running the handlers (connections need none)
+    int ioThreads = 2;               // threads holding the connections
     std::string researcherToken;     // empty = a random one
     std::filesystem::path stimuliDir; // empty = the folder recorded at `study create`
-    std::size_t maxBodyBytes = 16 * 1024; // larger request bodies are refused with 413
+    std::size_t maxBodyBytes = 16 * 1024;  // larger request bodies are refused with 413 (chunked too)
+    std::size_t maxHeaderBytes = 8 * 1024; // larger request headers are refused with 431
+    int connectionsPerClient = 64;   // open connections per client address (more: 429)
+    std::string publicHost;          // a name the server is reached by (Host header); empty = its address only
+    double joinsPerMinute = 60;      // new participants per client address: sustained rate...
+    double joinBurst = 60;           // ...and burst (more: 429 with Retry-After)
+    std::chrono::milliseconds requestTimeout{10000}; // a request must arrive within this once started (else 408)
 };
 
 class StudyServer {
 public:
-    // Checks every stimulus image against its sha256 before serving (InputError naming the file otherwise).
+    // Reads every stimulus image once and checks it against its sha256 (InputError naming the file otherwise);
+    // an image that resolves outside the stimulus folder (a link out of the set) is refused too.
     StudyServer(StudyStore& store, ServerOptions options);
     ~StudyServer();
 
@@ -43,16 +52,29 @@ public:
     int port() const { return port_; }
     const std::string& researcherToken() const { return options_.researcherToken; }
     std::string url() const;
+    int openConnections() const { return http_->openConnections(); }
 
 private:
-    void registerRoutes();
+    struct Stimulus {
+        std::shared_ptr<const std::string> bytes; // verified at start; served from memory
+        std::string etag;  // "\"<sha256>\""
+    };
+    HttpResponse handle(const HttpRequest& request);
+    HttpResponse route(const HttpRequest& request);
+    bool hostAllowed(const std::string& host) const;
+    bool allowJoin(const std::string& clientAddress, double& retryAfterSeconds);
 
     StudyStore& store_;
     ServerOptions options_;
-    std::vector<std::filesystem::path> stimulusFiles_;
-    std::unique_ptr<httplib::Server> server_;
+    std::vector<Stimulus> stimuli_;
+    std::unique_ptr<HttpServer> http_;
     int port_ = 0;
-    int listeningSocket_ = -1;
+    struct JoinBucket {
+        double tokens = 0;
+        std::chrono::steady_clock::time_point updated;
+    };
+    std::mutex joinMutex_;
+    std::map<std::string, JoinBucket> joinBuckets_;
 };
 
 } // namespace skinlab::experiments

@@ -21,6 +21,7 @@ namespace {
 
 constexpr const char* kFormat = "skinlab-study";
 constexpr int kFormatVersion = 1;
+constexpr std::size_t kMaxStoredText = 512; // bytes of a stored client string (User-Agent, client time)
 
 // The schema. responses.trial_id is the PRIMARY KEY: at most one response per planned trial, whatever the
 // network does. responses_long is contract 3 (read by analysis/scaling).
@@ -190,6 +191,57 @@ std::string randomHex(std::size_t bytes) {
     return out;
 }
 
+std::int64_t trialReference(const std::string& token, std::int64_t trialId) {
+    // 20 bits of SHA-256(token, id) above the 32-bit row id: below 2^53, so JavaScript numbers carry it exactly.
+    const std::string digest = sha256Hex(token + ":" + std::to_string(trialId));
+    const std::int64_t tag = static_cast<std::int64_t>(std::stoul(digest.substr(0, 5), nullptr, 16)) | 1;
+    return (tag << 32) | (trialId & 0xFFFFFFFFll);
+}
+
+std::string validUtf8(std::string_view text, std::size_t maxBytes) {
+    // Well-formed UTF-8 (RFC 3629: no overlongs, no surrogates, at most U+10FFFF); every ill-formed byte becomes
+    // U+FFFD, and the result is cut before `maxBytes` on a character boundary.
+    static const std::string_view replacement = "\xEF\xBF\xBD";
+    std::string out;
+    std::size_t i = 0;
+    auto append = [&](std::string_view piece) {
+        if (out.size() + piece.size() > maxBytes) return false;
+        out += piece;
+        return true;
+    };
+    while (i < text.size()) {
+        const auto b = static_cast<unsigned char>(text[i]);
+        std::size_t length = 0;
+        unsigned char low = 0x80, high = 0xBF;
+        if (b < 0x80) length = 1;
+        else if (b >= 0xC2 && b <= 0xDF) length = 2;
+        else if (b >= 0xE0 && b <= 0xEF) {
+            length = 3;
+            if (b == 0xE0) low = 0xA0;
+            if (b == 0xED) high = 0x9F;
+        } else if (b >= 0xF0 && b <= 0xF4) {
+            length = 4;
+            if (b == 0xF0) low = 0x90;
+            if (b == 0xF4) high = 0x8F;
+        }
+        bool ok = length > 0 && i + length <= text.size();
+        for (std::size_t k = 1; ok && k < length; ++k) {
+            const auto c = static_cast<unsigned char>(text[i + k]);
+            const unsigned char lo = k == 1 ? low : 0x80, hi = k == 1 ? high : 0xBF;
+            ok = c >= lo && c <= hi;
+        }
+        if (ok && b < 0x20 && b != '\t') ok = false; // control characters have no place in a stored header
+        if (!append(ok ? text.substr(i, length) : replacement)) break;
+        if (ok) i += length;
+        else {
+            // Skip the lead byte and any continuation bytes that belonged to it.
+            ++i;
+            while (i < text.size() && (static_cast<unsigned char>(text[i]) & 0xC0) == 0x80) ++i;
+        }
+    }
+    return out;
+}
+
 void StudyStore::create(const fs::path& path, const StudyDefinition& definition, const std::string& designText,
                         const StimulusManifest& manifest) {
     std::error_code ec;
@@ -293,9 +345,23 @@ ParticipantRecord StudyStore::join(const std::string& requestedLabel, const std:
             throw RequestError(409, "participant label \"" + requestedLabel +
                                         "\" is already taken; open that participant's link to resume");
     }
-    char defaultLabel[32];
-    std::snprintf(defaultLabel, sizeof defaultLabel, "P%03lld", static_cast<long long>(p.index + 1));
-    p.label = requestedLabel.empty() ? defaultLabel : requestedLabel;
+    if (requestedLabel.empty()) {
+        // The default label follows the joining order, skipping labels already taken (an explicit label may equal a
+        // later default one: "P007" joined by hand must not lock out every bare join after P006).
+        SqliteStatement taken = db_->prepare("SELECT 1 FROM participants WHERE label = ?");
+        for (std::int64_t n = p.index + 1;; ++n) {
+            char defaultLabel[32];
+            std::snprintf(defaultLabel, sizeof defaultLabel, "P%03lld", static_cast<long long>(n));
+            taken.reset();
+            taken.bind(1, std::string(defaultLabel));
+            if (!taken.step()) {
+                p.label = defaultLabel;
+                break;
+            }
+        }
+    } else {
+        p.label = requestedLabel;
+    }
     p.token = randomHex(16);
     p.seed = participantSeed(definition_.design.seed, p.index);
     p.completionCode = makeCompletionCode();
@@ -328,7 +394,8 @@ std::int64_t StudyStore::startSession(std::int64_t participantId, const std::str
     SqliteStatement s = db_->prepare(
         "INSERT INTO sessions (participant_id, started_at, user_agent, viewport_width, viewport_height, device_pixel_ratio)"
         " VALUES (?,?,?,?,?,?)");
-    s.bind(1, participantId).bind(2, utcTimestamp()).bind(3, userAgent).bind(4, viewportWidth).bind(5, viewportHeight);
+    s.bind(1, participantId).bind(2, utcTimestamp()).bind(3, validUtf8(userAgent, kMaxStoredText)).bind(4, viewportWidth);
+    s.bind(5, viewportHeight);
     s.bind(6, devicePixelRatio);
     s.run();
     return db_->lastInsertId();
@@ -438,27 +505,30 @@ ResponseOutcome StudyStore::storeOne(const ResponseInput& in) {
         if (!s.step()) throw RequestError(404, "unknown participant");
         participantId = s.integer(0);
     }
+    // The reference must carry this participant's tag: another participant's trial (or a guessed number) is
+    // indistinguishable from one that does not exist.
     TrialRecord trial;
     {
+        const std::int64_t id = in.trialId & 0xFFFFFFFFll;
+        const std::string unknown = "trial " + std::to_string(in.trialId) + ": unknown trial";
+        if (in.trialId <= 0 || trialReference(in.token, id) != in.trialId) throw RequestError(404, unknown);
         SqliteStatement s = db_->prepare(std::string("SELECT ") + kTrialColumns + " FROM trials WHERE id = ?");
-        s.bind(1, in.trialId);
-        if (!s.step()) throw RequestError(404, "trial " + std::to_string(in.trialId) + ": unknown trial");
+        s.bind(1, id);
+        if (!s.step()) throw RequestError(404, unknown);
         trial = readTrial(s);
+        if (trial.participantId != participantId) throw RequestError(404, unknown);
     }
-    if (trial.participantId != participantId)
-        throw RequestError(403, "trial " + std::to_string(in.trialId) + ": belongs to another participant");
     {
         SqliteStatement s = db_->prepare("SELECT participant_id FROM sessions WHERE id = ?");
         s.bind(1, in.sessionId);
-        if (!s.step()) throw RequestError(404, "session " + std::to_string(in.sessionId) + ": unknown session");
-        if (s.integer(0) != participantId)
-            throw RequestError(403, "session " + std::to_string(in.sessionId) + ": belongs to another participant");
+        if (!s.step() || s.integer(0) != participantId)
+            throw RequestError(404, "session " + std::to_string(in.sessionId) + ": unknown session");
     }
     const bool leftIsA = trial.plan.aOnLeft;
     const std::string chosen = (in.side == "left") == leftIsA ? "A" : "B";
     {
         SqliteStatement s = db_->prepare("SELECT chosen FROM responses WHERE trial_id = ?");
-        s.bind(1, in.trialId);
+        s.bind(1, trial.id);
         if (s.step()) {
             // A re-send (lost acknowledgement, retry after a restart) is harmless; a different answer is not
             // allowed to replace the stored one.
@@ -478,9 +548,9 @@ ResponseOutcome StudyStore::storeOne(const ResponseInput& in) {
     SqliteStatement insert = db_->prepare(
         "INSERT INTO responses (trial_id, participant_id, session_id, chosen, side, response_ms, client_time, server_time,"
         " viewport_width, viewport_height, device_pixel_ratio, user_agent) VALUES (?,?,?,?,?,?,?,?,?,?,?,?)");
-    insert.bind(1, in.trialId).bind(2, participantId).bind(3, in.sessionId).bind(4, chosen).bind(5, in.side);
-    insert.bind(6, in.responseMs).bind(7, in.clientTime).bind(8, utcTimestamp()).bind(9, in.viewportWidth);
-    insert.bind(10, in.viewportHeight).bind(11, in.devicePixelRatio).bind(12, in.userAgent);
+    insert.bind(1, trial.id).bind(2, participantId).bind(3, in.sessionId).bind(4, chosen).bind(5, in.side);
+    insert.bind(6, in.responseMs).bind(7, validUtf8(in.clientTime, kMaxStoredText)).bind(8, utcTimestamp()).bind(9, in.viewportWidth);
+    insert.bind(10, in.viewportHeight).bind(11, in.devicePixelRatio).bind(12, validUtf8(in.userAgent, kMaxStoredText));
     insert.run();
     return ResponseOutcome::stored;
 }

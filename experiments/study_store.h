@@ -17,6 +17,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace skinlab::experiments {
@@ -42,7 +43,7 @@ struct TrialRecord {
 
 struct ResponseInput {
     std::string token;            // participant token
-    std::int64_t trialId = 0;
+    std::int64_t trialId = 0;     // the trial's reference (trialReference()), as the participant API shows it
     std::string side;             // "left" | "right"
     std::int64_t sessionId = 0;
     double responseMs = 0;        // from stimulus onset to key/click, measured by the page
@@ -122,7 +123,8 @@ public:
     std::optional<TrialRecord> nextTrial(std::int64_t participantId);
     Progress progress(std::int64_t participantId);
     // Validates and commits one response (see the header comment). Rejections throw RequestError:
-    // 404 unknown participant/trial, 403 another participant's trial or session, 409 out of order or a
+    // 404 unknown participant, trial or session (another participant's trial or session is unknown too: no answer
+    // tells whose it is), 409 out of order or a
     // different answer to an already answered trial.
     ResponseOutcome recordResponse(const ResponseInput& input);
 
@@ -159,6 +161,13 @@ private:
     std::vector<PendingResponse*> queue_;
     bool committing_ = false;
 };
+
+// The participant-facing reference of a trial: the row id with a tag derived from the participant's token above
+// it, so a trial reference can be neither guessed nor used by another participant (both answer 404).
+std::int64_t trialReference(const std::string& participantToken, std::int64_t trialId);
+// `text` as well-formed UTF-8 of at most `maxBytes` bytes: ill-formed sequences and control characters become
+// U+FFFD, and a character cut by the limit is dropped whole. Every client string is stored through this.
+std::string validUtf8(std::string_view text, std::size_t maxBytes);
 
 // Current UTC time as ISO-8601 with milliseconds ("2026-11-23T14:05:31.207Z").
 std::string utcTimestamp();

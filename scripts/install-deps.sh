@@ -15,7 +15,8 @@ PACKAGES=(
   # specs, CLI, logging
   libtomlplusplus-dev nlohmann-json3-dev libcli11-dev libspdlog-dev libfmt-dev
   # experiments: SQLite store, HTTP server, hashing
-  libsqlite3-dev sqlite3 libcpp-httplib-dev libssl-dev
+  libsqlite3-dev sqlite3 libssl-dev
+  libboost-dev   # Boost.Beast/Asio (header-only): the study server's event-driven HTTP layer
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
   # browser test of the participant page

@@ -6,56 +6,73 @@ namespace skinlab::analysis::scaling {
 
 std::vector<CsvRecord> parseCsv(std::string_view text, const std::string& file) {
     std::vector<CsvRecord> records;
-    int line = 0;
     size_t position = 0;
     // A UTF-8 byte-order mark (spreadsheet exports) is not part of the first column name.
     if (text.substr(0, 3) == "\xEF\xBB\xBF") position = 3;
+    int line = 1;  // line of the character at `position`
     while (position < text.size()) {
-        ++line;
-        size_t end = text.find('\n', position);
-        if (end == std::string_view::npos) end = text.size();
-        std::string_view row = text.substr(position, end - position);
-        position = end + 1;
-        if (!row.empty() && row.back() == '\r') row.remove_suffix(1);
-        if (row.find_first_not_of(" \t") == std::string_view::npos) continue;
         CsvRecord record;
         record.line = line;
         std::string field;
-        bool quoted = false;
-        for (size_t k = 0; k < row.size(); ++k) {
-            const char c = row[k];
+        bool quoted = false;      // inside double quotes
+        bool wasQuoted = false;   // the current field had a quoted part (its spaces are kept)
+        bool blank = true;        // only spaces and tabs so far
+        int quoteLine = line;
+        auto finishField = [&] {
+            if (!wasQuoted) {  // trim spaces around unquoted values
+                const size_t first = field.find_first_not_of(" \t");
+                const size_t last = field.find_last_not_of(" \t");
+                field = first == std::string::npos ? std::string() : field.substr(first, last - first + 1);
+            }
+            record.fields.push_back(std::move(field));
+            field.clear();
+            wasQuoted = false;
+        };
+        bool ended = false;
+        while (position < text.size() && !ended) {
+            const char c = text[position++];
             if (quoted) {
-                if (c == '"' && k + 1 < row.size() && row[k + 1] == '"') {
+                if (c == '"' && position < text.size() && text[position] == '"') {
                     field += '"';
-                    ++k;
+                    ++position;
                 } else if (c == '"') {
                     quoted = false;
                 } else {
+                    if (c == '\n') ++line;  // a quoted line break is part of the field
                     field += c;
                 }
-            } else if (c == '"') {
-                quoted = true;
+                continue;
+            }
+            if (c == '"') {
+                quoted = wasQuoted = true;
+                blank = false;
+                quoteLine = line;
             } else if (c == ',') {
-                record.fields.push_back(std::move(field));
-                field.clear();
+                blank = false;
+                finishField();
+            } else if (c == '\n') {
+                ++line;
+                ended = true;
+            } else if (c == '\r' && (position == text.size() || text[position] == '\n')) {
+                // CR of a CRLF line end
             } else {
+                if (c != ' ' && c != '\t') blank = false;
                 field += c;
             }
         }
-        if (quoted) throwInput(file, "line " + std::to_string(line), "unterminated double quote");
-        record.fields.push_back(std::move(field));
-        for (auto& value : record.fields) {  // trim spaces around unquoted values
-            const size_t first = value.find_first_not_of(" \t");
-            const size_t last = value.find_last_not_of(" \t");
-            value = first == std::string::npos ? std::string() : value.substr(first, last - first + 1);
-        }
+        if (quoted) throwInput(file, "line " + std::to_string(quoteLine), "unterminated double quote");
+        if (blank) continue;  // blank line
+        finishField();
         records.push_back(std::move(record));
     }
     return records;
 }
 
 std::string csvField(std::string_view value) {
-    if (value.find_first_of(",\"\r\n") == std::string_view::npos) return std::string(value);
+    // Quoted also when it starts or ends with a blank, which parseCsv trims from unquoted fields.
+    const bool blankEdge = !value.empty() && (value.front() == ' ' || value.front() == '\t' || value.back() == ' ' ||
+                                              value.back() == '\t');
+    if (!blankEdge && value.find_first_of(",\"\r\n") == std::string_view::npos) return std::string(value);
     std::string out = "\"";
     for (char c : value) {
         if (c == '"') out += '"';

@@ -1,6 +1,6 @@
 #pragma once
 // Minimal RFC 4180 CSV reading: comma-separated fields, optional double quotes ("" escapes a quote), LF or
-// CRLF line ends. One record per line (quoted fields may not span lines: no skinlab export writes such fields).
+// CRLF line ends; a quoted field may hold commas, quotes and line breaks (a record then spans lines).
 #include <string>
 #include <string_view>
 #include <vector>

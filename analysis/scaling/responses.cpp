@@ -4,6 +4,7 @@
 #include "common/error.h"
 #include "common/files.h"
 
+#include <nlohmann/json.hpp>
 #include <sqlite3.h>
 
 #include <algorithm>
@@ -192,6 +193,58 @@ ResponseTable readCsv(const std::filesystem::path& path) {
     return table;
 }
 
+// `skinlab study export --format json`: {"format": "skinlab-responses", "responses": [{...contract 3 keys...}]}.
+ResponseTable readJson(const std::filesystem::path& path) {
+    ResponseTable table;
+    table.file = path.string();
+    table.format = ResponseFormat::SkinlabJson;
+    nlohmann::json root;
+    try {
+        root = nlohmann::json::parse(readFile(path));
+    } catch (const nlohmann::json::exception& e) {
+        throwInput(table.file, "", std::string("not valid JSON: ") + e.what());
+    }
+    if (!root.is_object() || root.value("format", std::string()) != "skinlab-responses" ||
+        !root.contains("responses") || !root["responses"].is_array())
+        throwInput(table.file, "format", "expected a skinlab-responses JSON export with a \"responses\" array");
+    int row = 0;
+    for (const nlohmann::json& entry : root["responses"]) {
+        ++row;
+        const std::string at = "responses[" + std::to_string(row - 1) + "]";
+        auto text = [&](const char* key) -> std::string {
+            if (!entry.is_object() || !entry.contains(key) || !entry[key].is_string())
+                throwInput(table.file, at + "." + key, "expected a string");
+            return entry[key].get<std::string>();
+        };
+        auto flag = [&](const char* key, bool optional) -> std::optional<bool> {
+            if (!entry.is_object() || !entry.contains(key) || entry[key].is_null()) {
+                if (optional) return std::nullopt;
+                throwInput(table.file, at + "." + key, "missing");
+            }
+            const nlohmann::json& v = entry[key];
+            if (v.is_boolean()) return v.get<bool>();
+            if (v.is_number_integer() && (v.get<std::int64_t>() == 0 || v.get<std::int64_t>() == 1)) return v.get<std::int64_t>() == 1;
+            throwInput(table.file, at + "." + key, "'" + v.dump() + "' is not 0 or 1");
+        };
+        Response response;
+        response.line = row;
+        response.observer = text("observer");
+        response.block = text("scene");
+        response.conditionA = text("condition_A");
+        response.conditionB = text("condition_B");
+        response.aSelected = *flag("is_A_selected", false);
+        response.aOnLeft = flag("A_on_left", true);
+        response.kind = parseKind(table.file, row, text("trial_kind"));
+        response.correct = flag("correct", true);
+        if (entry.contains("response_ms") && entry["response_ms"].is_number())
+            response.responseMs = entry["response_ms"].get<double>();
+        checkResponse(table.file, response);
+        table.responses.push_back(std::move(response));
+    }
+    if (table.responses.empty()) throwInput(table.file, "responses", "no responses");
+    return table;
+}
+
 ResponseTable readDatabase(const std::filesystem::path& path) {
     ResponseTable table;
     table.file = path.string();
@@ -264,6 +317,7 @@ const char* responseFormatName(ResponseFormat format) {
     case ResponseFormat::SkinlabCsv: return "skinlab-csv";
     case ResponseFormat::PwcmpCsv: return "pwcmp-csv";
     case ResponseFormat::CountMatrix: return "count-matrix";
+    case ResponseFormat::SkinlabJson: return "skinlab-json";
     }
     return "skinlab-csv";
 }
@@ -276,6 +330,8 @@ ResponseTable readResponses(const std::filesystem::path& path) {
     head.resize(static_cast<size_t>(stream.gcount()));
     // Every SQLite 3 database starts with this 16-byte magic string (sqlite.org/fileformat.html §1.3).
     if (head == std::string("SQLite format 3\0", 16)) return readDatabase(path);
+    const size_t first = head.find_first_not_of(" \t\r\n");
+    if (first != std::string::npos && head[first] == '{') return readJson(path);
     return readCsv(path);
 }
 

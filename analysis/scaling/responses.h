@@ -4,6 +4,7 @@
 //  - a CSV export of that view (`skinlab study export --format csv`): columns observer, scene, condition_A,
 //    condition_B, is_A_selected, A_on_left, trial_kind, correct, response_ms (any order, all required);
 //  - a pwcmp long-format CSV: observer, scene, condition_A, condition_B, is_A_selected;
+//  - a JSON export (`skinlab study export --format json`, key "responses");
 //  - a count matrix CSV: header `condition,<name 1>,...,<name m>`, then one row per condition
 //    `<name i>,D_i1,...,D_im` with D_ij = times i was chosen over j (one block, no observers).
 #include <filesystem>
@@ -29,7 +30,7 @@ struct Response {
     int line = 0;  // 1-based line (CSV) or row (SQLite) it came from, for error messages
 };
 
-enum class ResponseFormat { StudyDatabase, SkinlabCsv, PwcmpCsv, CountMatrix };
+enum class ResponseFormat { StudyDatabase, SkinlabCsv, PwcmpCsv, CountMatrix, SkinlabJson };
 const char* responseFormatName(ResponseFormat format);
 
 struct ResponseTable {

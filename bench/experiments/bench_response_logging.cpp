@@ -71,6 +71,9 @@ Run measure(const fs::path& root, int observers, double thinkMin, double thinkMa
     ServerOptions options;
     options.port = 0;
     options.threads = 64;
+    // Every simulated participant connects from 127.0.0.1: lift the per-address caps meant for real clients.
+    options.connectionsPerClient = 4096;
+    options.joinBurst = 100000;
     StudyServer server(store, options);
     server.bind();
     std::thread serving([&] { server.run(); });

@@ -55,7 +55,8 @@ async function api(method, path, body) {
   return data;
 }
 
-// Retries network failures and server errors (5xx) with back-off; client errors (4xx) are final.
+// Retries network failures, server errors (5xx) and 429 (too many joins or connections from this address) with
+// back-off; other client errors (4xx) are final.
 async function apiRetrying(method, path, body) {
   for (let attempt = 0; ; attempt++) {
     try {
@@ -63,7 +64,7 @@ async function apiRetrying(method, path, body) {
       notice('');
       return data;
     } catch (e) {
-      if (e.status && e.status < 500) throw e;
+      if (e.status && e.status < 500 && e.status !== 429) throw e;
       if (attempt >= 60) throw e; // about 5 minutes
       notice('Connection to the study server lost — retrying…');
       await new Promise((r) => setTimeout(r, Math.min(500 * (attempt + 1), 5000)));

@@ -242,7 +242,8 @@ async function runSession({ name, dpr, launch, resize, reloadAfter }) {
     }
     await checkOneToOne(page, `${name} trial ${trial}`);
     const side = answers.size % 2 === 0 ? 'left' : 'right';
-    answers.set(Number(trial), side);
+    // The page's trial reference carries the trial's row id (the export's trial_id) in its low 32 bits.
+    answers.set(Number(trial) % 4294967296, side);
     await page.keyboard.press(side === 'left' ? 'ArrowLeft' : 'ArrowRight');
     lastTrial = trial;
   }

@@ -5,7 +5,9 @@
 
 namespace skinlab::experiments::test_support {
 
-RunningStudy::RunningStudy(const std::string& designToml, const StimulusSetSpec& spec) : folder_("server") {
+RunningStudy::RunningStudy(const std::string& designToml, const StimulusSetSpec& spec,
+                           const std::function<void(ServerOptions&)>& configure)
+    : folder_("server") {
     writeStimulusSet(folder_.path() / "stimuli", spec);
     const auto design = writeText(folder_.path(), "design.toml", designToml);
     database_ = folder_.path() / "study.db";
@@ -14,7 +16,8 @@ RunningStudy::RunningStudy(const std::string& designToml, const StimulusSetSpec&
     ServerOptions options;
     options.port = 0;
     options.researcherToken = kResearcherToken;
-    options.threads = 16;
+    options.threads = 8;
+    if (configure) configure(options);
     server_ = std::make_unique<StudyServer>(*store_, options);
     server_->bind();
     thread_ = std::thread([this] { server_->run(); });
@@ -25,10 +28,9 @@ RunningStudy::~RunningStudy() {
     thread_.join();
 }
 
-httplib::Client RunningStudy::client() const {
-    httplib::Client client("127.0.0.1", port());
-    client.set_connection_timeout(5, 0);
-    client.set_read_timeout(30, 0);
+HttpClient RunningStudy::client() const {
+    HttpClient client("127.0.0.1", port());
+    client.setTimeout(std::chrono::seconds(30));
     return client;
 }
 
@@ -47,28 +49,28 @@ std::string RunningStudy::fingerprint() const {
 }
 
 namespace {
-JsonAnswer toAnswer(const httplib::Result& res) {
+JsonAnswer toAnswer(HttpAnswer res) {
     JsonAnswer answer;
-    if (!res) return answer;
-    answer.status = res->status;
-    answer.raw = res->body;
-    answer.contentType = res->get_header_value("Content-Type");
+    answer.status = res.status;
+    answer.raw = std::move(res.body);
+    answer.contentType = res.header("Content-Type");
+    answer.headers = std::move(res.headers);
     try {
-        answer.body = nlohmann::json::parse(res->body);
-    } catch (const nlohmann::json::parse_error&) {
+        answer.body = nlohmann::json::parse(answer.raw);
+    } catch (const nlohmann::json::exception&) {
     }
     return answer;
 }
 } // namespace
 
-JsonAnswer postJson(httplib::Client& client, const std::string& path, const nlohmann::json& body) {
-    return toAnswer(client.Post(path, body.dump(), "application/json"));
+JsonAnswer postJson(HttpClient& client, const std::string& path, const nlohmann::json& body) {
+    return toAnswer(client.post(path, body.dump()));
 }
-JsonAnswer postRaw(httplib::Client& client, const std::string& path, const std::string& body, const std::string& type) {
-    return toAnswer(client.Post(path, body, type));
+JsonAnswer postRaw(HttpClient& client, const std::string& path, const std::string& body, const std::string& type) {
+    return toAnswer(client.post(path, body, type));
 }
-JsonAnswer get(httplib::Client& client, const std::string& path, const httplib::Headers& headers) {
-    return toAnswer(client.Get(path, headers));
+JsonAnswer get(HttpClient& client, const std::string& path, const HttpHeaders& headers) {
+    return toAnswer(client.get(path, headers));
 }
 
 } // namespace skinlab::experiments::test_support

@@ -4,7 +4,8 @@
 #include "experiments/study_store.h"
 #include "stimulus_set_fixture.h"
 
-#include <httplib.h>
+#include "experiments/http_client.h"
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -16,13 +17,16 @@ inline const char* kResearcherToken = "researcher-secret-0123456789";
 
 class RunningStudy {
 public:
-    explicit RunningStudy(const std::string& designToml, const StimulusSetSpec& spec = {});
+    explicit RunningStudy(const std::string& designToml, const StimulusSetSpec& spec = {},
+                          const std::function<void(ServerOptions&)>& configure = {});
     ~RunningStudy();
 
     StudyStore& store() { return *store_; }
+    StudyServer& server() { return *server_; }
+    const std::filesystem::path& folder() const { return folder_.path(); }
     int port() const { return server_->port(); }
     const std::filesystem::path& databasePath() const { return database_; }
-    httplib::Client client() const;
+    HttpClient client() const;
     // Every row of every table, as text: equal fingerprints mean nothing was stored or changed.
     std::string fingerprint() const;
 
@@ -39,10 +43,11 @@ struct JsonAnswer {
     nlohmann::json body;
     std::string raw;
     std::string contentType;
+    HttpHeaders headers;
 };
 
-JsonAnswer postJson(httplib::Client& client, const std::string& path, const nlohmann::json& body);
-JsonAnswer postRaw(httplib::Client& client, const std::string& path, const std::string& body, const std::string& type);
-JsonAnswer get(httplib::Client& client, const std::string& path, const httplib::Headers& headers = {});
+JsonAnswer postJson(HttpClient& client, const std::string& path, const nlohmann::json& body);
+JsonAnswer postRaw(HttpClient& client, const std::string& path, const std::string& body, const std::string& type);
+JsonAnswer get(HttpClient& client, const std::string& path, const HttpHeaders& headers = {});
 
 } // namespace skinlab::experiments::test_support

@@ -36,7 +36,7 @@ struct Participant {
     json state;
 };
 
-Participant joinAndStart(httplib::Client& client, const std::string& label = "") {
+Participant joinAndStart(HttpClient& client, const std::string& label = "") {
     Participant p;
     json body = json::object();
     if (!label.empty()) body["label"] = label;
@@ -78,7 +78,7 @@ void expectRejected(RunningStudy& study, const std::string& what, int status, co
 
 TEST(StudyServer, ParticipantCompletesASessionAndExportsFollowContract3) {
     RunningStudy study(kDesign);
-    httplib::Client client = study.client();
+    HttpClient client = study.client();
     JsonAnswer page = get(client, "/");
     EXPECT_EQ(page.status, 200);
     EXPECT_NE(page.raw.find("<script src=\"/app.js\"></script>"), std::string::npos);
@@ -141,14 +141,15 @@ TEST(StudyServer, ParticipantCompletesASessionAndExportsFollowContract3) {
     const json exported = json::parse(exportResponses(study.store(), "json"));
     ASSERT_EQ(exported["responses"].size(), 16u);
     EXPECT_EQ(exported["responses"][0]["viewport_width"], 1600);
-    EXPECT_EQ(exported["responses"][0]["user_agent"].get<std::string>().rfind("cpp-httplib", 0), 0u);
+    EXPECT_EQ(exported["responses"][0]["user_agent"].get<std::string>().rfind("skinlab-client", 0), 0u);
 
     // Researcher endpoints with the token.
     JsonAnswer status = get(client, "/api/researcher/status", {{"Authorization", std::string("Bearer ") + kResearcherToken}});
     ASSERT_EQ(status.status, 200);
     EXPECT_EQ(status.body["participants"][0]["answered"], 16);
     EXPECT_EQ(status.body["participants"][0]["catch_answered"], 2);
-    JsonAnswer exportAnswer = get(client, std::string("/api/researcher/export?format=pwcmp&token=") + kResearcherToken);
+    JsonAnswer exportAnswer = get(client, "/api/researcher/export?format=pwcmp",
+                                  {{"Authorization", std::string("Bearer ") + kResearcherToken}});
     EXPECT_EQ(exportAnswer.status, 200);
     EXPECT_EQ(exportAnswer.raw, exportResponses(study.store(), "pwcmp"));
 
@@ -162,7 +163,7 @@ TEST(StudyServer, ParticipantCompletesASessionAndExportsFollowContract3) {
 
 TEST(StudyServer, ResumingContinuesAtTheFirstUnansweredTrial) {
     RunningStudy study(kDesign);
-    httplib::Client client = study.client();
+    HttpClient client = study.client();
     Participant p = joinAndStart(client);
     for (int i = 0; i < 5; ++i) {
         JsonAnswer ack = postJson(client, "/api/response", responseBody(p, p.state["trial"]["id"], "left"));
@@ -181,7 +182,7 @@ TEST(StudyServer, ResumingContinuesAtTheFirstUnansweredTrial) {
 
 TEST(StudyServer, HostileAndMalformedRequestsAreRejectedWithoutChangingData) {
     RunningStudy study(kDesign);
-    httplib::Client client = study.client();
+    HttpClient client = study.client();
     Participant alice = joinAndStart(client, "alice");
     Participant bob = joinAndStart(client, "bob");
     // Alice answers her first trial, so replays can be tested.
@@ -223,10 +224,14 @@ TEST(StudyServer, HostileAndMalformedRequestsAreRejectedWithoutChangingData) {
     expectRejected(study, "token as number", 400, post(with(good, "token", 12345)));
     expectRejected(study, "unknown participant", 404, post(with(good, "token", std::string(32, 'f'))));
     expectRejected(study, "unknown trial", 404, post(with(good, "trial", 999999)));
-    expectRejected(study, "someone else's trial", 403, post(with(good, "trial", bobsTrial)));
-    expectRejected(study, "someone else's session", 403, post(with(good, "session", bob.session)));
+    // Another participant's trial or session is as unknown as one that does not exist (no 403 tells whose it is).
+    expectRejected(study, "someone else's trial", 404, post(with(good, "trial", bobsTrial)));
+    expectRejected(study, "someone else's session", 404, post(with(good, "session", bob.session)));
     expectRejected(study, "unknown session", 404, post(with(good, "session", 99999)));
-    expectRejected(study, "out of order (skipping ahead)", 409, post(with(good, "trial", second + 3)));
+    expectRejected(study, "a trial row id without its tag", 404, post(with(good, "trial", second & 0xFFFFFFFF)));
+    const auto aliceTrials = study.store().trials(study.store().participant(alice.token).id);
+    expectRejected(study, "out of order (skipping ahead)", 409,
+                   post(with(good, "trial", trialReference(alice.token, aliceTrials[4].id))));
     expectRejected(study, "replay with a different answer", 409, post(responseBody(alice, first, "right")));
     expectRejected(study, "bad label", 400, [&] { return postJson(client, "/api/join", {{"label", "../../etc"}}); });
     expectRejected(study, "taken label", 409, [&] { return postJson(client, "/api/join", {{"label", "alice"}}); });
@@ -242,9 +247,14 @@ TEST(StudyServer, HostileAndMalformedRequestsAreRejectedWithoutChangingData) {
     expectRejected(study, "status with wrong token", 403, [&] {
         return get(client, "/api/researcher/status", {{"Authorization", "Bearer wrong"}});
     });
-    expectRejected(study, "export with wrong token", 403, [&] { return get(client, "/api/researcher/export?token=abc"); });
+    expectRejected(study, "export with wrong token", 403, [&] {
+        return get(client, "/api/researcher/export", {{"Authorization", "Bearer abc"}});
+    });
+    expectRejected(study, "export with the token in the URL", 401, [&] {
+        return get(client, std::string("/api/researcher/export?token=") + kResearcherToken);
+    });
     expectRejected(study, "export with bad format", 400, [&] {
-        return get(client, std::string("/api/researcher/export?format=xml&token=") + kResearcherToken);
+        return get(client, "/api/researcher/export?format=xml", {{"Authorization", std::string("Bearer ") + kResearcherToken}});
     });
 
     // Path traversal and files outside the study: nothing but the numbered stimuli is reachable.
@@ -320,4 +330,42 @@ TEST(StudyServer, FiftySimulatedParticipantsAtOnce) {
     EXPECT_EQ(catchByKind["inverted"].first, 0);
     EXPECT_GT(catchByKind["inverted"].second, 0);
     EXPECT_LT(report.latencyPercentile(50), 1000.0);
+}
+
+TEST(StudyServer, SimulateRunAgainWithTheSamePrefixContinuesItsObservers) {
+    RunningStudy study(kDesign);
+    // An interrupted run: observer "resume-001" joined (with the simulator's join key) and answered 3 trials.
+    HttpClient client = study.client();
+    JsonAnswer joined = postJson(client, "/api/join", {{"label", "resume-001"}, {"join_key", simulatedJoinKey("resume-001")}});
+    ASSERT_EQ(joined.status, 201) << joined.raw;
+    Participant p;
+    p.token = joined.body["token"];
+    json start = screen();
+    start["token"] = p.token;
+    JsonAnswer session = postJson(client, "/api/session", start);
+    p.session = session.body["session"];
+    p.state = session.body;
+    for (int i = 0; i < 3; ++i) {
+        JsonAnswer ack = postJson(client, "/api/response", responseBody(p, p.state["trial"]["id"], "left"));
+        ASSERT_EQ(ack.status, 200);
+        p.state = ack.body;
+    }
+    SimulationOptions options;
+    options.port = study.port();
+    options.observers = 2;
+    options.labelPrefix = "resume";
+    const SimulationReport first = simulateObservers(study.store(), options);
+    for (const ObserverResult& o : first.observers) EXPECT_TRUE(o.failure.empty()) << o.label << ": " << o.failure;
+    EXPECT_EQ(first.completed(), 2);
+    EXPECT_EQ(first.rejected(), 0);
+    EXPECT_EQ(first.acknowledged(), 16u - 3u + 16u) << "resume-001 continued after its 3 answers";
+    EXPECT_EQ(study.store().responseCount(), 32);
+    // The same command again: both observers are found complete; nothing is stored twice, nothing refused (no 409).
+    const SimulationReport again = simulateObservers(study.store(), options);
+    for (const ObserverResult& o : again.observers) EXPECT_TRUE(o.failure.empty()) << o.label << ": " << o.failure;
+    EXPECT_EQ(again.completed(), 2);
+    EXPECT_EQ(again.rejected(), 0);
+    EXPECT_EQ(again.acknowledged(), 0u);
+    EXPECT_EQ(study.store().status().size(), 2u);
+    EXPECT_EQ(study.store().responseCount(), 32);
 }

@@ -1,0 +1,543 @@
+// Benchmark: the study server under browser-like load (docs/benchmarks.md, "Study server under browser-like load").
+//
+// The server is the real `skinlab study serve` in its own process (so its RSS can be read and it can be killed).
+// Each simulated participant behaves like the participant page in a browser: one kept-alive connection, the
+// page's request sequence (/, app.js, style.css, /api/study, /api/join, /api/session, then per trial the images it
+// has not fetched yet — a browser caches them: they are immutable — and /api/response), a think time drawn from
+// [MIN, MAX] ms before each answer, participants starting over a ramp. Participants come from 127.0.x.y source
+// addresses, 8 per address (like a lab behind one NAT), so the per-address connection cap is exercised as deployed.
+// Every request's latency is recorded; a request that gets no answer (server killed) is re-sent on a new
+// connection, as the page does. At the end every acknowledged answer is checked against study.db: stored once, as
+// acknowledged.
+//
+// Usage: bench_experiments_browser_load [--participants N] [--think-ms MIN:MAX] [--ramp-s S] [--slow-headers N]
+//          [--chunked-floods N] [--kill-at F1,F2] [--image-kib K] [--folder DIR] [--server PATH]
+// Prints a summary (Markdown rows for docs/benchmarks.md).
+#include "common/files.h"
+#include "common/hash.h"
+#include "experiments/study_creation.h"
+#include "experiments/study_store.h"
+
+#include <boost/asio.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <csignal>
+#include <cstring>
+#include <fcntl.h>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <optional>
+#include <map>
+#include <random>
+#include <set>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+#include <thread>
+#include <unistd.h>
+#include <vector>
+
+namespace fs = std::filesystem;
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+namespace http = beast::http;
+using tcp = asio::ip::tcp;
+using json = nlohmann::json;
+using Clock = std::chrono::steady_clock;
+using namespace skinlab::experiments;
+
+namespace {
+
+struct Options {
+    int participants = 1000;
+    double thinkMin = 1500, thinkMax = 3000;
+    double rampSeconds = 30;
+    int slowHeaders = 0;
+    int chunkedFloods = 0;
+    std::vector<double> killAt; // fractions of all answers
+    int imageKiB = 1024;
+    fs::path folder = fs::temp_directory_path() / "skinlab-bench-browser-load";
+    std::string server = SKINLAB_CLI;
+};
+
+// Five conditions in one block: 10 pairs × 2 repetitions + 2 catch = 22 answers per participant; images are random
+// bytes of the given size (the server does not decode them; a 1280×720 PNG is about 1 MiB).
+void writeSet(const fs::path& folder, int imageKiB) {
+    fs::create_directories(folder / "png");
+    json manifest{{"format", "skinlab-stimuli"}, {"version", 1}, {"set", "bench"}, {"stimuli", json::array()}};
+    std::mt19937 random(1);
+    for (int m = 0; m < 5; ++m) {
+        const std::string id = "c" + std::to_string(m);
+        std::string bytes(static_cast<std::size_t>(imageKiB) * 1024, '\0');
+        for (char& c : bytes) c = static_cast<char>(random());
+        skinlab::writeFileAtomic(folder / "png" / (id + ".png"), bytes);
+        manifest["stimuli"].push_back({{"id", id}, {"files", {{"png", "png/" + id + ".png"}}},
+                                       {"sha256", {{"png", skinlab::sha256Hex(bytes)}}}, {"factors", {{"method", id}}},
+                                       {"block", "bench"}, {"reference", false}, {"width", 1280}, {"height", 720}});
+    }
+    skinlab::writeFileAtomic(folder / "manifest.json", manifest.dump());
+}
+
+// The server process.
+struct Server {
+    pid_t pid = -1;
+    int port = 0;
+    void start(const Options& o, const fs::path& db, int wantedPort) {
+        int pipeFds[2];
+        if (::pipe(pipeFds) != 0) throw std::runtime_error("pipe");
+        pid = ::fork();
+        if (pid == 0) {
+            ::dup2(pipeFds[1], 1);
+            ::close(pipeFds[0]);
+            const int devNull = ::open("/dev/null", O_WRONLY);
+            ::dup2(devNull, 2); // its log (one line per join) is not part of the measurement
+            const std::string portText = std::to_string(wantedPort);
+            ::execl(o.server.c_str(), o.server.c_str(), "study", "serve", db.c_str(), "--port", portText.c_str(),
+                    "--token", "bench-token", static_cast<char*>(nullptr));
+            ::_exit(127);
+        }
+        ::close(pipeFds[1]);
+        FILE* out = ::fdopen(pipeFds[0], "r");
+        char line[512];
+        port = -1;
+        while (std::fgets(line, sizeof line, out)) {
+            int p = 0;
+            if (std::sscanf(line, "serving %*s on http://127.0.0.1:%d/", &p) == 1) {
+                port = p;
+                break;
+            }
+        }
+        // Keep reading (and dropping) its output in the background so it never blocks on a full pipe.
+        std::thread([out] {
+            char buffer[512];
+            while (std::fgets(buffer, sizeof buffer, out)) {
+            }
+            std::fclose(out);
+        }).detach();
+        if (port <= 0) throw std::runtime_error("the server did not start");
+    }
+    long rssKiB(const char* key) const {
+        std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+        std::string line;
+        while (std::getline(status, line))
+            if (line.rfind(key, 0) == 0) return std::stol(line.substr(std::strlen(key)));
+        return 0;
+    }
+    void kill(int signal) {
+        ::kill(pid, signal);
+        int status = 0;
+        ::waitpid(pid, &status, 0);
+    }
+};
+
+struct Stats {
+    std::vector<double> all, answers, slowSideNormal;
+    int errors = 0;        // HTTP answers other than 2xx/304
+    int retries = 0;       // requests re-sent after no answer
+    std::map<int, int> statuses;
+};
+
+double percentile(std::vector<double> v, double p) {
+    if (v.empty()) return NAN;
+    std::sort(v.begin(), v.end());
+    const std::size_t rank = static_cast<std::size_t>(std::ceil(p / 100.0 * static_cast<double>(v.size())));
+    return v[std::min(v.size() - 1, rank == 0 ? 0 : rank - 1)];
+}
+
+class Participant : public std::enable_shared_from_this<Participant> {
+public:
+    Participant(asio::io_context& io, const Options& o, int index, int& port, Stats& stats, std::atomic<long>& answered)
+        : io_(io), o_(o), index_(index), port_(port), stats_(stats), answered_(answered), timer_(io),
+          random_(static_cast<unsigned>(index * 7919 + 1)) {
+        source_ = "127.0." + std::to_string(1 + index / 8 / 250) + "." + std::to_string(1 + (index / 8) % 250);
+    }
+    void start(double delaySeconds) {
+        timer_.expires_after(std::chrono::milliseconds(static_cast<long>(delaySeconds * 1000)));
+        timer_.async_wait([self = shared_from_this()](beast::error_code) { self->step(); });
+    }
+    std::atomic<bool> completed{false};
+    std::string token;
+    std::vector<std::pair<std::int64_t, std::string>> acknowledged; // (trial reference, side)
+
+private:
+    // The page's sequence, one request at a time.
+    void step() {
+        switch (stage_) {
+        case 0: return send("GET", "/", "", [this](const std::string&) { stage_ = 1; step(); });
+        case 1: return send("GET", "/app.js", "", [this](const std::string&) { stage_ = 2; step(); });
+        case 2: return send("GET", "/style.css", "", [this](const std::string&) { stage_ = 3; step(); });
+        case 3: return send("GET", "/api/study", "", [this](const std::string&) { stage_ = 4; step(); });
+        case 4:
+            return send("POST", "/api/join", json{{"join_key", "bench-" + std::to_string(index_)}}.dump(), [this](const std::string& body) {
+                token = json::parse(body)["token"];
+                stage_ = 5;
+                step();
+            });
+        case 5:
+            return send("POST", "/api/session", json{{"token", token}, {"viewport_width", 1920}, {"viewport_height", 1080}, {"device_pixel_ratio", 1.0}}.dump(),
+                        [this](const std::string& body) {
+                            state_ = json::parse(body);
+                            session_ = state_["session"];
+                            stage_ = 6;
+                            step();
+                        });
+        default: return trial();
+        }
+    }
+
+    void trial() {
+        if (state_["completed"].get<bool>()) {
+            completed = true;
+            close();
+            return;
+        }
+        for (const char* side : {"left", "right", "reference"}) {
+            const json& shown = state_["trial"][side];
+            if (shown.is_object() && shown.contains("url") && fetched_.insert(shown["url"].get<std::string>()).second)
+                return send("GET", shown["url"].get<std::string>(), "", [this](const std::string&) { trial(); });
+        }
+        std::uniform_real_distribution<double> think(o_.thinkMin, o_.thinkMax);
+        timer_.expires_after(std::chrono::microseconds(static_cast<long>(think(random_) * 1000)));
+        timer_.async_wait([self = shared_from_this()](beast::error_code) { self->answer(); });
+    }
+
+    void answer() {
+        const std::int64_t trial = state_["trial"]["id"];
+        const std::string side = random_() % 2 ? "left" : "right";
+        json body{{"token", token}, {"trial", trial}, {"side", side}, {"session", session_}, {"response_ms", 900.0},
+                  {"client_time", "2026-12-01T00:00:00.000Z"}, {"viewport_width", 1920}, {"viewport_height", 1080},
+                  {"device_pixel_ratio", 1.0}};
+        send("POST", "/api/response", body.dump(), [this, trial, side](const std::string& reply) {
+            acknowledged.emplace_back(trial, side);
+            ++answered_;
+            state_ = json::parse(reply);
+            this->trial();
+        }, true);
+    }
+
+    void send(const std::string& method, const std::string& target, const std::string& body,
+              std::function<void(const std::string&)> then, bool isAnswer = false) {
+        request_ = {http::string_to_verb(method), target, 11};
+        request_.set(http::field::host, "127.0.0.1:" + std::to_string(port_));
+        request_.set(http::field::user_agent, "Mozilla/5.0 (bench) skinlab-browser-load");
+        if (method == "POST") {
+            request_.set(http::field::content_type, "application/json");
+            request_.body() = body;
+        }
+        request_.prepare_payload();
+        then_ = std::move(then);
+        isAnswer_ = isAnswer;
+        started_ = Clock::now();
+        if (!stream_) return connect();
+        write();
+    }
+
+    void connect() {
+        stream_ = std::make_unique<beast::tcp_stream>(io_);
+        beast::error_code ec;
+        stream_->socket().open(tcp::v4(), ec);
+        stream_->socket().bind(tcp::endpoint(asio::ip::make_address(source_), 0), ec);
+        stream_->expires_after(std::chrono::seconds(10));
+        stream_->async_connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(port_)),
+                               [self = shared_from_this()](beast::error_code e) {
+                                   if (e) return self->retry();
+                                   self->write();
+                               });
+    }
+
+    void write() {
+        stream_->expires_after(std::chrono::seconds(30));
+        http::async_write(*stream_, request_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
+            if (ec) return self->retry();
+            self->response_ = {};
+            self->parser_.emplace();
+            self->parser_->body_limit(64u << 20);
+            http::async_read(*self->stream_, self->buffer_, *self->parser_, [self](beast::error_code e, std::size_t) {
+                if (e) return self->retry();
+                self->done();
+            });
+        });
+    }
+
+    void done() {
+        const double ms = std::chrono::duration<double, std::milli>(Clock::now() - started_).count();
+        const auto res = parser_->release();
+        const int status = res.result_int();
+        ++stats_.statuses[status];
+        stats_.all.push_back(ms);
+        if (isAnswer_) stats_.answers.push_back(ms);
+        if (!res.keep_alive()) stream_.reset();
+        if (status == 429 || status >= 500) { // the page retries these
+            ++stats_.errors;
+            timer_.expires_after(std::chrono::milliseconds(500));
+            timer_.async_wait([self = shared_from_this()](beast::error_code) { self->resend(); });
+            return;
+        }
+        if (status >= 400) {
+            ++stats_.errors;
+            std::fprintf(stderr, "participant %d: %s -> %d %s\n", index_, std::string(request_.target()).c_str(), status,
+                         res.body().substr(0, 200).c_str());
+            close();
+            return;
+        }
+        auto then = std::move(then_);
+        then(res.body());
+    }
+
+    void retry() {
+        // No answer (the server was killed or closed the kept-alive connection): a new connection, as the page does.
+        ++stats_.retries;
+        stream_.reset();
+        buffer_.clear();
+        timer_.expires_after(std::chrono::milliseconds(200));
+        timer_.async_wait([self = shared_from_this()](beast::error_code) { self->resend(); });
+    }
+    void resend() {
+        started_ = Clock::now();
+        if (!stream_) return connect();
+        write();
+    }
+    void close() {
+        if (stream_) {
+            beast::error_code ignored;
+            stream_->socket().shutdown(tcp::socket::shutdown_both, ignored);
+        }
+        stream_.reset();
+    }
+
+    asio::io_context& io_;
+    const Options& o_;
+    int index_;
+    int& port_;
+    Stats& stats_;
+    std::atomic<long>& answered_;
+    asio::steady_timer timer_;
+    std::mt19937 random_;
+    std::string source_;
+    std::unique_ptr<beast::tcp_stream> stream_;
+    beast::flat_buffer buffer_;
+    http::request<http::string_body> request_;
+    std::optional<http::response_parser<http::string_body>> parser_;
+    http::response<http::string_body> response_;
+    std::function<void(const std::string&)> then_;
+    bool isAnswer_ = false;
+    Clock::time_point started_;
+    int stage_ = 0;
+    json state_;
+    std::int64_t session_ = 0;
+    std::set<std::string> fetched_;
+};
+
+// A client that sends its header one line every 4 s, and reconnects when the server cuts it (408).
+class SlowHeader : public std::enable_shared_from_this<SlowHeader> {
+public:
+    SlowHeader(asio::io_context& io, int index, int& port, std::atomic<bool>& stop)
+        : io_(io), index_(index), port_(port), stop_(stop), timer_(io) {}
+    std::atomic<int>* cut = nullptr;
+    void start() {
+        if (stop_) return;
+        socket_ = std::make_unique<tcp::socket>(io_);
+        beast::error_code ec;
+        socket_->open(tcp::v4(), ec);
+        const std::string source = "127.1." + std::to_string(1 + index_ / 50) + "." + std::to_string(1 + index_ % 50);
+        socket_->bind(tcp::endpoint(asio::ip::make_address(source), 0), ec);
+        lines_ = 0;
+        socket_->async_connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(port_)),
+                               [self = shared_from_this()](beast::error_code e) {
+                                   if (e) return self->later();
+                                   self->line();
+                                   self->watch();
+                               });
+    }
+
+private:
+    void line() {
+        const std::string text = lines_ == 0 ? "GET /api/study HTTP/1.1\r\n" : "X-Slow-" + std::to_string(lines_) + ": 1\r\n";
+        ++lines_;
+        auto bytes = std::make_shared<std::string>(text);
+        asio::async_write(*socket_, asio::buffer(*bytes), [bytes](beast::error_code, std::size_t) {});
+        timer_.expires_after(std::chrono::seconds(4));
+        timer_.async_wait([self = shared_from_this()](beast::error_code ec) {
+            if (!ec && self->socket_ && self->socket_->is_open() && !self->stop_) self->line();
+        });
+    }
+    void watch() {
+        // Whatever arrives (the 408) or the close ends this round; a new connection starts.
+        socket_->async_read_some(asio::buffer(sink_), [self = shared_from_this()](beast::error_code ec, std::size_t) {
+            if (!ec) return self->watch();
+            if (self->cut) ++*self->cut;
+            self->timer_.cancel();
+            self->later();
+        });
+    }
+    void later() {
+        auto retry = std::make_shared<asio::steady_timer>(io_, std::chrono::milliseconds(100));
+        retry->async_wait([self = shared_from_this(), retry](beast::error_code) { self->start(); });
+    }
+    asio::io_context& io_;
+    int index_;
+    int& port_;
+    std::atomic<bool>& stop_;
+    asio::steady_timer timer_;
+    std::unique_ptr<tcp::socket> socket_;
+    int lines_ = 0;
+    char sink_[1024];
+};
+
+// A client that sends a 500 MiB chunked body, again and again (blocking, in its own thread).
+void chunkedFlood(int& port, std::atomic<bool>& stop, std::atomic<long>& refused) {
+    const std::string chunk = "10000\r\n" + std::string(65536, ' ') + "\r\n";
+    while (!stop) {
+        asio::io_context io;
+        tcp::socket socket(io);
+        beast::error_code ec;
+        socket.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(port)), ec);
+        if (ec) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(200));
+            continue;
+        }
+        const std::string head = "POST /api/join HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) +
+                                 "\r\nContent-Type: application/json\r\nTransfer-Encoding: chunked\r\n\r\n";
+        asio::write(socket, asio::buffer(head), ec);
+        for (std::size_t sent = 0; !ec && !stop && sent < (500u << 20); sent += 65536) asio::write(socket, asio::buffer(chunk), ec);
+        ++refused;
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    Options o;
+    for (int i = 1; i + 1 < argc; i += 2) {
+        const std::string key = argv[i], value = argv[i + 1];
+        if (key == "--participants") o.participants = std::stoi(value);
+        else if (key == "--think-ms") {
+            o.thinkMin = std::stod(value);
+            o.thinkMax = value.find(':') != std::string::npos ? std::stod(value.substr(value.find(':') + 1)) : o.thinkMin;
+        } else if (key == "--ramp-s") o.rampSeconds = std::stod(value);
+        else if (key == "--slow-headers") o.slowHeaders = std::stoi(value);
+        else if (key == "--chunked-floods") o.chunkedFloods = std::stoi(value);
+        else if (key == "--kill-at") {
+            std::stringstream list(value);
+            std::string item;
+            while (std::getline(list, item, ',')) o.killAt.push_back(std::stod(item));
+        } else if (key == "--image-kib") o.imageKiB = std::stoi(value);
+        else if (key == "--folder") o.folder = value;
+        else if (key == "--server") o.server = value;
+        else {
+            std::fprintf(stderr, "unknown option %s\n", key.c_str());
+            return 2;
+        }
+    }
+    fs::remove_all(o.folder);
+    writeSet(o.folder / "stimuli", o.imageKiB);
+    const fs::path design = o.folder / "design.toml";
+    skinlab::writeFileAtomic(design, "title = \"Browser load\"\nseed = 3\nrepetitions = 2\n[catch]\nblank = 2\n");
+    const fs::path db = o.folder / "study.db";
+    createStudy(o.folder / "stimuli", design, {}, db);
+
+    Server server;
+    server.start(o, db, 0);
+    int port = server.port;
+    std::printf("server pid %d on port %d; %d participants, think %.0f–%.0f ms, ramp %.0f s, %d slow-header "
+                "connections, %d chunked floods, images %d KiB\n",
+                server.pid, port, o.participants, o.thinkMin, o.thinkMax, o.rampSeconds, o.slowHeaders, o.chunkedFloods, o.imageKiB);
+    std::fflush(stdout);
+
+    asio::io_context io;
+    Stats stats;
+    std::atomic<long> answered{0};
+    std::atomic<bool> stop{false};
+    std::atomic<int> slowCut{0};
+    std::vector<std::shared_ptr<Participant>> participants;
+    for (int i = 0; i < o.participants; ++i) {
+        participants.push_back(std::make_shared<Participant>(io, o, i, port, stats, answered));
+        participants.back()->start(o.rampSeconds * i / std::max(1, o.participants));
+    }
+    std::vector<std::shared_ptr<SlowHeader>> slow;
+    for (int i = 0; i < o.slowHeaders; ++i) {
+        slow.push_back(std::make_shared<SlowHeader>(io, i, port, stop));
+        slow.back()->cut = &slowCut;
+        slow.back()->start();
+    }
+    std::atomic<long> floodsRefused{0};
+    std::vector<std::thread> floods;
+    for (int i = 0; i < o.chunkedFloods; ++i) floods.emplace_back([&] { chunkedFlood(port, stop, floodsRefused); });
+
+    // Kill -9 and restart at the given fractions of all answers; sample the server's RSS meanwhile.
+    const long total = 22L * o.participants;
+    long peakRss = 0;
+    int kills = 0;
+    std::thread supervisor([&] {
+        std::size_t next = 0;
+        while (!stop) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(100));
+            peakRss = std::max(peakRss, server.rssKiB("VmRSS:"));
+            if (next < o.killAt.size() && answered >= static_cast<long>(o.killAt[next] * static_cast<double>(total))) {
+                peakRss = std::max(peakRss, server.rssKiB("VmHWM:"));
+                server.kill(SIGKILL);
+                ++kills;
+                std::this_thread::sleep_for(std::chrono::milliseconds(300));
+                server.start(o, db, port);
+                ++next;
+            }
+        }
+    });
+    const auto start = Clock::now();
+    std::thread ioThread([&] {
+        // Runs until every participant is done; the slow-header clients then stop reconnecting.
+        io.run();
+    });
+    while (true) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(200));
+        int done = 0;
+        for (auto& p : participants) done += p->completed ? 1 : 0;
+        if (done == o.participants || Clock::now() - start > std::chrono::minutes(10)) break;
+    }
+    const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    peakRss = std::max(peakRss, server.rssKiB("VmHWM:"));
+    stop = true;
+    io.stop();
+    ioThread.join();
+    supervisor.join();
+    for (auto& t : floods) t.join();
+    server.kill(SIGTERM);
+
+    // Every acknowledged answer stored exactly once, as acknowledged.
+    StudyStore store(db);
+    std::map<std::int64_t, bool> storedLeft; // by trial row id
+    for (const ResponseRow& r : store.responses()) storedLeft[r.trialId] = r.aSelected == r.aOnLeft;
+    long acknowledged = 0, lost = 0, mismatched = 0, completed = 0;
+    for (auto& p : participants) {
+        completed += p->completed ? 1 : 0;
+        for (const auto& [reference, side] : p->acknowledged) {
+            ++acknowledged;
+            const auto it = storedLeft.find(reference & 0xFFFFFFFFll);
+            if (it == storedLeft.end()) ++lost;
+            else if (it->second != (side == "left")) ++mismatched;
+        }
+    }
+    const long stored = store.responseCount();
+    std::printf("%.1f s: %ld/%d participants completed; %ld answers acknowledged, %ld stored (%ld lost, %ld stored "
+                "differently, %ld stored without acknowledgement); %d kills; %d HTTP errors, %d re-sent after no answer\n",
+                seconds, completed, o.participants, acknowledged, stored, lost, mismatched, stored - acknowledged + lost, kills,
+                stats.errors, stats.retries);
+    std::printf("statuses:");
+    for (const auto& [status, n] : stats.statuses) std::printf(" %d×%d", status, n);
+    std::printf("\nslow-header connections cut by the server: %d; chunked floods refused: %ld\n", slowCut.load(), floodsRefused.load());
+    std::printf("| %d | %.0f–%.0f | %d | %d | %zu | %.1f | %.1f | %.1f | %.1f | %.1f | %.0f | %ld |\n", o.participants,
+                o.thinkMin, o.thinkMax, o.slowHeaders, o.chunkedFloods, stats.all.size(), percentile(stats.all, 50),
+                percentile(stats.all, 99), percentile(stats.answers, 50), percentile(stats.answers, 99),
+                percentile(stats.all, 100), static_cast<double>(stats.answers.size()) / seconds, peakRss / 1024);
+    std::printf("(participants | think ms | slow headers | floods | requests | p50 all ms | p99 all ms | p50 answer ms | "
+                "p99 answer ms | max ms | answers/s | server peak RSS MiB)\n");
+    return lost == 0 && mismatched == 0 && completed == o.participants ? 0 : 1;
+}

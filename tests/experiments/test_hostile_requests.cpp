@@ -1,0 +1,583 @@
+// Hostile requests against the study server, sent byte for byte over raw sockets (no HTTP library in between
+// to tidy them up): path traversal in every encoding, malformed, oversized and deeply nested JSON, numbers no
+// double holds, slow headers, chunked floods, bad and foreign tokens, replays, out-of-order, concurrent and late
+// answers, non-UTF-8 headers, foreign Host names, join floods and connection floods. Each gets a 4xx (or the page
+// it should), and the study file afterwards holds exactly what it held before (every row of every table).
+#include "common/error.h"
+#include "common/files.h"
+#include "experiments/sqlite_database.h"
+#include "experiments/study_export.h"
+#include "study_server_fixture.h"
+
+#include <arpa/inet.h>
+#include <atomic>
+#include <fstream>
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <thread>
+#include <unistd.h>
+
+using namespace skinlab::experiments;
+using namespace skinlab::experiments::test_support;
+using nlohmann::json;
+using namespace std::chrono_literals;
+namespace fs = std::filesystem;
+
+namespace {
+
+const char* kDesign = R"(
+title = "Hostile test"
+seed = 9
+repetitions = 1
+[practice]
+trials = 1
+[catch]
+blank = 1
+)";
+
+// One raw TCP connection to the server.
+class RawSocket {
+public:
+    explicit RawSocket(int port, const char* source = nullptr) {
+        fd_ = ::socket(AF_INET, SOCK_STREAM, 0);
+        if (source) {
+            sockaddr_in local{};
+            local.sin_family = AF_INET;
+            ::inet_pton(AF_INET, source, &local.sin_addr);
+            ::bind(fd_, reinterpret_cast<sockaddr*>(&local), sizeof local);
+        }
+        sockaddr_in address{};
+        address.sin_family = AF_INET;
+        address.sin_port = htons(static_cast<std::uint16_t>(port));
+        ::inet_pton(AF_INET, "127.0.0.1", &address.sin_addr);
+        connected_ = ::connect(fd_, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0;
+    }
+    ~RawSocket() { ::close(fd_); }
+    bool connected() const { return connected_; }
+    // Sends everything; false when the server closed or reset the connection.
+    bool send(std::string_view bytes) {
+        while (!bytes.empty()) {
+            const ssize_t n = ::send(fd_, bytes.data(), bytes.size(), MSG_NOSIGNAL);
+            if (n <= 0) return false;
+            bytes.remove_prefix(static_cast<std::size_t>(n));
+        }
+        return true;
+    }
+    // Reads one response (status line, headers, Content-Length body); "" when the connection closes first.
+    std::string readResponse(std::chrono::milliseconds timeout = 10s) {
+        const auto deadline = std::chrono::steady_clock::now() + timeout;
+        while (true) {
+            const std::size_t end = buffer_.find("\r\n\r\n");
+            if (end != std::string::npos) {
+                std::size_t length = 0;
+                const std::string head = buffer_.substr(0, end);
+                std::string lower = head;
+                for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+                if (const std::size_t at = lower.find("content-length:"); at != std::string::npos)
+                    length = std::stoul(head.substr(at + 15));
+                if (buffer_.size() >= end + 4 + length) {
+                    std::string response = buffer_.substr(0, end + 4 + length);
+                    buffer_.erase(0, end + 4 + length);
+                    return response;
+                }
+            }
+            const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+            if (left.count() <= 0) return "";
+            pollfd p{fd_, POLLIN, 0};
+            if (::poll(&p, 1, static_cast<int>(left.count())) <= 0) return "";
+            char chunk[65536];
+            const ssize_t n = ::recv(fd_, chunk, sizeof chunk, 0);
+            if (n <= 0) return "";
+            buffer_.append(chunk, static_cast<std::size_t>(n));
+        }
+    }
+    // True when the server closed the connection (EOF or reset) within the timeout.
+    bool closedByServer(std::chrono::milliseconds timeout) {
+        pollfd p{fd_, POLLIN, 0};
+        if (::poll(&p, 1, static_cast<int>(timeout.count())) <= 0) return false;
+        char chunk[4096];
+        return ::recv(fd_, chunk, sizeof chunk, 0) <= 0;
+    }
+
+private:
+    int fd_ = -1;
+    bool connected_ = false;
+    std::string buffer_;
+};
+
+int statusOf(const std::string& response) {
+    if (response.rfind("HTTP/1.", 0) != 0 || response.size() < 12) return 0;
+    return std::stoi(response.substr(9, 3));
+}
+
+std::string bodyOf(const std::string& response) {
+    const std::size_t end = response.find("\r\n\r\n");
+    return end == std::string::npos ? "" : response.substr(end + 4);
+}
+
+long residentKiB() {
+    std::ifstream status("/proc/self/status");
+    std::string line;
+    while (std::getline(status, line))
+        if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
+    return 0;
+}
+
+struct Hostile {
+    RunningStudy study;
+    std::string host;
+    explicit Hostile(const std::function<void(ServerOptions&)>& configure = {})
+        : study(kDesign, {}, configure), host("127.0.0.1:" + std::to_string(study.port())) {}
+
+    // One request on a fresh connection; the raw response ("" = none).
+    std::string exchange(const std::string& bytes, std::chrono::milliseconds timeout = 10s) {
+        RawSocket socket(study.port());
+        if (!socket.send(bytes)) return "";
+        return socket.readResponse(timeout);
+    }
+    std::string request(const std::string& method, const std::string& target, const std::string& body = "",
+                        const std::string& extraHeaders = "", const std::string& type = "application/json") {
+        std::string bytes = method + " " + target + " HTTP/1.1\r\nHost: " + host + "\r\n" + extraHeaders;
+        if (!body.empty() || method == "POST")
+            bytes += "Content-Type: " + type + "\r\nContent-Length: " + std::to_string(body.size()) + "\r\n";
+        return exchange(bytes + "Connection: close\r\n\r\n" + body);
+    }
+    // Expects `status` (a 4xx; 0 = any 4xx), a JSON {"error"} body when the server could answer with one, and no change.
+    void expectRejected(const std::string& what, int status, const std::function<std::string()>& send) {
+        const std::string before = study.fingerprint();
+        const std::string response = send();
+        if (status == 0) // any client error
+            EXPECT_TRUE(statusOf(response) >= 400 && statusOf(response) < 500) << what << ": " << response.substr(0, 300);
+        else
+            EXPECT_EQ(statusOf(response), status) << what << ": " << response.substr(0, 300);
+        if (statusOf(response) >= 400) {
+            json body;
+            try {
+                body = json::parse(bodyOf(response));
+            } catch (const json::exception&) {
+            }
+            EXPECT_TRUE(body.is_object() && body.contains("error")) << what << ": " << response.substr(0, 300);
+        }
+        EXPECT_EQ(study.fingerprint(), before) << what << ": the request changed stored data";
+    }
+};
+
+json screen() { return {{"viewport_width", 1280}, {"viewport_height", 800}, {"device_pixel_ratio", 1.0}}; }
+
+struct Participant {
+    std::string token;
+    std::int64_t session = 0;
+    json state;
+};
+
+Participant joinAndStart(HttpClient& client) {
+    Participant p;
+    JsonAnswer joined = postJson(client, "/api/join", json::object());
+    EXPECT_EQ(joined.status, 201) << joined.raw;
+    p.token = joined.body.value("token", "");
+    json start = screen();
+    start["token"] = p.token;
+    JsonAnswer session = postJson(client, "/api/session", start);
+    EXPECT_EQ(session.status, 200) << session.raw;
+    p.session = session.body.value("session", 0);
+    p.state = session.body;
+    return p;
+}
+
+json answerBody(const Participant& p, const json& trial, const std::string& side) {
+    json body = screen();
+    body["token"] = p.token;
+    body["trial"] = trial;
+    body["side"] = side;
+    body["session"] = p.session;
+    body["response_ms"] = 900.0;
+    body["client_time"] = "2026-11-23T14:00:00.000Z";
+    return body;
+}
+
+} // namespace
+
+TEST(HostileRequests, TraversalInEveryEncodingReachesNothingButTheStudy) {
+    Hostile h;
+    for (const std::string target :
+         {"/../study.db", "/%2e%2e/study.db", "/%2E%2E/%2E%2E/etc/passwd", "/%252e%252e/study.db", "/..%2fstudy.db",
+          "/..%5cstudy.db", "/..\\study.db", "/%c0%ae%c0%ae/study.db", "/%e0%80%ae%e0%80%ae/study.db", "//etc/passwd",
+          "/stimuli/../manifest.json", "/stimuli/..%2f..%2fmanifest.json", "/stimuli/%2e%2e%2fmanifest.json",
+          "/stimuli/0.png/../../study.db", "/stimuli/%30.png", "/stimuli/0.png%00", "/stimuli/0.png%00.txt",
+          "/stimuli//0.png", "/stimuli/0x1.png", "/stimuli/1e1.png", "/stimuli/-0.png", "/stimuli/+1.png",
+          "/stimuli/0000001.png", "/stimuli/999999.png", "/stimuli/../../stimuli/png/0-separable.png",
+          "/png/0-separable.png", "/manifest.json", "/design.toml", "/study.db", "/study.db-wal", "/api/../study.db",
+          "/api/%2e%2e/study.db", "/index.html/../study.db", "/app.js/..", "/api/study/..", "/API/study"}) {
+        h.expectRejected("GET " + target, 404, [&] { return h.request("GET", target); });
+    }
+    // Raw non-ASCII bytes in the target: refused as malformed or unknown.
+    for (const std::string target : {"/\xff\xfe", "/stimuli/\xc0\xae\xc0\xae/study.db", "/stimuli/0.png\xff"})
+        h.expectRejected("GET " + target, 0, [&] { return h.request("GET", target); });
+    // Absolute-form and asterisk targets, and garbage request lines, are malformed or unknown, never files.
+    h.expectRejected("absolute form", 404, [&] { return h.request("GET", "http://127.0.0.1/../study.db"); });
+    h.expectRejected("asterisk", 404, [&] { return h.request("OPTIONS", "*"); });
+    h.expectRejected("no target", 400, [&] { return h.exchange("GET HTTP/1.1\r\nHost: " + h.host + "\r\n\r\n"); });
+    h.expectRejected("space in target", 400, [&] { return h.exchange("GET /a b HTTP/1.1\r\nHost: " + h.host + "\r\n\r\n"); });
+    h.expectRejected("not HTTP", 400, [&] { return h.exchange("\x16\x03\x01\x02\x10\x01\x10\x01\xfc\x03\x03\r\n\r\n"); });
+    // The page with hostile query strings is just the page.
+    for (const std::string target : {"/?p=../../etc/passwd", "/index.html?p=%00%ff", "/?p=<script>"}) {
+        const std::string before = h.study.fingerprint();
+        const std::string response = h.request("GET", target);
+        EXPECT_EQ(statusOf(response), 200) << target;
+        EXPECT_NE(bodyOf(response).find("<script src=\"/app.js\"></script>"), std::string::npos) << target;
+        EXPECT_EQ(h.study.fingerprint(), before);
+    }
+}
+
+TEST(HostileRequests, MalformedOversizedAndOverflowingJsonIs400Or413) {
+    Hostile h;
+    HttpClient client = h.study.client();
+    Participant p = joinAndStart(client);
+    const json good = answerBody(p, p.state["trial"]["id"], "left");
+    auto post = [&](const std::string& body) { return [&h, body] { return h.request("POST", "/api/response", body); }; };
+    auto with = [&](const std::string& key, const std::string& rawValue) {
+        json copy = good;
+        copy.erase(key);
+        std::string text = copy.dump();
+        text.insert(1, "\"" + key + "\":" + rawValue + ",");
+        return text;
+    };
+    for (const std::string body : {"", "{", "{\"token\":", "}", "null", "[]", "\"text\"", "{}x", "{\"a\":NaN}",
+                                   "{\"a\":Infinity}", "{\"a\":01}", "{'a':1}", "{\"a\":\"\xff\xfe\"}", "{\"a\":\"\\ud800\"}"}) {
+        h.expectRejected("body " + body, 400, post(body));
+    }
+    h.expectRejected("deep nesting", 400, post(std::string(7000, '[') + std::string(7000, ']')));
+    h.expectRejected("deep object nesting", 400, [&] {
+        std::string body;
+        for (int i = 0; i < 1500; ++i) body += "{\"a\":";
+        body += "1" + std::string(1500, '}');
+        return h.request("POST", "/api/response", body);
+    });
+    // Numbers no double (or no 64-bit integer) holds, and numbers out of range.
+    for (const auto& [key, value] :
+         std::vector<std::pair<std::string, std::string>>{{"trial", "1e400"}, {"trial", "-1e400"}, {"trial", "1e-400"},
+                                                          {"trial", "18446744073709551615"}, {"trial", "99999999999999999999999"},
+                                                          {"trial", "9223372036854775808"}, {"trial", "1.5"}, {"trial", "-0"},
+                                                          {"session", "1e400"}, {"response_ms", "1e400"}, {"response_ms", "1e308"},
+                                                          {"response_ms", "-1"}, {"device_pixel_ratio", "1e-400"},
+                                                          {"device_pixel_ratio", "17"}, {"viewport_width", "1e400"},
+                                                          {"viewport_width", "4294967297"}, {"side", "1e400"}}) {
+        h.expectRejected(key + "=" + value, 400, post(with(key, value)));
+    }
+    h.expectRejected("join with 1e400", 400, [&] { return h.request("POST", "/api/join", "{\"label\":1e400}"); });
+    h.expectRejected("session with 1e400", 400, [&] {
+        return h.request("POST", "/api/session", "{\"token\":\"" + p.token + "\",\"viewport_width\":1e400}");
+    });
+    // Oversized: announced, sent, or only claimed.
+    h.expectRejected("17 KiB body", 413, post("{\"client_time\":\"" + std::string(17 * 1024, 'x') + "\"}"));
+    h.expectRejected("claimed 1 TB", 413, [&] {
+        return h.exchange("POST /api/join HTTP/1.1\r\nHost: " + h.host +
+                          "\r\nContent-Type: application/json\r\nContent-Length: 1000000000000\r\n\r\n{}");
+    });
+    h.expectRejected("negative length", 400, [&] {
+        return h.exchange("POST /api/join HTTP/1.1\r\nHost: " + h.host +
+                          "\r\nContent-Type: application/json\r\nContent-Length: -1\r\n\r\n{}");
+    });
+    h.expectRejected("two lengths", 400, [&] {
+        return h.exchange("POST /api/join HTTP/1.1\r\nHost: " + h.host +
+                          "\r\nContent-Type: application/json\r\nContent-Length: 2\r\nContent-Length: 3\r\n\r\n{}");
+    });
+    h.expectRejected("9 KiB header", 431, [&] { return h.request("GET", "/api/study", "", "X-Pad: " + std::string(9000, 'a') + "\r\n"); });
+    h.expectRejected("2,000 small headers", 431, [&] {
+        std::string headers;
+        for (int i = 0; i < 2000; ++i) headers += "X-" + std::to_string(i) + ": a\r\n";
+        return h.request("GET", "/api/study", "", headers);
+    });
+    h.expectRejected("text/plain", 415, [&] { return h.request("POST", "/api/response", good.dump(), "", "text/plain"); });
+    // The good request still works afterwards.
+    EXPECT_EQ(statusOf(h.request("POST", "/api/response", good.dump())), 200);
+}
+
+TEST(HostileRequests, SlowHeadersAreCutWithout408BlockingAnyoneElse) {
+    Hostile h([](ServerOptions& o) { o.requestTimeout = 1500ms; });
+    const std::string before = h.study.fingerprint();
+    std::vector<std::unique_ptr<RawSocket>> slow;
+    for (int i = 0; i < 40; ++i) {
+        slow.push_back(std::make_unique<RawSocket>(h.study.port(), ("127.0.1." + std::to_string(i + 1)).c_str()));
+        ASSERT_TRUE(slow.back()->send("POST /api/join HTTP/1.1\r\nHost: " + h.host + "\r\n"));
+    }
+    // Meanwhile a normal request is answered at once.
+    const auto start = std::chrono::steady_clock::now();
+    EXPECT_EQ(statusOf(h.request("GET", "/api/study")), 200);
+    EXPECT_LT(std::chrono::steady_clock::now() - start, 1000ms);
+    // One more header line every 500 ms does not extend the deadline: 408, then the connection is closed.
+    for (int i = 0; i < 2; ++i) {
+        std::this_thread::sleep_for(500ms);
+        for (auto& s : slow) s->send("X-Slow-" + std::to_string(i) + ": 1\r\n");
+    }
+    for (auto& s : slow) {
+        const std::string response = s->readResponse(5s);
+        EXPECT_EQ(statusOf(response), 408) << response;
+        EXPECT_TRUE(s->closedByServer(3s));
+    }
+    EXPECT_EQ(h.study.fingerprint(), before);
+}
+
+TEST(HostileRequests, ChunkedFloodsAreRefusedEarlyWithoutBuffering) {
+    Hostile h;
+    const std::string before = h.study.fingerprint();
+    const long rssBefore = residentKiB();
+    // Three floods at once, each offering 500 MiB in 64 KiB chunks: the server stops reading after 16 KiB of body
+    // (413), discards at most a few MiB more and closes.
+    std::atomic<std::size_t> maxSent{0};
+    std::vector<std::thread> floods;
+    std::vector<std::string> answers(3);
+    for (int f = 0; f < 3; ++f) {
+        floods.emplace_back([&, f] {
+            RawSocket socket(h.study.port());
+            socket.send("POST /api/join HTTP/1.1\r\nHost: " + h.host +
+                        "\r\nContent-Type: application/json\r\nTransfer-Encoding: chunked\r\n\r\n");
+            char size[32];
+            std::snprintf(size, sizeof size, "%x\r\n", 65536);
+            const std::string chunk = std::string(size) + std::string(65536, ' ') + "\r\n";
+            std::size_t sent = 0;
+            while (sent < (500u << 20) && socket.send(chunk)) sent += 65536;
+            std::size_t seen = maxSent.load();
+            while (sent > seen && !maxSent.compare_exchange_weak(seen, sent)) {
+            }
+            answers[static_cast<std::size_t>(f)] = socket.readResponse(3s);
+        });
+    }
+    for (std::thread& t : floods) t.join();
+    EXPECT_LT(maxSent.load(), 64u << 20) << "the server kept reading a flood";
+    for (const std::string& a : answers)
+        if (!a.empty()) {
+            EXPECT_EQ(statusOf(a), 413) << a.substr(0, 200);
+        }
+    EXPECT_LT(residentKiB() - rssBefore, 64 * 1024) << "RSS grew while refusing floods";
+    // Chunk sizes that overflow, or a single chunk over the limit.
+    h.expectRejected("chunk size overflow", 0, [&] {
+        return h.exchange("POST /api/join HTTP/1.1\r\nHost: " + h.host +
+                          "\r\nContent-Type: application/json\r\nTransfer-Encoding: chunked\r\n\r\nfffffffffffffffffffff\r\n{}\r\n0\r\n\r\n");
+    });
+    h.expectRejected("one huge chunk", 413, [&] {
+        return h.exchange("POST /api/join HTTP/1.1\r\nHost: " + h.host +
+                          "\r\nContent-Type: application/json\r\nTransfer-Encoding: chunked\r\n\r\n40000000\r\n{}");
+    });
+    EXPECT_EQ(h.study.fingerprint(), before);
+    // A small chunked body is fine.
+    const std::string joined = h.exchange("POST /api/join HTTP/1.1\r\nHost: " + h.host +
+                                          "\r\nContent-Type: application/json\r\nTransfer-Encoding: chunked\r\n\r\n2\r\n{}\r\n0\r\n\r\n");
+    EXPECT_EQ(statusOf(joined), 201) << joined;
+}
+
+TEST(HostileRequests, TokensReplaysOrderConcurrencyAndLateAnswers) {
+    Hostile h;
+    HttpClient client = h.study.client();
+    Participant alice = joinAndStart(client);
+    Participant bob = joinAndStart(client);
+    const json first = alice.state["trial"]["id"];
+    auto post = [&](const json& body) { return [&h, body] { return h.request("POST", "/api/response", body.dump()); }; };
+    auto with = [](json body, const std::string& key, const json& value) {
+        if (value.is_null()) body.erase(key);
+        else body[key] = value;
+        return body;
+    };
+    const json good = answerBody(alice, first, "left");
+    h.expectRejected("missing token", 400, post(with(good, "token", nullptr)));
+    h.expectRejected("empty token", 404, post(with(good, "token", "")));
+    h.expectRejected("wrong token", 404, post(with(good, "token", std::string(32, '0'))));
+    h.expectRejected("token too long", 400, post(with(good, "token", std::string(65, 'a'))));
+    h.expectRejected("token as object", 400, post(with(good, "token", json{{"$ne", ""}})));
+    h.expectRejected("SQL in token", 404, post(with(good, "token", "' OR 1=1 --")));
+    h.expectRejected("bob's token on alice's trial", 404, post(with(good, "token", bob.token)));
+    h.expectRejected("bob's session", 404, post(with(good, "session", bob.session)));
+    h.expectRejected("bob's trial", 404, post(with(good, "trial", bob.state["trial"]["id"])));
+    h.expectRejected("state with bob's token changed", 404, [&] {
+        return h.request("GET", "/api/state?token=" + bob.token.substr(0, 31) + "0");
+    });
+    h.expectRejected("session for nobody", 404, [&] {
+        return h.request("POST", "/api/session", with(screen(), "token", "nobody").dump());
+    });
+    h.expectRejected("researcher status without token", 401, [&] { return h.request("GET", "/api/researcher/status"); });
+    h.expectRejected("researcher token in the URL", 401, [&] {
+        return h.request("GET", std::string("/api/researcher/status?token=") + kResearcherToken);
+    });
+    h.expectRejected("participant token as researcher token", 403, [&] {
+        return h.request("GET", "/api/researcher/export", "", "Authorization: Bearer " + alice.token + "\r\n");
+    });
+
+    // Out of order: alice's third trial before her first.
+    const auto trials = h.study.store().trials(h.study.store().participant(alice.token).id);
+    h.expectRejected("out of order", 409, post(with(good, "trial", trialReference(alice.token, trials[2].id))));
+
+    // Concurrent answers to the same trial: one stored, the same answer again is a duplicate, a different one 409.
+    std::vector<std::thread> threads;
+    std::vector<int> statuses(16);
+    for (int i = 0; i < 16; ++i)
+        threads.emplace_back([&, i] {
+            const std::string response = h.request("POST", "/api/response", answerBody(alice, first, i % 2 ? "left" : "right").dump());
+            statuses[static_cast<std::size_t>(i)] = statusOf(response);
+        });
+    for (std::thread& t : threads) t.join();
+    EXPECT_EQ(h.study.store().responseCount(), 1);
+    int ok = 0, conflict = 0;
+    for (int s : statuses) (s == 200 ? ok : conflict) += 1;
+    EXPECT_EQ(ok + conflict, 16);
+    EXPECT_EQ(ok, 8) << "every request with the stored side is acknowledged (stored or duplicate)";
+    const bool storedLeft = h.study.store().responses()[0].aSelected == h.study.store().responses()[0].aOnLeft;
+    // Replays: the stored answer again is harmless, another one is refused.
+    {
+        const std::string before = h.study.fingerprint();
+        const std::string replay = h.request("POST", "/api/response", answerBody(alice, first, storedLeft ? "left" : "right").dump());
+        EXPECT_EQ(statusOf(replay), 200);
+        EXPECT_TRUE(json::parse(bodyOf(replay))["duplicate"].get<bool>());
+        EXPECT_EQ(h.study.fingerprint(), before);
+    }
+    h.expectRejected("replay, other side", 409, post(answerBody(alice, first, storedLeft ? "right" : "left")));
+
+    // Finish alice, then answer after completion.
+    json state = json::parse(bodyOf(h.request("GET", "/api/state?token=" + alice.token)));
+    json last;
+    while (!state["completed"].get<bool>()) {
+        last = state["trial"]["id"];
+        state = json::parse(bodyOf(h.request("POST", "/api/response", answerBody(alice, last, "left").dump())));
+    }
+    {
+        const std::string before = h.study.fingerprint();
+        const std::string again = h.request("POST", "/api/response", answerBody(alice, last, "left").dump());
+        EXPECT_EQ(statusOf(again), 200);
+        EXPECT_TRUE(json::parse(bodyOf(again))["completed"].get<bool>());
+        EXPECT_EQ(h.study.fingerprint(), before);
+    }
+    h.expectRejected("after completion, changed answer", 409, post(answerBody(alice, last, "right")));
+    h.expectRejected("after completion, next id", 404, post(answerBody(alice, last.get<std::int64_t>() + 1, "left")));
+}
+
+TEST(HostileRequests, HostHeadersNonUtf8HeadersAndFloodsOfJoinsOrConnections) {
+    Hostile h([](ServerOptions& o) {
+        o.joinBurst = 5;
+        o.joinsPerMinute = 1;
+        o.connectionsPerClient = 6;
+    });
+    auto withHost = [&](const std::string& host) {
+        return h.exchange("GET /api/study HTTP/1.1\r\nHost: " + host + "\r\nConnection: close\r\n\r\n");
+    };
+    const std::string port = std::to_string(h.study.port());
+    for (const std::string& host : std::vector<std::string>{"evil.example", "evil.example:" + port, "localhost.evil.example",
+                                                           "127.0.0.1", "127.0.0.1:1", "127.0.0.2:" + port, "[::1]",
+                                                           "\xff\xfe", "", "127.0.0.1:" + port + "@evil"}) {
+        h.expectRejected("Host " + host, 421, [&] { return withHost(host); });
+    }
+    h.expectRejected("no Host (HTTP/1.0)", 400, [&] { return h.exchange("GET /api/study HTTP/1.0\r\n\r\n"); });
+    h.expectRejected("two Hosts", 400, [&] {
+        return h.exchange("GET /api/study HTTP/1.1\r\nHost: " + h.host + "\r\nHost: evil.example\r\n\r\n");
+    });
+    EXPECT_EQ(statusOf(withHost("localhost:" + std::to_string(h.study.port()))), 200);
+    EXPECT_EQ(statusOf(withHost(h.host)), 200);
+
+    // Non-UTF-8 and control bytes in headers: a request with them works, and only well-formed UTF-8 is stored.
+    HttpClient client = h.study.client();
+    Participant p = joinAndStart(client);
+    json start = screen();
+    start["token"] = p.token;
+    const std::string body = start.dump();
+    const std::string response = h.exchange("POST /api/session HTTP/1.1\r\nHost: " + h.host + "\r\nUser-Agent: Mozilla\xff\xfe\xc3\r\n"
+                                            "Content-Type: application/json\r\nContent-Length: " + std::to_string(body.size()) +
+                                            "\r\nConnection: close\r\n\r\n" + body);
+    EXPECT_EQ(statusOf(response), 200) << response;
+    {
+        SqliteDatabase db(h.study.databasePath().string(), false);
+        SqliteStatement s = db.prepare("SELECT user_agent FROM sessions ORDER BY id DESC LIMIT 1");
+        ASSERT_TRUE(s.step());
+        EXPECT_EQ(s.text(0), "Mozilla\xEF\xBF\xBD\xEF\xBF\xBD\xEF\xBF\xBD");
+    }
+    EXPECT_NO_THROW({
+        const json exported = json::parse(exportResponses(h.study.store(), "json"));
+        EXPECT_TRUE(exported.is_object());
+    });
+    h.expectRejected("bad header name", 400, [&] { return h.exchange("GET /api/study HTTP/1.1\r\nHost: " + h.host + "\r\nBad\xff Name: 1\r\n\r\n"); });
+    h.expectRejected("NUL in a header", 400, [&] {
+        return h.exchange(std::string("GET /api/study HTTP/1.1\r\nHost: ") + h.host + "\r\nX: a" + std::string(1, '\0') + "b\r\n\r\n");
+    });
+
+    // Joins: a burst of 5 per address (one already used above), then 429 with Retry-After; nothing stored by those.
+    for (int i = 0; i < 4; ++i) EXPECT_EQ(statusOf(h.request("POST", "/api/join", "{}")), 201);
+    for (int i = 0; i < 5; ++i) {
+        h.expectRejected("join flood", 429, [&] { return h.request("POST", "/api/join", "{}"); });
+    }
+    EXPECT_NE(h.request("POST", "/api/join", "{}").find("Retry-After:"), std::string::npos);
+    // Another address has its own allowance.
+    {
+        RawSocket other(h.study.port(), "127.0.0.9");
+        other.send("POST /api/join HTTP/1.1\r\nHost: " + h.host + "\r\nContent-Type: application/json\r\nContent-Length: 2\r\n\r\n{}");
+        EXPECT_EQ(statusOf(other.readResponse()), 201);
+    }
+
+    // Connections: 6 open at once from one address; the 7th is refused (429) and closed, the others still work.
+    std::vector<std::unique_ptr<RawSocket>> open;
+    for (int i = 0; i < 6; ++i) open.push_back(std::make_unique<RawSocket>(h.study.port(), "127.0.0.3"));
+    std::this_thread::sleep_for(200ms);
+    {
+        RawSocket extra(h.study.port(), "127.0.0.3");
+        EXPECT_EQ(statusOf(extra.readResponse(3s)), 429);
+    }
+    ASSERT_TRUE(open[0]->send("GET /api/study HTTP/1.1\r\nHost: " + h.host + "\r\n\r\n"));
+    EXPECT_EQ(statusOf(open[0]->readResponse()), 200);
+    RawSocket elsewhere(h.study.port(), "127.0.0.4");
+    ASSERT_TRUE(elsewhere.send("GET /api/study HTTP/1.1\r\nHost: " + h.host + "\r\n\r\n"));
+    EXPECT_EQ(statusOf(elsewhere.readResponse()), 200);
+}
+
+TEST(HostileRequests, PublicHostNameIsAcceptedWhenGiven) {
+    Hostile h([](ServerOptions& o) { o.publicHost = "study.example.org"; });
+    for (const std::string host : {"study.example.org", "Study.Example.org:443", "study.example.org:8080"})
+        EXPECT_EQ(statusOf(h.exchange("GET /api/study HTTP/1.1\r\nHost: " + host + "\r\nConnection: close\r\n\r\n")), 200) << host;
+    EXPECT_EQ(statusOf(h.exchange("GET /api/study HTTP/1.1\r\nHost: evil.example.org\r\nConnection: close\r\n\r\n")), 421);
+}
+
+TEST(HostileRequests, StimuliArePinnedCachedAndNeverFollowLinksOutOfTheSet) {
+    Hostile h;
+    const fs::path png = h.study.folder() / "stimuli" / "png";
+    fs::path first;
+    for (const auto& entry : fs::directory_iterator(png))
+        if (first.empty() || entry.path() < first) first = entry.path();
+    // Which number serves which file: find the stimulus whose bytes are `first`.
+    const std::string original = skinlab::readFile(first);
+    int number = -1;
+    std::string etag;
+    for (int i = 0; i < 64 && number < 0; ++i) {
+        const std::string response = h.request("GET", "/stimuli/" + std::to_string(i) + ".png");
+        if (bodyOf(response) == original) {
+            number = i;
+            const std::size_t at = response.find("ETag: ");
+            ASSERT_NE(at, std::string::npos);
+            etag = response.substr(at + 6, response.find("\r\n", at) - at - 6);
+            EXPECT_NE(response.find("Cache-Control: private, max-age=31536000, immutable"), std::string::npos);
+        }
+    }
+    ASSERT_GE(number, 0);
+    const std::string target = "/stimuli/" + std::to_string(number) + ".png";
+    // Revalidation: 304 without a body.
+    const std::string revalidated = h.request("GET", target, "", "If-None-Match: " + etag + "\r\n");
+    EXPECT_EQ(statusOf(revalidated), 304);
+    EXPECT_TRUE(bodyOf(revalidated).empty());
+    EXPECT_EQ(statusOf(h.request("GET", target, "", "If-None-Match: \"other\"\r\n")), 200);
+    // The file changed on disk, then replaced by a link out of the set: the verified bytes are still served.
+    skinlab::writeFileAtomic(first, "changed");
+    EXPECT_EQ(bodyOf(h.request("GET", target)), original);
+    fs::remove(first);
+    fs::create_symlink("/etc/hostname", first);
+    EXPECT_EQ(bodyOf(h.request("GET", target)), original);
+    // A server started on a set whose image links out of the folder refuses to start.
+    fs::remove(first);
+    const fs::path outside = h.study.folder() / "outside.png";
+    skinlab::writeFileAtomic(outside, original); // same bytes, same sha256: only the location is wrong
+    fs::create_symlink(outside, first);
+    StudyStore store(h.study.databasePath());
+    ServerOptions options;
+    options.port = 0;
+    try {
+        StudyServer server(store, options);
+        ADD_FAILURE() << "a stimulus linking out of the set was accepted";
+    } catch (const skinlab::InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("outside the stimulus folder"), std::string::npos) << e.what();
+    }
+}
