@@ -10,6 +10,7 @@ void registerStimuli(CLI::App& app);
 void registerStudy(CLI::App& app);
 void registerAnalyze(CLI::App& app);
 void registerBench(CLI::App& app);
+void registerPathtraced(CLI::App& app);
 } // namespace skinlab::cli
 
 namespace skinlab::cli {

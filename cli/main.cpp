@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
     skinlab::cli::registerStudy(app);
     skinlab::cli::registerAnalyze(app);
     skinlab::cli::registerBench(app);
+    skinlab::cli::registerPathtraced(app);
 
     try {
         app.parse(argc, argv);

@@ -21,6 +21,7 @@ PACKAGES=(
   # browser test of the participant page
   chromium nodejs   # npm ships with the machine's Node.js (nodesource); Debian's npm conflicts with it
   fonts-dejavu-core   # stimuli: captions of contact.png (OpenImageIO render_text needs a TrueType font)
+  blender   # the pathtraced method: Cycles runs as a child process (docs/pathtraced.md)
 )
 
 missing=()
