@@ -68,7 +68,7 @@ void registerPathtraced(CLI::App& app) {
     fit->add_option("--samples", options->settings.samples, "Cycles samples per pixel")->check(CLI::Range(1, 1 << 20));
     fit->add_option("--seed", options->settings.seed, "Cycles seed")->check(CLI::Range(0, 2147483647));
     fit->add_option("--pixels", options->settings.pixels, "Pixels along the strip (even)")->check(CLI::Range(16, 65536));
-    fit->add_option("--rows", options->settings.rows, "Rows across the strip (averaged)")->check(CLI::Range(1, 4096));
+    fit->add_option("--rows", options->settings.rows, "Rows across the strip (averaged; at least 4)")->check(CLI::Range(4, 4096));
     fit->add_option("--half-length-mm", options->settings.halfLengthMm, "Half length of the strip at radius 1 mm")
         ->check(CLI::Range(1.0, 1000.0));
     fit->add_option("--blender", options->settings.blender, "The Blender program");

@@ -15,7 +15,7 @@ namespace skinlab::renderer::pathtraced {
 
 EdgeResponse measureEdgeResponse(const EdgeMeasurementSettings& s) {
     if (s.pixels < 16 || s.pixels % 2 != 0) throwInput("fit-profile", "pixels", std::to_string(s.pixels) + " must be even and at least 16");
-    if (s.rows < 1) throwInput("fit-profile", "rows", "must be at least 1");
+    if (s.rows < 4) throwInput("fit-profile", "rows", std::to_string(s.rows) + " is below Blender's smallest image (4 rows)");
     const std::filesystem::path folder = makeWorkFolder("skinlab-profile");
     const nlohmann::json description = {
         {"settings", {{"width", s.pixels}, {"height", s.rows}, {"samples", s.samples}, {"seed", s.seed},
@@ -34,7 +34,9 @@ EdgeResponse measureEdgeResponse(const EdgeMeasurementSettings& s) {
     int width = 0, height = 0;
     const std::filesystem::path exr = folder / "cycles.exr";
     const auto channels = readExrChannels(exr, width, height);
-    if (width != s.pixels || height != s.rows) throw InputError(exr.string() + ": unexpected size");
+    if (width != s.pixels || height != s.rows)
+        throw InputError(exr.string() + ": Cycles wrote " + std::to_string(width) + "x" + std::to_string(height) +
+                         ", expected " + std::to_string(s.pixels) + "x" + std::to_string(s.rows));
     EdgeResponse response;
     const double pixelMm = 2.0 * s.halfLengthMm / s.pixels;
     const int half = s.pixels / 2;

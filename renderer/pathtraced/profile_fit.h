@@ -22,7 +22,7 @@ struct EdgeMeasurementSettings {
     int samples = 256;
     int seed = 0;
     int pixels = 2048;               // along the strip
-    int rows = 8;                    // across it (averaged)
+    int rows = 8;                    // across it (averaged; Blender renders at least 4)
     // The strip covers x in [−half, +half] at radius 1 mm; a skin-coloured walk of radius 1 mm leaves E < 1e-4
     // beyond 1 mm, so ±4 mm holds the whole response at 0.004 mm pixels.
     double halfLengthMm = 4.0;
