@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <cstdlib>
 #include <limits>
@@ -103,6 +104,14 @@ CyclesImage renderWithCycles(const BlenderSceneInputs& inputs, float exposure) {
         // Cycles writes 1e10 where a camera ray leaves the scene.
         image.depth[p] = depth[p] >= 1e9f ? std::numeric_limits<float>::infinity() : depth[p];
         image.mask[p] = skin[p] >= 0.5f ? 1.0f : 0.0f;
+        if (std::isinf(image.depth[p])) {
+            // Where no surface is seen the rasterizer's diffuse layer holds the background (its background pass
+            // writes there) and its specular 0: the same here, so that every layer means the same in both.
+            for (std::size_t c = 0; c < 3; ++c) {
+                image.diffuse[p * 3 + c] = image.beauty[p * 3 + c];
+                image.specular[p * 3 + c] = 0.0f;
+            }
+        }
     }
     const nlohmann::json record = readRecord(folder / "cycles.json");
     image.blenderVersion = record.value("blender_version", "");
