@@ -11,6 +11,7 @@ void registerStudy(CLI::App& app);
 void registerAnalyze(CLI::App& app);
 void registerBench(CLI::App& app);
 void registerReport(CLI::App& app);
+void registerPathtraced(CLI::App& app);
 } // namespace skinlab::cli
 
 namespace skinlab::cli {

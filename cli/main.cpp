@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
     skinlab::cli::registerAnalyze(app);
     skinlab::cli::registerBench(app);
     skinlab::cli::registerReport(app);
+    skinlab::cli::registerPathtraced(app);
 
     try {
         app.parse(argc, argv);

@@ -23,6 +23,8 @@
 #include "renderer/gl/transmittance_pass.h"
 #include "renderer/output/display_output.h"
 #include "renderer/output/exr_writer.h"
+#include "renderer/pathtraced/cycles_render.h"
+#include "renderer/shading/tone_mappers.h"
 #include "renderer/scene/builtin_geometry.h"
 #include "renderer/scene/environment.h"
 #include "renderer/scene/mesh_loader.h"
@@ -36,6 +38,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <limits>
 #include <map>
+#include <optional>
 #include <spdlog/spdlog.h>
 
 namespace skinlab::renderer {
@@ -255,6 +258,25 @@ RenderResult Renderer::render(const RenderRequest& request) {
     glFinish();
     const double uploadMs = millisecondsSince(uploadStart);
 
+    // sss.method = "pathtraced": Blender Cycles renders the same triangles, camera, lights and environment
+    // (renderer/pathtraced, docs/pathtraced.md) before any pass runs, so a missing or failing Blender leaves
+    // nothing done. The passes below still run (the screen-space stage copies through) for the AOVs Cycles does
+    // not produce: albedo, normals, transmittance, aux, curvature.
+    std::optional<pathtraced::CyclesImage> cycles;
+    bool fractionalSkin = !spec.textures.skinMask.empty();
+    for (const Vertex& v : model->vertices) fractionalSkin = fractionalSkin || v.skin < 1.0f;
+    if (spec.sssMethod == "pathtraced") {
+        pathtraced::BlenderSceneInputs cyclesInputs;
+        cyclesInputs.spec = &spec;
+        cyclesInputs.model = model.get();
+        for (const gl::GpuMaterial& m : partMaterials)
+            cyclesInputs.partMaterials.push_back({m.albedo, m.skin, m.glossiness, m.specularIntensity});
+        cyclesInputs.camera = camera;
+        cyclesInputs.params = pathtraced::pathtracedParamsFromJson(spec.pathtraced, spec.source);
+        cyclesInputs.sssWidthMm = sss::sssParamsFromJson(spec.sss, spec.source).widthMm;
+        cycles = pathtraced::renderWithCycles(cyclesInputs, exposure);
+    }
+
     // --- passes ------------------------------------------------------------------------------------------
     // sss.method = "reference": check its parameters and tessellate (cached) before the first pass, so bad input
     // fails with no pass half done.
@@ -399,7 +421,13 @@ RenderResult Renderer::render(const RenderRequest& request) {
     const std::vector<float> aux = read(impl.targets.aux.get(), 1);
     const std::vector<float> curvature = read(impl.targets.curvature.get(), 1);
     std::vector<float> display;
-    if (!request.pngPath.empty()) {
+    if (!request.pngPath.empty() && cycles) {
+        // Cycles' beauty through the same tone mapper (renderer/shading/tone_mappers.h mirrors the GL pass).
+        display.resize(pixels * 3);
+        for (std::size_t i = 0; i < pixels * 3; ++i)
+            display[i] = toneMap(cycles->beauty[i], spec.toneMapper, static_cast<float>(spec.exponentialK),
+                                 static_cast<float>(spec.filmicWhite));
+    } else if (!request.pngPath.empty()) {
         const std::vector<float> displayRgba = read(impl.targets.display.get(), 4);
         display.resize(pixels * 3);
         for (std::size_t p = 0; p < pixels; ++p)
@@ -418,14 +446,26 @@ RenderResult Renderer::render(const RenderRequest& request) {
             channels.push_back(std::move(channel));
         }
     };
-    addChannels("", beauty, 4, "RGB");
-    addChannels("diffuse", diffuse, 4, "RGB");
-    addChannels("specular", specular, 4, "RGB");
+    if (cycles) {
+        // Beauty, diffuse, specular, depth and mask from Cycles; the other AOVs from the rasterizer's passes.
+        addChannels("", cycles->beauty, 3, "RGB");
+        addChannels("diffuse", cycles->diffuse, 3, "RGB");
+        addChannels("specular", cycles->specular, 3, "RGB");
+    } else {
+        addChannels("", beauty, 4, "RGB");
+        addChannels("diffuse", diffuse, 4, "RGB");
+        addChannels("specular", specular, 4, "RGB");
+    }
     addChannels("albedo", albedo, 4, "RGB");
-    addChannels("depth", depth, 1, "Z");
+    addChannels("depth", cycles ? cycles->depth : depth, 1, "Z");
     addChannels("normal", normal, 4, "XYZ");
     addChannels("geonormal", geometricNormal, 4, "XYZ");
-    addChannels("mask", mask, 1, "Y");
+    if (cycles && fractionalSkin) {
+        // A skin-mask map or per-vertex skin below 1: Cycles' index pass only knows the material's flag, so the
+        // rasterizer's mask (same camera, point-sampled) supplies the fraction.
+        for (std::size_t p = 0; p < pixels; ++p) cycles->mask[p] *= std::clamp(mask[p], 0.0f, 1.0f);
+    }
+    addChannels("mask", cycles ? cycles->mask : mask, 1, "Y");
     addChannels("transmittance", transmittance, 4, "RGB");
     addChannels("aux", aux, 1, "Y");
     addChannels("curvature", curvature, 1, "Y");
@@ -446,9 +486,26 @@ RenderResult Renderer::render(const RenderRequest& request) {
     metadata.strings["skinlab:camera"] = cameraJson.dump();
     metadata.floats["skinlab:f_px"] = camera.focalLengthPixels;
     metadata.floats["skinlab:mm_per_unit"] = static_cast<float>(spec.mmPerUnit);
+    // pathtraced: the support of the profile its radii are matched to (as the object-space reference declares).
     metadata.floats["skinlab:sss_radius_mm"] =
         referenceMethod ? gl::ReferenceMethod::supportRadiusMm(referenceParams, spec.source)
+        : cycles        ? gl::ReferenceMethod::supportRadiusMm(sss::sssParamsFromJson(spec.sss, spec.source), spec.source)
                         : impl.sssStage.supportRadiusMm(sssSettings);
+    if (cycles) {
+        const nlohmann::json params = spec.pathtraced;
+        metadata.strings["skinlab:pathtraced"] =
+            nlohmann::json{{"samples", params.at("samples")},
+                           {"seed", params.at("seed")},
+                           {"blender_version", cycles->blenderVersion},
+                           {"render_seconds", cycles->renderSeconds},
+                           {"wall_seconds", cycles->wallSeconds},
+                           {"channels_from_cycles", {"R", "G", "B", "diffuse.*", "specular.*", "depth.Z", "mask.Y"}}}
+                .dump();
+        metadata.strings["skinlab:blender_version"] = cycles->blenderVersion;
+        metadata.floats["skinlab:pathtraced_samples"] = static_cast<float>(params.at("samples").get<int>());
+        metadata.floats["skinlab:pathtraced_seed"] = static_cast<float>(params.at("seed").get<int>());
+        metadata.floats["skinlab:render_seconds"] = static_cast<float>(cycles->renderSeconds);
+    }
     writeExr(request.exrPath, width, height, channels, metadata);
     if (!request.pngPath.empty()) writePng(request.pngPath, width, height, encodeDisplaySrgb8(display));
     const double writeMs = millisecondsSince(writeStart);
@@ -460,6 +517,8 @@ RenderResult Renderer::render(const RenderRequest& request) {
     result.timingsMs = timer.json();
     result.timingsMs["cpu"] = {{"load", loadMs}, {"upload", uploadMs}, {"readback", readbackMs}, {"write", writeMs}};
     if (referenceMethod) result.timingsMs["reference"] = impl.referenceMethod.lastRun();  // CPU parts of "sss"
+    if (cycles)
+        result.timingsMs["pathtraced"] = {{"render", cycles->renderSeconds * 1000.0}, {"blender_wall", cycles->wallSeconds * 1000.0}};
     result.timingsMs["width"] = width;
     result.timingsMs["height"] = height;
     result.timingsMs["gl_renderer"] = result.glRenderer;

@@ -67,6 +67,7 @@ void SssStage::run(const SssStageInputs& inputs, const SssStageSettings& setting
         return;
     }
     case sss::SssMethod::None:
+    case sss::SssMethod::Pathtraced:  // Cycles replaces the image afterwards (render_job.cpp); copy through
         break;
     }
     // A framebuffer per run: texture names are recycled when the frame is resized, so caching one by name

@@ -3,6 +3,7 @@
 #include "common/error.h"
 #include "common/spec.h"
 #include "renderer/scene/builtin_scenes.h"
+#include "renderer/pathtraced/pathtraced_params.h"
 #include "renderer/sss/sss_params.h"
 
 #include <cmath>
@@ -293,6 +294,8 @@ SceneSpec loadSceneSpec(const std::string& scene, const std::vector<std::string>
         spec.transmittance = transmittanceParams.toJson();
         resolved["sss"] = spec.sss;
         resolved["transmittance"] = spec.transmittance;
+        spec.pathtraced = pathtraced::readPathtracedParams(root).toJson();
+        if (sssParams.method == sss::SssMethod::Pathtraced) resolved["pathtraced"] = spec.pathtraced;
     }
 
     root.finish();

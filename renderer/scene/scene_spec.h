@@ -90,6 +90,9 @@ struct SceneSpec {
     std::string sssMethod = "none";
     nlohmann::json sss = nlohmann::json::object();           // resolved [sss] table
     nlohmann::json transmittance = nlohmann::json::object(); // resolved [transmittance] table
+    // Resolved [pathtraced] table (renderer/pathtraced/pathtraced_params.h); read for every scene, recorded in
+    // `resolved` only when sss.method = "pathtraced" (the other methods do not depend on it).
+    nlohmann::json pathtraced = nlohmann::json::object();
 
     nlohmann::json resolved;           // every parameter after defaults and overrides
 };

@@ -51,6 +51,10 @@ Kernel makeKernel(const SssParams& params) {
     case SssMethod::None:
         kernel.source = "none";
         break;
+    case SssMethod::Pathtraced:
+        // Rendered by Blender Cycles (renderer/pathtraced): no screen-space taps.
+        kernel.source = "path-traced (Blender Cycles, random walk)";
+        break;
     case SssMethod::Reference:
         // Computed on the surface (renderer/reference), not with screen-space taps.
         kernel.source = "object-space reference (" + makeMarginal(params)->description() + ", 3-D distances)";

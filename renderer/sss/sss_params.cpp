@@ -8,7 +8,7 @@
 namespace skinlab::renderer::sss {
 
 namespace {
-const std::vector<std::string> kMethodNames{"none", "gaussian-sum", "separable", "artistic", "pscbf", "reference"};
+const std::vector<std::string> kMethodNames{"none", "gaussian-sum", "separable", "artistic", "pscbf", "reference", "pathtraced"};
 const std::vector<std::string> kCurvatureNames{"off", "increase", "reduce", "reduce-floor"};
 const std::vector<std::string> kPlacementNames{"quadratic", "importance"};
 const std::vector<std::string> kPscbfSigmaNames{"variance", "std-dev"};
@@ -52,6 +52,7 @@ SssParams readSssTable(const SpecReader& sss) {
                : method == "artistic"   ? SssMethod::Artistic
                : method == "pscbf"      ? SssMethod::Pscbf
                : method == "reference"  ? SssMethod::Reference
+               : method == "pathtraced" ? SssMethod::Pathtraced
                                         : SssMethod::None;
     if (p.method == SssMethod::Pscbf) p.samples = SssParams::kDefaultPscbfSamples;
     p.samples = static_cast<int>(sss.integer("samples", p.samples, 3, 101));
@@ -110,6 +111,7 @@ std::string_view methodName(SssMethod method) {
     case SssMethod::Artistic: return "artistic";
     case SssMethod::Pscbf: return "pscbf";
     case SssMethod::Reference: return "reference";
+    case SssMethod::Pathtraced: return "pathtraced";
     }
     return "none";
 }

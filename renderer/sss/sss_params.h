@@ -20,6 +20,7 @@ enum class SssMethod {
     Artistic,     // Jimenez's demo kernel (width, strength, falloff), two passes
     Pscbf,        // Mikkelsen 2010: pseudo-separable cross-bilateral filter, spike + one Gaussian per channel
     Reference,    // object-space SSS on the tessellated surface (the ground truth of the metrics)
+    Pathtraced,   // Blender Cycles' random walk (renderer/pathtraced; the screen-space stage copies through)
 };
 
 // How a continuous 1-D kernel is discretised into taps (docs/methods.md, "Discretisation").

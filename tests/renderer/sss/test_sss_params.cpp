@@ -65,7 +65,7 @@ artistic_falloff = [0.4, 0.5, 0.6]
 
 TEST(SssParams, ErrorsNameFileKeyAndValue) {
     EXPECT_EQ(sssError("[sss]\nmethod = \"blur\""),
-              "scene.toml: sss.method: 'blur' is not one of: none, gaussian-sum, separable, artistic, pscbf, reference");
+              "scene.toml: sss.method: 'blur' is not one of: none, gaussian-sum, separable, artistic, pscbf, reference, pathtraced");
     EXPECT_EQ(sssError("[sss]\nsamples = 20"),
               "scene.toml: sss.samples: 20 is even; a symmetric kernel needs an odd number of taps (3…101)");
     EXPECT_EQ(sssError("[sss]\nsamples = 103"), "scene.toml: sss.samples: 103 is out of range [3, 101]");

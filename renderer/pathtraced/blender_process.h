@@ -1,0 +1,25 @@
+#pragma once
+// Blender as a child process (never linked): found on PATH or by path, run headless with its output kept in a
+// log file. docs/pathtraced.md, "Running Blender".
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace skinlab::renderer::pathtraced {
+
+// The program's full path: `program` itself when it contains a '/', else the first executable of that name on
+// PATH; empty when there is none.
+std::filesystem::path findProgram(const std::string& program);
+
+// Runs `program args...` in `workingDirectory` with stdin from /dev/null and stdout + stderr appended to
+// `logPath`; waits and returns the exit status (128 + signal when killed by a signal). Throws InputError naming
+// the program when it cannot be started.
+int runProcess(const std::filesystem::path& program, const std::vector<std::string>& args,
+               const std::filesystem::path& workingDirectory, const std::filesystem::path& logPath);
+
+// Runs `blender -b --factory-startup -noaudio --python SCRIPT -- ARGS...`. Throws InputError naming the program
+// (missing: how to install it) or, when it fails, its exit status, the last error line of its log and the log's path.
+void runBlender(const std::string& program, const std::filesystem::path& script, const std::vector<std::string>& args,
+                const std::filesystem::path& workingDirectory, const std::filesystem::path& logPath);
+
+} // namespace skinlab::renderer::pathtraced

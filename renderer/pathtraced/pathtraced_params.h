@@ -1,0 +1,44 @@
+#pragma once
+// Typed parameters of the scene spec table [pathtraced] (sss.method = "pathtraced": Blender Cycles renders the
+// scene; docs/pathtraced.md lists every key with its unit and range), their strict reader and their JSON form.
+#include <array>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <string_view>
+
+namespace skinlab {
+class SpecReader;
+}
+
+namespace skinlab::renderer::pathtraced {
+
+// Per-channel random-walk radii (mean free paths, mm) at sss.width_mm = 3, fitted so that the radial profile of
+// Cycles' RANDOM_WALK_FIXED_RADIUS on a flat skin slab matches d'Eon's sum of Gaussians (the profile of the
+// screen-space methods): `skinlab pathtraced fit-profile`, docs/pathtraced.md "Matched profiles".
+// The values and the measurement that produced them: pathtraced_params.cpp.
+std::array<double, 3> fittedRadiusMm();
+
+struct PathtracedParams {
+    int samples = 64;          // camera samples per pixel (no adaptive sampling, no denoising)
+    int seed = 0;              // Cycles' sampling seed
+    int maxBounces = 8;        // total, diffuse and glossy bounce limits (0: direct light only)
+    bool sss = true;           // random-walk subsurface scattering on skin (false: a plain Principled surface)
+    bool specular = true;      // the specular lobe (false: Principled specular 0)
+    // Random-walk radii per channel (mm) at the profile's own scale; scaled by sss.width_mm / 3 like every
+    // screen-space kernel, then divided by mm_per_unit (Cycles takes them in scene units).
+    std::array<double, 3> radiusMm = fittedRadiusMm();
+    double sunAngleDeg = 0.0;    // angular diameter of directional lights (0: a hard sun, as the shadow map)
+    double filterWidthPx = 0.01; // pixel filter width; 0.01 point-samples the pixel centre like the rasterizer
+    int threads = 0;             // Cycles threads (0: all cores); pixels do not depend on it
+    std::string blender = "blender";  // the Blender program (a name on PATH or a path)
+
+    nlohmann::json toJson() const;
+};
+
+// Reads the [pathtraced] table of a scene spec (read and finished here). Defaults for absent keys; InputError
+// naming file and key for bad ones.
+PathtracedParams readPathtracedParams(const SpecReader& scene);
+// From the JSON form written by toJson(); same validation, errors name `source`.
+PathtracedParams pathtracedParamsFromJson(const nlohmann::json& json, std::string_view source = "pathtraced");
+
+} // namespace skinlab::renderer::pathtraced

@@ -1,0 +1,66 @@
+#pragma once
+// Matched profiles (docs/pathtraced.md, "Matched profiles"): the edge response of Cycles' random walk
+// (RANDOM_WALK_FIXED_RADIUS) on a flat semi-infinite skin slab, and the per-channel radii that make it match the
+// edge response of d'Eon's sum of Gaussians, the profile of the screen-space methods.
+//
+// Measurement: a hard sun lights the slab from straight above over x < 0 only (a plate invisible to the camera cuts
+// it off at x = 0); an orthographic camera looks at a strip across the edge. The diffuse radiance L(x) at x > 0 is
+// the light that travelled further than x in one direction inside the slab, so E(x) = L(x) / (L(x) + L(−x)) is the
+// edge response 1 − ∫_{−∞}^{x} a(t) dt of the profile's 1-D marginal a (exact for any radial profile, whatever
+// the slab's total albedo). A fixed-radius random walk is scale-free: radius r gives E_r(x) = E_1(x / r), so one
+// render at r = 1 mm serves every radius; the fit minimises Σ (E_1(x_k / r) − E_dEon(x_k))² over x_k in (0, 8] mm,
+// with E_dEon(x) = Σ w_i · ½ erfc(x / √(2 v_i)).
+#include <array>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace skinlab::renderer::pathtraced {
+
+struct EdgeMeasurementSettings {
+    int samples = 256;
+    int seed = 0;
+    int pixels = 2048;               // along the strip
+    int rows = 8;                    // across it (averaged; Blender renders at least 4)
+    // The strip covers x in [−half, +half] at radius 1 mm; a skin-coloured walk of radius 1 mm leaves E < 1e-4
+    // beyond 1 mm, so ±4 mm holds the whole response at 0.004 mm pixels.
+    double halfLengthMm = 4.0;
+    std::array<double, 3> albedo{0.60, 0.42, 0.34};  // subsurface colour (the built-in scenes' skin)
+    std::string blender = "blender";
+    int threads = 0;
+};
+
+struct EdgeResponse {
+    std::vector<double> xMm;                   // pixel centres x > 0 (radius 1 mm)
+    std::array<std::vector<double>, 3> value;  // E(x) per channel
+    std::array<double, 3> plateau{};           // L(x) + L(−x), averaged: the lit slab's diffuse radiance
+    std::string blenderVersion;
+    double renderSeconds = 0.0;
+};
+
+// Renders the edge scene with Blender (temporary folder; kept with its log on failure).
+EdgeResponse measureEdgeResponse(const EdgeMeasurementSettings& settings);
+
+// d'Eon's edge response per channel at x mm.
+double deonEdgeResponse(int channel, double xMm);
+
+struct ProfileFit {
+    std::array<double, 3> radiusMm{};        // fitted radius per channel
+    std::array<double, 3> rmsError{};        // RMS of E_fit − E_dEon over the fit range
+    std::array<double, 3> maxError{};
+    std::array<double, 3> initialRmsError{}; // the same with the radii before the fit (for comparison)
+};
+
+// Fits the radius of each channel (golden-section search on log r after a coarse scan).
+ProfileFit fitRadii(const EdgeResponse& response, const std::array<double, 3>& initialRadiusMm,
+                    double fitRangeMm = 8.0, double stepMm = 0.01);
+
+// E_1(x / r) by linear interpolation (0 beyond the measured range).
+double scaledEdgeResponse(const EdgeResponse& response, int channel, double radiusMm, double xMm);
+
+// A plot of the fit (log E against x, measured-and-scaled solid, d'Eon dashed, one colour per channel) as a PNG.
+void writeFitPlot(const std::filesystem::path& path, const EdgeResponse& response, const ProfileFit& fit,
+                  double rangeMm = 6.0);
+
+} // namespace skinlab::renderer::pathtraced
