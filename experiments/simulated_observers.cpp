@@ -143,7 +143,7 @@ ObserverResult runObserver(StudyStore& store, const SimulationOptions& options, 
         const std::int64_t trialId = body["trial"]["id"].get<std::int64_t>();
         auto it = plan.find(trialId);
         if (it == plan.end()) { // an active design's next batch, stored since the plan was read
-            for (const TrialRecord& t : store.trials(participant.id)) plan[t.id] = t.plan;
+            for (const TrialRecord& t : store.trials(participant.id)) plan[trialReference(token, t.id)] = {t.id, t.plan};
             it = plan.find(trialId);
         }
         if (it == plan.end()) {
