@@ -102,7 +102,7 @@ std::vector<std::string> answerAll(const fs::path& database, const std::string& 
         else if (t.stimulusB != kBlankStimulus) chooseA = kTruth.at(t.conditionA) > kTruth.at(t.conditionB);
         ResponseInput in;
         in.token = p.token;
-        in.trialId = next->id;
+        in.trialId = trialReference(p.token, next->id);
         in.side = chooseA == t.aOnLeft ? "left" : "right";
         in.sessionId = session;
         in.clientTime = "2026-01-01T00:00:00.000Z";
