@@ -1,4 +1,5 @@
 #include "analysis/agreement/metric_agreement.h"
+#include "common/csv.h"
 
 #include "analysis/scaling/bootstrap.h"
 #include "common/error.h"
@@ -25,15 +26,7 @@ std::string csvNumber(double value) {
     return text;
 }
 
-std::string csvText(const std::string& text) {
-    if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
-    std::string quoted = "\"";
-    for (char c : text) {
-        if (c == '"') quoted += '"';
-        quoted += c;
-    }
-    return quoted + "\"";
-}
+std::string csvText(const std::string& text) { return csvField(text); }
 
 std::vector<double> ranks(const std::vector<double>& values) {
     std::vector<std::size_t> order(values.size());

@@ -1,4 +1,5 @@
 #include "analysis/metrics/metrics_report.h"
+#include "common/csv.h"
 
 #include "common/version.h"
 
@@ -21,15 +22,7 @@ std::string csvNumber(double value) {
     return text;
 }
 
-std::string csvText(const std::string& text) {
-    if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
-    std::string quoted = "\"";
-    for (char c : text) {
-        if (c == '"') quoted += '"';
-        quoted += c;
-    }
-    return quoted + "\"";
-}
+std::string csvText(const std::string& text) { return csvField(text); }
 
 nlohmann::json jsonNumber(double value) { return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(); }
 
