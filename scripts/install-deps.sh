@@ -22,6 +22,7 @@ PACKAGES=(
   # browser test of the participant page
   chromium nodejs   # npm: see below
   fonts-dejavu-core   # stimuli: captions of contact.png (OpenImageIO render_text needs a TrueType font)
+  curl   # tests: the server-defect checks send raw HTTP
   slurm-wlm munge jq   # stimuli: the single-node Slurm cluster test (slurmctld, slurmd, sbatch; munged; jq reads manifests)
   blender   # the pathtraced method: Cycles runs as a child process (docs/pathtraced.md)
 )
