@@ -24,6 +24,7 @@ PACKAGES=(
   fonts-dejavu-core   # stimuli: captions of contact.png (OpenImageIO render_text needs a TrueType font)
   slurm-wlm munge jq   # stimuli: the single-node Slurm cluster test (slurmctld, slurmd, sbatch; munged; jq reads manifests)
   blender   # the pathtraced method: Cycles runs as a child process (docs/pathtraced.md)
+  nginx openssl   # online studies: the HTTPS deployment test (nginx in front of the server, a self-signed certificate)
 )
 
 missing=()
