@@ -2,6 +2,7 @@
 // proxy (X-Forwarded-For believed from it only), and `study backup` while answers are being written. Real HTTP on
 // an ephemeral loopback port, real SQLite.
 #include "common/error.h"
+#include "experiments/nginx_config.h"
 #include "experiments/sqlite_database.h"
 #include "experiments/study_backup.h"
 #include "study_server_fixture.h"
@@ -267,7 +268,9 @@ TEST(StudyBackup, CopyWhileAnswersAreWrittenHoldsAConsistentPrefix) {
                 ++position;
                 ++k;
             }
-            if (k < stored.size()) EXPECT_EQ(position, count) << "a later participant's answer before this one finished";
+            if (k < stored.size()) {
+                EXPECT_EQ(position, count) << "a later participant's answer before this one finished";
+            }
         }
         EXPECT_GE(summary.responses, previous) << "a later copy holds fewer answers";
         previous = summary.responses;
@@ -285,4 +288,46 @@ TEST(StudyBackup, CopyWhileAnswersAreWrittenHoldsAConsistentPrefix) {
     EXPECT_THROW(backupStudy(study.databasePath(), study.databasePath(), true), skinlab::InputError);
     std::set<std::int64_t> distinct(seen.begin(), seen.end());
     std::printf("%d copies taken while answering, %zu distinct answer counts\n", copies, distinct.size());
+}
+
+TEST(NginxSiteConfig, FillsTheTemplateAndRefusesValuesNginxWouldMisread) {
+    TemporaryFolder folder("nginx-config");
+    const auto cert = writeText(folder.path(), "cert.pem", "-----BEGIN CERTIFICATE-----\nMIIB\n-----END CERTIFICATE-----\n");
+    const auto key = writeText(folder.path(), "key.pem", "-----BEGIN PRIVATE KEY-----\nMIIB\n-----END PRIVATE KEY-----\n");
+    NginxSiteOptions o;
+    o.serverName = "study.example.org";
+    o.upstream = "127.0.0.1:8080";
+    o.certificate = cert.string();
+    o.key = key.string();
+    o.redirectPort = 80;
+    const std::string text = nginxSiteConfig(o);
+    EXPECT_EQ(text.find('@'), std::string::npos) << "a placeholder left unfilled";
+    for (const std::string& expected :
+         {std::string("server 127.0.0.1:8080;"), std::string("server_name study.example.org;"),
+          "ssl_certificate     " + cert.string() + ";", "ssl_certificate_key " + key.string() + ";",
+          std::string("listen 443 ssl http2;"), std::string("listen [::]:443 ssl http2;"),
+          std::string("proxy_set_header X-Forwarded-For $remote_addr;"), std::string("client_max_body_size 16k;"),
+          std::string("return 301 https://$host$request_uri;"), std::string("--public-host study.example.org")}) {
+        EXPECT_NE(text.find(expected), std::string::npos) << expected;
+    }
+
+    auto refused = [&](const std::function<void(NginxSiteOptions&)>& change, const std::string& option) {
+        NginxSiteOptions bad = o;
+        change(bad);
+        try {
+            nginxSiteConfig(bad);
+            ADD_FAILURE() << option << ": accepted";
+        } catch (const skinlab::InputError& e) {
+            EXPECT_EQ(std::string(e.what()).rfind(option, 0), 0u) << e.what();
+        }
+    };
+    refused([](NginxSiteOptions& b) { b.serverName = "study.example.org; include /etc/passwd"; }, "--server-name");
+    refused([](NginxSiteOptions& b) { b.serverName = ""; }, "--server-name");
+    refused([](NginxSiteOptions& b) { b.upstream = "localhost:8080"; }, "--upstream");
+    refused([](NginxSiteOptions& b) { b.upstream = "127.0.0.1:99999"; }, "--upstream");
+    refused([](NginxSiteOptions& b) { b.certificate = "cert.pem"; }, "--cert");
+    refused([](NginxSiteOptions& b) { b.certificate = b.certificate + " ssl_verify"; }, "--cert");
+    refused([&](NginxSiteOptions& b) { b.key = (folder.path() / "missing.pem").string(); }, "--key");
+    refused([&](NginxSiteOptions& b) { b.key = writeText(folder.path(), "plain.txt", "not a key\n").string(); }, "--key");
+    refused([](NginxSiteOptions& b) { b.listen = "443x"; }, "--listen");
 }
