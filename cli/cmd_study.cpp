@@ -1,8 +1,10 @@
-// `skinlab study create|serve|simulate|status|export` — the 2AFC experiment runner (docs/experiments.md).
+// `skinlab study create|serve|simulate|status|export|backup|deploy-config` — the 2AFC experiment runner (docs/experiments.md).
 #include "cli/commands.h"
 #include "common/error.h"
 #include "common/files.h"
+#include "experiments/nginx_config.h"
 #include "experiments/simulated_observers.h"
+#include "experiments/study_backup.h"
 #include "experiments/study_creation.h"
 #include "experiments/study_export.h"
 #include "experiments/study_server.h"
@@ -31,6 +33,7 @@ struct StudyOptions {
     int connectionsPerClient = 64;
     double joinsPerMinute = 60;
     std::string publicHost;
+    std::vector<std::string> trustedProxies;
     std::string token;
     std::string url = "http://127.0.0.1:8080";
     int observers = 0;
@@ -45,6 +48,8 @@ struct StudyOptions {
     std::string labelPrefix;
     bool apiOnly = false;
     std::string format;
+    bool overwrite = false;
+    ex::NginxSiteOptions site;
 };
 
 void runCreate(const StudyOptions& o) {
@@ -73,6 +78,7 @@ void runServe(const StudyOptions& o) {
     options.joinsPerMinute = o.joinsPerMinute;
     options.joinBurst = o.joinsPerMinute;
     options.publicHost = o.publicHost;
+    options.trustedProxies = o.trustedProxies;
     options.researcherToken = o.token;
     options.stimuliDir = o.stimuli;
     ex::StudyServer server(store, options);
@@ -82,6 +88,7 @@ void runServe(const StudyOptions& o) {
     std::printf("researcher token: %s\n", server.researcherToken().c_str());
     std::printf("status: curl -H 'Authorization: Bearer %s' %sapi/researcher/status\n", server.researcherToken().c_str(),
                 server.url().c_str());
+    std::printf("dashboard: %sresearcher#token=%s\n", server.url().c_str(), server.researcherToken().c_str());
     std::fflush(stdout);
 
     std::thread waiter([&] {
@@ -138,6 +145,18 @@ void runStatus(const StudyOptions& o) {
     else std::printf("%s", ex::statusText(store).c_str());
 }
 
+void runBackup(const StudyOptions& o) {
+    const ex::BackupSummary summary = ex::backupStudy(o.study, o.output, o.overwrite);
+    std::printf("%s: %lld participants, %lld responses, %ju bytes\n", o.output.c_str(),
+                static_cast<long long>(summary.participants), static_cast<long long>(summary.responses), summary.bytes);
+}
+
+void runDeployConfig(const StudyOptions& o) {
+    const std::string text = ex::nginxSiteConfig(o.site);
+    if (o.output.empty() || o.output == "-") std::fwrite(text.data(), 1, text.size(), stdout);
+    else writeFileAtomic(o.output, text);
+}
+
 void runExport(const StudyOptions& o) {
     ex::StudyStore store(o.study);
     const std::string text = ex::exportResponses(store, o.format);
@@ -173,6 +192,9 @@ void registerStudy(CLI::App& app) {
     serve->add_option("--joins-per-minute", options->joinsPerMinute,
                       "New participants per client address per minute (also the burst)")->capture_default_str()
         ->check(CLI::Range(1.0, 1e6));
+    serve->add_option("--trusted-proxy", options->trustedProxies,
+                      "Address of a reverse proxy whose X-Forwarded-For is believed (repeatable; default with "
+                      "--public-host: 127.0.0.1 and ::1)");
     serve->add_option("--token", options->token, "Researcher token (default: random, printed at start)");
     serve->add_option("--stimuli", options->stimuli, "Stimulus folder, if it moved since `study create`");
     serve->callback([options] { runServe(*options); });
@@ -200,6 +222,26 @@ void registerStudy(CLI::App& app) {
     status->add_option("study", options->study, "study.db")->required();
     status->add_option("--format", options->format, "text or json")->check(CLI::IsMember({"text", "json"}))->default_val("text");
     status->callback([options] { runStatus(*options); });
+
+    CLI::App* backup = study->add_subcommand("backup", "Consistent copy of a study file, also while it is served "
+                                                        "(SQLite online backup)");
+    backup->add_option("study", options->study, "study.db")->required();
+    backup->add_option("output", options->output, "Copy to write (atomically)")->required();
+    backup->add_flag("--overwrite", options->overwrite, "Replace an existing copy");
+    backup->callback([options] { runBackup(*options); });
+
+    CLI::App* deploy = study->add_subcommand("deploy-config", "Write the nginx site file that serves the study over "
+                                                              "HTTPS (docs/deployment.md)");
+    deploy->add_option("--server-name", options->site.serverName, "Public host name (also: study serve --public-host)")
+        ->required();
+    deploy->add_option("--upstream", options->site.upstream, "The study server: IP:PORT (e.g. 127.0.0.1:8080)")->required();
+    deploy->add_option("--cert", options->site.certificate, "Certificate chain (PEM), absolute path")->required();
+    deploy->add_option("--key", options->site.key, "Private key (PEM), absolute path")->required();
+    deploy->add_option("--listen", options->site.listen, "HTTPS port, or IPv4-ADDRESS:PORT")->capture_default_str();
+    deploy->add_option("--redirect-port", options->site.redirectPort, "Also redirect plain HTTP on this port (0 = no)")
+        ->capture_default_str()->check(CLI::Range(0, 65535));
+    deploy->add_option("-o,--output", options->output, "Site file to write (default: standard output)");
+    deploy->callback([options] { runDeployConfig(*options); });
 
     CLI::App* exportCommand = study->add_subcommand("export", "Export responses (contract 3)");
     exportCommand->add_option("study", options->study, "study.db")->required();

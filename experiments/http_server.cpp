@@ -13,6 +13,7 @@
 #include <spdlog/spdlog.h>
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <atomic>
 #include <mutex>
 #include <thread>
@@ -107,6 +108,10 @@ struct HttpServer::State {
     bool admit(const std::string& address) {
         std::lock_guard lock(perClientMutex);
         if (open.load() >= limits.maxConnections) return false;
+        if (std::find(limits.uncappedClients.begin(), limits.uncappedClients.end(), address) != limits.uncappedClients.end()) {
+            ++open; // a trusted proxy carries many clients; they are counted per forwarded address by the handler
+            return true;
+        }
         int& n = perClient[address];
         if (n >= limits.connectionsPerClient) {
             if (n == 0) perClient.erase(address);

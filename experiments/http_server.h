@@ -27,7 +27,8 @@ struct HttpRequest {
     std::string query;         // after '?', not decoded
     std::vector<std::pair<std::string, std::string>> headers; // names in lower case, values as sent
     std::string body;
-    std::string clientAddress; // peer IP address
+    std::string clientAddress; // peer IP address (StudyServer: the forwarded one behind a trusted proxy)
+    std::string forwardedBy;   // the trusted proxy's address when clientAddress was forwarded by it, else ""
 
     // The first header of that name (case-insensitive), or "".
     std::string header(std::string_view name) const;
@@ -53,6 +54,7 @@ struct HttpLimits {
     std::chrono::milliseconds idleTimeout{30000};    // a kept-alive connection with no request
     std::chrono::milliseconds writeTimeout{30000};
     int connectionsPerClient = 64;                // open connections per client IP address
+    std::vector<std::string> uncappedClients;     // addresses exempt from connectionsPerClient (a trusted proxy)
     int maxConnections = 20000;                   // in all (bounded by the open-file limit too)
     int ioThreads = 2;
     int workerThreads = 8;                        // run the handlers

@@ -4,6 +4,7 @@
 #include "common/files.h"
 #include "common/hash.h"
 #include "experiments/request_error.h"
+#include "experiments/study_dashboard.h"
 #include "experiments/study_export.h"
 
 #include <boost/asio/ip/address.hpp>
@@ -151,7 +152,16 @@ StudyServer::StudyServer(StudyStore& store, ServerOptions options) : store_(stor
         stimulus.etag = "\"" + s.sha256 + "\"";
         stimuli_.push_back(std::move(stimulus));
     }
+    if (options_.trustedProxies.empty() && !options_.publicHost.empty()) options_.trustedProxies = {"127.0.0.1", "::1"};
+    for (std::string& proxy : options_.trustedProxies) {
+        boost::system::error_code invalid;
+        const auto address = boost::asio::ip::make_address(proxy, invalid);
+        if (invalid) throw InputError("--trusted-proxy: \"" + proxy + "\" is not an IP address");
+        proxy = address.to_string();
+    }
+    dashboard_ = std::make_unique<StudyDashboard>(store_, options_.dashboardInterval);
     HttpLimits limits;
+    limits.uncappedClients = options_.trustedProxies;
     limits.bodyBytes = options_.maxBodyBytes;
     limits.headerBytes = options_.maxHeaderBytes;
     limits.connectionsPerClient = options_.connectionsPerClient;
@@ -227,12 +237,57 @@ bool StudyServer::allowJoin(const std::string& clientAddress, double& retryAfter
     return false;
 }
 
+bool StudyServer::trustedProxy(const std::string& peer) const {
+    return std::find(options_.trustedProxies.begin(), options_.trustedProxies.end(), peer) != options_.trustedProxies.end();
+}
+
+std::string StudyServer::clientAddress(const HttpRequest& req) const {
+    if (!trustedProxy(req.clientAddress) || req.headerCount("X-Forwarded-For") == 0) return req.clientAddress;
+    // The proxy sets the header to the address it saw (experiments/deploy/); should it append instead, the
+    // rightmost entry of the last header is still the one it added, whatever the client sent.
+    std::string value;
+    for (const auto& [name, v] : req.headers)
+        if (name == "x-forwarded-for") value = v;
+    const std::size_t comma = value.rfind(',');
+    std::string last = comma == std::string::npos ? value : value.substr(comma + 1);
+    const auto first = last.find_first_not_of(" \t");
+    last = first == std::string::npos ? "" : last.substr(first, last.find_last_not_of(" \t") - first + 1);
+    boost::system::error_code ec;
+    const auto address = boost::asio::ip::make_address(last, ec);
+    if (ec)
+        throw RequestError(400, "X-Forwarded-For: \"" + validUtf8(last, 64) + "\" from the proxy is not an IP address");
+    return address.to_string();
+}
+
 HttpResponse StudyServer::handle(const HttpRequest& req) {
     try {
         if (req.headerCount("Host") != 1) throw RequestError(400, "Host: exactly one Host header is required");
         if (!hostAllowed(req.header("Host")))
             throw RequestError(421, "Host: \"" + validUtf8(req.header("Host"), 64) +
                                         "\" is not this server (serve with --public-host NAME to be reached by a name)");
+        if (trustedProxy(req.clientAddress)) {
+            // Behind the proxy every connection is the proxy's: the per-client cap applies to the forwarded address,
+            // as requests in progress (the proxy limits connections per client itself; experiments/deploy/).
+            HttpRequest forwarded = req;
+            forwarded.clientAddress = clientAddress(req);
+            if (req.headerCount("X-Forwarded-For") > 0) forwarded.forwardedBy = req.clientAddress;
+            {
+                std::lock_guard lock(inFlightMutex_);
+                if (inFlight_[forwarded.clientAddress] >= options_.connectionsPerClient)
+                    throw RequestError(429, "too many requests in progress from this address");
+                ++inFlight_[forwarded.clientAddress];
+            }
+            struct Release {
+                StudyServer* server;
+                const std::string& address;
+                ~Release() {
+                    std::lock_guard lock(server->inFlightMutex_);
+                    auto it = server->inFlight_.find(address);
+                    if (it != server->inFlight_.end() && --it->second <= 0) server->inFlight_.erase(it);
+                }
+            } release{this, forwarded.clientAddress};
+            return route(forwarded);
+        }
         return route(req);
     } catch (const RequestError& e) {
         spdlog::debug("{} {}: {} {}", req.method, validUtf8(req.path, 128), e.status(), e.what());
@@ -267,6 +322,14 @@ HttpResponse StudyServer::route(const HttpRequest& req) {
     if (get && (path == "/" || path == "/index.html")) return webFile("index.html", "text/html; charset=utf-8");
     if (get && path == "/app.js") return webFile("app.js", "text/javascript; charset=utf-8");
     if (get && path == "/style.css") return webFile("style.css", "text/css; charset=utf-8");
+    // The researcher's dashboard: the page holds no data; its script asks /api/researcher/dashboard with the token.
+    if (get && (path == "/researcher" || path == "/researcher.html")) {
+        HttpResponse res = webFile("researcher.html", "text/html; charset=utf-8");
+        res.headers.emplace_back("Referrer-Policy", "no-referrer");
+        return res;
+    }
+    if (get && path == "/researcher.js") return webFile("researcher.js", "text/javascript; charset=utf-8");
+    if (get && path == "/researcher.css") return webFile("researcher.css", "text/css; charset=utf-8");
 
     // Stimuli by number only: the number indexes the study's own list, so no request can name another file.
     // The bytes never change while the study runs (content-addressed by sha256): cached for good by the browser.
@@ -348,6 +411,7 @@ HttpResponse StudyServer::route(const HttpRequest& req) {
             return res;
         }
         const ParticipantRecord p = store_.join(label, joinKey);
+        store_.recordJoinAddress(p.id, req.clientAddress, req.forwardedBy.empty() ? "peer" : "forwarded");
         spdlog::info("participant {} joined", p.label);
         return jsonResponse(201, {{"token", p.token}, {"observer", p.label}});
     }
@@ -403,6 +467,7 @@ HttpResponse StudyServer::route(const HttpRequest& req) {
         if (!constantTimeEqual(authorization.substr(7), options_.researcherToken))
             throw RequestError(403, "wrong researcher token");
         if (path == "/api/researcher/status") return jsonResponse(200, statusJson(store_));
+        if (path == "/api/researcher/dashboard") return jsonResponse(200, dashboard_->snapshot());
         if (path == "/api/researcher/export") {
             const std::string format = req.queryParameter("format").value_or("csv");
             if (format != "csv" && format != "json" && format != "pwcmp")

@@ -33,7 +33,14 @@ struct ServerOptions {
     double joinsPerMinute = 60;      // new participants per client address: sustained rate...
     double joinBurst = 60;           // ...and burst (more: 429 with Retry-After)
     std::chrono::milliseconds requestTimeout{10000}; // a request must arrive within this once started (else 408)
+    // Reverse proxies (IP addresses) whose X-Forwarded-For is believed: a request from one of them counts as coming
+    // from the address the proxy forwards (join rate limit, per-client request cap, the stored join address); from
+    // any other peer the header is ignored. Empty = loopback (127.0.0.1, ::1) when publicHost is set, none otherwise.
+    std::vector<std::string> trustedProxies;
+    std::chrono::milliseconds dashboardInterval{5000}; // the dashboard's JOD scale is recomputed at most this often
 };
+
+class StudyDashboard;
 
 class StudyServer {
 public:
@@ -63,6 +70,9 @@ private:
     HttpResponse route(const HttpRequest& request);
     bool hostAllowed(const std::string& host) const;
     bool allowJoin(const std::string& clientAddress, double& retryAfterSeconds);
+    // The client's address: the peer's, or the one a trusted proxy forwards (X-Forwarded-For, rightmost entry).
+    std::string clientAddress(const HttpRequest& request) const;
+    bool trustedProxy(const std::string& peer) const;
 
     StudyStore& store_;
     ServerOptions options_;
@@ -75,6 +85,10 @@ private:
     };
     std::mutex joinMutex_;
     std::map<std::string, JoinBucket> joinBuckets_;
+    // Requests in progress per forwarded client address (behind a proxy every connection is the proxy's).
+    std::mutex inFlightMutex_;
+    std::map<std::string, int> inFlight_;
+    std::unique_ptr<StudyDashboard> dashboard_;
 };
 
 } // namespace skinlab::experiments

@@ -305,6 +305,20 @@ StudyStore::StudyStore(const fs::path& path) : path_(path) {
     if (meta("format_version") != std::to_string(kFormatVersion))
         throw InputError(path.string() + ": study file version " + meta("format_version") + " is not supported");
     definition_ = StudyDefinition::fromJson(nlohmann::json::parse(meta("definition")));
+    // Added after format version 1 first shipped: created on open, so older study files gain it too.
+    db_->execute("CREATE TABLE IF NOT EXISTS participant_addresses ("
+                 " participant_id INTEGER PRIMARY KEY REFERENCES participants(id),"
+                 " client_address TEXT NOT NULL,"
+                 " source TEXT NOT NULL CHECK (source IN ('peer','forwarded')),"
+                 " recorded_at TEXT NOT NULL)");
+}
+
+void StudyStore::recordJoinAddress(std::int64_t participantId, const std::string& address, const std::string& source) {
+    std::lock_guard lock(mutex_);
+    SqliteStatement s = db_->prepare("INSERT OR IGNORE INTO participant_addresses (participant_id, client_address, source,"
+                                     " recorded_at) VALUES (?,?,?,?)");
+    s.bind(1, participantId).bind(2, validUtf8(address, 64)).bind(3, source).bind(4, utcTimestamp());
+    s.run();
 }
 
 StudyStore::~StudyStore() = default;

@@ -121,6 +121,10 @@ public:
     // The first unanswered trial, if any. For an active design whose stored trials are all answered, the next
     // batch is planned from the current answers and stored first (see experiments/active_plan.h).
     std::optional<TrialRecord> nextTrial(std::int64_t participantId);
+    // The client address a participant joined from (table participant_addresses; the first one is kept when a
+    // retried join returns the same participant). `source`: "peer" (the TCP peer) or "forwarded" (by a trusted
+    // proxy, X-Forwarded-For).
+    void recordJoinAddress(std::int64_t participantId, const std::string& address, const std::string& source);
     Progress progress(std::int64_t participantId);
     // Validates and commits one response (see the header comment). Rejections throw RequestError:
     // 404 unknown participant, trial or session (another participant's trial or session is unknown too: no answer

@@ -25,6 +25,7 @@ PACKAGES=(
   curl   # tests: the server-defect checks send raw HTTP
   slurm-wlm munge jq   # stimuli: the single-node Slurm cluster test (slurmctld, slurmd, sbatch; munged; jq reads manifests)
   blender   # the pathtraced method: Cycles runs as a child process (docs/pathtraced.md)
+  nginx openssl   # online studies: the HTTPS deployment test (nginx in front of the server, a self-signed certificate)
 )
 
 missing=()

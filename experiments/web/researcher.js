@@ -1,0 +1,192 @@
+// The researcher's dashboard: polls GET /api/researcher/dashboard (token in the Authorization header only) and
+// draws participants, catch-trial accuracy, the response-time histogram and the JOD scale with its intervals.
+'use strict';
+
+const REFRESH_MS = 3000;
+const SVG = 'http://www.w3.org/2000/svg';
+let token = '';
+let timer = null;
+
+function $(id) { return document.getElementById(id); }
+function text(value) { return value === null || value === undefined ? '–' : String(value); }
+function fixed(value, digits) { return typeof value === 'number' ? value.toFixed(digits) : '–'; }
+function element(tag, attributes, content) {
+  const e = document.createElement(tag);
+  for (const [k, v] of Object.entries(attributes || {})) e.setAttribute(k, v);
+  if (content !== undefined) e.textContent = content;
+  return e;
+}
+function svgElement(tag, attributes, content) {
+  const e = document.createElementNS(SVG, tag);
+  for (const [k, v] of Object.entries(attributes || {})) e.setAttribute(k, String(v));
+  if (content !== undefined) e.textContent = content;
+  return e;
+}
+
+// The token: from #token=... (the fragment never leaves the browser; removed from the address bar at once),
+// else from this tab's storage, else typed into the form.
+function initialToken() {
+  const match = /(?:^#|&)token=([^&]*)/.exec(location.hash);
+  if (match) {
+    history.replaceState(null, '', location.pathname + location.search);
+    return decodeURIComponent(match[1]);
+  }
+  return sessionStorage.getItem('skinlab-researcher-token') || '';
+}
+
+function showLogin(message) {
+  $('dashboard').hidden = true;
+  $('login').hidden = false;
+  $('login-error').hidden = !message;
+  $('login-error').textContent = message || '';
+  $('updated').textContent = 'Not connected';
+  $('token-input').focus();
+}
+
+async function refresh() {
+  clearTimeout(timer);
+  let response;
+  try {
+    response = await fetch('/api/researcher/dashboard', { headers: { Authorization: 'Bearer ' + token }, cache: 'no-store' });
+  } catch (e) {
+    $('updated').textContent = 'Server not reachable; retrying';
+    timer = setTimeout(refresh, REFRESH_MS);
+    return;
+  }
+  if (response.status === 401 || response.status === 403) {
+    sessionStorage.removeItem('skinlab-researcher-token');
+    showLogin(response.status === 403 ? 'Wrong researcher token.' : 'The researcher token is required.');
+    return;
+  }
+  if (!response.ok) {
+    $('updated').textContent = 'Server answered ' + response.status + '; retrying';
+    timer = setTimeout(refresh, REFRESH_MS);
+    return;
+  }
+  const data = await response.json();
+  sessionStorage.setItem('skinlab-researcher-token', token);
+  $('login').hidden = true;
+  $('dashboard').hidden = false;
+  render(data);
+  document.body.dataset.refreshes = String(Number(document.body.dataset.refreshes || 0) + 1);
+  timer = setTimeout(refresh, REFRESH_MS);
+}
+
+function render(data) {
+  $('title').textContent = data.study.title || 'Study dashboard';
+  $('updated').textContent = 'Updated ' + new Date().toLocaleTimeString() + ' (every ' + REFRESH_MS / 1000 + ' s)';
+  const totals = data.totals;
+  $('participant-count').textContent = text(totals.participants);
+  $('completed-count').textContent = text(totals.completed);
+  $('response-count').textContent = text(totals.responses);
+  $('catch-accuracy').textContent = totals.catch_accuracy === null ? '–' :
+    Math.round(totals.catch_accuracy * 100) + ' % (' + totals.catch_correct + '/' + totals.catch_answered + ')';
+  renderParticipants(data.participants);
+  renderHistogram(data.response_times);
+  renderScale(data.scale);
+  $('flagged').textContent = data.flagged_trials.recorded ? text(data.flagged_trials.count) : data.flagged_trials.note;
+  $('viewing').textContent = data.viewing_conditions.recorded ? '' : data.viewing_conditions.note;
+}
+
+function renderParticipants(participants) {
+  const body = $('participants').querySelector('tbody');
+  body.replaceChildren(...participants.map((p) => {
+    const row = element('tr', { 'data-observer': p.observer, 'data-answered': p.answered, 'data-total': p.total });
+    row.append(element('td', {}, p.observer),
+      element('td', { class: 'number' }, p.answered + ' / ' + p.total + (p.completed ? ' ✓' : '')),
+      element('td', { class: 'number' }, p.catch_answered ? p.catch_correct + ' / ' + p.catch_answered : '–'),
+      element('td', {}, p.client_address ? p.client_address + (p.address_source === 'forwarded' ? ' (via proxy)' : '') : '–'),
+      element('td', {}, p.last_response_at || '–'));
+    return row;
+  }));
+}
+
+function renderHistogram(times) {
+  const svg = $('rt-histogram');
+  const width = 640, height = 180, left = 36, bottom = 36, top = 8;
+  const bins = times.bins;
+  const most = Math.max(1, ...bins.map((b) => b.count));
+  const barWidth = (width - left - 8) / bins.length;
+  const parts = [svgElement('line', { class: 'axis', x1: left, y1: height - bottom, x2: width - 4, y2: height - bottom })];
+  bins.forEach((bin, i) => {
+    const h = (height - bottom - top) * bin.count / most;
+    const x = left + i * barWidth;
+    const bar = svgElement('rect', { class: 'bar', x: x + 1, y: height - bottom - h, width: Math.max(1, barWidth - 2), height: h,
+      'data-count': bin.count });
+    bar.append(svgElement('title', {}, `${bin.from_ms}–${bin.to_ms === null ? '∞' : bin.to_ms} ms: ${bin.count}`));
+    parts.push(bar);
+    if (i % 2 === 0) parts.push(svgElement('text', { x: x + 1, y: height - bottom + 14 }, (bin.from_ms / 1000).toString()));
+  });
+  parts.push(svgElement('text', { x: left, y: height - 4 }, 'seconds from stimulus onset'));
+  parts.push(svgElement('text', { x: 2, y: top + 10 }, String(most)));
+  svg.replaceChildren(...parts);
+  $('rt-note').textContent = times.count === 0 ? 'No answers yet.' :
+    `${times.count} answers (${times.excludes} excluded): median ${fixed(times.median_ms, 0)} ms, ` +
+    `10th–90th percentile ${fixed(times.p10_ms, 0)}–${fixed(times.p90_ms, 0)} ms`;
+}
+
+function renderScale(scale) {
+  const container = $('scale');
+  if (scale.state !== 'ok') {
+    container.replaceChildren();
+    $('scale-note').textContent = scale.state === 'computing' ? 'Computing…' :
+      scale.state === 'none' ? 'No test answers to scale yet.' : 'Not computed: ' + (scale.message || scale.state);
+    return;
+  }
+  $('scale-note').textContent = `Thurstone Case V, JOD with ${Math.round(scale.level * 100)} % intervals ` +
+    `(${scale.bootstrap_samples} bootstrap samples over observers); ${scale.responses} answers, ` +
+    `computed ${scale.computed_at} in ${fixed(scale.compute_ms, 0)} ms.` +
+    (scale.blocks.some((b) => b.conditions.some((c) => c.interval_fallback)) ?
+      ' * : the bootstrap-t interval was not usable; the interval shown is the fallback (percentile ∪ profile likelihood).' : '');
+  document.body.dataset.scaleComputedAt = scale.computed_at;
+  container.replaceChildren(...scale.blocks.map((block) => {
+    const div = element('div', { class: 'scale-block', 'data-block': block.block });
+    div.append(element('h3', {}, `${block.block} — ${block.observers} observers, ${block.interval_method}`));
+    const table = element('table');
+    table.append(element('thead'));
+    table.tHead.append(element('tr'));
+    for (const h of ['Condition', 'JOD', 'Interval']) table.tHead.rows[0].append(element('th', {}, h));
+    const body = element('tbody');
+    for (const c of block.conditions) {
+      const row = element('tr', { class: 'scale-row', 'data-condition': c.condition, 'data-jod': c.jod });
+      row.append(element('td', {}, c.condition), element('td', { class: 'number' }, fixed(c.jod, 2)),
+        element('td', { class: 'number' }, `[${fixed(c.low, 2)}, ${fixed(c.high, 2)}]` + (c.interval_fallback ? ' *' : '')));
+      body.append(row);
+    }
+    table.append(body);
+    div.append(table, scalePlot(block.conditions));
+    return div;
+  }));
+}
+
+// Each condition's score (dot) and interval (line) on a common JOD axis.
+function scalePlot(conditions) {
+  const width = 640, rowHeight = 22, left = 160, right = 20;
+  const height = conditions.length * rowHeight + 28;
+  const values = conditions.flatMap((c) => [c.low, c.high, c.jod]).filter((v) => typeof v === 'number');
+  const lo = Math.min(...values, 0), hi = Math.max(...values, 0);
+  const span = hi - lo || 1;
+  const x = (v) => left + (width - left - right) * (v - lo) / span;
+  const svg = svgElement('svg', { width, height, role: 'img', 'aria-label': 'JOD scale with intervals' });
+  svg.append(svgElement('line', { class: 'axis', x1: x(0), y1: 4, x2: x(0), y2: height - 20 }));
+  conditions.forEach((c, i) => {
+    const y = 14 + i * rowHeight;
+    svg.append(svgElement('text', { x: 4, y: y + 4 }, c.condition));
+    if (typeof c.low === 'number' && typeof c.high === 'number')
+      svg.append(svgElement('line', { class: 'interval', x1: x(c.low), y1: y, x2: x(c.high), y2: y }));
+    if (typeof c.jod === 'number') svg.append(svgElement('circle', { class: 'point', cx: x(c.jod), cy: y, r: 4 }));
+  });
+  svg.append(svgElement('text', { x: x(lo), y: height - 4 }, fixed(lo, 1) + ' JOD'),
+    svgElement('text', { x: x(hi) - 40, y: height - 4 }, fixed(hi, 1) + ' JOD'));
+  return svg;
+}
+
+$('login').addEventListener('submit', (event) => {
+  event.preventDefault();
+  token = $('token-input').value.trim();
+  if (token) refresh();
+});
+
+token = initialToken();
+if (token) refresh();
+else showLogin('');

@@ -1,0 +1,186 @@
+// Shared by the deployment and dashboard tests: a tiny stimulus set and study, `skinlab study serve` started on an
+// ephemeral port, a participant session driven with the keyboard, and HTTP(S) requests from a chosen local address.
+import { spawn, spawnSync } from 'node:child_process';
+import { createHash } from 'node:crypto';
+import fs from 'node:fs';
+import http from 'node:http';
+import https from 'node:https';
+import net from 'node:net';
+import path from 'node:path';
+import readline from 'node:readline';
+import zlib from 'node:zlib';
+
+export const SKIP = 77;
+export const CHROMIUM = '/usr/bin/chromium';
+export const FLAGS = ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
+  '--disable-component-update', '--disable-sync'];
+
+export async function loadPlaywright(here) {
+  if (!fs.existsSync(CHROMIUM)) { console.log('SKIP: /usr/bin/chromium not installed'); process.exit(SKIP); }
+  try {
+    return (await import(path.join(here, 'node_modules/playwright-core/index.mjs'))).chromium;
+  } catch (e) {
+    console.log('SKIP: playwright-core not installed (run npm install in tests/browser)');
+    process.exit(SKIP);
+  }
+}
+
+const crcTable = Array.from({ length: 256 }, (_, n) => {
+  let c = n;
+  for (let k = 0; k < 8; k++) c = c & 1 ? 0xedb88320 ^ (c >>> 1) : c >>> 1;
+  return c >>> 0;
+});
+function crc32(buffer) {
+  let c = 0xffffffff;
+  for (const b of buffer) c = crcTable[(c ^ b) & 0xff] ^ (c >>> 8);
+  return (c ^ 0xffffffff) >>> 0;
+}
+function chunk(type, data) {
+  const length = Buffer.alloc(4); length.writeUInt32BE(data.length);
+  const body = Buffer.concat([Buffer.from(type, 'ascii'), data]);
+  const crc = Buffer.alloc(4); crc.writeUInt32BE(crc32(body));
+  return Buffer.concat([length, body, crc]);
+}
+function encodePng(width, height, rgb) {
+  const header = Buffer.alloc(13);
+  header.writeUInt32BE(width, 0); header.writeUInt32BE(height, 4);
+  header[8] = 8; header[9] = 2;
+  const raw = Buffer.alloc((width * 3 + 1) * height);
+  for (let y = 0; y < height; y++) rgb.copy(raw, y * (width * 3 + 1) + 1, y * width * 3, (y + 1) * width * 3);
+  return Buffer.concat([Buffer.from([137, 80, 78, 71, 13, 10, 26, 10]), chunk('IHDR', header),
+    chunk('IDAT', zlib.deflateSync(raw)), chunk('IEND', Buffer.alloc(0))]);
+}
+
+// One block, `methods` conditions; design with one practice and one blank catch trial. Returns the study path.
+export function createStudy(cli, work, { methods = ['reference-like', 'separable', 'artistic'], title = 'Online test' } = {}) {
+  const W = 96, H = 64;
+  fs.mkdirSync(path.join(work, 'stimuli/png'), { recursive: true });
+  const manifest = { format: 'skinlab-stimuli', version: 1, set: 'online-test', spec_sha256: '0'.repeat(64),
+    renderer: { gl_renderer: 'none', gl_version: '', skinlab_version: '' }, stimuli: [] };
+  methods.forEach((method, m) => {
+    const rgb = Buffer.alloc(W * H * 3);
+    for (let i = 0; i < W * H; i++) for (let k = 0; k < 3; k++) rgb[i * 3 + k] = (40 + 70 * m + 50 * k + (i % 2) * 30) % 256;
+    const png = encodePng(W, H, rgb);
+    const id = 'head-mid-' + method;
+    fs.writeFileSync(path.join(work, 'stimuli/png', id + '.png'), png);
+    manifest.stimuli.push({ id, files: { exr: 'exr/' + id + '.exr', png: 'png/' + id + '.png' },
+      sha256: { exr: '0'.repeat(64), png: createHash('sha256').update(png).digest('hex') },
+      factors: { scene: 'builtin:head', view: 'mid', method }, block: 'builtin:head/mid', reference: false,
+      width: W, height: H, resolved: {}, timings_ms: {} });
+  });
+  fs.writeFileSync(path.join(work, 'stimuli/manifest.json'), JSON.stringify(manifest, null, 2));
+  fs.writeFileSync(path.join(work, 'design.toml'),
+    `title = "${title}"\nquestion = "Which looks more like real skin?"\nseed = 5\nbreak_every = 0\nrepetitions = 1\n` +
+    '[practice]\ntrials = 1\n[catch]\nblank = 1\n');
+  const database = path.join(work, 'study.db');
+  const created = spawnSync(cli, ['study', 'create', '--stimuli', path.join(work, 'stimuli'), '--design',
+    path.join(work, 'design.toml'), '-o', database], { encoding: 'utf8' });
+  if (created.status !== 0) throw new Error('study create failed: ' + created.stderr);
+  return database;
+}
+
+// `skinlab study serve DB --port 0 ARGS...`; resolves { process, port } once it prints its address.
+export async function serve(cli, database, args = []) {
+  const server = spawn(cli, ['study', 'serve', database, '--port', '0', ...args], { stdio: ['ignore', 'pipe', 'inherit'] });
+  const port = await new Promise((resolve, reject) => {
+    const timer = setTimeout(() => reject(new Error('server did not start')), 20000);
+    server.on('exit', (code) => reject(new Error('server exited with ' + code)));
+    readline.createInterface({ input: server.stdout }).on('line', (line) => {
+      const m = /serving .* on http:\/\/127\.0\.0\.1:(\d+)\//.exec(line);
+      if (m) { clearTimeout(timer); resolve(Number(m[1])); }
+    });
+  });
+  return { process: server, port };
+}
+
+export function freePort() {
+  return new Promise((resolve, reject) => {
+    const s = net.createServer();
+    s.on('error', reject);
+    s.listen(0, '127.0.0.1', () => { const { port } = s.address(); s.close(() => resolve(port)); });
+  });
+}
+
+// One request; `options`: { method, headers, body, localAddress, tls (https, any certificate), host, servername }.
+export function request(port, target, options = {}) {
+  const { method = 'GET', headers = {}, body, localAddress, tls = false, host = '127.0.0.1' } = options;
+  return new Promise((resolve, reject) => {
+    const req = (tls ? https : http).request({ host, port, path: target, method, headers, localAddress,
+      rejectUnauthorized: false, servername: options.servername, agent: false }, (res) => {
+      const parts = [];
+      res.on('data', (d) => parts.push(d));
+      res.on('end', () => {
+        const text = Buffer.concat(parts).toString('utf8');
+        let json = null;
+        try { json = JSON.parse(text); } catch (e) { /* not JSON */ }
+        resolve({ status: res.statusCode, headers: res.headers, text, json });
+      });
+    });
+    req.on('error', reject);
+    req.setTimeout(20000, () => req.destroy(new Error('request timed out')));
+    if (body !== undefined) req.write(body);
+    req.end();
+  });
+}
+
+// Joins and answers every trial through the API ("left" each time); returns the number answered.
+export async function answerAll(port, { tls = false, headers = {}, localAddress, limit = Infinity } = {}) {
+  const json = { 'Content-Type': 'application/json', ...headers };
+  const post = (target, body) => request(port, target, { method: 'POST', headers: json, body: JSON.stringify(body), localAddress, tls });
+  const joined = await post('/api/join', {});
+  if (joined.status !== 201) throw new Error('join: ' + joined.status + ' ' + joined.text);
+  const token = joined.json.token;
+  const screenSize = { viewport_width: 1280, viewport_height: 800, device_pixel_ratio: 1 };
+  const session = await post('/api/session', { token, ...screenSize });
+  let state = session.json, answered = 0;
+  while (state.trial && answered < limit) {
+    const r = await post('/api/response', { token, trial: state.trial.id, side: answered % 3 === 0 ? 'right' : 'left',
+      session: session.json.session, response_ms: 500 + 137 * answered, client_time: new Date().toISOString(), ...screenSize });
+    if (r.status !== 200) throw new Error('response: ' + r.status + ' ' + r.text);
+    state = r.json;
+    answered++;
+  }
+  return { token, observer: joined.json.observer, answered };
+}
+
+// Completes a participant session in the page with the keyboard; returns { answers: Map(trial row id → side), code }.
+export async function runSession(page, url, check, name) {
+  await page.goto(url);
+  const answers = new Map();
+  let lastTrial = '', code = '';
+  for (let step = 0; step < 40; step++) {
+    const state = await (await page.waitForFunction((last) => {
+      if (document.body.dataset.completed === 'true') return 'done';
+      const stage = document.getElementById('stage');
+      const screen = document.getElementById('screen');
+      if (!stage.hidden && stage.style.visibility === 'visible' && document.body.dataset.trial !== last &&
+          !document.body.classList.contains('busy')) return 'trial';
+      if (!screen.hidden && screen.querySelector('h1')) return 'screen:' + screen.querySelector('h1').textContent;
+      return false;
+    }, lastTrial, { timeout: 20000, polling: 50 })).jsonValue();
+    if (state === 'done') { code = await page.textContent('#completion-code'); break; }
+    if (state.startsWith('screen:')) {
+      const title = state.slice(7);
+      check(title !== 'The window is too small', `${name}: window reported too small`);
+      await page.keyboard.press('Enter');
+      await page.waitForFunction((t) => document.getElementById('screen').hidden ||
+        document.querySelector('#screen h1')?.textContent !== t, title);
+      continue;
+    }
+    const trial = await page.evaluate(() => document.body.dataset.trial);
+    const side = answers.size % 2 === 0 ? 'left' : 'right';
+    answers.set(Number(trial) % 4294967296, side);
+    await page.keyboard.press(side === 'left' ? 'ArrowLeft' : 'ArrowRight');
+    lastTrial = trial;
+  }
+  check(/^[A-Z2-9]{8}$/.test(code), `${name}: completion code "${code}"`);
+  return { answers, code };
+}
+
+export function removeFolder(work) {
+  try {
+    fs.rmSync(work, { recursive: true, force: true, maxRetries: 10, retryDelay: 200 });
+  } catch (e) {
+    console.error(`warning: could not remove ${work}: ${e.message}`);
+  }
+}
