@@ -23,7 +23,22 @@
 
 namespace skinlab::renderer::reference {
 
+// How light travels between samples (the render method uses ThroughTissue):
+//  - Euclidean: every skin source within r_c at its 3-D distance, normalised by Σ K over all of them. Light jumps
+//    air gaps under r_c (lips, ear folds), and a thin part lit from the front is dimmed by 1/(1 + T), T the
+//    kernel weight of its back face.
+//  - ThroughTissue (default): a source counts only when the chord p → q runs inside the body (neither leaves p's
+//    surface nor reaches q from outside at more than asin(kAirGapSine) = 10° to the tangent plane; a concave
+//    surface of radius R keeps its sources up to 2R · 0.17 mm away, the rest of the kernel's energy is handed back
+//    by the normaliser; two faces across a gap g lose each other up to g / 0.17 mm apart), and Σ K of the
+//    normaliser holds only the sources facing the receiver's way (n_p · n_q > 0): a uniformly lit flat surface
+//    stays unchanged, the energy of tails and non-skin neighbours is still handed back, and the light of a thin
+//    part's back face adds to its front (through-light) instead of averaging with it.
+enum class Transport { Euclidean, ThroughTissue };
+inline constexpr float kAirGapSine = 0.17364818f;  // sin 10°
+
 struct ConvolutionSettings {
+    Transport transport = Transport::ThroughTissue;
     double cutoffTail = 1e-3;  // share of each channel's energy allowed outside the cutoff radius
     unsigned threads = 0;      // worker threads; 0: std::thread::hardware_concurrency()
 };
