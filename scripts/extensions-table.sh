@@ -8,7 +8,7 @@
 #
 # Environment: SKINLAB (the skinlab executable; default build/release/cli/skinlab), SKINLAB_ASSETS (the shared
 # assets; without the scanned head its set is skipped with a message), PATHTRACED (0: no path-traced reference),
-# PATHTRACED_SAMPLES (its samples, default 64). Needs python3 for the table and blender for the second reference.
+# PATHTRACED_SAMPLES (its samples, default 64), SETS (a subset of the sets: "halo bleed head"). Needs python3 for the table and blender for the second reference.
 # Writes, under OUT_DIR:
 #   halo/, bleed/, head/   the stimulus sets (stimuli/specs/extensions-*.toml): exr/, png/, manifest, contact.png
 #   */metrics/             metrics.csv, metrics.json and the ΔE00 heat maps with the bands outlined
@@ -26,7 +26,9 @@ command -v python3 > /dev/null || { echo "extensions-table: python3 is needed to
 mkdir -p "$out"
 
 sets=(halo bleed)
-if [ -n "${SKINLAB_ASSETS:-}" ] && [ -e "$SKINLAB_ASSETS/LeePerrySmith/LeePerrySmith.glb" ]; then
+if [ -n "${SETS:-}" ]; then
+  read -r -a sets <<< "$SETS"  # a subset, e.g. SETS="bleed"
+elif [ -n "${SKINLAB_ASSETS:-}" ] && [ -e "$SKINLAB_ASSETS/LeePerrySmith/LeePerrySmith.glb" ]; then
   sets+=(head)
 else
   echo "extensions-table: scanned head skipped (\$SKINLAB_ASSETS/LeePerrySmith/LeePerrySmith.glb not found)" >&2

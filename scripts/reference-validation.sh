@@ -431,7 +431,7 @@ lines = ["# Reference validation: `reference` against `pathtraced`", "",
          "| case | band | pixels | E(reference) | E(noise) | ΔE00 mean (reference) | ΔE00 mean (noise) |",
          "|---|---|---|---|---|---|---|"]
 taus = ["", "## Rankings of the 24 conditions: Kendall's τ_b between the two references", "",
-        "| case | halo E | bleed E | spill E | skin ΔE00 mean | halo ΔE00 excess | bleed ΔE00 excess | smallest halo/bleed E (vs `reference`) | noise E of that band |",
+        "| case | halo E | bleed E | spill E | skin ΔE00 mean | halo ΔE00 excess | bleed ΔE00 excess | smallest halo E (vs `reference`) / noise E | smallest bleed E / noise E |",
         "|---|---|---|---|---|---|---|---|---|"]
 for name in cases:
     against_ref = load(os.path.join(out, name, "metrics-reference", "metrics.json"))
@@ -456,15 +456,30 @@ for name in cases:
         if any(v is None for v in x + y): row.append("–"); continue
         tau = kendall_tau_b(x, y)
         row.append("–" if tau is None else f"{tau:+.2f}")
-    smallest = None
     for b in ["halo", "bleed"]:
-        values = [band(against_ref[k], b, "leak_energy") for k in conditions]
-        values = [v for v in values if v is not None]
-        if values and (smallest is None or min(values) < smallest[0]): smallest = (min(values), b)
-    row.append("–" if smallest is None else f"{number(smallest[0])} ({smallest[1]})")
-    row.append("–" if smallest is None else number(band(noise, smallest[1], "leak_energy")))
+        values = [v for v in (band(against_ref[k], b, "leak_energy") for k in conditions) if v is not None]
+        row.append("–" if not values else f"{number(min(values))} / {number(band(noise, b, 'leak_energy'))}")
     taus.append("| " + " | ".join(row) + " |")
     # The per-condition scores under both references, for the docs' discussion.
+# Levels: the mask-weighted mean skin diffuse of each reference (oiiotool; a mean over thousands of pixels, so the
+# path tracer's per-pixel noise averages out, unlike in the per-pixel scores above).
+import re, subprocess
+def skin_mean(exr):
+    def means(*args):
+        text = subprocess.run(["oiiotool", *args, "--printstats"], check=True, capture_output=True, text=True).stdout
+        return [float(v) for v in re.search(r"Stats Avg: (.*?) \(float\)", text).group(1).split()]
+    area = means(exr, "--ch", "mask.Y")[0]
+    return [v / area for v in means(exr, "--ch", "diffuse.R,diffuse.G,diffuse.B", exr, "--ch", "mask.Y,mask.Y,mask.Y", "--mul")]
+levels = ["", "## Skin level: mask-weighted mean skin diffuse (R, G, B)", "",
+          "| case | `reference` | `pathtraced` seed 0 | seed 1 | reference − pathtraced (relative) |", "|---|---|---|---|---|"]
+for name in cases:
+    manifest = json.load(open(os.path.join(out, name, "set", "manifest.json")))
+    ref_exr = os.path.join(out, name, "set", next(s["files"]["exr"] for s in manifest["stimuli"] if s["reference"]))
+    r, p0, p1 = (skin_mean(f) for f in (ref_exr, os.path.join(out, name, "pathtraced.exr"),
+                                        os.path.join(out, name, "pathtraced-seed1.exr")))
+    fmt = lambda v: ", ".join(f"{x:.4f}" for x in v)
+    levels.append(f"| {name} | {fmt(r)} | {fmt(p0)} | {fmt(p1)} | "
+                  + ", ".join(f"{(a - b) / b * 100:+.1f} %" for a, b in zip(r, p0)) + " |")
 per_condition = ["", "## Scores per condition under both references", "",
                  "| case | condition | halo E (ref / pt) | bleed E (ref / pt) | skin ΔE00 mean (ref / pt) |", "|---|---|---|---|---|"]
 for name in cases:
@@ -477,7 +492,7 @@ for name in cases:
                              f"{number(a['skin']['delta_e00_mean'])} / {number(p['skin']['delta_e00_mean'])} |")
 path = os.path.join(out, "reference-validation.md")
 with open(path + ".tmp", "w") as f:
-    f.write("\n".join(lines + taus + per_condition) + "\n")
+    f.write("\n".join(lines + taus + levels + per_condition) + "\n")
 os.replace(path + ".tmp", path)
 print(f"reference-validation: {path}")
 PYTHON
