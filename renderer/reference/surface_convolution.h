@@ -7,6 +7,8 @@
 //   K_c(p, p) = ∫_0^a 2πs R_c(s) ds,  a = √(A_p / π)  (the receiver's own disc: exact for the narrow lobes that
 //                                                      fall between samples, and finite for Burley's 1/r centre)
 //   out_c(p)  = Σ_q K_c(p, q) E_c(q) α_c(q) / Σ_q K_c(p, q)
+// (Transport::ThroughTissue, the default below: the sums skip sources across air, and the denominator sums only
+// the sources facing the receiver's way.)
 // E: irradiance, α: albedo. Non-skin samples neither scatter (they are never sources) nor receive (their output is
 // E·α, unblurred). Dividing by Σ K keeps a uniformly lit, uniformly coloured skin surface unchanged and hands the
 // energy of the tails beyond r_c, of non-skin neighbours and of the quadrature error back to the receiver, as the
