@@ -420,6 +420,15 @@ RenderResult Renderer::render(const RenderRequest& request) {
     const std::vector<float> transmittance = read(impl.targets.transmittance.get(), 4);
     const std::vector<float> aux = read(impl.targets.aux.get(), 1);
     const std::vector<float> curvature = read(impl.targets.curvature.get(), 1);
+    if (cycles && pathtraced::pathtracedParamsFromJson(spec.pathtraced, spec.source).specularSource == "rasterizer") {
+        // pathtraced.specular_source = "rasterizer": Cycles rendered no specular lobe; its beauty gets the
+        // rasterizer's specular pass (same camera), so only the diffuse/subsurface layer comes from Cycles.
+        for (std::size_t p = 0; p < pixels; ++p)
+            for (std::size_t c = 0; c < 3; ++c) {
+                cycles->specular[p * 3 + c] = specular[p * 4 + c];
+                cycles->beauty[p * 3 + c] += specular[p * 4 + c];
+            }
+    }
     std::vector<float> display;
     if (!request.pngPath.empty() && cycles) {
         // Cycles' beauty through the same tone mapper (renderer/shading/tone_mappers.h mirrors the GL pass).
@@ -499,7 +508,10 @@ RenderResult Renderer::render(const RenderRequest& request) {
                            {"blender_version", cycles->blenderVersion},
                            {"render_seconds", cycles->renderSeconds},
                            {"wall_seconds", cycles->wallSeconds},
-                           {"channels_from_cycles", {"R", "G", "B", "diffuse.*", "specular.*", "depth.Z", "mask.Y"}}}
+                           {"channels_from_cycles",
+                            params.value("specular_source", "cycles") == "rasterizer"
+                                ? nlohmann::json{"R, G, B: diffuse only", "diffuse.*", "depth.Z", "mask.Y"}
+                                : nlohmann::json{"R", "G", "B", "diffuse.*", "specular.*", "depth.Z", "mask.Y"}}}
                 .dump();
         metadata.strings["skinlab:blender_version"] = cycles->blenderVersion;
         metadata.floats["skinlab:pathtraced_samples"] = static_cast<float>(params.at("samples").get<int>());

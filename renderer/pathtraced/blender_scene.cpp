@@ -116,7 +116,7 @@ nlohmann::json blenderSceneJson(const BlenderSceneInputs& inputs, std::string_vi
                              {"sss", p.sss},
                              {"radius", {p.radiusMm[0] * radiusScale, p.radiusMm[1] * radiusScale, p.radiusMm[2] * radiusScale}},
                              {"roughness", principledRoughness(m.glossiness)},
-                             {"specular", p.specular ? principledSpecular(kSkinF0) * m.specularIntensity : 0.0}});
+                             {"specular", p.specular && p.specularSource == "cycles" ? principledSpecular(kSkinF0) * m.specularIntensity : 0.0}});
     }
     scene["materials"] = materials;
     scene["textures"] = {{"albedo", spec.textures.albedo.string()},

@@ -20,6 +20,9 @@ PathtracedParams readTable(const SpecReader& t) {
     p.maxBounces = static_cast<int>(t.integer("max_bounces", p.maxBounces, 0, 1024));
     p.sss = t.boolean("sss", p.sss);
     p.specular = t.boolean("specular", p.specular);
+    p.specularSource = t.string("specular_source", p.specularSource);
+    if (p.specularSource != "cycles" && p.specularSource != "rasterizer")
+        t.fail("specular_source", "'" + p.specularSource + "' is not one of \"cycles\", \"rasterizer\"");
     p.radiusMm = t.vec3("radius_mm", p.radiusMm, 1e-4, 1000.0);
     p.sunAngleDeg = t.number("sun_angle_deg", p.sunAngleDeg, 0.0, 90.0);
     p.filterWidthPx = t.number("filter_width_px", p.filterWidthPx, 0.01, 10.0);
@@ -33,7 +36,8 @@ PathtracedParams readTable(const SpecReader& t) {
 nlohmann::json PathtracedParams::toJson() const {
     return {{"samples", samples},         {"seed", seed},
             {"max_bounces", maxBounces},  {"sss", sss},
-            {"specular", specular},       {"radius_mm", radiusMm},
+            {"specular", specular},       {"specular_source", specularSource},
+            {"radius_mm", radiusMm},
             {"sun_angle_deg", sunAngleDeg}, {"filter_width_px", filterWidthPx},
             {"threads", threads},         {"blender", blender}};
 }

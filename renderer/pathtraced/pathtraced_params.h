@@ -24,6 +24,10 @@ struct PathtracedParams {
     int maxBounces = 8;        // total, diffuse and glossy bounce limits (0: direct light only)
     bool sss = true;           // random-walk subsurface scattering on skin (false: a plain Principled surface)
     bool specular = true;      // the specular lobe (false: Principled specular 0)
+    // Where the specular layer comes from: "cycles" (Cycles' GGX lobe, environment reflections included) or
+    // "rasterizer" (Cycles renders no specular; the beauty is Cycles' diffuse + the rasterizer's specular pass of
+    // the same camera), so that a reference differs from a screen-space render in the subsurface transport only.
+    std::string specularSource = "cycles";
     // Random-walk radii per channel (mm) at the profile's own scale; scaled by sss.width_mm / 3 like every
     // screen-space kernel, then divided by mm_per_unit (Cycles takes them in scene units).
     std::array<double, 3> radiusMm = fittedRadiusMm();

@@ -51,10 +51,23 @@ std::vector<glm::vec3> convolveSurface(const SurfaceSamples& samples, const std:
     const auto convolveOne = [&](std::size_t t) {
         const std::uint32_t p = targets[t];
         const glm::vec3 centre = samples.positionMm[p];
+        const glm::vec3 normal = samples.normal[p];
         std::array<double, 3> weighted{0.0, 0.0, 0.0};
         std::array<double, 3> weightSum{0.0, 0.0, 0.0};
         std::size_t sources = 0;
         grid.forEachWithin(centre, static_cast<float>(cutoff), [&](std::uint32_t q) {
+            bool facing = true;  // q lies on the receiver's side of the surface (counts in the normaliser)
+            if (settings.transport == Transport::ThroughTissue && q != p) {
+                // The chord p → q must run inside the body: it may not leave p's surface outwards, nor reach q
+                // from outside, steeper than 10° (a flat or convex neighbour gives ≤ 0, a concave one a little
+                // above 0; across an air gap — lips, a fold, a nostril — the chord leaves through p's surface). A source behind a thin part (its normal turned away) passes: that is through-light.
+                const glm::vec3 chord = samples.positionMm[q] - centre;
+                const float length = glm::length(chord);
+                if (glm::dot(chord, normal) > kAirGapSine * length ||
+                    glm::dot(chord, samples.normal[q]) < -kAirGapSine * length)
+                    return;
+                facing = glm::dot(normal, samples.normal[q]) > 0.0f;
+            }
             std::array<double, 3> k;
             if (q == p) {
                 const double radius = std::sqrt(samples.areaMm2[p] / std::numbers::pi);
@@ -70,7 +83,7 @@ std::vector<glm::vec3> convolveSurface(const SurfaceSamples& samples, const std:
             const glm::vec3 value = irradiance[q] * samples.albedo[q];
             for (int c = 0; c < 3; ++c) {
                 weighted[c] += k[c] * value[c];
-                weightSum[c] += k[c];
+                if (facing) weightSum[c] += k[c];
             }
             ++sources;
         });

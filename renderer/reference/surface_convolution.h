@@ -7,6 +7,8 @@
 //   K_c(p, p) = ∫_0^a 2πs R_c(s) ds,  a = √(A_p / π)  (the receiver's own disc: exact for the narrow lobes that
 //                                                      fall between samples, and finite for Burley's 1/r centre)
 //   out_c(p)  = Σ_q K_c(p, q) E_c(q) α_c(q) / Σ_q K_c(p, q)
+// (Transport::ThroughTissue, the default below: the sums skip sources across air, and the denominator sums only
+// the sources facing the receiver's way.)
 // E: irradiance, α: albedo. Non-skin samples neither scatter (they are never sources) nor receive (their output is
 // E·α, unblurred). Dividing by Σ K keeps a uniformly lit, uniformly coloured skin surface unchanged and hands the
 // energy of the tails beyond r_c, of non-skin neighbours and of the quadrature error back to the receiver, as the
@@ -23,7 +25,22 @@
 
 namespace skinlab::renderer::reference {
 
+// How light travels between samples (the render method uses ThroughTissue):
+//  - Euclidean: every skin source within r_c at its 3-D distance, normalised by Σ K over all of them. Light jumps
+//    air gaps under r_c (lips, ear folds), and a thin part lit from the front is dimmed by 1/(1 + T), T the
+//    kernel weight of its back face.
+//  - ThroughTissue (default): a source counts only when the chord p → q runs inside the body (neither leaves p's
+//    surface nor reaches q from outside at more than asin(kAirGapSine) = 10° to the tangent plane; a concave
+//    surface of radius R keeps its sources up to 2R · 0.17 mm away, the rest of the kernel's energy is handed back
+//    by the normaliser; two faces across a gap g lose each other up to g / 0.17 mm apart), and Σ K of the
+//    normaliser holds only the sources facing the receiver's way (n_p · n_q > 0): a uniformly lit flat surface
+//    stays unchanged, the energy of tails and non-skin neighbours is still handed back, and the light of a thin
+//    part's back face adds to its front (through-light) instead of averaging with it.
+enum class Transport { Euclidean, ThroughTissue };
+inline constexpr float kAirGapSine = 0.17364818f;  // sin 10°
+
 struct ConvolutionSettings {
+    Transport transport = Transport::ThroughTissue;
     double cutoffTail = 1e-3;  // share of each channel's energy allowed outside the cutoff radius
     unsigned threads = 0;      // worker threads; 0: std::thread::hardware_concurrency()
 };

@@ -206,6 +206,33 @@ TEST(PathtracedRender, SameInputsGiveTheSameImage) {
     EXPECT_NE(a.channels.at("R"), readExr(folder / "c.exr").channels.at("R"));
 }
 
+TEST(PathtracedRender, RasterizerSpecularSourceAddsTheRasterizersSpecularLayer) {
+    // pathtraced.specular_source = "rasterizer": specular.* is the rasterizer's specular pass of the same camera and
+    // the beauty is Cycles' diffuse plus it (builtin:halo: a glossy skin sphere under a directional key light).
+    SKINLAB_REQUIRE_BLENDER();
+    SKINLAB_REQUIRE_RENDERER(renderer);
+    TempFolder folder("pathtraced-specular-source");
+    renderToExr(*renderer, "builtin:halo", "pathtraced", {"pathtraced.samples=4", "pathtraced.specular_source=\"rasterizer\""},
+                32, 32, folder / "cycles.exr");
+    renderToExr(*renderer, "builtin:halo", "none", {}, 32, 32, folder / "raster.exr");
+    const ExrImage cycles = readExr(folder / "cycles.exr");
+    const ExrImage raster = readExr(folder / "raster.exr");
+    double specular = 0.0;
+    for (const char* c : {"R", "G", "B"}) {
+        const std::string channel = std::string("specular.") + c;
+        EXPECT_EQ(cycles.channels.at(channel), raster.channels.at(channel)) << channel;
+        for (int y = 0; y < 32; ++y)
+            for (int x = 0; x < 32; ++x) {
+                specular += raster.at(channel, x, y);
+                EXPECT_NEAR(cycles.at(c, x, y), cycles.at(std::string("diffuse.") + c, x, y) + raster.at(channel, x, y),
+                            // Combined = diffuse passes within 1 % (docs/pathtraced.md, "What comes back")
+                            0.02f * cycles.at(c, x, y) + 1e-4f)
+                    << c << " at " << x << ", " << y;
+            }
+    }
+    EXPECT_GT(specular, 0.1);  // the sphere has a highlight: the check above is not on zeros
+}
+
 TEST(PathtracedCli, MissingBlenderIsAOneLineErrorAndWritesNothing) {
     SKINLAB_REQUIRE_RENDERER(renderer);
     TempFolder folder("pathtraced-cli");

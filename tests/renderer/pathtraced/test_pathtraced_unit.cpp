@@ -79,6 +79,19 @@ TEST(PathtracedParams, DefaultsAndStrictKeys) {
     EXPECT_EQ(pathtracedParamsFromJson(p.toJson()).toJson(), p.toJson());
 }
 
+TEST(PathtracedParams, SpecularSourceRasterizerRendersNoCyclesSpecular) {
+    // "cycles" (default): the Principled specular of every part follows the material; "rasterizer": 0 (the beauty
+    // gets the rasterizer's specular pass instead, renderer/render_job.cpp); anything else is an error naming the key.
+    const Exported own = exportScene("builtin:halo", {});
+    EXPECT_EQ(own.spec.resolved.at("pathtraced").at("specular_source"), "cycles");
+    EXPECT_GT(own.json.at("materials").at(0).at("specular").get<double>(), 0.0);
+    const Exported borrowed = exportScene("builtin:halo", {"pathtraced.specular_source=\"rasterizer\""});
+    for (const auto& material : borrowed.json.at("materials")) EXPECT_EQ(material.at("specular").get<double>(), 0.0);
+    const std::string bad = errorOf([] { loadSceneSpec("builtin:halo", {"pathtraced.specular_source=\"glossy\""}, {}); });
+    EXPECT_NE(bad.find("pathtraced.specular_source"), std::string::npos) << bad;
+    EXPECT_NE(bad.find("glossy"), std::string::npos) << bad;
+}
+
 TEST(BlenderScene, LightsInBlenderUnits) {
     // builtin:head: a spot (intensity 1.6, colour [1, 0.95, 0.88]) and a directional light (0.25, [0.85, 0.9, 1]).
     const SceneSpec spec = loadSceneSpec("builtin:head", {"sss.method=\"pathtraced\""}, {});

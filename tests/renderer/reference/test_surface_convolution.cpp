@@ -220,3 +220,78 @@ TEST(SurfaceConvolution, DeterministicForAnyThreadCount) {
     three.threads = 3;
     EXPECT_EQ(convolveSurface(samples, irradiance, *profile, one), convolveSurface(samples, irradiance, *profile, three));
 }
+
+namespace {
+// Two parallel square grids of skin samples (side 30 mm, spacing 0.5 mm, albedo 1): the first at z = 0 with
+// normal +z, the second at z = zSecond with normal secondNormalZ · z. Returns the samples; `first` gets the index
+// of the first grid's centre sample, `second` the second's.
+SurfaceSamples twoPlanes(float zSecond, float secondNormalZ, std::uint32_t& first, std::uint32_t& second) {
+    SurfaceSamples s;
+    const int n = 61;
+    const float h = 0.5f;
+    for (int plane = 0; plane < 2; ++plane)
+        for (int j = 0; j < n; ++j)
+            for (int i = 0; i < n; ++i) {
+                if (i == n / 2 && j == n / 2) (plane == 0 ? first : second) = static_cast<std::uint32_t>(s.size());
+                s.positionMm.push_back(glm::vec3((i - n / 2) * h, (j - n / 2) * h, plane == 0 ? 0.0f : zSecond));
+                s.normal.push_back(glm::vec3(0.0f, 0.0f, plane == 0 ? 1.0f : secondNormalZ));
+                s.albedo.push_back(glm::vec3(1.0f));
+                s.areaMm2.push_back(h * h);
+                s.skin.push_back(1);
+            }
+    return s;
+}
+} // namespace
+
+TEST(SurfaceConvolution, ThroughTissueKeepsThinPartsBrightAndCarriesTheirThroughLight) {
+    // A 2 mm slab: front face z = 0 (normal +z), back face z = −2 mm (normal −z).
+    std::uint32_t front = 0, back = 0;
+    const SurfaceSamples slab = twoPlanes(-2.0f, -1.0f, front, back);
+    const auto profile = makeRadialProfile(profileParams("deon"));
+    std::vector<glm::vec3> frontLit(slab.size()), backLit(slab.size());
+    for (std::size_t i = 0; i < slab.size(); ++i) {
+        frontLit[i] = glm::vec3(slab.normal[i].z > 0.0f ? 1.0f : 0.0f);
+        backLit[i] = glm::vec3(1.0f) - frontLit[i];
+    }
+    ConvolutionSettings euclidean, tissue;
+    euclidean.transport = Transport::Euclidean;
+    const auto oldFront = convolveSurface(slab, frontLit, *profile, euclidean);
+    const auto newFront = convolveSurface(slab, frontLit, *profile, tissue);
+    const auto oldBack = convolveSurface(slab, backLit, *profile, euclidean);
+    const auto newBack = convolveSurface(slab, backLit, *profile, tissue);
+    for (int c = 0; c < 3; ++c) {
+        // T: the kernel weight of the back face relative to the front's, from the Euclidean back-lit response
+        // t = T / (1 + T).
+        const double t = oldBack[front][c];
+        const double transmission = t / (1.0 - t);
+        // Euclidean: the front-lit front is dimmed to 1 / (1 + T); through tissue: it keeps E·α exactly.
+        EXPECT_NEAR(oldFront[front][c], 1.0 / (1.0 + transmission), 1e-4) << c;
+        EXPECT_NEAR(newFront[front][c], 1.0, 1e-5) << c;
+        // Back-lit: the front receives T itself (not T / (1 + T)).
+        EXPECT_NEAR(newBack[front][c], transmission, 1e-4) << c;
+        EXPECT_GT(newBack[front][c], oldBack[front][c]) << c;
+    }
+    // Red, the widest lobe, carries the most light through 2 mm; the difference is large enough to matter.
+    EXPECT_GT(newBack[front][0], 0.05);
+    EXPECT_GT(newBack[front][0], newBack[front][2]);
+}
+
+TEST(SurfaceConvolution, ThroughTissueStopsLightAcrossAnAirGap) {
+    // Two surfaces facing each other across a 2 mm air gap (lips, an ear fold): the lower one (normal +z) lit, the
+    // upper one (z = 2 mm, normal −z) dark. The Euclidean convolution moves light across; through tissue none.
+    std::uint32_t lower = 0, upper = 0;
+    const SurfaceSamples gap = twoPlanes(2.0f, -1.0f, lower, upper);
+    const auto profile = makeRadialProfile(profileParams("deon"));
+    std::vector<glm::vec3> irradiance(gap.size());
+    for (std::size_t i = 0; i < gap.size(); ++i) irradiance[i] = glm::vec3(gap.normal[i].z > 0.0f ? 1.0f : 0.0f);
+    ConvolutionSettings euclidean, tissue;
+    euclidean.transport = Transport::Euclidean;
+    const auto across = convolveSurface(gap, irradiance, *profile, euclidean);
+    const auto stopped = convolveSurface(gap, irradiance, *profile, tissue);
+    EXPECT_GT(across[upper][0], 0.05);
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_EQ(stopped[upper][c], 0.0f) << c;
+        EXPECT_NEAR(stopped[lower][c], 1.0, 1e-5) << c;
+        EXPECT_LT(across[lower][c], 1.0f) << c;  // the dark upper face dilutes the lit one in the old normaliser
+    }
+}

@@ -1,0 +1,498 @@
+#!/usr/bin/env bash
+# Validation of the object-space `reference` method against the path-traced one (docs/pathtraced.md, "Reference
+# validation"). For each case — builtin:halo with a skin backdrop at depth gaps 5 and 200 mm, builtin:bleed with the
+# paint inside the skin mask (references: the true materials), builtin:ear, builtin:head and (with SKINLAB_ASSETS)
+# the scanned head — it renders
+#   - the 24 screen-space conditions of the evaluation table (gaussian-sum, separable, artistic, pscbf × none,
+#     follow-surface, +cbf, +lab_weight, +curvature reduce-floor, all) and the `reference` render (2 mm edges) as a
+#     stimulus set;
+#   - `pathtraced` twice, with seeds 0 and 1 (the second measures the path tracer's own noise on every score);
+# and scores, with `skinlab analyze metrics` (the bands of docs/metrics.md, from each reference's depth and mask):
+#   - every condition against `reference` and against `pathtraced`;
+#   - `reference` against `pathtraced` (the per-band disagreement), and `pathtraced` seed 1 against seed 0 (noise).
+# The table: per case and band, the leak energy and mean ΔE00 of `reference` against `pathtraced` next to the
+# path tracer's own; and per case and score, Kendall's τ_b between the rankings of the 24 conditions under the
+# two references.
+#
+#   scripts/reference-validation.sh [OUT_DIR] [SIZE] [SAMPLES]       (defaults: out/reference-validation 256 64)
+#
+# Environment: SKINLAB (default build/release/cli/skinlab), SKINLAB_ASSETS (without the scanned head its case is
+# skipped with a message), CASES (a space-separated subset of: halo-5 halo-200 bleed ear head scan).
+# Every scene key that matters is written out below (model, materials, camera, lights, environment, SSS width,
+# the path tracer's settings), so the numbers do not move with the built-in scenes' defaults. Rerunning resumes:
+# stimuli and path-traced images already rendered with the same parameters are not rendered again.
+# Writes OUT_DIR/reference-validation.md (atomically) and, per case, OUT_DIR/CASE/{*.toml,set/,pathtraced*.exr,
+# metrics-*/}.
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+out="${1:-out/reference-validation}"
+size="${2:-256}"
+samples="${3:-64}"
+skinlab="${SKINLAB:-$root/build/release/cli/skinlab}"
+[ -x "$skinlab" ] || { echo "reference-validation: $skinlab not found (build it: scripts/build.sh, or set SKINLAB)" >&2; exit 2; }
+command -v python3 > /dev/null || { echo "reference-validation: python3 is needed to write the table" >&2; exit 2; }
+command -v "${BLENDER:-blender}" > /dev/null || { echo "reference-validation: blender not found (Debian package blender)" >&2; exit 2; }
+mkdir -p "$out"
+out="$(cd "$out" && pwd)"
+
+cases="${CASES:-halo-5 halo-200 bleed ear head scan}"
+if [[ " $cases " == *" scan "* ]] && { [ -z "${SKINLAB_ASSETS:-}" ] || [ ! -e "$SKINLAB_ASSETS/LeePerrySmith/LeePerrySmith.glb" ]; }; then
+  echo "reference-validation: scanned head skipped (\$SKINLAB_ASSETS/LeePerrySmith/LeePerrySmith.glb not found)" >&2
+  cases="${cases/scan/}"
+fi
+
+# Settings shared by every scene: the SSS width, and the path tracer set to agree with the rasterizer everywhere
+# but in the subsurface transport: no interreflection, a hard sun, pixel-centre sampling, and the rasterizer's
+# specular layer (docs/pathtraced.md, "Rasterizer and Cycles").
+common_tail() {
+  cat <<EOF
+
+[render]
+width = $size
+height = $size
+exposure_ev = 0.0
+
+[tone_map]
+operator = "filmic"
+
+[sss]
+width_mm = 3.0
+
+[pathtraced]
+samples = $samples
+max_bounces = 0
+sun_angle_deg = 0.0
+filter_width_px = 0.01
+specular_source = "rasterizer"
+EOF
+}
+
+# halo_scene GAP: builtin:halo with the backdrop made skin (as renderer/scenes/evaluation/halo-skin-backdrop.toml).
+halo_scene() {
+  cat <<EOF
+mm_per_unit = 1.0
+
+[model]
+source = "builtin:halo"
+depth_gap_mm = $1
+
+[[materials]]
+name = "skin"
+albedo = [0.60, 0.42, 0.34]
+skin = true
+glossiness = 0.6
+specular_intensity = 1.0
+
+[[materials]]
+name = "backdrop"
+albedo = [0.5, 0.5, 0.5]
+skin = true
+glossiness = 0.3
+specular_intensity = 1.0
+
+[camera]
+view = "explicit"
+position = [0.0, 0.0, 300.0]
+target = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+fov_deg = 30.0
+
+[[lights]]
+type = "directional"
+direction = [0.45, -0.45, -0.77]
+color = [1.0, 0.97, 0.92]
+intensity = 1.2
+shadow = false
+
+[environment]
+radiance = [0.08, 0.085, 0.1]
+intensity = 1.0
+background = "color"
+background_color = [0.02, 0.02, 0.02]
+EOF
+  common_tail
+}
+
+# bleed_scene PAINT_IS_SKIN: builtin:bleed; true for the screen-space renders (a mask coarser than the material),
+# false for the references (the true materials, so the bands come from the true mask).
+bleed_scene() {
+  cat <<EOF
+mm_per_unit = 1.0
+
+[model]
+source = "builtin:bleed"
+
+[[materials]]
+name = "skin"
+albedo = [0.60, 0.42, 0.34]
+skin = true
+glossiness = 0.6
+specular_intensity = 1.0
+
+[[materials]]
+name = "paint-dark"
+albedo = [0.02, 0.02, 0.02]
+skin = $1
+glossiness = 0.3
+specular_intensity = 1.0
+
+[[materials]]
+name = "paint-bright"
+albedo = [0.05, 0.6, 0.8]
+skin = $1
+glossiness = 0.3
+specular_intensity = 1.0
+
+[camera]
+view = "mid"
+fov_deg = 30.0
+yaw_deg = 0.0
+pitch_deg = 0.0
+
+[[lights]]
+type = "directional"
+direction = [0.2, -0.25, -0.95]
+color = [1.0, 1.0, 1.0]
+intensity = 1.0
+shadow = false
+
+[environment]
+radiance = [0.1, 0.1, 0.1]
+intensity = 1.0
+background = "color"
+background_color = [0.02, 0.02, 0.02]
+EOF
+  common_tail
+}
+
+ear_scene() {
+  cat <<EOF
+mm_per_unit = 1.0
+
+[model]
+source = "builtin:ear"
+thickness_mm = 2.5
+
+[[materials]]
+name = "skin"
+albedo = [0.60, 0.42, 0.34]
+skin = true
+glossiness = 0.6
+specular_intensity = 1.0
+
+[camera]
+view = "mid"
+fov_deg = 30.0
+yaw_deg = 0.0
+pitch_deg = 0.0
+
+[[lights]]
+type = "directional"
+direction = [0.15, -0.2, 0.97]
+color = [1.0, 0.95, 0.88]
+intensity = 3.0
+shadow = true
+
+[[lights]]
+type = "directional"
+direction = [-0.3, -0.3, -0.9]
+color = [1.0, 1.0, 1.0]
+intensity = 0.15
+shadow = false
+
+[environment]
+radiance = [0.03, 0.03, 0.035]
+intensity = 1.0
+background = "color"
+background_color = [0.01, 0.01, 0.01]
+EOF
+  common_tail
+}
+
+head_scene() {
+  cat <<EOF
+mm_per_unit = 1.0
+
+[model]
+source = "builtin:head"
+
+[[materials]]
+name = "skin"
+albedo = [0.60, 0.42, 0.34]
+skin = true
+glossiness = 0.5
+specular_intensity = 1.0
+
+[[materials]]
+name = "eye"
+albedo = [0.8, 0.78, 0.75]
+skin = false
+glossiness = 0.95
+specular_intensity = 1.0
+
+[camera]
+view = "mid"
+fov_deg = 30.0
+yaw_deg = 20.0
+pitch_deg = 0.0
+
+[[lights]]
+type = "spot"
+position = [-500.0, 450.0, 700.0]
+target = [0.0, 0.0, 40.0]
+color = [1.0, 0.95, 0.88]
+intensity = 1.6
+shadow = true
+inner_angle_deg = 15.0
+outer_angle_deg = 25.0
+
+[[lights]]
+type = "directional"
+direction = [-0.7, -0.1, -0.7]
+color = [0.85, 0.9, 1.0]
+intensity = 0.25
+shadow = false
+
+[environment]
+radiance = [0.12, 0.125, 0.14]
+intensity = 1.0
+background = "color"
+background_color = [0.03, 0.03, 0.035]
+EOF
+  common_tail
+}
+
+scan_scene() {
+  cat <<EOF
+mm_per_unit = 47.9
+
+[model]
+source = "assets:LeePerrySmith/LeePerrySmith.glb"
+flip_v = true
+
+[textures]
+albedo = "assets:LeePerrySmith/Map-COL.jpg"
+normal = "assets:LeePerrySmith/Infinite-Level_02_Tangent_SmoothUV.jpg"
+specular = "assets:LeePerrySmith/Map-SPEC.jpg"
+normal_strength = 1.0
+
+[[materials]]
+name = "*"
+albedo = [1.0, 1.0, 1.0]
+skin = true
+glossiness = 0.5
+specular_intensity = 1.0
+
+[camera]
+view = "close"
+fov_deg = 30.0
+yaw_deg = 20.0
+pitch_deg = 0.0
+
+[[lights]]
+type = "directional"
+direction = [0.55, -0.45, -0.7]
+color = [1.0, 0.95, 0.88]
+intensity = 1.2
+shadow = true
+
+[environment]
+file = "assets:envmaps/royal_esplanade_1k.hdr"
+intensity = 1.0
+rotation_deg = 0.0
+background = "environment"
+EOF
+  common_tail
+}
+
+# The 24 screen-space conditions of stimuli/specs/extensions-*.toml and the object-space reference (2 mm edges).
+set_spec() {  # set_spec NAME TEST_SCENE REF_SCENE
+  cat <<EOF
+[set]
+name = "validation-$1"
+description = "reference validation, $1: 24 screen-space conditions + the object-space reference"
+seed = 4
+block = ["scene"]
+
+[fixed]
+render = { width = $size, height = $size, exposure_ev = 0.0 }
+tone_map = { operator = "filmic" }
+
+[[factor]]
+name = "scene"
+levels = ["$2"]
+labels = ["$1"]
+
+[[factor]]
+name = "method"
+levels = ["gaussian-sum", "separable", "artistic", "pscbf"]
+
+[[factor]]
+name = "sss.follow_surface"
+levels = [false, true]
+labels = ["none", "follow"]
+
+[[reference]]
+scene = "$3"
+method = "reference"
+sss.reference_edge_mm = 2.0
+EOF
+  for method in gaussian-sum separable artistic pscbf; do
+    beta=0.09; [ "$method" = gaussian-sum ] && beta=0.5
+    printf '\n[[include]]\nmethod = "%s"\nsss.cbf = true\n' "$method"
+    printf '\n[[include]]\nmethod = "%s"\nsss.lab_weight = %s\n' "$method" "$beta"
+    printf '\n[[include]]\nmethod = "%s"\nsss.curvature = "reduce-floor"\n' "$method"
+    printf '\n[[include]]\nmethod = "%s"\nsss.cbf = true\nsss.lab_weight = %s\nsss.curvature = "reduce-floor"\n' "$method" "$beta"
+  done
+}
+
+# Renders with `skinlab render` unless the EXR exists with the same scene file and overrides (stamp file).
+render_once() {  # render_once OUT.exr SCENE OVERRIDES...
+  local exr="$1" scene="$2"; shift 2
+  local stamp="$exr.inputs"
+  local inputs; inputs="$(cat "$scene"; printf '%s\n' "$@")"
+  if [ -e "$exr" ] && [ -e "$stamp" ] && [ "$(cat "$stamp")" = "$inputs" ]; then return 0; fi
+  local start=$SECONDS args=()
+  for o in "$@"; do args+=(--set "$o"); done
+  "$skinlab" render --scene "$scene" "${args[@]}" -o "$exr" > /dev/null
+  printf '%s' "$inputs" > "$stamp.tmp" && mv "$stamp.tmp" "$stamp"
+  echo "reference-validation: $(basename "$(dirname "$exr")")/$(basename "$exr") in $((SECONDS - start)) s" >&2
+}
+
+ran=()
+for name in $cases; do
+  dir="$out/$name"
+  mkdir -p "$dir"
+  case "$name" in
+    halo-5) halo_scene 5.0 > "$dir/test.toml"; cp "$dir/test.toml" "$dir/ref.toml" ;;
+    halo-200) halo_scene 200.0 > "$dir/test.toml"; cp "$dir/test.toml" "$dir/ref.toml" ;;
+    bleed) bleed_scene true > "$dir/test.toml"; bleed_scene false > "$dir/ref.toml" ;;
+    ear) ear_scene > "$dir/test.toml"; cp "$dir/test.toml" "$dir/ref.toml" ;;
+    head) head_scene > "$dir/test.toml"; cp "$dir/test.toml" "$dir/ref.toml" ;;
+    scan) scan_scene > "$dir/test.toml"; cp "$dir/test.toml" "$dir/ref.toml" ;;
+    *) echo "reference-validation: unknown case '$name' in CASES (halo-5 halo-200 bleed ear head scan)" >&2; exit 2 ;;
+  esac
+  set_spec "$name" "$dir/test.toml" "$dir/ref.toml" > "$dir/set.toml"
+  echo "reference-validation: $name: stimuli" >&2
+  start=$SECONDS
+  "$skinlab" stimuli build "$dir/set.toml" -o "$dir/set" --progress lines
+  echo "reference-validation: $name: stimuli in $((SECONDS - start)) s" >&2
+  render_once "$dir/pathtraced.exr" "$dir/ref.toml" 'sss.method="pathtraced"' 'pathtraced.seed=0'
+  render_once "$dir/pathtraced-seed1.exr" "$dir/ref.toml" 'sss.method="pathtraced"' 'pathtraced.seed=1'
+  ref_exr="$(python3 -c 'import json,sys; m=json.load(open(sys.argv[1])); print(next(s["files"]["exr"] for s in m["stimuli"] if s["reference"]))' "$dir/set/manifest.json")"
+  tests=()
+  while IFS= read -r f; do tests+=("$dir/set/$f"); done < <(python3 -c 'import json,sys; m=json.load(open(sys.argv[1])); [print(s["files"]["exr"]) for s in m["stimuli"] if not s["reference"]]' "$dir/set/manifest.json")
+  "$skinlab" analyze metrics --reference "$dir/set/$ref_exr" "${tests[@]}" -o "$dir/metrics-reference" > /dev/null
+  "$skinlab" analyze metrics --reference "$dir/pathtraced.exr" "${tests[@]}" "$dir/set/$ref_exr" "$dir/pathtraced-seed1.exr" \
+    -o "$dir/metrics-pathtraced" > /dev/null
+  ran+=("$name")
+done
+
+python3 - "$out" "$size" "$samples" "${ran[@]}" <<'PYTHON'
+# The table: per-band disagreement of `reference` with `pathtraced` (next to the path tracer's own noise), and
+# Kendall's τ_b between the rankings of the 24 conditions under the two references, per score.
+import json, os, sys
+
+out, size, samples, cases = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4:]
+bands = ["halo", "bleed", "spill", "interior"]
+
+def load(path):
+    m = json.load(open(path))
+    return {c["test"]["name"]: c
+            for c in m["comparisons"]}
+
+def kendall_tau_b(x, y):
+    n, concordant, discordant, ties_x, ties_y = len(x), 0, 0, 0, 0
+    for i in range(n):
+        for j in range(i + 1, n):
+            dx, dy = x[i] - x[j], y[i] - y[j]
+            if dx == 0 and dy == 0: continue
+            if dx == 0: ties_x += 1
+            elif dy == 0: ties_y += 1
+            elif dx * dy > 0: concordant += 1
+            else: discordant += 1
+    denominator = ((concordant + discordant + ties_x) * (concordant + discordant + ties_y)) ** 0.5
+    return None if denominator == 0 else (concordant - discordant) / denominator
+
+def number(v, digits=3):
+    if v is None: return "–"
+    return f"{v:.{digits}e}" if v != 0 and abs(v) < 0.01 else f"{v:.{digits}f}"
+
+def band(c, b, key):
+    entry = c["bands"].get(b) if c.get("bands") else None
+    return None if not entry or not entry.get("pixels") else entry.get(key)
+
+lines = ["# Reference validation: `reference` against `pathtraced`", "",
+         f"Generated by `scripts/reference-validation.sh` at {size}×{size}, `pathtraced` at {samples} samples "
+         "(seed 0; seed 1 for the noise column), max_bounces 0, the rasterizer's specular layer; `reference` at 2 mm "
+         "edges. Leak energy E = Σ_band |Y_test − Y_ref| / Σ_skin Y_ref; bands from the path-traced reference's "
+         "depth and mask (docs/metrics.md).", "",
+         "## Per band: `reference` scored against `pathtraced`", "",
+         "| case | band | pixels | E(reference) | E(noise) | ΔE00 mean (reference) | ΔE00 mean (noise) |",
+         "|---|---|---|---|---|---|---|"]
+taus = ["", "## Rankings of the 24 conditions: Kendall's τ_b between the two references", "",
+        "| case | halo E | bleed E | spill E | skin ΔE00 mean | halo ΔE00 excess | bleed ΔE00 excess | smallest halo E (vs `reference`) / noise E | smallest bleed E / noise E |",
+        "|---|---|---|---|---|---|---|---|---|"]
+for name in cases:
+    against_ref = load(os.path.join(out, name, "metrics-reference", "metrics.json"))
+    against_pt = load(os.path.join(out, name, "metrics-pathtraced", "metrics.json"))
+    ref_key = next(k for k in against_pt if k not in against_ref and k != "pathtraced-seed1")
+    reference, noise = against_pt[ref_key], against_pt["pathtraced-seed1"]
+    for b in bands:
+        if not band(reference, b, "pixels"): continue
+        lines.append(f"| {name} | {b} | {band(reference, b, 'pixels')} | {number(band(reference, b, 'leak_energy'))} | "
+                     f"{number(band(noise, b, 'leak_energy'))} | {number(band(reference, b, 'delta_e00_mean'))} | "
+                     f"{number(band(noise, b, 'delta_e00_mean'))} |")
+    lines.append(f"| {name} | skin | – | – | – | {number(reference['skin']['delta_e00_mean'])} | "
+                 f"{number(noise['skin']['delta_e00_mean'])} |")
+    conditions = sorted(against_ref)
+    row = [name]
+    scores = [("halo", "leak_energy"), ("bleed", "leak_energy"), ("spill", "leak_energy"), ("skin", "delta_e00_mean"),
+              ("halo", "excess"), ("bleed", "excess")]
+    for b, key in scores:
+        get = (lambda c: c["skin"][key]) if b == "skin" else (lambda c: band(c, b, key))
+        x = [get(against_ref[k]) for k in conditions]
+        y = [get(against_pt[k]) for k in conditions]
+        if any(v is None for v in x + y): row.append("–"); continue
+        tau = kendall_tau_b(x, y)
+        row.append("–" if tau is None else f"{tau:+.2f}")
+    for b in ["halo", "bleed"]:
+        values = [v for v in (band(against_ref[k], b, "leak_energy") for k in conditions) if v is not None]
+        row.append("–" if not values else f"{number(min(values))} / {number(band(noise, b, 'leak_energy'))}")
+    taus.append("| " + " | ".join(row) + " |")
+    # The per-condition scores under both references, for the docs' discussion.
+# Levels: the mask-weighted mean skin diffuse of each reference (oiiotool; a mean over thousands of pixels, so the
+# path tracer's per-pixel noise averages out, unlike in the per-pixel scores above).
+import re, subprocess
+def skin_mean(exr):
+    def means(*args):
+        text = subprocess.run(["oiiotool", *args, "--printstats"], check=True, capture_output=True, text=True).stdout
+        return [float(v) for v in re.search(r"Stats Avg: (.*?) \(float\)", text).group(1).split()]
+    area = means(exr, "--ch", "mask.Y")[0]
+    return [v / area for v in means(exr, "--ch", "diffuse.R,diffuse.G,diffuse.B", exr, "--ch", "mask.Y,mask.Y,mask.Y", "--mul")]
+levels = ["", "## Skin level: mask-weighted mean skin diffuse (R, G, B)", "",
+          "| case | `reference` | `pathtraced` seed 0 | seed 1 | reference − pathtraced (relative) |", "|---|---|---|---|---|"]
+for name in cases:
+    manifest = json.load(open(os.path.join(out, name, "set", "manifest.json")))
+    ref_exr = os.path.join(out, name, "set", next(s["files"]["exr"] for s in manifest["stimuli"] if s["reference"]))
+    r, p0, p1 = (skin_mean(f) for f in (ref_exr, os.path.join(out, name, "pathtraced.exr"),
+                                        os.path.join(out, name, "pathtraced-seed1.exr")))
+    fmt = lambda v: ", ".join(f"{x:.4f}" for x in v)
+    levels.append(f"| {name} | {fmt(r)} | {fmt(p0)} | {fmt(p1)} | "
+                  + ", ".join(f"{(a - b) / b * 100:+.1f} %" for a, b in zip(r, p0)) + " |")
+per_condition = ["", "## Scores per condition under both references", "",
+                 "| case | condition | halo E (ref / pt) | bleed E (ref / pt) | skin ΔE00 mean (ref / pt) |", "|---|---|---|---|---|"]
+for name in cases:
+    against_ref = load(os.path.join(out, name, "metrics-reference", "metrics.json"))
+    against_pt = load(os.path.join(out, name, "metrics-pathtraced", "metrics.json"))
+    for k in sorted(against_ref):
+        a, p = against_ref[k], against_pt[k]
+        per_condition.append(f"| {name} | {k} | {number(band(a, 'halo', 'leak_energy'))} / {number(band(p, 'halo', 'leak_energy'))} | "
+                             f"{number(band(a, 'bleed', 'leak_energy'))} / {number(band(p, 'bleed', 'leak_energy'))} | "
+                             f"{number(a['skin']['delta_e00_mean'])} / {number(p['skin']['delta_e00_mean'])} |")
+path = os.path.join(out, "reference-validation.md")
+with open(path + ".tmp", "w") as f:
+    f.write("\n".join(lines + taus + levels + per_condition) + "\n")
+os.replace(path + ".tmp", path)
+print(f"reference-validation: {path}")
+PYTHON

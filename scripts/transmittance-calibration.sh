@@ -1,0 +1,123 @@
+#!/usr/bin/env bash
+# Through-light of thin skin against the path tracer (docs/pathtraced.md, "Through-light: calibration"):
+# builtin:ear (a skin fin lit from behind) at fin thicknesses 1 and 2 mm (THICKNESSES), rendered by `pathtraced`,
+# by the object-space `reference` (2 mm edges) and by `separable` without and with screen-space transmittance at
+# several `transmittance.translucency` values (TRANSLUCENCIES); prints the mean skin diffuse (R, G, B) of each,
+# i.e. the diffuse averaged over the skin pixels weighted by mask.Y (a mean over thousands of pixels: the path
+# tracer's per-pixel noise averages out), and writes OUT_DIR/transmittance-calibration.md.
+#
+#   scripts/transmittance-calibration.sh [OUT_DIR] [SIZE] [SAMPLES]     (defaults: out/transmittance 96 64)
+#
+# Environment: SKINLAB (default build/release/cli/skinlab), THICKNESSES (default "1.0 2.0"), TRANSLUCENCIES
+# (default "0.5 0.7 0.8 0.9 0.95"). Needs blender, oiiotool and python3. Every scene key is written out below.
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+out="${1:-out/transmittance}"
+size="${2:-96}"
+samples="${3:-64}"
+skinlab="${SKINLAB:-$root/build/release/cli/skinlab}"
+[ -x "$skinlab" ] || { echo "transmittance-calibration: $skinlab not found (build it: scripts/build.sh, or set SKINLAB)" >&2; exit 2; }
+for program in oiiotool python3 blender; do
+  command -v "$program" > /dev/null || { echo "transmittance-calibration: $program not found" >&2; exit 2; }
+done
+mkdir -p "$out"
+
+ear_scene() {  # ear_scene THICKNESS_MM
+  cat <<EOF
+mm_per_unit = 1.0
+
+[model]
+source = "builtin:ear"
+thickness_mm = $1
+
+[[materials]]
+name = "skin"
+albedo = [0.60, 0.42, 0.34]
+skin = true
+glossiness = 0.6
+specular_intensity = 1.0
+
+[camera]
+view = "mid"
+fov_deg = 30.0
+yaw_deg = 0.0
+pitch_deg = 0.0
+
+[[lights]]
+type = "directional"
+direction = [0.15, -0.2, 0.97]
+color = [1.0, 0.95, 0.88]
+intensity = 3.0
+shadow = true
+
+[[lights]]
+type = "directional"
+direction = [-0.3, -0.3, -0.9]
+color = [1.0, 1.0, 1.0]
+intensity = 0.15
+shadow = false
+
+[environment]
+radiance = [0.03, 0.03, 0.035]
+intensity = 1.0
+background = "color"
+background_color = [0.01, 0.01, 0.01]
+
+[render]
+width = $size
+height = $size
+exposure_ev = 0.0
+
+[tone_map]
+operator = "filmic"
+
+[sss]
+width_mm = 3.0
+
+[pathtraced]
+samples = $samples
+max_bounces = 0
+sun_angle_deg = 0.0
+filter_width_px = 0.01
+specular_source = "rasterizer"
+EOF
+}
+
+# Mask-weighted mean skin diffuse: Σ diffuse · mask.Y / Σ mask.Y, by oiiotool.
+skin_mean() {
+  python3 - "$1" <<'PYTHON'
+import re, subprocess, sys
+def means(*args):
+    text = subprocess.run(["oiiotool", *args, "--printstats"], check=True, capture_output=True, text=True).stdout
+    return [float(v) for v in re.search(r"Stats Avg: (.*?) \(float\)", text).group(1).split()]
+exr = sys.argv[1]
+area = means(exr, "--ch", "mask.Y")[0]
+lit = means(exr, "--ch", "diffuse.R,diffuse.G,diffuse.B", exr, "--ch", "mask.Y,mask.Y,mask.Y", "--mul")
+print(" ".join(f"{v / area:.4f}" for v in lit))
+PYTHON
+}
+
+lines=("| thickness | render | mean skin diffuse R | G | B |" "|---|---|---|---|---|")
+for t in ${THICKNESSES:-1.0 2.0}; do
+  scene="$out/ear-$t.toml"
+  ear_scene "$t" > "$scene"
+  runs=("pathtraced|sss.method=\"pathtraced\"" "reference|sss.method=\"reference\" sss.reference_edge_mm=2.0"
+        "separable|sss.method=\"separable\"")
+  for tr in ${TRANSLUCENCIES:-0.5 0.7 0.8 0.9 0.95}; do
+    runs+=("separable + transmittance $tr|sss.method=\"separable\" transmittance.enabled=true transmittance.translucency=$tr")
+  done
+  for run in "${runs[@]}"; do
+    name="${run%%|*}"
+    args=()
+    for o in ${run#*|}; do args+=(--set "$o"); done
+    exr="$out/ear-$t-$(echo "$name" | tr ' +' '__').exr"
+    start=$SECONDS
+    [ -e "$exr" ] || "$skinlab" render --scene "$scene" "${args[@]}" -o "$exr" > /dev/null
+    m="$(skin_mean "$exr")"
+    echo "transmittance-calibration: $t mm, $name: $m ($((SECONDS - start)) s)" >&2
+    lines+=("| $t mm | $name | ${m// / | } |")
+  done
+done
+printf '%s\n' "${lines[@]}" > "$out/transmittance-calibration.md.tmp"
+mv "$out/transmittance-calibration.md.tmp" "$out/transmittance-calibration.md"
+cat "$out/transmittance-calibration.md"
