@@ -1,6 +1,7 @@
 // Browser test of an online study: Debian's headless Chromium driven by playwright-core arrives from a Prolific
 // link (?PROLIFIC_PID=...&STUDY_ID=...&SESSION_ID=...), matches the calibration card, answers two trials (the page
-// hidden during the second), leaves, comes back in a fresh browser with the same link and resumes where it stopped,
+// hidden during the second: another tab brought to the front, and where headless Chromium keeps every tab visible,
+// as Debian 12's does, document.hidden = true with a visibilitychange event dispatched to the page), leaves, comes back in a fresh browser with the same link and resumes where it stopped,
 // loses the focus during one more trial, finishes, and is redirected to the completion URL (served here by a
 // stand-in for the platform). The export must hold one participant with the platform ids, the session's viewing
 // conditions and pixels per degree, and exactly the hidden and unfocused trials flagged.
@@ -167,6 +168,7 @@ async function visit({ name, answerCount, disturb, expectWelcomeBack }) {
       const other = await context.newPage();
       await other.bringToFront();
       const hidden = await page.evaluate(() => document.hidden);
+      console.log(`${name}: page hidden by ${hidden ? 'another tab in front' : 'a dispatched visibilitychange'}`);
       if (!hidden) {
         // Some headless builds keep every tab visible: hide the page the way a browser does.
         await page.evaluate(() => {
