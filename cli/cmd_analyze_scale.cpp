@@ -31,6 +31,7 @@ struct ScaleArguments {
     std::string block;
     bool singleBlock = false;
     std::vector<std::string> conditions;
+    bool dropFlagged = false;
 };
 
 void runScale(const ScaleArguments& arguments) {
@@ -48,7 +49,15 @@ void runScale(const ScaleArguments& arguments) {
     options.alpha = arguments.alpha;
     options.screeningWhisker = arguments.whisker;
 
-    const scaling::ResponseTable table = scaling::readResponses(arguments.responses);
+    scaling::ResponseTable table = scaling::readResponses(arguments.responses);
+    if (arguments.dropFlagged) {
+        const scaling::DroppedFlagged dropped = scaling::dropFlagged(table);
+        if (dropped.recorded)
+            std::printf("dropped %zu flagged trials (page hidden or focus lost while shown), %zu responses left\n",
+                        dropped.dropped, table.responses.size());
+        else
+            std::printf("dropped 0 flagged trials: %s records no page-hidden or focus flags\n", table.file.c_str());
+    }
     const scaling::Dataset dataset = scaling::buildDataset(table, datasetOptions);
     const scaling::Analysis analysis = scaling::analyzeDataset(dataset, options);
     for (const std::string& warning : analysis.warnings) spdlog::warn("{}", warning);
@@ -176,6 +185,8 @@ void registerAnalyzeScale(CLI::App& analyze) {
     scale->add_option("--conditions", scaleArguments->conditions,
                       "the conditions in display order; any other condition in the file is an error")
         ->delimiter(',');
+    scale->add_flag("--drop-flagged", scaleArguments->dropFlagged,
+                    "leave out trials during which the page was hidden or lost the focus (online studies)");
     scale->callback([scaleArguments] { runScale(*scaleArguments); });
 
     auto validateArguments = std::make_shared<ValidateArguments>();

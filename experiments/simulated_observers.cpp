@@ -1,10 +1,13 @@
 #include "experiments/simulated_observers.h"
 
+#include "experiments/recruitment.h"
+
 #include "common/error.h"
 #include "common/files.h"
 #include "experiments/seeded_random.h"
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include "experiments/http_client.h"
@@ -105,15 +108,31 @@ ObserverResult runObserver(StudyStore& store, const SimulationOptions& options, 
     // the label, so a second run with the same --label-prefix continues these observers instead of failing).
     for (const char* asset : {"/", "/app.js", "/style.css"}) api.fetchOnce(asset, result.transportRetries);
     if (options.browserLike) api.send("GET", "/api/study", json(), result.transportRetries);
-    HttpResult joined = api.send("POST", "/api/join", json{{"label", result.label}, {"join_key", simulatedJoinKey(result.label)}},
-                                 result.transportRetries);
-    if (joined.status != 201) {
+    json join{{"label", result.label}, {"join_key", simulatedJoinKey(result.label)}};
+    const StudyDesign& design = store.definition().design;
+    // An online design: the platform's id parameters, as a recruitment link would carry them (derived from the
+    // label, so a second run returns the same observers).
+    if (const PlatformParameters names = platformParameters(design.recruitment); !names.id.empty()) {
+        const std::string hex = skinlab::sha256Hex("skinlab-simulate-id:" + result.label);
+        std::string upper = hex.substr(0, 20);
+        for (char& c : upper) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+        const std::string id = design.recruitment.platform == "prolific" ? hex.substr(0, 24)
+                               : design.recruitment.platform == "mturk"  ? "SIM" + upper
+                                                                          : "sim" + hex.substr(0, 20);
+        join["recruitment"] = {{names.id, id}};
+    }
+    HttpResult joined = api.send("POST", "/api/join", join, result.transportRetries);
+    if (joined.status != 201 && joined.status != 200) {
         result.failure = "join: " + (joined.status ? joined.body.value("error", std::string("?")) : "no answer");
         return result;
     }
     const std::string token = joined.body["token"].get<std::string>();
     const json screen{{"viewport_width", 1920}, {"viewport_height", 1080}, {"device_pixel_ratio", 1.0}};
     json sessionBody = screen;
+    // The viewing conditions a desktop browser in full screen reports (and a calibrated card, if asked for).
+    sessionBody.update({{"screen_width", 1920}, {"screen_height", 1080}, {"colour_depth", 24}, {"fullscreen", true},
+                        {"pointer_fine", true}, {"touch_points", 0}});
+    if (design.display.calibrate) sessionBody["card_width"] = 323.5;
     sessionBody["token"] = token;
     HttpResult state = api.send("POST", "/api/session", sessionBody, result.transportRetries);
     if (state.status != 200) {

@@ -3,6 +3,7 @@
 #include "common/error.h"
 #include "common/spec.h"
 
+#include <cctype>
 #include <limits>
 
 namespace skinlab::experiments {
@@ -87,6 +88,49 @@ StudyDesign designFromToml(toml::table& root, const std::string& file, const std
             pair.fail("expected", "must be the first or the second stimulus id, got \"" + c.expected + "\"");
         d.catchPairs.push_back(std::move(c));
     }
+
+    SpecReader recruitment = spec.table("recruitment");
+    d.recruitment.platform = recruitment.choice("platform", "none", {"none", "prolific", "mturk", "sona", "generic"});
+    const bool named = d.recruitment.platform == "sona" || d.recruitment.platform == "generic";
+    if (named) {
+        d.recruitment.idParameter = recruitment.requiredString("id_parameter");
+        const std::string& name = d.recruitment.idParameter;
+        bool valid = !name.empty() && name.size() <= 64 && name != "p";
+        for (char c : name)
+            valid = valid && (std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-');
+        if (!valid)
+            recruitment.fail("id_parameter", "\"" + name + "\" is not a URL parameter name (1 to 64 letters, digits, "
+                                             "'_' or '-'; not \"p\", the participant link's own)");
+    } else if (recruitment.has("id_parameter")) {
+        recruitment.fail("id_parameter", "only used with platform = \"sona\" or \"generic\" (platform \"" +
+                                             d.recruitment.platform + "\" has fixed parameters)");
+    }
+    d.recruitment.completionUrl = recruitment.string("completion_url", "");
+    if (!d.recruitment.completionUrl.empty()) {
+        const std::string& url = d.recruitment.completionUrl;
+        bool valid = (url.rfind("https://", 0) == 0 || url.rfind("http://", 0) == 0) && url.size() <= 2000;
+        for (char c : url) valid = valid && static_cast<unsigned char>(c) > 0x20 && c != 0x7f && c != '"' && c != '<' && c != '>';
+        if (!valid)
+            recruitment.fail("completion_url", "\"" + url + "\" is not an http(s) URL without spaces or quotes");
+    }
+    d.recruitment.completionCode = recruitment.string("completion_code", "");
+    for (char c : d.recruitment.completionCode)
+        if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_') || d.recruitment.completionCode.size() > 64)
+            recruitment.fail("completion_code", "\"" + d.recruitment.completionCode +
+                                                    "\": only letters, digits, '-' and '_' (at most 64)");
+
+    SpecReader display = spec.table("display");
+    d.display.calibrate = display.boolean("calibrate", false);
+    if (d.display.calibrate && !display.has("viewing_distance_mm"))
+        display.fail("viewing_distance_mm", "required with calibrate = true (pixels per degree need the distance)");
+    d.display.viewingDistanceMm = display.number("viewing_distance_mm", 0, 100, 5000);
+
+    SpecReader requirements = spec.table("requirements");
+    d.requirements.minScreenWidth = static_cast<int>(requirements.integer("min_screen_width", 0, 0, 100000));
+    d.requirements.minScreenHeight = static_cast<int>(requirements.integer("min_screen_height", 0, 0, 100000));
+    d.requirements.noZoom = requirements.boolean("no_zoom", false);
+    d.requirements.fullscreen = requirements.boolean("fullscreen", false);
+    d.requirements.desktop = requirements.boolean("desktop", false);
     spec.finish();
     return d;
 }
@@ -125,7 +169,19 @@ nlohmann::json StudyDesign::toJson() const {
             {"break_every", breakEvery},
             {"reference", {{"show", showReference}}},
             {"practice", {{"trials", practiceTrials}}},
-            {"catch", {{"blank", blankCatchTrials}, {"pairs", catchJson}}}};
+            {"catch", {{"blank", blankCatchTrials}, {"pairs", catchJson}}},
+            {"recruitment",
+             {{"platform", recruitment.platform},
+              {"id_parameter", recruitment.idParameter},
+              {"completion_url", recruitment.completionUrl},
+              {"completion_code", recruitment.completionCode}}},
+            {"display", {{"calibrate", display.calibrate}, {"viewing_distance_mm", display.viewingDistanceMm}}},
+            {"requirements",
+             {{"min_screen_width", requirements.minScreenWidth},
+              {"min_screen_height", requirements.minScreenHeight},
+              {"no_zoom", requirements.noZoom},
+              {"fullscreen", requirements.fullscreen},
+              {"desktop", requirements.desktop}}}};
 }
 
 StudyDesign StudyDesign::fromJson(const nlohmann::json& j) {
@@ -156,6 +212,24 @@ StudyDesign StudyDesign::fromJson(const nlohmann::json& j) {
     for (const auto& c : j.at("catch").at("pairs"))
         d.catchPairs.push_back({c.at("first").get<std::string>(), c.at("second").get<std::string>(),
                                 c.at("expected").get<std::string>(), c.at("repeat").get<int>()});
+    // Study files created before recruitment, display and requirements existed hold none of them.
+    if (const auto r = j.find("recruitment"); r != j.end()) {
+        d.recruitment.platform = r->at("platform").get<std::string>();
+        d.recruitment.idParameter = r->at("id_parameter").get<std::string>();
+        d.recruitment.completionUrl = r->at("completion_url").get<std::string>();
+        d.recruitment.completionCode = r->at("completion_code").get<std::string>();
+    }
+    if (const auto display = j.find("display"); display != j.end()) {
+        d.display.calibrate = display->at("calibrate").get<bool>();
+        d.display.viewingDistanceMm = display->at("viewing_distance_mm").get<double>();
+    }
+    if (const auto r = j.find("requirements"); r != j.end()) {
+        d.requirements.minScreenWidth = r->at("min_screen_width").get<int>();
+        d.requirements.minScreenHeight = r->at("min_screen_height").get<int>();
+        d.requirements.noZoom = r->at("no_zoom").get<bool>();
+        d.requirements.fullscreen = r->at("fullscreen").get<bool>();
+        d.requirements.desktop = r->at("desktop").get<bool>();
+    }
     return d;
 }
 

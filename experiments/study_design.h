@@ -19,6 +19,31 @@ struct DeclaredCatchPair {
     int repeat = 1; // times per participant
 };
 
+// [recruitment]: where participants come from (docs/experiments.md, "Recruitment"). The platform fixes the URL
+// parameters carrying the external participant id; sona and generic name theirs with id_parameter.
+struct RecruitmentDesign {
+    std::string platform = "none"; // none | prolific | mturk | sona | generic
+    std::string idParameter;       // sona, generic: the URL parameter holding the participant's id
+    std::string completionUrl;     // redirect at the end ("{code}" = the completion code); empty = none
+    std::string completionCode;    // the code shown at the end; empty = each participant's own generated code
+};
+
+// [display]: the credit-card calibration (pixels per mm) and the viewing distance the study asks for.
+struct DisplayDesign {
+    bool calibrate = false;
+    double viewingDistanceMm = 0; // 0 = not stated
+};
+
+// [requirements]: a session that does not meet them is refused before the first trial.
+struct RequirementsDesign {
+    int minScreenWidth = 0;  // CSS pixels (screen.width); 0 = any
+    int minScreenHeight = 0;
+    bool noZoom = false;     // devicePixelRatio a whole number, unchanged during the session
+    bool fullscreen = false; // the page in full screen
+    bool desktop = false;    // a fine pointer (mouse, trackpad) and no mobile browser
+    bool any() const { return minScreenWidth > 0 || minScreenHeight > 0 || noZoom || fullscreen || desktop; }
+};
+
 struct StudyDesign {
     std::string sourceName;    // file name for messages
     std::string title = "Image comparison";
@@ -43,6 +68,9 @@ struct StudyDesign {
     int practiceTrials = 2;
     int blankCatchTrials = 2;  // stimulus vs a blank grey panel; the stimulus is the right answer
     std::vector<DeclaredCatchPair> catchPairs;
+    RecruitmentDesign recruitment;
+    DisplayDesign display;
+    RequirementsDesign requirements;
 
     nlohmann::json toJson() const;
     static StudyDesign fromJson(const nlohmann::json& json);

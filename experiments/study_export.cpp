@@ -27,6 +27,78 @@ std::string formatMs(double ms) {
     return buffer;
 }
 
+std::string formatNumber(double value) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%.6g", value);
+    return buffer;
+}
+
+// The columns after contract 3's (csv) or pwcmp's five: the online viewing conditions and platform ids of each
+// response. An empty field is "not recorded".
+constexpr const char* kOnlineColumns =
+    "flagged,page_hidden,focus_lost,fullscreen,device_pixel_ratio,dpr_changed,viewport_width,viewport_height,"
+    "screen_width,screen_height,screen_width_px,screen_height_px,colour_depth,pixels_per_mm,viewing_distance_mm,"
+    "pixels_per_degree,platform,external_id,external_study_id,external_session_id";
+
+std::string flag(bool value) { return value ? "1" : "0"; }
+
+std::string onlineFields(const ResponseRow& r) {
+    std::string out;
+    auto add = [&](const std::string& field) { out += ',' + field; };
+    if (r.conditions) {
+        add(flag(r.conditions->flagged()));
+        add(flag(r.conditions->pageHidden));
+        add(flag(r.conditions->focusLost));
+        add(flag(r.conditions->fullscreen));
+    } else {
+        for (int k = 0; k < 4; ++k) add("");
+    }
+    add(formatNumber(r.devicePixelRatio));
+    add(flag(r.devicePixelRatio != r.sessionDevicePixelRatio));
+    add(std::to_string(r.viewportWidth));
+    add(std::to_string(r.viewportHeight));
+    if (r.viewing) {
+        const ViewingConditions& v = *r.viewing;
+        add(std::to_string(v.screenWidth));
+        add(std::to_string(v.screenHeight));
+        add(std::to_string(v.screenWidthPx));
+        add(std::to_string(v.screenHeightPx));
+        add(std::to_string(v.colourDepth));
+        add(v.pixelsPerMm ? formatNumber(*v.pixelsPerMm) : "");
+        add(v.viewingDistanceMm ? formatNumber(*v.viewingDistanceMm) : "");
+        add(v.pixelsPerDegree ? formatNumber(*v.pixelsPerDegree) : "");
+    } else {
+        for (int k = 0; k < 8; ++k) add("");
+    }
+    if (r.external) {
+        add(csvField(r.external->platform));
+        add(csvField(r.external->id));
+        add(csvField(r.external->study));
+        add(csvField(r.external->session));
+    } else {
+        for (int k = 0; k < 4; ++k) add("");
+    }
+    return out;
+}
+
+nlohmann::json optionalNumber(const std::optional<double>& value) { return value ? nlohmann::json(*value) : nlohmann::json(); }
+
+nlohmann::json viewingJson(const std::optional<ViewingConditions>& viewing) {
+    if (!viewing) return nullptr;
+    const ViewingConditions& v = *viewing;
+    return {{"screen_width", v.screenWidth}, {"screen_height", v.screenHeight}, {"screen_width_px", v.screenWidthPx},
+            {"screen_height_px", v.screenHeightPx}, {"colour_depth", v.colourDepth}, {"fullscreen", v.fullscreen},
+            {"pointer_fine", v.pointerFine}, {"touch_points", v.touchPoints}, {"mobile", v.mobile},
+            {"pixels_per_mm", optionalNumber(v.pixelsPerMm)}, {"viewing_distance_mm", optionalNumber(v.viewingDistanceMm)},
+            {"pixels_per_degree", optionalNumber(v.pixelsPerDegree)}};
+}
+
+nlohmann::json externalJson(const std::optional<ExternalIds>& external) {
+    if (!external) return nullptr;
+    return {{"platform", external->platform}, {"external_id", external->id},
+            {"external_study_id", external->study}, {"external_session_id", external->session}};
+}
+
 } // namespace
 
 std::string exportResponses(StudyStore& store, const std::string& format) {
@@ -48,10 +120,17 @@ std::string exportResponses(StudyStore& store, const std::string& format) {
             out["participants"].push_back({{"observer", p.participant.label}, {"seed", p.participant.seed},
                                            {"participant_index", p.participant.index},
                                            {"created_at", p.participant.createdAt},
-                                           {"answered", p.progress.answered}, {"total", p.progress.total}});
+                                           {"answered", p.progress.answered}, {"total", p.progress.total},
+                                           {"recruitment", externalJson(p.external)}});
+        out["sessions"] = nlohmann::json::array();
+        for (const SessionViewing& v : store.viewingConditions())
+            out["sessions"].push_back({{"observer", v.observer}, {"session_id", v.sessionId}, {"started_at", v.startedAt},
+                                       {"user_agent", v.userAgent}, {"viewport_width", v.viewportWidth},
+                                       {"viewport_height", v.viewportHeight}, {"device_pixel_ratio", v.devicePixelRatio},
+                                       {"viewing", viewingJson(v.viewing)}});
         out["responses"] = nlohmann::json::array();
-        for (const ResponseRow& r : rows)
-            out["responses"].push_back({{"observer", r.observer}, {"scene", r.scene}, {"condition_A", r.conditionA},
+        for (const ResponseRow& r : rows) {
+            nlohmann::json row = {{"observer", r.observer}, {"scene", r.scene}, {"condition_A", r.conditionA},
                                         {"condition_B", r.conditionB}, {"is_A_selected", r.aSelected ? 1 : 0},
                                         {"A_on_left", r.aOnLeft ? 1 : 0}, {"trial_kind", trialKindName(r.kind)},
                                         {"correct", r.correct ? nlohmann::json(*r.correct ? 1 : 0) : nlohmann::json()},
@@ -60,14 +139,25 @@ std::string exportResponses(StudyStore& store, const std::string& format) {
                                         {"session_id", r.sessionId}, {"client_time", r.clientTime},
                                         {"server_time", r.serverTime}, {"viewport_width", r.viewportWidth},
                                         {"viewport_height", r.viewportHeight},
-                                        {"device_pixel_ratio", r.devicePixelRatio}, {"user_agent", r.userAgent}});
+                                        {"device_pixel_ratio", r.devicePixelRatio}, {"user_agent", r.userAgent}};
+            row["flagged"] = r.conditions ? nlohmann::json(r.flagged() ? 1 : 0) : nlohmann::json();
+            row["page_hidden"] = r.conditions ? nlohmann::json(r.conditions->pageHidden) : nlohmann::json();
+            row["focus_lost"] = r.conditions ? nlohmann::json(r.conditions->focusLost) : nlohmann::json();
+            row["fullscreen"] = r.conditions ? nlohmann::json(r.conditions->fullscreen) : nlohmann::json();
+            row["dpr_changed"] = r.devicePixelRatio != r.sessionDevicePixelRatio;
+            row["viewing"] = viewingJson(r.viewing);
+            row["recruitment"] = externalJson(r.external);
+            out["responses"].push_back(std::move(row));
+        }
         // Stored text is well-formed UTF-8 (validUtf8), but a study file written by an older version may hold raw
         // header bytes: those are replaced (U+FFFD) rather than failing the whole export.
         return out.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
     }
     const bool pwcmp = format == "pwcmp";
-    std::string out = pwcmp ? "observer,scene,condition_A,condition_B,is_A_selected\n"
-                            : "observer,scene,condition_A,condition_B,is_A_selected,A_on_left,trial_kind,correct,response_ms\n";
+    std::string out = std::string(pwcmp ? "observer,scene,condition_A,condition_B,is_A_selected"
+                                        : "observer,scene,condition_A,condition_B,is_A_selected,A_on_left,trial_kind,"
+                                          "correct,response_ms") +
+                      "," + kOnlineColumns + "\n";
     for (const ResponseRow& r : rows) {
         if (pwcmp && r.kind != TrialKind::test && r.kind != TrialKind::repeat) continue;
         out += csvField(r.observer) + ',' + csvField(r.scene) + ',' + csvField(r.conditionA) + ',' + csvField(r.conditionB) +
@@ -76,7 +166,7 @@ std::string exportResponses(StudyStore& store, const std::string& format) {
             out += std::string(",") + (r.aOnLeft ? "1" : "0") + ',' + trialKindName(r.kind) + ',' +
                    (r.correct ? (*r.correct ? "1" : "0") : "") + ',' + formatMs(r.responseMs);
         }
-        out += '\n';
+        out += onlineFields(r) + '\n';
     }
     return out;
 }

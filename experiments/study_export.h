@@ -1,9 +1,15 @@
 #pragma once
 // Exports of a study's responses and its status report.
 //  csv:   contract 3, one row per response: observer,scene,condition_A,condition_B,is_A_selected,A_on_left,
-//         trial_kind,correct,response_ms (correct is 1/0 for catch trials, empty otherwise)
-//  pwcmp: the first five columns, test and repeat trials only (Perez-Ortiz & Mantiuk's pwcmp long format)
-//  json:  every stored field of every response, with the study's metadata
+//         trial_kind,correct,response_ms (correct is 1/0 for catch trials, empty otherwise), then the online
+//         columns: flagged,page_hidden,focus_lost,fullscreen,device_pixel_ratio,dpr_changed,viewport_width,
+//         viewport_height,screen_width,screen_height,screen_width_px,screen_height_px,colour_depth,pixels_per_mm,
+//         viewing_distance_mm,pixels_per_degree,platform,external_id,external_study_id,external_session_id
+//         (empty = not recorded)
+//  pwcmp: the first five columns, test and repeat trials only (Perez-Ortiz & Mantiuk's pwcmp long format), then
+//         the same online columns
+//  json:  every stored field of every response, with the study's metadata, the participants' platform ids and
+//         every session's viewing conditions
 #include "experiments/study_store.h"
 
 #include <nlohmann/json.hpp>

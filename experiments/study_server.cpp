@@ -3,9 +3,11 @@
 #include "common/error.h"
 #include "common/files.h"
 #include "common/hash.h"
+#include "experiments/recruitment.h"
 #include "experiments/request_error.h"
 #include "experiments/study_dashboard.h"
 #include "experiments/study_export.h"
+#include "experiments/viewing_conditions.h"
 
 #include <boost/asio/ip/address.hpp>
 #include <algorithm>
@@ -89,6 +91,35 @@ double numberField(const json& body, const char* name, double min, double max) {
     if (!(value >= min && value <= max))
         throw RequestError(400, std::string(name) + ": out of range [" + std::to_string(min) + ", " + std::to_string(max) + "]");
     return value;
+}
+
+bool booleanField(const json& body, const char* name) {
+    if (!body.contains(name)) throw RequestError(400, std::string(name) + ": missing");
+    if (!body[name].is_boolean()) throw RequestError(400, std::string(name) + ": expected true or false");
+    return body[name].get<bool>();
+}
+
+// The optional per-trial conditions of a response: all three fields or none.
+std::optional<TrialConditions> trialConditionsField(const json& body) {
+    if (!body.contains("page_hidden") && !body.contains("focus_lost") && !body.contains("fullscreen")) return std::nullopt;
+    return TrialConditions{booleanField(body, "page_hidden"), booleanField(body, "focus_lost"),
+                           booleanField(body, "fullscreen")};
+}
+
+// The recruitment parameters the page forwarded from its URL: {"NAME": "value", ...} (strings only).
+std::map<std::string, std::string> recruitmentField(const json& body) {
+    std::map<std::string, std::string> out;
+    if (!body.contains("recruitment")) return out;
+    const json& r = body["recruitment"];
+    if (!r.is_object() || r.size() > 8) throw RequestError(400, "recruitment: expected an object of at most 8 parameters");
+    for (const auto& [name, value] : r.items()) {
+        if (name.size() > 64) throw RequestError(400, "recruitment: parameter name longer than 64 characters");
+        if (!value.is_string()) throw RequestError(400, validUtf8(name, 64) + ": expected a string");
+        const std::string text = value.get<std::string>();
+        if (text.size() > 256) throw RequestError(400, validUtf8(name, 64) + ": longer than 256 characters");
+        out[name] = text;
+    }
+    return out;
 }
 
 std::string userAgentOf(const HttpRequest& req) { return validUtf8(req.header("User-Agent"), kMaxTextLength); }
@@ -384,14 +415,36 @@ HttpResponse StudyServer::route(const HttpRequest& req) {
                    {"practice_total", practiceTotal},
                    {"trial", next ? trialJson(*next, p.token) : json()},
                    {"completed", !next.has_value()}};
-        if (!next) state["completion_code"] = p.completionCode;
+        if (!next) {
+            const RecruitmentDesign& recruitment = store_.definition().design.recruitment;
+            const std::string code = recruitment.completionCode.empty() ? p.completionCode : recruitment.completionCode;
+            state["completion_code"] = code;
+            const std::string url = completionUrl(recruitment, code);
+            if (!url.empty()) state["completion_url"] = url;
+        }
         return state;
     };
 
     if (get && path == "/api/study") {
         const StudyDesign& d = definition.design;
+        const PlatformParameters names = platformParameters(d.recruitment);
+        json parameters = json::array();
+        for (const std::string& name : {names.id, names.study, names.session})
+            if (!name.empty()) parameters.push_back(name);
         return jsonResponse(200, {{"title", d.title}, {"question", d.question}, {"instructions", d.instructions},
-                                  {"consent", d.consent}, {"break_every", d.breakEvery}});
+                                  {"consent", d.consent}, {"break_every", d.breakEvery},
+                                  {"recruitment", {{"platform", d.recruitment.platform},
+                                                   {"id_parameter", names.id},
+                                                   {"parameters", parameters}}},
+                                  {"display", {{"calibrate", d.display.calibrate},
+                                               {"viewing_distance_mm", d.display.viewingDistanceMm},
+                                               {"card_width_mm", kIdCardWidthMm},
+                                               {"card_height_mm", kIdCardHeightMm}}},
+                                  {"requirements", {{"min_screen_width", d.requirements.minScreenWidth},
+                                                    {"min_screen_height", d.requirements.minScreenHeight},
+                                                    {"no_zoom", d.requirements.noZoom},
+                                                    {"fullscreen", d.requirements.fullscreen},
+                                                    {"desktop", d.requirements.desktop}}}});
     }
 
     if (post && path == "/api/join") {
@@ -404,16 +457,27 @@ HttpResponse StudyServer::route(const HttpRequest& req) {
         for (char c : joinKey)
             if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_'))
                 throw RequestError(400, "join_key: only letters, digits, '-' and '_' are allowed");
+        // A platform's participant: validated ids (400 naming the parameter), and the same id resumes.
+        const std::optional<ExternalIds> external =
+            validateExternalIds(definition.design.recruitment, recruitmentField(body));
+        if (external) {
+            if (const std::optional<ParticipantRecord> known = store_.participantByExternalId(*external)) {
+                spdlog::info("participant {} returned", known->label);
+                return jsonResponse(200, {{"token", known->token}, {"observer", known->label}, {"resumed", true}});
+            }
+        }
         double retryAfter = 0;
         if (!allowJoin(req.clientAddress, retryAfter)) {
             HttpResponse res = errorResponse(429, "too many new participants from this address; retry later");
             res.headers.emplace_back("Retry-After", std::to_string(static_cast<int>(std::ceil(retryAfter))));
             return res;
         }
-        const ParticipantRecord p = store_.join(label, joinKey);
+        const ParticipantRecord p = store_.join(label, joinKey, external);
         store_.recordJoinAddress(p.id, req.clientAddress, req.forwardedBy.empty() ? "peer" : "forwarded");
-        spdlog::info("participant {} joined", p.label);
-        return jsonResponse(201, {{"token", p.token}, {"observer", p.label}});
+        spdlog::info("participant {} {}", p.label, p.resumed ? "returned" : "joined");
+        // A repeated join key answers as its first join did (201); a known platform id answers 200.
+        return jsonResponse(p.resumed && external ? 200 : 201,
+                            {{"token", p.token}, {"observer", p.label}, {"resumed", p.resumed}});
     }
 
     if (post && path == "/api/session") {
@@ -422,7 +486,45 @@ HttpResponse StudyServer::route(const HttpRequest& req) {
         const int width = static_cast<int>(integerField(body, "viewport_width", 0, 100000));
         const int height = static_cast<int>(integerField(body, "viewport_height", 0, 100000));
         const double dpr = numberField(body, "device_pixel_ratio", 0.1, 16);
-        const std::int64_t session = store_.startSession(p.id, userAgentOf(req), width, height, dpr);
+        const StudyDesign& design = definition.design;
+        // Viewing conditions: reported by the page as a group (an older client sends none of them).
+        std::optional<ViewingConditions> viewing;
+        if (body.contains("screen_width")) {
+            ViewingConditions v;
+            v.screenWidth = static_cast<int>(integerField(body, "screen_width", 0, 100000));
+            v.screenHeight = static_cast<int>(integerField(body, "screen_height", 0, 100000));
+            v.screenWidthPx = static_cast<int>(std::lround(v.screenWidth * dpr));
+            v.screenHeightPx = static_cast<int>(std::lround(v.screenHeight * dpr));
+            v.devicePixelRatio = dpr;
+            v.colourDepth = static_cast<int>(integerField(body, "colour_depth", 0, 64));
+            v.viewportWidth = width;
+            v.viewportHeight = height;
+            v.fullscreen = booleanField(body, "fullscreen");
+            v.pointerFine = booleanField(body, "pointer_fine");
+            v.touchPoints = static_cast<int>(integerField(body, "touch_points", 0, 1000));
+            v.mobile = mobileUserAgent(req.header("User-Agent"));
+            if (body.contains("card_width")) {
+                v.pixelsPerMm = pixelsPerMmFromCard(numberField(body, "card_width", 20, 20000), dpr);
+                if (design.display.viewingDistanceMm > 0) {
+                    v.viewingDistanceMm = design.display.viewingDistanceMm;
+                    v.pixelsPerDegree = pixelsPerDegree(*v.pixelsPerMm, *v.viewingDistanceMm);
+                }
+            }
+            viewing = v;
+        }
+        if (design.display.calibrate && !(viewing && viewing->pixelsPerMm))
+            throw RequestError(400, "card_width: missing (the study asks for the card calibration first)");
+        if (design.requirements.any()) {
+            // Refused before the first trial; nothing is stored, so the participant can fix it and try again.
+            if (!viewing) throw RequestError(403, "requirements: the page did not report the screen; reload it");
+            const std::vector<std::string> unmet = unmetRequirements(design.requirements, *viewing);
+            if (!unmet.empty()) {
+                std::string message;
+                for (const std::string& sentence : unmet) message += (message.empty() ? "" : " ") + sentence;
+                return jsonResponse(403, {{"error", message}, {"unmet", unmet}});
+            }
+        }
+        const std::int64_t session = store_.startSession(p.id, userAgentOf(req), width, height, dpr, viewing);
         json state = stateJson(p);
         state["session"] = session;
         return jsonResponse(200, state);
@@ -447,6 +549,7 @@ HttpResponse StudyServer::route(const HttpRequest& req) {
         in.viewportWidth = static_cast<int>(integerField(body, "viewport_width", 0, 100000));
         in.viewportHeight = static_cast<int>(integerField(body, "viewport_height", 0, 100000));
         in.devicePixelRatio = numberField(body, "device_pixel_ratio", 0.1, 16);
+        in.conditions = trialConditionsField(body);
         in.userAgent = userAgentOf(req);
         const ResponseOutcome outcome = store_.recordResponse(in);
         // Reached only after COMMIT: the acknowledgement below promises durability.

@@ -82,15 +82,71 @@ CREATE TABLE responses (
   device_pixel_ratio REAL NOT NULL,
   user_agent TEXT NOT NULL);
 CREATE INDEX responses_by_participant ON responses(participant_id);
+)SQL";
+
+// Added to format version 1 later (online studies): created when missing, so a study file written before them opens
+// unchanged and gains them. trial_conditions.trial_id is a response's trial; viewing_conditions holds what the
+// page reported when a session started (no row: a client that reported nothing beyond the viewport).
+constexpr const char* kOnlineSchema = R"SQL(
+CREATE TABLE IF NOT EXISTS recruitment (
+  participant_id INTEGER PRIMARY KEY REFERENCES participants(id),
+  platform TEXT NOT NULL,            -- prolific | mturk | sona | generic
+  external_id TEXT NOT NULL,         -- PROLIFIC_PID, workerId, or the design's id_parameter
+  external_study_id TEXT NOT NULL,   -- STUDY_ID, hitId ('' when not sent)
+  external_session_id TEXT NOT NULL, -- SESSION_ID, assignmentId ('' when not sent)
+  UNIQUE (platform, external_id));
+CREATE TABLE IF NOT EXISTS viewing_conditions (
+  session_id INTEGER PRIMARY KEY REFERENCES sessions(id),
+  screen_width INTEGER NOT NULL,     -- CSS pixels
+  screen_height INTEGER NOT NULL,
+  screen_width_px INTEGER NOT NULL,  -- device pixels
+  screen_height_px INTEGER NOT NULL,
+  colour_depth INTEGER NOT NULL,
+  fullscreen INTEGER NOT NULL,
+  pointer_fine INTEGER NOT NULL,
+  touch_points INTEGER NOT NULL,
+  mobile INTEGER NOT NULL,
+  pixels_per_mm REAL,                -- device pixels per mm (card calibration); NULL = not calibrated
+  viewing_distance_mm REAL,
+  pixels_per_degree REAL);
+CREATE TABLE IF NOT EXISTS trial_conditions (
+  trial_id INTEGER PRIMARY KEY REFERENCES responses(trial_id),
+  page_hidden INTEGER NOT NULL,      -- the page was hidden (other tab, minimised) while the trial was shown
+  focus_lost INTEGER NOT NULL,       -- the window lost the focus while the trial was shown
+  fullscreen INTEGER NOT NULL);      -- full screen when answered
+)SQL";
+
+// Contract 3 (read by analysis/scaling), and `flagged` (1 = page hidden or focus lost while shown; NULL = not
+// recorded) after it.
+constexpr const char* kResponsesView = R"SQL(
+DROP VIEW IF EXISTS responses_long;
 CREATE VIEW responses_long AS
   SELECT p.label AS observer, t.block AS scene, t.condition_a AS condition_A, t.condition_b AS condition_B,
          CASE r.chosen WHEN 'A' THEN 1 ELSE 0 END AS is_A_selected, t.a_on_left AS A_on_left,
          t.kind AS trial_kind,
          CASE WHEN t.kind = 'catch' THEN (CASE WHEN r.chosen = t.expected THEN 1 ELSE 0 END) ELSE NULL END AS correct,
-         r.response_ms AS response_ms
+         r.response_ms AS response_ms,
+         CASE WHEN c.trial_id IS NULL THEN NULL WHEN c.page_hidden OR c.focus_lost THEN 1 ELSE 0 END AS flagged
   FROM responses r JOIN trials t ON t.id = r.trial_id JOIN participants p ON p.id = t.participant_id
+  LEFT JOIN trial_conditions c ON c.trial_id = r.trial_id
   ORDER BY p.id, t.position;
 )SQL";
+
+// Brings a study file's schema up to date (idempotent; writes only when something is missing).
+void upgradeSchema(SqliteDatabase& db) {
+    bool current = false;
+    {
+        SqliteStatement s = db.prepare("SELECT (SELECT COUNT(*) FROM sqlite_master WHERE name = 'trial_conditions'),"
+                                       " (SELECT COUNT(*) FROM pragma_table_info('responses_long') WHERE name = 'flagged')");
+        s.step();
+        current = s.integer(0) == 1 && s.integer(1) == 1;
+    }
+    if (current) return;
+    SqliteTransaction tx(db);
+    db.execute(kOnlineSchema);
+    db.execute(kResponsesView);
+    tx.commit();
+}
 
 void configureConnection(SqliteDatabase& db) {
     // WAL: readers (status, export) never block the writer; synchronous=FULL: COMMIT fsyncs the WAL, so a
@@ -256,6 +312,8 @@ void StudyStore::create(const fs::path& path, const StudyDefinition& definition,
         db.execute("PRAGMA foreign_keys=ON");
         SqliteTransaction tx(db);
         db.execute(kSchema);
+        db.execute(kOnlineSchema);
+        db.execute(kResponsesView);
         SqliteStatement meta = db.prepare("INSERT INTO meta (key, value) VALUES (?, ?)");
         auto putMeta = [&](const std::string& key, const std::string& value) {
             meta.bind(1, key).bind(2, value);
@@ -304,6 +362,7 @@ StudyStore::StudyStore(const fs::path& path) : path_(path) {
     if (meta("format") != kFormat) throw InputError(path.string() + ": not a skinlab study file");
     if (meta("format_version") != std::to_string(kFormatVersion))
         throw InputError(path.string() + ": study file version " + meta("format_version") + " is not supported");
+    upgradeSchema(*db_);
     definition_ = StudyDefinition::fromJson(nlohmann::json::parse(meta("definition")));
     // Added after format version 1 first shipped: created on open, so older study files gain it too.
     db_->execute("CREATE TABLE IF NOT EXISTS participant_addresses ("
@@ -333,9 +392,22 @@ std::string StudyStore::meta(const std::string& key) const {
     return s.text(0);
 }
 
-ParticipantRecord StudyStore::join(const std::string& requestedLabel, const std::string& joinKey) {
+ParticipantRecord StudyStore::join(const std::string& requestedLabel, const std::string& joinKey,
+                                   const std::optional<ExternalIds>& external) {
     std::lock_guard lock(mutex_);
     SqliteTransaction tx(*db_);
+    if (external) {
+        // One platform id, one participant: a second visit (another link, another browser) resumes the first.
+        SqliteStatement s = db_->prepare(std::string("SELECT ") + kParticipantColumns +
+                                         " FROM participants WHERE id = (SELECT participant_id FROM recruitment"
+                                         " WHERE platform = ? AND external_id = ?)");
+        s.bind(1, external->platform).bind(2, external->id);
+        if (s.step()) {
+            ParticipantRecord existing = readParticipant(s);
+            existing.resumed = true;
+            return existing;
+        }
+    }
     if (!joinKey.empty()) {
         SqliteStatement s = db_->prepare(std::string("SELECT ") + kParticipantColumns + " FROM participants WHERE join_key = ?");
         s.bind(1, joinKey);
@@ -343,6 +415,7 @@ ParticipantRecord StudyStore::join(const std::string& requestedLabel, const std:
             ParticipantRecord existing = readParticipant(s);
             if (!requestedLabel.empty() && existing.label != requestedLabel)
                 throw RequestError(409, "join_key: already used by another participant");
+            existing.resumed = true;
             return existing;
         }
     }
@@ -388,9 +461,28 @@ ParticipantRecord StudyStore::join(const std::string& requestedLabel, const std:
     insert.bind(5, static_cast<std::int64_t>(p.seed)).bind(6, p.completionCode).bind(7, p.createdAt);
     insert.run();
     p.id = db_->lastInsertId();
+    if (external) {
+        SqliteStatement ids = db_->prepare("INSERT INTO recruitment (participant_id, platform, external_id,"
+                                           " external_study_id, external_session_id) VALUES (?,?,?,?,?)");
+        ids.bind(1, p.id).bind(2, external->platform).bind(3, external->id).bind(4, external->study);
+        ids.bind(5, external->session);
+        ids.run();
+    }
     if (definition_.design.activePairs) insertTrials(*db_, p.id, activeTrials(p.index, p.seed, {}));
     else insertTrials(*db_, p.id, planTrials(definition_, p.index, p.seed));
     tx.commit();
+    return p;
+}
+
+std::optional<ParticipantRecord> StudyStore::participantByExternalId(const ExternalIds& external) {
+    std::lock_guard lock(mutex_);
+    SqliteStatement s = db_->prepare(std::string("SELECT ") + kParticipantColumns +
+                                     " FROM participants WHERE id = (SELECT participant_id FROM recruitment"
+                                     " WHERE platform = ? AND external_id = ?)");
+    s.bind(1, external.platform).bind(2, external.id);
+    if (!s.step()) return std::nullopt;
+    ParticipantRecord p = readParticipant(s);
+    p.resumed = true;
     return p;
 }
 
@@ -403,8 +495,10 @@ ParticipantRecord StudyStore::participant(const std::string& token) {
 }
 
 std::int64_t StudyStore::startSession(std::int64_t participantId, const std::string& userAgent, int viewportWidth,
-                                      int viewportHeight, double devicePixelRatio) {
+                                      int viewportHeight, double devicePixelRatio,
+                                      const std::optional<ViewingConditions>& viewing) {
     std::lock_guard lock(mutex_);
+    SqliteTransaction tx(*db_);
     SqliteStatement s = db_->prepare(
         "INSERT INTO sessions (participant_id, started_at, user_agent, viewport_width, viewport_height, device_pixel_ratio)"
         " VALUES (?,?,?,?,?,?)");
@@ -412,7 +506,23 @@ std::int64_t StudyStore::startSession(std::int64_t participantId, const std::str
     s.bind(5, viewportHeight);
     s.bind(6, devicePixelRatio);
     s.run();
-    return db_->lastInsertId();
+    const std::int64_t session = db_->lastInsertId();
+    if (viewing) {
+        const ViewingConditions& v = *viewing;
+        SqliteStatement c = db_->prepare(
+            "INSERT INTO viewing_conditions (session_id, screen_width, screen_height, screen_width_px, screen_height_px,"
+            " colour_depth, fullscreen, pointer_fine, touch_points, mobile, pixels_per_mm, viewing_distance_mm,"
+            " pixels_per_degree) VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?)");
+        c.bind(1, session).bind(2, v.screenWidth).bind(3, v.screenHeight).bind(4, v.screenWidthPx);
+        c.bind(5, v.screenHeightPx).bind(6, v.colourDepth).bind(7, v.fullscreen ? 1 : 0).bind(8, v.pointerFine ? 1 : 0);
+        c.bind(9, v.touchPoints).bind(10, v.mobile ? 1 : 0);
+        if (v.pixelsPerMm) c.bind(11, *v.pixelsPerMm); else c.bindNull(11);
+        if (v.viewingDistanceMm) c.bind(12, *v.viewingDistanceMm); else c.bindNull(12);
+        if (v.pixelsPerDegree) c.bind(13, *v.pixelsPerDegree); else c.bindNull(13);
+        c.run();
+    }
+    tx.commit();
+    return session;
 }
 
 std::optional<TrialRecord> StudyStore::nextTrial(std::int64_t participantId) {
@@ -566,6 +676,13 @@ ResponseOutcome StudyStore::storeOne(const ResponseInput& in) {
     insert.bind(6, in.responseMs).bind(7, validUtf8(in.clientTime, kMaxStoredText)).bind(8, utcTimestamp()).bind(9, in.viewportWidth);
     insert.bind(10, in.viewportHeight).bind(11, in.devicePixelRatio).bind(12, validUtf8(in.userAgent, kMaxStoredText));
     insert.run();
+    if (in.conditions) {
+        SqliteStatement c = db_->prepare(
+            "INSERT INTO trial_conditions (trial_id, page_hidden, focus_lost, fullscreen) VALUES (?,?,?,?)");
+        c.bind(1, trial.id).bind(2, in.conditions->pageHidden ? 1 : 0).bind(3, in.conditions->focusLost ? 1 : 0);
+        c.bind(4, in.conditions->fullscreen ? 1 : 0);
+        c.run();
+    }
     return ResponseOutcome::stored;
 }
 
@@ -628,7 +745,8 @@ std::vector<ParticipantStatus> StudyStore::status() {
         ", (SELECT COUNT(*) FROM responses r JOIN trials t ON t.id = r.trial_id WHERE r.participant_id = p.id AND t.kind = 'catch')"
         ", (SELECT COUNT(*) FROM responses r JOIN trials t ON t.id = r.trial_id WHERE r.participant_id = p.id AND t.kind = 'catch' AND r.chosen = t.expected)"
         ", (SELECT COALESCE(MAX(server_time), '') FROM responses r WHERE r.participant_id = p.id)"
-        " FROM participants p ORDER BY p.id");
+        ", rec.platform, rec.external_id, rec.external_study_id, rec.external_session_id"
+        " FROM participants p LEFT JOIN recruitment rec ON rec.participant_id = p.id ORDER BY p.id");
     while (s.step()) {
         ParticipantStatus st;
         st.participant = readParticipant(s);
@@ -638,19 +756,55 @@ std::vector<ParticipantStatus> StudyStore::status() {
         st.catchAnswered = static_cast<int>(s.integer(10));
         st.catchCorrect = static_cast<int>(s.integer(11));
         st.lastResponseAt = s.text(12);
+        if (!s.isNull(13)) st.external = ExternalIds{s.text(13), s.text(14), s.text(15), s.text(16)};
         out.push_back(std::move(st));
     }
     return out;
 }
 
+namespace {
+
+constexpr const char* kViewingColumns =
+    "v.screen_width, v.screen_height, v.screen_width_px, v.screen_height_px, v.colour_depth, v.fullscreen,"
+    " v.pointer_fine, v.touch_points, v.mobile, v.pixels_per_mm, v.viewing_distance_mm, v.pixels_per_degree";
+
+// The kViewingColumns starting at `first` (NULL session_id of the LEFT JOIN: not reported).
+std::optional<ViewingConditions> readViewing(const SqliteStatement& s, int first, double devicePixelRatio,
+                                             int viewportWidth, int viewportHeight) {
+    if (s.isNull(first)) return std::nullopt;
+    ViewingConditions v;
+    v.screenWidth = static_cast<int>(s.integer(first));
+    v.screenHeight = static_cast<int>(s.integer(first + 1));
+    v.screenWidthPx = static_cast<int>(s.integer(first + 2));
+    v.screenHeightPx = static_cast<int>(s.integer(first + 3));
+    v.colourDepth = static_cast<int>(s.integer(first + 4));
+    v.fullscreen = s.integer(first + 5) != 0;
+    v.pointerFine = s.integer(first + 6) != 0;
+    v.touchPoints = static_cast<int>(s.integer(first + 7));
+    v.mobile = s.integer(first + 8) != 0;
+    if (!s.isNull(first + 9)) v.pixelsPerMm = s.real(first + 9);
+    if (!s.isNull(first + 10)) v.viewingDistanceMm = s.real(first + 10);
+    if (!s.isNull(first + 11)) v.pixelsPerDegree = s.real(first + 11);
+    v.devicePixelRatio = devicePixelRatio;
+    v.viewportWidth = viewportWidth;
+    v.viewportHeight = viewportHeight;
+    return v;
+}
+
+} // namespace
+
 std::vector<ResponseRow> StudyStore::responses() {
     std::lock_guard lock(mutex_);
     SqliteStatement s = db_->prepare(
-        "SELECT p.label, p.id, t.id, t.position, t.kind, t.block, t.condition_a, t.condition_b, sa.stimulus,"
+        std::string("SELECT p.label, p.id, t.id, t.position, t.kind, t.block, t.condition_a, t.condition_b, sa.stimulus,"
         " COALESCE(sb.stimulus, 'blank'), t.a_on_left, r.chosen, t.expected, r.response_ms, r.client_time,"
-        " r.server_time, r.viewport_width, r.viewport_height, r.device_pixel_ratio, r.user_agent, r.session_id"
+        " r.server_time, r.viewport_width, r.viewport_height, r.device_pixel_ratio, r.user_agent, r.session_id,"
+        " c.page_hidden, c.focus_lost, c.fullscreen, ses.device_pixel_ratio, ses.viewport_width, ses.viewport_height,"
+        " rec.platform, rec.external_id, rec.external_study_id, rec.external_session_id, ") + kViewingColumns +
         " FROM responses r JOIN trials t ON t.id = r.trial_id JOIN participants p ON p.id = t.participant_id"
         " JOIN stimuli sa ON sa.id = t.stimulus_a LEFT JOIN stimuli sb ON sb.id = t.stimulus_b"
+        " JOIN sessions ses ON ses.id = r.session_id LEFT JOIN trial_conditions c ON c.trial_id = r.trial_id"
+        " LEFT JOIN recruitment rec ON rec.participant_id = p.id LEFT JOIN viewing_conditions v ON v.session_id = r.session_id"
         " ORDER BY p.id, t.position");
     std::vector<ResponseRow> out;
     while (s.step()) {
@@ -676,7 +830,42 @@ std::vector<ResponseRow> StudyStore::responses() {
         r.devicePixelRatio = s.real(18);
         r.userAgent = s.text(19);
         r.sessionId = s.integer(20);
+        if (!s.isNull(21)) r.conditions = TrialConditions{s.integer(21) != 0, s.integer(22) != 0, s.integer(23) != 0};
+        r.sessionDevicePixelRatio = s.real(24);
+        r.viewing = readViewing(s, 31, r.sessionDevicePixelRatio, static_cast<int>(s.integer(25)),
+                                static_cast<int>(s.integer(26)));
+        if (!s.isNull(27)) r.external = ExternalIds{s.text(27), s.text(28), s.text(29), s.text(30)};
         out.push_back(std::move(r));
+    }
+    return out;
+}
+
+std::vector<ResponseRow> StudyStore::flaggedTrials() {
+    std::vector<ResponseRow> rows = responses();
+    std::erase_if(rows, [](const ResponseRow& r) { return !r.flagged(); });
+    return rows;
+}
+
+std::vector<SessionViewing> StudyStore::viewingConditions() {
+    std::lock_guard lock(mutex_);
+    SqliteStatement s = db_->prepare(
+        std::string("SELECT p.label, p.id, ses.id, ses.started_at, ses.user_agent, ses.viewport_width,"
+                    " ses.viewport_height, ses.device_pixel_ratio, ") + kViewingColumns +
+        " FROM sessions ses JOIN participants p ON p.id = ses.participant_id"
+        " LEFT JOIN viewing_conditions v ON v.session_id = ses.id ORDER BY ses.id");
+    std::vector<SessionViewing> out;
+    while (s.step()) {
+        SessionViewing v;
+        v.observer = s.text(0);
+        v.participantId = s.integer(1);
+        v.sessionId = s.integer(2);
+        v.startedAt = s.text(3);
+        v.userAgent = s.text(4);
+        v.viewportWidth = static_cast<int>(s.integer(5));
+        v.viewportHeight = static_cast<int>(s.integer(6));
+        v.devicePixelRatio = s.real(7);
+        v.viewing = readViewing(s, 8, v.devicePixelRatio, v.viewportWidth, v.viewportHeight);
+        out.push_back(std::move(v));
     }
     return out;
 }

@@ -6,8 +6,10 @@
 // together share one: group commit), and recordResponse() returns only after COMMIT, which with WAL + synchronous=FULL means the WAL frame is fsynced. The server
 // acknowledges after that, so an acknowledged response survives kill -9 and power loss. A response is keyed by
 // its trial (PRIMARY KEY), so a re-sent response can never be stored twice.
+#include "experiments/recruitment.h"
 #include "experiments/study_definition.h"
 #include "experiments/trial_plan.h"
+#include "experiments/viewing_conditions.h"
 
 #include <cstdint>
 #include <filesystem>
@@ -32,6 +34,15 @@ struct ParticipantRecord {
     std::uint64_t seed = 0;
     std::string completionCode;
     std::string createdAt;
+    bool resumed = false;     // join(): an existing participant was returned (same join key or external id)
+};
+
+// What the page saw while one trial was shown (sent with the response).
+struct TrialConditions {
+    bool pageHidden = false;  // document hidden at any moment (another tab, minimised window)
+    bool focusLost = false;   // the window lost the focus at any moment
+    bool fullscreen = false;  // full screen when answered
+    bool flagged() const { return pageHidden || focusLost; }
 };
 
 struct TrialRecord {
@@ -52,6 +63,7 @@ struct ResponseInput {
     int viewportHeight = 0;
     double devicePixelRatio = 1;
     std::string userAgent;
+    std::optional<TrialConditions> conditions; // absent: the client reported none
 };
 
 enum class ResponseOutcome { stored, duplicate };
@@ -69,6 +81,7 @@ struct ParticipantStatus {
     int catchAnswered = 0;
     int catchCorrect = 0;
     std::string lastResponseAt;
+    std::optional<ExternalIds> external; // the recruitment platform's ids, when the participant came from one
 };
 
 // One stored response joined with its trial: everything the exports need.
@@ -94,6 +107,24 @@ struct ResponseRow {
     double devicePixelRatio = 1;
     std::string userAgent;
     std::int64_t sessionId = 0;
+    std::optional<TrialConditions> conditions;      // per trial; absent = not recorded
+    double sessionDevicePixelRatio = 1;             // at the session's start (a change = browser zoom)
+    std::optional<ViewingConditions> viewing;       // the session's; absent = not reported
+    std::optional<ExternalIds> external;            // the participant's platform ids
+    bool flagged() const { return conditions && conditions->flagged(); }
+};
+
+// The viewing conditions of one session, with whose it is.
+struct SessionViewing {
+    std::string observer;
+    std::int64_t participantId = 0;
+    std::int64_t sessionId = 0;
+    std::string startedAt;
+    std::string userAgent;
+    int viewportWidth = 0;
+    int viewportHeight = 0;
+    double devicePixelRatio = 1;
+    std::optional<ViewingConditions> viewing; // absent: the client reported only the viewport
 };
 
 class StudyStore {
@@ -113,11 +144,18 @@ public:
     // A new participant with a fresh token, seed and planned trials (one transaction). `label` empty = "P001"...
     // `joinKey` (chosen by the client, may be empty) makes joining idempotent: a retried join whose first answer
     // was lost returns the participant it created. Throws RequestError 409 when the label is taken.
-    ParticipantRecord join(const std::string& label, const std::string& joinKey = "");
+    // `external` (a recruitment platform's ids): the participant with the same platform id is returned (resumed)
+    // instead of a new one, whatever the join key; a new participant stores them.
+    ParticipantRecord join(const std::string& label, const std::string& joinKey = "",
+                           const std::optional<ExternalIds>& external = std::nullopt);
+    // The participant who joined with these platform ids, if any.
+    std::optional<ParticipantRecord> participantByExternalId(const ExternalIds& external);
     // Throws RequestError 404 for an unknown token.
     ParticipantRecord participant(const std::string& token);
+    // `viewing` (when the page reported it) is stored with the session.
     std::int64_t startSession(std::int64_t participantId, const std::string& userAgent, int viewportWidth,
-                              int viewportHeight, double devicePixelRatio);
+                              int viewportHeight, double devicePixelRatio,
+                              const std::optional<ViewingConditions>& viewing = std::nullopt);
     // The first unanswered trial, if any. For an active design whose stored trials are all answered, the next
     // batch is planned from the current answers and stored first (see experiments/active_plan.h).
     std::optional<TrialRecord> nextTrial(std::int64_t participantId);
@@ -134,6 +172,10 @@ public:
 
     std::vector<ParticipantStatus> status();
     std::vector<ResponseRow> responses();
+    // Every session's viewing conditions, in order of starting (the researcher's overview).
+    std::vector<SessionViewing> viewingConditions();
+    // The responses to trials during which the page was hidden or lost the focus.
+    std::vector<ResponseRow> flaggedTrials();
     std::vector<TrialRecord> trials(std::int64_t participantId);
     std::int64_t responseCount();
 

@@ -22,6 +22,12 @@ const std::array<const char*, 9> kSkinlabColumns = {"observer",      "scene",   
                                                     "condition_B",   "is_A_selected", "A_on_left",
                                                     "trial_kind",    "correct",   "response_ms"};
 const std::array<const char*, 5> kPwcmpColumns = {"observer", "scene", "condition_A", "condition_B", "is_A_selected"};
+// Columns `skinlab study export` appends to both CSV formats (online studies); accepted after either set.
+const std::array<const char*, 20> kOnlineColumns = {
+    "flagged",          "page_hidden",      "focus_lost",       "fullscreen",          "device_pixel_ratio",
+    "dpr_changed",      "viewport_width",   "viewport_height",  "screen_width",        "screen_height",
+    "screen_width_px",  "screen_height_px", "colour_depth",     "pixels_per_mm",       "viewing_distance_mm",
+    "pixels_per_degree", "platform",        "external_id",      "external_study_id",   "external_session_id"};
 
 std::string where(int line, std::string_view column) {
     std::string out = "line " + std::to_string(line);
@@ -96,6 +102,8 @@ void readLongCsv(ResponseTable& table, const std::vector<CsvRecord>& records) {
         response.conditionA = field("condition_A");
         response.conditionB = field("condition_B");
         response.aSelected = parseFlag(table.file, record.line, "is_A_selected", field("is_A_selected"));
+        if (columnIndex.count("flagged"))
+            response.flagged = parseOptionalFlag(table.file, record.line, "flagged", field("flagged"));
         if (full) {
             response.aOnLeft = parseOptionalFlag(table.file, record.line, "A_on_left", field("A_on_left"));
             response.kind = parseKind(table.file, record.line, field("trial_kind"));
@@ -163,18 +171,22 @@ ResponseTable readCsv(const std::filesystem::path& path) {
     const std::set<std::string> pwcmpSet(kPwcmpColumns.begin(), kPwcmpColumns.end());
     std::string first = header.front();
     std::transform(first.begin(), first.end(), first.begin(), [](unsigned char c) { return std::tolower(c); });
-    if (headerSet == skinlabSet && header.size() == skinlabSet.size()) {
+    // The online columns are accepted after either set; the rest must match exactly.
+    std::set<std::string> coreSet;
+    for (const std::string& name : headerSet)
+        if (std::find(kOnlineColumns.begin(), kOnlineColumns.end(), name) == kOnlineColumns.end()) coreSet.insert(name);
+    if (coreSet == skinlabSet && headerSet.size() == header.size()) {
         table.format = ResponseFormat::SkinlabCsv;
-    } else if (headerSet == pwcmpSet && header.size() == pwcmpSet.size()) {
+    } else if (coreSet == pwcmpSet && headerSet.size() == header.size()) {
         table.format = ResponseFormat::PwcmpCsv;
     } else if (first.empty() || first == "condition") {
         table.format = ResponseFormat::CountMatrix;
     } else {
         // Name the first column that is missing or unexpected, judged against the closer of the two formats.
-        const bool closerToPwcmp = header.size() <= 5;
+        const bool closerToPwcmp = coreSet.size() <= 5;
         const auto& expected = closerToPwcmp ? pwcmpSet : skinlabSet;
         for (size_t k = 0; k < header.size(); ++k)
-            if (!expected.count(header[k]))
+            if (!expected.count(header[k]) && !(coreSet.size() < headerSet.size() && !coreSet.count(header[k])))
                 throwInput(table.file, where(records.front().line, std::to_string(k + 1)),
                            "unexpected column '" + header[k] + "'; expected the columns " +
                                (closerToPwcmp ? joined(kPwcmpColumns) : joined(kSkinlabColumns)) +
@@ -238,6 +250,7 @@ ResponseTable readJson(const std::filesystem::path& path) {
         response.correct = flag("correct", true);
         if (entry.contains("response_ms") && entry["response_ms"].is_number())
             response.responseMs = entry["response_ms"].get<double>();
+        response.flagged = flag("flagged", true);
         checkResponse(table.file, response);
         table.responses.push_back(std::move(response));
     }
@@ -264,9 +277,19 @@ ResponseTable readDatabase(const std::filesystem::path& path) {
         }
     } closer{database};
     sqlite3_busy_timeout(database, 5000);  // the study server may be writing
+    // `flagged` (online studies) is in the view of study files written or opened by a newer skinlab.
+    bool hasFlagged = false;
+    {
+        sqlite3_stmt* probe = nullptr;
+        if (sqlite3_prepare_v2(database, "SELECT COUNT(*) FROM pragma_table_info('responses_long') WHERE name = 'flagged'",
+                               -1, &probe, nullptr) == SQLITE_OK &&
+            sqlite3_step(probe) == SQLITE_ROW)
+            hasFlagged = sqlite3_column_int(probe, 0) == 1;
+        sqlite3_finalize(probe);
+    }
     const std::string query =
-        "SELECT observer, scene, condition_A, condition_B, is_A_selected, A_on_left, trial_kind, correct, "
-        "response_ms FROM responses_long";
+        std::string("SELECT observer, scene, condition_A, condition_B, is_A_selected, A_on_left, trial_kind, correct, "
+                    "response_ms") + (hasFlagged ? ", flagged" : "") + " FROM responses_long";
     if (sqlite3_prepare_v2(database, query.c_str(), -1, &closer.statement, nullptr) != SQLITE_OK)
         throwInput(table.file, "responses_long",
                    std::string("cannot read the responses view: ") + sqlite3_errmsg(database));
@@ -290,6 +313,8 @@ ResponseTable readDatabase(const std::filesystem::path& path) {
         response.correct = parseOptionalFlag(table.file, row, "correct", text(7));
         if (sqlite3_column_type(closer.statement, 8) != SQLITE_NULL)
             response.responseMs = sqlite3_column_double(closer.statement, 8);
+        if (hasFlagged && sqlite3_column_type(closer.statement, 9) != SQLITE_NULL)
+            response.flagged = sqlite3_column_int(closer.statement, 9) != 0;
         checkResponse(table.file, response);
         table.responses.push_back(std::move(response));
     }
@@ -320,6 +345,17 @@ const char* responseFormatName(ResponseFormat format) {
     case ResponseFormat::SkinlabJson: return "skinlab-json";
     }
     return "skinlab-csv";
+}
+
+DroppedFlagged dropFlagged(ResponseTable& table) {
+    DroppedFlagged result;
+    for (const Response& r : table.responses) result.recorded = result.recorded || r.flagged.has_value();
+    const size_t before = table.responses.size();
+    std::erase_if(table.responses, [](const Response& r) { return r.flagged.value_or(false); });
+    result.dropped = before - table.responses.size();
+    if (table.responses.empty() && before > 0)
+        throwInput(table.file, "flagged", "every response is flagged; nothing is left to scale");
+    return result;
 }
 
 ResponseTable readResponses(const std::filesystem::path& path) {

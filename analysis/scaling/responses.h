@@ -2,8 +2,10 @@
 // Reading 2AFC responses for scaling. Accepted inputs (detected from the file's first bytes / header line):
 //  - a study database (SQLite): the VIEW `responses_long` (contract 3);
 //  - a CSV export of that view (`skinlab study export --format csv`): columns observer, scene, condition_A,
-//    condition_B, is_A_selected, A_on_left, trial_kind, correct, response_ms (any order, all required);
-//  - a pwcmp long-format CSV: observer, scene, condition_A, condition_B, is_A_selected;
+//    condition_B, is_A_selected, A_on_left, trial_kind, correct, response_ms (any order, all required), optionally
+//    followed by the online columns of the export (flagged, external_id, ...; only `flagged` is read);
+//  - a pwcmp long-format CSV: observer, scene, condition_A, condition_B, is_A_selected (plus the same optional
+//    online columns);
 //  - a JSON export (`skinlab study export --format json`, key "responses");
 //  - a count matrix CSV: header `condition,<name 1>,...,<name m>`, then one row per condition
 //    `<name i>,D_i1,...,D_im` with D_ij = times i was chosen over j (one block, no observers).
@@ -27,6 +29,7 @@ struct Response {
     TrialKind kind = TrialKind::Test;
     std::optional<bool> correct;  // catch trials only
     std::optional<double> responseMs;
+    std::optional<bool> flagged;  // page hidden or focus lost while shown (online studies); unknown when absent
     int line = 0;  // 1-based line (CSV) or row (SQLite) it came from, for error messages
 };
 
@@ -44,5 +47,13 @@ struct ResponseTable {
 
 // Reads any accepted format; throws InputError "FILE: line N: column C: message" on bad input.
 ResponseTable readResponses(const std::filesystem::path& path);
+
+// Removes the responses flagged as given while the page was hidden or without focus (`analyze scale
+// --drop-flagged`). Returns how many were removed; `recorded` tells whether any response carried a flag at all.
+struct DroppedFlagged {
+    size_t dropped = 0;
+    bool recorded = false;
+};
+DroppedFlagged dropFlagged(ResponseTable& table);
 
 } // namespace skinlab::analysis::scaling

@@ -1,7 +1,11 @@
 // skinlab participant page: consent → instructions → practice → trials (2AFC) → completion code.
 // Every answer is sent to the server and only counted once the server has committed it; a failed send is
 // retried with the same body (the server treats a re-send as harmless). Reloading the page with the same ?p=
-// link resumes at the first unanswered trial.
+// link resumes at the first unanswered trial. Online studies: the recruitment platform's URL parameters are
+// forwarded when joining (the same platform id resumes), the optional card calibration and the viewing conditions
+// are reported when a session starts (the server refuses one that misses the design's requirements), every
+// answer says whether the page was hidden or lost the focus while the trial was shown, and the end may redirect
+// to the platform's completion URL.
 'use strict';
 
 const params = new URLSearchParams(location.search);
@@ -12,6 +16,9 @@ let state = null;       // last participant state from the server
 let shownAt = 0;        // performance.now() when the current pair appeared
 let accepting = false;  // true while a trial waits for an answer
 let breakShownAt = -1;  // answered count at which the last break was shown
+let cardWidth = null;   // CSS px of the calibrated card (null: no calibration)
+let trialHidden = false; // the page was hidden while the current trial was shown
+let trialBlurred = false; // the window lost the focus while the current trial was shown
 
 const $ = (id) => document.getElementById(id);
 const MARGIN = 16;      // CSS px between and around the images
@@ -37,6 +44,23 @@ function viewport() {
   return {viewport_width: window.innerWidth, viewport_height: window.innerHeight,
           device_pixel_ratio: window.devicePixelRatio || 1};
 }
+
+function isFullscreen() {
+  return !!(document.fullscreenElement || document.webkitFullscreenElement);
+}
+
+// Reported when a session starts: the screen (CSS px), colour depth, full screen, pointer, and the calibration.
+function viewingConditions() {
+  const conditions = Object.assign(viewport(), {
+    screen_width: screen.width, screen_height: screen.height, colour_depth: screen.colorDepth || 0,
+    fullscreen: isFullscreen(), pointer_fine: window.matchMedia('(pointer: fine)').matches,
+    touch_points: navigator.maxTouchPoints || 0});
+  if (cardWidth !== null) conditions.card_width = cardWidth;
+  return conditions;
+}
+
+document.addEventListener('visibilitychange', () => { if (document.hidden) trialHidden = true; });
+window.addEventListener('blur', () => { trialBlurred = true; });
 
 async function api(method, path, body) {
   const init = {method, headers: {}};
@@ -83,9 +107,87 @@ function waitForKeyOrClick(keys) {
   });
 }
 
+// The recruitment platform's parameters present in the link.
+function recruitmentParameters() {
+  const found = {};
+  for (const name of study.recruitment.parameters) if (params.has(name)) found[name] = params.get(name);
+  return found;
+}
+
+// The credit-card match (ISO/IEC 7810 ID-1): resize the outline until it covers a real card held to the screen.
+async function calibrate() {
+  const ratio = study.display.card_height_mm / study.display.card_width_mm;
+  let width = Math.round(study.display.card_width_mm / 25.4 * 96); // the CSS inch as a first guess
+  showScreen('<h1>Screen size</h1><p class="message">Hold a credit card (or any card of that size) flat against ' +
+    'the screen, over the outline. Make the outline exactly as large as the card with ← and → (hold Shift for ' +
+    'bigger steps) or the slider, then press <b>Enter</b>.' +
+    (study.display.viewing_distance_mm > 0 ? '\nDuring the study, please sit about ' +
+      Math.round(study.display.viewing_distance_mm / 10) + ' cm from the screen.' : '') +
+    '</p><input id="card-size" type="range" min="100" max="1200" step="1"><div id="card"></div>' +
+    '<button id="card-done">Done</button>');
+  const card = $('card');
+  const slider = $('card-size');
+  const apply = () => {
+    card.style.width = width + 'px';
+    card.style.height = Math.round(width * ratio * 100) / 100 + 'px';
+    slider.value = String(width);
+    card.dataset.width = String(width);
+  };
+  apply();
+  await new Promise((resolve) => {
+    slider.addEventListener('input', () => { width = Number(slider.value); apply(); });
+    const onKey = (e) => {
+      if (e.key === 'ArrowLeft' || e.key === 'ArrowRight') {
+        e.preventDefault();
+        width = Math.min(1200, Math.max(100, width + (e.key === 'ArrowRight' ? 1 : -1) * (e.shiftKey ? 10 : 1)));
+        apply();
+      } else if (e.key === 'Enter') {
+        e.preventDefault();
+        done();
+      }
+    };
+    function done() { window.removeEventListener('keydown', onKey); resolve(); }
+    window.addEventListener('keydown', onKey);
+    $('card-done').addEventListener('click', done);
+  });
+  cardWidth = width;
+}
+
+// Starts a session; a session that misses the study's requirements is refused by the server, with the reason.
+async function startSession() {
+  for (;;) {
+    try {
+      return await apiRetrying('POST', '/api/session', Object.assign({token}, viewingConditions()));
+    } catch (e) {
+      if (e.status !== 403) throw e;
+      document.body.dataset.refused = 'true';
+      showScreen('<h1>This study cannot start yet</h1><p class="message" id="refusal">' + escapeHtml(e.message) +
+        '</p><p>Change this and press <b>Enter</b> or the button to try again.</p><button>Try again</button>');
+      await waitForKeyOrClick(['Enter']);
+      if (study.requirements.fullscreen && !isFullscreen() && document.documentElement.requestFullscreen) {
+        try { await document.documentElement.requestFullscreen(); } catch (ignored) { /* the message stays */ }
+      }
+    }
+  }
+}
+
 async function start() {
   study = await apiRetrying('GET', '/api/study');
   document.title = study.title;
+  const platform = study.recruitment.platform;
+  if (!token && platform === 'mturk' && params.get('assignmentId') === 'ASSIGNMENT_ID_NOT_AVAILABLE') {
+    // MTurk's preview of the HIT: the instructions only; nobody joins before accepting it.
+    document.body.dataset.preview = 'true';
+    showScreen('<h1>' + escapeHtml(study.title) + '</h1><p class="message">' +
+      escapeHtml(study.instructions || 'Each trial shows two images side by side. ' + study.question) +
+      '</p><p><b>Accept the HIT to take part.</b></p>');
+    return;
+  }
+  if (!token && platform !== 'none' && !params.has(study.recruitment.id_parameter)) {
+    showScreen('<h1>' + escapeHtml(study.title) + '</h1><p class="message">Please open this study from its link on ' +
+      escapeHtml(platform) + ' (the link carries your participant id).</p>');
+    return;
+  }
   if (!token) {
     showScreen('<h1>' + escapeHtml(study.title) + '</h1><p class="message">' +
       escapeHtml(study.consent || 'This study shows you pairs of images and asks which one matches a question. ' +
@@ -101,13 +203,16 @@ async function start() {
       joinKey = Array.from(bytes, (b) => b.toString(16).padStart(2, '0')).join('');
       sessionStorage.setItem('skinlab-join-key', joinKey);
     }
-    const joined = await apiRetrying('POST', '/api/join', {join_key: joinKey});
+    const join = {join_key: joinKey};
+    if (platform !== 'none') join.recruitment = recruitmentParameters();
+    const joined = await apiRetrying('POST', '/api/join', join);
     token = joined.token;
     sessionStorage.removeItem('skinlab-join-key'); // a later visit to the bare link is a new participant
     // The link now identifies this participant: reloading or reopening it resumes.
     history.replaceState(null, '', '?p=' + encodeURIComponent(token));
   }
-  state = await apiRetrying('POST', '/api/session', Object.assign({token}, viewport()));
+  if (study.display.calibrate) await calibrate();
+  state = await startSession();
   session = state.session;
   if (state.completed) return finish();
   if (state.answered === 0 && state.practice_answered === 0) {
@@ -250,6 +355,8 @@ async function runTrials() {
     await imagesLoaded();
     $('stage').style.visibility = 'visible';
     document.body.dataset.trial = String(trial.id);  // for automated checks
+    trialHidden = document.hidden;
+    trialBlurred = false;
     shownAt = performance.now();
     accepting = true;
     const side = await waitForAnswer();
@@ -258,7 +365,8 @@ async function runTrials() {
     try {
       state = await apiRetrying('POST', '/api/response', Object.assign({
         token, session, trial: trial.id, side, response_ms: Math.round(responseMs * 10) / 10,
-        client_time: new Date().toISOString()}, viewport()));
+        client_time: new Date().toISOString(), page_hidden: trialHidden, focus_lost: trialBlurred,
+        fullscreen: isFullscreen()}, viewport()));
     } catch (e) {
       if (e.status === 409) {
         // Answered elsewhere (another tab): continue from the server's state.
@@ -279,7 +387,12 @@ function finish() {
   document.body.dataset.completed = 'true';
   showScreen('<h1>Thank you!</h1><p>You have completed the study. Your completion code is:</p>' +
     '<p class="code" id="completion-code">' + escapeHtml(state.completion_code || '') + '</p>' +
-    '<p>You can close this page now.</p>');
+    (state.completion_url ? '<p>Returning you to the recruitment site… (<a id="completion-link" href="' +
+      escapeHtml(state.completion_url) + '">continue</a>)</p>' : '<p>You can close this page now.</p>'));
+  if (state.completion_url) {
+    document.body.dataset.redirect = state.completion_url;
+    setTimeout(() => location.assign(state.completion_url), 1500);
+  }
 }
 
 start().catch((e) => {

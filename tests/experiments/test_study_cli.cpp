@@ -9,6 +9,7 @@
 #include "experiments/study_store.h"
 #include "stimulus_set_fixture.h"
 
+#include <algorithm>
 #include <atomic>
 #include <csignal>
 #include <gtest/gtest.h>
@@ -106,7 +107,10 @@ TEST(StudyCli, CreateStatusExportAndTheirErrors) {
     EXPECT_EQ(status.exitCode, 0);
     EXPECT_NE(status.out.find("0 participants, 0 completed, 0 responses"), std::string::npos) << status.out;
     CommandResult csv = runSkinlab({"study", "export", files.database.string(), "--format", "csv"});
-    EXPECT_EQ(csv.out, "observer,scene,condition_A,condition_B,is_A_selected,A_on_left,trial_kind,correct,response_ms\n");
+    // Contract 3's columns, then the online columns (docs/experiments.md), and no rows.
+    EXPECT_EQ(csv.out.rfind("observer,scene,condition_A,condition_B,is_A_selected,A_on_left,trial_kind,correct,response_ms,"
+                            "flagged,", 0), 0u) << csv.out;
+    EXPECT_EQ(std::count(csv.out.begin(), csv.out.end(), '\n'), 1) << csv.out;
     CommandResult badFormat = runSkinlab({"study", "export", files.database.string(), "--format", "xls"});
     EXPECT_NE(badFormat.exitCode, 0);
     CommandResult missing = runSkinlab({"study", "status", (files.folder.path() / "nope.db").string()});
