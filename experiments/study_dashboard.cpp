@@ -45,10 +45,54 @@ StudyDashboard::~StudyDashboard() = default;
 json StudyDashboard::snapshot() {
     json out = counts();
     out["scale"] = scale(out["totals"]["responses"].get<std::int64_t>());
-    // Filled in by the recording of viewing conditions and of hidden-page trials; until then, said plainly.
-    out["viewing_conditions"] = {{"recorded", false}, {"note", "not recorded"}};
-    out["flagged_trials"] = {{"recorded", false}, {"note", "not recorded"}};
+    out["viewing_conditions"] = viewingConditions();
+    out["flagged_trials"] = flaggedTrials();
     return out;
+}
+
+json StudyDashboard::viewingConditions() {
+    // One row per session (page load); "recorded" is false until a page reported its screen.
+    json sessions = json::array();
+    bool recorded = false;
+    for (const SessionViewing& v : store_.viewingConditions()) {
+        json row = {{"observer", v.observer},
+                    {"session", v.sessionId},
+                    {"started_at", v.startedAt},
+                    {"viewport", {v.viewportWidth, v.viewportHeight}},
+                    {"device_pixel_ratio", v.devicePixelRatio}};
+        if (v.viewing) {
+            recorded = true;
+            const ViewingConditions& c = *v.viewing;
+            row["screen_css"] = {c.screenWidth, c.screenHeight};
+            row["screen_px"] = {c.screenWidthPx, c.screenHeightPx};
+            row["colour_depth"] = c.colourDepth;
+            row["fullscreen"] = c.fullscreen;
+            row["mobile"] = c.mobile;
+            row["pixels_per_degree"] = c.pixelsPerDegree ? json(*c.pixelsPerDegree) : json();
+        }
+        sessions.push_back(std::move(row));
+    }
+    return {{"recorded", recorded}, {"note", recorded ? "" : "not recorded"}, {"sessions", std::move(sessions)}};
+}
+
+json StudyDashboard::flaggedTrials() {
+    // Trials during which the page was hidden or lost the focus ("recorded" once any answer carried the flags).
+    json trials = json::array();
+    for (const ResponseRow& r : store_.flaggedTrials())
+        trials.push_back({{"observer", r.observer},
+                          {"position", r.position},
+                          {"block", r.scene},
+                          {"page_hidden", r.conditions && r.conditions->pageHidden},
+                          {"focus_lost", r.conditions && r.conditions->focusLost}});
+    bool recorded = !trials.empty();
+    if (!recorded) {
+        std::lock_guard lock(readMutex_);
+        SqliteStatement s = db_->prepare("SELECT EXISTS (SELECT 1 FROM trial_conditions)");
+        recorded = s.step() && s.integer(0) != 0;
+    }
+    const std::size_t count = trials.size();
+    return {{"recorded", recorded}, {"note", recorded ? "" : "not recorded"}, {"count", count},
+            {"trials", std::move(trials)}};
 }
 
 json StudyDashboard::counts() {

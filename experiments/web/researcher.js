@@ -84,8 +84,55 @@ function render(data) {
   renderParticipants(data.participants);
   renderHistogram(data.response_times);
   renderScale(data.scale);
-  $('flagged').textContent = data.flagged_trials.recorded ? text(data.flagged_trials.count) : data.flagged_trials.note;
-  $('viewing').textContent = data.viewing_conditions.recorded ? '' : data.viewing_conditions.note;
+  renderFlagged(data.flagged_trials);
+  renderViewing(data.viewing_conditions);
+}
+
+function renderFlagged(flagged) {
+  const note = $('flagged');
+  note.dataset.count = String(flagged.count || 0);
+  if (!flagged.recorded) {
+    note.textContent = flagged.note;
+    return;
+  }
+  note.classList.remove('placeholder');
+  const shown = flagged.trials.slice(0, 50);
+  note.replaceChildren(document.createTextNode(flagged.count + ' trial(s) shown while the page was hidden or unfocused' +
+    (flagged.count > shown.length ? ' (first ' + shown.length + ')' : '') + (flagged.count ? ':' : '.')));
+  if (flagged.count) {
+    const list = element('ul', { id: 'flagged-list' });
+    list.append(...shown.map((t) => element('li', {}, t.observer + ', trial ' + (t.position + 1) + ' (' + t.block + '): ' +
+      [t.page_hidden ? 'hidden' : '', t.focus_lost ? 'focus lost' : ''].filter(Boolean).join(', '))));
+    note.append(list);
+  }
+}
+
+function renderViewing(viewing) {
+  const note = $('viewing');
+  note.dataset.sessions = String(viewing.sessions ? viewing.sessions.length : 0);
+  if (!viewing.recorded) {
+    note.textContent = viewing.note;
+    return;
+  }
+  note.classList.remove('placeholder');
+  const table = element('table', { id: 'viewing-table' });
+  const head = element('tr');
+  for (const h of ['participant', 'screen (CSS px)', 'screen (device px)', 'DPR', 'viewport', 'colour', 'full screen', 'px/degree'])
+    head.append(element('th', {}, h));
+  table.append(head);
+  for (const v of viewing.sessions) {
+    const row = element('tr', { 'data-observer': v.observer });
+    row.append(element('td', {}, v.observer),
+      element('td', {}, v.screen_css ? v.screen_css.join(' × ') : '–'),
+      element('td', {}, v.screen_px ? v.screen_px.join(' × ') : '–'),
+      element('td', { class: 'number' }, fixed(v.device_pixel_ratio, 2)),
+      element('td', {}, v.viewport.join(' × ')),
+      element('td', { class: 'number' }, v.colour_depth ? v.colour_depth + ' bit' : '–'),
+      element('td', {}, v.fullscreen === undefined ? '–' : v.fullscreen ? 'yes' : 'no'),
+      element('td', { class: 'number' }, fixed(v.pixels_per_degree, 1)));
+    table.append(row);
+  }
+  note.replaceChildren(table);
 }
 
 function renderParticipants(participants) {

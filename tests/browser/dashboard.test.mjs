@@ -70,11 +70,18 @@ try {
   check(await page.$$eval('#scale svg circle.point', (c) => c.length) === 4, 'scale plot points');
 
   // A third participant: the dashboard follows without a reload (the scale is recomputed, at most every 5 s).
-  const third = await answerAll(port);
+  // It reports its viewing conditions and one trial shown while the page was hidden.
+  const third = await answerAll(port, { hiddenAt: 1, viewing: { screen_width: 1920, screen_height: 1080,
+    colour_depth: 24, fullscreen: true, pointer_fine: true, touch_points: 0 } });
   await page.waitForFunction((before) => document.getElementById('participant-count').textContent === '3' &&
     document.body.dataset.scaleComputedAt !== before, scaleBefore, { timeout: 30000, polling: 250 });
   check(await page.textContent('#response-count') === String(first.answered + second.answered + third.answered),
     'response count after the third participant');
+  await page.waitForSelector('#viewing-table tr[data-observer="' + third.observer + '"]', { timeout: 10000 });
+  check(/1920 × 1080/.test(await page.textContent('#viewing-table tr[data-observer="' + third.observer + '"]')),
+    'viewing conditions row: ' + await page.textContent('#viewing'));
+  check(await page.getAttribute('#flagged', 'data-count') === '1', 'flagged count: ' + await page.textContent('#flagged'));
+  check(/hidden, focus lost/.test(await page.textContent('#flagged-list')), 'flagged trial: ' + await page.textContent('#flagged'));
   const jodAfter = await page.$$eval('#scale tr.scale-row', (trs) => trs.map((tr) => tr.dataset.jod).join(','));
   check(jodAfter !== jodBefore, 'the scale did not change with more answers: ' + jodAfter);
   const shot = screenshot || path.join(work, 'dashboard.png');

@@ -124,18 +124,22 @@ export function request(port, target, options = {}) {
 }
 
 // Joins and answers every trial through the API ("left" each time); returns the number answered.
-export async function answerAll(port, { tls = false, headers = {}, localAddress, limit = Infinity } = {}) {
+// `viewing`: extra /api/session fields (the page's viewing conditions); `hiddenAt`: answer number (from 0) sent as
+// shown while the page was hidden.
+export async function answerAll(port, { tls = false, headers = {}, localAddress, limit = Infinity, viewing = {},
+  hiddenAt = -1 } = {}) {
   const json = { 'Content-Type': 'application/json', ...headers };
   const post = (target, body) => request(port, target, { method: 'POST', headers: json, body: JSON.stringify(body), localAddress, tls });
   const joined = await post('/api/join', {});
   if (joined.status !== 201) throw new Error('join: ' + joined.status + ' ' + joined.text);
   const token = joined.json.token;
   const screenSize = { viewport_width: 1280, viewport_height: 800, device_pixel_ratio: 1 };
-  const session = await post('/api/session', { token, ...screenSize });
+  const session = await post('/api/session', { token, ...screenSize, ...viewing });
   let state = session.json, answered = 0;
   while (state.trial && answered < limit) {
     const r = await post('/api/response', { token, trial: state.trial.id, side: answered % 3 === 0 ? 'right' : 'left',
-      session: session.json.session, response_ms: 500 + 137 * answered, client_time: new Date().toISOString(), ...screenSize });
+      session: session.json.session, response_ms: 500 + 137 * answered, client_time: new Date().toISOString(), ...screenSize,
+      ...(hiddenAt === answered ? { page_hidden: true, focus_lost: true, fullscreen: false } : {}) });
     if (r.status !== 200) throw new Error('response: ' + r.status + ' ' + r.text);
     state = r.json;
     answered++;
