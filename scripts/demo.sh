@@ -28,7 +28,8 @@ else
     "using the built-in head builtin:head"
 fi
 # A rerun after a switch between the two heads starts from an empty stimulus folder (the set name differs).
-if [ -e "$out/stimuli/manifest.json" ] && ! grep -q "\"$(sed -n 's/^name = "\(.*\)"$/\1/p' "$stimuli_spec")\"" "$out/stimuli/manifest.json"; then
+set_name=$(sed -n 's/^name = "\(.*\)"$/\1/p' "$stimuli_spec" | head -n 1)  # [set] comes first
+if [ -e "$out/stimuli/manifest.json" ] && ! grep -q "\"set\": *\"$set_name\"" "$out/stimuli/manifest.json"; then
   rm -rf "$out/stimuli"
 fi
 "$skinlab" stimuli build "$stimuli_spec" -o "$out/stimuli"
