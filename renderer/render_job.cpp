@@ -122,13 +122,14 @@ struct Renderer::Impl {
         std::string key = spec.modelSource;
         if (spec.modelSource == "builtin:halo") key += "|" + std::to_string(spec.depthGapMm);
         if (spec.modelSource == "builtin:ear") key += "|" + std::to_string(spec.thicknessMm);
+        if (spec.modelSource == "builtin:head" && !spec.skinDetail) key += "|smooth";
         if (spec.flipV) key += "|flip_v";
         if (auto found = models.find(key); found != models.end()) return found->second;
         Model loaded;
         if (spec.modelSource == "builtin:halo") loaded = makeHaloScene(static_cast<float>(spec.depthGapMm));
         else if (spec.modelSource == "builtin:bleed") loaded = makeBleedScene();
         else if (spec.modelSource == "builtin:ear") loaded = makeEarScene(static_cast<float>(spec.thicknessMm));
-        else if (spec.modelSource == "builtin:head") loaded = makeHeadScene();
+        else if (spec.modelSource == "builtin:head") loaded = makeHeadScene(spec.skinDetail);
         else {
             ModelLoadOptions options;
             options.flipV = spec.flipV;
@@ -213,8 +214,9 @@ RenderResult Renderer::render(const RenderRequest& request) {
         }
         for (const SubMesh& part : model->parts) partMaterials.push_back(byMaterial.at(part.material));
     }
-    const auto albedoMap = impl.image(spec.textures.albedo, ColorEncoding::sRGB);
-    const auto normalMap = impl.image(spec.textures.normal, ColorEncoding::Data);
+    // A spec's maps replace the ones the model brings (builtin:head's procedural skin detail).
+    const auto albedoMap = spec.textures.albedo.empty() ? model->albedoMap : impl.image(spec.textures.albedo, ColorEncoding::sRGB);
+    const auto normalMap = spec.textures.normal.empty() ? model->normalMap : impl.image(spec.textures.normal, ColorEncoding::Data);
     const auto specularMap = impl.image(spec.textures.specular, ColorEncoding::Data);
     const auto occlusionMap = impl.image(spec.textures.occlusion, ColorEncoding::Data);
     const auto skinMaskMap = impl.image(spec.textures.skinMask, ColorEncoding::Data);

@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # The main job, end to end, on a fresh Debian 12 machine (no GPU needed):
 #   1. installs missing packages and builds (scripts/build.sh);
-#   2. builds the demo stimulus set (built-in head, every SSS method and the main extensions) with a contact sheet;
+#   2. builds the demo stimulus set (every SSS method and the main extensions) with a contact sheet: on the scanned
+#      head when its assets are found ($SKINLAB_ASSETS, default ../shared/assets: stimuli/specs/demo-scan.toml),
+#      otherwise on the built-in head (stimuli/specs/demo.toml), with a message saying so;
 #   3. creates a 2AFC study from it, serves it on loopback and runs 20 simulated observers through the real
 #      HTTP API (true scores in experiments/designs/demo-truth.json);
 #   4. scales the answers to JOD with confidence intervals;
@@ -16,11 +18,25 @@ skinlab=./build/release/cli/skinlab
 out=out/demo
 mkdir -p "$out"
 
-"$skinlab" stimuli build stimuli/specs/demo.toml -o "$out/stimuli"
+# The scanned head shows skin as the methods change it best; the built-in head needs no files.
+if [ -e "$SKINLAB_ASSETS/LeePerrySmith/LeePerrySmith.glb" ]; then
+  stimuli_spec=stimuli/specs/demo-scan.toml design=experiments/designs/demo-scan.toml
+  echo "demo: the scanned head (assets in $SKINLAB_ASSETS)"
+else
+  stimuli_spec=stimuli/specs/demo.toml design=experiments/designs/demo.toml
+  echo "demo: scanned head not found (\$SKINLAB_ASSETS/LeePerrySmith/LeePerrySmith.glb, SKINLAB_ASSETS=$SKINLAB_ASSETS);" \
+    "using the built-in head builtin:head"
+fi
+# A rerun after a switch between the two heads starts from an empty stimulus folder (the set name differs).
+set_name=$(sed -n 's/^name = "\(.*\)"$/\1/p' "$stimuli_spec" | head -n 1)  # [set] comes first
+if [ -e "$out/stimuli/manifest.json" ] && ! grep -q "\"set\": *\"$set_name\"" "$out/stimuli/manifest.json"; then
+  rm -rf "$out/stimuli"
+fi
+"$skinlab" stimuli build "$stimuli_spec" -o "$out/stimuli"
 
 # A demo study is recreated on every run (a real study is never overwritten by `study create`).
 rm -f "$out/study.db" "$out/study.db-wal" "$out/study.db-shm"
-"$skinlab" study create --stimuli "$out/stimuli" --design experiments/designs/demo.toml -o "$out/study.db"
+"$skinlab" study create --stimuli "$out/stimuli" --design "$design" -o "$out/study.db"
 
 "$skinlab" study serve "$out/study.db" --port 0 > "$out/serve.log" 2>&1 &
 server=$!

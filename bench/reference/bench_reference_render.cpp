@@ -24,7 +24,7 @@ int main(int argc, char** argv) {
         std::string name, scene;
         std::vector<std::string> overrides;
     };
-    std::vector<Case> cases = {{"builtin:halo (mid view)", "builtin:halo", {}}};
+    std::vector<Case> cases = {{"builtin:halo-grey-backdrop (mid view)", "builtin:halo-grey-backdrop", {}}};
     if (assets && std::filesystem::exists(std::filesystem::path(assets) / "LeePerrySmith/LeePerrySmith.glb"))
         cases.push_back({"scanned head (close view)", std::string(SKINLAB_SOURCE_DIR) + "/renderer/scenes/lee-perry-smith.toml",
                          {"camera.view=close"}});

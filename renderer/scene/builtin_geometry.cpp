@@ -1,6 +1,7 @@
 #include "renderer/scene/builtin_geometry.h"
 
 #include "common/error.h"
+#include "renderer/scene/skin_detail.h"
 #include "renderer/scene/tangent_space.h"
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -406,9 +407,17 @@ glm::vec3 headColour(const glm::vec3& p) {
     return colour;
 }
 
+// Maps a part's own UVs (in [0, 1]²) linearly into the rectangle [u0, u1] × [v0, v1] of the head's chart.
+void remapUVs(Surface& surface, float u0, float u1, float v0, float v1) {
+    for (Vertex& vertex : surface.vertices)
+        vertex.uv = glm::vec2(u0 + (u1 - u0) * vertex.uv.x, v0 + (v1 - v0) * vertex.uv.y);
+}
+
 } // namespace
 
-Model makeHeadScene() {
+glm::vec3 headSurfaceAt(float u, float v) { return headSurface(sphereDirection(u, v)); }
+
+Model makeHeadScene(bool skinDetail) {
     Model model;
     const std::uint32_t skin = addMaterial(model, "skin", kSkinAlbedo, true, 0.6f);
     const std::uint32_t eye = addMaterial(model, "eye", glm::vec3(0.8f, 0.78f, 0.75f), false, 0.95f);
@@ -435,6 +444,8 @@ Model makeHeadScene() {
         const glm::vec3 centre(transform[3]);
         orient(ear, [centre](const glm::vec3& p) { return p - centre; });
         smoothNormals(ear);
+        // Behind the ear on the back of the head's chart: generic skin detail, no facial features.
+        remapUVs(ear, 0.40f, 0.52f, 0.36f, 0.56f);
         appendPart(model, ear, skin);
     }
 
@@ -449,6 +460,8 @@ Model makeHeadScene() {
                                                 glm::vec3(side * kEyeCentre.x, kEyeCentre.y,
                                                           socket.z - kEyeRadius + 3.0f)));
         smoothNormals(ball);
+        // One texel of the maps' flat row 0: the skin detail does not reach the eyes.
+        for (Vertex& vertex : ball.vertices) vertex.uv = glm::vec2(0.5f, 0.5f / static_cast<float>(kHeadDetailHeight));
         appendPart(model, ball, eye);
     }
 
@@ -465,6 +478,7 @@ Model makeHeadScene() {
         });
         orient(side, [=](const glm::vec3& p) { return glm::vec3(p.x, 0.0f, p.z - centreZ); });
         smoothNormals(side);
+        remapUVs(side, 0.25f, 0.75f, 0.72f, 0.80f);  // the back of the lower head's chart: generic skin
         appendPart(model, side, skin);
         Surface cap;
         addGrid(cap, 64, 4, true, [=](float s, float t) {
@@ -473,9 +487,15 @@ Model makeHeadScene() {
         });
         orient(cap, [](const glm::vec3&) { return glm::vec3(0.0f, -1.0f, 0.0f); });
         smoothNormals(cap);
+        remapUVs(cap, 0.45f, 0.55f, 0.60f, 0.62f);
         appendPart(model, cap, skin);
     }
     finishModel(model);
+    if (skinDetail) {
+        SkinDetailMaps maps = makeHeadSkinDetail();
+        model.albedoMap = std::make_shared<const Image>(std::move(maps.albedo));
+        model.normalMap = std::make_shared<const Image>(std::move(maps.normal));
+    }
     return model;
 }
 

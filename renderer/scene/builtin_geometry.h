@@ -62,6 +62,10 @@ Model makeEarScene(float thicknessMm = 2.5f);
 // nose, brow ridge, chin, cheekbones, eye sockets, lips and two ears, plus a neck stub. Albedo variation is carried in
 // Vertex::color (multiplying the "skin" material albedo): redder lips, darker eyebrows. The eyes are
 // separate non-skin spheres (material "eye"). 51,712 triangles.
+// With skinDetail (the default) the model also brings procedural skin maps (skin_detail.h): an albedo map
+// (mottling, redness, spots, brow hairs, lip lines) and a tangent-space normal map (pores, fine wrinkles), over
+// the head surface's UVs; the ears and the neck use UVs inside the back of the head's chart (generic skin) and the
+// eyes one flat texel (row 0, the crown pole). Without it (model.skin_detail = false) the head is smooth.
 // Materials: "skin" (skin), "eye" (non-skin).
 // Landmarks (mm, for tests and camera/light placement):
 // (measured on the generated mesh; the tests check them to ±1 mm).
@@ -70,6 +74,9 @@ inline constexpr float kHeadChinY = -113.0f;       // lowest point of the chin (
 inline constexpr float kHeadNoseTipZ = 113.4f;     // nose tip (pronasale), the most anterior point, at y ≈ -31
 inline constexpr float kHeadEarOuterX = 86.8f;     // outer rim of each ear, |x|
 inline constexpr float kHeadNeckBottomY = -175.0f; // the neck stub's flat bottom (the model's lowest point)
-Model makeHeadScene();
+Model makeHeadScene(bool skinDetail = true);
+// The head surface (without ears, eyes and neck) at its UV (u around from the front, towards +X first; v from the
+// top, v = 0 at the vertex): the parametric surface the head's grid samples; its texture maps are laid out on it.
+glm::vec3 headSurfaceAt(float u, float v);
 
 } // namespace skinlab::renderer

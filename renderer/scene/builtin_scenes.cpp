@@ -7,7 +7,9 @@ std::optional<std::string_view> embeddedFile(std::string_view name);
 
 namespace skinlab::renderer {
 
-std::vector<std::string> builtinSceneNames() { return {"halo", "bleed", "ear", "head"}; }
+std::vector<std::string> builtinSceneNames() {
+    return {"halo", "bleed", "ear", "head", "halo-grey-backdrop", "bleed-true-mask"};
+}
 
 std::optional<std::string_view> builtinSceneText(std::string_view name) {
     for (const auto& known : builtinSceneNames())

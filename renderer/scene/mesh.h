@@ -3,10 +3,13 @@
 // scenes). Positions in world units (the scene's mm_per_unit gives their physical size).
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace skinlab::renderer {
+
+struct Image;
 
 struct Vertex {
     glm::vec3 position{0.0f};
@@ -40,6 +43,10 @@ struct Model {
     std::vector<MeshMaterial> materials;
     glm::vec3 boundsMin{0.0f};
     glm::vec3 boundsMax{0.0f};
+    // Maps the model brings itself (the procedural skin maps of builtin:head; null: none). A scene spec's
+    // textures.albedo / textures.normal replace them.
+    std::shared_ptr<const Image> albedoMap;
+    std::shared_ptr<const Image> normalMap;
 
     void computeBounds();
 };

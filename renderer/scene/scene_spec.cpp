@@ -114,6 +114,11 @@ SceneSpec loadSceneSpec(const std::string& scene, const std::vector<std::string>
         if (model.has("thickness_mm")) {
             if (source != "builtin:ear") model.fail("thickness_mm", "only applies to builtin:ear");
         }
+        if (model.has("skin_detail")) {
+            if (source != "builtin:head") model.fail("skin_detail", "only applies to builtin:head");
+        }
+        spec.skinDetail = model.boolean("skin_detail", true);
+        if (source == "builtin:head") resolved["model"]["skin_detail"] = spec.skinDetail;
         if (model.has("flip_v") && source.rfind("builtin:", 0) == 0)
             model.fail("flip_v", "only applies to model files");
         spec.flipV = model.boolean("flip_v", false);

@@ -71,6 +71,7 @@ struct SceneSpec {
     std::string modelSource;           // "builtin:NAME" or the model file path (resolved)
     double depthGapMm = 200.0;         // builtin:halo only
     double thicknessMm = 2.5;          // builtin:ear only
+    bool skinDetail = true;            // builtin:head only: its procedural skin maps (skin_detail.h)
     bool flipV = false;                // model files whose UVs are upside down (v = 1 - v), e.g. the scan
     double mmPerUnit = 1.0;
     TexturesSpec textures;

@@ -341,7 +341,9 @@ TEST(StimulusOutputFolder, RefusesForeignFolders) {
 
 namespace {
 // The shipped specs that render the scanned head (the others use built-in scenes only).
-bool needsHead(const std::string& file) { return file.rfind("thesis-", 0) == 0 || file == "extensions-head.toml"; }
+bool needsHead(const std::string& file) {
+    return file.rfind("thesis-", 0) == 0 || file == "extensions-head.toml" || file == "demo-scan.toml";
+}
 } // namespace
 
 // The shipped specs parse and expand to the documented counts (docs/stimuli.md). The thesis specs' scene is
@@ -350,6 +352,7 @@ TEST(ShippedSpecs, ExpandToTheDocumentedCounts) {
     const fs::path dir = fs::path(SKINLAB_SOURCE_DIR) / "stimuli" / "specs";
     const std::vector<std::pair<std::string, size_t>> expected = {
         {"demo.toml", 19},
+        {"demo-scan.toml", 19},
         {"thesis-fig5.2-methods.toml", 18},
         {"thesis-fig3.16-halos.toml", 7},
         {"thesis-fig3.17-bleeding.toml", 7},

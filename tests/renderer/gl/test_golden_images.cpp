@@ -1,4 +1,4 @@
-// Golden images of the four built-in scenes at 128×128 (label gl). The goldens are the beauty channels of
+// Golden images of the built-in scenes and their named variants at 128×128 (label gl). The goldens are the beauty channels of
 // tests/data/golden/NAME.exr (half float). Regenerate after an intended change with
 //   SKINLAB_UPDATE_GOLDENS=1 ctest -R GoldenImages
 // and review the new images before committing them. A failure writes NAME-actual.exr, NAME-expected.exr and
@@ -104,7 +104,9 @@ TEST_P(GoldenImages, BuiltinSceneMatchesItsGolden) {
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(Builtin, GoldenImages, ::testing::Values("halo", "bleed", "ear", "head"));
+// The named variants halo-grey-backdrop and bleed-true-mask keep the goldens of the former halo and bleed defaults.
+INSTANTIATE_TEST_SUITE_P(Builtin, GoldenImages,
+                         ::testing::Values("halo", "bleed", "ear", "head", "halo-grey-backdrop", "bleed-true-mask"));
 
 } // namespace
 } // namespace skinlab::renderer

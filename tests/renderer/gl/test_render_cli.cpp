@@ -91,7 +91,7 @@ TEST_F(RenderCli, UnknownBuiltinScene) {
     const CliRun run = runCli({"render", "--scene", "builtin:torso", "-o", (out / "x.exr").string()}, folder);
     EXPECT_EQ(run.exitCode, 2);
     EXPECT_EQ(errorLine(run), "skinlab: error: unknown built-in scene 'builtin:torso' (known: builtin:halo, "
-                              "builtin:bleed, builtin:ear, builtin:head)");
+                              "builtin:bleed, builtin:ear, builtin:head, builtin:halo-grey-backdrop, builtin:bleed-true-mask)");
     EXPECT_TRUE(folderIsEmpty(out.path()));
 }
 

@@ -24,7 +24,7 @@ using test::TempFolder;
 // head-on directional light of L_c = 2 and no environment: the analytic scene of these tests.
 RenderRequest lambertPlane(const std::filesystem::path& exr, std::vector<std::string> extra = {}) {
     RenderRequest request;
-    request.scene = "builtin:bleed";
+    request.scene = "builtin:bleed-true-mask";
     request.overrides = {"materials=[{name = \"skin\", albedo = [0.5, 0.5, 0.5], glossiness = 0.5, specular_intensity = 1.0}]",
                          "lights=[{type = \"directional\", direction = [0.0, 0.0, -1.0], intensity = 2.0, shadow = false}]",
                          "environment.radiance=[0.0, 0.0, 0.0]",
@@ -143,7 +143,7 @@ TEST(RenderPipeline, ShadowsDarkenTheBackdropBehindTheSphere) {
     SKINLAB_REQUIRE_RENDERER(renderer);
     TempFolder folder("shadow");
     RenderRequest request;
-    request.scene = "builtin:halo";
+    request.scene = "builtin:halo-grey-backdrop";
     request.width = 96;
     request.height = 96;
     request.exrPath = folder / "lit.exr";
@@ -173,7 +173,7 @@ TEST(RenderPipeline, ExrLayoutChannelsAndMetadata) {
     SKINLAB_REQUIRE_RENDERER(renderer);
     TempFolder folder("layout");
     RenderRequest request;
-    request.scene = "builtin:halo";
+    request.scene = "builtin:halo-grey-backdrop";
     request.width = 64;
     request.height = 64;
     request.exrPath = folder / "halo.exr";

@@ -49,7 +49,7 @@ TEST(SurfaceAovs, SphereCurvatureIsOneOverItsRadius) {
     // Two resolutions and two distances: the measure is in 1/world unit, independent of the pixel scale.
     for (const Variant variant : {Variant{128, "mid"}, Variant{64, "mid"}, Variant{96, "far"}}) {
         const ExrImage image =
-            renderScene(*renderer, folder, "builtin:halo", variant.size, {std::string("camera.view=") + variant.view});
+            renderScene(*renderer, folder, "builtin:halo-grey-backdrop", variant.size, {std::string("camera.view=") + variant.view});
         std::vector<double> interior;
         for (const auto& [x, y] : test::interiorSkinPixels(image, 4)) interior.push_back(image.at("curvature.Y", x, y));
         const double measured = median(interior);
@@ -73,7 +73,7 @@ TEST(SurfaceAovs, SphereCurvatureIsOneOverItsRadius) {
 TEST(SurfaceAovs, FlatPatchCurvatureIsNearZero) {
     SKINLAB_REQUIRE_RENDERER(renderer);
     TempFolder folder("curvature-plane");
-    const ExrImage image = renderScene(*renderer, folder, "builtin:bleed", 128);
+    const ExrImage image = renderScene(*renderer, folder, "builtin:bleed-true-mask", 128);
     const auto interior = test::interiorSkinPixels(image, 4);
     ASSERT_GT(interior.size(), 1000u);
     float largest = 0.0f;
@@ -86,7 +86,7 @@ TEST(SurfaceAovs, FlatPatchCurvatureIsNearZero) {
 TEST(SurfaceAovs, AuxiliaryImageMatchesTheCppMirrorAndGrowsTowardsTheSilhouette) {
     SKINLAB_REQUIRE_RENDERER(renderer);
     TempFolder folder("aux-sphere");
-    const ExrImage image = renderScene(*renderer, folder, "builtin:halo", 128);
+    const ExrImage image = renderScene(*renderer, folder, "builtin:halo-grey-backdrop", 128);
     const test::ExrCamera camera = test::exrCamera(image);
     const glm::mat3 viewFromWorld(camera.view);
     int checked = 0;
@@ -137,8 +137,8 @@ TEST(SurfaceAovs, AuxiliaryImageMatchesTheCppMirrorAndGrowsTowardsTheSilhouette)
 TEST(SurfaceAovs, ScreenSpaceCurvatureGrowsTowardsTheSilhouette) {
     SKINLAB_REQUIRE_RENDERER(renderer);
     TempFolder folder("curvature-screen");
-    const ExrImage normal = renderScene(*renderer, folder, "builtin:halo", 160);
-    const ExrImage screen = renderScene(*renderer, folder, "builtin:halo", 160, {"sss.curvature_measure=screen"});
+    const ExrImage normal = renderScene(*renderer, folder, "builtin:halo-grey-backdrop", 160);
+    const ExrImage screen = renderScene(*renderer, folder, "builtin:halo-grey-backdrop", 160, {"sss.curvature_measure=screen"});
     const test::ExrCamera camera = test::exrCamera(screen);
     const glm::vec4 clip = camera.projection * camera.view * glm::vec4(0, 0, 0, 1);
     const int centreX = static_cast<int>(std::floor((clip.x / clip.w * 0.5f + 0.5f) * static_cast<float>(screen.width)));

@@ -101,8 +101,9 @@ TEST(PathtracedRender, LayoutMaskAndDepthAgreeWithTheRasterizer) {
     SKINLAB_REQUIRE_BLENDER();
     SKINLAB_REQUIRE_RENDERER(renderer);
     TempFolder folder("pathtraced-agreement");
-    // builtin:halo: skin sphere against a non-skin backdrop; builtin:ear: a thin skin part against the background.
-    for (const std::string scene : {"halo", "ear"}) {
+    // builtin:halo-grey-backdrop: skin sphere against a non-skin backdrop; builtin:ear: a thin skin part against the
+    // background.
+    for (const std::string scene : {"halo-grey-backdrop", "ear"}) {
         renderToExr(*renderer, "builtin:" + scene, "pathtraced", kTiny, 64, 64, folder / (scene + "-cycles.exr"));
         renderToExr(*renderer, "builtin:" + scene, "none", {}, 64, 64, folder / (scene + "-raster.exr"));
         const ExrImage cycles = readExr(folder / (scene + "-cycles.exr"));

@@ -45,7 +45,7 @@ const std::vector<std::string> kHeadOnLight = {
 TEST(ReferenceRender, RendersEveryBuiltinScene) {
     SKINLAB_REQUIRE_RENDERER(renderer);
     TempFolder folder("reference-builtin");
-    for (const std::string scene : {"halo", "bleed", "ear", "head"}) {
+    for (const std::string scene : {"halo-grey-backdrop", "bleed-true-mask", "ear", "head"}) {
         const std::string edge = scene == "head" ? "4" : "3";
         const Rendered reference = renderScene(*renderer, folder, scene, "builtin:" + scene, "reference",
                                                {"sss.reference_edge_mm=" + edge});
@@ -75,7 +75,7 @@ TEST(ReferenceRender, RendersEveryBuiltinScene) {
         EXPECT_GT(skin, 100) << scene;
         // SSS softens the lighting almost everywhere on curved skin; the flat, uniformly lit bleed patch stays as
         // it is (the renormalised convolution keeps uniform light unchanged, at the paint borders too).
-        if (scene == "bleed") EXPECT_EQ(changed, 0) << scene;
+        if (scene == "bleed-true-mask") EXPECT_EQ(changed, 0) << scene;
         else EXPECT_GT(changed, skin / 4) << scene;
         EXPECT_EQ(nonSkinDifference, 0.0) << scene;  // non-skin and background: the main pass's diffuse
         EXPECT_LE(run.at("longest_edge_mm").get<double>(), std::stod(edge)) << scene;
@@ -123,8 +123,8 @@ TEST(ReferenceRender, UniformlyLitFlatSkinKeepsItsDiffuse) {
     std::vector<std::string> overrides = kHeadOnLight;
     overrides.push_back("materials=[{name = \"*\", albedo = [0.6, 0.45, 0.4], skin = true}]");
     overrides.push_back("sss.reference_edge_mm=3");
-    const Rendered reference = renderScene(*renderer, folder, "flat", "builtin:bleed", "reference", overrides, 128);
-    const Rendered none = renderScene(*renderer, folder, "flat-none", "builtin:bleed", "none", overrides, 128);
+    const Rendered reference = renderScene(*renderer, folder, "flat", "builtin:bleed-true-mask", "reference", overrides, 128);
+    const Rendered none = renderScene(*renderer, folder, "flat-none", "builtin:bleed-true-mask", "none", overrides, 128);
     const ExrImage& image = reference.image;
     // Pixels whose 9 × 9 neighbourhood is all skin: away from the patch border (interpolation of the last
     // triangle row against the background is not what this test is about).
@@ -155,7 +155,7 @@ TEST(ReferenceRender, ConvergesAsTheEdgeShrinks) {
     std::vector<ExrImage> images;
     const char* edges[] = {"2", "1", "0.5"};
     for (const char* edge : edges)
-        images.push_back(renderScene(*renderer, folder, std::string("halo-") + edge, "builtin:halo", "reference",
+        images.push_back(renderScene(*renderer, folder, std::string("halo-") + edge, "builtin:halo-grey-backdrop", "reference",
                                      {std::string("sss.reference_edge_mm=") + edge, "sss.width_mm=0.75"}, 128)
                              .image);
     std::vector<double> differences;
@@ -186,10 +186,10 @@ TEST(ReferenceRender, PaintNeverReachesTheSkin) {
     const std::string paint =
         "materials=[{name = \"paint-dark\", albedo = [0.9, 0.1, 0.05]}, {name = \"paint-bright\", albedo = [1.0, 1.0, 1.0]}]";
     const std::vector<std::string> edge = {"sss.reference_edge_mm=3"};
-    const Rendered plain = renderScene(*renderer, folder, "plain", "builtin:bleed", "reference", edge, 128);
-    const Rendered painted = renderScene(*renderer, folder, "painted", "builtin:bleed", "reference",
+    const Rendered plain = renderScene(*renderer, folder, "plain", "builtin:bleed-true-mask", "reference", edge, 128);
+    const Rendered painted = renderScene(*renderer, folder, "painted", "builtin:bleed-true-mask", "reference",
                                          {edge[0], paint}, 128);
-    const Rendered none = renderScene(*renderer, folder, "painted-none", "builtin:bleed", "none", {paint}, 128);
+    const Rendered none = renderScene(*renderer, folder, "painted-none", "builtin:bleed-true-mask", "none", {paint}, 128);
     int skin = 0, paintPixels = 0, paintChanged = 0;
     double skinDifference = 0.0, paintDifference = 0.0;
     for (int y = 0; y < plain.image.height; ++y)
@@ -219,7 +219,7 @@ TEST(ReferenceRender, DiffuseDoesNotDependOnTheCameraDistance) {
     TempFolder folder("reference-view");
     std::vector<ExrImage> images;
     for (const char* distance : {"200", "400"})
-        images.push_back(renderScene(*renderer, folder, std::string("view-") + distance, "builtin:halo", "reference",
+        images.push_back(renderScene(*renderer, folder, std::string("view-") + distance, "builtin:halo-grey-backdrop", "reference",
                                      {"sss.reference_edge_mm=3", "camera.view=explicit", "camera.fov_deg=30",
                                       std::string("camera.position=[0.0, 0.0, ") + distance + "]",
                                       "camera.target=[0.0, 0.0, 0.0]"},
@@ -278,13 +278,13 @@ TEST(ReferenceRender, RefusesTabulatedProfilesAndTooFineEdges) {
         out.write(reinterpret_cast<const char*>(values), sizeof(values));
     }
     try {
-        renderScene(*renderer, folder, "tabulated", "builtin:halo", "reference", {"sss.profile=file:" + kernel.string()},
+        renderScene(*renderer, folder, "tabulated", "builtin:halo-grey-backdrop", "reference", {"sss.profile=file:" + kernel.string()},
                     48);
         FAIL() << "no exception";
     } catch (const skinlab::InputError& e) {
         const std::string message = e.what();
         std::printf("tabulated: %s\n", message.c_str());
-        EXPECT_EQ(message, "builtin:halo: sss.profile: 'file:" + kernel.string() +
+        EXPECT_EQ(message, "builtin:halo-grey-backdrop: sss.profile: 'file:" + kernel.string() +
                                "' has no radial form for the reference method (use deon or burley)");
     }
 }

@@ -127,7 +127,7 @@ TEST(Tessellation, SplitsOnlyLongTrianglesOfAMixedMesh) {
 }
 
 TEST(Tessellation, BuiltinHeadNeedsFarFewerVerticesThanUniformRounds) {
-    const Model head = makeHeadScene();
+    const Model head = makeHeadScene(false);
     TessellationStatistics statistics;
     const Model fine = tessellateSkin(head, 2.0f, 1.0f, &statistics);
     const std::size_t uniform = uniformSchemeVertices(head, 2.0f, 1.0f);

@@ -3,10 +3,12 @@
 // thickness, head landmarks).
 #include "common/error.h"
 #include "renderer/scene/builtin_geometry.h"
+#include "renderer/scene/skin_detail.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <functional>
 #include <map>
@@ -332,7 +334,7 @@ TEST(EarScene, ConcaveSideFacesTheViewer) {
 // --- builtin:head -------------------------------------------------------------------------------------------
 
 TEST(HeadScene, SizeTriangleCountAndMaterials) {
-    const Model model = makeHeadScene();
+    const Model model = makeHeadScene(false);
     expectValidModel(model);
     const std::size_t triangles = model.indices.size() / 3;
     EXPECT_GE(triangles, 20000u);
@@ -348,7 +350,7 @@ TEST(HeadScene, SizeTriangleCountAndMaterials) {
 }
 
 TEST(HeadScene, HeadSurfaceIsWatertightAndFeaturesSitWhereDocumented) {
-    const Model model = makeHeadScene();
+    const Model model = makeHeadScene(false);
     // The first part is the skull/face surface.
     const SubMesh& head = model.parts.front();
     EXPECT_EQ(countOpenEdges(Model{model.vertices, model.indices, {head}, model.materials, {}, {}}, head.material), 0);
@@ -383,7 +385,7 @@ TEST(HeadScene, HeadSurfaceIsWatertightAndFeaturesSitWhereDocumented) {
 }
 
 TEST(HeadScene, LipsAreRedderAndBrowsDarker) {
-    const Model model = makeHeadScene();
+    const Model model = makeHeadScene(false);
     const SubMesh& head = model.parts.front();
     int lips = 0;
     int brows = 0;
@@ -403,7 +405,7 @@ TEST(HeadScene, LipsAreRedderAndBrowsDarker) {
 }
 
 TEST(HeadScene, EarsProtrudeAtTheSidesAtEarHeight) {
-    const Model model = makeHeadScene();
+    const Model model = makeHeadScene(false);
     // Parts after the head surface: ear, ear, eye, eye, neck side, neck cap.
     ASSERT_GE(model.parts.size(), 3u);
     for (int ear : {1, 2}) {
@@ -425,11 +427,80 @@ TEST(HeadScene, EarsProtrudeAtTheSidesAtEarHeight) {
 }
 
 TEST(BuiltinGeometry, IsDeterministic) {
-    const Model first = makeHeadScene();
-    const Model second = makeHeadScene();
+    const Model first = makeHeadScene(false);
+    const Model second = makeHeadScene(false);
     ASSERT_EQ(first.vertices.size(), second.vertices.size());
     EXPECT_EQ(0, std::memcmp(first.vertices.data(), second.vertices.data(), first.vertices.size() * sizeof(Vertex)));
     EXPECT_EQ(first.indices, second.indices);
+}
+
+// --- builtin:head's skin detail (skin_detail.h) -------------------------------------------------------------
+
+TEST(HeadSkinDetail, MapsAreDeterministicUnitNormalsWithDetailAndNoSeam) {
+    // Smaller than the built-in 2048 × 1024 to stay quick; the features are functions of the surface point in mm,
+    // so the statistics are those of the full maps, sampled more coarsely.
+    const SkinDetailMaps maps = makeHeadSkinDetail(1024, 512);
+    const SkinDetailMaps again = makeHeadSkinDetail(1024, 512);
+    ASSERT_EQ(maps.normal.width, 1024);
+    ASSERT_EQ(maps.albedo.height, 512);
+    EXPECT_EQ(maps.normal.pixels, again.normal.pixels);
+    EXPECT_EQ(maps.albedo.pixels, again.albedo.pixels);
+    double albedoSum = 0.0, tiltSum = 0.0;
+    int tilted = 0, count = 0;
+    for (int y = 0; y < 512; ++y)
+        for (int x = 0; x < 1024; ++x) {
+            const glm::vec4 n = maps.normal.texel(x, y);
+            const glm::vec3 normal = glm::vec3(n) * 2.0f - 1.0f;
+            ASSERT_NEAR(glm::length(normal), 1.0f, 1e-4f) << x << ", " << y;
+            ASSERT_GT(normal.z, 0.0f);
+            if (y == 0) {
+                // Row 0 (the crown pole, sampled by the eyes) is flat with albedo 1.
+                EXPECT_EQ(glm::vec3(n), glm::vec3(0.5f, 0.5f, 1.0f));
+                EXPECT_EQ(glm::vec3(maps.albedo.texel(x, y)), glm::vec3(1.0f));
+                continue;
+            }
+            const glm::vec3 a(maps.albedo.texel(x, y));
+            ASSERT_GT(a.g, 0.2f);
+            ASSERT_LT(a.r, 1.5f);
+            albedoSum += (a.r + a.g + a.b) / 3.0;
+            const double tilt = std::sqrt(normal.x * normal.x + normal.y * normal.y);
+            tiltSum += tilt;
+            tilted += tilt > 0.1;
+            ++count;
+        }
+    const double albedoMean = albedoSum / count;
+    const double tiltMean = tiltSum / count;
+    std::printf("head skin detail 1024×512: albedo multiplier mean %.4f; normal tilt mean %.4f, %.1f %% of texels tilted > "
+                "0.1\n", albedoMean, tiltMean, 100.0 * tilted / count);
+    EXPECT_NEAR(albedoMean, 1.0, 0.05);  // the map varies the skin albedo, it does not change its tone
+    // Pores and lines: the normal map is not flat (a flat map gives 0 and 0; measured at this size: 0.023 and 1.1 %).
+    EXPECT_GT(tiltMean, 0.01);
+    EXPECT_GT(tilted, count / 200);
+    // No seam at u = 0 = 1 (the front of the face): neighbours across the seam differ no more than neighbours
+    // inside the chart do, on average over the face rows.
+    double across = 0.0, inside = 0.0;
+    for (int y = 200; y < 330; ++y) {
+        across += glm::length(glm::vec3(maps.albedo.texel(0, y)) - glm::vec3(maps.albedo.texel(1023, y)));
+        inside += glm::length(glm::vec3(maps.albedo.texel(1, y)) - glm::vec3(maps.albedo.texel(0, y)));
+    }
+    EXPECT_LT(across, 2.0 * inside + 1e-3);
+}
+
+TEST(HeadSkinDetail, TheHeadBringsTheMapsUnlessAskedForTheSmoothHead) {
+    const Model detailed = makeHeadScene();
+    ASSERT_TRUE(detailed.albedoMap && detailed.normalMap);
+    EXPECT_EQ(detailed.normalMap->width, kHeadDetailWidth);
+    EXPECT_EQ(detailed.normalMap->height, kHeadDetailHeight);
+    const Model smooth = makeHeadScene(false);
+    EXPECT_FALSE(smooth.albedoMap || smooth.normalMap);
+    // The same mesh either way.
+    ASSERT_EQ(detailed.vertices.size(), smooth.vertices.size());
+    EXPECT_EQ(0, std::memcmp(detailed.vertices.data(), smooth.vertices.data(), smooth.vertices.size() * sizeof(Vertex)));
+    // The eyes sample the flat row 0 of the maps.
+    const SubMesh& eye = detailed.parts[3];
+    ASSERT_EQ(detailed.materials[eye.material].name, "eye");
+    for (std::uint32_t i = eye.firstIndex; i < eye.firstIndex + eye.indexCount; ++i)
+        ASSERT_LT(detailed.vertices[detailed.indices[i]].uv.y, 1.0f / static_cast<float>(kHeadDetailHeight));
 }
 
 } // namespace

@@ -70,13 +70,13 @@ TEST(ExtensionScores, FollowSurfaceAndCbfAgainstTheHaloOfEveryScreenSpaceMethod)
         const std::string gap = std::to_string(static_cast<int>(gapMm));
         // 2 mm reference edges: the skin backdrop is 600 × 600 mm, and 1 mm edges take 3–4× as long (11 s per
         // reference); 4 mm edges moved the halo scores by < 10 % and changed none of the comparisons below.
-        const auto referenceExr = renderExr(*renderer, folder, "reference-" + gap, "builtin:halo", "reference",
+        const auto referenceExr = renderExr(*renderer, folder, "reference-" + gap, "builtin:halo-grey-backdrop", "reference",
                                             with(scene, {"sss.reference_edge_mm=2"}));
         const metrics::PreparedReference reference = prepare(referenceExr);
         for (const auto& method : kScreenSpaceMethods) {
             auto halo = [&](const std::string& name, std::initializer_list<std::string> overrides) {
                 return leakEnergy(reference,
-                                  renderExr(*renderer, folder, method + "-" + gap + "-" + name, "builtin:halo", method,
+                                  renderExr(*renderer, folder, method + "-" + gap + "-" + name, "builtin:halo-grey-backdrop", method,
                                             with(scene, overrides)),
                                   metrics::Band::halo);
             };
@@ -109,7 +109,7 @@ TEST(ExtensionScores, LabWeightCutsTheBleedOfTheSeparableMethods) {
     SKINLAB_REQUIRE_RENDERER(renderer);
     TempFolder folder("extension-scores-bleed");
     const metrics::PreparedReference reference =
-        prepare(renderExr(*renderer, folder, "reference", "builtin:bleed", "reference", {}));
+        prepare(renderExr(*renderer, folder, "reference", "builtin:bleed-true-mask", "reference", {}));
     const std::vector<std::string> coarseMask{"materials=[{name = \"*\", skin = true}]"};
     struct Case {
         std::string method;
@@ -118,11 +118,11 @@ TEST(ExtensionScores, LabWeightCutsTheBleedOfTheSeparableMethods) {
     for (const Case& c : std::vector<Case>{{"separable", 0.09}, {"artistic", 0.09}, {"pscbf", 0.09},
                                            {"gaussian-sum", 0.5}}) {
         const double off = leakEnergy(
-            reference, renderExr(*renderer, folder, c.method + "-off", "builtin:bleed", c.method, coarseMask),
+            reference, renderExr(*renderer, folder, c.method + "-off", "builtin:bleed-true-mask", c.method, coarseMask),
             metrics::Band::bleed);
         const double lab = leakEnergy(
             reference,
-            renderExr(*renderer, folder, c.method + "-lab", "builtin:bleed", c.method,
+            renderExr(*renderer, folder, c.method + "-lab", "builtin:bleed-true-mask", c.method,
                       with(coarseMask, {"sss.lab_weight=" + std::to_string(c.beta)})),
             metrics::Band::bleed);
         std::printf("  %-13s bleed leak energy: %.3e without, %.3e with sss.lab_weight = %.2f (x %.4f)\n",
@@ -145,11 +145,11 @@ TEST(ExtensionScores, CurvatureStrategiesOnAFlatPlane) {
                0.0722 * image.at("diffuse.B", x, y);
     };
     const test::ExrImage none =
-        test::readExr(renderExr(*renderer, folder, "none", "builtin:bleed", "none", coarseMask));
+        test::readExr(renderExr(*renderer, folder, "none", "builtin:bleed-true-mask", "none", coarseMask));
     for (const std::string method : {"separable", "gaussian-sum"}) {
         auto blur = [&](const std::string& strategy) {
             const test::ExrImage image = test::readExr(
-                renderExr(*renderer, folder, method + "-" + strategy, "builtin:bleed", method,
+                renderExr(*renderer, folder, method + "-" + strategy, "builtin:bleed-true-mask", method,
                           with(coarseMask, {"sss.curvature=" + strategy, "sss.curvature_floor=0.5"})));
             double change = 0.0, curvature = 0.0;
             for (int y = 0; y < image.height; ++y)
@@ -188,10 +188,10 @@ TEST(ExtensionScores, CurvatureStrategiesOnTheHaloSphere) {
         return 0.2126 * image.at("diffuse.R", x, y) + 0.7152 * image.at("diffuse.G", x, y) +
                0.0722 * image.at("diffuse.B", x, y);
     };
-    const test::ExrImage none = test::readExr(renderExr(*renderer, folder, "none", "builtin:halo", "none", scene));
+    const test::ExrImage none = test::readExr(renderExr(*renderer, folder, "none", "builtin:halo-grey-backdrop", "none", scene));
     auto blur = [&](const std::string& strategy) {
         const test::ExrImage image = test::readExr(
-            renderExr(*renderer, folder, strategy, "builtin:halo", "separable",
+            renderExr(*renderer, folder, strategy, "builtin:halo-grey-backdrop", "separable",
                       with(scene, {"sss.curvature=" + strategy, "sss.curvature_floor=0.5"})));
         double change = 0.0, curvature = 0.0;
         int sphere = 0;

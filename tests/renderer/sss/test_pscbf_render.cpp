@@ -206,7 +206,7 @@ SyntheticFrame impulseOnPlane(std::array<double, 3> normal) {
 
 TEST(PscbfRender, RendersEveryBuiltinScene) {
     SKINLAB_REQUIRE_RENDERER(renderer);
-    for (const char* scene : {"builtin:halo", "builtin:bleed", "builtin:ear", "builtin:head"})
+    for (const char* scene : {"builtin:halo-grey-backdrop", "builtin:bleed-true-mask", "builtin:ear", "builtin:head"})
         renderScene(*renderer, scene);
 }
 
@@ -226,8 +226,8 @@ TEST(PscbfRender, UniformlyLitSkinPlaneKeepsItsMean) {
         "materials=[{name = \"*\", skin = true, albedo = [0.5, 0.5, 0.5]}]",
         "lights=[{type = \"directional\", direction = [0.0, 0.0, -1.0], intensity = 2.0, shadow = false}]",
         "environment.radiance=[0.0, 0.0, 0.0]"};
-    const ExrImage none = render(*renderer, folder, "builtin:bleed", "none", plane, 96, 64);
-    const ExrImage image = render(*renderer, folder, "builtin:bleed", "pscbf", plane, 96, 64);
+    const ExrImage none = render(*renderer, folder, "builtin:bleed-true-mask", "none", plane, 96, 64);
+    const ExrImage image = render(*renderer, folder, "builtin:bleed-true-mask", "pscbf", plane, 96, 64);
     for (const char* c : {"diffuse.R", "diffuse.G", "diffuse.B"}) {
         double before = 0.0, after = 0.0;
         int count = 0;
@@ -255,8 +255,8 @@ TEST(PscbfRender, DepthWeightStopsLightCrossingTheDepthGapOfHalo) {
             "materials=[{name = \"*\", skin = true}]",
             "lights=[{type = \"directional\", direction = [0.45, -0.45, -0.77], intensity = 1.2, shadow = false}]",
             std::string("sss.follow_surface=") + (follow ? "true" : "false"), "sss.width_mm=12"};
-        const ExrImage none = render(*renderer, folder, "builtin:halo", "none", overrides, 96, 96);
-        const ExrImage image = render(*renderer, folder, "builtin:halo", method, overrides, 96, 96);
+        const ExrImage none = render(*renderer, folder, "builtin:halo-grey-backdrop", "none", overrides, 96, 96);
+        const ExrImage image = render(*renderer, folder, "builtin:halo-grey-backdrop", method, overrides, 96, 96);
         float nearest = 1e30f;
         for (float z : image.channels.at("depth.Z")) nearest = std::min(nearest, z);
         double leak = 0.0;

@@ -60,7 +60,7 @@ void renderEveryMethod(Renderer& renderer, const std::string& scene, const std::
 
 TEST(SssRender, EveryMethodRendersEveryBuiltinScene) {
     SKINLAB_REQUIRE_RENDERER(renderer);
-    for (const char* scene : {"builtin:halo", "builtin:bleed", "builtin:ear", "builtin:head"})
+    for (const char* scene : {"builtin:halo-grey-backdrop", "builtin:bleed-true-mask", "builtin:ear", "builtin:head"})
         renderEveryMethod(*renderer, scene);
 }
 
@@ -79,7 +79,7 @@ TEST(SssRender, EveryMethodWithEveryExtensionRendersEveryScene) {
     const std::vector<std::string> all{"sss.cbf=true", "sss.lab_weight=0.09", "sss.curvature=reduce-floor",
                                        "transmittance.enabled=true", "transmittance.curvature=true"};
     const std::vector<std::string> methods{"gaussian-sum", "separable", "artistic", "pscbf"};
-    std::vector<std::string> scenes{"builtin:halo", "builtin:bleed", "builtin:ear", "builtin:head"};
+    std::vector<std::string> scenes{"builtin:halo-grey-backdrop", "builtin:bleed-true-mask", "builtin:ear", "builtin:head"};
     const char* assets = std::getenv("SKINLAB_ASSETS");
     if (assets && *assets)
         scenes.push_back((std::filesystem::path(SKINLAB_SOURCE_DIR) / "renderer/scenes/lee-perry-smith.toml").string());
@@ -96,9 +96,9 @@ TEST(SssRender, UniformlyLitSkinPlaneKeepsItsMean) {
         "materials=[{name = \"*\", skin = true, albedo = [0.5, 0.5, 0.5]}]",
         "lights=[{type = \"directional\", direction = [0.0, 0.0, -1.0], intensity = 2.0, shadow = false}]",
         "environment.radiance=[0.0, 0.0, 0.0]"};
-    const ExrImage none = render(*renderer, folder, "builtin:bleed", "none", plane, 96, 64);
+    const ExrImage none = render(*renderer, folder, "builtin:bleed-true-mask", "none", plane, 96, 64);
     for (const auto& method : kMethods) {
-        const ExrImage image = render(*renderer, folder, "builtin:bleed", method, plane, 96, 64);
+        const ExrImage image = render(*renderer, folder, "builtin:bleed-true-mask", method, plane, 96, 64);
         for (const char* c : {"diffuse.R", "diffuse.G", "diffuse.B"}) {
             double before = 0.0, after = 0.0;
             int count = 0;
@@ -129,8 +129,8 @@ TEST(SssRender, FollowSurfaceStopsLightCrossingTheDepthGapOfHalo) {
         overrides.push_back(std::string("sss.follow_surface=") + (follow ? "true" : "false"));
         // Wide kernel so that it reaches across the silhouette at this small size.
         overrides.push_back("sss.width_mm=12");
-        const ExrImage none = render(*renderer, folder, "builtin:halo", "none", overrides, 96, 96);
-        const ExrImage image = render(*renderer, folder, "builtin:halo", method, overrides, 96, 96);
+        const ExrImage none = render(*renderer, folder, "builtin:halo-grey-backdrop", "none", overrides, 96, 96);
+        const ExrImage image = render(*renderer, folder, "builtin:halo-grey-backdrop", method, overrides, 96, 96);
         float nearest = 1e30f;
         for (float z : image.channels.at("depth.Z")) nearest = std::min(nearest, z);
         double leak = 0.0;
