@@ -5,6 +5,7 @@
 #include "cli/commands.h"
 #include "common/error.h"
 #include "common/files.h"
+#include "experiments/active_sampling.h"
 
 #include <spdlog/spdlog.h>
 
@@ -32,6 +33,7 @@ struct ScaleArguments {
     bool singleBlock = false;
     std::vector<std::string> conditions;
     bool dropFlagged = false;
+    std::string intervals = "auto";
 };
 
 void runScale(const ScaleArguments& arguments) {
@@ -58,6 +60,16 @@ void runScale(const ScaleArguments& arguments) {
         else
             std::printf("dropped 0 flagged trials: %s records no page-hidden or focus flags\n", table.file.c_str());
     }
+    // Likelihood-based intervals stay valid when each observer's pairs depended on earlier answers; the observer
+    // bootstrap does not (docs/analysis.md, "Validation of active designs").
+    if (arguments.intervals == "profile" || (arguments.intervals == "auto" && table.adaptiveDesign)) {
+        options.intervals = scaling::IntervalMethod::profile;
+        options.intervalReason = arguments.intervals == "profile" ? "--intervals profile" : "active design";
+    } else {
+        options.intervalReason = arguments.intervals == "bootstrap" ? "--intervals bootstrap" : "fixed design";
+    }
+    if (options.intervals == scaling::IntervalMethod::profile && arguments.intervals == "auto")
+        std::printf("active design (pairs chosen from earlier answers): profile-likelihood intervals\n");
     const scaling::Dataset dataset = scaling::buildDataset(table, datasetOptions);
     const scaling::Analysis analysis = scaling::analyzeDataset(dataset, options);
     for (const std::string& warning : analysis.warnings) spdlog::warn("{}", warning);
@@ -101,7 +113,8 @@ std::vector<std::string> failedTargets(const scaling::ValidationReport& report) 
             if (row.observers == 20 && row.rmse > 0.16) fail("RMSE > 0.16", row.rmse);
             if (row.significantReversed > 0.002) fail("significant & reversed > 0.002", row.significantReversed);
         }
-        if (row.scenario == "sparse" || row.scenario == "disconnected" || row.scenario == "near-unanimous") {
+        if (row.scenario == "sparse" || row.scenario == "disconnected" || row.scenario == "near-unanimous" ||
+            row.scenario == "active") {
             if (row.coverage < 0.93) fail("coverage < 0.93", row.coverage);
         }
         if (!(row.maximumHalfWidth <= 250.0)) fail("an interval wider than the prior allows", row.maximumHalfWidth);
@@ -129,6 +142,15 @@ void runValidate(ValidateArguments& arguments) {
     for (int observers : arguments.options.observerCounts)
         if (observers < 2 + arguments.options.randomObservers + arguments.options.invertedObservers)
             throwInput("--observers", "", std::to_string(observers) + " is too few (at least 2 genuine observers)");
+    // The "active" scenario plans with the study server's planner (experiments/active_sampling.h): the posterior of
+    // every earlier answer, one batch = the spanning tree over 1/information gain.
+    arguments.options.activePlanner = [](int conditions, const std::vector<scaling::PlannerAnswer>& answers,
+                                         std::uint64_t seed) {
+        std::vector<experiments::active::Comparison> comparisons;
+        comparisons.reserve(answers.size());
+        for (const scaling::PlannerAnswer& a : answers) comparisons.push_back({a.winner, a.loser});
+        return experiments::active::spanningTreeBatch(experiments::active::fitPosterior(conditions, comparisons), seed);
+    };
     const scaling::ValidationReport report = scaling::runValidation(arguments.options);
     const std::string markdown = scaling::validationMarkdown(report);
     std::printf("%s", markdown.c_str());
@@ -187,6 +209,11 @@ void registerAnalyzeScale(CLI::App& analyze) {
         ->delimiter(',');
     scale->add_flag("--drop-flagged", scaleArguments->dropFlagged,
                     "leave out trials during which the page was hidden or lost the focus (online studies)");
+    scale->add_option("--intervals", scaleArguments->intervals,
+                      "bootstrap (over observers), profile (profile likelihood, valid for active designs), or auto: "
+                      "profile for a study.db with pairs = \"active\", bootstrap otherwise")
+        ->check(CLI::IsMember({"auto", "bootstrap", "profile"}))
+        ->capture_default_str();
     scale->callback([scaleArguments] { runScale(*scaleArguments); });
 
     auto validateArguments = std::make_shared<ValidateArguments>();
@@ -234,8 +261,15 @@ void registerAnalyzeScale(CLI::App& analyze) {
     validate->add_option("--stretch", o.nearUnanimousStretch, "factor on the true scores (near-unanimous)")
         ->check(CLI::Range(1.0, 100.0))
         ->capture_default_str();
+    validate->add_option("--active-trials", o.activeTrials,
+                         "trials per observer in the active scenario (0: as many as the full design)")
+        ->check(CLI::Range(0, 100000))
+        ->capture_default_str();
+    validate->add_option("--active-stretch", o.activeStretch, "factor on the true scores (active)")
+        ->check(CLI::Range(0.1, 100.0))
+        ->capture_default_str();
     validate->add_option("--scenarios", o.scenarios,
-                         "thurstone, lapses+side-bias, screening, sparse, disconnected, near-unanimous")
+                         "thurstone, lapses+side-bias, screening, sparse, disconnected, near-unanimous, active")
         ->delimiter(',')
         ->capture_default_str();
     validate->add_flag("--check", validateArguments->check,

@@ -160,19 +160,33 @@ ScorePosterior fitPosterior(int conditions, const std::vector<Comparison>& answe
         auto& entry = counts[{std::min(c.winner, c.loser), std::max(c.winner, c.loser)}];
         (c.winner < c.loser ? entry.first : entry.second) += 1.0;
     }
-    std::vector<Comparison> ends;      // site k is a function of d_k = q_ends[k].winner − q_ends[k].loser
+    std::vector<PairCount> pairs;
+    for (const auto& [pair, won] : counts) pairs.push_back({pair.first, pair.second, won.first, won.second});
+    return fitPosteriorFromCounts(conditions, pairs, options);
+}
+
+ScorePosterior fitPosteriorFromCounts(int conditions, const std::vector<PairCount>& counts, const PosteriorOptions& options) {
+    if (conditions < 1) throw RuntimeError("active sampling: a block needs at least one condition");
+    std::vector<Comparison> ends; // site k is a function of d_k = q_ends[k].winner − q_ends[k].loser
     std::vector<double> iWon, jWon;
-    for (const auto& [pair, won] : counts) {
-        ends.push_back({pair.first, pair.second});
-        iWon.push_back(won.first);
-        jWon.push_back(won.second);
+    double total = 0.0;
+    for (std::size_t k = 0; k < counts.size(); ++k) {
+        const PairCount& c = counts[k];
+        if (c.i < 0 || c.j >= conditions || !(c.i < c.j) || !(c.iWon >= 0.0 && c.jWon >= 0.0 && c.iWon + c.jWon > 0.0) ||
+            (k > 0 && !(std::pair(counts[k - 1].i, counts[k - 1].j) < std::pair(c.i, c.j))))
+            throw RuntimeError("active sampling: answer counts of pair (" + std::to_string(c.i) + ", " + std::to_string(c.j) +
+                               ") are not sorted, unique, non-empty pairs of " + std::to_string(conditions) + " conditions");
+        ends.push_back({c.i, c.j});
+        iWon.push_back(c.iWon);
+        jWon.push_back(c.jWon);
+        total += c.iWon + c.jWon;
     }
     const auto n = static_cast<std::size_t>(conditions);
     const double priorPrecision = 1.0 / options.priorVariance;
     ScorePosterior out = ScorePosterior::independent(std::vector<double>(n, 0.0), std::vector<double>(n, options.priorVariance));
-    out.comparisons = static_cast<int>(sorted.size());
+    out.comparisons = static_cast<int>(total);
     out.converged = true;
-    if (sorted.empty()) return out;
+    if (ends.empty()) return out;
     out.converged = false;
 
     // Site k: a Gaussian in d_k with precision π̃_k and shift τ̃_k (natural parameters).
@@ -284,6 +298,76 @@ std::vector<std::pair<int, int>> spanningTreeBatch(const ScorePosterior& posteri
                gains[static_cast<std::size_t>(y.first)][static_cast<std::size_t>(y.second)];
     });
     return edges;
+}
+
+namespace {
+// Expected precision one answer adds to d = q_i − q_j (the variance after either answer, weighted by the
+// predictive probabilities).
+double answerPrecision(double md, double vd) {
+    const double pi = normalCdf(md / std::sqrt(kThurstoneSigma * kThurstoneSigma + vd));
+    const double vAfter = pi * afterAnswer(md, vd).variance + (1.0 - pi) * afterAnswer(-md, vd).variance;
+    return std::max(0.0, 1.0 / vAfter - 1.0 / vd);
+}
+} // namespace
+
+std::vector<std::pair<int, int>> greedyBatch(const ScorePosterior& posterior, int size, std::uint64_t tieSeed,
+                                             BatchCriterion criterion) {
+    const int m = posterior.conditions();
+    if (m < 2 || size < 1) return {};
+    const auto n = static_cast<std::size_t>(m);
+    ScorePosterior p = posterior;
+    SeededRandom random(tieSeed);
+    std::vector<double> jitter(n * n);
+    for (double& j : jitter) j = 1.0 + 1e-6 * random.unit();
+    std::vector<std::pair<int, int>> out;
+    std::vector<double> sa(n);
+    for (int k = 0; k < size; ++k) {
+        double best = -1.0;
+        int bi = 0, bj = 1;
+        // Row sums of Σ (for the centring: C Σ a = Σa − mean(Σa)).
+        std::vector<double> rowMean(n, 0.0);
+        if (criterion == BatchCriterion::varianceReduction)
+            for (std::size_t r = 0; r < n; ++r) {
+                for (std::size_t c = 0; c < n; ++c) rowMean[r] += p.covariance[c * n + r];
+                rowMean[r] /= static_cast<double>(n);
+            }
+        for (int i = 0; i < m; ++i)
+            for (int j = i + 1; j < m; ++j) {
+                double value = 0.0;
+                if (criterion == BatchCriterion::informationGain) {
+                    value = expectedInformationGain(p, i, j);
+                } else {
+                    const auto ui = static_cast<std::size_t>(i), uj = static_cast<std::size_t>(j);
+                    const double vd = std::max(p.covariance[ui * n + ui] + p.covariance[uj * n + uj] - 2.0 * p.covariance[ui * n + uj], 1e-12);
+                    const double precision = answerPrecision(p.mean[ui] - p.mean[uj], vd);
+                    const double shift = rowMean[ui] - rowMean[uj];
+                    double norm = 0.0;
+                    for (std::size_t r = 0; r < n; ++r) {
+                        const double x = p.covariance[r * n + ui] - p.covariance[r * n + uj] - shift;
+                        norm += x * x;
+                    }
+                    value = precision / (1.0 + precision * vd) * norm;
+                }
+                const double g = value * jitter[static_cast<std::size_t>(i) * n + static_cast<std::size_t>(j)];
+                if (g > best) {
+                    best = g;
+                    bi = i;
+                    bj = j;
+                }
+            }
+        out.emplace_back(bi, bj);
+        // The covariance after the answer: d's variance shrinks as after either answer (weighted by their
+        // predictive probabilities); as a site of precision π on d, Σ ← Σ − π/(1 + π v) (Σa)(Σa)ᵀ.
+        const auto wi = static_cast<std::size_t>(bi), wj = static_cast<std::size_t>(bj);
+        for (std::size_t r = 0; r < n; ++r) sa[r] = p.covariance[r * n + wi] - p.covariance[r * n + wj];
+        const double md = p.mean[wi] - p.mean[wj];
+        const double vd = std::max(sa[wi] - sa[wj], 1e-12);
+        const double precision = answerPrecision(md, vd);
+        const double gain = precision / (1.0 + precision * vd);
+        for (std::size_t r = 0; r < n; ++r)
+            for (std::size_t c = 0; c < n; ++c) p.covariance[r * n + c] -= gain * sa[r] * sa[c];
+    }
+    return out;
 }
 
 } // namespace skinlab::experiments::active

@@ -65,6 +65,16 @@ struct ScorePosterior {
 // The posterior of `conditions` scores given the answers (any order; indices must be in [0, conditions)).
 ScorePosterior fitPosterior(int conditions, const std::vector<Comparison>& answers, const PosteriorOptions& options = {});
 
+// All answers to one pair: i < j, i chosen `iWon` times over j, j `jWon` times over i.
+struct PairCount {
+    int i = 0, j = 0;
+    double iWon = 0.0, jWon = 0.0;
+    bool operator==(const PairCount&) const = default;
+};
+// The same posterior from answer counts per pair (pairs in increasing (i, j) order, each at most once, some answer
+// each): fitPosterior(answers) counts its answers and calls this, so both give identical results.
+ScorePosterior fitPosteriorFromCounts(int conditions, const std::vector<PairCount>& counts, const PosteriorOptions& options = {});
+
 // Expected information gain (nats) of one more comparison of i and j under `posterior`.
 double expectedInformationGain(const ScorePosterior& posterior, int i, int j);
 
@@ -76,5 +86,17 @@ std::vector<std::vector<double>> informationGains(const ScorePosterior& posterio
 // each weight is scaled by a factor in [1, 1 + 1e-6] drawn from the seed, so different participants starting
 // together get different trees, and a given seed always the same one.
 std::vector<std::pair<int, int>> spanningTreeBatch(const ScorePosterior& posterior, std::uint64_t tieSeed);
+
+// An alternative batch (compared in bench_active_sampling; the server uses the spanning tree): `size` pairs chosen
+// greedily, each the pair of highest gain under the posterior updated for the pairs already chosen. The update of
+// a chosen pair is the one its answer will make to the covariance (a probit answer's precision on d, averaged over
+// the two answers; the means are left as they are, the answer being unknown), so a batch does not spend several
+// trials on one uncertain region. Ties broken by `tieSeed` as above.
+// `criterion`: the expected information gain of the pair (as above), or the expected reduction of the summed
+// posterior variance of the mean-centred scores (A-optimal design: what the scale's RMSE depends on), i.e.
+// π/(1 + π v) ‖C Σ a‖² with π the expected precision of one answer on d, v = Var d, C the centring matrix.
+enum class BatchCriterion { informationGain, varianceReduction };
+std::vector<std::pair<int, int>> greedyBatch(const ScorePosterior& posterior, int size, std::uint64_t tieSeed,
+                                             BatchCriterion criterion = BatchCriterion::informationGain);
 
 } // namespace skinlab::experiments::active

@@ -7,6 +7,7 @@
 #include "experiments/request_error.h"
 #include "experiments/sqlite_database.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <ctime>
@@ -370,6 +371,8 @@ StudyStore::StudyStore(const fs::path& path) : path_(path) {
                  " client_address TEXT NOT NULL,"
                  " source TEXT NOT NULL CHECK (source IN ('peer','forwarded')),"
                  " recorded_at TEXT NOT NULL)");
+    for (std::size_t b = 0; b < definition_.blocks.size(); ++b)
+        posteriorCache_.push_back(std::make_unique<BlockPosteriorCache>());
 }
 
 void StudyStore::recordJoinAddress(std::int64_t participantId, const std::string& address, const std::string& source) {
@@ -394,6 +397,16 @@ std::string StudyStore::meta(const std::string& key) const {
 
 ParticipantRecord StudyStore::join(const std::string& requestedLabel, const std::string& joinKey,
                                    const std::optional<ExternalIds>& external) {
+    bool created = false;
+    ParticipantRecord p = joinLocked(requestedLabel, joinKey, external, created);
+    // Active design: the first stretch (practice trials, the first batch) is planned outside the lock and stored
+    // before the join is answered. Should the process die in between, the participant's first nextTrial() plans it.
+    if (created && definition_.design.activePairs) extendActivePlan(p.id);
+    return p;
+}
+
+ParticipantRecord StudyStore::joinLocked(const std::string& requestedLabel, const std::string& joinKey,
+                                         const std::optional<ExternalIds>& external, bool& created) {
     std::lock_guard lock(mutex_);
     SqliteTransaction tx(*db_);
     if (external) {
@@ -468,9 +481,9 @@ ParticipantRecord StudyStore::join(const std::string& requestedLabel, const std:
         ids.bind(5, external->session);
         ids.run();
     }
-    if (definition_.design.activePairs) insertTrials(*db_, p.id, activeTrials(p.index, p.seed, {}));
-    else insertTrials(*db_, p.id, planTrials(definition_, p.index, p.seed));
+    if (!definition_.design.activePairs) insertTrials(*db_, p.id, planTrials(definition_, p.index, p.seed));
     tx.commit();
+    created = true;
     return p;
 }
 
@@ -526,7 +539,19 @@ std::int64_t StudyStore::startSession(std::int64_t participantId, const std::str
 }
 
 std::optional<TrialRecord> StudyStore::nextTrial(std::int64_t participantId) {
-    std::lock_guard lock(mutex_);
+    for (;;) {
+        {
+            std::lock_guard lock(mutex_);
+            std::optional<TrialRecord> next = firstUnanswered(participantId);
+            if (next || !definition_.design.activePairs) return next;
+        }
+        // Active design: every stored trial answered, so the next batch is planned and stored now (before it is
+        // shown). When another request of the same participant stored one meanwhile, look again.
+        if (extendActivePlan(participantId) == ActiveExtension::complete) return std::nullopt;
+    }
+}
+
+std::optional<TrialRecord> StudyStore::firstUnanswered(std::int64_t participantId) {
     auto first = [&]() -> std::optional<TrialRecord> {
         SqliteStatement s = db_->prepare(std::string("SELECT ") + kTrialColumns +
                                          " FROM trials WHERE participant_id = ? AND id NOT IN"
@@ -535,64 +560,93 @@ std::optional<TrialRecord> StudyStore::nextTrial(std::int64_t participantId) {
         if (!s.step()) return std::nullopt;
         return readTrial(s);
     };
-    std::optional<TrialRecord> next = first();
-    // Active design: every stored trial answered, so the next batch is planned and stored now (before it is shown).
-    if (!next && definition_.design.activePairs && extendActivePlan(participantId)) next = first();
-    return next;
+    return first();
 }
 
 // ---- Active designs (experiments/active_plan.h) ----
 
-std::vector<PlannedTrial> StudyStore::activeTrials(std::int64_t participantIndex, std::uint64_t seed,
-                                                   const std::vector<PlannedTrial>& stored) {
-    return nextActiveTrials(definition_, participantIndex, seed, stored, [this](std::size_t b) {
+void StudyStore::loadActiveCounts() {
+    if (activeCountsLoaded_) return;
+    activeAnswers_.assign(definition_.blocks.size(), {});
+    for (std::size_t b = 0; b < definition_.blocks.size(); ++b) {
         const StudyBlock& block = definition_.blocks[b];
+        std::map<std::string, int> index;
+        for (std::size_t i = 0; i < block.conditions.size(); ++i) index[block.conditions[i]] = static_cast<int>(i);
         // Every stored answer to a test trial of the block, of every participant, counted per ordered pair.
         SqliteStatement s = db_->prepare(
             "SELECT t.condition_a, t.condition_b, SUM(r.chosen = 'A'), SUM(r.chosen = 'B') FROM responses r"
             " JOIN trials t ON t.id = r.trial_id WHERE t.block = ? AND t.kind IN ('test','repeat')"
             " GROUP BY t.condition_a, t.condition_b");
         s.bind(1, block.name);
-        std::vector<PlannedTrial> trials;
-        std::vector<bool> aSelected;
+        BlockAnswers& answers = activeAnswers_[b];
         while (s.step()) {
-            PlannedTrial t;
-            t.kind = TrialKind::test;
-            t.block = block.name;
-            t.conditionA = s.text(0);
-            t.conditionB = s.text(1);
-            for (std::int64_t k = 0; k < s.integer(2) + s.integer(3); ++k) {
-                trials.push_back(t);
-                aSelected.push_back(k < s.integer(2));
-            }
+            const auto a = index.find(s.text(0)), c = index.find(s.text(1));
+            if (a == index.end() || c == index.end() || a->second == c->second) continue;
+            const double aWon = static_cast<double>(s.integer(2)), cWon = static_cast<double>(s.integer(3));
+            auto& entry = answers.counts[{std::min(a->second, c->second), std::max(a->second, c->second)}];
+            entry.first += a->second < c->second ? aWon : cWon;
+            entry.second += a->second < c->second ? cWon : aWon;
+            answers.generation += static_cast<std::uint64_t>(aWon + cWon);
         }
-        return active::fitPosterior(static_cast<int>(block.conditions.size()), blockComparisons(block, trials, aSelected));
-    });
+    }
+    activeCountsLoaded_ = true;
 }
 
-bool StudyStore::extendActivePlan(std::int64_t participantId) {
-    SqliteTransaction tx(*db_);
+active::ScorePosterior StudyStore::blockPosterior(std::size_t b, std::uint64_t generation) {
+    BlockPosteriorCache& cache = *posteriorCache_[b];
+    std::lock_guard fitting(cache.mutex);
+    if (cache.valid && cache.generation >= generation) return cache.posterior;
+    // The latest answers (at least `generation` of them; more when some arrived while this request waited).
+    std::vector<active::PairCount> counts;
+    std::uint64_t latest = 0;
+    {
+        std::lock_guard lock(mutex_);
+        loadActiveCounts();
+        const BlockAnswers& answers = activeAnswers_[b];
+        latest = answers.generation;
+        for (const auto& [pair, won] : answers.counts) counts.push_back({pair.first, pair.second, won.first, won.second});
+    }
+    cache.posterior = active::fitPosteriorFromCounts(static_cast<int>(definition_.blocks[b].conditions.size()), counts);
+    cache.generation = latest;
+    cache.valid = true;
+    return cache.posterior;
+}
+
+StudyStore::ActiveExtension StudyStore::extendActivePlan(std::int64_t participantId) {
     std::int64_t index = 0;
     std::uint64_t seed = 0;
+    std::vector<PlannedTrial> stored;
+    std::vector<std::uint64_t> generations;
     {
+        std::lock_guard lock(mutex_);
         SqliteStatement s = db_->prepare("SELECT participant_index, seed FROM participants WHERE id = ?");
         s.bind(1, participantId);
-        if (!s.step()) return false;
+        if (!s.step()) return ActiveExtension::complete;
         index = s.integer(0);
         seed = static_cast<std::uint64_t>(s.integer(1));
-    }
-    std::vector<PlannedTrial> stored;
-    {
-        SqliteStatement s = db_->prepare(std::string("SELECT ") + kTrialColumns +
+        SqliteStatement t = db_->prepare(std::string("SELECT ") + kTrialColumns +
                                          " FROM trials WHERE participant_id = ? ORDER BY position");
-        s.bind(1, participantId);
-        while (s.step()) stored.push_back(readTrial(s).plan);
+        t.bind(1, participantId);
+        while (t.step()) stored.push_back(readTrial(t).plan);
+        loadActiveCounts();
+        for (const BlockAnswers& answers : activeAnswers_) generations.push_back(answers.generation);
     }
-    const std::vector<PlannedTrial> next = activeTrials(index, seed, stored);
-    if (next.empty()) return false;
+    // Planned without the store's lock: other requests go on meanwhile.
+    const std::vector<PlannedTrial> next = nextActiveTrials(
+        definition_, index, seed, stored, [&](std::size_t b) { return blockPosterior(b, generations[b]); });
+    if (next.empty()) return ActiveExtension::complete;
+    std::lock_guard lock(mutex_);
+    SqliteTransaction tx(*db_);
+    {
+        // Re-check: nothing stored for this participant since the read above (a concurrent request planned).
+        SqliteStatement s = db_->prepare("SELECT COUNT(*) FROM trials WHERE participant_id = ?");
+        s.bind(1, participantId);
+        s.step();
+        if (s.integer(0) != static_cast<std::int64_t>(stored.size())) return ActiveExtension::raced;
+    }
     insertTrials(*db_, participantId, next, static_cast<int>(stored.size()));
     tx.commit();
-    return true;
+    return ActiveExtension::stored;
 }
 
 int StudyStore::plannedTrialCount() const {
@@ -683,6 +737,17 @@ ResponseOutcome StudyStore::storeOne(const ResponseInput& in) {
         c.bind(4, in.conditions->fullscreen ? 1 : 0);
         c.run();
     }
+    if (definition_.design.activePairs && (trial.plan.kind == TrialKind::test || trial.plan.kind == TrialKind::repeat))
+        for (std::size_t b = 0; b < definition_.blocks.size(); ++b) {
+            const StudyBlock& block = definition_.blocks[b];
+            if (block.name != trial.plan.block) continue;
+            const auto a = std::find(block.conditions.begin(), block.conditions.end(), trial.plan.conditionA);
+            const auto c = std::find(block.conditions.begin(), block.conditions.end(), trial.plan.conditionB);
+            if (a == block.conditions.end() || c == block.conditions.end() || a == c) break;
+            const int ia = static_cast<int>(a - block.conditions.begin()), ic = static_cast<int>(c - block.conditions.begin());
+            uncommittedAnswers_.push_back({b, std::min(ia, ic), std::max(ia, ic), (chosen == "A") == (ia < ic)});
+            break;
+        }
     return ResponseOutcome::stored;
 }
 
@@ -725,7 +790,17 @@ void StudyStore::commitBatch(const std::vector<PendingResponse*>& batch) {
             }
         }
         tx.commit();
+        // The committed answers of an active design's test trials join their blocks' counts.
+        if (activeCountsLoaded_)
+            for (const ActiveAnswer& a : uncommittedAnswers_) {
+                BlockAnswers& answers = activeAnswers_[a.block];
+                auto& entry = answers.counts[{a.i, a.j}];
+                (a.iWon ? entry.first : entry.second) += 1.0;
+                ++answers.generation;
+            }
+        uncommittedAnswers_.clear();
     } catch (...) {
+        uncommittedAnswers_.clear();
         // Nothing of this batch was committed: every response not already rejected fails (and is re-sent).
         for (PendingResponse* p : batch)
             if (!p->error) p->error = std::current_exception();

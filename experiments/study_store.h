@@ -7,12 +7,14 @@
 // acknowledges after that, so an acknowledged response survives kill -9 and power loss. A response is keyed by
 // its trial (PRIMARY KEY), so a re-sent response can never be stored twice.
 #include "experiments/recruitment.h"
+#include "experiments/active_sampling.h"
 #include "experiments/study_definition.h"
 #include "experiments/trial_plan.h"
 #include "experiments/viewing_conditions.h"
 
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <condition_variable>
 #include <exception>
 #include <memory>
@@ -191,12 +193,42 @@ private:
     };
     void commitBatch(const std::vector<PendingResponse*>& batch);
     ResponseOutcome storeOne(const ResponseInput& input); // inside an open transaction, mutex_ held
-    // Active designs (experiments/active_plan.h), mutex_ held: the next stretch of a plan from the posterior of
-    // the stored answers; storing it (one transaction) returns false when the plan is already complete.
-    std::vector<PlannedTrial> activeTrials(std::int64_t participantIndex, std::uint64_t seed,
-                                           const std::vector<PlannedTrial>& stored);
-    bool extendActivePlan(std::int64_t participantId);
+    // Active designs (experiments/active_plan.h). Planning a batch runs outside mutex_: what it needs (the
+    // participant's stored trials, the generation of each block's answers) is read under the lock, the batch is
+    // planned without it, and the lock is taken again to re-check that nothing was stored for the participant
+    // meanwhile before the batch is stored (one transaction).
+    enum class ActiveExtension { stored, complete, raced };
+    ActiveExtension extendActivePlan(std::int64_t participantId);
+    ParticipantRecord joinLocked(const std::string& label, const std::string& joinKey,
+                                 const std::optional<ExternalIds>& external, bool& created);
+    std::optional<TrialRecord> firstUnanswered(std::int64_t participantId); // mutex_ held
     int plannedTrialCount() const; // per participant
+    // mutex_ held: the in-memory answer counts of every block, read from the database on first use and updated
+    // after each committed response.
+    void loadActiveCounts();
+    // The posterior of block b from answers at least as recent as `generation` (a block's generation counts its
+    // committed answers). One fit per block at a time; a request waiting for a running fit takes its result when
+    // that covers the request's generation, so answers arriving together cost one fit, not one each.
+    active::ScorePosterior blockPosterior(std::size_t block, std::uint64_t generation);
+    struct ActiveAnswer {
+        std::size_t block = 0;
+        int i = 0, j = 0; // condition indices, i < j
+        bool iWon = false;
+    };
+    struct BlockAnswers {
+        std::map<std::pair<int, int>, std::pair<double, double>> counts; // (i < j) → (i won, j won)
+        std::uint64_t generation = 0;
+    };
+    struct BlockPosteriorCache {
+        std::mutex mutex; // held while fitting
+        bool valid = false;
+        std::uint64_t generation = 0;
+        active::ScorePosterior posterior;
+    };
+    bool activeCountsLoaded_ = false;
+    std::vector<BlockAnswers> activeAnswers_;        // per block, under mutex_
+    std::vector<ActiveAnswer> uncommittedAnswers_;   // stored in the open transaction, under mutex_
+    std::vector<std::unique_ptr<BlockPosteriorCache>> posteriorCache_; // per block, fixed size
 
     std::unique_ptr<SqliteDatabase> db_;
     std::filesystem::path path_;

@@ -287,6 +287,15 @@ ResponseTable readDatabase(const std::filesystem::path& path) {
             hasFlagged = sqlite3_column_int(probe, 0) == 1;
         sqlite3_finalize(probe);
     }
+    // The design (pairs = "active": pairs chosen from earlier answers), from the stored study definition.
+    if (sqlite3_prepare_v2(database, "SELECT json_extract(value, '$.design.pairs') FROM meta WHERE key = 'definition'",
+                           -1, &closer.statement, nullptr) == SQLITE_OK &&
+        sqlite3_step(closer.statement) == SQLITE_ROW) {
+        const unsigned char* pairs = sqlite3_column_text(closer.statement, 0);
+        table.adaptiveDesign = pairs != nullptr && std::string(reinterpret_cast<const char*>(pairs)) == "active";
+    }
+    sqlite3_finalize(closer.statement);
+    closer.statement = nullptr;
     const std::string query =
         std::string("SELECT observer, scene, condition_A, condition_B, is_A_selected, A_on_left, trial_kind, correct, "
                     "response_ms") + (hasFlagged ? ", flagged" : "") + " FROM responses_long";

@@ -43,6 +43,8 @@ struct ResponseTable {
     // Count-matrix files only: the block's conditions (header order) and the counts D (row-major, m × m).
     std::vector<std::string> matrixConditions;
     std::vector<double> matrixCounts;
+    // Study databases only: the pairs were chosen from earlier answers (a study with pairs = "active").
+    bool adaptiveDesign = false;
 };
 
 // Reads any accepted format; throws InputError "FILE: line N: column C: message" on bad input.

@@ -113,7 +113,7 @@ BlockAnalysis analyzeBlock(const BlockData& block, const AnalysisOptions& option
 
     // Intervals and tests.
     std::vector<double> pValues;
-    if (n >= 2) {
+    if (n >= 2 && options.intervals == IntervalMethod::bootstrap) {
         const BootstrapResult bootstrap = bootstrapObservers(block, result.thurstone, thurstoneOptions, options.bootstrap);
         result.intervalMethod = "studentized-bootstrap";
         result.bootstrapSamples = bootstrap.samples;
@@ -146,8 +146,10 @@ BlockAnalysis analyzeBlock(const BlockData& block, const AnalysisOptions& option
                                       "ones (" + why + ")");
         }
     } else {
-        // One observer or a bare count matrix: nothing to resample. Profile-posterior intervals (asymmetric where
-        // the data are, finite under the prior) and score tests, both model-based.
+        // One observer or a bare count matrix: nothing to resample; or an adaptive design, where resampling
+        // observers is not valid. Profile-posterior intervals (asymmetric where the data are, finite under the
+        // prior) and score tests, both model-based (the score test with the observer-robust variance when there are
+        // observers).
         result.intervalMethod = "profile-likelihood";
         const Eigen::MatrixXd& v = result.thurstone.inverseInformation;
         result.standardError = v.diagonal().cwiseMax(0.0).cwiseSqrt();
@@ -181,10 +183,10 @@ BlockAnalysis analyzeBlock(const BlockData& block, const AnalysisOptions& option
                 test.low = profile.low;
                 test.high = profile.high;
                 if (profile.lowAtCap || profile.highAtCap) test.diagnosis.reasons.emplace_back("bound-at-search-cap");
-                test.pValue = scoreTestPValue(nullptr, totals, thurstoneOptions, result.thurstone, i, j);
+                test.pValue = scoreTestPValue(n >= 2 ? &block : nullptr, totals, thurstoneOptions, result.thurstone, i, j);
                 result.pairs.push_back({test});
             }
-        if (block.hasObservers)
+        if (block.hasObservers && n < 2)
             result.warnings.push_back("a single observer: intervals are profile-likelihood intervals");
     }
     for (PairTest& pair : result.pairs) {

@@ -15,8 +15,16 @@
 
 namespace skinlab::analysis::scaling {
 
+// How the score intervals and pairwise tests are made. `bootstrap`: the studentized bootstrap over observers
+// (profile likelihood with fewer than 2 observers). `profile`: profile-likelihood intervals and score tests for
+// every block — valid when the pairs were chosen from earlier answers (an active design), where resampling
+// observers is not (docs/analysis.md, "Validation of active designs").
+enum class IntervalMethod { bootstrap, profile };
+
 struct AnalysisOptions {
     FitOptions fit;                    // fit.model is ignored: both models are always fitted
+    IntervalMethod intervals = IntervalMethod::bootstrap;
+    std::string intervalReason;        // why `intervals` was chosen (e.g. "active design"), reported in scale.json
     BootstrapOptions bootstrap;
     Correction correction = Correction::Holm;
     double alpha = 0.05;               // significance level after correction

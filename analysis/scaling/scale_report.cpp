@@ -101,6 +101,8 @@ nlohmann::json analysisJson(const Analysis& analysis) {
                         {"interval", "symmetric studentized bootstrap over observers, cluster-robust SE; where the "
                                      "studentization is degenerate (flagged per interval) the hull of the percentile "
                                      "and the profile-posterior intervals, with a score test"},
+                        {"intervals", o.intervals == IntervalMethod::profile ? "profile" : "bootstrap"},
+                        {"intervals_reason", o.intervalReason},
                         {"level", o.bootstrap.level},
                         {"bootstrap_samples", o.bootstrap.samples},
                         {"seed", o.bootstrap.seed},
@@ -212,9 +214,13 @@ std::string reportSectionHtml(const Analysis& analysis) {
     html << "<section class=\"skinlab-scaling\">\n<h2>Perceptual scaling (Thurstone Case V, JOD)</h2>\n"
          << "<p>Input <code>" << escapeHtml(analysis.file) << "</code> (" << responseFormatName(analysis.format)
          << "). Scores in JOD (1 JOD = 75 % preference, each block's mean = 0); " << fixed(100 * o.bootstrap.level, 0)
-         << " % intervals by a symmetric studentized bootstrap over observers (" << o.bootstrap.samples
-         << " samples, seed " << o.bootstrap.seed << "); where studentization is degenerate (marked †) the hull of "
-            "the percentile and profile-posterior intervals, and a score test; pairwise tests with "
+         << (o.intervals == IntervalMethod::profile
+                 ? " % profile-likelihood intervals (" + o.intervalReason + ") and score tests; "
+                 : " % intervals by a symmetric studentized bootstrap over observers (" +
+                       std::to_string(o.bootstrap.samples) + " samples, seed " + std::to_string(o.bootstrap.seed) +
+                       "); where studentization is degenerate (marked †) the hull of the percentile and "
+                       "profile-posterior intervals, and a score test; ")
+         << "pairwise tests with "
          << correctionName(o.correction) << " correction at α = " << o.alpha << ".</p>\n";
     for (size_t b = 0; b < analysis.blocks.size(); ++b) {
         const BlockAnalysis& block = analysis.blocks[b];

@@ -1,6 +1,9 @@
 #include "analysis/scaling/validation.h"
 
+#include "common/error.h"
+
 #include "analysis/scaling/bootstrap.h"
+#include "analysis/scaling/scale_analysis.h"
 #include "analysis/scaling/screening.h"
 #include "analysis/scaling/simulation.h"
 
@@ -9,7 +12,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <numeric>
+#include <random>
 #include <thread>
 
 namespace skinlab::analysis::scaling {
@@ -23,7 +28,9 @@ struct Tally {
     double pairs = 0, significantCorrect = 0, significantReversed = 0;
     double randomObservers = 0, randomFlagged = 0, invertedObservers = 0, invertedFlagged = 0;
     double genuineObservers = 0, genuineFlagged = 0;
+    double bootstrapCovered = 0;
     void add(const Tally& o) {
+        bootstrapCovered += o.bootstrapCovered;
         intervals += o.intervals, covered += o.covered, width += o.width, percentileCovered += o.percentileCovered;
         fallbacks += o.fallbacks, maximumHalfWidth = std::max(maximumHalfWidth, o.maximumHalfWidth);
         percentileWidth += o.percentileWidth, squaredError += o.squaredError, rankCorrelation += o.rankCorrelation;
@@ -65,6 +72,111 @@ BlockData withoutObservers(const BlockData& block, const std::vector<bool>& drop
     return kept;
 }
 
+// The "active" scenario's data: Case V observers one after another, each answering activeTrials trials in batches
+// the planner chose from all earlier answers; sides alternate within an observer.
+BlockData simulateActive(const ValidationOptions& options, const std::vector<double>& truth, int observers, std::uint64_t seed) {
+    const int m = static_cast<int>(truth.size());
+    const int perObserver = options.activeTrials > 0 ? options.activeTrials : options.trialsPerPair * m * (m - 1) / 2;
+    std::mt19937_64 random(seed);
+    std::normal_distribution<double> noise(0.0, kThurstoneSigma / std::sqrt(2.0));
+    struct Trial {
+        int observer, i, j;
+        bool firstChosen, firstOnLeft;
+    };
+    std::vector<Trial> trials;
+    std::vector<PlannerAnswer> answers;
+    for (int k = 0; k < observers; ++k) {
+        int done = 0;
+        for (std::uint64_t batch = 0; done < perObserver; ++batch) {
+            const auto pairs = options.activePlanner(m, answers, mixSeed(seed, static_cast<std::uint64_t>(k) * 100000 + batch));
+            if (pairs.empty()) throw RuntimeError("validate: the active planner returned no pairs");
+            for (auto [i, j] : pairs) {
+                if (done == perObserver) break;
+                if (i > j) std::swap(i, j);
+                const bool chosen = truth[i] + noise(random) > truth[j] + noise(random);
+                trials.push_back({k, i, j, chosen, done % 2 == 0});
+                answers.push_back(chosen ? PlannerAnswer{i, j} : PlannerAnswer{j, i});
+                ++done;
+            }
+        }
+    }
+    BlockData block;
+    block.name = "simulated";
+    for (int i = 0; i < m; ++i) block.conditions.push_back("c" + std::to_string(i));
+    for (int k = 0; k < observers; ++k) {
+        char name[16];
+        std::snprintf(name, sizeof name, "o%03d", k + 1);
+        block.observers.push_back(name);
+    }
+    std::map<std::pair<int, int>, int> column;
+    for (const Trial& t : trials)
+        if (column.emplace(std::make_pair(t.i, t.j), static_cast<int>(block.pairs.size())).second) block.pairs.emplace_back(t.i, t.j);
+    const auto pairCount = static_cast<Eigen::Index>(block.pairs.size());
+    block.winsFirst = Eigen::MatrixXd::Zero(observers, pairCount);
+    block.winsSecond = Eigen::MatrixXd::Zero(observers, pairCount);
+    block.sideCounts.assign(block.pairs.size(), {0, 0, 0, 0});
+    block.leftChosen = Eigen::VectorXd::Zero(observers);
+    block.sideTrials = Eigen::VectorXd::Zero(observers);
+    for (const Trial& t : trials) {
+        const int p = column.at({t.i, t.j});
+        (t.firstChosen ? block.winsFirst : block.winsSecond)(t.observer, p) += 1.0;
+        block.sideCounts[p][(t.firstOnLeft ? 0 : 2) + (t.firstChosen ? 0 : 1)] += 1.0;
+        block.sideTrials[t.observer] += 1.0;
+        if (t.firstChosen == t.firstOnLeft) block.leftChosen[t.observer] += 1.0;
+    }
+    return block;
+}
+
+Tally runActiveExperiment(const ValidationOptions& options, int observers, std::uint64_t seed) {
+    const int m = static_cast<int>(options.trueScores.size());
+    std::vector<double> scores = options.trueScores;
+    for (double& q : scores) q *= options.activeStretch;
+    const BlockData block = simulateActive(options, scores, observers, seed);
+    AnalysisOptions analysisOptions;
+    analysisOptions.intervals = IntervalMethod::profile;
+    analysisOptions.correction = options.correction;
+    analysisOptions.alpha = options.alpha;
+    analysisOptions.bootstrap.level = 0.95;
+    const BlockAnalysis analysis = analyzeBlock(block, analysisOptions);
+    // The observer bootstrap on the same data, for comparison.
+    FitOptions fitOptions;
+    BootstrapOptions bootstrapOptions;
+    bootstrapOptions.samples = options.bootstrapSamples;
+    bootstrapOptions.seed = mixSeed(seed, 1);
+    bootstrapOptions.threads = 1;
+    const BootstrapResult bootstrap = bootstrapObservers(block, analysis.thurstone, fitOptions, bootstrapOptions);
+
+    Tally tally;
+    tally.experiments = 1;
+    Eigen::VectorXd truth = Eigen::Map<const Eigen::VectorXd>(scores.data(), m);
+    truth.array() -= truth.mean();
+    const Eigen::VectorXd& fit = analysis.thurstone.scores;
+    for (int i = 0; i < m; ++i) {
+        tally.intervals += 1;
+        tally.covered += analysis.low[i] <= truth[i] && truth[i] <= analysis.high[i];
+        tally.width += analysis.high[i] - analysis.low[i];
+        tally.maximumHalfWidth = std::max({tally.maximumHalfWidth, fit[i] - analysis.low[i], analysis.high[i] - fit[i]});
+        tally.bootstrapCovered += bootstrap.low[i] <= truth[i] && truth[i] <= bootstrap.high[i];
+        tally.percentileCovered += bootstrap.percentileLow[i] <= truth[i] && truth[i] <= bootstrap.percentileHigh[i];
+        tally.percentileWidth += bootstrap.percentileHigh[i] - bootstrap.percentileLow[i];
+        tally.squaredError += (fit[i] - truth[i]) * (fit[i] - truth[i]);
+    }
+    const std::vector<double> estimatedRank = ranks(fit), trueRank = ranks(truth);
+    double rankSquares = 0;
+    for (int i = 0; i < m; ++i) rankSquares += (estimatedRank[i] - trueRank[i]) * (estimatedRank[i] - trueRank[i]);
+    tally.rankCorrelation = 1.0 - 6.0 * rankSquares / (static_cast<double>(m) * (m * m - 1.0));
+    for (const PairTest& pair : analysis.pairs) {
+        const double trueDifference = truth[pair.test.first] - truth[pair.test.second];
+        tally.pairs += 1;
+        if (!pair.significant || trueDifference == 0.0) continue;
+        if ((pair.test.difference > 0) == (trueDifference > 0))
+            tally.significantCorrect += 1;
+        else
+            tally.significantReversed += 1;
+    }
+    return tally;
+}
+
 Tally runExperiment(const ValidationOptions& options, const std::string& scenario, int observers, int experiment) {
     SimulationDesign design;
     design.trueScores = options.trueScores;
@@ -102,6 +214,7 @@ Tally runExperiment(const ValidationOptions& options, const std::string& scenari
     const std::uint64_t stream = (scenarioIndex * 1000 + static_cast<std::uint64_t>(observers)) * 1000000 +
                                  static_cast<std::uint64_t>(experiment);
     const std::uint64_t seed = mixSeed(options.seed, stream);
+    if (scenario == "active") return runActiveExperiment(options, observers, seed);
     const SimulatedBlock simulated = simulateBlock(design, seed);
     Tally tally;
     tally.experiments = 1;
@@ -169,7 +282,7 @@ Tally runExperiment(const ValidationOptions& options, const std::string& scenari
 
 const std::vector<std::string>& validationScenarios() {
     static const std::vector<std::string> names = {"thurstone",    "lapses+side-bias", "screening",
-                                                   "sparse",       "disconnected",     "near-unanimous"};
+                                                   "sparse",       "disconnected",     "near-unanimous", "active"};
     return names;
 }
 
@@ -202,6 +315,7 @@ ValidationReport runValidation(const ValidationOptions& options) {
             row.maximumHalfWidth = total.maximumHalfWidth;
             row.percentileCoverage = total.percentileCovered / total.intervals;
             row.percentileMeanWidth = total.percentileWidth / total.intervals;
+            if (scenario == "active") row.bootstrapCoverage = total.bootstrapCovered / total.intervals;
             row.rmse = std::sqrt(total.squaredError / total.intervals);
             row.rankCorrelation = total.rankCorrelation / total.experiments;
             row.significantCorrect = total.significantCorrect / total.pairs;
@@ -220,20 +334,35 @@ std::string validationMarkdown(const ValidationReport& report) {
     const ValidationOptions& o = report.options;
     std::string scores;
     for (double s : o.trueScores) scores += (scores.empty() ? "" : ", ") + std::to_string(s).substr(0, 4);
-    char line[1536];
+    char line[2048];
     std::string out;
+    std::string bootstrapCoverages;
+    for (const ValidationRow& r : report.rows)
+        if (r.bootstrapCoverage >= 0) {
+            char cell[64];
+            std::snprintf(cell, sizeof cell, "%s%.4f (%d observers)", bootstrapCoverages.empty() ? "" : ", ",
+                          r.bootstrapCoverage, r.observers);
+            bootstrapCoverages += cell;
+        }
+    if (bootstrapCoverages.empty()) bootstrapCoverages = "not run";
     std::snprintf(line, sizeof line,
                   "True scores [%s] JOD, full design, %d trials per pair per observer (each order %s), %d "
                   "experiments per row, %d bootstrap samples, %s correction at alpha = %.2f, seed %llu.\n"
                   "Lapses %.3f and side-bias sd %.2f JOD in the 'lapses+side-bias' and 'screening' scenarios; "
                   "'screening' adds %d random and %d inverted observer(s) and scores the remaining ones. "
                   "'sparse': each observer judges %.0f %% of the pairs; 'disconnected': %d groups never compared "
-                  "(truth centred per group); 'near-unanimous': true scores x %.1f.\n\n",
+                  "(truth centred per group); 'near-unanimous': true scores x %.1f. 'active': observers one after "
+                  "another on true scores x %.1f, %d trials each in batches chosen from all earlier answers, "
+                  "profile-likelihood intervals and score tests (as `analyze scale` for an active study); its "
+                  "studentized observer bootstrap on the same data covers: %s.\n\n",
                   scores.c_str(), o.trialsPerPair, o.trialsPerPair % 2 == 0 ? "equally often" : "alternating",
                   o.experiments, o.bootstrapSamples, correctionName(o.correction), o.alpha,
                   static_cast<unsigned long long>(o.seed), o.lapseRate, o.sideBiasStandardDeviation,
                   o.randomObservers, o.invertedObservers, 100.0 * o.sparsePairFraction, o.disconnectedGroups,
-                  o.nearUnanimousStretch);
+                  o.nearUnanimousStretch, o.activeStretch,
+                  o.activeTrials > 0 ? o.activeTrials
+                                     : o.trialsPerPair * static_cast<int>(o.trueScores.size() * (o.trueScores.size() - 1) / 2),
+                  bootstrapCoverages.c_str());
     out += line;
     out += "| scenario | observers | coverage | mean width | fallback share | largest half-width | "
            "coverage (percentile, pwcmp) | "
@@ -271,7 +400,8 @@ nlohmann::json validationJson(const ValidationReport& report) {
                        {"correction", correctionName(o.correction)}, {"alpha", o.alpha},
                        {"screening_whisker", o.screeningWhisker}, {"scenarios", o.scenarios},
                        {"sparse_pair_fraction", o.sparsePairFraction}, {"disconnected_groups", o.disconnectedGroups},
-                       {"near_unanimous_stretch", o.nearUnanimousStretch}};
+                       {"near_unanimous_stretch", o.nearUnanimousStretch},
+                       {"active_trials", o.activeTrials}, {"active_stretch", o.activeStretch}};
     json["seconds"] = report.seconds;
     for (const ValidationRow& r : report.rows) {
         nlohmann::json row = {{"scenario", r.scenario},
@@ -290,6 +420,7 @@ nlohmann::json validationJson(const ValidationReport& report) {
         if (r.randomHitRate >= 0) row["random_hit_rate"] = r.randomHitRate;
         if (r.invertedHitRate >= 0) row["inverted_hit_rate"] = r.invertedHitRate;
         if (r.falseAlarmRate >= 0) row["false_alarm_rate"] = r.falseAlarmRate;
+        if (r.bootstrapCoverage >= 0) row["bootstrap_coverage"] = r.bootstrapCoverage;
         json["rows"].push_back(row);
     }
     return json;

@@ -7,8 +7,13 @@
 //    false-alarm rates, and the intervals after removing the flagged observers;
 //  - "sparse": Case V observers who each judge only a random share of the pairs;
 //  - "disconnected": Case V observers, the conditions in groups never compared with each other;
-//  - "near-unanimous": Case V observers on a scale stretched so far pairs are (nearly) always unanimous.
+//  - "near-unanimous": Case V observers on a scale stretched so far pairs are (nearly) always unanimous;
+//  - "active": Case V observers, one after another, each judging pairs an active planner chose from every earlier
+//    answer (pairs = "active" in a study), scaled as `analyze scale` scales an active study: profile-likelihood
+//    intervals (the observer bootstrap is not valid there; its coverage is reported alongside).
 #include "analysis/scaling/multiple_comparisons.h"
+
+#include <functional>
 
 #include <nlohmann/json.hpp>
 
@@ -17,6 +22,15 @@
 #include <vector>
 
 namespace skinlab::analysis::scaling {
+
+// One answer of the "active" scenario: `winner` chosen over `loser` (condition indices).
+struct PlannerAnswer {
+    int winner = 0, loser = 0;
+};
+// The next batch of pairs (i, j) given every answer so far: the study server's planner, supplied by the caller
+// (the analysis does not link the server; `skinlab analyze validate` passes experiments/active_sampling's).
+using ActivePlanner = std::function<std::vector<std::pair<int, int>>(int conditions, const std::vector<PlannerAnswer>& answers,
+                                                                     std::uint64_t seed)>;
 
 struct ValidationOptions {
     std::vector<double> trueScores = {0.0, 0.3, 0.9, 1.0, 1.8, 2.5};  // JOD
@@ -40,6 +54,10 @@ struct ValidationOptions {
     double nearUnanimousStretch = 3.0; // "near-unanimous": true scores multiplied by this
     std::vector<std::string> scenarios = {"thurstone", "lapses+side-bias", "screening",
                                           "sparse", "disconnected", "near-unanimous"};
+    // "active": trials per observer (0: as many as the full design, trialsPerPair per pair), and the planner.
+    int activeTrials = 0;
+    double activeStretch = 1.0;  // "active": true scores multiplied by this
+    ActivePlanner activePlanner;
 };
 
 // Every scenario runValidation knows.
@@ -55,6 +73,7 @@ struct ValidationRow {
     double maximumHalfWidth = 0.0;    // JOD, largest distance from a score to one of its bounds
     double percentileCoverage = 0.0;  // pwcmp's percentile bootstrap on the same resamples
     double percentileMeanWidth = 0.0;
+    double bootstrapCoverage = -1.0;  // "active" only: the studentized observer bootstrap on the same data
     double rmse = 0.0;                // JOD, mean-zero scores against mean-zero truth
     double rankCorrelation = 0.0;     // mean Spearman ρ
     double significantCorrect = 0.0;  // fraction of (experiment, pair): significant with the true sign

@@ -11,10 +11,20 @@
 // observers is computed and its coverage of the true scores counted.
 // Also times the planning of one batch at m = 30 with 200 participants' answers (the server's request path).
 //
+// Coverage is counted for two intervals: the studentized bootstrap over observers (`analyze scale`'s default) and
+// the profile-likelihood interval (`analyze scale --intervals profile`, automatic for active studies).
+// Also prints, per m, a bound on the saving any choice of pairs can reach (Fisher information, Cramér–Rao): with N
+// comparisons the information matrix is at most I(0)·(the comparison-count Laplacian), whose trace of the
+// pseudo-inverse is at least (m − 1)²/(2 N I(0)) (Cauchy–Schwarz over its eigenvalues; equality for the complete
+// graph with equal counts), against the full design's trace of (N/M · Σ_pairs I(δ) a aᵀ)⁺.
+//
 // Usage: bench_active_sampling [--experiments E] [--coverage-experiments C] [--bootstrap B] [--spread S]
-//                              [--rounds R] [--threads T] [--seed N] [--plot FILE.png]
+//                              [--truth normal|uniform] [--prior-sd P] [--selection mst|greedy|variance]
+//                              [--rounds R] [--threads T] [--seed N] [--timing 0|1] [--coverage-rounds 1,2]
+//                              [--plot FILE.png]
 #include "analysis/scaling/bootstrap.h"
 #include "analysis/scaling/pairwise_model.h"
+#include "analysis/scaling/profile_likelihood.h"
 #include "experiments/active_sampling.h"
 
 #include <opencv2/imgcodecs.hpp>
@@ -47,7 +57,12 @@ struct Settings {
     int experiments = 60;
     int coverageExperiments = 30;
     int bootstrap = 200;
-    double spread = 1.0; // true scores ~ N(0, spread²) JOD
+    double spread = 1.0; // true scores ~ N(0, spread²) JOD, or uniform with this sd
+    std::string truth = "normal";
+    double priorSd = 1.0;           // prior sd of the active design's posterior (JOD)
+    std::string selection = "mst";  // active batches: spanning tree over 1/gain, or greedy with updates
+    bool timing = true;
+    std::vector<double> coverageRounds = {0.6, 1.0, 1.2, 2.0, 2.4}; // coverage budgets, in full rounds
     int rounds = 4;      // longest design, in full-design rounds m(m−1)/2
     int threads = 2;
     std::uint64_t seed = 1;
@@ -95,7 +110,8 @@ sc::BlockData blockOf(const std::vector<Trial>& trials, std::size_t count, int m
     return block;
 }
 
-std::vector<Trial> simulateDesign(int design, const std::vector<double>& truth, std::size_t length, std::uint64_t seed) {
+std::vector<Trial> simulateDesign(int design, const std::vector<double>& truth, std::size_t length, std::uint64_t seed,
+                                  const Settings& settings) {
     const int m = static_cast<int>(truth.size());
     std::mt19937_64 random(seed);
     std::vector<Trial> trials;
@@ -120,9 +136,16 @@ std::vector<Trial> simulateDesign(int design, const std::vector<double>& truth, 
     } else {
         std::vector<ac::Comparison> answers;
         std::uint64_t batch = 0;
+        ac::PosteriorOptions posteriorOptions;
+        posteriorOptions.priorVariance = settings.priorSd * settings.priorSd;
         while (trials.size() < length) {
-            const ac::ScorePosterior posterior = ac::fitPosterior(m, answers);
-            for (const auto& [i, j] : ac::spanningTreeBatch(posterior, seed * 1000003u + batch++)) {
+            const ac::ScorePosterior posterior = ac::fitPosterior(m, answers, posteriorOptions);
+            const std::uint64_t tieSeed = seed * 1000003u + batch++;
+            const auto pairs = settings.selection == "greedy"   ? ac::greedyBatch(posterior, m - 1, tieSeed)
+                               : settings.selection == "variance" ? ac::greedyBatch(posterior, m - 1, tieSeed,
+                                                                                    ac::BatchCriterion::varianceReduction)
+                                                                  : ac::spanningTreeBatch(posterior, tieSeed);
+            for (const auto& [i, j] : pairs) {
                 if (trials.size() >= length) break;
                 const Trial t = make(random, truth, i, j);
                 trials.push_back(t);
@@ -131,6 +154,34 @@ std::vector<Trial> simulateDesign(int design, const std::vector<double>& truth, 
         }
     }
     return trials;
+}
+
+// Fisher information of one comparison at true difference δ: φ(δ/σ)² / (σ² Φ(δ/σ) Φ(−δ/σ)).
+double comparisonInformation(double delta) {
+    const double z = delta / ac::kThurstoneSigma;
+    const double pdf = std::exp(-0.5 * z * z) / std::sqrt(2.0 * M_PI);
+    const double cdf = 0.5 * std::erfc(-z / std::sqrt(2.0));
+    return pdf * pdf / (ac::kThurstoneSigma * ac::kThurstoneSigma * std::max(cdf * (1.0 - cdf), 1e-300));
+}
+
+// The least share of the full design's comparisons any design needs for the full design's asymptotic mean
+// squared error (see the header): (m − 1)² / (2 I(0) M tr(L⁺)), L = Σ_pairs I(δ_ij) a aᵀ.
+double fisherSavingBound(const std::vector<double>& truth) {
+    const int m = static_cast<int>(truth.size());
+    Eigen::MatrixXd laplacian = Eigen::MatrixXd::Zero(m, m);
+    for (int i = 0; i < m; ++i)
+        for (int j = i + 1; j < m; ++j) {
+            const double w = comparisonInformation(truth[static_cast<std::size_t>(i)] - truth[static_cast<std::size_t>(j)]);
+            laplacian(i, i) += w;
+            laplacian(j, j) += w;
+            laplacian(i, j) -= w;
+            laplacian(j, i) -= w;
+        }
+    // tr(L⁺) = tr((L + J/m)⁻¹) − 1 for a connected graph (J = 1 1ᵀ).
+    const Eigen::MatrixXd shifted = laplacian + Eigen::MatrixXd::Constant(m, m, 1.0 / m);
+    const double trace = shifted.inverse().trace() - 1.0;
+    const double pairs = m * (m - 1) / 2.0;
+    return (m - 1.0) * (m - 1.0) / (2.0 * comparisonInformation(0.0) * pairs * trace);
 }
 
 double rmse(const Eigen::VectorXd& scores, const std::vector<double>& truth) {
@@ -239,6 +290,19 @@ int main(int argc, char** argv) {
         else if (key == "--threads") s.threads = std::atoi(value);
         else if (key == "--seed") s.seed = static_cast<std::uint64_t>(std::atoll(value));
         else if (key == "--plot") s.plot = value;
+        else if (key == "--truth") s.truth = value;
+        else if (key == "--prior-sd") s.priorSd = std::atof(value);
+        else if (key == "--selection") s.selection = value;
+        else if (key == "--timing") s.timing = std::atoi(value) != 0;
+        else if (key == "--coverage-rounds") {
+            s.coverageRounds.clear();
+            for (const char* p = value; *p;) {
+                char* end = nullptr;
+                s.coverageRounds.push_back(std::strtod(p, &end));
+                p = *end == ',' ? end + 1 : end;
+                if (end == p && *p) break;
+            }
+        }
         else {
             std::fprintf(stderr, "bench_active_sampling: unknown option %s\n", key.c_str());
             return 2;
@@ -246,17 +310,18 @@ int main(int argc, char** argv) {
     }
     const auto start = std::chrono::steady_clock::now();
     std::printf("hardware threads %u; %d experiments per m (coverage: %d, %d bootstrap samples); true scores ~ "
-                "N(0, %.2f^2) JOD; designs up to %d full rounds; observers answer m-1 trials each\n\n",
-                std::thread::hardware_concurrency(), s.experiments, s.coverageExperiments, s.bootstrap, s.spread,
-                s.rounds);
+                "%s with sd %.2f JOD; designs up to %d full rounds; observers answer m-1 trials each; active: %s batches, "
+                "prior sd %.2f JOD\n\n",
+                std::thread::hardware_concurrency(), s.experiments, s.coverageExperiments, s.bootstrap, s.truth.c_str(),
+                s.spread, s.rounds, s.selection.c_str(), s.priorSd);
     const std::vector<int> ms = {10, 20, 30};
     // Coverage budgets, in full rounds.
-    const std::vector<double> coverageRounds = {0.6, 1.0, 1.2, 2.0, 2.4};
+    const std::vector<double>& coverageRounds = s.coverageRounds;
     std::vector<std::vector<std::vector<double>>> allCurves;
     std::vector<std::vector<double>> allX;
     std::printf("| m | full rounds | comparisons (full) | RMSE full | RMSE random | RMSE active | active reaches full's RMSE at | "
                 "saving | random reaches it at |\n|---|---|---|---|---|---|---|---|---|\n");
-    std::vector<std::string> coverageLines;
+    std::vector<std::string> coverageLines, profileLines;
     for (const int m : ms) {
         const int M = m * (m - 1) / 2;
         const int step = m - 1;
@@ -264,7 +329,8 @@ int main(int argc, char** argv) {
         std::vector<double> x;
         for (std::size_t c = static_cast<std::size_t>(step); c <= length; c += static_cast<std::size_t>(step)) x.push_back(static_cast<double>(c));
         std::vector<std::vector<double>> sumSquared(3, std::vector<double>(x.size(), 0.0));
-        std::map<std::pair<int, int>, CoverageCell> coverage; // (design, budget index)
+        std::map<std::pair<int, int>, CoverageCell> coverage, profileCoverage; // (design, budget index)
+        double fisherRatio = 0.0;
         sc::FitOptions fitOptions;
         sc::BootstrapOptions bootOptions;
         bootOptions.samples = s.bootstrap;
@@ -272,14 +338,16 @@ int main(int argc, char** argv) {
         for (int e = 0; e < s.experiments; ++e) {
             std::mt19937_64 truthRandom(sc::mixSeed(s.seed, static_cast<std::uint64_t>(m * 100000 + e)));
             std::normal_distribution<double> draw(0.0, s.spread);
+            std::uniform_real_distribution<double> flat(-std::sqrt(3.0) * s.spread, std::sqrt(3.0) * s.spread);
             std::vector<double> truth(static_cast<std::size_t>(m));
             double mean = 0;
-            for (double& q : truth) mean += (q = draw(truthRandom));
+            for (double& q : truth) mean += (q = s.truth == "uniform" ? flat(truthRandom) : draw(truthRandom));
             mean /= m;
             for (double& q : truth) q -= mean;
+            fisherRatio += fisherSavingBound(truth);
             for (int d = 0; d < 3; ++d) {
                 const std::vector<Trial> trials =
-                    simulateDesign(d, truth, length, sc::mixSeed(s.seed + 17, static_cast<std::uint64_t>(m * 100000 + e * 3 + d)));
+                    simulateDesign(d, truth, length, sc::mixSeed(s.seed + 17, static_cast<std::uint64_t>(m * 100000 + e * 3 + d)), s);
                 for (std::size_t k = 0; k < x.size(); ++k) {
                     const sc::BlockData block = blockOf(trials, static_cast<std::size_t>(x[k]), m, step);
                     const sc::FitResult fit = sc::fitScores(block.totalCounts(), fitOptions);
@@ -295,10 +363,19 @@ int main(int argc, char** argv) {
                         bootOptions.seed = sc::mixSeed(s.seed, static_cast<std::uint64_t>(e * 7 + d));
                         const sc::BootstrapResult boot = sc::bootstrapObservers(block, fit, fitOptions, bootOptions);
                         CoverageCell& cell = coverage[{d, static_cast<int>(b)}];
+                        CoverageCell& profileCell = profileCoverage[{d, static_cast<int>(b)}];
+                        const sc::PairCounts totals = block.totalCounts();
                         for (int i = 0; i < m; ++i) {
-                            cell.covered += (boot.low[i] <= truth[static_cast<std::size_t>(i)] && truth[static_cast<std::size_t>(i)] <= boot.high[i]) ? 1 : 0;
+                            const double q = truth[static_cast<std::size_t>(i)];
+                            cell.covered += (boot.low[i] <= q && q <= boot.high[i]) ? 1 : 0;
                             cell.widths.push_back(boot.high[i] - boot.low[i]);
                             cell.total += 1;
+                            Eigen::VectorXd contrast = Eigen::VectorXd::Constant(m, -1.0 / m);
+                            contrast[i] += 1.0;
+                            const sc::ProfileInterval profile = sc::profileInterval(totals, fitOptions, fit, contrast, 0.95);
+                            profileCell.covered += (profile.low <= q && q <= profile.high) ? 1 : 0;
+                            profileCell.widths.push_back(profile.high - profile.low);
+                            profileCell.total += 1;
                         }
                     }
                 }
@@ -330,7 +407,16 @@ int main(int argc, char** argv) {
                           coverageRounds[b], count / static_cast<std::size_t>(step), f.covered / f.total, f.medianWidth(),
                           r.covered / r.total, r.medianWidth(), a.covered / a.total, a.medianWidth());
             coverageLines.push_back(line);
+            const CoverageCell& pf = profileCoverage[{0, static_cast<int>(b)}];
+            const CoverageCell& pr = profileCoverage[{1, static_cast<int>(b)}];
+            const CoverageCell& pa = profileCoverage[{2, static_cast<int>(b)}];
+            std::snprintf(line, sizeof line, "| %d | %zu (%.1f rounds, %zu observers) | %.3f (%.2f) | %.3f (%.2f) | %.3f (%.2f) |", m, count,
+                          coverageRounds[b], count / static_cast<std::size_t>(step), pf.covered / pf.total, pf.medianWidth(),
+                          pr.covered / pr.total, pr.medianWidth(), pa.covered / pa.total, pa.medianWidth());
+            profileLines.push_back(line);
         }
+        std::printf("| %d | Fisher bound: any design needs at least %.0f %% of the full design's comparisons (saving <= %.0f %%) |\n", m,
+                    100.0 * fisherRatio / s.experiments, 100.0 * (1.0 - fisherRatio / s.experiments));
         std::fflush(stdout);
         allCurves.push_back(curves);
         allX.push_back(x);
@@ -338,11 +424,15 @@ int main(int argc, char** argv) {
     std::printf("\nCoverage of the 95 %% studentized bootstrap intervals (median width, JOD):\n\n"
                 "| m | comparisons | full | random | active |\n|---|---|---|---|---|\n");
     for (const std::string& line : coverageLines) std::printf("%s\n", line.c_str());
+    std::printf("\nCoverage of the 95 %% profile-likelihood intervals (median width, JOD):\n\n"
+                "| m | comparisons | full | random | active |\n|---|---|---|---|---|\n");
+    for (const std::string& line : profileLines) std::printf("%s\n", line.c_str());
 
     // Planning time of one batch at m = 30 with 200 participants' answers (as the server plans it).
     std::printf("\nPlanning one batch (posterior from every answer, gains, spanning tree), m = 30:\n\n"
                 "| participants | answers | EP sweeps | plan median (ms) | plan min (ms) |\n|---|---|---|---|---|\n");
     for (const int perParticipant : {29, 58, 100}) {
+        if (!s.timing) break;
         const int m = 30;
         std::mt19937_64 random(7);
         std::vector<double> truth(m);

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <map>
 #include <cmath>
 #include <numeric>
 #include <random>
@@ -119,6 +120,36 @@ TEST(ActiveSampling, PosteriorDependsOnlyOnTheAnswersNotTheirOrder) {
     EXPECT_EQ(prior.mean, std::vector<double>(3, 0.0));
     EXPECT_EQ(prior.covariance, ScorePosterior::independent({0, 0, 0}, std::vector<double>(3, PosteriorOptions{}.priorVariance)).covariance);
     EXPECT_THROW(fitPosterior(3, {{0, 3}}), skinlab::RuntimeError);
+    // The same answers as counts per pair (how the server keeps them in memory): the identical posterior.
+    std::map<std::pair<int, int>, std::pair<double, double>> counted;
+    for (const Comparison& x : answers) {
+        auto& entry = counted[{std::min(x.winner, x.loser), std::max(x.winner, x.loser)}];
+        (x.winner < x.loser ? entry.first : entry.second) += 1.0;
+    }
+    std::vector<PairCount> counts;
+    for (const auto& [pair, won] : counted) counts.push_back({pair.first, pair.second, won.first, won.second});
+    const ScorePosterior d = fitPosteriorFromCounts(5, counts);
+    EXPECT_EQ(d.mean, a.mean);
+    EXPECT_EQ(d.covariance, a.covariance);
+    EXPECT_EQ(d.comparisons, static_cast<int>(answers.size()));
+    std::vector<PairCount> unsorted = counts;
+    std::swap(unsorted[0], unsorted[1]);
+    EXPECT_THROW(fitPosteriorFromCounts(5, unsorted), skinlab::RuntimeError);
+    EXPECT_THROW(fitPosteriorFromCounts(5, {{0, 1, 0.0, 0.0}}), skinlab::RuntimeError);
+}
+
+TEST(ActiveSampling, GreedyBatchSpreadsItsPairs) {
+    // Without an update a greedy batch would repeat the single best pair; with the covariance update for the pairs
+    // already chosen it moves on, and it is reproducible from its seed.
+    const std::vector<double> truth = {0.0, 0.1, 0.2, 2.0, 4.0, 6.0};
+    const ScorePosterior p = fitPosterior(6, simulate(truth, 3, 5));
+    const auto batch = greedyBatch(p, 5, 3);
+    ASSERT_EQ(batch.size(), 5u);
+    std::set<std::pair<int, int>> unique(batch.begin(), batch.end());
+    EXPECT_GE(unique.size(), 3u);
+    for (const auto& [a, b] : batch) EXPECT_LT(a, b);
+    EXPECT_EQ(batch, greedyBatch(p, 5, 3));
+    EXPECT_TRUE(greedyBatch(fitPosterior(1, {}), 3, 1).empty());
 }
 
 TEST(ActiveSampling, GainIsHighestForCloseUncertainPairs) {

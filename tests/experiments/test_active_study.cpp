@@ -140,6 +140,44 @@ TEST(ActiveStudy, PlansFromStoredAnswersSoARestartChangesNothing) {
     EXPECT_NE(plans[0][0], plans[0][2]);
 }
 
+TEST(ActiveStudy, ConcurrentRequestsOfOneParticipantStoreOneBatch) {
+    // A batch is planned outside the store's lock and stored after a re-check: requests of the same participant
+    // racing for the next batch must store it once, and all of them see the same next trial.
+    StudyFiles files;
+    createStudy(files.stimuli, files.design, {}, files.database);
+    StudyStore store(files.database);
+    const ParticipantRecord p = store.join("racer");
+    const std::int64_t session = store.startSession(p.id, "test", 800, 600, 1.0);
+    for (int guard = 0; guard < 100; ++guard) {
+        std::vector<std::optional<TrialRecord>> seen(8);
+        std::vector<std::thread> threads;
+        for (std::size_t k = 0; k < seen.size(); ++k) threads.emplace_back([&, k] { seen[k] = store.nextTrial(p.id); });
+        for (std::thread& t : threads) t.join();
+        for (const auto& s : seen) {
+            ASSERT_EQ(s.has_value(), seen[0].has_value());
+            if (s) {
+                EXPECT_EQ(s->id, seen[0]->id);
+            }
+        }
+        if (!seen[0]) break;
+        const PlannedTrial& t = seen[0]->plan;
+        bool chooseA = true;
+        if (t.kind == TrialKind::catchTrial) chooseA = t.expected == 'A';
+        else if (t.stimulusB != kBlankStimulus) chooseA = kTruth.at(t.conditionA) > kTruth.at(t.conditionB);
+        ResponseInput in;
+        in.token = p.token;
+        in.trialId = trialReference(p.token, seen[0]->id);
+        in.side = chooseA == t.aOnLeft ? "left" : "right";
+        in.sessionId = session;
+        in.clientTime = "2026-01-01T00:00:00.000Z";
+        store.recordResponse(in);
+    }
+    const std::vector<TrialRecord> trials = store.trials(p.id);
+    ASSERT_EQ(trials.size(), 15u);
+    for (std::size_t k = 0; k < trials.size(); ++k) EXPECT_EQ(trials[k].position, static_cast<int>(k));
+    EXPECT_EQ(store.responseCount(), 15);
+}
+
 TEST(ActiveStudy, RunsEndToEndOverHttpAndItsPlanSurvivesKillNine) {
     StudyFiles files;
     const CommandResult created = runSkinlab({"study", "create", "--stimuli", files.stimuli.string(), "--design",
@@ -231,6 +269,23 @@ TEST(ActiveStudy, RunsEndToEndOverHttpAndItsPlanSurvivesKillNine) {
     for (const auto& block : scale.at("blocks")) {
         ASSERT_EQ(block.at("conditions").size(), 5u) << block.dump();
     }
+    EXPECT_EQ(scale.at("settings").at("intervals"), "bootstrap"); // a CSV export does not say how pairs were chosen
+    // Scaled from study.db, the design is known: an active design gets likelihood intervals, said in the output.
+    const fs::path fromDatabase = files.folder.path() / "scale-db";
+    const CommandResult scaledDb = runSkinlab({"analyze", "scale", files.database.string(), "-o", fromDatabase.string()});
+    ASSERT_EQ(scaledDb.exitCode, 0) << scaledDb.out << scaledDb.err;
+    EXPECT_NE(scaledDb.out.find("active design (pairs chosen from earlier answers): profile-likelihood intervals"),
+              std::string::npos)
+        << scaledDb.out;
+    const nlohmann::json scaleDb = nlohmann::json::parse(skinlab::readFile(fromDatabase / "scale.json"));
+    EXPECT_EQ(scaleDb.at("settings").at("intervals"), "profile");
+    EXPECT_EQ(scaleDb.at("settings").at("intervals_reason"), "active design");
+    for (const auto& block : scaleDb.at("blocks")) EXPECT_EQ(block.at("interval_method"), "profile-likelihood") << block.dump();
+    const CommandResult forced = runSkinlab(
+        {"analyze", "scale", files.database.string(), "-o", (files.folder.path() / "scale-boot").string(), "--intervals",
+         "bootstrap", "--bootstrap", "200"});
+    ASSERT_EQ(forced.exitCode, 0) << forced.out << forced.err;
+    EXPECT_NE(forced.out.find("studentized-bootstrap"), std::string::npos) << forced.out;
 
     server->kill(SIGTERM);
     EXPECT_EQ(server->wait(), 0);

@@ -153,4 +153,26 @@ TEST(CliValidate, DegenerateScenariosGiveFiniteIntervals) {
     EXPECT_NE(bad.output.find("'unknown' is not one of"), std::string::npos) << bad.output;
 }
 
+TEST(CliValidate, ActiveScenarioRunsWithProfileIntervals) {
+    // Small numbers: the point is that the scenario runs through the study server's planner and reports the
+    // likelihood intervals next to the bootstrap's coverage; the figures themselves are in docs/analysis.md.
+    const fs::path output = scratch() / "validate-active";
+    const CliRun result = run("analyze validate --experiments 4 --observers 6 --bootstrap 100 --scores 0,0.5,1,2,3 "
+                              "--active-trials 8 --scenarios active -o " + output.string());
+    ASSERT_EQ(result.exitCode, 0) << result.output;
+    std::ifstream stream(output / "validation.json");
+    const nlohmann::json json = nlohmann::json::parse(stream);
+    ASSERT_EQ(json["rows"].size(), 1u);
+    const auto& row = json["rows"][0];
+    EXPECT_EQ(row["scenario"], "active");
+    EXPECT_EQ(row["experiments"], 4);
+    EXPECT_GT(row["coverage"].get<double>(), 0.5) << row.dump();
+    EXPECT_LE(row["coverage"].get<double>(), 1.0) << row.dump();
+    EXPECT_TRUE(row["bootstrap_coverage"].is_number()) << row.dump();
+    EXPECT_GT(row["mean_width"].get<double>(), 0.0) << row.dump();
+    EXPECT_LT(row["maximum_half_width"].get<double>(), 250.0) << row.dump();
+    EXPECT_EQ(json["options"]["active_trials"], 8);
+    EXPECT_NE(result.output.find("| active | 6 |"), std::string::npos) << result.output;
+}
+
 } // namespace
