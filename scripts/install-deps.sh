@@ -23,6 +23,7 @@ PACKAGES=(
   chromium nodejs   # npm: see below
   fonts-dejavu-core   # stimuli: captions of contact.png (OpenImageIO render_text needs a TrueType font)
   curl   # tests: the server-defect checks send raw HTTP
+  clang-format   # tests: style_clang_format checks every C++ file against .clang-format
   slurm-wlm munge jq   # stimuli: the single-node Slurm cluster test (slurmctld, slurmd, sbatch; munged; jq reads manifests)
   blender   # the pathtraced method: Cycles runs as a child process (docs/pathtraced.md)
   nginx openssl   # online studies: the HTTPS deployment test (nginx in front of the server, a self-signed certificate)
