@@ -161,7 +161,7 @@ std::vector<std::array<float, 4>> runStage(const SyntheticFrame& frame, const ss
     inputs.focalLengthPixels = frame.focalLengthPixels;
     inputs.mmPerUnit = frame.mmPerUnit;
     gl::SssStageSettings settings;
-    settings.sss = params.toJson();
+    settings.sss = params;
     stageFixture().stage->run(inputs, settings, output.get());
     std::vector<std::array<float, 4>> out(frame.diffuse.size());
     glGetTextureImage(output.get(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(out.size() * sizeof(out[0])), out.data());

@@ -3,6 +3,7 @@
 // plane keeps its mean, follow-surface stops light crossing the depth gap of builtin:halo.
 #include "../gl/render_test_support.h"
 #include "renderer/render_job.h"
+#include "renderer/sss/sss_params.h"
 
 #include <algorithm>
 #include <cmath>
@@ -17,7 +18,8 @@ using test::ExrImage;
 using test::readExr;
 using test::TempFolder;
 
-const std::vector<std::string> kMethods{"gaussian-sum", "separable", "artistic"};
+// The methods of the shared blur passes, from the method table (renderer/sss/sss_params.h).
+const std::vector<std::string> kMethods = renderer::sss::blurPassMethodNames();
 
 ExrImage render(Renderer& renderer, const TempFolder& folder, const std::string& scene, const std::string& method,
                 std::vector<std::string> overrides, int width, int height) {
@@ -78,7 +80,7 @@ TEST(SssRender, EveryMethodWithEveryExtensionRendersEveryScene) {
     SKINLAB_REQUIRE_RENDERER(renderer);
     const std::vector<std::string> all{"sss.cbf=true", "sss.lab_weight=0.09", "sss.curvature=reduce-floor",
                                        "transmittance.enabled=true", "transmittance.curvature=true"};
-    const std::vector<std::string> methods{"gaussian-sum", "separable", "artistic", "pscbf"};
+    const std::vector<std::string> methods = renderer::sss::screenSpaceMethodNames();
     std::vector<std::string> scenes{"builtin:halo", "builtin:bleed", "builtin:ear", "builtin:head"};
     const char* assets = std::getenv("SKINLAB_ASSETS");
     if (assets && *assets)
