@@ -56,8 +56,8 @@ std::vector<std::string> fixedOverrides(const SetSpec& spec) {
     return out;
 }
 
-// Checks the fixed parameters with every scene, then every factor level through the first stimulus that renders
-// it (its method decides which [sss] keys apply), so that an unknown factor key, an unknown level or a missing
+// Checks the fixed parameters with every scene, then every factor level with the method of the first stimulus that
+// renders it (the method decides which [sss] keys apply), so that an unknown factor key, an unknown level or a missing
 // asset is reported naming the scene, or the factor and level, before anything renders. Levels that every
 // stimulus excludes are not rendered and not checked.
 void validateLevels(const SetSpec& spec, const std::vector<Stimulus>& all, const fs::path& assets) {
@@ -81,8 +81,17 @@ void validateLevels(const SetSpec& spec, const std::vector<Stimulus>& all, const
         for (const auto& level : factor.levels) {
             const Stimulus* stimulus = firstWith(factor.name, level);
             if (!stimulus) continue;
+            // The stimulus' fixed parameters (those its method reads), its method and this level.
+            std::vector<std::string> overrides;
+            for (const auto& o : stimulus->overrides) {
+                const std::string key = o.substr(0, o.find('='));
+                const bool isFixed = std::any_of(spec.fixed.begin(), spec.fixed.end(),
+                                                 [&](const auto& p) { return p.key == key; });
+                if (isFixed || (key == "sss.method" && factor.key != "sss.method")) overrides.push_back(o);
+            }
+            overrides.push_back(factor.key + "=" + level.overrideText);
             try {
-                renderer::resolveScene(requestFor(stimulus->scene, stimulus->overrides, assets));
+                renderer::resolveScene(requestFor(stimulus->scene, overrides, assets));
             } catch (const InputError& e) {
                 throw InputError(spec.fileName + ": factor '" + factor.name + "': level '" + level.value +
                                  "': " + e.what());

@@ -136,10 +136,10 @@ TEST(SssRender, FollowSurfaceStopsLightCrossingTheDepthGapOfHalo) {
         "lights=[{type = \"directional\", direction = [0.45, -0.45, -0.77], intensity = 1.2, shadow = false}]"};
     auto crossing = [&](const std::string& method, bool follow) {
         std::vector<std::string> overrides = base;
-        overrides.push_back(std::string("sss.follow_surface=") + (follow ? "true" : "false"));
         // Wide kernel so that it reaches across the silhouette at this small size.
         overrides.push_back("sss.width_mm=12");
         const ExrImage none = render(*renderer, folder, "builtin:halo", "none", overrides, 96, 96);
+        overrides.push_back(std::string("sss.follow_surface=") + (follow ? "true" : "false"));  // not read by none
         const ExrImage image = render(*renderer, folder, "builtin:halo", method, overrides, 96, 96);
         float nearest = 1e30f;
         for (float z : image.channels.at("depth.Z")) nearest = std::min(nearest, z);
