@@ -115,9 +115,11 @@ void registerKernel(CLI::App& app) {
     auto options = std::make_shared<KernelOptions>();
     CLI::App* kernel = app.add_subcommand(
         "kernel", "Print the SSS kernel a method actually uses: taps (offset in mm on the surface, RGB weight)");
+    std::string names;
+    for (const std::string& name : sss::methodNames()) names += (names.empty() ? "" : " | ") + name;
     kernel->add_option("--method", options->method,
-                       "none | gaussian-sum | separable | artistic | pscbf (its broad Gaussian stage; the pass adds "
-                       "the spike) | reference (no taps: computed on the surface)")
+                       names + " (`skinlab methods`; pscbf: its broad Gaussian stage, the pass adds the spike; "
+                               "reference and pathtraced: no taps)")
         ->required();
     kernel->add_option("--samples", options->samples, "Taps per 1-D pass, odd, 3…101 (sss.samples; default 21, pscbf 13)");
     kernel->add_option("--profile", options->profile, "deon | burley | file:PATH.bn (sss.profile; default deon)");

@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
     skinlab::cli::registerBench(app);
     skinlab::cli::registerReport(app);
     skinlab::cli::registerPathtraced(app);
+    skinlab::cli::registerMethods(app);
 
     try {
         app.parse(argc, argv);

@@ -1,8 +1,9 @@
 // The renderer's public entry point (render_job.h): scene spec → GL passes → EXR (+ PNG), with timings.
 //
-// Pipeline (docs/rendering.md, "Pipeline"), one class per pass under renderer/gl/:
-//   shadow map → main pass → background → surface AOVs → transmittance → SSS stage → add specular → tone map
-//   → read back → EXR / PNG
+// Renderer::render runs named steps (docs/architecture.md, "Renderer"): materials (partMaterialsOf), lights
+// (gpuLightsOf), upload, the pass pipeline (Impl::runPasses, one class per pass under renderer/gl/:
+//   shadow map → main pass → background → surface AOVs → transmittance → SSS stage → add specular → tone map),
+// then read back and write, both driven by one AOV table (kAovs) → EXR / PNG.
 #include "renderer/render_job.h"
 
 #include "common/error.h"
@@ -33,6 +34,8 @@
 #include "renderer/shading/tone_mappers.h"
 #include "renderer/sss/sss_params.h"
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
@@ -94,7 +97,25 @@ void skinBounds(const Model& model, const std::vector<gl::GpuMaterial>& material
 
 nlohmann::json resolveScene(const RenderRequest& request) { return loadSpec(request).resolved; }
 
+namespace {
+// What the passes of one render need besides the frame targets: the scene, its model and materials as uploaded,
+// the camera and, for sss.method = "reference", the reference method's inputs.
+struct Frame {
+    const SceneSpec* spec = nullptr;
+    std::shared_ptr<const Model> model;
+    std::vector<gl::GpuMaterial> partMaterials;  // one per part of the model
+    gl::GpuScene* scene = nullptr;
+    CameraPose camera;
+    float exposure = 1.0f;                       // 2^exposure_ev
+    glm::mat3 environmentFromWorld{1.0f};
+    gl::ReferenceInputs referenceInputs;         // prepared before the passes (reference method only)
+};
+} // namespace
+
 struct Renderer::Impl {
+    // The pass pipeline of one frame (shadow map … tone map); returns the SSS support radius in mm.
+    float runPasses(const Frame& frame);
+
     gl::EglContext context;
     gl::ShaderLibrary shaders;
     gl::PassTimer timer;
@@ -179,59 +200,41 @@ Renderer::~Renderer() = default;
 std::string Renderer::glRenderer() const { return impl_->context.renderer(); }
 std::string Renderer::glVersion() const { return impl_->context.version(); }
 
-RenderResult Renderer::render(const RenderRequest& request) {
-    if (request.exrPath.empty()) throw InputError("render: an output EXR path is required (-o out.exr)");
-    const auto loadStart = std::chrono::steady_clock::now();
-    SceneSpec spec = loadSpec(request);
-    Impl& impl = *impl_;
-    impl.context.makeCurrent();
+namespace {
 
-    // --- scene data (CPU) -------------------------------------------------------------------------------
-    const std::shared_ptr<const Model> model = impl.model(spec);
-    std::vector<gl::GpuMaterial> partMaterials;
-    {
-        std::vector<gl::GpuMaterial> byMaterial;
-        for (const MeshMaterial& m : model->materials)
-            byMaterial.push_back({m.albedo, m.skin ? 1.0f : 0.0f, m.glossiness, m.specularIntensity});
-        for (std::size_t i = 0; i < spec.materials.size(); ++i) {
-            const MaterialSpec& override = spec.materials[i];
-            bool matched = false;
-            for (std::size_t m = 0; m < model->materials.size(); ++m) {
-                if (override.name != "*" && override.name != model->materials[m].name) continue;
-                matched = true;
-                gl::GpuMaterial& target = byMaterial[m];
-                if (override.albedo) target.albedo = *override.albedo;
-                if (override.skin) target.skin = *override.skin ? 1.0f : 0.0f;
-                if (override.glossiness) target.glossiness = static_cast<float>(*override.glossiness);
-                if (override.specularIntensity) target.specularIntensity = static_cast<float>(*override.specularIntensity);
-            }
-            if (!matched) {
-                std::string names;
-                for (const MeshMaterial& m : model->materials) names += (names.empty() ? "" : ", ") + m.name;
-                throwInput(spec.source, "materials[" + std::to_string(i) + "].name",
-                           "no material '" + override.name + "' in the model (it has: " + names + "; \"*\" means all)");
-            }
+// --- materials -----------------------------------------------------------------------------------------------
+// One GPU material per part of the model: the model's own materials with the scene's [[materials]] overrides.
+std::vector<gl::GpuMaterial> partMaterialsOf(const SceneSpec& spec, const Model& model) {
+    std::vector<gl::GpuMaterial> byMaterial;
+    for (const MeshMaterial& m : model.materials)
+        byMaterial.push_back({m.albedo, m.skin ? 1.0f : 0.0f, m.glossiness, m.specularIntensity});
+    for (std::size_t i = 0; i < spec.materials.size(); ++i) {
+        const MaterialSpec& override = spec.materials[i];
+        bool matched = false;
+        for (std::size_t m = 0; m < model.materials.size(); ++m) {
+            if (override.name != "*" && override.name != model.materials[m].name) continue;
+            matched = true;
+            gl::GpuMaterial& target = byMaterial[m];
+            if (override.albedo) target.albedo = *override.albedo;
+            if (override.skin) target.skin = *override.skin ? 1.0f : 0.0f;
+            if (override.glossiness) target.glossiness = static_cast<float>(*override.glossiness);
+            if (override.specularIntensity) target.specularIntensity = static_cast<float>(*override.specularIntensity);
         }
-        for (const SubMesh& part : model->parts) partMaterials.push_back(byMaterial.at(part.material));
+        if (!matched) {
+            std::string names;
+            for (const MeshMaterial& m : model.materials) names += (names.empty() ? "" : ", ") + m.name;
+            throwInput(spec.source, "materials[" + std::to_string(i) + "].name",
+                       "no material '" + override.name + "' in the model (it has: " + names + "; \"*\" means all)");
+        }
     }
-    // A spec's maps replace the ones the model brings (builtin:head's procedural skin detail).
-    const auto albedoMap = spec.textures.albedo.empty() ? model->albedoMap : impl.image(spec.textures.albedo, ColorEncoding::sRGB);
-    const auto normalMap = spec.textures.normal.empty() ? model->normalMap : impl.image(spec.textures.normal, ColorEncoding::Data);
-    const auto specularMap = impl.image(spec.textures.specular, ColorEncoding::Data);
-    const auto occlusionMap = impl.image(spec.textures.occlusion, ColorEncoding::Data);
-    const auto skinMaskMap = impl.image(spec.textures.skinMask, ColorEncoding::Data);
-    const Impl::CachedEnvironment& environment = impl.environment(spec.environment);
-    const double loadMs = millisecondsSince(loadStart);
+    std::vector<gl::GpuMaterial> parts;
+    for (const SubMesh& part : model.parts) parts.push_back(byMaterial.at(part.material));
+    return parts;
+}
 
-    // --- upload ------------------------------------------------------------------------------------------
-    const auto uploadStart = std::chrono::steady_clock::now();
-    gl::GpuScene scene;
-    scene.uploadModel(*model, partMaterials);
-    scene.uploadMaps(albedoMap.get(), normalMap.get(), specularMap.get(), occlusionMap.get(), skinMaskMap.get());
-    std::array<glm::vec3, 9> irradiance = irradianceCoefficientsSH9(environment.radianceSH);
-    for (glm::vec3& c : irradiance) c *= static_cast<float>(spec.environment.intensity);
-    const bool environmentBackground = spec.environment.background == "environment" && environment.environment;
-    scene.uploadEnvironment(environmentBackground ? environment.environment.get() : nullptr, irradiance);
+// --- lights --------------------------------------------------------------------------------------------------
+std::vector<gl::GpuLight> gpuLightsOf(const SceneSpec& spec) {
+    std::vector<gl::GpuLight> lights;
     for (const LightSpec& light : spec.lights) {
         gl::GpuLight g;
         g.radiance = light.color * static_cast<float>(light.intensity);
@@ -247,160 +250,261 @@ RenderResult Renderer::render(const RenderRequest& request) {
             g.cosInner = static_cast<float>(std::cos(glm::radians(light.innerAngleDeg)));
             g.cosOuter = static_cast<float>(std::cos(glm::radians(light.outerAngleDeg)));
         }
-        scene.lights.push_back(g);
+        lights.push_back(g);
     }
-    glm::vec3 frameMin, frameMax;
-    skinBounds(*model, partMaterials, frameMin, frameMax);
-    const CameraPose camera = frameCamera(spec.camera, frameMin, frameMax, model->boundsMin, model->boundsMax,
-                                          spec.width, spec.height);
-    impl.targets.resize(spec.width, spec.height);
-    const float exposure = static_cast<float>(std::exp2(spec.exposureEv));
-    const glm::mat3 environmentFromWorld(
-        glm::rotate(glm::mat4(1.0f), static_cast<float>(-glm::radians(spec.environment.rotationDeg)), glm::vec3(0, 1, 0)));
-    glFinish();
-    const double uploadMs = millisecondsSince(uploadStart);
+    return lights;
+}
 
-    // sss.method = "pathtraced": Blender Cycles renders the same triangles, camera, lights and environment
-    // (renderer/pathtraced, docs/pathtraced.md) before any pass runs, so a missing or failing Blender leaves
-    // nothing done. The passes below still run (the screen-space stage copies through) for the AOVs Cycles does
-    // not produce: albedo, normals, transmittance, aux, curvature.
-    std::optional<pathtraced::CyclesImage> cycles;
-    bool fractionalSkin = !spec.textures.skinMask.empty();
-    for (const Vertex& v : model->vertices) fractionalSkin = fractionalSkin || v.skin < 1.0f;
-    if (spec.sssMethod == "pathtraced") {
-        pathtraced::BlenderSceneInputs cyclesInputs;
-        cyclesInputs.spec = &spec;
-        cyclesInputs.model = model.get();
-        for (const gl::GpuMaterial& m : partMaterials)
-            cyclesInputs.partMaterials.push_back({m.albedo, m.skin, m.glossiness, m.specularIntensity});
-        cyclesInputs.camera = camera;
-        cyclesInputs.params = pathtraced::pathtracedParamsFromJson(spec.pathtraced, spec.source);
-        cyclesInputs.sssWidthMm = sss::sssParamsFromJson(spec.sss, spec.source).widthMm;
-        cycles = pathtraced::renderWithCycles(cyclesInputs, exposure);
+// --- AOVs ----------------------------------------------------------------------------------------------------
+// One table drives both the read-back and the EXR channels (docs/rendering.md, "EXR layout"): each AOV's frame
+// target, its layout there, its channel names in the EXR and, for sss.method = "pathtraced", the Cycles image that
+// replaces it (the other AOVs come from the rasterizer's passes in every method).
+struct Aov {
+    const char* layer;                                  // EXR layer; "" = the beauty's R, G, B
+    const char* channels;                               // one letter per EXR channel, e.g. "RGB", "Z"
+    gl::Texture gl::FrameTargets::*texture;             // where the passes write it
+    int textureChannels;                                // 4: RGBA32F, 1: R32F
+    std::vector<float> pathtraced::CyclesImage::*cycles;  // nullptr: never from Cycles
+    int cyclesChannels;                                 // components per pixel in the Cycles image
+};
+
+const std::array<Aov, 11> kAovs{{
+    {"", "RGB", &gl::FrameTargets::beauty, 4, &pathtraced::CyclesImage::beauty, 3},
+    {"diffuse", "RGB", &gl::FrameTargets::scatteredDiffuse, 4, &pathtraced::CyclesImage::diffuse, 3},
+    {"specular", "RGB", &gl::FrameTargets::specular, 4, &pathtraced::CyclesImage::specular, 3},
+    {"albedo", "RGB", &gl::FrameTargets::albedo, 4, nullptr, 0},
+    {"depth", "Z", &gl::FrameTargets::linearDepth, 1, &pathtraced::CyclesImage::depth, 1},
+    {"normal", "XYZ", &gl::FrameTargets::normal, 4, nullptr, 0},
+    {"geonormal", "XYZ", &gl::FrameTargets::geometricNormal, 4, nullptr, 0},
+    {"mask", "Y", &gl::FrameTargets::mask, 1, &pathtraced::CyclesImage::mask, 1},
+    {"transmittance", "RGB", &gl::FrameTargets::transmittance, 4, nullptr, 0},
+    {"aux", "Y", &gl::FrameTargets::aux, 1, nullptr, 0},
+    {"curvature", "Y", &gl::FrameTargets::curvature, 1, nullptr, 0},
+}};
+
+std::size_t aovIndex(std::string_view layer) {
+    for (std::size_t i = 0; i < kAovs.size(); ++i)
+        if (layer == kAovs[i].layer) return i;
+    return kAovs.size();
+}
+
+// The EXR channels of every AOV, from Cycles where the table says so and a Cycles image is given.
+std::vector<ExrChannel> exrChannels(const std::vector<std::vector<float>>& readBack,
+                                    const pathtraced::CyclesImage* cycles, std::size_t pixels) {
+    std::vector<ExrChannel> channels;
+    for (std::size_t a = 0; a < kAovs.size(); ++a) {
+        const Aov& aov = kAovs[a];
+        const bool fromCycles = cycles && aov.cycles;
+        const std::vector<float>& data = fromCycles ? cycles->*aov.cycles : readBack[a];
+        const std::size_t stride = static_cast<std::size_t>(fromCycles ? aov.cyclesChannels : aov.textureChannels);
+        const std::string layer = aov.layer;
+        for (std::size_t c = 0; aov.channels[c]; ++c) {
+            ExrChannel channel;
+            channel.name = layer.empty() ? std::string(1, aov.channels[c]) : layer + "." + std::string(1, aov.channels[c]);
+            channel.values.resize(pixels);
+            for (std::size_t p = 0; p < pixels; ++p) channel.values[p] = data[p * stride + c];
+            channels.push_back(std::move(channel));
+        }
     }
+    return channels;
+}
 
-    // --- passes ------------------------------------------------------------------------------------------
-    // sss.method = "reference": check its parameters and tessellate (cached) before the first pass, so bad input
-    // fails with no pass half done.
-    const bool referenceMethod = spec.sssMethod == "reference";
-    gl::ReferenceInputs referenceInputs;
-    sss::SssParams referenceParams;
-    if (referenceMethod) {
-        referenceParams = sss::sssParamsFromJson(spec.sss, spec.source);
-        referenceInputs.model = model;
-        referenceInputs.partMaterials = partMaterials;
-        referenceInputs.mmPerUnit = static_cast<float>(spec.mmPerUnit);
-        referenceInputs.source = spec.source;
-        impl.referenceMethod.prepare(referenceInputs, referenceParams);
-    }
+} // namespace
 
-    gl::PassTimer& timer = impl.timer;
-    timer.reset();
-    timer.begin("shadow");
-    impl.shadowMapPass.run(scene, model->boundsMin, model->boundsMax, spec.shadowResolution);
-    timer.end();
+// --- the pass pipeline ---------------------------------------------------------------------------------------
+// shadow map → main pass → background → surface AOVs → transmittance → SSS stage (or the object-space reference)
+// → add specular → tone map. Returns the SSS support radius for the EXR metadata.
+float Renderer::Impl::runPasses(const Frame& frame) {
+    const SceneSpec& spec = *frame.spec;
+    gl::PassTimer& passTimer = timer;
+    passTimer.reset();
+    passTimer.begin("shadow");
+    shadowMapPass.run(*frame.scene, frame.model->boundsMin, frame.model->boundsMax, spec.shadowResolution);
+    passTimer.end();
 
-    timer.begin("main");
+    passTimer.begin("main");
     gl::MainPassSettings mainSettings;
-    mainSettings.camera = camera;
-    mainSettings.exposure = exposure;
+    mainSettings.camera = frame.camera;
+    mainSettings.exposure = frame.exposure;
     mainSettings.normalStrength = static_cast<float>(spec.textures.normalStrength);
     mainSettings.pcfRadius = spec.shadowPcfRadius;
-    mainSettings.environmentFromWorld = environmentFromWorld;
-    const sss::TransmittanceParams transmittanceParams =
-        sss::transmittanceParamsFromJson(spec.transmittance, spec.source);
-    mainSettings.transmittanceEnabled = transmittanceParams.enabled;
-    mainSettings.translucency = static_cast<float>(transmittanceParams.translucency);
-    const sss::SssParams sssParams = sss::sssParamsFromJson(spec.sss, spec.source);
-    mainSettings.sssWidthMm = static_cast<float>(sssParams.widthMm);
+    mainSettings.environmentFromWorld = frame.environmentFromWorld;
+    mainSettings.transmittanceEnabled = spec.transmittance.enabled;
+    mainSettings.translucency = static_cast<float>(spec.transmittance.translucency);
+    mainSettings.sssWidthMm = static_cast<float>(spec.sss.widthMm);
     mainSettings.transmittanceThesisCurvature =
-        transmittanceParams.curvature && transmittanceParams.curvatureForm == "thesis";
-    mainSettings.curvatureReferenceMm = static_cast<float>(sssParams.curvatureReferenceMm);
+        spec.transmittance.curvature && spec.transmittance.curvatureForm == "thesis";
+    mainSettings.curvatureReferenceMm = static_cast<float>(spec.sss.curvatureReferenceMm);
     mainSettings.mmPerUnit = static_cast<float>(spec.mmPerUnit);
-    impl.mainPass.run(impl.targets, scene, impl.shadowMapPass.shadowMaps(), mainSettings);
-    timer.end();
+    mainPass.run(targets, *frame.scene, shadowMapPass.shadowMaps(), mainSettings);
+    passTimer.end();
 
-    timer.begin("background");
+    passTimer.begin("background");
     gl::BackgroundSettings backgroundSettings;
-    backgroundSettings.camera = camera;
-    backgroundSettings.environmentMap = scene.environmentMap();
+    backgroundSettings.camera = frame.camera;
+    backgroundSettings.environmentMap = frame.scene->environmentMap();
     backgroundSettings.color = spec.environment.background == "color"
                                    ? spec.environment.backgroundColor
                                    : spec.environment.radiance * static_cast<float>(spec.environment.intensity);
     backgroundSettings.environmentIntensity = static_cast<float>(spec.environment.intensity);
-    backgroundSettings.exposure = exposure;
-    backgroundSettings.environmentFromWorld = environmentFromWorld;
-    impl.backgroundPass.run(impl.targets, backgroundSettings);
-    timer.end();
+    backgroundSettings.exposure = frame.exposure;
+    backgroundSettings.environmentFromWorld = frame.environmentFromWorld;
+    backgroundPass.run(targets, backgroundSettings);
+    passTimer.end();
 
-    timer.begin("surface_aovs");
+    passTimer.begin("surface_aovs");
     gl::SurfaceAovSettings surfaceAovSettings;
-    surfaceAovSettings.camera = camera;
-    surfaceAovSettings.screenCurvature = sssParams.curvatureMeasure == "screen";
-    impl.surfaceAovPass.run(impl.targets, surfaceAovSettings);
-    timer.end();
+    surfaceAovSettings.camera = frame.camera;
+    surfaceAovSettings.screenCurvature = spec.sss.curvatureMeasure == "screen";
+    surfaceAovPass.run(targets, surfaceAovSettings);
+    passTimer.end();
 
-    timer.begin("transmittance");
+    passTimer.begin("transmittance");
     gl::TransmittanceSettings transmittanceSettings;
-    transmittanceSettings.enabled = transmittanceParams.enabled;
-    transmittanceSettings.curvature = transmittanceParams.curvature;
+    transmittanceSettings.enabled = spec.transmittance.enabled;
+    transmittanceSettings.curvature = spec.transmittance.curvature;
     transmittanceSettings.mmPerUnit = static_cast<float>(spec.mmPerUnit);
-    transmittanceSettings.thesisForm = transmittanceParams.curvatureForm == "thesis";
-    transmittanceSettings.curvatureReferenceMm = static_cast<float>(sssParams.curvatureReferenceMm);
-    impl.transmittancePass.run(impl.targets, transmittanceSettings);
-    timer.end();
+    transmittanceSettings.thesisForm = spec.transmittance.curvatureForm == "thesis";
+    transmittanceSettings.curvatureReferenceMm = static_cast<float>(spec.sss.curvatureReferenceMm);
+    transmittancePass.run(targets, transmittanceSettings);
+    passTimer.end();
 
-    timer.begin("sss");
-    gl::SssStageInputs sssInputs;
-    sssInputs.diffuse = impl.targets.diffuse.get();
-    sssInputs.linearDepth = impl.targets.linearDepth.get();
-    sssInputs.albedo = impl.targets.albedo.get();
-    sssInputs.skinMask = impl.targets.mask.get();
-    sssInputs.normal = impl.targets.normal.get();
-    sssInputs.geometricNormal = impl.targets.geometricNormal.get();
-    sssInputs.aux = impl.targets.aux.get();
-    sssInputs.curvature = impl.targets.curvature.get();
-    sssInputs.width = spec.width;
-    sssInputs.height = spec.height;
-    sssInputs.focalLengthPixels = camera.focalLengthPixels;
-    sssInputs.mmPerUnit = static_cast<float>(spec.mmPerUnit);
-    sssInputs.view = camera.view;
-    sssInputs.projection = camera.projection;
-    sssInputs.cameraPosition = camera.position;
+    passTimer.begin("sss");
+    float supportRadiusMm = 0.0f;
     gl::SssStageSettings sssSettings;
     sssSettings.sss = spec.sss;
     sssSettings.transmittance = spec.transmittance;
-    if (referenceMethod) {
+    if (spec.sss.method == sss::SssMethod::Reference) {
         // The object-space reference bakes the main pass's shading at the tessellated vertices itself, so it needs
         // the model, the scene and the main pass's settings rather than the screen-space inputs.
-        referenceInputs.scene = &scene;
-        referenceInputs.shadowMaps = impl.shadowMapPass.shadowMaps();
+        gl::ReferenceInputs referenceInputs = frame.referenceInputs;
+        referenceInputs.scene = frame.scene;
+        referenceInputs.shadowMaps = shadowMapPass.shadowMaps();
         referenceInputs.mainSettings = mainSettings;
-        referenceInputs.targets = &impl.targets;
-        impl.referenceMethod.run(referenceInputs, referenceParams, impl.targets.scatteredDiffuse.get());
+        referenceInputs.targets = &targets;
+        referenceMethod.run(referenceInputs, spec.sss, targets.scatteredDiffuse.get());
+        supportRadiusMm = gl::ReferenceMethod::supportRadiusMm(spec.sss, spec.source);
     } else {
-        impl.sssStage.run(sssInputs, sssSettings, impl.targets.scatteredDiffuse.get());
+        gl::SssStageInputs sssInputs;
+        sssInputs.diffuse = targets.diffuse.get();
+        sssInputs.linearDepth = targets.linearDepth.get();
+        sssInputs.albedo = targets.albedo.get();
+        sssInputs.skinMask = targets.mask.get();
+        sssInputs.normal = targets.normal.get();
+        sssInputs.geometricNormal = targets.geometricNormal.get();
+        sssInputs.aux = targets.aux.get();
+        sssInputs.curvature = targets.curvature.get();
+        sssInputs.width = spec.width;
+        sssInputs.height = spec.height;
+        sssInputs.focalLengthPixels = frame.camera.focalLengthPixels;
+        sssInputs.mmPerUnit = static_cast<float>(spec.mmPerUnit);
+        sssInputs.view = frame.camera.view;
+        sssInputs.projection = frame.camera.projection;
+        sssInputs.cameraPosition = frame.camera.position;
+        sssStage.run(sssInputs, sssSettings, targets.scatteredDiffuse.get());
+        // pathtraced: the support of the profile its radii are matched to (as the object-space reference declares).
+        supportRadiusMm = spec.sss.method == sss::SssMethod::Pathtraced
+                              ? gl::ReferenceMethod::supportRadiusMm(spec.sss, spec.source)
+                              : sssStage.supportRadiusMm(sssSettings);
     }
-    timer.end();
+    passTimer.end();
 
-    timer.begin("add_specular");
-    impl.addSpecularPass.run(impl.targets);
-    timer.end();
+    passTimer.begin("add_specular");
+    addSpecularPass.run(targets);
+    passTimer.end();
 
-    timer.begin("tone_map");
+    passTimer.begin("tone_map");
     float reinhardScale = 1.0f;
     if (spec.toneMapper == "reinhard") {
         // Reinhard et al. 2002, Eq. 1: the log-average luminance of the beauty (read back once, on the CPU).
         std::vector<float> linear(static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height) * 4);
-        gl::readTexture(impl.targets.beauty.get(), spec.width, spec.height, 4, linear.data());
+        gl::readTexture(targets.beauty.get(), spec.width, spec.height, 4, linear.data());
         const double logAverage = reinhardLogAverage(linear.data(), linear.size() / 4, 4);
         reinhardScale = static_cast<float>(spec.reinhardKey / logAverage);
     }
-    impl.toneMapPass.run(impl.targets, spec.toneMapper, static_cast<float>(spec.exponentialK),
-                         static_cast<float>(spec.filmicWhite), reinhardScale);
-    timer.end();
+    toneMapPass.run(targets, spec.toneMapper, static_cast<float>(spec.exponentialK), static_cast<float>(spec.filmicWhite),
+                    reinhardScale);
+    passTimer.end();
+    return supportRadiusMm;
+}
 
-    // --- read back and write -----------------------------------------------------------------------------
+RenderResult Renderer::render(const RenderRequest& request) {
+    if (request.exrPath.empty()) throw InputError("render: an output EXR path is required (-o out.exr)");
+    const auto loadStart = std::chrono::steady_clock::now();
+    SceneSpec spec = loadSpec(request);
+    Impl& impl = *impl_;
+    impl.context.makeCurrent();
+
+    // --- scene data (CPU): model, materials, maps, environment ----------------------------------------------
+    Frame frame;
+    frame.spec = &spec;
+    frame.model = impl.model(spec);
+    frame.partMaterials = partMaterialsOf(spec, *frame.model);
+    // A spec's maps replace the ones the model brings (builtin:head's procedural skin detail).
+    const auto albedoMap =
+        spec.textures.albedo.empty() ? frame.model->albedoMap : impl.image(spec.textures.albedo, ColorEncoding::sRGB);
+    const auto normalMap =
+        spec.textures.normal.empty() ? frame.model->normalMap : impl.image(spec.textures.normal, ColorEncoding::Data);
+    const auto specularMap = impl.image(spec.textures.specular, ColorEncoding::Data);
+    const auto occlusionMap = impl.image(spec.textures.occlusion, ColorEncoding::Data);
+    const auto skinMaskMap = impl.image(spec.textures.skinMask, ColorEncoding::Data);
+    const Impl::CachedEnvironment& environment = impl.environment(spec.environment);
+    const double loadMs = millisecondsSince(loadStart);
+
+    // --- upload: geometry, maps, environment, lights; camera and frame targets ------------------------------
+    const auto uploadStart = std::chrono::steady_clock::now();
+    gl::GpuScene scene;
+    frame.scene = &scene;
+    scene.uploadModel(*frame.model, frame.partMaterials);
+    scene.uploadMaps(albedoMap.get(), normalMap.get(), specularMap.get(), occlusionMap.get(), skinMaskMap.get());
+    std::array<glm::vec3, 9> irradiance = irradianceCoefficientsSH9(environment.radianceSH);
+    for (glm::vec3& c : irradiance) c *= static_cast<float>(spec.environment.intensity);
+    const bool environmentBackground = spec.environment.background == "environment" && environment.environment;
+    scene.uploadEnvironment(environmentBackground ? environment.environment.get() : nullptr, irradiance);
+    scene.lights = gpuLightsOf(spec);
+    glm::vec3 frameMin, frameMax;
+    skinBounds(*frame.model, frame.partMaterials, frameMin, frameMax);
+    frame.camera = frameCamera(spec.camera, frameMin, frameMax, frame.model->boundsMin, frame.model->boundsMax,
+                               spec.width, spec.height);
+    impl.targets.resize(spec.width, spec.height);
+    frame.exposure = static_cast<float>(std::exp2(spec.exposureEv));
+    frame.environmentFromWorld = glm::mat3(
+        glm::rotate(glm::mat4(1.0f), static_cast<float>(-glm::radians(spec.environment.rotationDeg)), glm::vec3(0, 1, 0)));
+    glFinish();
+    const double uploadMs = millisecondsSince(uploadStart);
+
+    // --- sss.method = "pathtraced": Blender Cycles renders the same triangles, camera, lights and environment
+    // (renderer/pathtraced, docs/pathtraced.md) before any pass runs, so a missing or failing Blender leaves
+    // nothing done. The passes below still run (the screen-space stage copies through) for the AOVs Cycles does
+    // not produce: albedo, normals, transmittance, aux, curvature.
+    std::optional<pathtraced::CyclesImage> cycles;
+    if (spec.sss.method == sss::SssMethod::Pathtraced) {
+        pathtraced::BlenderSceneInputs cyclesInputs;
+        cyclesInputs.spec = &spec;
+        cyclesInputs.model = frame.model.get();
+        for (const gl::GpuMaterial& m : frame.partMaterials)
+            cyclesInputs.partMaterials.push_back({m.albedo, m.skin, m.glossiness, m.specularIntensity});
+        cyclesInputs.camera = frame.camera;
+        cyclesInputs.params = pathtraced::pathtracedParamsFromJson(spec.pathtraced, spec.source);
+        cyclesInputs.sssWidthMm = spec.sss.widthMm;
+        cycles = pathtraced::renderWithCycles(cyclesInputs, frame.exposure);
+    }
+
+    // --- sss.method = "reference": check its parameters and tessellate (cached) before the first pass, so bad
+    // input fails with no pass half done.
+    const bool referenceMethod = spec.sss.method == sss::SssMethod::Reference;
+    if (referenceMethod) {
+        frame.referenceInputs.model = frame.model;
+        frame.referenceInputs.partMaterials = frame.partMaterials;
+        frame.referenceInputs.mmPerUnit = static_cast<float>(spec.mmPerUnit);
+        frame.referenceInputs.source = spec.source;
+        impl.referenceMethod.prepare(frame.referenceInputs, spec.sss);
+    }
+
+    // --- the pass pipeline ----------------------------------------------------------------------------------
+    const float supportRadiusMm = impl.runPasses(frame);
+
+    // --- read back: every AOV of the table, and the display image -------------------------------------------
     const auto readbackStart = std::chrono::steady_clock::now();
     const int width = spec.width;
     const int height = spec.height;
@@ -411,20 +515,12 @@ RenderResult Renderer::render(const RenderRequest& request) {
         gl::readTexture(texture, width, height, channels, data.data());
         return data;
     };
-    const std::vector<float> beauty = read(impl.targets.beauty.get(), 4);
-    const std::vector<float> diffuse = read(impl.targets.scatteredDiffuse.get(), 4);
-    const std::vector<float> specular = read(impl.targets.specular.get(), 4);
-    const std::vector<float> albedo = read(impl.targets.albedo.get(), 4);
-    const std::vector<float> depth = read(impl.targets.linearDepth.get(), 1);
-    const std::vector<float> normal = read(impl.targets.normal.get(), 4);
-    const std::vector<float> geometricNormal = read(impl.targets.geometricNormal.get(), 4);
-    const std::vector<float> mask = read(impl.targets.mask.get(), 1);
-    const std::vector<float> transmittance = read(impl.targets.transmittance.get(), 4);
-    const std::vector<float> aux = read(impl.targets.aux.get(), 1);
-    const std::vector<float> curvature = read(impl.targets.curvature.get(), 1);
+    std::vector<std::vector<float>> readBack;
+    for (const Aov& aov : kAovs) readBack.push_back(read((impl.targets.*aov.texture).get(), aov.textureChannels));
     if (cycles && pathtraced::pathtracedParamsFromJson(spec.pathtraced, spec.source).specularSource == "rasterizer") {
         // pathtraced.specular_source = "rasterizer": Cycles rendered no specular lobe; its beauty gets the
         // rasterizer's specular pass (same camera), so only the diffuse/subsurface layer comes from Cycles.
+        const std::vector<float>& specular = readBack[aovIndex("specular")];
         for (std::size_t p = 0; p < pixels; ++p)
             for (std::size_t c = 0; c < 3; ++c) {
                 cycles->specular[p * 3 + c] = specular[p * 4 + c];
@@ -446,41 +542,18 @@ RenderResult Renderer::render(const RenderRequest& request) {
     }
     const double readbackMs = millisecondsSince(readbackStart);
 
+    // --- write: EXR channels from the AOV table, metadata, PNG ----------------------------------------------
     const auto writeStart = std::chrono::steady_clock::now();
-    std::vector<ExrChannel> channels;
-    auto addChannels = [&](const std::string& layer, const std::vector<float>& data, int stride, const char* names) {
-        for (int c = 0; names[c]; ++c) {
-            ExrChannel channel;
-            channel.name = layer.empty() ? std::string(1, names[c]) : layer + "." + std::string(1, names[c]);
-            channel.values.resize(pixels);
-            for (std::size_t p = 0; p < pixels; ++p) channel.values[p] = data[p * static_cast<std::size_t>(stride) + static_cast<std::size_t>(c)];
-            channels.push_back(std::move(channel));
-        }
-    };
-    if (cycles) {
-        // Beauty, diffuse, specular, depth and mask from Cycles; the other AOVs from the rasterizer's passes.
-        addChannels("", cycles->beauty, 3, "RGB");
-        addChannels("diffuse", cycles->diffuse, 3, "RGB");
-        addChannels("specular", cycles->specular, 3, "RGB");
-    } else {
-        addChannels("", beauty, 4, "RGB");
-        addChannels("diffuse", diffuse, 4, "RGB");
-        addChannels("specular", specular, 4, "RGB");
-    }
-    addChannels("albedo", albedo, 4, "RGB");
-    addChannels("depth", cycles ? cycles->depth : depth, 1, "Z");
-    addChannels("normal", normal, 4, "XYZ");
-    addChannels("geonormal", geometricNormal, 4, "XYZ");
+    bool fractionalSkin = !spec.textures.skinMask.empty();
+    for (const Vertex& v : frame.model->vertices) fractionalSkin = fractionalSkin || v.skin < 1.0f;
     if (cycles && fractionalSkin) {
         // A skin-mask map or per-vertex skin below 1: Cycles' index pass only knows the material's flag, so the
         // rasterizer's mask (same camera, point-sampled) supplies the fraction.
+        const std::vector<float>& mask = readBack[aovIndex("mask")];
         for (std::size_t p = 0; p < pixels; ++p) cycles->mask[p] *= std::clamp(mask[p], 0.0f, 1.0f);
     }
-    addChannels("mask", cycles ? cycles->mask : mask, 1, "Y");
-    addChannels("transmittance", transmittance, 4, "RGB");
-    addChannels("aux", aux, 1, "Y");
-    addChannels("curvature", curvature, 1, "Y");
-
+    const std::vector<ExrChannel> channels = exrChannels(readBack, cycles ? &*cycles : nullptr, pixels);
+    const CameraPose& camera = frame.camera;
     const nlohmann::json cameraJson = {{"position", jsonVec3(camera.position)},
                                        {"target", jsonVec3(camera.target)},
                                        {"up", jsonVec3(camera.up)},
@@ -497,13 +570,18 @@ RenderResult Renderer::render(const RenderRequest& request) {
     metadata.strings["skinlab:camera"] = cameraJson.dump();
     metadata.floats["skinlab:f_px"] = camera.focalLengthPixels;
     metadata.floats["skinlab:mm_per_unit"] = static_cast<float>(spec.mmPerUnit);
-    // pathtraced: the support of the profile its radii are matched to (as the object-space reference declares).
-    metadata.floats["skinlab:sss_radius_mm"] =
-        referenceMethod ? gl::ReferenceMethod::supportRadiusMm(referenceParams, spec.source)
-        : cycles        ? gl::ReferenceMethod::supportRadiusMm(sss::sssParamsFromJson(spec.sss, spec.source), spec.source)
-                        : impl.sssStage.supportRadiusMm(sssSettings);
+    metadata.floats["skinlab:sss_radius_mm"] = supportRadiusMm;
     if (cycles) {
         const nlohmann::json params = spec.pathtraced;
+        nlohmann::json fromCycles = nlohmann::json::array();  // "R", "G", "B", "diffuse.*", ..., "depth.Z", "mask.Y"
+        for (const Aov& aov : kAovs) {
+            if (!aov.cycles) continue;
+            const std::string layer = aov.layer, letters = aov.channels;
+            if (layer.empty())
+                for (const char c : letters) fromCycles.push_back(std::string(1, c));
+            else
+                fromCycles.push_back(layer + "." + (letters.size() == 1 ? letters : std::string("*")));
+        }
         metadata.strings["skinlab:pathtraced"] =
             nlohmann::json{{"samples", params.at("samples")},
                            {"seed", params.at("seed")},
@@ -513,7 +591,7 @@ RenderResult Renderer::render(const RenderRequest& request) {
                            {"channels_from_cycles",
                             params.value("specular_source", "cycles") == "rasterizer"
                                 ? nlohmann::json{"R, G, B: diffuse only", "diffuse.*", "depth.Z", "mask.Y"}
-                                : nlohmann::json{"R", "G", "B", "diffuse.*", "specular.*", "depth.Z", "mask.Y"}}}
+                                : fromCycles}}
                 .dump();
         metadata.strings["skinlab:blender_version"] = cycles->blenderVersion;
         metadata.floats["skinlab:pathtraced_samples"] = static_cast<float>(params.at("samples").get<int>());
@@ -528,7 +606,7 @@ RenderResult Renderer::render(const RenderRequest& request) {
     result.resolved = spec.resolved;
     result.glRenderer = impl.context.renderer();
     result.glVersion = impl.context.version();
-    result.timingsMs = timer.json();
+    result.timingsMs = impl.timer.json();
     result.timingsMs["cpu"] = {{"load", loadMs}, {"upload", uploadMs}, {"readback", readbackMs}, {"write", writeMs}};
     if (referenceMethod) result.timingsMs["reference"] = impl.referenceMethod.lastRun();  // CPU parts of "sss"
     if (cycles)

@@ -5,5 +5,7 @@ cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 # ccache (when present) may reuse objects across clones of the repository in other folders.
 export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=true
-cmake --preset release >/dev/null
+# SKINLAB_WERROR=ON (scripts/test.sh, hence CI) treats every warning as an error, so e.g. a `switch` over SssMethod
+# that misses a method fails the build (-Wall includes -Wswitch).
+cmake --preset release -DSKINLAB_WERROR="${SKINLAB_WERROR:-OFF}" >/dev/null
 cmake --build --preset release -j "$(nproc)"

@@ -80,13 +80,14 @@ for name in "${sets[@]}"; do
   fi
 done
 
-python3 - "$out" "${sets[@]}" <<'PYTHON'
+# The screen-space methods, from the binary's method table (one name a line).
+methods="$("$skinlab" methods --list --screen-space | paste -sd, -)"
+python3 - "$out" "$methods" "${sets[@]}" <<'PYTHON'
 # Pivots each set's metrics.json by block × method × extension set. The extension set of a stimulus is read from
 # its resolved [sss] parameters in the manifest, so the table cannot disagree with what was rendered.
 import json, os, sys
 
-out, sets = sys.argv[1], sys.argv[2:]
-methods = ["gaussian-sum", "separable", "artistic", "pscbf"]
+out, methods, sets = sys.argv[1], sys.argv[2].split(","), sys.argv[3:]
 extension_sets = ["none", "follow-surface", "+cbf", "+lab_weight", "+curvature", "all"]
 
 def extension_set(sss):

@@ -5,11 +5,13 @@
 #include "common/hash.h"
 #include "common/version.h"
 #include "renderer/render_job.h"
+#include "renderer/sss/sss_params.h"
 #include "stimuli/contact_sheet.h"
 #include "stimuli/output_folder.h"
 #include "stimuli/progress.h"
 
 #include <OpenImageIO/imageio.h>
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <map>
@@ -36,15 +38,29 @@ RenderRequest requestFor(const std::string& scene, const std::vector<std::string
     return request;
 }
 
+// The fixed parameters that hold for every stimulus whatever its method: an [sss] key that only some methods read
+// applies to the stimuli whose method reads it (expansion.h), so it is checked with those stimuli.
 std::vector<std::string> fixedOverrides(const SetSpec& spec) {
+    const auto common = renderer::sss::kCommonSssKeys;
+    const auto known = renderer::sss::allSssKeys();
     std::vector<std::string> out;
-    for (const auto& p : spec.fixed) out.push_back(p.key + "=" + p.level.overrideText);
+    for (const auto& p : spec.fixed) {
+        if (p.key.rfind("sss.", 0) == 0) {
+            const std::string_view name = std::string_view(p.key).substr(4);
+            const bool methodSpecific = std::find(known.begin(), known.end(), name) != known.end() &&
+                                        std::find(common.begin(), common.end(), name) == common.end();
+            if (methodSpecific) continue;
+        }
+        out.push_back(p.key + "=" + p.level.overrideText);
+    }
     return out;
 }
 
-// Checks the fixed parameters with every scene, then every factor level on its own, so that an unknown factor
-// key, an unknown level or a missing asset is reported naming the factor and level before anything renders.
-void validateLevels(const SetSpec& spec, const fs::path& assets) {
+// Checks the fixed parameters with every scene, then every factor level with the method of the first stimulus that
+// renders it (the method decides which [sss] keys apply), so that an unknown factor key, an unknown level or a missing
+// asset is reported naming the scene, or the factor and level, before anything renders. Levels that every
+// stimulus excludes are not rendered and not checked.
+void validateLevels(const SetSpec& spec, const std::vector<Stimulus>& all, const fs::path& assets) {
     const Factor& scenes = spec.factors.front();
     const std::vector<std::string> fixed = fixedOverrides(spec);
     for (const auto& scene : scenes.levels) {
@@ -54,14 +70,28 @@ void validateLevels(const SetSpec& spec, const fs::path& assets) {
             throw InputError(spec.fileName + ": scene '" + scene.value + "': " + e.what());
         }
     }
-    const std::string& firstScene = scenes.levels.front().overrideText;
+    auto firstWith = [&](const std::string& factor, const Level& level) -> const Stimulus* {
+        for (const auto& stimulus : all)
+            for (const auto& [name, l] : stimulus.factors)
+                if (name == factor && l.overrideText == level.overrideText) return &stimulus;
+        return nullptr;
+    };
     for (const auto& factor : spec.factors) {
         if (factor.name == "scene") continue;
         for (const auto& level : factor.levels) {
-            std::vector<std::string> overrides = fixed;
+            const Stimulus* stimulus = firstWith(factor.name, level);
+            if (!stimulus) continue;
+            // The stimulus' fixed parameters (those its method reads), its method and this level.
+            std::vector<std::string> overrides;
+            for (const auto& o : stimulus->overrides) {
+                const std::string key = o.substr(0, o.find('='));
+                const bool isFixed = std::any_of(spec.fixed.begin(), spec.fixed.end(),
+                                                 [&](const auto& p) { return p.key == key; });
+                if (isFixed || (key == "sss.method" && factor.key != "sss.method")) overrides.push_back(o);
+            }
             overrides.push_back(factor.key + "=" + level.overrideText);
             try {
-                renderer::resolveScene(requestFor(firstScene, overrides, assets));
+                renderer::resolveScene(requestFor(stimulus->scene, overrides, assets));
             } catch (const InputError& e) {
                 throw InputError(spec.fileName + ": factor '" + factor.name + "': level '" + level.value +
                                  "': " + e.what());
@@ -146,7 +176,7 @@ BuildPlan planBuild(const fs::path& specPath, const std::vector<std::string>& sp
     plan.spec = readSetSpec(specPath, specOverrides);
     plan.all = expand(plan.spec);
     plan.selected = shard ? selectShard(plan.all, *shard) : plan.all;
-    validateLevels(plan.spec, assetsDir);
+    validateLevels(plan.spec, plan.all, assetsDir);
     for (const auto& stimulus : plan.selected) {
         try {
             plan.resolved.push_back(renderer::resolveScene(requestFor(stimulus.scene, stimulus.overrides, assetsDir)));

@@ -1,6 +1,7 @@
 #include "stimuli/expansion.h"
 
 #include "common/error.h"
+#include "renderer/sss/sss_params.h"
 #include "stimuli/naming.h"
 
 #include <algorithm>
@@ -142,16 +143,51 @@ private:
         return block;
     }
 
+    // The SSS method a stimulus sets (a factor, include or reference level, or [fixed]); nullptr when it keeps the
+    // scene's method, which the scene file decides (its reader then checks the keys).
+    const renderer::sss::MethodInfo* methodOf(const Assignment& combination) const {
+        std::string text;
+        for (const auto& p : spec_.fixed)
+            if (p.key == "sss.method") text = p.level.overrideText;
+        for (const auto& [name, level] : combination)
+            if (sceneKeyOf(name) == "sss.method") text = level.overrideText;
+        if (text.size() >= 2 && (text.front() == '"' || text.front() == '\'')) text = text.substr(1, text.size() - 2);
+        return text.empty() ? nullptr : renderer::sss::findMethod(text);
+    }
+
+    // Whether the method reads scene key `key`; keys outside [sss] and unknown keys are left to the scene reader.
+    static bool methodReads(const renderer::sss::MethodInfo& method, const std::string& key) {
+        if (key.rfind("sss.", 0) != 0) return true;
+        const std::string_view name = std::string_view(key).substr(4);
+        const auto known = renderer::sss::allSssKeys();
+        if (std::find(known.begin(), known.end(), name) == known.end()) return true;
+        return renderer::sss::methodUsesKey(method.method, name);
+    }
+
     void add(const Assignment& combination, bool reference, const std::string& where) {
         Stimulus s;
         s.reference = reference;
         s.factors = combination;
         s.id = makeId(combination, reference);
         s.block = makeBlock(combination);
-        for (const auto& p : spec_.fixed) s.overrides.push_back(p.key + "=" + p.level.overrideText);
+        const renderer::sss::MethodInfo* method = methodOf(combination);
+        // [fixed] holds for the whole set: an [sss] key there applies to the stimuli whose method reads it (e.g.
+        // sss.samples to the screen-space methods, not to the object-space reference).
+        for (const auto& p : spec_.fixed)
+            if (!method || methodReads(*method, p.key)) s.overrides.push_back(p.key + "=" + p.level.overrideText);
         for (const auto& [name, level] : combination) {
-            if (name == "scene") s.scene = level.overrideText;
-            else s.overrides.push_back(sceneKeyOf(name) + "=" + level.overrideText);
+            if (name == "scene") {
+                s.scene = level.overrideText;
+                continue;
+            }
+            const std::string key = sceneKeyOf(name);
+            // A factor level, include or reference that sets a key its stimulus' method does not read would
+            // render the same image under another name: refuse it.
+            if (method && !methodReads(*method, key))
+                throwInput(spec_.fileName, where,
+                           key + ": " + renderer::sss::notAParameterMessage(method->method) + "; stimulus '" + s.id +
+                               "' (leave such combinations out with [[exclude]])");
+            s.overrides.push_back(key + "=" + level.overrideText);
         }
         if (!isIdSafe(s.id))
             throwInput(spec_.fileName, spec_.idTemplate.empty() ? where : "set.id",

@@ -6,6 +6,7 @@
 // renders; the SSS stage's GPU time (GL_TIME_ELAPSED) is reported as the median and the minimum (on a machine
 // shared with other work the minimum is the figure least disturbed by it). Prints a Markdown table.
 #include "renderer/render_job.h"
+#include "renderer/sss/sss_params.h"
 
 #include <algorithm>
 #include <cstdio>
@@ -42,7 +43,7 @@ struct ExtensionSet {
 int main(int argc, char** argv) {
     std::string scene = "builtin:head", view = "close", assets;
     int width = 1280, height = 720, frames = 3;
-    std::vector<std::string> methods{"gaussian-sum", "separable", "artistic", "pscbf"};
+    std::vector<std::string> methods = skinlab::renderer::sss::screenSpaceMethodNames();
     for (int i = 1; i + 1 < argc; i += 2) {
         const std::string key = argv[i], value = argv[i + 1];
         if (key == "--scene") scene = value;

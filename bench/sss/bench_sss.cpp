@@ -8,6 +8,7 @@
 // is the figure least disturbed by it). Writes DIR/sss.csv and DIR/sss.png (atomically) and prints a table.
 #include "common/files.h"
 #include "renderer/render_job.h"
+#include "renderer/sss/sss_params.h"
 #include "sss_plot.h"
 
 #include <OpenImageIO/imageio.h>
@@ -54,7 +55,7 @@ int main(int argc, char** argv) {
     int width = 640, height = 360, frames = 3;
     std::vector<int> samples{5, 11, 21, 51, 101};
     std::vector<std::string> views{"close", "mid", "far"};
-    std::vector<std::string> methods{"gaussian-sum", "separable", "artistic", "pscbf"};
+    std::vector<std::string> methods = skinlab::renderer::sss::screenSpaceMethodNames();
     std::string assets, out = "bench-sss";
     for (int i = 1; i + 1 < argc; i += 2) {
         const std::string key = argv[i], value = argv[i + 1];

@@ -158,7 +158,7 @@ int main(int argc, char** argv) {
         for (const auto& method : methods)
             for (int n : samples) {
                 sss::SssParams params = sss::sssParamsFromJson({{"method", method}, {"samples", n}}, "bench");
-                configs.push_back({method, n, {params.toJson(), nlohmann::json::object()}, {}});
+                configs.push_back({method, n, {params, {}}, {}});
             }
         for (int repeat = 0; repeat < repeats; ++repeat)
             for (auto& config : configs) {

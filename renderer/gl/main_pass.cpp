@@ -17,7 +17,6 @@ GLuint shadowDepthSampler = 0;
 
 void MainPass::bindShading(GLuint program, const GpuScene& scene, GLuint shadowMaps, const MainPassSettings& settings) {
     setUniform(program, "view", settings.camera.view);
-    setUniform(program, "projection", settings.camera.projection);
     setUniform(program, "cameraPosition", settings.camera.position);
     setUniform(program, "exposure", settings.exposure);
     setUniform(program, "normalStrength", settings.normalStrength);
@@ -102,6 +101,7 @@ void MainPass::run(FrameTargets& targets, const GpuScene& scene, GLuint shadowMa
     glDisable(GL_CULL_FACE);  // thin and open surfaces (backdrop, fin) are seen from both sides
 
     bindShading(program, scene, shadowMaps, settings);
+    setUniform(program, "projection", settings.camera.projection);  // main_pass.vert (the bake's vertex stage has none)
     for (const GpuPart& part : scene.parts()) {
         setMaterial(program, part.material);
         scene.drawPart(part);

@@ -1,9 +1,13 @@
 #include "renderer/gl/shader_library.h"
 
 #include "common/error.h"
+#include "renderer/gl/shader_checks.h"
 
 #include <cstdlib>
+#include <algorithm>
 #include <fstream>
+#include <functional>
+#include <map>
 #include <glm/gtc/type_ptr.hpp>
 #include <optional>
 #include <sstream>
@@ -41,7 +45,10 @@ std::string ShaderLibrary::source(const std::string& name, const ShaderDefines& 
     std::string out;
     std::string line;
     bool versionSeen = false;
+    int lineNumber = 0;  // of `line` in the file
+    int includes = 0;    // source string numbers given to included files so far
     while (std::getline(in, line)) {
+        ++lineNumber;
         if (line.rfind("#extension GL_GOOGLE_include_directive", 0) == 0) {
             out += "\n";  // keep line numbers of the info log aligned with the file
             continue;
@@ -50,14 +57,20 @@ std::string ShaderLibrary::source(const std::string& name, const ShaderDefines& 
             const auto end = line.find('"', 10);
             if (end == std::string::npos) throw RuntimeError("shader " + name + ": malformed " + line);
             std::string included = raw(line.substr(10, end - 10));
-            out += "#line 1\n" + included + "\n";
+            if (!included.empty() && included.back() != '\n') included += "\n";
+            // The included text as source string N from its line 1, then this file (source string 0) again from
+            // the line after the #include.
+            const std::string number = std::to_string(++includes);
+            out += "// skinlab source " + number + " = " + line.substr(10, end - 10) + "\n";
+            out += "#line 1 " + number + "\n" + included;
+            out += "#line " + std::to_string(lineNumber + 1) + " 0\n";
             continue;
         }
         out += line + "\n";
         if (!versionSeen && line.rfind("#version", 0) == 0) {
             versionSeen = true;
             for (const auto& [key, value] : defines) out += "#define " + key + " " + value + "\n";
-            out += "#line 2\n";
+            out += "#line " + std::to_string(lineNumber + 1) + " 0\n";
         }
     }
     if (!versionSeen) throw RuntimeError("shader " + name + ": no #version line");
@@ -65,6 +78,63 @@ std::string ShaderLibrary::source(const std::string& name, const ShaderDefines& 
 }
 
 namespace {
+
+// "0 = name.frag, 1 = included.glsl, ...": the source string numbers of source()'s #line directives.
+std::string sourceLegend(const std::string& name, const std::string& text) {
+    std::string legend = "0 = " + name;
+    std::istringstream in(text);
+    std::string line;
+    const std::string marker = "// skinlab source ";
+    while (std::getline(in, line))
+        if (line.rfind(marker, 0) == 0) legend += ", " + line.substr(marker.size());
+    return legend;
+}
+
+// Every name declared `uniform TYPE NAME` (or `NAME[N]`) anywhere in `text`, whatever the #if around it.
+std::vector<std::string> declaredUniforms(const std::string& text) {
+    std::vector<std::string> names;
+    std::istringstream in(text);
+    std::string word;
+    // A declaration: [layout(...)] uniform [precision] TYPE NAME[N]; (one per line, as the shaders are written).
+    std::string line;
+    while (std::getline(in, line)) {
+        const auto start = line.find_first_not_of(" \t");
+        if (start == std::string::npos) continue;
+        std::string_view rest(line);
+        rest.remove_prefix(start);
+        if (rest.rfind("layout", 0) == 0) {
+            const auto close = rest.find(')');
+            if (close == std::string_view::npos) continue;
+            rest.remove_prefix(close + 1);
+            const auto next = rest.find_first_not_of(" \t");
+            if (next == std::string_view::npos) continue;
+            rest.remove_prefix(next);
+        }
+        if (rest.rfind("uniform ", 0) != 0) continue;
+        std::istringstream tokens{std::string(rest)};
+        std::vector<std::string> words;
+        while (tokens >> word) {
+            words.push_back(word);
+            if (word.find(';') != std::string::npos || word.find('[') != std::string::npos) break;
+        }
+        if (words.size() < 3) continue;  // "uniform Block {" and the like
+        std::string name = words.back();
+        name = name.substr(0, name.find_first_of("[;="));
+        if (name.empty() && words.size() >= 4) name = words[words.size() - 2];
+        if (!name.empty()) names.push_back(name);
+    }
+    return names;
+}
+
+// Per program linked by a ShaderLibrary: its shaders' names and the location of every declared uniform.
+struct UniformTable {
+    std::string shaders;
+    std::map<std::string, GLint, std::less<>> locations;
+};
+std::map<GLuint, UniformTable>& uniformTables() {
+    static std::map<GLuint, UniformTable> tables;
+    return tables;
+}
 
 GLuint compile(GLenum stage, const std::string& name, const std::string& text) {
     GLuint shader = glCreateShader(stage);
@@ -80,23 +150,55 @@ GLuint compile(GLenum stage, const std::string& name, const std::string& text) {
         glGetShaderInfoLog(shader, length, nullptr, log.data());
         glDeleteShader(shader);
         while (!log.empty() && (log.back() == '\0' || log.back() == '\n')) log.pop_back();
-        throw RuntimeError("shader " + name + ": compile failed: " + log);
+        throw RuntimeError("shader " + name + ": compile failed (sources: " + sourceLegend(name, text) + "): " + log);
     }
     return shader;
 }
 
 } // namespace
 
+const std::vector<ShaderVariant>& shaderVariants() {
+    static const std::vector<ShaderVariant> variants = [] {
+        std::vector<ShaderVariant> v;
+        for (const char* fragment : {"add_specular.frag", "background.frag", "copy.frag", "surface_aovs.frag",
+                                     "curvature_smooth.frag", "tone_map.frag", "transmittance.frag"})
+            v.push_back({"fullscreen.vert", fragment, {}});
+        v.push_back({"main_pass.vert", "main_pass.frag", {}});
+        v.push_back({"reference_bake.vert", "main_pass.frag", {}});
+        v.push_back({"reference_draw.vert", "reference_draw.frag", {}});
+        v.push_back({"shadow_map.vert", "shadow_map.frag", {}});
+        // The blur passes: the extension weights (SssExtensionSettings::defines) × the pass's own switch.
+        for (const bool weights : {false, true})
+            for (const auto& [fragment, own] : {std::pair{"sss_blur.frag", "SSS_ACCUMULATE"},
+                                                std::pair{"pscbf_blur.frag", "PSCBF_FINAL_PASS"}})
+                for (const bool last : {false, true}) {
+                    ShaderDefines defines;
+                    if (weights) defines.emplace_back("SSS_EXTENSION_WEIGHTS", "1");
+                    if (last) defines.emplace_back(own, "1");
+                    v.push_back({"fullscreen.vert", fragment, defines});
+                }
+        return v;
+    }();
+    return variants;
+}
+
 GLuint ShaderLibrary::program(const std::string& vertexName, const std::string& fragmentName,
                               const ShaderDefines& defines) {
     std::string key = vertexName + "|" + fragmentName;
     for (const auto& [k, v] : defines) key += "|" + k + "=" + v;
     if (auto found = programs_.find(key); found != programs_.end()) return found->second.get();
+    const auto& variants = shaderVariants();
+    if (std::none_of(variants.begin(), variants.end(), [&](const ShaderVariant& variant) {
+            return variant.vertex == vertexName && variant.fragment == fragmentName && variant.defines == defines;
+        }))
+        throw RuntimeError("shaders " + key + ": not a variant listed in shaderVariants() (renderer/gl/shader_library.cpp)");
 
-    const GLuint vertex = compile(GL_VERTEX_SHADER, vertexName, source(vertexName, defines));
+    const std::string vertexText = source(vertexName, defines);
+    const std::string fragmentText = source(fragmentName, defines);
+    const GLuint vertex = compile(GL_VERTEX_SHADER, vertexName, vertexText);
     GLuint fragment = 0;
     try {
-        fragment = compile(GL_FRAGMENT_SHADER, fragmentName, source(fragmentName, defines));
+        fragment = compile(GL_FRAGMENT_SHADER, fragmentName, fragmentText);
     } catch (...) {
         glDeleteShader(vertex);
         throw;
@@ -118,33 +220,58 @@ GLuint ShaderLibrary::program(const std::string& vertexName, const std::string& 
         throw RuntimeError("shaders " + vertexName + " + " + fragmentName + ": link failed: " + log);
     }
     const GLuint name = program.get();
+    // Uniform locations, once per program: every uniform the sources declare, -1 where the linker removed it.
+    UniformTable table;
+    table.shaders = vertexName + " + " + fragmentName;
+    for (const std::string* text : {&vertexText, &fragmentText})
+        for (const std::string& uniform : declaredUniforms(*text))
+            table.locations[uniform] = glGetUniformLocation(name, uniform.c_str());
+    uniformTables()[name] = std::move(table);  // replaces the table of a deleted program of the same name
     programs_.emplace(key, std::move(program));
     return name;
 }
 
+GLint uniformLocation(GLuint program, const char* name) {
+    const auto table = uniformTables().find(program);
+    if (table == uniformTables().end())
+        throw RuntimeError("uniform " + std::string(name) + ": program " + std::to_string(program) +
+                           " was not linked by ShaderLibrary");
+    auto& locations = table->second.locations;
+    if (const auto location = locations.find(std::string_view(name)); location != locations.end())
+        return location->second;
+    // An element or member of a declared array ("lightType[2]"): resolved on first use, then kept.
+    const std::string_view text(name);
+    const auto bracket = text.find('[');
+    if (bracket == std::string_view::npos || !locations.contains(text.substr(0, bracket)))
+        throw RuntimeError("uniform " + std::string(name) + ": not declared in shaders " + table->second.shaders);
+    const GLint location = glGetUniformLocation(program, name);
+    locations.emplace(std::string(name), location);
+    return location;
+}
+
 void setUniform(GLuint program, const char* name, float value) {
-    glProgramUniform1f(program, glGetUniformLocation(program, name), value);
+    glProgramUniform1f(program, uniformLocation(program, name), value);
 }
 void setUniform(GLuint program, const char* name, int value) {
-    glProgramUniform1i(program, glGetUniformLocation(program, name), value);
+    glProgramUniform1i(program, uniformLocation(program, name), value);
 }
 void setUniform(GLuint program, const char* name, const glm::vec2& value) {
-    glProgramUniform2fv(program, glGetUniformLocation(program, name), 1, glm::value_ptr(value));
+    glProgramUniform2fv(program, uniformLocation(program, name), 1, glm::value_ptr(value));
 }
 void setUniform(GLuint program, const char* name, const glm::vec3& value) {
-    glProgramUniform3fv(program, glGetUniformLocation(program, name), 1, glm::value_ptr(value));
+    glProgramUniform3fv(program, uniformLocation(program, name), 1, glm::value_ptr(value));
 }
 void setUniform(GLuint program, const char* name, const glm::vec4& value) {
-    glProgramUniform4fv(program, glGetUniformLocation(program, name), 1, glm::value_ptr(value));
+    glProgramUniform4fv(program, uniformLocation(program, name), 1, glm::value_ptr(value));
 }
 void setUniform(GLuint program, const char* name, const glm::mat4& value) {
-    glProgramUniformMatrix4fv(program, glGetUniformLocation(program, name), 1, GL_FALSE, glm::value_ptr(value));
+    glProgramUniformMatrix4fv(program, uniformLocation(program, name), 1, GL_FALSE, glm::value_ptr(value));
 }
 void setUniform(GLuint program, const char* name, const glm::mat3& value) {
-    glProgramUniformMatrix3fv(program, glGetUniformLocation(program, name), 1, GL_FALSE, glm::value_ptr(value));
+    glProgramUniformMatrix3fv(program, uniformLocation(program, name), 1, GL_FALSE, glm::value_ptr(value));
 }
 void setUniformArray(GLuint program, const char* name, const glm::vec3* values, int count) {
-    glProgramUniform3fv(program, glGetUniformLocation(program, name), count, glm::value_ptr(values[0]));
+    glProgramUniform3fv(program, uniformLocation(program, name), count, glm::value_ptr(values[0]));
 }
 
 void ShaderLibrary::drawFullscreenTriangle() {

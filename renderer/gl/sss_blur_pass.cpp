@@ -1,6 +1,7 @@
 #include "renderer/gl/sss_blur_pass.h"
 
 #include "common/error.h"
+#include "renderer/gl/shader_checks.h"
 #include "renderer/gl/shader_library.h"
 
 #include <glm/glm.hpp>
@@ -20,8 +21,7 @@ void setTapUniforms(GLuint program, const sss::KernelStage& stage) {
     for (const auto& tap : stage.taps)
         taps.emplace_back(static_cast<float>(tap.weight[0]), static_cast<float>(tap.weight[1]),
                           static_cast<float>(tap.weight[2]), static_cast<float>(tap.offsetMm));
-    glProgramUniform4fv(program, glGetUniformLocation(program, "taps"), static_cast<GLsizei>(taps.size()),
-                        &taps[0].x);
+    glProgramUniform4fv(program, uniformLocation(program, "taps"), static_cast<GLsizei>(taps.size()), &taps[0].x);
     setUniform(program, "tapCount", static_cast<int>(taps.size()));
 }
 

@@ -23,9 +23,9 @@ struct SssStage::Impl {
     std::unique_ptr<PscbfMethod> pscbfMethod;
 
     const sss::Kernel& kernelFor(const SssStageSettings& settings) {
-        const std::string key = settings.sss.dump();
+        const std::string key = settings.sss.toJson().dump();
         if (key != kernelKey) {
-            params = sss::sssParamsFromJson(settings.sss, "sss");
+            params = settings.sss;
             kernel = sss::makeKernel(params);
             kernelKey = key;
         }

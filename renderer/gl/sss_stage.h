@@ -13,6 +13,8 @@
 //  - the stage may allocate its own scratch textures/framebuffers (keep them between frames when the size is
 //    unchanged) and must leave GL state as it found it: no bound framebuffer/program, viewport = full frame,
 //    depth test and blending off.
+#include "renderer/sss/sss_params.h"
+
 #include <epoxy/gl.h>
 #include <glm/glm.hpp>
 #include <memory>
@@ -43,11 +45,10 @@ struct SssStageInputs {
     glm::vec3 cameraPosition{0.0f};  // world units
 };
 
-// The resolved [sss] and [transmittance] tables of the scene (as in the EXR's skinlab:resolved metadata,
-// e.g. {"method":"none", ...}); parsed into typed parameters by renderer/sss/sss_params.h. The method is sss.method.
+// The scene's typed [sss] and [transmittance] parameters (renderer/sss/sss_params.h). The method is sss.method.
 struct SssStageSettings {
-    nlohmann::json sss = nlohmann::json::object();
-    nlohmann::json transmittance = nlohmann::json::object();
+    sss::SssParams sss;
+    sss::TransmittanceParams transmittance;
 };
 
 class SssStage {

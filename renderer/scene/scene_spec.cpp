@@ -292,15 +292,12 @@ SceneSpec loadSceneSpec(const std::string& scene, const std::vector<std::string>
 
     // [sss] and [transmittance]: read by renderer/sss/sss_params; stored resolved.
     {
-        const sss::SssParams sssParams = sss::readSssParams(root);
-        const sss::TransmittanceParams transmittanceParams = sss::readTransmittanceParams(root);
-        spec.sssMethod = std::string(sss::methodName(sssParams.method));
-        spec.sss = sssParams.toJson();
-        spec.transmittance = transmittanceParams.toJson();
-        resolved["sss"] = spec.sss;
-        resolved["transmittance"] = spec.transmittance;
+        spec.sss = sss::readSssParams(root);
+        spec.transmittance = sss::readTransmittanceParams(root);
+        resolved["sss"] = spec.sss.toJson();
+        resolved["transmittance"] = spec.transmittance.toJson();
         spec.pathtraced = pathtraced::readPathtracedParams(root).toJson();
-        if (sssParams.method == sss::SssMethod::Pathtraced) resolved["pathtraced"] = spec.pathtraced;
+        if (spec.sss.method == sss::SssMethod::Pathtraced) resolved["pathtraced"] = spec.pathtraced;
     }
 
     root.finish();

@@ -6,6 +6,8 @@
 //
 // Paths in a spec: "assets:REL" is REL under the assets folder (--assets DIR or $SKINLAB_ASSETS); any other
 // relative path is relative to the spec file's folder.
+#include "renderer/sss/sss_params.h"
+
 #include <array>
 #include <filesystem>
 #include <glm/glm.hpp>
@@ -88,9 +90,8 @@ struct SceneSpec {
     double exponentialK = 1.0;         // exponential: 1 - exp(-k x)
     double filmicWhite = 11.2;         // filmic (Hable 2010): linear value mapped to display white
     double reinhardKey = 0.18;         // reinhard (Reinhard et al. 2002, Eq. 2): the key a
-    std::string sssMethod = "none";
-    nlohmann::json sss = nlohmann::json::object();           // resolved [sss] table
-    nlohmann::json transmittance = nlohmann::json::object(); // resolved [transmittance] table
+    sss::SssParams sss;                      // [sss], typed; the method's keys only (sss::methodTable())
+    sss::TransmittanceParams transmittance;  // [transmittance], typed
     // Resolved [pathtraced] table (renderer/pathtraced/pathtraced_params.h); read for every scene, recorded in
     // `resolved` only when sss.method = "pathtraced" (the other methods do not depend on it).
     nlohmann::json pathtraced = nlohmann::json::object();

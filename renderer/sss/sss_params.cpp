@@ -5,10 +5,36 @@
 #include "renderer/sss/materials.h"
 #include "renderer/sss/tabulated_kernel.h"
 
+#include <algorithm>
+
 namespace skinlab::renderer::sss {
 
 namespace {
-const std::vector<std::string> kMethodNames{"none", "gaussian-sum", "separable", "artistic", "pscbf", "reference", "pathtraced"};
+// The screen-space blur methods' shared keys: follow-surface and the thesis' extensions (docs/extensions.md).
+#define SKINLAB_BLUR_KEYS "follow_surface", "cbf", "cbf_lambda", "lab_weight", "extension_input", "curvature", \
+                          "curvature_floor"
+
+const std::vector<MethodInfo> kMethods{
+    {SssMethod::None, "none", false, false, "no SSS: the diffuse buffer is copied through", {}},
+    {SssMethod::GaussianSum, "gaussian-sum", true, true,
+     "Jimenez & Gutierrez 2010: d'Eon's six Gaussians as incremental separable blurs (12 passes)",
+     {"samples", "sampling", "follow_surface_k", SKINLAB_BLUR_KEYS}},
+    {SssMethod::Separable, "separable", true, true,
+     "Jimenez et al. 2015: two passes with the marginal of a physical profile (d'Eon, Burley or a file)",
+     {"samples", "sampling", "follow_surface_k", "profile", "material", SKINLAB_BLUR_KEYS}},
+    {SssMethod::Artistic, "artistic", true, true, "Jimenez's demo kernel (per-channel strength and falloff), two passes",
+     {"samples", "follow_surface_k", "artistic_strength", "artistic_falloff", SKINLAB_BLUR_KEYS}},
+    {SssMethod::Pscbf, "pscbf", true, false,
+     "Mikkelsen 2010: pseudo-separable cross-bilateral filter, spike + one Gaussian per channel",
+     {"samples", "pscbf_sigma", SKINLAB_BLUR_KEYS}},
+    {SssMethod::Reference, "reference", false, false,
+     "object-space SSS on the tessellated surface (the ground truth of the metrics)",
+     {"profile", "material", "reference_edge_mm"}},
+    {SssMethod::Pathtraced, "pathtraced", false, false, "Blender Cycles' random-walk SSS ([pathtraced] table)", {}},
+};
+#undef SKINLAB_BLUR_KEYS
+
+const std::vector<std::string> kMethodNames = methodNames();
 const std::vector<std::string> kCurvatureNames{"off", "increase", "reduce", "reduce-floor"};
 const std::vector<std::string> kPlacementNames{"quadratic", "importance"};
 const std::vector<std::string> kPscbfSigmaNames{"variance", "std-dev"};
@@ -46,14 +72,10 @@ toml::table jsonToToml(const nlohmann::json& object, std::string_view source) {
 
 SssParams readSssTable(const SpecReader& sss) {
     SssParams p;
-    const std::string method = sss.choice("method", "none", kMethodNames);
-    p.method = method == "gaussian-sum" ? SssMethod::GaussianSum
-               : method == "separable"  ? SssMethod::Separable
-               : method == "artistic"   ? SssMethod::Artistic
-               : method == "pscbf"      ? SssMethod::Pscbf
-               : method == "reference"  ? SssMethod::Reference
-               : method == "pathtraced" ? SssMethod::Pathtraced
-                                        : SssMethod::None;
+    p.method = findMethod(sss.choice("method", "none", kMethodNames))->method;
+    // A key of another method would be ignored silently: refuse it, naming the key and the method.
+    for (const std::string_view key : allSssKeys())
+        if (sss.has(key) && !methodUsesKey(p.method, key)) sss.fail(key, notAParameterMessage(p.method));
     if (p.method == SssMethod::Pscbf) p.samples = SssParams::kDefaultPscbfSamples;
     p.samples = static_cast<int>(sss.integer("samples", p.samples, 3, 101));
     if (p.samples % 2 == 0)
@@ -103,18 +125,63 @@ TransmittanceParams readTransmittanceTable(const SpecReader& t) {
 }
 } // namespace
 
-std::string_view methodName(SssMethod method) {
-    switch (method) {
-    case SssMethod::None: return "none";
-    case SssMethod::GaussianSum: return "gaussian-sum";
-    case SssMethod::Separable: return "separable";
-    case SssMethod::Artistic: return "artistic";
-    case SssMethod::Pscbf: return "pscbf";
-    case SssMethod::Reference: return "reference";
-    case SssMethod::Pathtraced: return "pathtraced";
-    }
-    return "none";
+const std::vector<MethodInfo>& methodTable() { return kMethods; }
+
+const MethodInfo& methodInfo(SssMethod method) {
+    for (const MethodInfo& info : kMethods)
+        if (info.method == method) return info;
+    return kMethods.front();
 }
+
+const MethodInfo* findMethod(std::string_view name) {
+    for (const MethodInfo& info : kMethods)
+        if (info.name == name) return &info;
+    return nullptr;
+}
+
+std::vector<std::string> methodNames() {
+    std::vector<std::string> names;
+    for (const MethodInfo& info : kMethods) names.emplace_back(info.name);
+    return names;
+}
+
+std::vector<std::string> screenSpaceMethodNames() {
+    std::vector<std::string> names;
+    for (const MethodInfo& info : kMethods)
+        if (info.screenSpace) names.emplace_back(info.name);
+    return names;
+}
+
+std::vector<std::string> blurPassMethodNames() {
+    std::vector<std::string> names;
+    for (const MethodInfo& info : kMethods)
+        if (info.blurPasses) names.emplace_back(info.name);
+    return names;
+}
+
+std::vector<std::string_view> allSssKeys() {
+    std::vector<std::string_view> keys(kCommonSssKeys.begin(), kCommonSssKeys.end());
+    for (const MethodInfo& info : kMethods)
+        for (const std::string_view key : info.keys)
+            if (std::find(keys.begin(), keys.end(), key) == keys.end()) keys.push_back(key);
+    return keys;
+}
+
+bool methodUsesKey(SssMethod method, std::string_view key) {
+    const auto& own = methodInfo(method).keys;
+    return std::find(kCommonSssKeys.begin(), kCommonSssKeys.end(), key) != kCommonSssKeys.end() ||
+           std::find(own.begin(), own.end(), key) != own.end();
+}
+
+std::string notAParameterMessage(SssMethod method) {
+    std::string keys;
+    for (const std::string_view k : kCommonSssKeys)
+        if (k != "method") keys += (keys.empty() ? "" : ", ") + std::string(k);
+    for (const std::string_view k : methodInfo(method).keys) keys += ", " + std::string(k);
+    return "not a parameter of method '" + std::string(methodName(method)) + "' (its keys: " + keys + ")";
+}
+
+std::string_view methodName(SssMethod method) { return methodInfo(method).name; }
 
 std::string_view pscbfSigmaName(PscbfSigma reading) {
     return reading == PscbfSigma::StdDev ? "std-dev" : "variance";
@@ -125,7 +192,7 @@ std::string_view placementName(TapPlacement placement) {
 }
 
 nlohmann::json SssParams::toJson() const {
-    return {{"method", std::string(methodName(method))},
+    const nlohmann::json all = {{"method", std::string(methodName(method))},
             {"samples", samples},
             {"width_mm", widthMm},
             {"sampling", std::string(placementName(placement))},
@@ -145,6 +212,10 @@ nlohmann::json SssParams::toJson() const {
             {"curvature_reference_mm", curvatureReferenceMm},
             {"pscbf_sigma", std::string(pscbfSigmaName(pscbfSigma))},
             {"reference_edge_mm", referenceEdgeMm}};
+    nlohmann::json own = nlohmann::json::object();
+    for (const auto& [key, value] : all.items())
+        if (methodUsesKey(method, key)) own[key] = value;
+    return own;
 }
 
 nlohmann::json TransmittanceParams::toJson() const {

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace skinlab {
 class SpecReader;
@@ -38,10 +39,48 @@ enum class PscbfSigma {
     StdDev,    // σ_c = 2.3 / 1.4 / 1.1 mm, v_c = σ_c²
 };
 
+// The method table: one row per SSS method, the single list the CLI (`skinlab methods`), the scene reader, the
+// stimulus specs, `skinlab kernel`, the benchmarks and the tests that cover "every method" iterate
+// (docs/methods.md, "Adding a method"). `keys` are the [sss] keys the method reads besides the keys every method
+// reads (kCommonSssKeys); any other [sss] key given with the method is an error naming the key and the method.
+struct MethodInfo {
+    SssMethod method;
+    std::string_view name;        // sss.method value
+    bool screenSpace;             // runs in the screen-space SSS stage on the frame's buffers (a 1-D tap kernel)
+    bool blurPasses;              // its kernel runs through the shared 1-D blur passes (renderer/gl/sss_blur_pass.h)
+    std::string_view summary;     // one line for `skinlab methods`
+    std::vector<std::string_view> keys;
+};
+
+// [sss] keys every method reads: the main pass's transmittance scale (width_mm), the curvature AOV's measure and
+// the curvature scale shared by the extensions and the transmittance.
+inline constexpr std::array<std::string_view, 4> kCommonSssKeys{"method", "width_mm", "curvature_measure",
+                                                               "curvature_reference_mm"};
+
+// Every method, in the order of the SssMethod enum.
+const std::vector<MethodInfo>& methodTable();
+const MethodInfo& methodInfo(SssMethod method);
+// nullptr when `name` names no method.
+const MethodInfo* findMethod(std::string_view name);
+// Every method name, in table order (for choices and help texts).
+std::vector<std::string> methodNames();
+// The screen-space methods' names (those the SSS stage runs as tap kernels), in table order.
+std::vector<std::string> screenSpaceMethodNames();
+// The methods whose kernels run through the shared blur passes (and the CPU mirror, renderer/sss/cpu_blur.h).
+std::vector<std::string> blurPassMethodNames();
+// Every [sss] key of any method.
+std::vector<std::string_view> allSssKeys();
+// Whether `method` reads [sss] key `key` (a common key or one of its own).
+bool methodUsesKey(SssMethod method, std::string_view key);
+// "not a parameter of method 'separable' (its keys: ...)": the message of the error for a key `method` does not read.
+std::string notAParameterMessage(SssMethod method);
+
 std::string_view methodName(SssMethod method);
 std::string_view pscbfSigmaName(PscbfSigma reading);
 std::string_view placementName(TapPlacement placement);
 
+// The typed values of the [sss] table. Which fields the chosen method reads is given by its row of the method
+// table (methodTable()): the reader accepts only those keys, and toJson() writes only those.
 struct SssParams {
     SssMethod method = SssMethod::None;
     // Taps per 1-D pass (odd, 3…101). gaussian-sum uses it for each of its 12 passes. Default 21; for pscbf 13,
@@ -95,6 +134,7 @@ struct SssParams {
     // reference method: longest skin edge (mm) after tessellation; irradiance is sampled at the vertices.
     double referenceEdgeMm = 1.0;
 
+    // The resolved record: the method and the keys it reads (its row of the method table), nothing else.
     nlohmann::json toJson() const;
 };
 
@@ -126,7 +166,8 @@ double widthMmFromDemoSssWidth(double sssWidth, double mmPerUnit);
 double transmittanceScalePerUnit(double translucency, double widthMm, double mmPerUnit);
 
 // Reads the [sss] table of a scene spec (through the scene's reader: `scene.table("sss")` is read and finished
-// here). Defaults for absent keys; InputError naming file and key for bad ones.
+// here). Defaults for absent keys; InputError naming file and key for bad ones, and for a key the chosen method
+// does not read ("sss.artistic_falloff: is not a parameter of method 'separable' (its keys: ...)").
 SssParams readSssParams(const SpecReader& scene);
 TransmittanceParams readTransmittanceParams(const SpecReader& scene);
 

@@ -134,6 +134,9 @@ levels = [11, 21]
 
 [[exclude]]
 method = "none"
+
+[[exclude]]
+method = "separable"
 "sss.samples" = 21
 
 [[include]]
@@ -144,18 +147,54 @@ view = "mid"
 [[reference]]
 method = "reference"
 )"));
-    // 2 views × (none: 1 + separable: 2 + gaussian-sum: 2) = 10, + 1 include, + 1 reference per view.
-    ASSERT_EQ(all.size(), 13u);
-    EXPECT_EQ(all[10].id, "head-mid-separable-samples-63");
-    EXPECT_EQ(all[10].overrides.back(), "sss.samples=63");
-    EXPECT_FALSE(all[10].reference);
-    EXPECT_EQ(all[11].id, "head-close-reference");
-    EXPECT_EQ(all[12].id, "head-mid-reference");
-    EXPECT_TRUE(all[12].reference);
-    EXPECT_EQ(all[12].block, "builtin:head/mid");
+    // 2 views × (separable: 1 + gaussian-sum: 2) = 6, + 1 include, + 1 reference per view.
+    ASSERT_EQ(all.size(), 9u);
+    EXPECT_EQ(all[6].id, "head-mid-separable-samples-63");
+    EXPECT_EQ(all[6].overrides.back(), "sss.samples=63");
+    EXPECT_FALSE(all[6].reference);
+    EXPECT_EQ(all[7].id, "head-close-reference");
+    EXPECT_EQ(all[8].id, "head-mid-reference");
+    EXPECT_TRUE(all[8].reference);
+    EXPECT_EQ(all[8].block, "builtin:head/mid");
     // A reference leaves non-block factors (samples) at the scene's default.
-    EXPECT_EQ(all[12].overrides, (std::vector<std::string>{"render.height=64", "render.width=96",
-                                                           "camera.view=\"mid\"", "sss.method=\"reference\""}));
+    EXPECT_EQ(all[8].overrides, (std::vector<std::string>{"render.height=64", "render.width=96",
+                                                          "camera.view=\"mid\"", "sss.method=\"reference\""}));
+}
+
+// An [sss] key the stimulus' method does not read is refused in a factor, an include and a reference alike, naming
+// the key, the method and the stimulus; a key in [fixed] applies to the stimuli whose method reads it.
+TEST(StimulusExpansion, KeysOfAnotherMethodAreRefused) {
+    const std::string base = R"(
+[set]
+name = "demo"
+scene = "builtin:head"
+[[factor]]
+name = "method"
+levels = ["separable", "artistic"]
+)";
+    EXPECT_EQ(errorOf([&] { expand(spec(base + "[[include]]\nmethod = \"artistic\"\nsss.profile = \"burley\"\n")); })
+                  .rfind("set.toml: include[0]: sss.profile: not a parameter of method 'artistic' (its keys: ", 0),
+              0u);
+    EXPECT_NE(errorOf([&] { expand(spec(base + "[[factor]]\nname = \"sss.pscbf_sigma\"\nlevels = [\"std-dev\"]\n")); })
+                  .find("sss.pscbf_sigma: not a parameter of method 'separable'"),
+              std::string::npos);
+    EXPECT_NE(errorOf([&] { expand(spec(base + "[[reference]]\nmethod = \"reference\"\nsss.samples = 11\n")); })
+                  .find("sss.samples: not a parameter of method 'reference'"),
+              std::string::npos);
+    // The same key where it belongs: fine.
+    EXPECT_EQ(errorOf([&] { expand(spec(base + "[[include]]\nmethod = \"separable\"\nsss.profile = \"burley\"\n")); }), "");
+    // [fixed]: sss.samples and sss.sampling go where they are read; width_mm (read by every method) everywhere.
+    const std::vector<Stimulus> all = expand(spec(base + R"(
+[fixed]
+sss = { samples = 11, sampling = "importance", width_mm = 2.0 }
+[[reference]]
+method = "reference"
+)"));
+    ASSERT_EQ(all.size(), 3u);
+    EXPECT_EQ(all[0].overrides, (std::vector<std::string>{"sss.samples=11", "sss.sampling=\"importance\"",
+                                                          "sss.width_mm=2.0", "sss.method=\"separable\""}));
+    EXPECT_EQ(all[1].overrides, (std::vector<std::string>{"sss.samples=11", "sss.width_mm=2.0", "sss.method=\"artistic\""}));
+    EXPECT_EQ(all[2].overrides, (std::vector<std::string>{"sss.width_mm=2.0", "sss.method=\"reference\""}));
 }
 
 TEST(StimulusExpansion, SceneFactorAndFixedView) {
@@ -286,7 +325,7 @@ INSTANTIATE_TEST_SUITE_P(
                 "set.toml: factor[2].name: the scene is both fixed (set.scene) and a factor; keep one"},
         BadSpec{"TableLevel", kBase + "[[factor]]\nname = \"sss.samples\"\nlevels = [{a = 1}]\n",
                 "set.toml: factor[2].levels[0]: a table is not allowed here"}),
-    [](const ::testing::TestParamInfo<BadSpec>& info) { return std::string(info.param.name); });
+    [](const ::testing::TestParamInfo<BadSpec>& param) { return std::string(param.param.name); });
 
 TEST(StimulusManifest, JsonRoundTripAndCsv) {
     SetSpec s = spec(kBase);

@@ -363,10 +363,17 @@ TEST_F(StimuliBuild, BadInputFailsBeforeRendering) {
     EXPECT_FALSE(fs::exists(out));
 
     // Unknown level of a known factor.
-    r = build(smallSpec("bad") + "[[factor]]\nname = \"sss.profile\"\nlevels = [\"no-such-profile\"]\n", out);
+    r = build(smallSpec("bad") + "[[factor]]\nname = \"sss.curvature_measure\"\nlevels = [\"gauss\"]\n", out);
     EXPECT_EQ(r.exitCode, 2);
-    EXPECT_EQ(r.output, "skinlab: error: " + spec + ": factor 'sss.profile': level 'no-such-profile': builtin:head: "
-                        "sss.profile: 'no-such-profile' is not one of: deon, burley, file:PATH\n");
+    EXPECT_EQ(r.output, "skinlab: error: " + spec + ": factor 'sss.curvature_measure': level 'gauss': builtin:head: "
+                        "sss.curvature_measure: 'gauss' is not one of: normal, screen\n");
+    EXPECT_FALSE(fs::exists(out));
+
+    // A key the stimulus' method does not read (the fixed method is none): refused, naming key and method.
+    r = build(smallSpec("bad") + "[[factor]]\nname = \"sss.profile\"\nlevels = [\"burley\"]\n", out);
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_EQ(r.output.rfind("skinlab: error: " + spec + ": factor: sss.profile: not a parameter of method 'none'", 0), 0u)
+        << r.output;
     EXPECT_FALSE(fs::exists(out));
 
     // Unknown level of the view (its allowed values are fixed by the scene spec).

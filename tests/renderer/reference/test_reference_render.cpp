@@ -122,9 +122,9 @@ TEST(ReferenceRender, UniformlyLitFlatSkinKeepsItsDiffuse) {
     TempFolder folder("reference-flat");
     std::vector<std::string> overrides = kHeadOnLight;
     overrides.push_back("materials=[{name = \"*\", albedo = [0.6, 0.45, 0.4], skin = true}]");
-    overrides.push_back("sss.reference_edge_mm=3");
-    const Rendered reference = renderScene(*renderer, folder, "flat", "builtin:bleed-true-mask", "reference", overrides, 128);
     const Rendered none = renderScene(*renderer, folder, "flat-none", "builtin:bleed-true-mask", "none", overrides, 128);
+    overrides.push_back("sss.reference_edge_mm=3");  // the reference method's key
+    const Rendered reference = renderScene(*renderer, folder, "flat", "builtin:bleed-true-mask", "reference", overrides, 128);
     const ExrImage& image = reference.image;
     // Pixels whose 9 × 9 neighbourhood is all skin: away from the patch border (interpolation of the last
     // triangle row against the background is not what this test is about).

@@ -98,6 +98,28 @@ TEST(SceneSpec, ErrorMessagesNameFileKeyAndValue) {
               "/nonexistent/scene.toml: scene spec not found (give a TOML file or builtin:NAME)");
 }
 
+// --set (the overrides) and scene files: an [sss] key the chosen method does not read is an error naming the key and
+// the method; the scene holds the typed values and records the method's keys only.
+TEST(SceneSpec, SssKeyOfAnotherMethodIsAnError) {
+    const std::string separable = "sss.method=separable";
+    EXPECT_EQ(errorOf("builtin:head", {separable, "sss.artistic_falloff=[1.0, 0.5, 0.5]"})
+                  .rfind("builtin:head: sss.artistic_falloff: not a parameter of method 'separable' (its keys: ", 0),
+              0u);
+    EXPECT_EQ(errorOf("builtin:head", {"sss.samples=31"}).rfind("builtin:head: sss.samples: not a parameter of method 'none'", 0),
+              0u);
+    TempFolder folder;
+    const auto file = folder.write(
+        "scene.toml", "[model]\nsource = \"builtin:head\"\n[sss]\nmethod = \"separable\"\nartistic_strength = [1, 1, 1]\n");
+    const std::string fromFile = errorOf(file.string(), {});
+    EXPECT_EQ(fromFile.rfind(file.string() + ": sss.artistic_strength: not a parameter of method 'separable'", 0), 0u)
+        << fromFile;
+    const SceneSpec spec = loadSceneSpec("builtin:head", {"sss.method=artistic", "sss.artistic_falloff=[1.0, 0.5, 0.5]"}, {});
+    EXPECT_EQ(spec.sss.method, sss::SssMethod::Artistic);
+    EXPECT_EQ(spec.sss.artisticFalloff[1], 0.5);
+    EXPECT_EQ(spec.resolved["sss"]["artistic_falloff"][1], 0.5);
+    EXPECT_FALSE(spec.resolved["sss"].contains("profile"));  // separable's key, not artistic's
+}
+
 TEST(SceneSpec, LightsAreValidatedPerType) {
     // --set replaces an array of tables as a whole (TOML inline tables).
     EXPECT_EQ(errorOf("builtin:bleed", {"lights=[{type = \"spot\", direction = [0, 0, -1]}]"}),

@@ -1,5 +1,6 @@
 // The CPU reference of the screen-space passes: energy, isotropy on 16:9, follow-surface, skin-only writing.
 #include "renderer/sss/cpu_blur.h"
+#include "renderer/sss/sss_params.h"
 
 #include <algorithm>
 #include <cmath>
@@ -29,7 +30,13 @@ SssParams method(SssMethod m, int samples = 21) {
     return p;
 }
 
-const std::vector<SssMethod> kMethods{SssMethod::GaussianSum, SssMethod::Separable, SssMethod::Artistic};
+// The methods of the shared blur passes (the CPU blur mirrors them), from the method table.
+const std::vector<SssMethod> kMethods = [] {
+    std::vector<SssMethod> out;
+    for (const MethodInfo& info : methodTable())
+        if (info.blurPasses) out.push_back(info.method);
+    return out;
+}();
 
 double channelSum(const std::vector<Rgb>& image, int c) {
     double sum = 0.0;

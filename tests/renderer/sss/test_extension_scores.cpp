@@ -15,6 +15,7 @@
 #include "../gl/render_test_support.h"
 #include "analysis/metrics/render_comparison.h"
 #include "renderer/render_job.h"
+#include "renderer/sss/sss_params.h"
 
 #include <algorithm>
 #include <cmath>
@@ -30,7 +31,7 @@ using test::TempFolder;
 
 constexpr int kSize = 128;  // pixels, square
 
-const std::vector<std::string> kScreenSpaceMethods{"gaussian-sum", "separable", "artistic", "pscbf"};
+const std::vector<std::string> kScreenSpaceMethods = renderer::sss::screenSpaceMethodNames();
 
 std::filesystem::path renderExr(Renderer& renderer, const TempFolder& folder, const std::string& name,
                                 const std::string& scene, const std::string& method,
@@ -85,9 +86,12 @@ TEST(ExtensionScores, FollowSurfaceAndCbfAgainstTheHaloOfEveryScreenSpaceMethod)
             const double followCbf = halo("follow-cbf", {"sss.follow_surface=true", "sss.cbf=true"});
             // A weak follow-surface (k = 0.02/mm: full stop only at 50 mm of depth difference) leaves residual
             // light across the steep depth gradient next to the silhouette; sss.cbf must cut it.
-            const double weak = halo("weak", {"sss.follow_surface=true", "sss.follow_surface_k=0.02"});
-            const double weakCbf =
-                halo("weak-cbf", {"sss.follow_surface=true", "sss.follow_surface_k=0.02", "sss.cbf=true"});
+            // pscbf's depth weight has no k (its σ follows the profile; the method does not read follow_surface_k):
+            // its "weak" case is its default follow-surface.
+            const bool hasK = sss::methodUsesKey(sss::findMethod(method)->method, "follow_surface_k");
+            const std::string weakK = hasK ? "sss.follow_surface_k=0.02" : "sss.follow_surface=true";
+            const double weak = halo("weak", {"sss.follow_surface=true", weakK});
+            const double weakCbf = halo("weak-cbf", {"sss.follow_surface=true", weakK, "sss.cbf=true"});
             std::printf("  gap %3s mm %-13s halo leak energy: off %.3e, follow %.3e, follow+cbf %.3e (x %.3f) | "
                         "k=0.02/mm: follow %.3e, follow+cbf %.3e (x %.3f)\n",
                         gap.c_str(), method.c_str(), off, follow, followCbf, followCbf / follow, weak, weakCbf,

@@ -30,8 +30,20 @@ CliRun runCli(const std::string& arguments) {
 
 } // namespace
 
+// The methods whose kernels run through the shared blur passes, as `skinlab methods` lists them.
+std::vector<std::string> blurPassMethods() {
+    const CliRun run = runCli("methods --json");
+    EXPECT_EQ(run.exitCode, 0) << run.out;
+    std::vector<std::string> names;
+    for (const auto& row : nlohmann::json::parse(run.out))
+        if (row["blur_passes"].get<bool>()) names.push_back(row["name"]);
+    return names;
+}
+
 TEST(KernelCli, PrintsNormalisedTapsAsJson) {
-    for (const char* method : {"gaussian-sum", "separable", "artistic"}) {
+    const std::vector<std::string> methods = blurPassMethods();
+    EXPECT_EQ(methods.size(), 3u);
+    for (const std::string& method : methods) {
         const CliRun run = runCli(std::string("kernel --method ") + method + " --samples 11 --stats");
         ASSERT_EQ(run.exitCode, 0) << run.out;
         const auto json = nlohmann::json::parse(run.out);
@@ -79,4 +91,23 @@ TEST(KernelCli, BadInputIsOneLineWithExitCode2) {
     run = runCli("kernel --method separable --set camera.view=close");
     EXPECT_EQ(run.exitCode, 2);
     EXPECT_EQ(run.out, "skinlab: error: command line: camera: unknown key\n");
+}
+
+// `skinlab methods` lists the method table; a key the chosen method does not read is refused by `kernel --set` and
+// by its shorthand options alike (exit 2, naming key and method).
+TEST(KernelCli, MethodsTableAndKeysOfAnotherMethod) {
+    const CliRun list = runCli("methods --list");
+    ASSERT_EQ(list.exitCode, 0) << list.out;
+    EXPECT_NE(list.out.find("separable\n"), std::string::npos);
+    EXPECT_NE(list.out.find("pathtraced\n"), std::string::npos);
+    const CliRun screen = runCli("methods --list --screen-space");
+    EXPECT_EQ(screen.out.find("reference"), std::string::npos);
+    EXPECT_NE(screen.out.find("pscbf\n"), std::string::npos);
+    const CliRun bad = runCli("kernel --method separable --set 'sss.artistic_falloff=[1.0,0.5,0.5]'");
+    EXPECT_EQ(bad.exitCode, 2);
+    EXPECT_NE(bad.out.find("command line: sss.artistic_falloff: not a parameter of method 'separable'"), std::string::npos)
+        << bad.out;
+    const CliRun profile = runCli("kernel --method artistic --profile burley");
+    EXPECT_EQ(profile.exitCode, 2);
+    EXPECT_NE(profile.out.find("sss.profile: not a parameter of method 'artistic'"), std::string::npos) << profile.out;
 }

@@ -161,7 +161,7 @@ std::vector<std::array<float, 4>> runStage(const SyntheticFrame& frame, const ss
     inputs.focalLengthPixels = frame.focalLengthPixels;
     inputs.mmPerUnit = frame.mmPerUnit;
     gl::SssStageSettings settings;
-    settings.sss = params.toJson();
+    settings.sss = params;
     stageFixture().stage->run(inputs, settings, output.get());
     std::vector<std::array<float, 4>> out(frame.diffuse.size());
     glGetTextureImage(output.get(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(out.size() * sizeof(out[0])), out.data());
@@ -251,11 +251,12 @@ TEST(PscbfRender, DepthWeightStopsLightCrossingTheDepthGapOfHalo) {
     // the backdrop alone is uniformly lit and SSS within it changes nothing: every change on the backdrop is light
     // that crossed the gap. Wide kernel (width_mm 12: r_max 18 mm) so that it reaches across the silhouette.
     auto crossing = [&](const std::string& method, bool follow) {
-        const std::vector<std::string> overrides{
+        std::vector<std::string> overrides{
             "materials=[{name = \"*\", skin = true}]",
             "lights=[{type = \"directional\", direction = [0.45, -0.45, -0.77], intensity = 1.2, shadow = false}]",
-            std::string("sss.follow_surface=") + (follow ? "true" : "false"), "sss.width_mm=12"};
+            "sss.width_mm=12"};
         const ExrImage none = render(*renderer, folder, "builtin:halo-grey-backdrop", "none", overrides, 96, 96);
+        overrides.push_back(std::string("sss.follow_surface=") + (follow ? "true" : "false"));  // not read by none
         const ExrImage image = render(*renderer, folder, "builtin:halo-grey-backdrop", method, overrides, 96, 96);
         float nearest = 1e30f;
         for (float z : image.channels.at("depth.Z")) nearest = std::min(nearest, z);

@@ -87,7 +87,7 @@ std::vector<Rgb> runOnGpu(const sss::SurfaceBuffers& surface, const std::vector<
     inputs.focalLengthPixels = surface.focalLengthPixels;
     inputs.mmPerUnit = surface.mmPerUnit;
     gl::SssStageSettings settings;
-    settings.sss = params.toJson();
+    settings.sss = params;
     fixture().stage->run(inputs, settings, output.get());
     std::vector<float> out(rgba.size());
     glGetTextureImage(output.get(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(out.size() * sizeof(float)), out.data());
@@ -118,8 +118,13 @@ sss::SurfaceBuffers flatPlane(int width, int height, float pixelsPerMm) {
     return s;
 }
 
-const std::vector<sss::SssMethod> kMethods{sss::SssMethod::GaussianSum, sss::SssMethod::Separable,
-                                           sss::SssMethod::Artistic};
+// The methods of the shared blur passes, from the method table (renderer/sss/sss_params.h).
+const std::vector<sss::SssMethod> kMethods = [] {
+    std::vector<sss::SssMethod> out;
+    for (const sss::MethodInfo& info : sss::methodTable())
+        if (info.blurPasses) out.push_back(info.method);
+    return out;
+}();
 
 } // namespace
 

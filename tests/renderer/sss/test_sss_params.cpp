@@ -49,8 +49,6 @@ follow_surface = false
 follow_surface_k = 2.0
 profile = "burley"
 material = "marble"
-artistic_strength = [0.1, 0.2, 0.3]
-artistic_falloff = [0.4, 0.5, 0.6]
 )");
     EXPECT_EQ(p.method, SssMethod::Separable);
     EXPECT_EQ(p.samples, 31);
@@ -60,24 +58,27 @@ artistic_falloff = [0.4, 0.5, 0.6]
     EXPECT_DOUBLE_EQ(p.followSurfaceK, 2.0);
     EXPECT_EQ(p.profile, "burley");
     EXPECT_EQ(p.material, "marble");
-    EXPECT_EQ(p.artisticFalloff[2], 0.6);
+    const SssParams artistic = readSss("[sss]\nmethod = \"artistic\"\nartistic_strength = [0.1, 0.2, 0.3]\n"
+                                       "artistic_falloff = [0.4, 0.5, 0.6]\n");
+    EXPECT_EQ(artistic.artisticStrength[0], 0.1);
+    EXPECT_EQ(artistic.artisticFalloff[2], 0.6);
 }
 
 TEST(SssParams, ErrorsNameFileKeyAndValue) {
     EXPECT_EQ(sssError("[sss]\nmethod = \"blur\""),
               "scene.toml: sss.method: 'blur' is not one of: none, gaussian-sum, separable, artistic, pscbf, reference, pathtraced");
-    EXPECT_EQ(sssError("[sss]\nsamples = 20"),
+    EXPECT_EQ(sssError("[sss]\nmethod = \"separable\"\nsamples = 20"),
               "scene.toml: sss.samples: 20 is even; a symmetric kernel needs an odd number of taps (3…101)");
-    EXPECT_EQ(sssError("[sss]\nsamples = 103"), "scene.toml: sss.samples: 103 is out of range [3, 101]");
+    EXPECT_EQ(sssError("[sss]\nmethod = \"separable\"\nsamples = 103"), "scene.toml: sss.samples: 103 is out of range [3, 101]");
     EXPECT_EQ(sssError("[sss]\nwidth_mm = 0"), "scene.toml: sss.width_mm: 0 is out of range [0.01, 100]");
-    EXPECT_EQ(sssError("[sss]\nmaterial = \"marble\""),
+    EXPECT_EQ(sssError("[sss]\nmethod = \"separable\"\nmaterial = \"marble\""),
               "scene.toml: sss.material: 'marble' has no d'Eon profile (only 'skin'); use sss.profile = \"burley\"");
-    EXPECT_EQ(sssError("[sss]\nprofile = \"gauss\""),
+    EXPECT_EQ(sssError("[sss]\nmethod = \"separable\"\nprofile = \"gauss\""),
               "scene.toml: sss.profile: 'gauss' is not one of: deon, burley, file:PATH");
-    EXPECT_EQ(sssError("[sss]\nprofile = \"file:/nonexistent/Skin1.bn\""),
+    EXPECT_EQ(sssError("[sss]\nmethod = \"separable\"\nprofile = \"file:/nonexistent/Skin1.bn\""),
               "scene.toml: sss.profile: /nonexistent/Skin1.bn: kernel file not found");
     EXPECT_EQ(sssError("[sss]\nwidht_mm = 3"), "scene.toml: sss.widht_mm: unknown key");
-    EXPECT_EQ(sssError("[sss]\nartistic_strength = [0.5, 0.5, 2]"),
+    EXPECT_EQ(sssError("[sss]\nmethod = \"artistic\"\nartistic_strength = [0.5, 0.5, 2]"),
               "scene.toml: sss.artistic_strength: element 2: 2 is out of range [0, 1]");
 }
 
@@ -167,13 +168,13 @@ TEST(SssParams, ThesisVariantKeys) {
     EXPECT_EQ(defaults.extensionInput, "albedo");
     EXPECT_EQ(defaults.curvatureMeasure, "normal");
     EXPECT_DOUBLE_EQ(defaults.curvatureReferenceMm, 20.0);
-    const SssParams p = readSss("[sss]\nextension_input = \"lit\"\ncurvature_measure = \"screen\"\n"
+    const SssParams p = readSss("[sss]\nmethod = \"separable\"\nextension_input = \"lit\"\ncurvature_measure = \"screen\"\n"
                                 "curvature_reference_mm = 40.0\n");
     EXPECT_EQ(p.extensionInput, "lit");
     EXPECT_EQ(p.curvatureMeasure, "screen");
     EXPECT_DOUBLE_EQ(p.curvatureReferenceMm, 40.0);
     EXPECT_EQ(sssParamsFromJson(p.toJson()).toJson(), p.toJson());
-    EXPECT_EQ(sssError("[sss]\nextension_input = \"image\""),
+    EXPECT_EQ(sssError("[sss]\nmethod = \"separable\"\nextension_input = \"image\""),
               "scene.toml: sss.extension_input: 'image' is not one of: albedo, lit");
     EXPECT_EQ(sssError("[sss]\ncurvature_measure = \"gauss\""),
               "scene.toml: sss.curvature_measure: 'gauss' is not one of: normal, screen");
@@ -182,4 +183,49 @@ TEST(SssParams, ThesisVariantKeys) {
     EXPECT_EQ(readTransmittanceParams(skinlab::SpecReader(root, "scene.toml")).curvatureForm, "thesis");
     const toml::table bad = skinlab::parseTomlString("[transmittance]\ncurvature_form = \"both\"\n", "scene.toml");
     EXPECT_THROW(readTransmittanceParams(skinlab::SpecReader(bad, "scene.toml")), skinlab::InputError);
+}
+
+// Every method reads its own keys only: a key of another method is an error naming the key and the method, in a
+// scene file and in the JSON form alike, and the resolved record holds the method's keys only.
+TEST(SssParams, KeyOfAnotherMethodIsAnError) {
+    EXPECT_EQ(sssError("[sss]\nmethod = \"separable\"\nartistic_falloff = [1.0, 0.5, 0.5]\n"),
+              "scene.toml: sss.artistic_falloff: not a parameter of method 'separable' (its keys: width_mm, "
+              "curvature_measure, curvature_reference_mm, samples, sampling, follow_surface_k, profile, material, "
+              "follow_surface, cbf, cbf_lambda, lab_weight, extension_input, curvature, curvature_floor)");
+    EXPECT_EQ(sssError("[sss]\nsamples = 31\n").rfind("scene.toml: sss.samples: not a parameter of method 'none'", 0),
+              0u);
+    EXPECT_EQ(sssError("[sss]\nmethod = \"reference\"\ncbf = true\n")
+                  .rfind("scene.toml: sss.cbf: not a parameter of method 'reference'", 0),
+              0u);
+    EXPECT_EQ(sssError("[sss]\nmethod = \"pscbf\"\nprofile = \"burley\"\n")
+                  .rfind("scene.toml: sss.profile: not a parameter of method 'pscbf'", 0),
+              0u);
+    EXPECT_THROW(sssParamsFromJson({{"method", "separable"}, {"artistic_strength", {1, 1, 1}}}), skinlab::InputError);
+    // The common keys are accepted with every method.
+    for (const MethodInfo& info : methodTable()) {
+        const std::string text = "[sss]\nmethod = \"" + std::string(info.name) +
+                                 "\"\nwidth_mm = 2.0\ncurvature_measure = \"screen\"\ncurvature_reference_mm = 30\n";
+        EXPECT_EQ(sssError(text), "no error") << info.name;
+        // toJson: exactly the method's keys, and they read back.
+        SssParams p;
+        p.method = info.method;
+        const nlohmann::json json = p.toJson();
+        EXPECT_EQ(json.size(), kCommonSssKeys.size() + info.keys.size()) << info.name;
+        for (const auto& [key, value] : json.items()) EXPECT_TRUE(methodUsesKey(info.method, key)) << key;
+        EXPECT_EQ(sssParamsFromJson(json).toJson(), json) << info.name;
+    }
+}
+
+// The method table: names, parse, screen-space flag; every SssMethod has one row, in enum order.
+TEST(SssParams, MethodTable) {
+    const auto& table = methodTable();
+    ASSERT_EQ(table.size(), 7u);
+    for (std::size_t i = 0; i < table.size(); ++i) {
+        EXPECT_EQ(static_cast<std::size_t>(table[i].method), i);
+        EXPECT_EQ(findMethod(table[i].name), &table[i]);
+        EXPECT_EQ(methodName(table[i].method), table[i].name);
+        EXPECT_EQ(readSss("[sss]\nmethod = \"" + std::string(table[i].name) + "\"\n").method, table[i].method);
+    }
+    EXPECT_EQ(findMethod("blur"), nullptr);
+    EXPECT_EQ(screenSpaceMethodNames(), (std::vector<std::string>{"gaussian-sum", "separable", "artistic", "pscbf"}));
 }

@@ -3,6 +3,7 @@
 // plane keeps its mean, follow-surface stops light crossing the depth gap of builtin:halo.
 #include "../gl/render_test_support.h"
 #include "renderer/render_job.h"
+#include "renderer/sss/sss_params.h"
 
 #include <algorithm>
 #include <cmath>
@@ -17,7 +18,8 @@ using test::ExrImage;
 using test::readExr;
 using test::TempFolder;
 
-const std::vector<std::string> kMethods{"gaussian-sum", "separable", "artistic"};
+// The methods of the shared blur passes, from the method table (renderer/sss/sss_params.h).
+const std::vector<std::string> kMethods = renderer::sss::blurPassMethodNames();
 
 ExrImage render(Renderer& renderer, const TempFolder& folder, const std::string& scene, const std::string& method,
                 std::vector<std::string> overrides, int width, int height) {
@@ -35,7 +37,15 @@ namespace {
 void renderEveryMethod(Renderer& renderer, const std::string& scene, const std::vector<std::string>& overrides = {},
                        const std::vector<std::string>& methods = kMethods) {
     TempFolder folder("sss-every-scene");
-    const ExrImage none = render(renderer, folder, scene, "none", overrides, 64, 48);
+    // The comparison without SSS gets the overrides that method none reads (the [sss] keys of the others would be
+    // an error there; transmittance and the rest hold for both).
+    std::vector<std::string> noneOverrides;
+    for (const std::string& o : overrides) {
+        const std::string key = o.substr(0, o.find('='));
+        if (key.rfind("sss.", 0) != 0 || sss::methodUsesKey(sss::SssMethod::None, key.substr(4)))
+            noneOverrides.push_back(o);
+    }
+    const ExrImage none = render(renderer, folder, scene, "none", noneOverrides, 64, 48);
     for (const auto& method : methods) {
         const ExrImage image = render(renderer, folder, scene, method, overrides, 64, 48);
         double changed = 0.0;
@@ -78,7 +88,7 @@ TEST(SssRender, EveryMethodWithEveryExtensionRendersEveryScene) {
     SKINLAB_REQUIRE_RENDERER(renderer);
     const std::vector<std::string> all{"sss.cbf=true", "sss.lab_weight=0.09", "sss.curvature=reduce-floor",
                                        "transmittance.enabled=true", "transmittance.curvature=true"};
-    const std::vector<std::string> methods{"gaussian-sum", "separable", "artistic", "pscbf"};
+    const std::vector<std::string> methods = renderer::sss::screenSpaceMethodNames();
     std::vector<std::string> scenes{"builtin:halo-grey-backdrop", "builtin:bleed-true-mask", "builtin:ear", "builtin:head"};
     const char* assets = std::getenv("SKINLAB_ASSETS");
     if (assets && *assets)
@@ -126,10 +136,10 @@ TEST(SssRender, FollowSurfaceStopsLightCrossingTheDepthGapOfHalo) {
         "lights=[{type = \"directional\", direction = [0.45, -0.45, -0.77], intensity = 1.2, shadow = false}]"};
     auto crossing = [&](const std::string& method, bool follow) {
         std::vector<std::string> overrides = base;
-        overrides.push_back(std::string("sss.follow_surface=") + (follow ? "true" : "false"));
         // Wide kernel so that it reaches across the silhouette at this small size.
         overrides.push_back("sss.width_mm=12");
         const ExrImage none = render(*renderer, folder, "builtin:halo-grey-backdrop", "none", overrides, 96, 96);
+        overrides.push_back(std::string("sss.follow_surface=") + (follow ? "true" : "false"));  // not read by none
         const ExrImage image = render(*renderer, folder, "builtin:halo-grey-backdrop", method, overrides, 96, 96);
         float nearest = 1e30f;
         for (float z : image.channels.at("depth.Z")) nearest = std::min(nearest, z);

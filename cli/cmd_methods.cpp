@@ -1,0 +1,69 @@
+// `skinlab methods`: the SSS method table (renderer/sss/sss_params.h, methodTable()) — every method's name, whether
+// it runs in the screen-space stage, and the [sss] keys it reads. Scripts ask it instead of keeping their own lists
+// (docs/methods.md, "Adding a method").
+#include "cli/commands.h"
+#include "common/error.h"
+#include "renderer/sss/sss_params.h"
+
+#include <cstdio>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace skinlab::cli {
+
+namespace {
+
+namespace sss = renderer::sss;
+
+struct MethodsOptions {
+    bool list = false;
+    bool screenSpace = false;
+    bool json = false;
+};
+
+void runMethods(const MethodsOptions& options) {
+    std::string text;
+    nlohmann::json table = nlohmann::json::array();
+    for (const sss::MethodInfo& info : sss::methodTable()) {
+        if (options.screenSpace && !info.screenSpace) continue;
+        std::vector<std::string> keys;
+        for (const std::string_view key : sss::kCommonSssKeys)
+            if (key != "method") keys.emplace_back(key);
+        for (const std::string_view key : info.keys) keys.emplace_back(key);
+        if (options.list) {
+            text += std::string(info.name) + "\n";
+        } else if (options.json) {
+            table.push_back({{"name", info.name},
+                             {"screen_space", info.screenSpace},
+                             {"blur_passes", info.blurPasses},
+                             {"summary", info.summary},
+                             {"keys", keys}});
+        } else {
+            text += std::string(info.name) + (info.screenSpace ? "  (screen-space)" : "") + "\n    " +
+                    std::string(info.summary) + "\n    keys:";
+            for (const auto& key : keys) text += " " + key;
+            text += "\n";
+        }
+    }
+    if (options.json) text = table.dump(2) + "\n";
+    std::fputs(text.c_str(), stdout);
+}
+
+} // namespace
+
+void registerMethods(CLI::App& app) {
+    auto options = std::make_shared<MethodsOptions>();
+    CLI::App* methods = app.add_subcommand(
+        "methods", "List the SSS methods (sss.method): name, screen-space or not, and the [sss] keys each reads");
+    methods->add_flag("--list", options->list, "Names only, one per line (for scripts)");
+    methods->add_flag("--screen-space", options->screenSpace,
+                      "Only the methods the screen-space SSS stage runs (tap kernels on the frame's buffers)");
+    methods->add_flag("--json", options->json, "The table as JSON: name, screen_space, blur_passes, summary, keys");
+    methods->callback([options] {
+        if (options->list && options->json) throw InputError("--list and --json: give one of them");
+        runMethods(*options);
+    });
+}
+
+} // namespace skinlab::cli
