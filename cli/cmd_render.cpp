@@ -2,7 +2,7 @@
 #include "cli/commands.h"
 #include "common/error.h"
 #include "common/files.h"
-#include "renderer/render_job.h"
+#include "renderer/renderer.h"
 
 #include <cstdio>
 #include <memory>

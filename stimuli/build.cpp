@@ -4,7 +4,7 @@
 #include "common/files.h"
 #include "common/hash.h"
 #include "common/version.h"
-#include "renderer/render_job.h"
+#include "renderer/renderer.h"
 #include "renderer/sss/sss_params.h"
 #include "stimuli/contact_sheet.h"
 #include "stimuli/output_folder.h"

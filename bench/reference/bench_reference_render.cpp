@@ -5,7 +5,7 @@
 // and edge length, then cached; measured here on the first render of each case), and the sample counts. Each case
 // renders twice; the second row shows the cached tessellation.
 //   bench_reference_render [width=1280] [height=720]
-#include "renderer/render_job.h"
+#include "renderer/renderer.h"
 
 #include <chrono>
 #include <cstdio>

@@ -6,7 +6,7 @@
 // clock) and the wall-clock total of the passes, and writes one CSV row per scene and pass. --set overrides a
 // scene key for every scene (repeatable), e.g. --set transmittance.enabled=true.
 #include "common/files.h"
-#include "renderer/render_job.h"
+#include "renderer/renderer.h"
 
 #include <algorithm>
 #include <cstdio>

@@ -6,7 +6,7 @@
 // minimum and median per pass for each setting (the minimum is the figure least disturbed by other processes) and
 // the median of the paired differences of the main pass (on − off), the cost of transmittance inside the main
 // pass. GPU ms from the renderer's timer queries.
-#include "renderer/render_job.h"
+#include "renderer/renderer.h"
 
 #include <algorithm>
 #include <cstdio>

@@ -5,7 +5,7 @@
 // For every method and extension set: one warm-up render (kernel construction, shader compilation), then N measured
 // renders; the SSS stage's GPU time (GL_TIME_ELAPSED) is reported as the median and the minimum (on a machine
 // shared with other work the minimum is the figure least disturbed by it). Prints a Markdown table.
-#include "renderer/render_job.h"
+#include "renderer/renderer.h"
 #include "renderer/sss/sss_params.h"
 
 #include <algorithm>

@@ -7,7 +7,7 @@
 // renderer) is reported as the median, and the minimum beside it (on a machine shared with other work the minimum
 // is the figure least disturbed by it). Writes DIR/sss.csv and DIR/sss.png (atomically) and prints a table.
 #include "common/files.h"
-#include "renderer/render_job.h"
+#include "renderer/renderer.h"
 #include "renderer/sss/sss_params.h"
 #include "sss_plot.h"
 

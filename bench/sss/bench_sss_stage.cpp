@@ -11,7 +11,7 @@
 #include "renderer/gl/gl_resources.h"
 #include "renderer/gl/shader_library.h"
 #include "renderer/gl/sss_stage.h"
-#include "renderer/render_job.h"
+#include "renderer/renderer.h"
 #include "renderer/sss/sss_params.h"
 
 #include <OpenImageIO/imageio.h>

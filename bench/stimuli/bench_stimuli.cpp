@@ -3,7 +3,7 @@
 // which re-hashes every file). Prints a table and writes bench_stimuli.csv into the output folder.
 //   bench_stimuli [--spec SPEC] [--jobs N] [-o DIR] [--assets DIR] [--set key=value ...]
 #include "common/files.h"
-#include "renderer/render_job.h"
+#include "renderer/renderer.h"
 #include "stimuli/build.h"
 
 #include <chrono>

@@ -1,7 +1,7 @@
 #pragma once
 // A scene as the GL passes see it: the model's vertex/index buffers, per-part materials, the texture maps,
 // the environment (equirect texture + irradiance SH) and the lights with their shadow matrices. Built from
-// GL-free data (Model, Image, Environment) by render_job.cpp.
+// GL-free data (Model, Image, Environment) by renderer.cpp.
 #include "renderer/gl/gl_resources.h"
 #include "renderer/scene/mesh.h"
 

@@ -1,6 +1,6 @@
 #pragma once
 // The object-space reference as a render method (sss.method = "reference"; docs/extensions.md, "The object-space
-// reference"). It replaces the SSS stage; render_job.cpp calls it after the main pass (and the passes that add to
+// reference"). It replaces the SSS stage; renderer.cpp calls it after the main pass (and the passes that add to
 // the diffuse buffer) and before add_specular:
 //
 //  1. tessellate the skin parts to sss.reference_edge_mm (renderer/reference/tessellation.h, adaptive) and gather
@@ -57,7 +57,7 @@ public:
     // Checks the parameters and tessellates (or finds the cached tessellation); needs model, partMaterials,
     // mmPerUnit and source of `inputs` only. Throws InputError "<source>: sss.profile: ..." for a profile without
     // a radial form and "<source>: sss.reference_edge_mm: ..." for an edge length that needs more than
-    // kMaxReferenceVertices vertices. render_job.cpp calls it before the first pass, so bad input fails before any
+    // kMaxReferenceVertices vertices. renderer.cpp calls it before the first pass, so bad input fails before any
     // GL work; run() calls it too (a cache hit then).
     void prepare(const ReferenceInputs& inputs, const sss::SssParams& params);
 

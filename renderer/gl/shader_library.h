@@ -44,7 +44,8 @@ private:
     VertexArray emptyVertexArray_;
 };
 
-// Uniform setters by name (a name the linker removed is ignored, as GL does for location -1).
+// Uniform setters by name. A name the program's sources do not declare is an error (RuntimeError); one the linker
+// removed as unused is ignored, as GL does for location -1 (shader_checks.h).
 void setUniform(GLuint program, const char* name, float value);
 void setUniform(GLuint program, const char* name, int value);
 void setUniform(GLuint program, const char* name, const glm::vec2& value);

@@ -42,7 +42,7 @@ void SssStage::run(const SssStageInputs& inputs, const SssStageSettings& setting
     const sss::SssParams& params = impl_->params;
     switch (params.method) {
     case sss::SssMethod::Reference:
-        // Computed on the surface, not on the screen: render_job.cpp runs ReferenceMethod instead of this stage.
+        // Computed on the surface, not on the screen: renderer.cpp runs ReferenceMethod instead of this stage.
         throw RuntimeError("SSS stage: method reference is run by ReferenceMethod, not by the screen-space stage");
     case sss::SssMethod::Pscbf: {
         // Mikkelsen 2010: its own two passes (renderer/gl/pscbf_method.h).
@@ -67,7 +67,7 @@ void SssStage::run(const SssStageInputs& inputs, const SssStageSettings& setting
         return;
     }
     case sss::SssMethod::None:
-    case sss::SssMethod::Pathtraced:  // Cycles replaces the image afterwards (render_job.cpp); copy through
+    case sss::SssMethod::Pathtraced:  // Cycles replaces the image afterwards (renderer.cpp); copy through
         break;
     }
     // A framebuffer per run: texture names are recycled when the frame is resized, so caching one by name

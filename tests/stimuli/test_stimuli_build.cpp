@@ -9,7 +9,7 @@
 //    fails with one line before anything is rendered.
 // Skips with a message when no EGL platform works.
 #include "common/hash.h"
-#include "renderer/render_job.h"
+#include "renderer/renderer.h"
 #include "stimuli/manifest.h"
 
 #include <OpenImageIO/imageio.h>

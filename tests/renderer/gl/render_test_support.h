@@ -2,7 +2,7 @@
 // Shared helpers of the GL tests: one Renderer per test process (EGL context creation costs ~100 ms), skipping
 // with the EGL failure message when no platform works; EXR reading; temporary folders.
 #include "common/error.h"
-#include "renderer/render_job.h"
+#include "renderer/renderer.h"
 
 #include <OpenImageIO/imageio.h>
 #include <filesystem>

@@ -81,7 +81,7 @@ TEST(PathtracedParams, DefaultsAndStrictKeys) {
 
 TEST(PathtracedParams, SpecularSourceRasterizerRendersNoCyclesSpecular) {
     // "cycles" (default): the Principled specular of every part follows the material; "rasterizer": 0 (the beauty
-    // gets the rasterizer's specular pass instead, renderer/render_job.cpp); anything else is an error naming the key.
+    // gets the rasterizer's specular pass instead, renderer/renderer.cpp); anything else is an error naming the key.
     const Exported own = exportScene("builtin:halo", {});
     EXPECT_EQ(own.spec.resolved.at("pathtraced").at("specular_source"), "cycles");
     EXPECT_GT(own.json.at("materials").at(0).at("specular").get<double>(), 0.0);

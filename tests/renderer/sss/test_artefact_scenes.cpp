@@ -9,7 +9,7 @@
 // override that puts the paint inside the skin mask, so the bands come from the true mask.
 #include "../gl/render_test_support.h"
 #include "analysis/metrics/render_comparison.h"
-#include "renderer/render_job.h"
+#include "renderer/renderer.h"
 
 #include <cstdio>
 #include <gtest/gtest.h>

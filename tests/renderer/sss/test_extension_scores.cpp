@@ -14,7 +14,7 @@
 //  - curvature: the strategies on a flat plane (curvature.Y = 0) and on builtin:halo's sphere (c ≈ 0.5).
 #include "../gl/render_test_support.h"
 #include "analysis/metrics/render_comparison.h"
-#include "renderer/render_job.h"
+#include "renderer/renderer.h"
 #include "renderer/sss/sss_params.h"
 
 #include <algorithm>

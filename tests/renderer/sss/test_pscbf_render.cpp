@@ -9,7 +9,7 @@
 #include "renderer/gl/pscbf_method.h"
 #include "renderer/gl/shader_library.h"
 #include "renderer/gl/sss_stage.h"
-#include "renderer/render_job.h"
+#include "renderer/renderer.h"
 #include "renderer/sss/cpu_blur.h"
 #include "renderer/sss/kernel.h"
 #include "renderer/sss/pscbf_cpu.h"

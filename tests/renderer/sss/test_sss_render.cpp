@@ -2,7 +2,7 @@
 // every method renders every builtin scene (and the scanned head when $SKINLAB_ASSETS is set), a uniformly lit
 // plane keeps its mean, follow-surface stops light crossing the depth gap of builtin:halo.
 #include "../gl/render_test_support.h"
-#include "renderer/render_job.h"
+#include "renderer/renderer.h"
 #include "renderer/sss/sss_params.h"
 
 #include <algorithm>

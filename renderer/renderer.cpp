@@ -1,10 +1,10 @@
-// The renderer's public entry point (render_job.h): scene spec → GL passes → EXR (+ PNG), with timings.
+// The renderer's public entry point (renderer.h): scene spec → GL passes → EXR (+ PNG), with timings.
 //
 // Renderer::render runs named steps (docs/architecture.md, "Renderer"): materials (partMaterialsOf), lights
 // (gpuLightsOf), upload, the pass pipeline (Impl::runPasses, one class per pass under renderer/gl/:
 //   shadow map → main pass → background → surface AOVs → transmittance → SSS stage → add specular → tone map),
 // then read back and write, both driven by one AOV table (kAovs) → EXR / PNG.
-#include "renderer/render_job.h"
+#include "renderer/renderer.h"
 
 #include "common/error.h"
 #include "common/version.h"
