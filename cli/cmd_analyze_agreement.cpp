@@ -27,8 +27,9 @@ void registerAnalyzeAgreement(CLI::App& analyze) {
         "agreement", "Image metrics against the JOD scale: Pearson/Spearman with bootstrap intervals over observers, "
                      "share of significant pairs each metric orders correctly (docs/metrics.md)");
     command->add_option("study", arguments->study, "Study file (study.db)")->required();
-    command->add_option("--metrics", arguments->metrics,
-                        "Folder with metrics.json from `skinlab analyze metrics --stimuli` on the study's stimulus set")
+    command
+        ->add_option("--metrics", arguments->metrics,
+                     "Folder with metrics.json from `skinlab analyze metrics --stimuli` on the study's stimulus set")
         ->required();
     command->add_option("-o,--output", arguments->output, "Output folder: agreement.json, agreement.csv")->required();
     command->add_option("--bootstrap", arguments->bootstrap, "Bootstrap resamples (default 1000)")
@@ -58,7 +59,8 @@ void registerAnalyzeAgreement(CLI::App& analyze) {
         }
         auto metrics = agreement::conditionMetricsFromJson(metricsJson, metricsFile.string(), conditionOfStimulus);
         if (metrics.empty())
-            throwInput(metricsFile.string(), "comparisons", "no comparison is a stimulus of the study " + arguments->study);
+            throwInput(metricsFile.string(), "comparisons",
+                       "no comparison is a stimulus of the study " + arguments->study);
         scaling::AnalysisOptions options;
         options.bootstrap.samples = arguments->bootstrap;
         options.bootstrap.seed = arguments->seed;
@@ -71,7 +73,8 @@ void registerAnalyzeAgreement(CLI::App& analyze) {
         for (const std::string& warning : result.warnings) spdlog::warn("{}", warning);
         ensureDirectory(arguments->output);
         writeFileAtomic(fs::path(arguments->output) / "agreement.csv", agreement::agreementCsv(result));
-        writeFileAtomic(fs::path(arguments->output) / "agreement.json", agreement::agreementJson(result).dump(2) + "\n");
+        writeFileAtomic(fs::path(arguments->output) / "agreement.json",
+                        agreement::agreementJson(result).dump(2) + "\n");
         for (const agreement::MetricAgreement& row : result.rows)
             if (row.metric.key == "image.flip_mean" || row.metric.key == "image.delta_e00_mean")
                 std::printf("%s  %-22s r = %+.3f [%+.3f, %+.3f]  rho = %+.3f  pairs %d/%d\n", row.block.c_str(),

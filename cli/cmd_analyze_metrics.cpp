@@ -31,13 +31,16 @@ void runAnalyzeMetrics(const AnalyzeMetricsArguments& arguments) {
     metrics::ComparisonPlan plan;
     if (!arguments.stimulusFolder.empty()) {
         if (!arguments.tests.empty())
-            throwInput(arguments.tests.front(), "", "test files cannot be combined with --stimuli (the set lists its renders)");
+            throwInput(arguments.tests.front(), "",
+                       "test files cannot be combined with --stimuli (the set lists its renders)");
         std::optional<std::string> referenceId;
         if (!arguments.reference.empty()) referenceId = arguments.reference;
         plan = metrics::planStimulusSetComparisons(arguments.stimulusFolder, referenceId);
     } else {
-        if (arguments.reference.empty()) throwInput("--reference", "", "required: the reference EXR (or use --stimuli DIR)");
-        if (arguments.tests.empty()) throwInput("TEST.exr", "", "required: at least one render to compare with the reference");
+        if (arguments.reference.empty())
+            throwInput("--reference", "", "required: the reference EXR (or use --stimuli DIR)");
+        if (arguments.tests.empty())
+            throwInput("TEST.exr", "", "required: at least one render to compare with the reference");
         std::vector<std::filesystem::path> tests(arguments.tests.begin(), arguments.tests.end());
         plan = metrics::planFileComparisons(arguments.reference, tests);
     }
@@ -60,23 +63,27 @@ void registerAnalyzeMetrics(CLI::App& analyze) {
     CLI::App* command = analyze.add_subcommand(
         "metrics",
         "Compare renders with a reference: PSNR, SSIM, CIEDE2000 and LDR-FLIP on the image and on skin, and halo/bleed/"
-        "spill/interior band scores; plain images (PNG, JPEG, RGB-only EXR) get the image-wide scores (docs/metrics.md)");
-    command->add_option("tests", arguments->tests,
-                        "Test renders (EXR, contract 1) or plain images (PNG, JPEG, EXR, ...) to compare with --reference");
+        "spill/interior band scores; plain images (PNG, JPEG, RGB-only EXR) get the image-wide scores "
+        "(docs/metrics.md)");
+    command->add_option(
+        "tests", arguments->tests,
+        "Test renders (EXR, contract 1) or plain images (PNG, JPEG, EXR, ...) to compare with --reference");
     command->add_option("--reference", arguments->reference,
                         "Reference EXR (with depth.Z, mask.Y and skinlab:f_px/mm_per_unit/sss_radius_mm); with "
                         "--stimuli: the id of the reference stimulus (default: each block's \"reference\": true)");
     command->add_option("--stimuli", arguments->stimulusFolder,
                         "Stimulus set folder (manifest.json): compare every stimulus with its block's reference");
-    command->add_option("-o,--output", arguments->outputFolder,
-                        "Output folder: metrics.csv, metrics.json, heatmaps/<test>.png")
+    command
+        ->add_option("-o,--output", arguments->outputFolder,
+                     "Output folder: metrics.csv, metrics.json, heatmaps/<test>.png")
         ->required();
     command->add_option("--exposure", arguments->exposure,
                         "Linear multiplier before the display encoding for dE00/PSNR/SSIM (default 1: the render's "
                         "own exposure)");
     command->add_option("--sss-radius-mm", arguments->sssRadiusMillimetres,
                         "SSS support radius in mm for the bands (default: the reference's skinlab:sss_radius_mm)");
-    command->add_option("--heatmap-max", arguments->heatmapMax, "dE00 at the top of the heat map's colour scale (default 10)");
+    command->add_option("--heatmap-max", arguments->heatmapMax,
+                        "dE00 at the top of the heat map's colour scale (default 10)");
     command->add_flag("--no-heatmaps", arguments->noHeatmaps, "Write only metrics.csv and metrics.json");
     command->add_option("--ppd", arguments->pixelsPerDegree,
                         "FLIP's pixels per degree of visual angle (default 67.0206: 0.7 m from a 0.7 m wide 3840-pixel "

@@ -57,8 +57,7 @@ void runScale(const ScaleArguments& arguments) {
         if (dropped.recorded)
             std::printf("dropped %zu flagged trials (page hidden or focus lost while shown), %zu responses left\n",
                         dropped.dropped, table.responses.size());
-        else
-            std::printf("dropped 0 flagged trials: %s records no page-hidden or focus flags\n", table.file.c_str());
+        else std::printf("dropped 0 flagged trials: %s records no page-hidden or focus flags\n", table.file.c_str());
     }
     // Likelihood-based intervals stay valid when each observer's pairs depended on earlier answers; the observer
     // bootstrap does not (docs/analysis.md, "Validation of active designs").
@@ -76,16 +75,18 @@ void runScale(const ScaleArguments& arguments) {
     scaling::writeScaleOutputs(analysis, arguments.output);
 
     for (const scaling::BlockAnalysis& block : analysis.blocks) {
-        std::printf("%s (%zu observers, %s)\n", block.name.c_str(), block.observers.size(), block.intervalMethod.c_str());
+        std::printf("%s (%zu observers, %s)\n", block.name.c_str(), block.observers.size(),
+                    block.intervalMethod.c_str());
         for (size_t i = 0; i < block.conditions.size(); ++i) {
             const auto k = static_cast<Eigen::Index>(i);
             std::string note;
             if (i < block.intervalFlags.size() && block.intervalFlags[i].fallback) {
-                for (const std::string& reason : block.intervalFlags[i].reasons) note += (note.empty() ? "" : ", ") + reason;
+                for (const std::string& reason : block.intervalFlags[i].reasons)
+                    note += (note.empty() ? "" : ", ") + reason;
                 note = "  percentile+profile (" + note + ")";
             }
-            std::printf("  %-24s %+7.3f JOD  [%+.3f, %+.3f]%s\n", block.conditions[i].c_str(), block.thurstone.scores[k],
-                        block.low[k], block.high[k], note.c_str());
+            std::printf("  %-24s %+7.3f JOD  [%+.3f, %+.3f]%s\n", block.conditions[i].c_str(),
+                        block.thurstone.scores[k], block.low[k], block.high[k], note.c_str());
         }
     }
     std::printf("wrote %s\n", (std::filesystem::path(arguments.output) / "scale.json").c_str());
@@ -137,8 +138,8 @@ void runValidate(ValidateArguments& arguments) {
             throwInput("--scenarios", "", "'" + scenario + "' is not one of " + names);
     if (arguments.options.trueScores.size() < 2) throwInput("--scores", "", "needs at least 2 true scores");
     if (2 * static_cast<size_t>(arguments.options.disconnectedGroups) > arguments.options.trueScores.size())
-        throwInput("--groups", "", std::to_string(arguments.options.disconnectedGroups) +
-                                       " groups need at least 2 true scores each");
+        throwInput("--groups", "",
+                   std::to_string(arguments.options.disconnectedGroups) + " groups need at least 2 true scores each");
     for (int observers : arguments.options.observerCounts)
         if (observers < 2 + arguments.options.randomObservers + arguments.options.invertedObservers)
             throwInput("--observers", "", std::to_string(observers) + " is too few (at least 2 genuine observers)");
@@ -175,8 +176,9 @@ void registerAnalyzeScale(CLI::App& analyze) {
     auto scaleArguments = std::make_shared<ScaleArguments>();
     CLI::App* scale = analyze.add_subcommand(
         "scale", "Scale 2AFC responses to JOD (Thurstone Case V) with bootstrap intervals, tests and screening");
-    scale->add_option("responses", scaleArguments->responses,
-                      "study.db (SQLite, view responses_long), a CSV export, a pwcmp long CSV or a count-matrix CSV")
+    scale
+        ->add_option("responses", scaleArguments->responses,
+                     "study.db (SQLite, view responses_long), a CSV export, a pwcmp long CSV or a count-matrix CSV")
         ->required();
     scale->add_option("-o,--output", scaleArguments->output, "output folder")->required();
     scale->add_option("--bootstrap", scaleArguments->bootstrap, "bootstrap samples over observers")
@@ -198,20 +200,23 @@ void registerAnalyzeScale(CLI::App& analyze) {
     scale->add_option("--whisker", scaleArguments->whisker, "inter-quartile rule factor w of the observer screening")
         ->check(CLI::Range(0.0, 10.0))
         ->capture_default_str();
-    scale->add_option("--prior-precision", scaleArguments->priorPrecision,
-                      "precision (1/JOD^2) of the Gaussian prior on every pairwise difference")
+    scale
+        ->add_option("--prior-precision", scaleArguments->priorPrecision,
+                     "precision (1/JOD^2) of the Gaussian prior on every pairwise difference")
         ->check(CLI::Range(1e-6, 10.0))
         ->capture_default_str();
     scale->add_option("--block", scaleArguments->block, "analyse only this block (scene)");
     scale->add_flag("--single-block", scaleArguments->singleBlock, "the file must hold one block only");
-    scale->add_option("--conditions", scaleArguments->conditions,
-                      "the conditions in display order; any other condition in the file is an error")
+    scale
+        ->add_option("--conditions", scaleArguments->conditions,
+                     "the conditions in display order; any other condition in the file is an error")
         ->delimiter(',');
     scale->add_flag("--drop-flagged", scaleArguments->dropFlagged,
                     "leave out trials during which the page was hidden or lost the focus (online studies)");
-    scale->add_option("--intervals", scaleArguments->intervals,
-                      "bootstrap (over observers), profile (profile likelihood, valid for active designs), or auto: "
-                      "profile for a study.db with pairs = \"active\", bootstrap otherwise")
+    scale
+        ->add_option("--intervals", scaleArguments->intervals,
+                     "bootstrap (over observers), profile (profile likelihood, valid for active designs), or auto: "
+                     "profile for a study.db with pairs = \"active\", bootstrap otherwise")
         ->check(CLI::IsMember({"auto", "bootstrap", "profile"}))
         ->capture_default_str();
     scale->callback([scaleArguments] { runScale(*scaleArguments); });
@@ -261,15 +266,17 @@ void registerAnalyzeScale(CLI::App& analyze) {
     validate->add_option("--stretch", o.nearUnanimousStretch, "factor on the true scores (near-unanimous)")
         ->check(CLI::Range(1.0, 100.0))
         ->capture_default_str();
-    validate->add_option("--active-trials", o.activeTrials,
-                         "trials per observer in the active scenario (0: as many as the full design)")
+    validate
+        ->add_option("--active-trials", o.activeTrials,
+                     "trials per observer in the active scenario (0: as many as the full design)")
         ->check(CLI::Range(0, 100000))
         ->capture_default_str();
     validate->add_option("--active-stretch", o.activeStretch, "factor on the true scores (active)")
         ->check(CLI::Range(0.1, 100.0))
         ->capture_default_str();
-    validate->add_option("--scenarios", o.scenarios,
-                         "thurstone, lapses+side-bias, screening, sparse, disconnected, near-unanimous, active")
+    validate
+        ->add_option("--scenarios", o.scenarios,
+                     "thurstone, lapses+side-bias, screening, sparse, disconnected, near-unanimous, active")
         ->delimiter(',')
         ->capture_default_str();
     validate->add_flag("--check", validateArguments->check,

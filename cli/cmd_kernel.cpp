@@ -52,7 +52,7 @@ sss::SssParams resolveParams(const KernelOptions& options) {
     }
     const SpecReader reader(root, kSource);
     sss::SssParams params = sss::readSssParams(reader);
-    reader.finish();  // a --set outside [sss] is an unknown key
+    reader.finish(); // a --set outside [sss] is an unknown key
     return params;
 }
 
@@ -117,11 +117,13 @@ void registerKernel(CLI::App& app) {
         "kernel", "Print the SSS kernel a method actually uses: taps (offset in mm on the surface, RGB weight)");
     std::string names;
     for (const std::string& name : sss::methodNames()) names += (names.empty() ? "" : " | ") + name;
-    kernel->add_option("--method", options->method,
-                       names + " (`skinlab methods`; pscbf: its broad Gaussian stage, the pass adds the spike; "
-                               "reference and pathtraced: no taps)")
+    kernel
+        ->add_option("--method", options->method,
+                     names + " (`skinlab methods`; pscbf: its broad Gaussian stage, the pass adds the spike; "
+                             "reference and pathtraced: no taps)")
         ->required();
-    kernel->add_option("--samples", options->samples, "Taps per 1-D pass, odd, 3…101 (sss.samples; default 21, pscbf 13)");
+    kernel->add_option("--samples", options->samples,
+                       "Taps per 1-D pass, odd, 3…101 (sss.samples; default 21, pscbf 13)");
     kernel->add_option("--profile", options->profile, "deon | burley | file:PATH.bn (sss.profile; default deon)");
     kernel->add_option("--material", options->material,
                        "skin | skin1 | skin2 | marble | apple | ketchup | wholemilk (sss.material; default skin)");
@@ -131,8 +133,9 @@ void registerKernel(CLI::App& app) {
         ->type_name("KEY=VALUE")
         ->take_all();
     kernel->add_option("--format", options->format, "json or csv")->check(CLI::IsMember({"json", "csv"}));
-    kernel->add_flag("--stats", options->statistics,
-                     "Add per-channel RMS width and energy beyond --beyond-mm, per stage and for the continuous marginal");
+    kernel->add_flag(
+        "--stats", options->statistics,
+        "Add per-channel RMS width and energy beyond --beyond-mm, per stage and for the continuous marginal");
     kernel->add_option("--beyond-mm", options->beyondMm, "Distance for --stats' tail energy, mm (default 2)")
         ->check(CLI::Range(0.0, 1000.0));
     kernel->add_option("-o,--output", options->output, "Write to this file (atomically) instead of stdout");

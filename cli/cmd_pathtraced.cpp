@@ -48,7 +48,8 @@ void runFit(const FitOptions& options) {
     std::ostringstream csv;
     csv << "x_mm_at_radius_1mm,E_R,E_G,E_B\n";
     for (std::size_t i = 0; i < response.xMm.size(); ++i)
-        csv << response.xMm[i] << "," << response.value[0][i] << "," << response.value[1][i] << "," << response.value[2][i] << "\n";
+        csv << response.xMm[i] << "," << response.value[0][i] << "," << response.value[1][i] << ","
+            << response.value[2][i] << "\n";
     writeFileAtomic(folder / "edge_response.csv", csv.str());
     pt::writeFitPlot(folder / "profile_fit.png", response, fit);
     std::printf("radius_mm %.4f %.4f %.4f\nrms_error %.5f %.5f %.5f\n", fit.radiusMm[0], fit.radiusMm[1],
@@ -63,16 +64,20 @@ void registerPathtraced(CLI::App& app) {
     auto options = std::make_shared<FitOptions>();
     CLI::App* fit = pathtraced->add_subcommand(
         "fit-profile", "Fit Cycles' random-walk radii to d'Eon's sum of Gaussians (edge response on a skin slab)");
-    fit->add_option("-o,--output", options->output, "Output folder (profile_fit.json, profile_fit.png, edge_response.csv)")
+    fit->add_option("-o,--output", options->output,
+                    "Output folder (profile_fit.json, profile_fit.png, edge_response.csv)")
         ->required();
     fit->add_option("--samples", options->settings.samples, "Cycles samples per pixel")->check(CLI::Range(1, 1 << 20));
     fit->add_option("--seed", options->settings.seed, "Cycles seed")->check(CLI::Range(0, 2147483647));
-    fit->add_option("--pixels", options->settings.pixels, "Pixels along the strip (even)")->check(CLI::Range(16, 65536));
-    fit->add_option("--rows", options->settings.rows, "Rows across the strip (averaged; at least 4)")->check(CLI::Range(4, 4096));
+    fit->add_option("--pixels", options->settings.pixels, "Pixels along the strip (even)")
+        ->check(CLI::Range(16, 65536));
+    fit->add_option("--rows", options->settings.rows, "Rows across the strip (averaged; at least 4)")
+        ->check(CLI::Range(4, 4096));
     fit->add_option("--half-length-mm", options->settings.halfLengthMm, "Half length of the strip at radius 1 mm")
         ->check(CLI::Range(1.0, 1000.0));
     fit->add_option("--blender", options->settings.blender, "The Blender program");
-    fit->add_option("--threads", options->settings.threads, "Cycles threads (0: all cores)")->check(CLI::Range(0, 1024));
+    fit->add_option("--threads", options->settings.threads, "Cycles threads (0: all cores)")
+        ->check(CLI::Range(0, 1024));
     fit->callback([options] { runFit(*options); });
 }
 

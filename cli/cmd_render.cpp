@@ -73,7 +73,8 @@ void registerRender(CLI::App& app) {
         ->check(CLI::Range(16, 8192));
     render->add_option("--height", options->height, "Image height in pixels (shorthand for --set render.height=H)")
         ->check(CLI::Range(16, 8192));
-    render->add_option("--assets", options->assets, "Folder of the shared assets for assets: paths (default $SKINLAB_ASSETS)");
+    render->add_option("--assets", options->assets,
+                       "Folder of the shared assets for assets: paths (default $SKINLAB_ASSETS)");
     render->add_option("-o,--output", options->exr, "Output EXR (float32, linear, AOV channels)")->required();
     render->add_option("--png", options->png, "Also write a display PNG (tone mapped, sRGB)");
     render->add_option("--timings", options->timings, "Write per-pass milliseconds (JSON)");

@@ -31,7 +31,8 @@ void registerReport(CLI::App& app) {
     command->add_option("--seed", arguments->options.seed, "Bootstrap seed (default 1)");
     command->add_option("--ppd", arguments->options.pixelsPerDegree,
                         "FLIP's pixels per degree when the metrics are computed here (default 67.0206)");
-    command->add_option("--chromium", arguments->options.chromium, "Chromium executable for the PDF (default chromium)");
+    command->add_option("--chromium", arguments->options.chromium,
+                        "Chromium executable for the PDF (default chromium)");
     command->add_flag("--no-pdf", arguments->noPdf, "Write only the HTML page");
     command->callback([arguments] {
         report::ReportOptions options = arguments->options;

@@ -43,7 +43,8 @@ std::string slurmCommandLine(const StimuliOptions& o) {
     namespace fs = std::filesystem;
     auto q = [](const std::string& v) { return stimuli::shellQuote(v); };
     auto abs = [&](const std::string& p) { return q(fs::absolute(p).lexically_normal().string()); };
-    std::string c = "skinlab stimuli slurm " + abs(o.spec) + " -o " + abs(o.output) + " --shards " + std::to_string(o.shards);
+    std::string c =
+        "skinlab stimuli slurm " + abs(o.spec) + " -o " + abs(o.output) + " --shards " + std::to_string(o.shards);
     if (!o.assets.empty()) c += " --assets " + abs(o.assets);
     for (const auto& v : o.overrides) c += " --set " + q(v);
     if (!o.partition.empty()) c += " --partition " + q(o.partition);
@@ -158,12 +159,18 @@ void runSlurm(const StimuliOptions& o) {
 void runStatus(const StimuliOptions& o) {
     stimuli::SlurmStatus status = stimuli::slurmStatus(o.output);
     if (o.format == "json") {
-        nlohmann::json out = {{"set", status.set}, {"shards", nlohmann::json::array()},
-                              {"merge", {{"job", status.mergeJob}, {"state", status.mergeState},
-                                         {"log", status.mergeLog.string()}}}};
+        nlohmann::json out = {
+            {"set", status.set},
+            {"shards", nlohmann::json::array()},
+            {"merge", {{"job", status.mergeJob}, {"state", status.mergeState}, {"log", status.mergeLog.string()}}}};
         for (const auto& s : status.shard)
-            out["shards"].push_back({{"shard", s.index}, {"state", s.state}, {"done", s.done}, {"total", s.total},
-                                     {"job", s.job}, {"slurm_state", s.slurmState}, {"log", s.log.string()},
+            out["shards"].push_back({{"shard", s.index},
+                                     {"state", s.state},
+                                     {"done", s.done},
+                                     {"total", s.total},
+                                     {"job", s.job},
+                                     {"slurm_state", s.slurmState},
+                                     {"log", s.log.string()},
                                      {"error", s.lastError}});
         std::cout << out.dump(2) << "\n";
         return;
@@ -231,19 +238,26 @@ void registerStimuli(CLI::App& app) {
     CLI::App* slurm = stimuli->add_subcommand(
         "slurm", "Build a set on a Slurm cluster: a job array (one task per shard) and a merge job (afterok)");
     specOptions(slurm);
-    slurm->add_option("-o,--output", options->output,
-                      "Folder on the shared file system: shards/I, set (the merged set), slurm (scripts, logs, job ids)")
+    slurm
+        ->add_option("-o,--output", options->output,
+                     "Folder on the shared file system: shards/I, set (the merged set), slurm (scripts, logs, job ids)")
         ->required();
-    slurm->add_option("--shards", options->shards, "Number of shards = array tasks (default 4)")->check(CLI::Range(1, 100000));
+    slurm->add_option("--shards", options->shards, "Number of shards = array tasks (default 4)")
+        ->check(CLI::Range(1, 100000));
     slurm->add_option("--partition", options->partition, "sbatch --partition");
     slurm->add_option("--time", options->time, "sbatch --time of each task and of the merge, e.g. 1:00:00");
     slurm->add_option("--account", options->account, "sbatch --account");
-    slurm->add_option("--gpus-per-task", options->gpusPerTask, "sbatch --gpus-per-task (GPU through the EGL device platform)")
+    slurm
+        ->add_option("--gpus-per-task", options->gpusPerTask,
+                     "sbatch --gpus-per-task (GPU through the EGL device platform)")
         ->check(CLI::Range(0, 64));
     slurm->add_option("--cpus-per-task", options->cpusPerTask, "sbatch --cpus-per-task")->check(CLI::Range(0, 4096));
     slurm->add_option("--mem", options->mem, "sbatch --mem of each task, e.g. 8G");
-    slurm->add_option("--jobs", options->jobs, "Renderers per task (build --jobs, default 1)")->check(CLI::Range(1, 64));
-    slurm->add_option("--sbatch", options->sbatchArgs, "Another sbatch option for both jobs, e.g. --sbatch=--qos=high (repeatable)")
+    slurm->add_option("--jobs", options->jobs, "Renderers per task (build --jobs, default 1)")
+        ->check(CLI::Range(1, 64));
+    slurm
+        ->add_option("--sbatch", options->sbatchArgs,
+                     "Another sbatch option for both jobs, e.g. --sbatch=--qos=high (repeatable)")
         ->allow_extra_args(false);
     slurm->add_option("--only-shard", options->onlyShard, "Resubmit shard I alone (and a new merge job)")
         ->check(CLI::Range(1, 100000));
@@ -251,7 +265,8 @@ void registerStimuli(CLI::App& app) {
     slurm->add_option("--skinlab", options->skinlab, "The skinlab executable the tasks run (default: this one)");
     slurm->callback([options] { runSlurm(*options); });
 
-    CLI::App* status = stimuli->add_subcommand("status", "Per shard of a Slurm build: done, running, pending or failed");
+    CLI::App* status =
+        stimuli->add_subcommand("status", "Per shard of a Slurm build: done, running, pending or failed");
     status->add_option("dir", options->output, "The folder given to `stimuli slurm -o`")->required();
     status->add_option("--format", options->format, "text or json")->check(CLI::IsMember({"text", "json"}));
     status->callback([options] { runStatus(*options); });

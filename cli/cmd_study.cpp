@@ -55,9 +55,10 @@ struct StudyOptions {
 void runCreate(const StudyOptions& o) {
     const ex::CreatedStudy created = ex::createStudy(o.stimuli, o.design, o.overrides, o.output);
     const ex::StudyDefinition& d = created.definition;
-    std::printf("%s: %zu block(s), %zu stimuli; per participant %d trials (%d practice, %d test, %d repeat, %d catch)\n",
-                o.output.c_str(), d.blocks.size(), d.stimuli.size(), created.trialsPerParticipant,
-                d.design.practiceTrials, d.testTrialCount(), d.repeatTrialCount(), d.catchTrialCount());
+    std::printf(
+        "%s: %zu block(s), %zu stimuli; per participant %d trials (%d practice, %d test, %d repeat, %d catch)\n",
+        o.output.c_str(), d.blocks.size(), d.stimuli.size(), created.trialsPerParticipant, d.design.practiceTrials,
+        d.testTrialCount(), d.repeatTrialCount(), d.catchTrialCount());
     std::printf("next: skinlab study serve %s\n", o.output.c_str());
 }
 
@@ -86,8 +87,8 @@ void runServe(const StudyOptions& o) {
     std::printf("serving %s on %s\n", o.study.c_str(), server.url().c_str());
     std::printf("participant link: %s  (each visit without ?p= starts a new participant)\n", server.url().c_str());
     std::printf("researcher token: %s\n", server.researcherToken().c_str());
-    std::printf("status: curl -H 'Authorization: Bearer %s' %sapi/researcher/status\n", server.researcherToken().c_str(),
-                server.url().c_str());
+    std::printf("status: curl -H 'Authorization: Bearer %s' %sapi/researcher/status\n",
+                server.researcherToken().c_str(), server.url().c_str());
     std::printf("dashboard: %sresearcher#token=%s\n", server.url().c_str(), server.researcherToken().c_str());
     std::fflush(stdout);
 
@@ -124,7 +125,8 @@ void runSimulate(const StudyOptions& o) {
     options.browserLike = !o.apiOnly;
     if (!o.think.empty()) {
         static const std::regex thinkPattern(R"((\d+(?:\.\d+)?)(?::(\d+(?:\.\d+)?))?)");
-        if (!std::regex_match(o.think, m, thinkPattern)) throw InputError("--think-ms: \"" + o.think + "\" is not MS or MIN:MAX");
+        if (!std::regex_match(o.think, m, thinkPattern))
+            throw InputError("--think-ms: \"" + o.think + "\" is not MS or MIN:MAX");
         options.thinkMinMs = std::stod(m[1].str());
         options.thinkMaxMs = m[2].matched ? std::stod(m[2].str()) : options.thinkMinMs;
         if (options.thinkMaxMs < options.thinkMinMs) throw InputError("--think-ms: MAX is below MIN");
@@ -135,7 +137,8 @@ void runSimulate(const StudyOptions& o) {
     std::printf("%d/%d observers completed, %zu responses acknowledged, %d rejected, %d re-sends, %.1f s\n",
                 report.completed(), o.observers, report.acknowledged(), report.rejected(), report.transportRetries(),
                 report.wallSeconds);
-    std::printf("response latency: p50 %.2f ms, p99 %.2f ms\n", report.latencyPercentile(50), report.latencyPercentile(99));
+    std::printf("response latency: p50 %.2f ms, p99 %.2f ms\n", report.latencyPercentile(50),
+                report.latencyPercentile(99));
     if (report.completed() != o.observers) throw RuntimeError("not every simulated observer completed the study");
 }
 
@@ -182,15 +185,23 @@ void registerStudy(CLI::App& app) {
     CLI::App* serve = study->add_subcommand("serve", "Serve the participant page and API");
     serve->add_option("study", options->study, "study.db")->required();
     serve->add_option("--host", options->host, "Address to bind (default loopback only)")->capture_default_str();
-    serve->add_option("--port", options->port, "Port (0 = any free port)")->capture_default_str()->check(CLI::Range(0, 65535));
+    serve->add_option("--port", options->port, "Port (0 = any free port)")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 65535));
     serve->add_option("--threads", options->threads, "Worker threads running the requests (connections need none)")
-        ->capture_default_str()->check(CLI::Range(2, 1024));
+        ->capture_default_str()
+        ->check(CLI::Range(2, 1024));
     serve->add_option("--public-host", options->publicHost,
                       "Name the server is reached by (checked against the Host header; default: its address only)");
-    serve->add_option("--max-connections-per-client", options->connectionsPerClient,
-                      "Open connections allowed per client address")->capture_default_str()->check(CLI::Range(1, 100000));
-    serve->add_option("--joins-per-minute", options->joinsPerMinute,
-                      "New participants per client address per minute (also the burst)")->capture_default_str()
+    serve
+        ->add_option("--max-connections-per-client", options->connectionsPerClient,
+                     "Open connections allowed per client address")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 100000));
+    serve
+        ->add_option("--joins-per-minute", options->joinsPerMinute,
+                     "New participants per client address per minute (also the burst)")
+        ->capture_default_str()
         ->check(CLI::Range(1.0, 1e6));
     serve->add_option("--trusted-proxy", options->trustedProxies,
                       "Address of a reverse proxy whose X-Forwarded-For is believed (repeatable; default with "
@@ -201,14 +212,20 @@ void registerStudy(CLI::App& app) {
 
     CLI::App* simulate = study->add_subcommand("simulate", "Run simulated Thurstone observers through the server");
     simulate->add_option("study", options->study, "study.db (the one the server serves)")->required();
-    simulate->add_option("--observers", options->observers, "Number of simultaneous observers")->required()->check(CLI::Range(1, 5000));
-    simulate->add_option("--truth", options->truth, "JSON of true scores in JOD: {\"cond\": q} or {\"block\": {\"cond\": q}}");
+    simulate->add_option("--observers", options->observers, "Number of simultaneous observers")
+        ->required()
+        ->check(CLI::Range(1, 5000));
+    simulate->add_option("--truth", options->truth,
+                         "JSON of true scores in JOD: {\"cond\": q} or {\"block\": {\"cond\": q}}");
     simulate->add_option("--truth-factor", options->truthFactor, "Numeric manifest factor holding the true score");
     simulate->add_option("--url", options->url, "Server URL")->capture_default_str();
     simulate->add_option("--lapse", options->lapse, "Probability of a random answer")->check(CLI::Range(0.0, 1.0));
-    simulate->add_option("--side-bias", options->sideBias, "JOD added to the left image")->check(CLI::Range(-10.0, 10.0));
-    simulate->add_option("--random", options->randomObservers, "Observers answering at random")->check(CLI::Range(0, 5000));
-    simulate->add_option("--inverted", options->invertedObservers, "Observers with inverted scores")->check(CLI::Range(0, 5000));
+    simulate->add_option("--side-bias", options->sideBias, "JOD added to the left image")
+        ->check(CLI::Range(-10.0, 10.0));
+    simulate->add_option("--random", options->randomObservers, "Observers answering at random")
+        ->check(CLI::Range(0, 5000));
+    simulate->add_option("--inverted", options->invertedObservers, "Observers with inverted scores")
+        ->check(CLI::Range(0, 5000));
     simulate->add_option("--seed", options->seed, "Seed of the simulated answers")->capture_default_str();
     simulate->add_option("--think-ms", options->think, "Pause before each answer: MS or MIN:MAX");
     simulate->add_option("--label-prefix", options->labelPrefix,
@@ -220,11 +237,13 @@ void registerStudy(CLI::App& app) {
 
     CLI::App* status = study->add_subcommand("status", "Per-participant progress and catch-trial accuracy");
     status->add_option("study", options->study, "study.db")->required();
-    status->add_option("--format", options->format, "text or json")->check(CLI::IsMember({"text", "json"}))->default_val("text");
+    status->add_option("--format", options->format, "text or json")
+        ->check(CLI::IsMember({"text", "json"}))
+        ->default_val("text");
     status->callback([options] { runStatus(*options); });
 
     CLI::App* backup = study->add_subcommand("backup", "Consistent copy of a study file, also while it is served "
-                                                        "(SQLite online backup)");
+                                                       "(SQLite online backup)");
     backup->add_option("study", options->study, "study.db")->required();
     backup->add_option("output", options->output, "Copy to write (atomically)")->required();
     backup->add_flag("--overwrite", options->overwrite, "Replace an existing copy");
@@ -234,19 +253,22 @@ void registerStudy(CLI::App& app) {
                                                               "HTTPS (docs/deployment.md)");
     deploy->add_option("--server-name", options->site.serverName, "Public host name (also: study serve --public-host)")
         ->required();
-    deploy->add_option("--upstream", options->site.upstream, "The study server: IP:PORT (e.g. 127.0.0.1:8080)")->required();
+    deploy->add_option("--upstream", options->site.upstream, "The study server: IP:PORT (e.g. 127.0.0.1:8080)")
+        ->required();
     deploy->add_option("--cert", options->site.certificate, "Certificate chain (PEM), absolute path")->required();
     deploy->add_option("--key", options->site.key, "Private key (PEM), absolute path")->required();
     deploy->add_option("--listen", options->site.listen, "HTTPS port, or IPv4-ADDRESS:PORT")->capture_default_str();
     deploy->add_option("--redirect-port", options->site.redirectPort, "Also redirect plain HTTP on this port (0 = no)")
-        ->capture_default_str()->check(CLI::Range(0, 65535));
+        ->capture_default_str()
+        ->check(CLI::Range(0, 65535));
     deploy->add_option("-o,--output", options->output, "Site file to write (default: standard output)");
     deploy->callback([options] { runDeployConfig(*options); });
 
     CLI::App* exportCommand = study->add_subcommand("export", "Export responses (contract 3)");
     exportCommand->add_option("study", options->study, "study.db")->required();
     exportCommand->add_option("--format", options->format, "csv, json or pwcmp")
-        ->check(CLI::IsMember({"csv", "json", "pwcmp"}))->default_val("csv");
+        ->check(CLI::IsMember({"csv", "json", "pwcmp"}))
+        ->default_val("csv");
     exportCommand->add_option("-o,--output", options->output, "Output file (default: standard output)");
     exportCommand->callback([options] { runExport(*options); });
 }

@@ -17,7 +17,7 @@ void registerMethods(CLI::App& app);
 
 namespace skinlab::cli {
 // `skinlab analyze` sub-subcommands, registered by cmd_analyze.cpp on the `analyze` subcommand.
-void registerAnalyzeScale(CLI::App& analyze);    // scale, validate
-void registerAnalyzeMetrics(CLI::App& analyze);  // metrics
-void registerAnalyzeAgreement(CLI::App& analyze);  // agreement
+void registerAnalyzeScale(CLI::App& analyze);     // scale, validate
+void registerAnalyzeMetrics(CLI::App& analyze);   // metrics
+void registerAnalyzeAgreement(CLI::App& analyze); // agreement
 } // namespace skinlab::cli

@@ -37,7 +37,7 @@ std::string bothValues(const char* expression, const A& a, const B& b) {
         const auto& skinlabCheckB = (b);                                                                               \
         if (!(skinlabCheckA op skinlabCheckB))                                                                         \
             ::skinlab::detail::checkFailed(                                                                            \
-                __FILE__, __LINE__, ::skinlab::detail::bothValues(#a " " #op " " #b, skinlabCheckA, skinlabCheckB));  \
+                __FILE__, __LINE__, ::skinlab::detail::bothValues(#a " " #op " " #b, skinlabCheckA, skinlabCheckB));   \
     } while (false)
 
 #define SKINLAB_CHECK_EQ(a, b) SKINLAB_CHECK_OP(a, ==, b)

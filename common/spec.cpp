@@ -39,8 +39,8 @@ std::vector<std::string> splitKey(std::string_view key) {
 
 struct SpecReader::State {
     std::string file;
-    std::set<std::string> read;    // key paths read as values or tables
-    std::set<std::string> opaque;  // key paths read raw: nothing below them is checked
+    std::set<std::string> read;   // key paths read as values or tables
+    std::set<std::string> opaque; // key paths read raw: nothing below them is checked
 };
 
 toml::table parseTomlFile(const std::filesystem::path& path) {
@@ -63,8 +63,7 @@ toml::table parseTomlString(std::string_view text, std::string_view sourceName) 
 void applyOverride(toml::table& root, std::string_view assignment, std::string_view source) {
     size_t eq = assignment.find('=');
     std::string quoted = "'" + std::string(assignment) + "'";
-    if (eq == std::string_view::npos || eq == 0)
-        throwInput(source, quoted, "expected key=value");
+    if (eq == std::string_view::npos || eq == 0) throwInput(source, quoted, "expected key=value");
     std::string_view key = assignment.substr(0, eq);
     std::string_view text = assignment.substr(eq + 1);
     std::vector<std::string> parts = splitKey(key);
@@ -102,8 +101,9 @@ void applyOverride(toml::table& root, std::string_view assignment, std::string_v
             throwInput(source, path, "is not an array, cannot index it in '" + std::string(key) + "'");
         toml::array& array = *child->as_array();
         if (index >= array.size())
-            throwInput(source, path, "has " + std::to_string(array.size()) + " element(s); index " +
-                                         std::to_string(index) + " is out of range");
+            throwInput(source, path,
+                       "has " + std::to_string(array.size()) + " element(s); index " + std::to_string(index) +
+                           " is out of range");
         path += "[" + std::to_string(index) + "]";
         return array;
     };

@@ -49,7 +49,8 @@ public:
     bool boolean(std::string_view key, bool fallback) const;
     std::string string(std::string_view key, const std::string& fallback) const;
     std::string requiredString(std::string_view key) const;
-    std::string choice(std::string_view key, const std::string& fallback, const std::vector<std::string>& allowed) const;
+    std::string choice(std::string_view key, const std::string& fallback,
+                       const std::vector<std::string>& allowed) const;
     std::array<double, 3> vec3(std::string_view key, std::array<double, 3> fallback, double min, double max) const;
     std::vector<double> numbers(std::string_view key, std::vector<double> fallback, double min, double max) const;
     std::vector<std::string> strings(std::string_view key, std::vector<std::string> fallback) const;

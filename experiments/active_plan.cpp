@@ -53,7 +53,8 @@ std::vector<PlannedTrial> nextActiveTrials(const StudyDefinition& study, std::in
         const auto& [i, j] = batch.front();
         const std::string& a = block.conditions[static_cast<std::size_t>(i)];
         const std::string& b = block.conditions[static_cast<std::size_t>(j)];
-        if ((lastTest->conditionA == a && lastTest->conditionB == b) || (lastTest->conditionA == b && lastTest->conditionB == a))
+        if ((lastTest->conditionA == a && lastTest->conditionB == b) ||
+            (lastTest->conditionA == b && lastTest->conditionB == a))
             std::rotate(batch.begin(), batch.begin() + 1, batch.end());
     }
 
@@ -93,7 +94,8 @@ std::vector<active::Comparison> blockComparisons(const StudyBlock& block, const 
         if (t.block != block.name || (t.kind != TrialKind::test && t.kind != TrialKind::repeat)) continue;
         const auto a = index.find(t.conditionA), b = index.find(t.conditionB);
         if (a == index.end() || b == index.end()) continue;
-        out.push_back(aSelected[k] ? active::Comparison{a->second, b->second} : active::Comparison{b->second, a->second});
+        out.push_back(aSelected[k] ? active::Comparison{a->second, b->second}
+                                   : active::Comparison{b->second, a->second});
     }
     return out;
 }

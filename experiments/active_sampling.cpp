@@ -86,8 +86,9 @@ Moments tiltedMoments(double m, double v, double a, double b) {
 
 // Σ = (Λ₀ + Σ_k π̃_k a_k a_kᵀ)⁻¹ and μ = Σ η, recomputed from the sites after every sweep (Cholesky), so that the
 // rounding of thousands of rank-one updates never accumulates across sweeps.
-void recompute(int m, double priorPrecision, const std::vector<Comparison>& answers, const std::vector<double>& sitePrecision,
-               const std::vector<double>& siteShift, std::vector<double>& mean, std::vector<double>& covariance) {
+void recompute(int m, double priorPrecision, const std::vector<Comparison>& answers,
+               const std::vector<double>& sitePrecision, const std::vector<double>& siteShift,
+               std::vector<double>& mean, std::vector<double>& covariance) {
     const auto n = static_cast<std::size_t>(m);
     std::vector<double> a(n * n, 0.0), eta(n, 0.0);
     for (std::size_t i = 0; i < n; ++i) a[i * n + i] = priorPrecision;
@@ -165,17 +166,20 @@ ScorePosterior fitPosterior(int conditions, const std::vector<Comparison>& answe
     return fitPosteriorFromCounts(conditions, pairs, options);
 }
 
-ScorePosterior fitPosteriorFromCounts(int conditions, const std::vector<PairCount>& counts, const PosteriorOptions& options) {
+ScorePosterior fitPosteriorFromCounts(int conditions, const std::vector<PairCount>& counts,
+                                      const PosteriorOptions& options) {
     if (conditions < 1) throw RuntimeError("active sampling: a block needs at least one condition");
     std::vector<Comparison> ends; // site k is a function of d_k = q_ends[k].winner − q_ends[k].loser
     std::vector<double> iWon, jWon;
     double total = 0.0;
     for (std::size_t k = 0; k < counts.size(); ++k) {
         const PairCount& c = counts[k];
-        if (c.i < 0 || c.j >= conditions || !(c.i < c.j) || !(c.iWon >= 0.0 && c.jWon >= 0.0 && c.iWon + c.jWon > 0.0) ||
+        if (c.i < 0 || c.j >= conditions || !(c.i < c.j) ||
+            !(c.iWon >= 0.0 && c.jWon >= 0.0 && c.iWon + c.jWon > 0.0) ||
             (k > 0 && !(std::pair(counts[k - 1].i, counts[k - 1].j) < std::pair(c.i, c.j))))
-            throw RuntimeError("active sampling: answer counts of pair (" + std::to_string(c.i) + ", " + std::to_string(c.j) +
-                               ") are not sorted, unique, non-empty pairs of " + std::to_string(conditions) + " conditions");
+            throw RuntimeError("active sampling: answer counts of pair (" + std::to_string(c.i) + ", " +
+                               std::to_string(c.j) + ") are not sorted, unique, non-empty pairs of " +
+                               std::to_string(conditions) + " conditions");
         ends.push_back({c.i, c.j});
         iWon.push_back(c.iWon);
         jWon.push_back(c.jWon);
@@ -183,7 +187,8 @@ ScorePosterior fitPosteriorFromCounts(int conditions, const std::vector<PairCoun
     }
     const auto n = static_cast<std::size_t>(conditions);
     const double priorPrecision = 1.0 / options.priorVariance;
-    ScorePosterior out = ScorePosterior::independent(std::vector<double>(n, 0.0), std::vector<double>(n, options.priorVariance));
+    ScorePosterior out =
+        ScorePosterior::independent(std::vector<double>(n, 0.0), std::vector<double>(n, options.priorVariance));
     out.comparisons = static_cast<int>(total);
     out.converged = true;
     if (ends.empty()) return out;
@@ -247,16 +252,19 @@ double expectedInformationGain(const ScorePosterior& p, int i, int j) {
     const double pi = normalCdf(md / std::sqrt(kThurstoneSigma * kThurstoneSigma + vd)); // predictive P(i wins)
     const Moments iWins = afterAnswer(md, vd);
     const Moments jWins = afterAnswer(-md, vd); // in terms of −d
-    return pi * gaussianKl(iWins.mean, iWins.variance, md, vd) + (1.0 - pi) * gaussianKl(jWins.mean, jWins.variance, -md, vd);
+    return pi * gaussianKl(iWins.mean, iWins.variance, md, vd) +
+           (1.0 - pi) * gaussianKl(jWins.mean, jWins.variance, -md, vd);
 }
 
 std::vector<std::vector<double>> informationGains(const ScorePosterior& posterior) {
     const int m = posterior.conditions();
-    std::vector<std::vector<double>> gains(static_cast<std::size_t>(m), std::vector<double>(static_cast<std::size_t>(m), 0.0));
+    std::vector<std::vector<double>> gains(static_cast<std::size_t>(m),
+                                           std::vector<double>(static_cast<std::size_t>(m), 0.0));
     for (int i = 0; i < m; ++i)
         for (int j = i + 1; j < m; ++j)
             gains[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)] =
-                gains[static_cast<std::size_t>(j)][static_cast<std::size_t>(i)] = expectedInformationGain(posterior, i, j);
+                gains[static_cast<std::size_t>(j)][static_cast<std::size_t>(i)] =
+                    expectedInformationGain(posterior, i, j);
     return gains;
 }
 
@@ -290,7 +298,8 @@ std::vector<std::pair<int, int>> spanningTreeBatch(const ScorePosterior& posteri
         for (std::size_t v = 0; v < n; ++v)
             if (!inTree[v] && (next == n || best[v] < best[next])) next = v;
         inTree[next] = true;
-        edges.emplace_back(static_cast<int>(std::min(next, parent[next])), static_cast<int>(std::max(next, parent[next])));
+        edges.emplace_back(static_cast<int>(std::min(next, parent[next])),
+                           static_cast<int>(std::max(next, parent[next])));
         current = next;
     }
     std::stable_sort(edges.begin(), edges.end(), [&gains](const auto& x, const auto& y) {
@@ -338,7 +347,8 @@ std::vector<std::pair<int, int>> greedyBatch(const ScorePosterior& posterior, in
                     value = expectedInformationGain(p, i, j);
                 } else {
                     const auto ui = static_cast<std::size_t>(i), uj = static_cast<std::size_t>(j);
-                    const double vd = std::max(p.covariance[ui * n + ui] + p.covariance[uj * n + uj] - 2.0 * p.covariance[ui * n + uj], 1e-12);
+                    const double vd = std::max(
+                        p.covariance[ui * n + ui] + p.covariance[uj * n + uj] - 2.0 * p.covariance[ui * n + uj], 1e-12);
                     const double precision = answerPrecision(p.mean[ui] - p.mean[uj], vd);
                     const double shift = rowMean[ui] - rowMean[uj];
                     double norm = 0.0;

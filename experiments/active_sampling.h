@@ -63,7 +63,8 @@ struct ScorePosterior {
 };
 
 // The posterior of `conditions` scores given the answers (any order; indices must be in [0, conditions)).
-ScorePosterior fitPosterior(int conditions, const std::vector<Comparison>& answers, const PosteriorOptions& options = {});
+ScorePosterior fitPosterior(int conditions, const std::vector<Comparison>& answers,
+                            const PosteriorOptions& options = {});
 
 // All answers to one pair: i < j, i chosen `iWon` times over j, j `jWon` times over i.
 struct PairCount {
@@ -73,7 +74,8 @@ struct PairCount {
 };
 // The same posterior from answer counts per pair (pairs in increasing (i, j) order, each at most once, some answer
 // each): fitPosterior(answers) counts its answers and calls this, so both give identical results.
-ScorePosterior fitPosteriorFromCounts(int conditions, const std::vector<PairCount>& counts, const PosteriorOptions& options = {});
+ScorePosterior fitPosteriorFromCounts(int conditions, const std::vector<PairCount>& counts,
+                                      const PosteriorOptions& options = {});
 
 // Expected information gain (nats) of one more comparison of i and j under `posterior`.
 double expectedInformationGain(const ScorePosterior& posterior, int i, int j);

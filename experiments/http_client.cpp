@@ -22,8 +22,9 @@ struct HttpClient::Connection {
 
 std::string HttpAnswer::header(std::string_view name) const {
     for (const auto& [key, value] : headers)
-        if (key.size() == name.size() &&
-            std::equal(key.begin(), key.end(), name.begin(), [](char a, char b) { return a == std::tolower(static_cast<unsigned char>(b)); }))
+        if (key.size() == name.size() && std::equal(key.begin(), key.end(), name.begin(), [](char a, char b) {
+                return a == std::tolower(static_cast<unsigned char>(b));
+            }))
             return value;
     return "";
 }
@@ -82,7 +83,8 @@ HttpAnswer HttpClient::attempt(const std::string& method, const std::string& tar
         connection_ = fresh.release();
     }
     http::request<http::string_body> request(http::string_to_verb(method), target, 11);
-    request.set(http::field::host, (host_.find(':') != std::string::npos ? "[" + host_ + "]" : host_) + ":" + std::to_string(port_));
+    request.set(http::field::host,
+                (host_.find(':') != std::string::npos ? "[" + host_ + "]" : host_) + ":" + std::to_string(port_));
     request.set(http::field::user_agent, userAgent_);
     for (const auto& [name, value] : headers) request.set(name, value);
     if (!body.empty() || method == "POST") {

@@ -12,10 +12,10 @@ namespace skinlab::experiments {
 using HttpHeaders = std::vector<std::pair<std::string, std::string>>;
 
 struct HttpAnswer {
-    int status = 0;       // 0 = no answer (refused, reset, timed out)
+    int status = 0; // 0 = no answer (refused, reset, timed out)
     std::string body;
-    HttpHeaders headers;  // names in lower case
-    std::string error;    // why there is no answer
+    HttpHeaders headers; // names in lower case
+    std::string error;   // why there is no answer
     std::string header(std::string_view name) const;
 };
 
@@ -31,8 +31,11 @@ public:
     // connection the server had closed meanwhile is sent once more on a fresh one; otherwise status 0.
     HttpAnswer send(const std::string& method, const std::string& target, const std::string& body = "",
                     const HttpHeaders& headers = {}, const std::string& contentType = "application/json");
-    HttpAnswer get(const std::string& target, const HttpHeaders& headers = {}) { return send("GET", target, "", headers); }
-    HttpAnswer post(const std::string& target, const std::string& body, const std::string& contentType = "application/json") {
+    HttpAnswer get(const std::string& target, const HttpHeaders& headers = {}) {
+        return send("GET", target, "", headers);
+    }
+    HttpAnswer post(const std::string& target, const std::string& body,
+                    const std::string& contentType = "application/json") {
         return send("POST", target, body, {}, contentType);
     }
 

@@ -31,7 +31,8 @@ namespace {
 bool equalsIgnoringCase(std::string_view a, std::string_view b) {
     if (a.size() != b.size()) return false;
     for (std::size_t i = 0; i < a.size(); ++i)
-        if (std::tolower(static_cast<unsigned char>(a[i])) != std::tolower(static_cast<unsigned char>(b[i]))) return false;
+        if (std::tolower(static_cast<unsigned char>(a[i])) != std::tolower(static_cast<unsigned char>(b[i])))
+            return false;
     return true;
 }
 
@@ -108,7 +109,8 @@ struct HttpServer::State {
     bool admit(const std::string& address) {
         std::lock_guard lock(perClientMutex);
         if (open.load() >= limits.maxConnections) return false;
-        if (std::find(limits.uncappedClients.begin(), limits.uncappedClients.end(), address) != limits.uncappedClients.end()) {
+        if (std::find(limits.uncappedClients.begin(), limits.uncappedClients.end(), address) !=
+            limits.uncappedClients.end()) {
             ++open; // a trusted proxy carries many clients; they are counted per forwarded address by the handler
             return true;
         }
@@ -150,11 +152,12 @@ private:
         if (buffer_.size() == 0) {
             // Idle: wait for the first byte of the next request under the (long) keep-alive deadline.
             stream_.expires_after(state_->limits.idleTimeout);
-            stream_.async_read_some(buffer_.prepare(1024), [self = shared_from_this()](beast::error_code ec, std::size_t n) {
-                if (ec) return self->close();
-                self->buffer_.commit(n);
-                self->readRest();
-            });
+            stream_.async_read_some(buffer_.prepare(1024),
+                                    [self = shared_from_this()](beast::error_code ec, std::size_t n) {
+                                        if (ec) return self->close();
+                                        self->buffer_.commit(n);
+                                        self->readRest();
+                                    });
             return;
         }
         readRest();
@@ -183,7 +186,8 @@ private:
         if (ec == http::error::body_limit)
             return fail(413, "request body too large (limit " + std::to_string(state_->limits.bodyBytes) + " bytes)");
         if (ec == http::error::header_limit || ec == http::error::buffer_overflow)
-            return fail(431, "request header too large (limit " + std::to_string(state_->limits.headerBytes) + " bytes)");
+            return fail(431,
+                        "request header too large (limit " + std::to_string(state_->limits.headerBytes) + " bytes)");
         if (ec == http::error::end_of_stream || ec == asio::error::eof || ec == asio::error::connection_reset ||
             ec == asio::error::operation_aborted || ec == http::error::partial_message)
             return close();
@@ -217,9 +221,10 @@ private:
                 spdlog::error("{} {}: {}", request->method, request->path, e.what());
                 response = HttpResponse{500, "application/json", {}, errorBody("internal error")};
             }
-            asio::post(self->stream_.get_executor(), [self, response = std::move(response), keepAlive, version, head]() mutable {
-                self->write(std::move(response), keepAlive, version, head);
-            });
+            asio::post(self->stream_.get_executor(),
+                       [self, response = std::move(response), keepAlive, version, head]() mutable {
+                           self->write(std::move(response), keepAlive, version, head);
+                       });
         });
     }
 
@@ -242,18 +247,20 @@ private:
         drainSome();
     }
     void drainSome() {
-        stream_.async_read_some(asio::buffer(drainBuffer_.get(), 16384), [self = shared_from_this()](beast::error_code ec, std::size_t n) {
-            self->drained_ += n;
-            if (ec || self->drained_ >= kDrainBytes) return self->close();
-            self->drainSome();
-        });
+        stream_.async_read_some(asio::buffer(drainBuffer_.get(), 16384),
+                                [self = shared_from_this()](beast::error_code ec, std::size_t n) {
+                                    self->drained_ += n;
+                                    if (ec || self->drained_ >= kDrainBytes) return self->close();
+                                    self->drainSome();
+                                });
     }
 
     void write(HttpResponse response, bool keepAlive, unsigned version, bool head) {
         // The body is written from a shared buffer: a stimulus image held in memory is never copied per request.
         std::shared_ptr<const std::string> bytes =
             response.sharedBody ? response.sharedBody : std::make_shared<const std::string>(std::move(response.body));
-        auto message = std::make_shared<http::response<http::span_body<const char>>>(static_cast<http::status>(response.status), version);
+        auto message = std::make_shared<http::response<http::span_body<const char>>>(
+            static_cast<http::status>(response.status), version);
         message->set(http::field::server, "skinlab");
         if (!response.contentType.empty()) message->set(http::field::content_type, response.contentType);
         for (const auto& [name, value] : response.headers) message->insert(name, value);
@@ -263,11 +270,12 @@ private:
         message->prepare_payload();
         if (head) message->content_length(length);
         stream_.expires_after(state_->limits.writeTimeout);
-        http::async_write(stream_, *message, [self = shared_from_this(), message, bytes, keepAlive](beast::error_code ec, std::size_t) {
-            if (!ec && self->failing_) return self->drain();
-            if (ec || !keepAlive) return self->close();
-            self->readRequest();
-        });
+        http::async_write(stream_, *message,
+                          [self = shared_from_this(), message, bytes, keepAlive](beast::error_code ec, std::size_t) {
+                              if (!ec && self->failing_) return self->drain();
+                              if (ec || !keepAlive) return self->close();
+                              self->readRequest();
+                          });
     }
 
     void close() {
@@ -350,7 +358,8 @@ int HttpServer::bind(const std::string& host, int port) {
     if (!ec) acceptor.bind(endpoint, ec);
     if (!ec) acceptor.listen(asio::socket_base::max_listen_connections, ec);
     if (ec)
-        throw InputError("--host/--port: cannot listen on " + host + ":" + std::to_string(port) + " (" + ec.message() + ")");
+        throw InputError("--host/--port: cannot listen on " + host + ":" + std::to_string(port) + " (" + ec.message() +
+                         ")");
     return acceptor.local_endpoint().port();
 }
 

@@ -21,10 +21,10 @@
 namespace skinlab::experiments {
 
 struct HttpRequest {
-    std::string method;        // "GET", "POST", ... ("HEAD" is handed over as "GET"; the body is dropped)
-    std::string target;        // as sent: path and query
-    std::string path;          // target up to '?', not decoded
-    std::string query;         // after '?', not decoded
+    std::string method; // "GET", "POST", ... ("HEAD" is handed over as "GET"; the body is dropped)
+    std::string target; // as sent: path and query
+    std::string path;   // target up to '?', not decoded
+    std::string query;  // after '?', not decoded
     std::vector<std::pair<std::string, std::string>> headers; // names in lower case, values as sent
     std::string body;
     std::string clientAddress; // peer IP address (StudyServer: the forwarded one behind a trusted proxy)
@@ -48,16 +48,16 @@ struct HttpResponse {
 using HttpHandler = std::function<HttpResponse(const HttpRequest&)>;
 
 struct HttpLimits {
-    std::size_t headerBytes = 8 * 1024;           // request line + header fields
-    std::size_t bodyBytes = 16 * 1024;            // decoded body, chunked or not
+    std::size_t headerBytes = 8 * 1024;              // request line + header fields
+    std::size_t bodyBytes = 16 * 1024;               // decoded body, chunked or not
     std::chrono::milliseconds requestTimeout{10000}; // from the first byte... to the whole request read
     std::chrono::milliseconds idleTimeout{30000};    // a kept-alive connection with no request
     std::chrono::milliseconds writeTimeout{30000};
-    int connectionsPerClient = 64;                // open connections per client IP address
-    std::vector<std::string> uncappedClients;     // addresses exempt from connectionsPerClient (a trusted proxy)
-    int maxConnections = 20000;                   // in all (bounded by the open-file limit too)
+    int connectionsPerClient = 64;            // open connections per client IP address
+    std::vector<std::string> uncappedClients; // addresses exempt from connectionsPerClient (a trusted proxy)
+    int maxConnections = 20000;               // in all (bounded by the open-file limit too)
     int ioThreads = 2;
-    int workerThreads = 8;                        // run the handlers
+    int workerThreads = 8; // run the handlers
 };
 
 class HttpServer {

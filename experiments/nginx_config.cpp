@@ -62,14 +62,16 @@ std::string readablePemFile(const std::string& option, const std::string& path) 
 } // namespace
 
 std::string nginxSiteConfig(const NginxSiteOptions& o) {
-    static const std::regex hostName(R"([A-Za-z0-9]([A-Za-z0-9-]{0,61}[A-Za-z0-9])?(\.[A-Za-z0-9]([A-Za-z0-9-]{0,61}[A-Za-z0-9])?)*)");
+    static const std::regex hostName(
+        R"([A-Za-z0-9]([A-Za-z0-9-]{0,61}[A-Za-z0-9])?(\.[A-Za-z0-9]([A-Za-z0-9-]{0,61}[A-Za-z0-9])?)*)");
     if (o.serverName.size() > 253 || !std::regex_match(o.serverName, hostName))
         throw InputError("--server-name: \"" + o.serverName + "\" is not a host name");
     const std::string upstream = addressAndPort("--upstream", o.upstream);
     std::string listen;
     if (o.listen.find(':') == std::string::npos) {
         const int port = portOf("--listen", o.listen);
-        listen = "    listen " + std::to_string(port) + " ssl http2;\n    listen [::]:" + std::to_string(port) + " ssl http2;";
+        listen = "    listen " + std::to_string(port) + " ssl http2;\n    listen [::]:" + std::to_string(port) +
+                 " ssl http2;";
     } else {
         listen = "    listen " + addressAndPort("--listen", o.listen) + " ssl http2;";
     }
@@ -79,7 +81,8 @@ std::string nginxSiteConfig(const NginxSiteOptions& o) {
         const std::string httpsPort = o.listen.substr(o.listen.rfind(':') + 1);
         redirect = "\n# Plain HTTP: only a redirect to https://\nserver {\n    listen " + std::to_string(port) +
                    ";\n    listen [::]:" + std::to_string(port) + ";\n    server_name " + o.serverName +
-                   ";\n    return 301 https://$host" + (httpsPort == "443" ? "" : ":" + httpsPort) + "$request_uri;\n}\n";
+                   ";\n    return 301 https://$host" + (httpsPort == "443" ? "" : ":" + httpsPort) +
+                   "$request_uri;\n}\n";
     }
     std::string zone = "skinlab_";
     for (char c : o.serverName) zone += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';

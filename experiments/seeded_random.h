@@ -37,7 +37,8 @@ public:
     double unit() { return static_cast<double>(engine_() >> 11) * (1.0 / 9007199254740992.0); }
 
     // Fisher–Yates shuffle.
-    template <class T> void shuffle(std::vector<T>& items) {
+    template <class T>
+    void shuffle(std::vector<T>& items) {
         for (std::size_t i = items.size(); i > 1; --i) {
             std::size_t j = static_cast<std::size_t>(below(i));
             std::swap(items[i - 1], items[j]);

@@ -46,7 +46,8 @@ public:
         for (int attempt = 0; attempt < options_.maxAttempts; ++attempt) {
             const auto start = std::chrono::steady_clock::now();
             HttpAnswer res = method == "GET" ? client_.get(path) : client_.post(path, body.dump());
-            const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+            const double ms =
+                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
             if (res.status == 429) {
                 const int wait = std::clamp(std::atoi(res.header("Retry-After").c_str()), 1, 10);
                 std::this_thread::sleep_for(std::chrono::seconds(wait));
@@ -118,7 +119,7 @@ ObserverResult runObserver(StudyStore& store, const SimulationOptions& options, 
         for (char& c : upper) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
         const std::string id = design.recruitment.platform == "prolific" ? hex.substr(0, 24)
                                : design.recruitment.platform == "mturk"  ? "SIM" + upper
-                                                                          : "sim" + hex.substr(0, 20);
+                                                                         : "sim" + hex.substr(0, 20);
         join["recruitment"] = {{names.id, id}};
     }
     HttpResult joined = api.send("POST", "/api/join", join, result.transportRetries);
@@ -130,8 +131,12 @@ ObserverResult runObserver(StudyStore& store, const SimulationOptions& options, 
     const json screen{{"viewport_width", 1920}, {"viewport_height", 1080}, {"device_pixel_ratio", 1.0}};
     json sessionBody = screen;
     // The viewing conditions a desktop browser in full screen reports (and a calibrated card, if asked for).
-    sessionBody.update({{"screen_width", 1920}, {"screen_height", 1080}, {"colour_depth", 24}, {"fullscreen", true},
-                        {"pointer_fine", true}, {"touch_points", 0}});
+    sessionBody.update({{"screen_width", 1920},
+                        {"screen_height", 1080},
+                        {"colour_depth", 24},
+                        {"fullscreen", true},
+                        {"pointer_fine", true},
+                        {"touch_points", 0}});
     if (design.display.calibrate) sessionBody["card_width"] = 323.5;
     sessionBody["token"] = token;
     HttpResult state = api.send("POST", "/api/session", sessionBody, result.transportRetries);
@@ -162,7 +167,8 @@ ObserverResult runObserver(StudyStore& store, const SimulationOptions& options, 
         const std::int64_t trialId = body["trial"]["id"].get<std::int64_t>();
         auto it = plan.find(trialId);
         if (it == plan.end()) { // an active design's next batch, stored since the plan was read
-            for (const TrialRecord& t : store.trials(participant.id)) plan[trialReference(token, t.id)] = {t.id, t.plan};
+            for (const TrialRecord& t : store.trials(participant.id))
+                plan[trialReference(token, t.id)] = {t.id, t.plan};
             it = plan.find(trialId);
         }
         if (it == plan.end()) {
@@ -173,7 +179,8 @@ ObserverResult runObserver(StudyStore& store, const SimulationOptions& options, 
         // Both images (and the reference), each once: the browser's cache keeps them (immutable, ETag).
         for (const char* side : {"left", "right", "reference"}) {
             const json& shown = body["trial"][side];
-            if (shown.is_object() && shown.contains("url")) api.fetchOnce(shown["url"].get<std::string>(), result.transportRetries);
+            if (shown.is_object() && shown.contains("url"))
+                api.fetchOnce(shown["url"].get<std::string>(), result.transportRetries);
         }
         bool chooseA;
         if (kind == "random" || random.unit() < options.lapseRate) {
@@ -225,7 +232,9 @@ ObserverResult runObserver(StudyStore& store, const SimulationOptions& options, 
 
 } // namespace
 
-std::string simulatedJoinKey(const std::string& label) { return "sim-" + skinlab::sha256Hex("skinlab-simulate:" + label).substr(0, 40); }
+std::string simulatedJoinKey(const std::string& label) {
+    return "sim-" + skinlab::sha256Hex("skinlab-simulate:" + label).substr(0, 40);
+}
 
 double SimulationTruth::quality(const std::string& block, const std::string& condition) const {
     if (auto b = byBlock.find(block); b != byBlock.end()) {
@@ -285,8 +294,8 @@ SimulationTruth truthFromFactor(StudyStore& store, const std::string& factor) {
                 q = std::stod(text, &used);
                 if (used != text.size()) throw std::invalid_argument(text);
             } catch (const std::exception&) {
-                throw InputError("--truth-factor: stimulus \"" + s.id + "\": factor \"" + factor + "\" = " + value.dump() +
-                                 " is not a number");
+                throw InputError("--truth-factor: stimulus \"" + s.id + "\": factor \"" + factor +
+                                 "\" = " + value.dump() + " is not a number");
             }
         }
         truth.byBlock[s.block][s.condition] = q;
@@ -338,9 +347,9 @@ SimulationReport simulateObservers(StudyStore& store, const SimulationOptions& o
     const auto start = std::chrono::steady_clock::now();
     std::vector<std::thread> threads;
     for (int i = 0; i < options.observers; ++i) {
-        const std::string kind = i < options.randomObservers                              ? "random"
+        const std::string kind = i < options.randomObservers                               ? "random"
                                  : i < options.randomObservers + options.invertedObservers ? "inverted"
-                                                                                          : "thurstone";
+                                                                                           : "thurstone";
         threads.emplace_back([&, i, kind] {
             try {
                 report.observers[static_cast<std::size_t>(i)] =

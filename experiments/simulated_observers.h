@@ -34,31 +34,31 @@ struct SimulationOptions {
     int port = 8080;
     int observers = 10;
     SimulationTruth truth;
-    double lapseRate = 0.0;   // probability of answering at random
-    double sideBias = 0.0;    // JOD added to the left image's utility (positive = prefers left)
-    int randomObservers = 0;  // answer every trial at random
+    double lapseRate = 0.0;    // probability of answering at random
+    double sideBias = 0.0;     // JOD added to the left image's utility (positive = prefers left)
+    int randomObservers = 0;   // answer every trial at random
     int invertedObservers = 0; // use −q (and fail catch trials)
     std::uint64_t seed = 1;
-    double thinkMinMs = 0;    // pause before each answer, uniform in [min, max]
+    double thinkMinMs = 0; // pause before each answer, uniform in [min, max]
     double thinkMaxMs = 0;
-    std::string labelPrefix;  // observer labels "<prefix>-001[-random|-inverted]"; empty = "sim-<random>"
-    bool browserLike = true;  // as the participant page does: kept-alive connection, page + study + images (each
-                              // once: the browser caches them) around the API calls; false = API calls only, each
-                              // on a new connection
-    int maxAttempts = 300;    // per request, when the server cannot be reached (restarts); bounded
+    std::string labelPrefix; // observer labels "<prefix>-001[-random|-inverted]"; empty = "sim-<random>"
+    bool browserLike = true; // as the participant page does: kept-alive connection, page + study + images (each
+                             // once: the browser caches them) around the API calls; false = API calls only, each
+                             // on a new connection
+    int maxAttempts = 300;   // per request, when the server cannot be reached (restarts); bounded
     int retryDelayMs = 50;
 };
 
 struct ObserverResult {
     std::string label;
-    std::string kind;          // thurstone | random | inverted
+    std::string kind; // thurstone | random | inverted
     bool completed = false;
-    int answered = 0;          // acknowledged responses (stored or duplicate)
-    int rejected = 0;          // 4xx/5xx answers
-    int transportRetries = 0;  // re-sends after a failed connection
+    int answered = 0;                                               // acknowledged responses (stored or duplicate)
+    int rejected = 0;                                               // 4xx/5xx answers
+    int transportRetries = 0;                                       // re-sends after a failed connection
     std::vector<std::pair<std::int64_t, std::string>> acknowledged; // (trial row id, side) in order
     std::string completionCode;
-    std::string failure;       // why it stopped early, if it did
+    std::string failure; // why it stopped early, if it did
 };
 
 struct SimulationReport {

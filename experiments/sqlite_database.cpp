@@ -71,7 +71,8 @@ SqliteStatement& SqliteStatement::bind(int index, double value) {
     return *this;
 }
 SqliteStatement& SqliteStatement::bind(int index, std::string_view value) {
-    if (sqlite3_bind_text(statement_, index, value.data(), static_cast<int>(value.size()), SQLITE_TRANSIENT) != SQLITE_OK)
+    if (sqlite3_bind_text(statement_, index, value.data(), static_cast<int>(value.size()), SQLITE_TRANSIENT) !=
+        SQLITE_OK)
         db_->fail("bind");
     return *this;
 }
@@ -104,7 +105,8 @@ std::int64_t SqliteStatement::integer(int column) const { return sqlite3_column_
 double SqliteStatement::real(int column) const { return sqlite3_column_double(statement_, column); }
 std::string SqliteStatement::text(int column) const {
     const unsigned char* t = sqlite3_column_text(statement_, column);
-    return t ? std::string(reinterpret_cast<const char*>(t), static_cast<std::size_t>(sqlite3_column_bytes(statement_, column)))
+    return t ? std::string(reinterpret_cast<const char*>(t),
+                           static_cast<std::size_t>(sqlite3_column_bytes(statement_, column)))
              : std::string();
 }
 std::optional<std::int64_t> SqliteStatement::optionalInteger(int column) const {

@@ -71,12 +71,12 @@ StimulusManifest readStimulusManifest(const fs::path& folder) {
         if (!entry.contains("files") || !entry["files"].is_object())
             throwInput(where, key + ".files", "expected an object with a \"png\" path");
         s.pngPath = requireString(entry["files"], "png", key + ".files.png");
-        if (!staysInside(s.pngPath)) throwInput(where, key + ".files.png", "path leaves the stimulus folder: " + s.pngPath);
+        if (!staysInside(s.pngPath))
+            throwInput(where, key + ".files.png", "path leaves the stimulus folder: " + s.pngPath);
         if (entry.contains("sha256") && entry["sha256"].is_object() && entry["sha256"].contains("png") &&
             entry["sha256"]["png"].is_string())
             s.pngSha256 = entry["sha256"]["png"].get<std::string>();
-        else
-            throwInput(where, key + ".sha256.png", "expected the PNG's sha256 (hex)");
+        else throwInput(where, key + ".sha256.png", "expected the PNG's sha256 (hex)");
         s.block = requireString(entry, "block", key + ".block");
         s.reference = entry.value("reference", false);
         for (const char* dim : {"width", "height"}) {
@@ -99,12 +99,14 @@ StimulusManifest readStimulusManifest(const fs::path& folder) {
 void verifyStimulusFiles(const StimulusManifest& manifest, const std::vector<std::string>& ids) {
     for (const std::string& id : ids) {
         const ManifestStimulus* s = manifest.find(id);
-        if (!s) throwInput((manifest.folder / "manifest.json").string(), "stimuli", "no stimulus with id \"" + id + "\"");
+        if (!s)
+            throwInput((manifest.folder / "manifest.json").string(), "stimuli", "no stimulus with id \"" + id + "\"");
         const fs::path png = manifest.folder / s->pngPath;
         if (!fs::is_regular_file(png)) throwInput(png.string(), "", "stimulus image missing (stimulus \"" + id + "\")");
         if (sha256File(png) != s->pngSha256)
-            throwInput(png.string(), "", "sha256 differs from the manifest (stimulus \"" + id +
-                                             "\"); the set changed after it was built");
+            throwInput(png.string(), "",
+                       "sha256 differs from the manifest (stimulus \"" + id +
+                           "\"); the set changed after it was built");
     }
 }
 

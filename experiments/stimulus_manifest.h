@@ -15,16 +15,16 @@ struct ManifestStimulus {
     std::string pngSha256; // lower-case hex from the manifest
     std::string block;     // comparisons only happen within a block (e.g. "builtin:head/mid")
     bool reference = false;
-    int width = 0;         // image pixels
+    int width = 0; // image pixels
     int height = 0;
     std::map<std::string, std::string> factors; // factor name -> level (numbers are kept as their JSON text)
 };
 
 struct StimulusManifest {
-    std::filesystem::path folder;  // absolute folder holding manifest.json
+    std::filesystem::path folder; // absolute folder holding manifest.json
     std::string set;
-    std::string text;              // the manifest file's bytes, stored in the study
-    std::string sha256;            // of `text`
+    std::string text;   // the manifest file's bytes, stored in the study
+    std::string sha256; // of `text`
     std::vector<ManifestStimulus> stimuli;
 
     const ManifestStimulus* find(const std::string& id) const;

@@ -14,8 +14,7 @@ BackupSummary backupStudy(const fs::path& study, const fs::path& output, bool ov
     if (!fs::is_regular_file(study, ec)) throw InputError(study.string() + ": no such study file");
     if (fs::exists(output, ec)) {
         if (fs::equivalent(study, output, ec)) throw InputError(output.string() + ": is the study file itself");
-        if (!overwrite)
-            throw InputError(output.string() + ": already exists; choose another name or pass --overwrite");
+        if (!overwrite) throw InputError(output.string() + ": already exists; choose another name or pass --overwrite");
     }
     SqliteDatabase source(study.string(), false);
     {
@@ -48,7 +47,8 @@ BackupSummary backupStudy(const fs::path& study, const fs::path& output, bool ov
     BackupSummary summary;
     {
         SqliteDatabase copy(out.tempPath().string(), false);
-        SqliteStatement s = copy.prepare("SELECT (SELECT COUNT(*) FROM participants), (SELECT COUNT(*) FROM responses)");
+        SqliteStatement s =
+            copy.prepare("SELECT (SELECT COUNT(*) FROM participants), (SELECT COUNT(*) FROM responses)");
         s.step();
         summary.participants = s.integer(0);
         summary.responses = s.integer(1);

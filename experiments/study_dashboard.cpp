@@ -91,7 +91,9 @@ json StudyDashboard::flaggedTrials() {
         recorded = s.step() && s.integer(0) != 0;
     }
     const std::size_t count = trials.size();
-    return {{"recorded", recorded}, {"note", recorded ? "" : "not recorded"}, {"count", count},
+    return {{"recorded", recorded},
+            {"note", recorded ? "" : "not recorded"},
+            {"count", count},
             {"trials", std::move(trials)}};
 }
 
@@ -101,7 +103,9 @@ json StudyDashboard::counts() {
     const int planned = design.practiceTrials + definition.testTrialCount() + definition.repeatTrialCount() +
                         definition.catchTrialCount();
     json out;
-    out["study"] = {{"title", design.title}, {"blocks", definition.blocks.size()}, {"stimuli", definition.stimuli.size()},
+    out["study"] = {{"title", design.title},
+                    {"blocks", definition.blocks.size()},
+                    {"stimuli", definition.stimuli.size()},
                     {"generated_at", utcTimestamp()}};
     std::lock_guard lock(readMutex_);
     SqliteTransaction readTransaction(*db_, false); // one consistent view of every table
@@ -113,8 +117,10 @@ json StudyDashboard::counts() {
             "SELECT p.label, p.created_at, COALESCE(a.client_address, ''), COALESCE(a.source, ''),"
             " (SELECT COUNT(*) FROM trials t WHERE t.participant_id = p.id),"
             " (SELECT COUNT(*) FROM responses r WHERE r.participant_id = p.id),"
-            " (SELECT COUNT(*) FROM responses r JOIN trials t ON t.id = r.trial_id WHERE r.participant_id = p.id AND t.kind = 'catch'),"
-            " (SELECT COUNT(*) FROM responses r JOIN trials t ON t.id = r.trial_id WHERE r.participant_id = p.id AND t.kind = 'catch' AND r.chosen = t.expected),"
+            " (SELECT COUNT(*) FROM responses r JOIN trials t ON t.id = r.trial_id WHERE r.participant_id = p.id AND "
+            "t.kind = 'catch'),"
+            " (SELECT COUNT(*) FROM responses r JOIN trials t ON t.id = r.trial_id WHERE r.participant_id = p.id AND "
+            "t.kind = 'catch' AND r.chosen = t.expected),"
             " (SELECT COALESCE(MAX(server_time), '') FROM responses r WHERE r.participant_id = p.id)"
             " FROM participants p LEFT JOIN participant_addresses a ON a.participant_id = p.id ORDER BY p.id");
         while (s.step()) {
@@ -125,10 +131,15 @@ json StudyDashboard::counts() {
             catchAnswered += catchN;
             catchCorrect += catchOk;
             responses += answered;
-            participants.push_back({{"observer", s.text(0)}, {"joined_at", s.text(1)},
-                                    {"client_address", s.text(2)}, {"address_source", s.text(3)},
-                                    {"answered", answered}, {"total", total}, {"completed", answered >= total},
-                                    {"catch_answered", catchN}, {"catch_correct", catchOk},
+            participants.push_back({{"observer", s.text(0)},
+                                    {"joined_at", s.text(1)},
+                                    {"client_address", s.text(2)},
+                                    {"address_source", s.text(3)},
+                                    {"answered", answered},
+                                    {"total", total},
+                                    {"completed", answered >= total},
+                                    {"catch_answered", catchN},
+                                    {"catch_correct", catchOk},
                                     {"last_response_at", s.text(8)}});
         }
     }
@@ -139,9 +150,13 @@ json StudyDashboard::counts() {
         while (s.step()) times.push_back(s.real(0));
     }
     out["participants"] = std::move(participants);
-    out["totals"] = {{"participants", out["participants"].size()}, {"completed", completed}, {"responses", responses},
-                     {"catch_answered", catchAnswered}, {"catch_correct", catchCorrect},
-                     {"catch_accuracy", catchAnswered > 0 ? json(static_cast<double>(catchCorrect) / catchAnswered) : json()}};
+    out["totals"] = {
+        {"participants", out["participants"].size()},
+        {"completed", completed},
+        {"responses", responses},
+        {"catch_answered", catchAnswered},
+        {"catch_correct", catchCorrect},
+        {"catch_accuracy", catchAnswered > 0 ? json(static_cast<double>(catchCorrect) / catchAnswered) : json()}};
     json bins = json::array();
     const std::size_t edges = std::size(kEdges);
     for (std::size_t i = 0; i < edges; ++i) {
@@ -151,8 +166,11 @@ json StudyDashboard::counts() {
         const auto last = std::lower_bound(times.begin(), times.end(), to);
         bins.push_back({{"from_ms", from}, {"to_ms", number(to)}, {"count", last - first}});
     }
-    out["response_times"] = {{"count", times.size()}, {"excludes", "practice trials"}, {"bins", std::move(bins)},
-                             {"p10_ms", number(percentile(times, 10))}, {"median_ms", number(percentile(times, 50))},
+    out["response_times"] = {{"count", times.size()},
+                             {"excludes", "practice trials"},
+                             {"bins", std::move(bins)},
+                             {"p10_ms", number(percentile(times, 10))},
+                             {"median_ms", number(percentile(times, 50))},
                              {"p90_ms", number(percentile(times, 90))}};
     return out;
 }
@@ -207,12 +225,16 @@ json StudyDashboard::computeScale() const {
         for (std::size_t i = 0; i < block.conditions.size(); ++i) {
             const auto k = static_cast<Eigen::Index>(i);
             const bool fallback = i < block.intervalFlags.size() && block.intervalFlags[i].fallback;
-            conditions.push_back({{"condition", block.conditions[i]}, {"jod", number(block.thurstone.scores[k])},
-                                  {"low", number(block.low[k])}, {"high", number(block.high[k])},
+            conditions.push_back({{"condition", block.conditions[i]},
+                                  {"jod", number(block.thurstone.scores[k])},
+                                  {"low", number(block.low[k])},
+                                  {"high", number(block.high[k])},
                                   {"interval_fallback", fallback}});
         }
-        blocks.push_back({{"block", block.name}, {"observers", block.observers.size()},
-                          {"interval_method", block.intervalMethod}, {"conditions", std::move(conditions)},
+        blocks.push_back({{"block", block.name},
+                          {"observers", block.observers.size()},
+                          {"interval_method", block.intervalMethod},
+                          {"conditions", std::move(conditions)},
                           {"warnings", block.warnings}});
     }
     out["state"] = "ok";

@@ -32,10 +32,10 @@ public:
     nlohmann::json snapshot();
 
 private:
-    nlohmann::json counts();          // participants, progress, catch trials, response times (fresh)
+    nlohmann::json counts();            // participants, progress, catch trials, response times (fresh)
     nlohmann::json viewingConditions(); // per session: screen, zoom, full screen, pixels per degree (fresh)
     nlohmann::json flaggedTrials();     // trials shown while the page was hidden or unfocused (fresh)
-    nlohmann::json scale(std::int64_t responseCount);  // cached (see above)
+    nlohmann::json scale(std::int64_t responseCount); // cached (see above)
     nlohmann::json computeScale() const;
 
     StudyStore& store_;
@@ -44,8 +44,8 @@ private:
     std::mutex readMutex_; // the dashboard's connection
     std::unique_ptr<SqliteDatabase> db_;
     std::mutex scaleMutex_;
-    nlohmann::json scale_;                 // null until first computed
-    std::int64_t scaleResponses_ = -1;     // response count it was computed from
+    nlohmann::json scale_;             // null until first computed
+    std::int64_t scaleResponses_ = -1; // response count it was computed from
     std::chrono::steady_clock::time_point scaleComputed_;
     bool computing_ = false;
 };

@@ -36,7 +36,8 @@ StudyDefinition resolveStudy(const StudyDesign& design, const StimulusManifest& 
         if (std::find(blockNames.begin(), blockNames.end(), s.block) == blockNames.end()) blockNames.push_back(s.block);
     for (const std::string& b : design.blocks)
         if (std::find(blockNames.begin(), blockNames.end(), b) == blockNames.end())
-            throwInput(file, "blocks", "\"" + b + "\" is not a block of the stimulus set (blocks: " + joinNames(blockNames) + ")");
+            throwInput(file, "blocks",
+                       "\"" + b + "\" is not a block of the stimulus set (blocks: " + joinNames(blockNames) + ")");
     if (!design.blocks.empty()) blockNames = design.blocks;
 
     // All condition levels present (in manifest order), for defaults and messages.
@@ -50,14 +51,16 @@ StudyDefinition resolveStudy(const StudyDesign& design, const StimulusManifest& 
         throwInput(file, "condition_factor", "no stimulus has factor \"" + design.conditionFactor + "\"");
     for (const std::string& c : design.conditions)
         if (std::find(levels.begin(), levels.end(), c) == levels.end())
-            throwInput(file, "conditions", "\"" + c + "\" is not a level of factor \"" + design.conditionFactor +
-                                               "\" (levels: " + joinNames(levels) + ")");
+            throwInput(file, "conditions",
+                       "\"" + c + "\" is not a level of factor \"" + design.conditionFactor +
+                           "\" (levels: " + joinNames(levels) + ")");
     const std::vector<std::string> conditions = design.conditions.empty() ? levels : design.conditions;
     if (conditions.size() < 2) throwInput(file, "conditions", "at least two conditions are needed for a comparison");
     for (const auto& [a, b] : design.pairs)
         for (const std::string& c : {a, b})
             if (std::find(conditions.begin(), conditions.end(), c) == conditions.end())
-                throwInput(file, "pairs", "\"" + c + "\" is not one of the study's conditions (" + joinNames(conditions) + ")");
+                throwInput(file, "pairs",
+                           "\"" + c + "\" is not one of the study's conditions (" + joinNames(conditions) + ")");
 
     auto addStimulus = [&](const ManifestStimulus& s, const std::string& condition) {
         for (const StudyStimulus& existing : def.stimuli)
@@ -84,7 +87,8 @@ StudyDefinition resolveStudy(const StudyDesign& design, const StimulusManifest& 
             if (s.block != blockName) continue;
             if (s.reference && design.showReference) {
                 if (block.referenceStimulus >= 0)
-                    throwInput(manifestWhere, "stimuli", "block \"" + blockName + "\" has more than one reference stimulus");
+                    throwInput(manifestWhere, "stimuli",
+                               "block \"" + blockName + "\" has more than one reference stimulus");
                 block.referenceStimulus = addStimulus(s, "");
                 continue;
             }
@@ -92,8 +96,9 @@ StudyDefinition resolveStudy(const StudyDesign& design, const StimulusManifest& 
             if (c.empty() || std::find(conditions.begin(), conditions.end(), c) == conditions.end()) continue;
             if (byCondition.count(c))
                 throwInput(file, "condition_factor",
-                           "block \"" + blockName + "\" has two stimuli with " + design.conditionFactor + "=" + c + " (\"" +
-                               byCondition[c]->id + "\", \"" + s.id + "\"); choose a factor that tells them apart, or split blocks");
+                           "block \"" + blockName + "\" has two stimuli with " + design.conditionFactor + "=" + c +
+                               " (\"" + byCondition[c]->id + "\", \"" + s.id +
+                               "\"); choose a factor that tells them apart, or split blocks");
             byCondition[c] = &s;
         }
         if (design.showReference && block.referenceStimulus < 0)
@@ -116,12 +121,14 @@ StudyDefinition resolveStudy(const StudyDesign& design, const StimulusManifest& 
             }
         if (!block.pairs.empty()) def.blocks.push_back(std::move(block));
     }
-    if (def.blocks.empty()) throwInput(file, "pairs", "no block holds two of the study's conditions; nothing to compare");
+    if (def.blocks.empty())
+        throwInput(file, "pairs", "no block holds two of the study's conditions; nothing to compare");
     for (const auto& [a, b] : design.pairs) {
         bool found = false;
         for (const StudyBlock& block : def.blocks)
             for (const auto& [i, j] : block.pairs)
-                if ((block.conditions[i] == a && block.conditions[j] == b) || (block.conditions[i] == b && block.conditions[j] == a))
+                if ((block.conditions[i] == a && block.conditions[j] == b) ||
+                    (block.conditions[i] == b && block.conditions[j] == a))
                     found = true;
         if (!found) throwInput(file, "pairs", "no block holds both \"" + a + "\" and \"" + b + "\"");
     }
@@ -162,20 +169,32 @@ nlohmann::json StudyDefinition::toJson() const {
     j["design"] = design.toJson();
     j["stimuli"] = nlohmann::json::array();
     for (const StudyStimulus& s : stimuli)
-        j["stimuli"].push_back({{"index", s.index}, {"id", s.id}, {"block", s.block}, {"condition", s.condition},
-                                {"png", s.pngPath}, {"sha256", s.sha256}, {"width", s.width}, {"height", s.height},
+        j["stimuli"].push_back({{"index", s.index},
+                                {"id", s.id},
+                                {"block", s.block},
+                                {"condition", s.condition},
+                                {"png", s.pngPath},
+                                {"sha256", s.sha256},
+                                {"width", s.width},
+                                {"height", s.height},
                                 {"reference", s.reference}});
     j["blocks"] = nlohmann::json::array();
     for (const StudyBlock& b : blocks) {
         nlohmann::json pairs = nlohmann::json::array();
         for (const auto& [x, y] : b.pairs) pairs.push_back({x, y});
-        j["blocks"].push_back({{"name", b.name}, {"conditions", b.conditions}, {"condition_stimulus", b.conditionStimulus},
-                               {"pairs", pairs}, {"reference_stimulus", b.referenceStimulus}});
+        j["blocks"].push_back({{"name", b.name},
+                               {"conditions", b.conditions},
+                               {"condition_stimulus", b.conditionStimulus},
+                               {"pairs", pairs},
+                               {"reference_stimulus", b.referenceStimulus}});
     }
     j["catch_pairs"] = nlohmann::json::array();
     for (const StudyCatchPair& c : catchPairs)
-        j["catch_pairs"].push_back({{"block", c.block}, {"first", c.first}, {"second", c.second},
-                                    {"expect_first", c.expectFirst}, {"repeat", c.repeat}});
+        j["catch_pairs"].push_back({{"block", c.block},
+                                    {"first", c.first},
+                                    {"second", c.second},
+                                    {"expect_first", c.expectFirst},
+                                    {"repeat", c.repeat}});
     return j;
 }
 
@@ -183,10 +202,10 @@ StudyDefinition StudyDefinition::fromJson(const nlohmann::json& j) {
     StudyDefinition def;
     def.design = StudyDesign::fromJson(j.at("design"));
     for (const auto& s : j.at("stimuli"))
-        def.stimuli.push_back({s.at("index").get<int>(), s.at("id").get<std::string>(), s.at("block").get<std::string>(),
-                               s.at("condition").get<std::string>(), s.at("png").get<std::string>(),
-                               s.at("sha256").get<std::string>(), s.at("width").get<int>(), s.at("height").get<int>(),
-                               s.at("reference").get<bool>()});
+        def.stimuli.push_back({s.at("index").get<int>(), s.at("id").get<std::string>(),
+                               s.at("block").get<std::string>(), s.at("condition").get<std::string>(),
+                               s.at("png").get<std::string>(), s.at("sha256").get<std::string>(),
+                               s.at("width").get<int>(), s.at("height").get<int>(), s.at("reference").get<bool>()});
     for (const auto& b : j.at("blocks")) {
         StudyBlock block;
         block.name = b.at("name").get<std::string>();

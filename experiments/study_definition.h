@@ -12,8 +12,8 @@
 namespace skinlab::experiments {
 
 struct StudyStimulus {
-    int index = 0;         // position in StudyDefinition::stimuli; also the public URL /stimuli/<index>.png
-    std::string id;        // manifest id
+    int index = 0;  // position in StudyDefinition::stimuli; also the public URL /stimuli/<index>.png
+    std::string id; // manifest id
     std::string block;
     std::string condition; // level of the design's condition factor ("" for a reference stimulus)
     std::string pngPath;   // relative to the stimulus folder
@@ -25,15 +25,15 @@ struct StudyStimulus {
 
 struct StudyBlock {
     std::string name;
-    std::vector<std::string> conditions; // in design order
-    std::vector<int> conditionStimulus;  // stimulus index per condition
+    std::vector<std::string> conditions;    // in design order
+    std::vector<int> conditionStimulus;     // stimulus index per condition
     std::vector<std::pair<int, int>> pairs; // indices into `conditions`, first < second in design order
-    int referenceStimulus = -1;          // shown above the pair when the design asks for it
+    int referenceStimulus = -1;             // shown above the pair when the design asks for it
 };
 
 struct StudyCatchPair {
     std::string block;
-    int first = -1;       // stimulus indices
+    int first = -1; // stimulus indices
     int second = -1;
     bool expectFirst = true;
     int repeat = 1;

@@ -96,11 +96,11 @@ StudyDesign designFromToml(toml::table& root, const std::string& file, const std
         d.recruitment.idParameter = recruitment.requiredString("id_parameter");
         const std::string& name = d.recruitment.idParameter;
         bool valid = !name.empty() && name.size() <= 64 && name != "p";
-        for (char c : name)
-            valid = valid && (std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-');
+        for (char c : name) valid = valid && (std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-');
         if (!valid)
-            recruitment.fail("id_parameter", "\"" + name + "\" is not a URL parameter name (1 to 64 letters, digits, "
-                                             "'_' or '-'; not \"p\", the participant link's own)");
+            recruitment.fail("id_parameter", "\"" + name +
+                                                 "\" is not a URL parameter name (1 to 64 letters, digits, "
+                                                 "'_' or '-'; not \"p\", the participant link's own)");
     } else if (recruitment.has("id_parameter")) {
         recruitment.fail("id_parameter", "only used with platform = \"sona\" or \"generic\" (platform \"" +
                                              d.recruitment.platform + "\" has fixed parameters)");
@@ -109,13 +109,15 @@ StudyDesign designFromToml(toml::table& root, const std::string& file, const std
     if (!d.recruitment.completionUrl.empty()) {
         const std::string& url = d.recruitment.completionUrl;
         bool valid = (url.rfind("https://", 0) == 0 || url.rfind("http://", 0) == 0) && url.size() <= 2000;
-        for (char c : url) valid = valid && static_cast<unsigned char>(c) > 0x20 && c != 0x7f && c != '"' && c != '<' && c != '>';
+        for (char c : url)
+            valid = valid && static_cast<unsigned char>(c) > 0x20 && c != 0x7f && c != '"' && c != '<' && c != '>';
         if (!valid)
             recruitment.fail("completion_url", "\"" + url + "\" is not an http(s) URL without spaces or quotes");
     }
     d.recruitment.completionCode = recruitment.string("completion_code", "");
     for (char c : d.recruitment.completionCode)
-        if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_') || d.recruitment.completionCode.size() > 64)
+        if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_') ||
+            d.recruitment.completionCode.size() > 64)
             recruitment.fail("completion_code", "\"" + d.recruitment.completionCode +
                                                     "\": only letters, digits, '-' and '_' (at most 64)");
 
@@ -162,7 +164,9 @@ nlohmann::json StudyDesign::toJson() const {
             {"condition_factor", conditionFactor},
             {"conditions", conditions},
             {"blocks", blocks},
-            {"pairs", activePairs ? nlohmann::json("active") : allPairs ? nlohmann::json("all") : pairsJson},
+            {"pairs", activePairs ? nlohmann::json("active")
+                      : allPairs  ? nlohmann::json("all")
+                                  : pairsJson},
             {"trials_per_participant", trialsPerParticipant},
             {"repetitions", repetitions},
             {"block_order", blockOrder},
@@ -201,7 +205,8 @@ StudyDesign StudyDesign::fromJson(const nlohmann::json& j) {
         d.trialsPerParticipant = j.value("trials_per_participant", 0);
     } else {
         d.allPairs = false;
-        for (const auto& p : j.at("pairs")) d.pairs.emplace_back(p.at(0).get<std::string>(), p.at(1).get<std::string>());
+        for (const auto& p : j.at("pairs"))
+            d.pairs.emplace_back(p.at(0).get<std::string>(), p.at(1).get<std::string>());
     }
     d.repetitions = j.at("repetitions").get<int>();
     d.blockOrder = j.at("block_order").get<std::string>();

@@ -36,7 +36,7 @@ struct DisplayDesign {
 
 // [requirements]: a session that does not meet them is refused before the first trial.
 struct RequirementsDesign {
-    int minScreenWidth = 0;  // CSS pixels (screen.width); 0 = any
+    int minScreenWidth = 0; // CSS pixels (screen.width); 0 = any
     int minScreenHeight = 0;
     bool noZoom = false;     // devicePixelRatio a whole number, unchanged during the session
     bool fullscreen = false; // the page in full screen
@@ -45,12 +45,12 @@ struct RequirementsDesign {
 };
 
 struct StudyDesign {
-    std::string sourceName;    // file name for messages
+    std::string sourceName; // file name for messages
     std::string title = "Image comparison";
     std::string question = "Which image looks more like real skin?";
-    std::string instructions;  // shown before practice; empty = a default text
-    std::string consent;       // shown first; empty = a default text
-    std::uint64_t seed = 1;    // design seed; participant seeds are derived from it and stored
+    std::string instructions;               // shown before practice; empty = a default text
+    std::string consent;                    // shown first; empty = a default text
+    std::uint64_t seed = 1;                 // design seed; participant seeds are derived from it and stored
     std::string conditionFactor = "method"; // manifest factor naming a stimulus's condition ("id" = the stimulus id)
     std::vector<std::string> conditions;    // empty = every level found
     std::vector<std::string> blocks;        // empty = every block of the manifest
@@ -61,12 +61,12 @@ struct StudyDesign {
     // (every pair of a block is a candidate).
     bool activePairs = false;
     int trialsPerParticipant = 0;
-    int repetitions = 2;       // times each pair is shown to each participant (alternating sides)
+    int repetitions = 2;                    // times each pair is shown to each participant (alternating sides)
     std::string blockOrder = "interleaved"; // interleaved | grouped
-    int breakEvery = 40;       // a pause screen every K trials (0 = none)
-    bool showReference = false; // show the block's reference stimulus above the pair (reference-based 2AFC)
+    int breakEvery = 40;                    // a pause screen every K trials (0 = none)
+    bool showReference = false;             // show the block's reference stimulus above the pair (reference-based 2AFC)
     int practiceTrials = 2;
-    int blankCatchTrials = 2;  // stimulus vs a blank grey panel; the stimulus is the right answer
+    int blankCatchTrials = 2; // stimulus vs a blank grey panel; the stimulus is the right answer
     std::vector<DeclaredCatchPair> catchPairs;
     RecruitmentDesign recruitment;
     DisplayDesign display;

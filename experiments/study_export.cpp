@@ -81,22 +81,33 @@ std::string onlineFields(const ResponseRow& r) {
     return out;
 }
 
-nlohmann::json optionalNumber(const std::optional<double>& value) { return value ? nlohmann::json(*value) : nlohmann::json(); }
+nlohmann::json optionalNumber(const std::optional<double>& value) {
+    return value ? nlohmann::json(*value) : nlohmann::json();
+}
 
 nlohmann::json viewingJson(const std::optional<ViewingConditions>& viewing) {
     if (!viewing) return nullptr;
     const ViewingConditions& v = *viewing;
-    return {{"screen_width", v.screenWidth}, {"screen_height", v.screenHeight}, {"screen_width_px", v.screenWidthPx},
-            {"screen_height_px", v.screenHeightPx}, {"colour_depth", v.colourDepth}, {"fullscreen", v.fullscreen},
-            {"pointer_fine", v.pointerFine}, {"touch_points", v.touchPoints}, {"mobile", v.mobile},
-            {"pixels_per_mm", optionalNumber(v.pixelsPerMm)}, {"viewing_distance_mm", optionalNumber(v.viewingDistanceMm)},
+    return {{"screen_width", v.screenWidth},
+            {"screen_height", v.screenHeight},
+            {"screen_width_px", v.screenWidthPx},
+            {"screen_height_px", v.screenHeightPx},
+            {"colour_depth", v.colourDepth},
+            {"fullscreen", v.fullscreen},
+            {"pointer_fine", v.pointerFine},
+            {"touch_points", v.touchPoints},
+            {"mobile", v.mobile},
+            {"pixels_per_mm", optionalNumber(v.pixelsPerMm)},
+            {"viewing_distance_mm", optionalNumber(v.viewingDistanceMm)},
             {"pixels_per_degree", optionalNumber(v.pixelsPerDegree)}};
 }
 
 nlohmann::json externalJson(const std::optional<ExternalIds>& external) {
     if (!external) return nullptr;
-    return {{"platform", external->platform}, {"external_id", external->id},
-            {"external_study_id", external->study}, {"external_session_id", external->session}};
+    return {{"platform", external->platform},
+            {"external_id", external->id},
+            {"external_study_id", external->study},
+            {"external_session_id", external->session}};
 }
 
 } // namespace
@@ -109,37 +120,51 @@ std::string exportResponses(StudyStore& store, const std::string& format) {
         nlohmann::json out;
         out["format"] = "skinlab-responses";
         out["version"] = 1;
-        out["study"] = {{"title", store.definition().design.title},
-                        {"question", store.definition().design.question},
-                        {"design_sha256", store.meta("design_sha256")},
-                        {"manifest_sha256", store.meta("manifest_sha256")},
-                        {"stimulus_set", store.meta("stimulus_set")},
-                        {"skinlab_version", store.meta("skinlab_version")}};
+        out["study"] = {
+            {"title", store.definition().design.title},     {"question", store.definition().design.question},
+            {"design_sha256", store.meta("design_sha256")}, {"manifest_sha256", store.meta("manifest_sha256")},
+            {"stimulus_set", store.meta("stimulus_set")},   {"skinlab_version", store.meta("skinlab_version")}};
         out["participants"] = nlohmann::json::array();
         for (const ParticipantStatus& p : store.status())
-            out["participants"].push_back({{"observer", p.participant.label}, {"seed", p.participant.seed},
+            out["participants"].push_back({{"observer", p.participant.label},
+                                           {"seed", p.participant.seed},
                                            {"participant_index", p.participant.index},
                                            {"created_at", p.participant.createdAt},
-                                           {"answered", p.progress.answered}, {"total", p.progress.total},
+                                           {"answered", p.progress.answered},
+                                           {"total", p.progress.total},
                                            {"recruitment", externalJson(p.external)}});
         out["sessions"] = nlohmann::json::array();
         for (const SessionViewing& v : store.viewingConditions())
-            out["sessions"].push_back({{"observer", v.observer}, {"session_id", v.sessionId}, {"started_at", v.startedAt},
-                                       {"user_agent", v.userAgent}, {"viewport_width", v.viewportWidth},
-                                       {"viewport_height", v.viewportHeight}, {"device_pixel_ratio", v.devicePixelRatio},
+            out["sessions"].push_back({{"observer", v.observer},
+                                       {"session_id", v.sessionId},
+                                       {"started_at", v.startedAt},
+                                       {"user_agent", v.userAgent},
+                                       {"viewport_width", v.viewportWidth},
+                                       {"viewport_height", v.viewportHeight},
+                                       {"device_pixel_ratio", v.devicePixelRatio},
                                        {"viewing", viewingJson(v.viewing)}});
         out["responses"] = nlohmann::json::array();
         for (const ResponseRow& r : rows) {
-            nlohmann::json row = {{"observer", r.observer}, {"scene", r.scene}, {"condition_A", r.conditionA},
-                                        {"condition_B", r.conditionB}, {"is_A_selected", r.aSelected ? 1 : 0},
-                                        {"A_on_left", r.aOnLeft ? 1 : 0}, {"trial_kind", trialKindName(r.kind)},
-                                        {"correct", r.correct ? nlohmann::json(*r.correct ? 1 : 0) : nlohmann::json()},
-                                        {"response_ms", r.responseMs}, {"stimulus_A", r.stimulusA},
-                                        {"stimulus_B", r.stimulusB}, {"trial_id", r.trialId}, {"position", r.position},
-                                        {"session_id", r.sessionId}, {"client_time", r.clientTime},
-                                        {"server_time", r.serverTime}, {"viewport_width", r.viewportWidth},
-                                        {"viewport_height", r.viewportHeight},
-                                        {"device_pixel_ratio", r.devicePixelRatio}, {"user_agent", r.userAgent}};
+            nlohmann::json row = {{"observer", r.observer},
+                                  {"scene", r.scene},
+                                  {"condition_A", r.conditionA},
+                                  {"condition_B", r.conditionB},
+                                  {"is_A_selected", r.aSelected ? 1 : 0},
+                                  {"A_on_left", r.aOnLeft ? 1 : 0},
+                                  {"trial_kind", trialKindName(r.kind)},
+                                  {"correct", r.correct ? nlohmann::json(*r.correct ? 1 : 0) : nlohmann::json()},
+                                  {"response_ms", r.responseMs},
+                                  {"stimulus_A", r.stimulusA},
+                                  {"stimulus_B", r.stimulusB},
+                                  {"trial_id", r.trialId},
+                                  {"position", r.position},
+                                  {"session_id", r.sessionId},
+                                  {"client_time", r.clientTime},
+                                  {"server_time", r.serverTime},
+                                  {"viewport_width", r.viewportWidth},
+                                  {"viewport_height", r.viewportHeight},
+                                  {"device_pixel_ratio", r.devicePixelRatio},
+                                  {"user_agent", r.userAgent}};
             row["flagged"] = r.conditions ? nlohmann::json(r.flagged() ? 1 : 0) : nlohmann::json();
             row["page_hidden"] = r.conditions ? nlohmann::json(r.conditions->pageHidden) : nlohmann::json();
             row["focus_lost"] = r.conditions ? nlohmann::json(r.conditions->focusLost) : nlohmann::json();
@@ -160,8 +185,8 @@ std::string exportResponses(StudyStore& store, const std::string& format) {
                       "," + kOnlineColumns + "\n";
     for (const ResponseRow& r : rows) {
         if (pwcmp && r.kind != TrialKind::test && r.kind != TrialKind::repeat) continue;
-        out += csvField(r.observer) + ',' + csvField(r.scene) + ',' + csvField(r.conditionA) + ',' + csvField(r.conditionB) +
-               ',' + (r.aSelected ? "1" : "0");
+        out += csvField(r.observer) + ',' + csvField(r.scene) + ',' + csvField(r.conditionA) + ',' +
+               csvField(r.conditionB) + ',' + (r.aSelected ? "1" : "0");
         if (!pwcmp) {
             out += std::string(",") + (r.aOnLeft ? "1" : "0") + ',' + trialKindName(r.kind) + ',' +
                    (r.correct ? (*r.correct ? "1" : "0") : "") + ',' + formatMs(r.responseMs);
@@ -181,11 +206,17 @@ nlohmann::json statusJson(StudyStore& store) {
         completed += p.progress.completed() ? 1 : 0;
         responses += p.progress.answered;
         out["participants"].push_back(
-            {{"observer", p.participant.label}, {"answered", p.progress.answered}, {"total", p.progress.total},
-             {"completed", p.progress.completed()}, {"test_answered", p.testAnswered},
-             {"catch_answered", p.catchAnswered}, {"catch_correct", p.catchCorrect},
-             {"catch_accuracy", p.catchAnswered ? nlohmann::json(double(p.catchCorrect) / p.catchAnswered) : nlohmann::json()},
-             {"created_at", p.participant.createdAt}, {"last_response_at", p.lastResponseAt},
+            {{"observer", p.participant.label},
+             {"answered", p.progress.answered},
+             {"total", p.progress.total},
+             {"completed", p.progress.completed()},
+             {"test_answered", p.testAnswered},
+             {"catch_answered", p.catchAnswered},
+             {"catch_correct", p.catchCorrect},
+             {"catch_accuracy",
+              p.catchAnswered ? nlohmann::json(double(p.catchCorrect) / p.catchAnswered) : nlohmann::json()},
+             {"created_at", p.participant.createdAt},
+             {"last_response_at", p.lastResponseAt},
              {"completion_code", p.progress.completed() ? p.participant.completionCode : std::string()}});
     }
     out["completed"] = completed;
@@ -203,10 +234,12 @@ std::string statusText(StudyStore& store) {
     for (const auto& p : status["participants"]) {
         std::string catchText = "-";
         if (p["catch_answered"].get<int>() > 0)
-            catchText = std::to_string(p["catch_correct"].get<int>()) + "/" + std::to_string(p["catch_answered"].get<int>());
+            catchText =
+                std::to_string(p["catch_correct"].get<int>()) + "/" + std::to_string(p["catch_answered"].get<int>());
         std::snprintf(line, sizeof line, "%-16s %9d %9d %7s  %-10s %s\n", p["observer"].get<std::string>().c_str(),
                       p["answered"].get<int>(), p["total"].get<int>(), catchText.c_str(),
-                      p["completion_code"].get<std::string>().c_str(), p["last_response_at"].get<std::string>().c_str());
+                      p["completion_code"].get<std::string>().c_str(),
+                      p["last_response_at"].get<std::string>().c_str());
         out += line;
     }
     std::snprintf(line, sizeof line, "%zu participants, %d completed, %ld responses\n", status["participants"].size(),

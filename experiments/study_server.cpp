@@ -41,7 +41,9 @@ HttpResponse jsonResponse(int status, const json& body) {
     return res;
 }
 
-HttpResponse errorResponse(int status, const std::string& message) { return jsonResponse(status, json{{"error", message}}); }
+HttpResponse errorResponse(int status, const std::string& message) {
+    return jsonResponse(status, json{{"error", message}});
+}
 
 json parseBody(const HttpRequest& req) {
     const std::string type = req.header("Content-Type");
@@ -89,7 +91,8 @@ double numberField(const json& body, const char* name, double min, double max) {
     if (!v.is_number()) throw RequestError(400, std::string(name) + ": expected a number");
     const double value = v.get<double>();
     if (!(value >= min && value <= max))
-        throw RequestError(400, std::string(name) + ": out of range [" + std::to_string(min) + ", " + std::to_string(max) + "]");
+        throw RequestError(400, std::string(name) + ": out of range [" + std::to_string(min) + ", " +
+                                    std::to_string(max) + "]");
     return value;
 }
 
@@ -101,7 +104,8 @@ bool booleanField(const json& body, const char* name) {
 
 // The optional per-trial conditions of a response: all three fields or none.
 std::optional<TrialConditions> trialConditionsField(const json& body) {
-    if (!body.contains("page_hidden") && !body.contains("focus_lost") && !body.contains("fullscreen")) return std::nullopt;
+    if (!body.contains("page_hidden") && !body.contains("focus_lost") && !body.contains("fullscreen"))
+        return std::nullopt;
     return TrialConditions{booleanField(body, "page_hidden"), booleanField(body, "focus_lost"),
                            booleanField(body, "fullscreen")};
 }
@@ -111,7 +115,8 @@ std::map<std::string, std::string> recruitmentField(const json& body) {
     std::map<std::string, std::string> out;
     if (!body.contains("recruitment")) return out;
     const json& r = body["recruitment"];
-    if (!r.is_object() || r.size() > 8) throw RequestError(400, "recruitment: expected an object of at most 8 parameters");
+    if (!r.is_object() || r.size() > 8)
+        throw RequestError(400, "recruitment: expected an object of at most 8 parameters");
     for (const auto& [name, value] : r.items()) {
         if (name.size() > 64) throw RequestError(400, "recruitment: parameter name longer than 64 characters");
         if (!value.is_string()) throw RequestError(400, validUtf8(name, 64) + ": expected a string");
@@ -209,7 +214,8 @@ StudyServer::~StudyServer() {
 
 std::string StudyServer::url() const {
     const std::string host = options_.host == "0.0.0.0" ? "127.0.0.1" : options_.host;
-    return "http://" + (host.find(':') != std::string::npos ? "[" + host + "]" : host) + ":" + std::to_string(port_) + "/";
+    return "http://" + (host.find(':') != std::string::npos ? "[" + host + "]" : host) + ":" + std::to_string(port_) +
+           "/";
 }
 
 int StudyServer::bind() {
@@ -258,7 +264,10 @@ bool StudyServer::allowJoin(const std::string& clientAddress, double& retryAfter
     JoinBucket& bucket = it->second;
     const double perSecond = options_.joinsPerMinute / 60.0;
     if (fresh) bucket.tokens = options_.joinBurst;
-    else bucket.tokens = std::min(options_.joinBurst, bucket.tokens + perSecond * std::chrono::duration<double>(now - bucket.updated).count());
+    else
+        bucket.tokens =
+            std::min(options_.joinBurst,
+                     bucket.tokens + perSecond * std::chrono::duration<double>(now - bucket.updated).count());
     bucket.updated = now;
     if (bucket.tokens >= 1) {
         bucket.tokens -= 1;
@@ -269,7 +278,8 @@ bool StudyServer::allowJoin(const std::string& clientAddress, double& retryAfter
 }
 
 bool StudyServer::trustedProxy(const std::string& peer) const {
-    return std::find(options_.trustedProxies.begin(), options_.trustedProxies.end(), peer) != options_.trustedProxies.end();
+    return std::find(options_.trustedProxies.begin(), options_.trustedProxies.end(), peer) !=
+           options_.trustedProxies.end();
 }
 
 std::string StudyServer::clientAddress(const HttpRequest& req) const {
@@ -294,8 +304,9 @@ HttpResponse StudyServer::handle(const HttpRequest& req) {
     try {
         if (req.headerCount("Host") != 1) throw RequestError(400, "Host: exactly one Host header is required");
         if (!hostAllowed(req.header("Host")))
-            throw RequestError(421, "Host: \"" + validUtf8(req.header("Host"), 64) +
-                                        "\" is not this server (serve with --public-host NAME to be reached by a name)");
+            throw RequestError(421,
+                               "Host: \"" + validUtf8(req.header("Host"), 64) +
+                                   "\" is not this server (serve with --public-host NAME to be reached by a name)");
         if (trustedProxy(req.clientAddress)) {
             // Behind the proxy every connection is the proxy's: the per-client cap applies to the forwarded address,
             // as requests in progress (the proxy limits connections per client itself; experiments/deploy/).
@@ -344,9 +355,10 @@ HttpResponse StudyServer::route(const HttpRequest& req) {
         if (!file) return errorResponse(404, "not found");
         HttpResponse res;
         res.contentType = type;
-        res.headers = {{"Cache-Control", "no-cache"},
-                       {"X-Content-Type-Options", "nosniff"},
-                       {"Content-Security-Policy", "default-src 'self'; img-src 'self'; style-src 'self'; script-src 'self'"}};
+        res.headers = {
+            {"Cache-Control", "no-cache"},
+            {"X-Content-Type-Options", "nosniff"},
+            {"Content-Security-Policy", "default-src 'self'; img-src 'self'; style-src 'self'; script-src 'self'"}};
         res.body = std::string(*file);
         return res;
     };
@@ -431,20 +443,25 @@ HttpResponse StudyServer::route(const HttpRequest& req) {
         json parameters = json::array();
         for (const std::string& name : {names.id, names.study, names.session})
             if (!name.empty()) parameters.push_back(name);
-        return jsonResponse(200, {{"title", d.title}, {"question", d.question}, {"instructions", d.instructions},
-                                  {"consent", d.consent}, {"break_every", d.breakEvery},
-                                  {"recruitment", {{"platform", d.recruitment.platform},
-                                                   {"id_parameter", names.id},
-                                                   {"parameters", parameters}}},
-                                  {"display", {{"calibrate", d.display.calibrate},
-                                               {"viewing_distance_mm", d.display.viewingDistanceMm},
-                                               {"card_width_mm", kIdCardWidthMm},
-                                               {"card_height_mm", kIdCardHeightMm}}},
-                                  {"requirements", {{"min_screen_width", d.requirements.minScreenWidth},
-                                                    {"min_screen_height", d.requirements.minScreenHeight},
-                                                    {"no_zoom", d.requirements.noZoom},
-                                                    {"fullscreen", d.requirements.fullscreen},
-                                                    {"desktop", d.requirements.desktop}}}});
+        return jsonResponse(
+            200, {{"title", d.title},
+                  {"question", d.question},
+                  {"instructions", d.instructions},
+                  {"consent", d.consent},
+                  {"break_every", d.breakEvery},
+                  {"recruitment",
+                   {{"platform", d.recruitment.platform}, {"id_parameter", names.id}, {"parameters", parameters}}},
+                  {"display",
+                   {{"calibrate", d.display.calibrate},
+                    {"viewing_distance_mm", d.display.viewingDistanceMm},
+                    {"card_width_mm", kIdCardWidthMm},
+                    {"card_height_mm", kIdCardHeightMm}}},
+                  {"requirements",
+                   {{"min_screen_width", d.requirements.minScreenWidth},
+                    {"min_screen_height", d.requirements.minScreenHeight},
+                    {"no_zoom", d.requirements.noZoom},
+                    {"fullscreen", d.requirements.fullscreen},
+                    {"desktop", d.requirements.desktop}}}});
     }
 
     if (post && path == "/api/join") {

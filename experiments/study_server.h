@@ -20,18 +20,18 @@
 namespace skinlab::experiments {
 
 struct ServerOptions {
-    std::string host = "127.0.0.1"; // loopback unless the researcher says otherwise
-    int port = 8080;                 // 0 = any free port
-    int threads = 8;                 // worker threads running the handlers (connections need none)
-    int ioThreads = 2;               // threads holding the connections
-    std::string researcherToken;     // empty = a random one
-    std::filesystem::path stimuliDir; // empty = the folder recorded at `study create`
+    std::string host = "127.0.0.1";        // loopback unless the researcher says otherwise
+    int port = 8080;                       // 0 = any free port
+    int threads = 8;                       // worker threads running the handlers (connections need none)
+    int ioThreads = 2;                     // threads holding the connections
+    std::string researcherToken;           // empty = a random one
+    std::filesystem::path stimuliDir;      // empty = the folder recorded at `study create`
     std::size_t maxBodyBytes = 16 * 1024;  // larger request bodies are refused with 413 (chunked too)
     std::size_t maxHeaderBytes = 8 * 1024; // larger request headers are refused with 431
-    int connectionsPerClient = 64;   // open connections per client address (more: 429)
-    std::string publicHost;          // a name the server is reached by (Host header); empty = its address only
-    double joinsPerMinute = 60;      // new participants per client address: sustained rate...
-    double joinBurst = 60;           // ...and burst (more: 429 with Retry-After)
+    int connectionsPerClient = 64;         // open connections per client address (more: 429)
+    std::string publicHost;                // a name the server is reached by (Host header); empty = its address only
+    double joinsPerMinute = 60;            // new participants per client address: sustained rate...
+    double joinBurst = 60;                 // ...and burst (more: 429 with Retry-After)
     std::chrono::milliseconds requestTimeout{10000}; // a request must arrive within this once started (else 408)
     // Reverse proxies (IP addresses) whose X-Forwarded-For is believed: a request from one of them counts as coming
     // from the address the proxy forwards (join rate limit, per-client request cap, the stored join address); from
@@ -64,7 +64,7 @@ public:
 private:
     struct Stimulus {
         std::shared_ptr<const std::string> bytes; // verified at start; served from memory
-        std::string etag;  // "\"<sha256>\""
+        std::string etag;                         // "\"<sha256>\""
     };
     HttpResponse handle(const HttpRequest& request);
     HttpResponse route(const HttpRequest& request);

@@ -137,8 +137,9 @@ CREATE VIEW responses_long AS
 void upgradeSchema(SqliteDatabase& db) {
     bool current = false;
     {
-        SqliteStatement s = db.prepare("SELECT (SELECT COUNT(*) FROM sqlite_master WHERE name = 'trial_conditions'),"
-                                       " (SELECT COUNT(*) FROM pragma_table_info('responses_long') WHERE name = 'flagged')");
+        SqliteStatement s =
+            db.prepare("SELECT (SELECT COUNT(*) FROM sqlite_master WHERE name = 'trial_conditions'),"
+                       " (SELECT COUNT(*) FROM pragma_table_info('responses_long') WHERE name = 'flagged')");
         s.step();
         current = s.integer(0) == 1 && s.integer(1) == 1;
     }
@@ -178,10 +179,13 @@ void insertTrials(SqliteDatabase& db, std::int64_t participantId, const std::vec
     for (const PlannedTrial& t : plan) {
         insert.bind(1, participantId).bind(2, position++).bind(3, trialKindName(t.kind)).bind(4, t.block);
         insert.bind(5, t.conditionA).bind(6, t.conditionB).bind(7, t.stimulusA);
-        if (t.stimulusB == kBlankStimulus) insert.bindNull(8); else insert.bind(8, t.stimulusB);
+        if (t.stimulusB == kBlankStimulus) insert.bindNull(8);
+        else insert.bind(8, t.stimulusB);
         insert.bind(9, t.aOnLeft ? 1 : 0);
-        if (t.referenceStimulus < 0) insert.bindNull(10); else insert.bind(10, t.referenceStimulus);
-        if (t.expected) insert.bind(11, std::string(1, t.expected)); else insert.bindNull(11);
+        if (t.referenceStimulus < 0) insert.bindNull(10);
+        else insert.bind(10, t.referenceStimulus);
+        if (t.expected) insert.bind(11, std::string(1, t.expected));
+        else insert.bindNull(11);
         insert.run();
     }
 }
@@ -377,8 +381,9 @@ StudyStore::StudyStore(const fs::path& path) : path_(path) {
 
 void StudyStore::recordJoinAddress(std::int64_t participantId, const std::string& address, const std::string& source) {
     std::lock_guard lock(mutex_);
-    SqliteStatement s = db_->prepare("INSERT OR IGNORE INTO participant_addresses (participant_id, client_address, source,"
-                                     " recorded_at) VALUES (?,?,?,?)");
+    SqliteStatement s =
+        db_->prepare("INSERT OR IGNORE INTO participant_addresses (participant_id, client_address, source,"
+                     " recorded_at) VALUES (?,?,?,?)");
     s.bind(1, participantId).bind(2, validUtf8(address, 64)).bind(3, source).bind(4, utcTimestamp());
     s.run();
 }
@@ -422,7 +427,8 @@ ParticipantRecord StudyStore::joinLocked(const std::string& requestedLabel, cons
         }
     }
     if (!joinKey.empty()) {
-        SqliteStatement s = db_->prepare(std::string("SELECT ") + kParticipantColumns + " FROM participants WHERE join_key = ?");
+        SqliteStatement s =
+            db_->prepare(std::string("SELECT ") + kParticipantColumns + " FROM participants WHERE join_key = ?");
         s.bind(1, joinKey);
         if (s.step()) {
             ParticipantRecord existing = readParticipant(s);
@@ -470,7 +476,8 @@ ParticipantRecord StudyStore::joinLocked(const std::string& requestedLabel, cons
         "INSERT INTO participants (participant_index, label, token, join_key, seed, completion_code, created_at)"
         " VALUES (?,?,?,?,?,?,?)");
     insert.bind(1, p.index).bind(2, p.label).bind(3, p.token);
-    if (joinKey.empty()) insert.bindNull(4); else insert.bind(4, joinKey);
+    if (joinKey.empty()) insert.bindNull(4);
+    else insert.bind(4, joinKey);
     insert.bind(5, static_cast<std::int64_t>(p.seed)).bind(6, p.completionCode).bind(7, p.createdAt);
     insert.run();
     p.id = db_->lastInsertId();
@@ -501,7 +508,8 @@ std::optional<ParticipantRecord> StudyStore::participantByExternalId(const Exter
 
 ParticipantRecord StudyStore::participant(const std::string& token) {
     std::lock_guard lock(mutex_);
-    SqliteStatement s = db_->prepare(std::string("SELECT ") + kParticipantColumns + " FROM participants WHERE token = ?");
+    SqliteStatement s =
+        db_->prepare(std::string("SELECT ") + kParticipantColumns + " FROM participants WHERE token = ?");
     s.bind(1, token);
     if (!s.step()) throw RequestError(404, "unknown participant");
     return readParticipant(s);
@@ -512,10 +520,13 @@ std::int64_t StudyStore::startSession(std::int64_t participantId, const std::str
                                       const std::optional<ViewingConditions>& viewing) {
     std::lock_guard lock(mutex_);
     SqliteTransaction tx(*db_);
-    SqliteStatement s = db_->prepare(
-        "INSERT INTO sessions (participant_id, started_at, user_agent, viewport_width, viewport_height, device_pixel_ratio)"
-        " VALUES (?,?,?,?,?,?)");
-    s.bind(1, participantId).bind(2, utcTimestamp()).bind(3, validUtf8(userAgent, kMaxStoredText)).bind(4, viewportWidth);
+    SqliteStatement s = db_->prepare("INSERT INTO sessions (participant_id, started_at, user_agent, viewport_width, "
+                                     "viewport_height, device_pixel_ratio)"
+                                     " VALUES (?,?,?,?,?,?)");
+    s.bind(1, participantId)
+        .bind(2, utcTimestamp())
+        .bind(3, validUtf8(userAgent, kMaxStoredText))
+        .bind(4, viewportWidth);
     s.bind(5, viewportHeight);
     s.bind(6, devicePixelRatio);
     s.run();
@@ -523,15 +534,19 @@ std::int64_t StudyStore::startSession(std::int64_t participantId, const std::str
     if (viewing) {
         const ViewingConditions& v = *viewing;
         SqliteStatement c = db_->prepare(
-            "INSERT INTO viewing_conditions (session_id, screen_width, screen_height, screen_width_px, screen_height_px,"
+            "INSERT INTO viewing_conditions (session_id, screen_width, screen_height, screen_width_px, "
+            "screen_height_px,"
             " colour_depth, fullscreen, pointer_fine, touch_points, mobile, pixels_per_mm, viewing_distance_mm,"
             " pixels_per_degree) VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?)");
         c.bind(1, session).bind(2, v.screenWidth).bind(3, v.screenHeight).bind(4, v.screenWidthPx);
         c.bind(5, v.screenHeightPx).bind(6, v.colourDepth).bind(7, v.fullscreen ? 1 : 0).bind(8, v.pointerFine ? 1 : 0);
         c.bind(9, v.touchPoints).bind(10, v.mobile ? 1 : 0);
-        if (v.pixelsPerMm) c.bind(11, *v.pixelsPerMm); else c.bindNull(11);
-        if (v.viewingDistanceMm) c.bind(12, *v.viewingDistanceMm); else c.bindNull(12);
-        if (v.pixelsPerDegree) c.bind(13, *v.pixelsPerDegree); else c.bindNull(13);
+        if (v.pixelsPerMm) c.bind(11, *v.pixelsPerMm);
+        else c.bindNull(11);
+        if (v.viewingDistanceMm) c.bind(12, *v.viewingDistanceMm);
+        else c.bindNull(12);
+        if (v.pixelsPerDegree) c.bind(13, *v.pixelsPerDegree);
+        else c.bindNull(13);
         c.run();
     }
     tx.commit();
@@ -553,9 +568,10 @@ std::optional<TrialRecord> StudyStore::nextTrial(std::int64_t participantId) {
 
 std::optional<TrialRecord> StudyStore::firstUnanswered(std::int64_t participantId) {
     auto first = [&]() -> std::optional<TrialRecord> {
-        SqliteStatement s = db_->prepare(std::string("SELECT ") + kTrialColumns +
-                                         " FROM trials WHERE participant_id = ? AND id NOT IN"
-                                         " (SELECT trial_id FROM responses WHERE participant_id = ?) ORDER BY position LIMIT 1");
+        SqliteStatement s =
+            db_->prepare(std::string("SELECT ") + kTrialColumns +
+                         " FROM trials WHERE participant_id = ? AND id NOT IN"
+                         " (SELECT trial_id FROM responses WHERE participant_id = ?) ORDER BY position LIMIT 1");
         s.bind(1, participantId).bind(2, participantId);
         if (!s.step()) return std::nullopt;
         return readTrial(s);
@@ -604,7 +620,8 @@ active::ScorePosterior StudyStore::blockPosterior(std::size_t b, std::uint64_t g
         loadActiveCounts();
         const BlockAnswers& answers = activeAnswers_[b];
         latest = answers.generation;
-        for (const auto& [pair, won] : answers.counts) counts.push_back({pair.first, pair.second, won.first, won.second});
+        for (const auto& [pair, won] : answers.counts)
+            counts.push_back({pair.first, pair.second, won.first, won.second});
     }
     cache.posterior = active::fitPosteriorFromCounts(static_cast<int>(definition_.blocks[b].conditions.size()), counts);
     cache.generation = latest;
@@ -720,14 +737,19 @@ ResponseOutcome StudyStore::storeOne(const ResponseInput& in) {
         s.bind(1, participantId);
         s.step();
         if (s.isNull(0) || s.integer(0) != trial.position)
-            throw RequestError(409, "trial " + std::to_string(in.trialId) + ": out of order (the next trial is at position " +
+            throw RequestError(409, "trial " + std::to_string(in.trialId) +
+                                        ": out of order (the next trial is at position " +
                                         (s.isNull(0) ? std::string("none") : std::to_string(s.integer(0))) + ")");
     }
     SqliteStatement insert = db_->prepare(
-        "INSERT INTO responses (trial_id, participant_id, session_id, chosen, side, response_ms, client_time, server_time,"
+        "INSERT INTO responses (trial_id, participant_id, session_id, chosen, side, response_ms, client_time, "
+        "server_time,"
         " viewport_width, viewport_height, device_pixel_ratio, user_agent) VALUES (?,?,?,?,?,?,?,?,?,?,?,?)");
     insert.bind(1, trial.id).bind(2, participantId).bind(3, in.sessionId).bind(4, chosen).bind(5, in.side);
-    insert.bind(6, in.responseMs).bind(7, validUtf8(in.clientTime, kMaxStoredText)).bind(8, utcTimestamp()).bind(9, in.viewportWidth);
+    insert.bind(6, in.responseMs)
+        .bind(7, validUtf8(in.clientTime, kMaxStoredText))
+        .bind(8, utcTimestamp())
+        .bind(9, in.viewportWidth);
     insert.bind(10, in.viewportHeight).bind(11, in.devicePixelRatio).bind(12, validUtf8(in.userAgent, kMaxStoredText));
     insert.run();
     if (in.conditions) {
@@ -744,7 +766,8 @@ ResponseOutcome StudyStore::storeOne(const ResponseInput& in) {
             const auto a = std::find(block.conditions.begin(), block.conditions.end(), trial.plan.conditionA);
             const auto c = std::find(block.conditions.begin(), block.conditions.end(), trial.plan.conditionB);
             if (a == block.conditions.end() || c == block.conditions.end() || a == c) break;
-            const int ia = static_cast<int>(a - block.conditions.begin()), ic = static_cast<int>(c - block.conditions.begin());
+            const int ia = static_cast<int>(a - block.conditions.begin()),
+                      ic = static_cast<int>(c - block.conditions.begin());
             uncommittedAnswers_.push_back({b, std::min(ia, ic), std::max(ia, ic), (chosen == "A") == (ia < ic)});
             break;
         }
@@ -807,21 +830,23 @@ void StudyStore::commitBatch(const std::vector<PendingResponse*>& batch) {
     }
 }
 
-
-
 std::vector<ParticipantStatus> StudyStore::status() {
     std::lock_guard lock(mutex_);
     SqliteTransaction tx(*db_, false); // one consistent snapshot
     std::vector<ParticipantStatus> out;
-    SqliteStatement s = db_->prepare(std::string("SELECT ") + kParticipantColumns +
-        ", (SELECT COUNT(*) FROM trials t WHERE t.participant_id = p.id)"
-        ", (SELECT COUNT(*) FROM responses r WHERE r.participant_id = p.id)"
-        ", (SELECT COUNT(*) FROM responses r JOIN trials t ON t.id = r.trial_id WHERE r.participant_id = p.id AND t.kind IN ('test','repeat'))"
-        ", (SELECT COUNT(*) FROM responses r JOIN trials t ON t.id = r.trial_id WHERE r.participant_id = p.id AND t.kind = 'catch')"
-        ", (SELECT COUNT(*) FROM responses r JOIN trials t ON t.id = r.trial_id WHERE r.participant_id = p.id AND t.kind = 'catch' AND r.chosen = t.expected)"
-        ", (SELECT COALESCE(MAX(server_time), '') FROM responses r WHERE r.participant_id = p.id)"
-        ", rec.platform, rec.external_id, rec.external_study_id, rec.external_session_id"
-        " FROM participants p LEFT JOIN recruitment rec ON rec.participant_id = p.id ORDER BY p.id");
+    SqliteStatement s =
+        db_->prepare(std::string("SELECT ") + kParticipantColumns +
+                     ", (SELECT COUNT(*) FROM trials t WHERE t.participant_id = p.id)"
+                     ", (SELECT COUNT(*) FROM responses r WHERE r.participant_id = p.id)"
+                     ", (SELECT COUNT(*) FROM responses r JOIN trials t ON t.id = r.trial_id WHERE r.participant_id = "
+                     "p.id AND t.kind IN ('test','repeat'))"
+                     ", (SELECT COUNT(*) FROM responses r JOIN trials t ON t.id = r.trial_id WHERE r.participant_id = "
+                     "p.id AND t.kind = 'catch')"
+                     ", (SELECT COUNT(*) FROM responses r JOIN trials t ON t.id = r.trial_id WHERE r.participant_id = "
+                     "p.id AND t.kind = 'catch' AND r.chosen = t.expected)"
+                     ", (SELECT COALESCE(MAX(server_time), '') FROM responses r WHERE r.participant_id = p.id)"
+                     ", rec.platform, rec.external_id, rec.external_study_id, rec.external_session_id"
+                     " FROM participants p LEFT JOIN recruitment rec ON rec.participant_id = p.id ORDER BY p.id");
     while (s.step()) {
         ParticipantStatus st;
         st.participant = readParticipant(s);
@@ -871,15 +896,19 @@ std::optional<ViewingConditions> readViewing(const SqliteStatement& s, int first
 std::vector<ResponseRow> StudyStore::responses() {
     std::lock_guard lock(mutex_);
     SqliteStatement s = db_->prepare(
-        std::string("SELECT p.label, p.id, t.id, t.position, t.kind, t.block, t.condition_a, t.condition_b, sa.stimulus,"
-        " COALESCE(sb.stimulus, 'blank'), t.a_on_left, r.chosen, t.expected, r.response_ms, r.client_time,"
-        " r.server_time, r.viewport_width, r.viewport_height, r.device_pixel_ratio, r.user_agent, r.session_id,"
-        " c.page_hidden, c.focus_lost, c.fullscreen, ses.device_pixel_ratio, ses.viewport_width, ses.viewport_height,"
-        " rec.platform, rec.external_id, rec.external_study_id, rec.external_session_id, ") + kViewingColumns +
+        std::string(
+            "SELECT p.label, p.id, t.id, t.position, t.kind, t.block, t.condition_a, t.condition_b, sa.stimulus,"
+            " COALESCE(sb.stimulus, 'blank'), t.a_on_left, r.chosen, t.expected, r.response_ms, r.client_time,"
+            " r.server_time, r.viewport_width, r.viewport_height, r.device_pixel_ratio, r.user_agent, r.session_id,"
+            " c.page_hidden, c.focus_lost, c.fullscreen, ses.device_pixel_ratio, ses.viewport_width, "
+            "ses.viewport_height,"
+            " rec.platform, rec.external_id, rec.external_study_id, rec.external_session_id, ") +
+        kViewingColumns +
         " FROM responses r JOIN trials t ON t.id = r.trial_id JOIN participants p ON p.id = t.participant_id"
         " JOIN stimuli sa ON sa.id = t.stimulus_a LEFT JOIN stimuli sb ON sb.id = t.stimulus_b"
         " JOIN sessions ses ON ses.id = r.session_id LEFT JOIN trial_conditions c ON c.trial_id = r.trial_id"
-        " LEFT JOIN recruitment rec ON rec.participant_id = p.id LEFT JOIN viewing_conditions v ON v.session_id = r.session_id"
+        " LEFT JOIN recruitment rec ON rec.participant_id = p.id LEFT JOIN viewing_conditions v ON v.session_id = "
+        "r.session_id"
         " ORDER BY p.id, t.position");
     std::vector<ResponseRow> out;
     while (s.step()) {
@@ -923,11 +952,12 @@ std::vector<ResponseRow> StudyStore::flaggedTrials() {
 
 std::vector<SessionViewing> StudyStore::viewingConditions() {
     std::lock_guard lock(mutex_);
-    SqliteStatement s = db_->prepare(
-        std::string("SELECT p.label, p.id, ses.id, ses.started_at, ses.user_agent, ses.viewport_width,"
-                    " ses.viewport_height, ses.device_pixel_ratio, ") + kViewingColumns +
-        " FROM sessions ses JOIN participants p ON p.id = ses.participant_id"
-        " LEFT JOIN viewing_conditions v ON v.session_id = ses.id ORDER BY ses.id");
+    SqliteStatement s =
+        db_->prepare(std::string("SELECT p.label, p.id, ses.id, ses.started_at, ses.user_agent, ses.viewport_width,"
+                                 " ses.viewport_height, ses.device_pixel_ratio, ") +
+                     kViewingColumns +
+                     " FROM sessions ses JOIN participants p ON p.id = ses.participant_id"
+                     " LEFT JOIN viewing_conditions v ON v.session_id = ses.id ORDER BY ses.id");
     std::vector<SessionViewing> out;
     while (s.step()) {
         SessionViewing v;

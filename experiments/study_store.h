@@ -30,38 +30,38 @@ class SqliteDatabase;
 
 struct ParticipantRecord {
     std::int64_t id = 0;
-    std::int64_t index = 0;   // 0-based order of joining (drives the side mirroring of trial_plan.h)
-    std::string label;        // the observer name in exports
-    std::string token;        // secret in the participant link
+    std::int64_t index = 0; // 0-based order of joining (drives the side mirroring of trial_plan.h)
+    std::string label;      // the observer name in exports
+    std::string token;      // secret in the participant link
     std::uint64_t seed = 0;
     std::string completionCode;
     std::string createdAt;
-    bool resumed = false;     // join(): an existing participant was returned (same join key or external id)
+    bool resumed = false; // join(): an existing participant was returned (same join key or external id)
 };
 
 // What the page saw while one trial was shown (sent with the response).
 struct TrialConditions {
-    bool pageHidden = false;  // document hidden at any moment (another tab, minimised window)
-    bool focusLost = false;   // the window lost the focus at any moment
-    bool fullscreen = false;  // full screen when answered
+    bool pageHidden = false; // document hidden at any moment (another tab, minimised window)
+    bool focusLost = false;  // the window lost the focus at any moment
+    bool fullscreen = false; // full screen when answered
     bool flagged() const { return pageHidden || focusLost; }
 };
 
 struct TrialRecord {
-    std::int64_t id = 0;          // global trial id
+    std::int64_t id = 0; // global trial id
     std::int64_t participantId = 0;
-    int position = 0;             // 0-based order within the participant's plan
+    int position = 0; // 0-based order within the participant's plan
     PlannedTrial plan;
 };
 
 struct ResponseInput {
-    std::string token;            // participant token
-    std::int64_t trialId = 0;     // the trial's reference (trialReference()), as the participant API shows it
-    std::string side;             // "left" | "right"
+    std::string token;        // participant token
+    std::int64_t trialId = 0; // the trial's reference (trialReference()), as the participant API shows it
+    std::string side;         // "left" | "right"
     std::int64_t sessionId = 0;
-    double responseMs = 0;        // from stimulus onset to key/click, measured by the page
-    std::string clientTime;       // client's ISO-8601 clock at the response
-    int viewportWidth = 0;        // CSS pixels
+    double responseMs = 0;  // from stimulus onset to key/click, measured by the page
+    std::string clientTime; // client's ISO-8601 clock at the response
+    int viewportWidth = 0;  // CSS pixels
     int viewportHeight = 0;
     double devicePixelRatio = 1;
     std::string userAgent;
@@ -79,7 +79,7 @@ struct Progress {
 struct ParticipantStatus {
     ParticipantRecord participant;
     Progress progress;
-    int testAnswered = 0;   // test + repeat
+    int testAnswered = 0; // test + repeat
     int catchAnswered = 0;
     int catchCorrect = 0;
     std::string lastResponseAt;
@@ -93,10 +93,10 @@ struct ResponseRow {
     std::int64_t trialId = 0;
     int position = 0;
     TrialKind kind = TrialKind::test;
-    std::string scene;           // block name
+    std::string scene; // block name
     std::string conditionA;
     std::string conditionB;
-    std::string stimulusA;       // manifest ids ("blank" for the panel)
+    std::string stimulusA; // manifest ids ("blank" for the panel)
     std::string stimulusB;
     bool aOnLeft = true;
     bool aSelected = true;
@@ -109,10 +109,10 @@ struct ResponseRow {
     double devicePixelRatio = 1;
     std::string userAgent;
     std::int64_t sessionId = 0;
-    std::optional<TrialConditions> conditions;      // per trial; absent = not recorded
-    double sessionDevicePixelRatio = 1;             // at the session's start (a change = browser zoom)
-    std::optional<ViewingConditions> viewing;       // the session's; absent = not reported
-    std::optional<ExternalIds> external;            // the participant's platform ids
+    std::optional<TrialConditions> conditions; // per trial; absent = not recorded
+    double sessionDevicePixelRatio = 1;        // at the session's start (a change = browser zoom)
+    std::optional<ViewingConditions> viewing;  // the session's; absent = not reported
+    std::optional<ExternalIds> external;       // the participant's platform ids
     bool flagged() const { return conditions && conditions->flagged(); }
 };
 
@@ -202,7 +202,7 @@ private:
     ParticipantRecord joinLocked(const std::string& label, const std::string& joinKey,
                                  const std::optional<ExternalIds>& external, bool& created);
     std::optional<TrialRecord> firstUnanswered(std::int64_t participantId); // mutex_ held
-    int plannedTrialCount() const; // per participant
+    int plannedTrialCount() const;                                          // per participant
     // mutex_ held: the in-memory answer counts of every block, read from the database on first use and updated
     // after each committed response.
     void loadActiveCounts();
@@ -226,8 +226,8 @@ private:
         active::ScorePosterior posterior;
     };
     bool activeCountsLoaded_ = false;
-    std::vector<BlockAnswers> activeAnswers_;        // per block, under mutex_
-    std::vector<ActiveAnswer> uncommittedAnswers_;   // stored in the open transaction, under mutex_
+    std::vector<BlockAnswers> activeAnswers_;                          // per block, under mutex_
+    std::vector<ActiveAnswer> uncommittedAnswers_;                     // stored in the open transaction, under mutex_
     std::vector<std::unique_ptr<BlockPosteriorCache>> posteriorCache_; // per block, fixed size
 
     std::unique_ptr<SqliteDatabase> db_;

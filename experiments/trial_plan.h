@@ -29,10 +29,10 @@ struct PlannedTrial {
     std::string conditionA; // condition_A / condition_B of the responses export (contract 3)
     std::string conditionB; // "blank" for the panel of a blank catch trial
     int stimulusA = 0;
-    int stimulusB = 0;      // kBlankStimulus for a blank catch trial
+    int stimulusB = 0; // kBlankStimulus for a blank catch trial
     bool aOnLeft = true;
     int referenceStimulus = -1;
-    char expected = 0;      // 'A' or 'B' for catch trials, 0 otherwise
+    char expected = 0; // 'A' or 'B' for catch trials, 0 otherwise
 };
 
 // Seed of participant number `participantIndex` (0, 1, 2, ... in order of joining) under the design seed.

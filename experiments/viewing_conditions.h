@@ -15,19 +15,19 @@ inline constexpr double kIdCardWidthMm = 85.60;
 inline constexpr double kIdCardHeightMm = 53.98;
 
 struct ViewingConditions {
-    int screenWidth = 0;        // CSS pixels (screen.width)
+    int screenWidth = 0; // CSS pixels (screen.width)
     int screenHeight = 0;
-    int screenWidthPx = 0;      // device pixels (CSS x devicePixelRatio, rounded)
+    int screenWidthPx = 0; // device pixels (CSS x devicePixelRatio, rounded)
     int screenHeightPx = 0;
     double devicePixelRatio = 1;
-    int colourDepth = 0;        // screen.colorDepth, bits per pixel
-    int viewportWidth = 0;      // CSS pixels (innerWidth)
+    int colourDepth = 0;   // screen.colorDepth, bits per pixel
+    int viewportWidth = 0; // CSS pixels (innerWidth)
     int viewportHeight = 0;
     bool fullscreen = false;
-    bool pointerFine = true;    // matchMedia("(pointer: fine)")
-    int touchPoints = 0;        // navigator.maxTouchPoints
-    bool mobile = false;        // the browser says it is a mobile one (User-Agent "Mobi", "Android", "iPhone", "iPad")
-    std::optional<double> pixelsPerMm;      // device pixels per mm, from the card calibration
+    bool pointerFine = true; // matchMedia("(pointer: fine)")
+    int touchPoints = 0;     // navigator.maxTouchPoints
+    bool mobile = false;     // the browser says it is a mobile one (User-Agent "Mobi", "Android", "iPhone", "iPad")
+    std::optional<double> pixelsPerMm;       // device pixels per mm, from the card calibration
     std::optional<double> viewingDistanceMm; // the design's
     std::optional<double> pixelsPerDegree;   // device (= image) pixels per degree of visual angle
 };

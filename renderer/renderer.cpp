@@ -69,11 +69,12 @@ nlohmann::json jsonMat4(const glm::mat4& m) {
     nlohmann::json out = nlohmann::json::array();
     for (int column = 0; column < 4; ++column)
         for (int row = 0; row < 4; ++row) out.push_back(m[column][row]);
-    return out;  // column-major, as GLM / OpenGL
+    return out; // column-major, as GLM / OpenGL
 }
 
 // Bounds of the parts whose material is skin (the named views frame them); the whole model without skin.
-void skinBounds(const Model& model, const std::vector<gl::GpuMaterial>& materials, glm::vec3& lowest, glm::vec3& highest) {
+void skinBounds(const Model& model, const std::vector<gl::GpuMaterial>& materials, glm::vec3& lowest,
+                glm::vec3& highest) {
     lowest = glm::vec3(std::numeric_limits<float>::max());
     highest = glm::vec3(std::numeric_limits<float>::lowest());
     bool any = false;
@@ -103,12 +104,12 @@ namespace {
 struct Frame {
     const SceneSpec* spec = nullptr;
     std::shared_ptr<const Model> model;
-    std::vector<gl::GpuMaterial> partMaterials;  // one per part of the model
+    std::vector<gl::GpuMaterial> partMaterials; // one per part of the model
     gl::GpuScene* scene = nullptr;
     CameraPose camera;
-    float exposure = 1.0f;                       // 2^exposure_ev
+    float exposure = 1.0f; // 2^exposure_ev
     glm::mat3 environmentFromWorld{1.0f};
-    gl::ReferenceInputs referenceInputs;         // prepared before the passes (reference method only)
+    gl::ReferenceInputs referenceInputs; // prepared before the passes (reference method only)
 };
 } // namespace
 
@@ -126,7 +127,7 @@ struct Renderer::Impl {
     gl::SurfaceAovPass surfaceAovPass{shaders};
     gl::TransmittancePass transmittancePass{shaders};
     gl::SssStage sssStage{shaders};
-    gl::ReferenceMethod referenceMethod{shaders};  // sss.method = "reference": replaces the SSS stage
+    gl::ReferenceMethod referenceMethod{shaders}; // sss.method = "reference": replaces the SSS stage
     gl::AddSpecularPass addSpecularPass{shaders};
     gl::ToneMapPass toneMapPass{shaders};
 
@@ -260,12 +261,12 @@ std::vector<gl::GpuLight> gpuLightsOf(const SceneSpec& spec) {
 // target, its layout there, its channel names in the EXR and, for sss.method = "pathtraced", the Cycles image that
 // replaces it (the other AOVs come from the rasterizer's passes in every method).
 struct Aov {
-    const char* layer;                                  // EXR layer; "" = the beauty's R, G, B
-    const char* channels;                               // one letter per EXR channel, e.g. "RGB", "Z"
-    gl::Texture gl::FrameTargets::*texture;             // where the passes write it
-    int textureChannels;                                // 4: RGBA32F, 1: R32F
-    std::vector<float> pathtraced::CyclesImage::*cycles;  // nullptr: never from Cycles
-    int cyclesChannels;                                 // components per pixel in the Cycles image
+    const char* layer;                                   // EXR layer; "" = the beauty's R, G, B
+    const char* channels;                                // one letter per EXR channel, e.g. "RGB", "Z"
+    gl::Texture gl::FrameTargets::*texture;              // where the passes write it
+    int textureChannels;                                 // 4: RGBA32F, 1: R32F
+    std::vector<float> pathtraced::CyclesImage::*cycles; // nullptr: never from Cycles
+    int cyclesChannels;                                  // components per pixel in the Cycles image
 };
 
 const std::array<Aov, 11> kAovs{{
@@ -300,7 +301,8 @@ std::vector<ExrChannel> exrChannels(const std::vector<std::vector<float>>& readB
         const std::string layer = aov.layer;
         for (std::size_t c = 0; aov.channels[c]; ++c) {
             ExrChannel channel;
-            channel.name = layer.empty() ? std::string(1, aov.channels[c]) : layer + "." + std::string(1, aov.channels[c]);
+            channel.name =
+                layer.empty() ? std::string(1, aov.channels[c]) : layer + "." + std::string(1, aov.channels[c]);
             channel.values.resize(pixels);
             for (std::size_t p = 0; p < pixels; ++p) channel.values[p] = data[p * stride + c];
             channels.push_back(std::move(channel));
@@ -422,8 +424,8 @@ float Renderer::Impl::runPasses(const Frame& frame) {
         const double logAverage = reinhardLogAverage(linear.data(), linear.size() / 4, 4);
         reinhardScale = static_cast<float>(spec.reinhardKey / logAverage);
     }
-    toneMapPass.run(targets, spec.toneMapper, static_cast<float>(spec.exponentialK), static_cast<float>(spec.filmicWhite),
-                    reinhardScale);
+    toneMapPass.run(targets, spec.toneMapper, static_cast<float>(spec.exponentialK),
+                    static_cast<float>(spec.filmicWhite), reinhardScale);
     passTimer.end();
     return supportRadiusMm;
 }
@@ -468,8 +470,8 @@ RenderResult Renderer::render(const RenderRequest& request) {
                                spec.width, spec.height);
     impl.targets.resize(spec.width, spec.height);
     frame.exposure = static_cast<float>(std::exp2(spec.exposureEv));
-    frame.environmentFromWorld = glm::mat3(
-        glm::rotate(glm::mat4(1.0f), static_cast<float>(-glm::radians(spec.environment.rotationDeg)), glm::vec3(0, 1, 0)));
+    frame.environmentFromWorld = glm::mat3(glm::rotate(
+        glm::mat4(1.0f), static_cast<float>(-glm::radians(spec.environment.rotationDeg)), glm::vec3(0, 1, 0)));
     glFinish();
     const double uploadMs = millisecondsSince(uploadStart);
 
@@ -573,26 +575,24 @@ RenderResult Renderer::render(const RenderRequest& request) {
     metadata.floats["skinlab:sss_radius_mm"] = supportRadiusMm;
     if (cycles) {
         const nlohmann::json params = spec.pathtraced;
-        nlohmann::json fromCycles = nlohmann::json::array();  // "R", "G", "B", "diffuse.*", ..., "depth.Z", "mask.Y"
+        nlohmann::json fromCycles = nlohmann::json::array(); // "R", "G", "B", "diffuse.*", ..., "depth.Z", "mask.Y"
         for (const Aov& aov : kAovs) {
             if (!aov.cycles) continue;
             const std::string layer = aov.layer, letters = aov.channels;
             if (layer.empty())
                 for (const char c : letters) fromCycles.push_back(std::string(1, c));
-            else
-                fromCycles.push_back(layer + "." + (letters.size() == 1 ? letters : std::string("*")));
+            else fromCycles.push_back(layer + "." + (letters.size() == 1 ? letters : std::string("*")));
         }
-        metadata.strings["skinlab:pathtraced"] =
-            nlohmann::json{{"samples", params.at("samples")},
-                           {"seed", params.at("seed")},
-                           {"blender_version", cycles->blenderVersion},
-                           {"render_seconds", cycles->renderSeconds},
-                           {"wall_seconds", cycles->wallSeconds},
-                           {"channels_from_cycles",
-                            params.value("specular_source", "cycles") == "rasterizer"
-                                ? nlohmann::json{"R, G, B: diffuse only", "diffuse.*", "depth.Z", "mask.Y"}
-                                : fromCycles}}
-                .dump();
+        metadata.strings["skinlab:pathtraced"] = nlohmann::json{
+            {"samples", params.at("samples")},
+            {"seed", params.at("seed")},
+            {"blender_version", cycles->blenderVersion},
+            {"render_seconds", cycles->renderSeconds},
+            {"wall_seconds", cycles->wallSeconds},
+            {"channels_from_cycles",
+             params.value("specular_source", "cycles") == "rasterizer"
+                 ? nlohmann::json{"R, G, B: diffuse only", "diffuse.*", "depth.Z", "mask.Y"}
+                 : fromCycles}}.dump();
         metadata.strings["skinlab:blender_version"] = cycles->blenderVersion;
         metadata.floats["skinlab:pathtraced_samples"] = static_cast<float>(params.at("samples").get<int>());
         metadata.floats["skinlab:pathtraced_seed"] = static_cast<float>(params.at("seed").get<int>());
@@ -608,9 +608,10 @@ RenderResult Renderer::render(const RenderRequest& request) {
     result.glVersion = impl.context.version();
     result.timingsMs = impl.timer.json();
     result.timingsMs["cpu"] = {{"load", loadMs}, {"upload", uploadMs}, {"readback", readbackMs}, {"write", writeMs}};
-    if (referenceMethod) result.timingsMs["reference"] = impl.referenceMethod.lastRun();  // CPU parts of "sss"
+    if (referenceMethod) result.timingsMs["reference"] = impl.referenceMethod.lastRun(); // CPU parts of "sss"
     if (cycles)
-        result.timingsMs["pathtraced"] = {{"render", cycles->renderSeconds * 1000.0}, {"blender_wall", cycles->wallSeconds * 1000.0}};
+        result.timingsMs["pathtraced"] = {{"render", cycles->renderSeconds * 1000.0},
+                                          {"blender_wall", cycles->wallSeconds * 1000.0}};
     result.timingsMs["width"] = width;
     result.timingsMs["height"] = height;
     result.timingsMs["gl_renderer"] = result.glRenderer;

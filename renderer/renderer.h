@@ -28,10 +28,10 @@ struct RenderRequest {
 };
 
 struct RenderResult {
-    nlohmann::json resolved;    // every parameter after defaults and overrides (also stored in the EXR metadata)
-    std::string glRenderer;     // GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
-    std::string glVersion;      // GL_VERSION
-    nlohmann::json timingsMs;   // {"passes": {"shadow": ms, ...}, "gpu_total": ms, "wall_total": ms}
+    nlohmann::json resolved;  // every parameter after defaults and overrides (also stored in the EXR metadata)
+    std::string glRenderer;   // GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
+    std::string glVersion;    // GL_VERSION
+    nlohmann::json timingsMs; // {"passes": {"shadow": ms, ...}, "gpu_total": ms, "wall_total": ms}
 };
 
 // Resolves a request's scene spec (defaults, overrides, validation) without touching GL. Throws InputError for
@@ -41,7 +41,7 @@ nlohmann::json resolveScene(const RenderRequest& request);
 // Owns the headless EGL context and GL resources; create once, render many times (not thread-safe).
 class Renderer {
 public:
-    Renderer();   // throws RuntimeError naming what was tried when no EGL platform works
+    Renderer(); // throws RuntimeError naming what was tried when no EGL platform works
     ~Renderer();
     Renderer(const Renderer&) = delete;
     Renderer& operator=(const Renderer&) = delete;

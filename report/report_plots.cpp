@@ -94,21 +94,25 @@ std::string scaleSvg(const std::vector<IntervalPoint>& points) {
     for (std::size_t i = 0; i < points.size(); ++i) {
         const IntervalPoint& p = points[i];
         double y = top + rowHeight * (static_cast<double>(i) + 0.5);
-        svg += "<text x=\"" + px(left - 8) + "\" y=\"" + px(y + 4) + "\" class=\"label\">" + escapeHtml(p.label) + "</text>";
+        svg += "<text x=\"" + px(left - 8) + "\" y=\"" + px(y + 4) + "\" class=\"label\">" + escapeHtml(p.label) +
+               "</text>";
         if (!std::isfinite(p.value)) continue;
         double low = std::isfinite(p.low) ? p.low : range.low - 1.0;
         double high = std::isfinite(p.high) ? p.high : range.high + 1.0;
-        bool clippedLow = low < range.low, clippedHigh = high > range.high;
+        bool clippedLow = low<range.low, clippedHigh = high> range.high;
         double x0 = range.map(std::max(low, range.low), left, right);
         double x1 = range.map(std::min(high, range.high), left, right);
         double xv = range.map(p.value, left, right);
-        svg += "<line x1=\"" + px(x0) + "\" y1=\"" + px(y) + "\" x2=\"" + px(x1) + "\" y2=\"" + px(y) + "\" class=\"bar\"/>";
+        svg += "<line x1=\"" + px(x0) + "\" y1=\"" + px(y) + "\" x2=\"" + px(x1) + "\" y2=\"" + px(y) +
+               "\" class=\"bar\"/>";
         if (clippedLow)
-            svg += "<path d=\"M" + px(x0) + " " + px(y) + " l8 -5 v10 z\" class=\"clip\"><title>interval continues to " +
-                   formatNumber(p.low, 2) + "</title></path>";
+            svg += "<path d=\"M" + px(x0) + " " + px(y) +
+                   " l8 -5 v10 z\" class=\"clip\"><title>interval continues to " + formatNumber(p.low, 2) +
+                   "</title></path>";
         if (clippedHigh)
-            svg += "<path d=\"M" + px(x1) + " " + px(y) + " l-8 -5 v10 z\" class=\"clip\"><title>interval continues to " +
-                   formatNumber(p.high, 2) + "</title></path>";
+            svg += "<path d=\"M" + px(x1) + " " + px(y) +
+                   " l-8 -5 v10 z\" class=\"clip\"><title>interval continues to " + formatNumber(p.high, 2) +
+                   "</title></path>";
         svg += "<circle cx=\"" + px(xv) + "\" cy=\"" + px(y) + "\" r=\"4.5\" class=\"dot\"/>";
     }
     return svg + "</svg>";
@@ -145,8 +149,8 @@ std::string scatterSvg(const std::vector<ScatterPoint>& points, const std::strin
         double x = rx.map(p.x, left, right);
         double lowValue = std::isfinite(p.low) ? std::max(p.low, ry.low) : ry.low;
         double highValue = std::isfinite(p.high) ? std::min(p.high, ry.high) : ry.high;
-        svg += "<line x1=\"" + px(x) + "\" y1=\"" + px(ry.map(lowValue, bottom, top)) + "\" x2=\"" + px(x) + "\" y2=\"" +
-               px(ry.map(highValue, bottom, top)) + "\" class=\"bar\"/>";
+        svg += "<line x1=\"" + px(x) + "\" y1=\"" + px(ry.map(lowValue, bottom, top)) + "\" x2=\"" + px(x) +
+               "\" y2=\"" + px(ry.map(highValue, bottom, top)) + "\" class=\"bar\"/>";
         double y = ry.map(p.y, bottom, top);
         svg += "<circle cx=\"" + px(x) + "\" cy=\"" + px(y) + "\" r=\"4\" class=\"dot\"><title>" + escapeHtml(p.label) +
                "</title></circle><text x=\"" + px(x + 6) + "\" y=\"" + px(y - 6) + "\" class=\"point\">" +

@@ -17,8 +17,8 @@ std::string scaleSvg(const std::vector<IntervalPoint>& points);
 
 struct ScatterPoint {
     std::string label;
-    double x = 0.0;                     // metric value
-    double y = 0.0, low = 0.0, high = 0.0;  // JOD and its interval
+    double x = 0.0;                        // metric value
+    double y = 0.0, low = 0.0, high = 0.0; // JOD and its interval
 };
 
 std::string scatterSvg(const std::vector<ScatterPoint>& points, const std::string& xLabel);

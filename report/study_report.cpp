@@ -70,12 +70,12 @@ struct Observer {
 };
 
 struct ConditionImages {
-    std::string condition, stimulus, png;  // png relative to the report folder
+    std::string condition, stimulus, png; // png relative to the report folder
 };
 
 struct Crop {
     cv::Rect window;
-    std::map<std::string, std::string> files;  // condition → crop PNG relative to the report folder
+    std::map<std::string, std::string> files; // condition → crop PNG relative to the report folder
 };
 
 // The window (a square about a fifth of the image height) where the conditions differ most: the largest box mean
@@ -155,7 +155,8 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
         throwInput((stimuliFolder / "manifest.json").string(), "",
                    "file not found (the study's stimulus folder; give --stimuli DIR if it moved)");
     if (!options.metrics.empty() && !fs::is_regular_file(options.metrics / "metrics.json"))
-        throwInput((options.metrics / "metrics.json").string(), "", "file not found (run `skinlab analyze metrics` first)");
+        throwInput((options.metrics / "metrics.json").string(), "",
+                   "file not found (run `skinlab analyze metrics` first)");
     for (const experiments::StudyStimulus& s : definition.stimuli)
         if (!fs::is_regular_file(stimuliFolder / s.pngPath))
             throwInput((stimuliFolder / s.pngPath).string(), "", "file not found (stimulus " + s.id + ")");
@@ -179,7 +180,8 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
             o.reason = "no answers";
         } else if (o.catchAnswered > 0 && 4 * failures > o.catchAnswered) {
             o.excluded = true;
-            o.reason = "failed " + std::to_string(failures) + " of " + std::to_string(o.catchAnswered) + " catch trials";
+            o.reason =
+                "failed " + std::to_string(failures) + " of " + std::to_string(o.catchAnswered) + " catch trials";
         }
         observerIndex[o.label] = observers.size();
         observers.push_back(o);
@@ -215,11 +217,11 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
         }
         table.responses.push_back(r);
     }
-    const int included = static_cast<int>(std::count_if(observers.begin(), observers.end(), [](const Observer& o) {
-        return !o.excluded;
-    }));
-    if (included < 2) throwInput(options.study.string(), "", "fewer than 2 observers with answers to analyse (" +
-                                                                  std::to_string(included) + ")");
+    const int included = static_cast<int>(
+        std::count_if(observers.begin(), observers.end(), [](const Observer& o) { return !o.excluded; }));
+    if (included < 2)
+        throwInput(options.study.string(), "",
+                   "fewer than 2 observers with answers to analyse (" + std::to_string(included) + ")");
 
     // --- The scale (existing analysis). ---
     scaling::AnalysisOptions analysisOptions;
@@ -246,7 +248,8 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
         std::vector<cv::Mat> images;
         std::vector<std::string> names;
         for (std::size_t c = 0; c < block.conditions.size(); ++c) {
-            const experiments::StudyStimulus& s = definition.stimuli[static_cast<std::size_t>(block.conditionStimulus[c])];
+            const experiments::StudyStimulus& s =
+                definition.stimuli[static_cast<std::size_t>(block.conditionStimulus[c])];
             std::string file = "stimuli/" + slug(s.id) + ".png";
             copyFileAtomic(stimuliFolder / s.pngPath, out / file);
             imagesOfBlock[block.name].push_back({block.conditions[c], s.id, file});
@@ -282,7 +285,8 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
         } catch (const InputError& e) {
             spdlog::warn("report: no image metrics ({})", e.what());
         }
-        std::erase_if(plan.jobs, [&](const metrics::ComparisonJob& job) { return !conditionOfStimulus.count(job.testName); });
+        std::erase_if(plan.jobs,
+                      [&](const metrics::ComparisonJob& job) { return !conditionOfStimulus.count(job.testName); });
         if (!plan.jobs.empty()) {
             metricsFolder = out / "metrics";
             metrics::MetricsRunOptions metricOptions;
@@ -294,7 +298,7 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
         }
     }
     std::vector<agreement::ConditionMetrics> conditionMetrics;
-    std::map<std::string, std::string> heatmapOf, flipHeatmapOf;  // stimulus → copied heat map
+    std::map<std::string, std::string> heatmapOf, flipHeatmapOf; // stimulus → copied heat map
     if (!metricsFolder.empty()) {
         const fs::path file = metricsFolder / "metrics.json";
         try {
@@ -333,13 +337,15 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
          << " · stimulus set " << h(store.meta("stimulus_set")) << " · skinlab " << h(version()) << "</p>\n";
     html << "<p class=\"question\">Question put to observers: <strong>" << h(design.question) << "</strong></p>\n";
     html << "<nav class=\"note\">Contents: <a href=\"#findings\">Findings</a> · <a href=\"#design\">Design</a> · "
-            "<a href=\"#participants\">Participants</a> · <a href=\"#stimuli\">Stimuli</a> · <a href=\"#scale\">Scale</a>"
+            "<a href=\"#participants\">Participants</a> · <a href=\"#stimuli\">Stimuli</a> · <a "
+            "href=\"#scale\">Scale</a>"
             " · <a href=\"#metrics\">Objective errors</a> · <a href=\"#agreement\">Metrics vs. perception</a></nav>\n";
 
     // --- Findings (generated). ---
     html << "<h2 id=\"findings\">Findings</h2><ul class=\"findings\">\n";
     html << "<li>" << linked("participants", std::to_string(included)) << " observers analysed";
-    if (excluded > 0) html << "; " << linked("participants", std::to_string(excluded)) << " excluded (reasons in the table)";
+    if (excluded > 0)
+        html << "; " << linked("participants", std::to_string(excluded)) << " excluded (reasons in the table)";
     html << ".</li>\n";
     for (const scaling::BlockAnalysis& block : analysis.blocks) {
         const std::string anchor = "scale-" + slug(block.name);
@@ -358,8 +364,9 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
                 beaten.push_back(block.conditions[static_cast<std::size_t>(other)]);
         }
         const std::size_t pairCount = block.pairs.size();
-        html << "<li><strong>" << h(block.name) << "</strong>: <em>" << h(block.conditions[static_cast<std::size_t>(best)])
-             << "</em> scored highest, " << linked(anchor, num(block.thurstone.scores[best]) + " JOD") << " ["
+        html << "<li><strong>" << h(block.name) << "</strong>: <em>"
+             << h(block.conditions[static_cast<std::size_t>(best)]) << "</em> scored highest, "
+             << linked(anchor, num(block.thurstone.scores[best]) + " JOD") << " ["
              << linked(anchor, num(block.low[best])) << ", " << linked(anchor, num(block.high[best])) << "]; <em>"
              << h(block.conditions[static_cast<std::size_t>(worst)]) << "</em> lowest, "
              << linked(anchor, num(block.thurstone.scores[worst]) + " JOD") << ". "
@@ -368,7 +375,8 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
              << "-corrected, α = " << num(analysis.options.alpha, 2) << ")";
         if (!beaten.empty()) {
             html << "; the best is significantly above ";
-            for (std::size_t i = 0; i < beaten.size(); ++i) html << (i ? ", " : "") << "<em>" << h(beaten[i]) << "</em>";
+            for (std::size_t i = 0; i < beaten.size(); ++i)
+                html << (i ? ", " : "") << "<em>" << h(beaten[i]) << "</em>";
         } else if (block.conditions.size() > 1) {
             html << "; the best is not significantly above any other condition";
         }
@@ -382,7 +390,8 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
             return (row.metric.higherIsBetter ? 1.0 : -1.0) * row.pearson;
         };
         for (const agreement::MetricAgreement& row : agreementResult.rows) {
-            if (row.block != block.name || row.conditions < 3 || !std::isfinite(row.spearman) || !std::isfinite(row.pearson))
+            if (row.block != block.name || row.conditions < 3 || !std::isfinite(row.spearman) ||
+                !std::isfinite(row.pearson))
                 continue;
             if (!bestMetric || oriented(row) > oriented(*bestMetric) ||
                 (oriented(row) == oriented(*bestMetric) && orientedPearson(row) > orientedPearson(*bestMetric)))
@@ -398,7 +407,8 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
                  << " conditions";
             if (bestMetric->significantPairs > 0)
                 html << "; it orders " << linked(a, std::to_string(bestMetric->predictedPairs)) << " of "
-                     << linked(a, std::to_string(bestMetric->significantPairs)) << " significantly separated pairs as the observers did";
+                     << linked(a, std::to_string(bestMetric->significantPairs))
+                     << " significantly separated pairs as the observers did";
             html << ".</li>\n";
         } else if (!conditionMetrics.empty()) {
             html << "<li>" << h(block.name) << ": too few conditions with metric values for a correlation.</li>\n";
@@ -420,12 +430,13 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
              << " conditions, " << definition.blocks[b].pairs.size() << " pairs)";
     html << "</td></tr><tr><th class=\"l\">Repetitions per pair</th><td class=\"l\">" << design.repetitions
          << " (both left/right orders)</td></tr>"
-         << "<tr><th class=\"l\">Trials per participant</th><td class=\"l\">" << definition.testTrialCount() << " test, "
-         << definition.repeatTrialCount() << " repeat, " << definition.catchTrialCount() << " catch, "
+         << "<tr><th class=\"l\">Trials per participant</th><td class=\"l\">" << definition.testTrialCount()
+         << " test, " << definition.repeatTrialCount() << " repeat, " << definition.catchTrialCount() << " catch, "
          << design.practiceTrials << " practice (not analysed)</td></tr>"
          << "<tr><th class=\"l\">Seed</th><td class=\"l\">" << design.seed << "</td></tr>"
-         << "<tr><th class=\"l\">Design / manifest sha256</th><td class=\"l\"><code>" << h(store.meta("design_sha256").substr(0, 16))
-         << "…</code> / <code>" << h(store.meta("manifest_sha256").substr(0, 16)) << "…</code></td></tr>"
+         << "<tr><th class=\"l\">Design / manifest sha256</th><td class=\"l\"><code>"
+         << h(store.meta("design_sha256").substr(0, 16)) << "…</code> / <code>"
+         << h(store.meta("manifest_sha256").substr(0, 16)) << "…</code></td></tr>"
          << "<tr><th class=\"l\">Analysis</th><td class=\"l\">Thurstone Case V in JOD (1 JOD = 75 % preference), "
          << h(analysis.blocks.empty() ? std::string("—") : analysis.blocks.front().intervalMethod) << " intervals ("
          << options.bootstrapSamples << " resamples, " << num(100.0 * analysisOptions.bootstrap.level, 0)
@@ -438,11 +449,15 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
          << "as the protocol recommends): more than one failed catch trial in four, or no answers. Screening "
          << "(held-out log-likelihood per trial, low outliers by the inter-quartile rule) is reported, not used to "
          << "exclude.</p>\n<table><thead><tr><th class=\"l\">observer</th><th>answered</th><th>catch correct</th>"
-            "<th>held-out log-lik./trial</th><th class=\"l\">screening</th><th class=\"l\">status</th></tr></thead><tbody>\n";
+            "<th>held-out log-lik./trial</th><th class=\"l\">screening</th><th "
+            "class=\"l\">status</th></tr></thead><tbody>\n";
     for (const Observer& o : observers)
         html << "<tr><td class=\"l\">" << h(o.label) << "</td><td>" << o.answered << " / " << o.total << "</td><td>"
              << o.catchCorrect << " / " << o.catchAnswered << "</td><td>" << num(o.heldOutPerTrial, 3)
-             << "</td><td class=\"l\">" << (o.excluded ? "—" : o.screeningFlag ? "low outlier (flagged)" : "ok")
+             << "</td><td class=\"l\">"
+             << (o.excluded        ? "—"
+                 : o.screeningFlag ? "low outlier (flagged)"
+                                   : "ok")
              << "</td><td class=\"l\">" << (o.excluded ? "excluded: " + h(o.reason) : std::string("included"))
              << "</td></tr>\n";
     html << "</tbody></table>\n<p><strong>Viewing conditions.</strong> Recorded per answer by the browser: viewports ";
@@ -474,8 +489,7 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
             html << "<figure><a href=\"" << h(image.png) << "\"><img src=\"" << h(image.png)
                  << "\" alt=\"reference\" loading=\"eager\"></a><figcaption><strong>reference</strong> ("
                  << (design.showReference ? "shown above each pair" : "not shown to observers") << ") · "
-                 << h(image.stimulus)
-                 << "</figcaption></figure>";
+                 << h(image.stimulus) << "</figcaption></figure>";
         }
         for (const ConditionImages& image : imagesOfBlock[block.name])
             html << "<figure><a href=\"" << h(image.png) << "\"><img src=\"" << h(image.png) << "\" alt=\""
@@ -505,15 +519,16 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
                   [&](int a, int b) { return block.thurstone.scores[a] > block.thurstone.scores[b]; });
         std::vector<IntervalPoint> points;
         for (int i : order)
-            points.push_back({block.conditions[static_cast<std::size_t>(i)], block.thurstone.scores[i], block.low[i], block.high[i]});
+            points.push_back({block.conditions[static_cast<std::size_t>(i)], block.thurstone.scores[i], block.low[i],
+                              block.high[i]});
         html << "<h3 id=\"scale-" << slug(block.name) << "\">" << h(block.name) << " (" << block.observers.size()
              << " observers)</h3>" << scaleSvg(points);
         html << "<table><thead><tr><th class=\"l\">condition</th><th>JOD</th><th>low</th><th>high</th><th>SE</th></tr>"
                 "</thead><tbody>";
         for (int i : order)
             html << "<tr><td class=\"l\">" << h(block.conditions[static_cast<std::size_t>(i)]) << "</td><td>"
-                 << num(block.thurstone.scores[i]) << "</td><td>" << num(block.low[i]) << "</td><td>" << num(block.high[i])
-                 << "</td><td>" << num(block.standardError[i]) << "</td></tr>";
+                 << num(block.thurstone.scores[i]) << "</td><td>" << num(block.low[i]) << "</td><td>"
+                 << num(block.high[i]) << "</td><td>" << num(block.standardError[i]) << "</td></tr>";
         html << "</tbody></table>";
         for (const std::string& warning : block.warnings) html << "<p class=\"note\">Note: " << h(warning) << "</p>";
         // Pairwise significance matrix.
@@ -536,9 +551,10 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
                 }
                 const scaling::PairTest& pair = *found->second;
                 double difference = block.thurstone.scores[i] - block.thurstone.scores[j];
-                html << "<td class=\"" << (pair.significant ? "sig" : "ns") << "\" title=\"adjusted p = "
-                     << num(pair.adjustedPValue, 4) << "\">" << num(difference) << "<br><span class=\"note\">p="
-                     << num(pair.adjustedPValue, 3) << (pair.comparisons > 0 ? "" : " n/c") << "</span></td>";
+                html << "<td class=\"" << (pair.significant ? "sig" : "ns")
+                     << "\" title=\"adjusted p = " << num(pair.adjustedPValue, 4) << "\">" << num(difference)
+                     << "<br><span class=\"note\">p=" << num(pair.adjustedPValue, 3)
+                     << (pair.comparisons > 0 ? "" : " n/c") << "</span></td>";
             }
             html << "</tr>";
         }
@@ -554,7 +570,8 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
         if (!referencePng.empty()) {
             html << " (";
             int k = 0;
-            for (const auto& [block, reference] : referencePng) html << (k++ ? ", " : "") << h(block) << ": " << h(reference);
+            for (const auto& [block, reference] : referencePng)
+                html << (k++ ? ", " : "") << h(block) << ": " << h(reference);
             html << ")";
         }
         html << ". ΔE00 and FLIP: lower is better; PSNR and SSIM: higher is better. Bands: mean ΔE00 in the halo, "
@@ -572,12 +589,13 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
             for (const agreement::ConditionMetrics& row : conditionMetrics) {
                 if (row.block != block.name) continue;
                 auto v = [&](const char* key) { return row.values.at(key); };
-                html << "<tr><td class=\"l\">" << h(row.condition) << "</td><td>" << num(v("image.psnr_db")) << "</td><td>"
-                     << num(v("image.ssim"), 4) << "</td><td>" << num(v("image.delta_e00_mean"), 3) << "</td><td>"
-                     << num(v("image.delta_e00_p95"), 3) << "</td><td>" << num(v("image.flip_mean"), 4) << "</td><td>"
-                     << num(v("skin.flip_mean"), 4) << "</td><td>" << num(v("bands.halo.delta_e00_mean"), 3) << "</td><td>"
-                     << num(v("bands.bleed.delta_e00_mean"), 3) << "</td><td>" << num(v("bands.spill.delta_e00_mean"), 3)
-                     << "</td><td>" << num(v("bands.interior.delta_e00_mean"), 3) << "</td></tr>";
+                html << "<tr><td class=\"l\">" << h(row.condition) << "</td><td>" << num(v("image.psnr_db"))
+                     << "</td><td>" << num(v("image.ssim"), 4) << "</td><td>" << num(v("image.delta_e00_mean"), 3)
+                     << "</td><td>" << num(v("image.delta_e00_p95"), 3) << "</td><td>" << num(v("image.flip_mean"), 4)
+                     << "</td><td>" << num(v("skin.flip_mean"), 4) << "</td><td>"
+                     << num(v("bands.halo.delta_e00_mean"), 3) << "</td><td>" << num(v("bands.bleed.delta_e00_mean"), 3)
+                     << "</td><td>" << num(v("bands.spill.delta_e00_mean"), 3) << "</td><td>"
+                     << num(v("bands.interior.delta_e00_mean"), 3) << "</td></tr>";
             }
             html << "</tbody></table><div class=\"thumbs heat\">";
             for (const ConditionImages& image : imagesOfBlock[block.name]) {
@@ -599,14 +617,17 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
     if (conditionMetrics.empty()) {
         html << "<p>Not available without image metrics.</p>\n";
     } else {
-        html << "<p class=\"note\">Correlation of each metric with the JOD scale over the block's conditions (raw sign: "
-                "an error metric that agrees with the observers correlates negatively). Intervals: "
-             << num(100.0 * agreementOptions.level, 0) << " % percentile bootstrap over observers ("
-             << agreementOptions.samples << " resamples, the scale re-fitted each time). Pairs: of the pairs the "
-                "observers separated significantly, how many the metric orders the same way (ties count as not). "
-                "Also in agreement.csv and agreement.json.</p>\n";
-        static const std::vector<std::string> plotted = {"image.psnr_db", "image.ssim", "image.delta_e00_mean",
-                                                         "image.flip_mean", "skin.flip_mean", "bands.halo.delta_e00_mean"};
+        html
+            << "<p class=\"note\">Correlation of each metric with the JOD scale over the block's conditions (raw sign: "
+               "an error metric that agrees with the observers correlates negatively). Intervals: "
+            << num(100.0 * agreementOptions.level, 0) << " % percentile bootstrap over observers ("
+            << agreementOptions.samples
+            << " resamples, the scale re-fitted each time). Pairs: of the pairs the "
+               "observers separated significantly, how many the metric orders the same way (ties count as not). "
+               "Also in agreement.csv and agreement.json.</p>\n";
+        static const std::vector<std::string> plotted = {"image.psnr_db",        "image.ssim",
+                                                         "image.delta_e00_mean", "image.flip_mean",
+                                                         "skin.flip_mean",       "bands.halo.delta_e00_mean"};
         for (const scaling::BlockAnalysis& block : analysis.blocks) {
             html << "<h3 id=\"agreement-" << slug(block.name) << "\">" << h(block.name) << "</h3><table><thead><tr>"
                  << "<th class=\"l\">metric</th><th>better</th><th>n</th><th>Pearson r</th><th>95 % interval</th>"
@@ -620,9 +641,9 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
                      << num(row.pearson) << "</td><td>[" << num(row.pearsonLow) << ", " << num(row.pearsonHigh)
                      << "]</td><td>" << num(row.spearman) << "</td><td>[" << num(row.spearmanLow) << ", "
                      << num(row.spearmanHigh) << "]</td><td>"
-                     << (row.significantPairs ? std::to_string(row.predictedPairs) + " / " +
-                                                    std::to_string(row.significantPairs)
-                                              : std::string("—"))
+                     << (row.significantPairs
+                             ? std::to_string(row.predictedPairs) + " / " + std::to_string(row.significantPairs)
+                             : std::string("—"))
                      << "</td></tr>";
             }
             html << "</tbody></table><div class=\"scatters\">";
@@ -634,8 +655,8 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
                     auto it = std::find(block.conditions.begin(), block.conditions.end(), metricRow.condition);
                     if (it == block.conditions.end()) continue;
                     auto i = static_cast<Eigen::Index>(it - block.conditions.begin());
-                    points.push_back({metricRow.condition, metricRow.values.at(row->metric.key), block.thurstone.scores[i],
-                                      block.low[i], block.high[i]});
+                    points.push_back({metricRow.condition, metricRow.values.at(row->metric.key),
+                                      block.thurstone.scores[i], block.low[i], block.high[i]});
                 }
                 html << "<figure>" << scatterSvg(points, row->metric.label) << "<figcaption>" << h(row->metric.label)
                      << ": r = " << num(row->pearson) << " [" << num(row->pearsonLow) << ", " << num(row->pearsonHigh)
@@ -643,7 +664,8 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
             }
             html << "</div>\n";
         }
-        for (const std::string& warning : agreementResult.warnings) html << "<p class=\"note\">Note: " << h(warning) << "</p>";
+        for (const std::string& warning : agreementResult.warnings)
+            html << "<p class=\"note\">Note: " << h(warning) << "</p>";
     }
     html << "<p class=\"note\">Written by <code>skinlab report</code> from " << h(options.study.filename().string())
          << ". Tables: scale.json" << (conditionMetrics.empty() ? "" : ", agreement.csv, agreement.json")
@@ -670,8 +692,8 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
         std::string command = "timeout 180 " + quote(options.chromium) +
                               " --headless --no-sandbox --disable-gpu --disable-quic --no-first-run "
                               "--disable-background-networking --disable-component-update --disable-sync "
-                              "--no-pdf-header-footer --user-data-dir=" + quote(profile.string()) +
-                              " --print-to-pdf=" + quote(temp.string()) + " " +
+                              "--no-pdf-header-footer --user-data-dir=" +
+                              quote(profile.string()) + " --print-to-pdf=" + quote(temp.string()) + " " +
                               quote("file://" + fs::absolute(out / "index.html").string()) + " >/dev/null 2>&1";
         int status = std::system(command.c_str());
         fs::remove_all(profile);

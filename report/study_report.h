@@ -10,21 +10,21 @@
 namespace skinlab::report {
 
 struct ReportOptions {
-    std::filesystem::path study;     // study.db
-    std::filesystem::path stimuli;   // stimulus folder; empty = the folder recorded in the study file
-    std::filesystem::path metrics;   // folder with metrics.json; empty = compute them (when the set has references)
-    std::filesystem::path output;    // REPORT/ folder
-    int bootstrapSamples = 1000;     // scale intervals and correlation intervals
+    std::filesystem::path study;   // study.db
+    std::filesystem::path stimuli; // stimulus folder; empty = the folder recorded in the study file
+    std::filesystem::path metrics; // folder with metrics.json; empty = compute them (when the set has references)
+    std::filesystem::path output;  // REPORT/ folder
+    int bootstrapSamples = 1000;   // scale intervals and correlation intervals
     std::uint64_t seed = 1;
     int threads = 2;
-    double pixelsPerDegree = 67.02064327658226;  // FLIP, when the metrics are computed here
+    double pixelsPerDegree = 67.02064327658226; // FLIP, when the metrics are computed here
     bool pdf = true;
-    std::string chromium = "chromium";  // executable for the PDF
+    std::string chromium = "chromium"; // executable for the PDF
 };
 
 struct ReportSummary {
     std::filesystem::path html;
-    std::filesystem::path pdf;  // empty when no PDF was written
+    std::filesystem::path pdf; // empty when no PDF was written
     int observers = 0;
     int excluded = 0;
     bool metrics = false;

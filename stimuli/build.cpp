@@ -85,8 +85,8 @@ void validateLevels(const SetSpec& spec, const std::vector<Stimulus>& all, const
             std::vector<std::string> overrides;
             for (const auto& o : stimulus->overrides) {
                 const std::string key = o.substr(0, o.find('='));
-                const bool isFixed = std::any_of(spec.fixed.begin(), spec.fixed.end(),
-                                                 [&](const auto& p) { return p.key == key; });
+                const bool isFixed =
+                    std::any_of(spec.fixed.begin(), spec.fixed.end(), [&](const auto& p) { return p.key == key; });
                 if (isFixed || (key == "sss.method" && factor.key != "sss.method")) overrides.push_back(o);
             }
             overrides.push_back(factor.key + "=" + level.overrideText);
@@ -130,8 +130,9 @@ nlohmann::json renderStimulus(renderer::Renderer& renderer, const Stimulus& stim
     auto [width, height] = imageSize(exr.finalPath());
     entry["width"] = width;
     entry["height"] = height;
-    nlohmann::json timings = result.timingsMs.is_object() ? result.timingsMs : nlohmann::json{{"render", result.timingsMs}};
-    timings["stimulus_wall"] = secondsSince(start) * 1000.0;  // render + write + hash, ms
+    nlohmann::json timings =
+        result.timingsMs.is_object() ? result.timingsMs : nlohmann::json{{"render", result.timingsMs}};
+    timings["stimulus_wall"] = secondsSince(start) * 1000.0; // render + write + hash, ms
     entry["timings_ms"] = timings;
     return entry;
 }
@@ -194,11 +195,11 @@ BuildSummary buildSet(const BuildOptions& options) {
     const fs::path& dir = options.outputDir;
     std::optional<Manifest> existing = claimOutputFolder(dir, plan.spec.name, options.shard);
     ensureDirectory(dir);
-    OutputFolderLock folderLock(dir);  // one build per folder at a time (a requeued task whose first run still lives)
-    existing = claimOutputFolder(dir, plan.spec.name, options.shard);  // re-read: a build may have ended meanwhile
+    OutputFolderLock folderLock(dir); // one build per folder at a time (a requeued task whose first run still lives)
+    existing = claimOutputFolder(dir, plan.spec.name, options.shard); // re-read: a build may have ended meanwhile
 
     Manifest manifest = manifestHeader(plan.spec, plan.all, options.shard);
-    std::map<std::string, nlohmann::json> entries;  // id → entry of every stimulus done
+    std::map<std::string, nlohmann::json> entries; // id → entry of every stimulus done
     if (existing && existing->renderer.skinlabVersion == version()) {
         manifest.renderer = existing->renderer;
         for (size_t i = 0; i < plan.selected.size(); ++i) {
@@ -226,7 +227,7 @@ BuildSummary buildSet(const BuildOptions& options) {
         manifest.complete = manifest.stimuli.size() == plan.selected.size();
         writeManifest(dir, manifest);
     };
-    writeCurrent();  // marks the folder as this set's before anything renders (or creates a subfolder)
+    writeCurrent(); // marks the folder as this set's before anything renders (or creates a subfolder)
     ensureDirectory(dir / "exr");
     ensureDirectory(dir / "png");
     tidyOutputFolder(dir, selectedIds);

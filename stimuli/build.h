@@ -15,11 +15,11 @@ namespace skinlab::stimuli {
 
 struct BuildOptions {
     std::filesystem::path spec;
-    std::vector<std::string> specOverrides;  // --set key=value on the set spec
+    std::vector<std::string> specOverrides; // --set key=value on the set spec
     std::filesystem::path outputDir;
     std::optional<Shard> shard;
-    int jobs = 1;                             // parallel renderers (one EGL context each)
-    std::filesystem::path assetsDir;          // empty: $SKINLAB_ASSETS
+    int jobs = 1;                    // parallel renderers (one EGL context each)
+    std::filesystem::path assetsDir; // empty: $SKINLAB_ASSETS
     bool contactSheet = true;
     enum class ProgressStyle { automatic, bar, lines } progress = ProgressStyle::automatic;
 };
@@ -27,9 +27,9 @@ struct BuildOptions {
 // The checked plan of a build: what would be rendered, and each stimulus's resolved scene parameters.
 struct BuildPlan {
     SetSpec spec;
-    std::vector<Stimulus> all;        // the whole set
-    std::vector<Stimulus> selected;   // this shard's slice (all of it without --shard)
-    std::vector<nlohmann::json> resolved;  // per selected stimulus: resolveScene()'s JSON
+    std::vector<Stimulus> all;            // the whole set
+    std::vector<Stimulus> selected;       // this shard's slice (all of it without --shard)
+    std::vector<nlohmann::json> resolved; // per selected stimulus: resolveScene()'s JSON
 };
 
 // Reads the spec, expands it and resolves every selected stimulus (no GL). Throws InputError for bad input:
@@ -38,12 +38,12 @@ BuildPlan planBuild(const std::filesystem::path& spec, const std::vector<std::st
                     const std::optional<Shard>& shard, const std::filesystem::path& assetsDir);
 
 struct BuildSummary {
-    size_t stimuli = 0;    // in this folder's selection
-    size_t rendered = 0;   // rendered by this run
-    size_t kept = 0;       // unchanged from an earlier run
+    size_t stimuli = 0;  // in this folder's selection
+    size_t rendered = 0; // rendered by this run
+    size_t kept = 0;     // unchanged from an earlier run
     double wallSeconds = 0.0;
     std::filesystem::path manifest;
-    std::filesystem::path contactHtml;  // empty when no contact sheet was written
+    std::filesystem::path contactHtml; // empty when no contact sheet was written
 };
 
 BuildSummary buildSet(const BuildOptions& options);

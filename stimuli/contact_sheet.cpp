@@ -16,7 +16,6 @@ namespace skinlab::stimuli {
 
 namespace fs = std::filesystem;
 
-
 namespace {
 
 struct Block {
@@ -38,7 +37,9 @@ std::vector<Block> groupByBlock(const Manifest& manifest) {
     return blocks;
 }
 
-std::string valueText(const nlohmann::json& value) { return value.is_string() ? value.get<std::string>() : value.dump(); }
+std::string valueText(const nlohmann::json& value) {
+    return value.is_string() ? value.get<std::string>() : value.dump();
+}
 
 // The factor levels that tell the stimuli of one block apart (the caption of a thumbnail).
 std::vector<std::string> varyingFactors(const Block& block) {
@@ -91,7 +92,7 @@ std::string caption(const nlohmann::json& stimulus, const std::vector<std::strin
 std::vector<std::string> wrapCaption(const std::string& caption, int width, int maxLines, const std::string& font) {
     auto fits = [&](const std::string& text) {
         const OIIO::ROI box = OIIO::ImageBufAlgo::text_size(text, 13, font);
-        return !box.defined() || box.width() <= width;  // no font: nothing is drawn anyway
+        return !box.defined() || box.width() <= width; // no font: nothing is drawn anyway
     };
     std::vector<std::string> words;
     std::istringstream in(caption);
@@ -132,9 +133,9 @@ std::string html(const Manifest& manifest, const std::vector<Block>& blocks) {
         << "table{border-collapse:collapse}td{padding:0 .6em 0 0;vertical-align:top}\n"
         << "</style>\n</head>\n<body>\n<h1>Stimulus set " << escapeHtml(manifest.set) << "</h1>\n";
     if (!manifest.description.empty()) out << "<p>" << escapeHtml(manifest.description) << "</p>\n";
-    out << "<p>" << manifest.stimuli.size() << " stimuli in " << blocks.size() << " block(s). Renderer: "
-        << escapeHtml(manifest.renderer.glRenderer) << " (skinlab " << escapeHtml(manifest.renderer.skinlabVersion)
-        << "). Fixed: ";
+    out << "<p>" << manifest.stimuli.size() << " stimuli in " << blocks.size()
+        << " block(s). Renderer: " << escapeHtml(manifest.renderer.glRenderer) << " (skinlab "
+        << escapeHtml(manifest.renderer.skinlabVersion) << "). Fixed: ";
     std::string fixed;
     for (auto it = manifest.fixed.begin(); it != manifest.fixed.end(); ++it)
         fixed += (fixed.empty() ? "" : ", ") + it.key() + " = " + valueText(it.value());
@@ -146,8 +147,8 @@ std::string html(const Manifest& manifest, const std::vector<Block>& blocks) {
             std::string png = s->at("files").at("png").get<std::string>();
             out << "<figure" << (reference ? " class=\"reference\"" : "") << "><a href=\"" << escapeHtml(png)
                 << "\"><img src=\"" << escapeHtml(png) << "\" alt=\"" << escapeHtml(s->at("id").get<std::string>())
-                << "\" loading=\"lazy\"></a>\n<figcaption><div class=\"id\">" << escapeHtml(s->at("id").get<std::string>())
-                << (reference ? " — reference" : "") << "</div><table>";
+                << "\" loading=\"lazy\"></a>\n<figcaption><div class=\"id\">"
+                << escapeHtml(s->at("id").get<std::string>()) << (reference ? " — reference" : "") << "</div><table>";
             const auto& f = s->at("factors");
             for (auto it = f.begin(); it != f.end(); ++it)
                 out << "<tr><td>" << escapeHtml(it.key()) << "</td><td>" << escapeHtml(valueText(it.value()))

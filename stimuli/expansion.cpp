@@ -13,7 +13,7 @@ namespace skinlab::stimuli {
 
 namespace {
 
-using Assignment = std::vector<std::pair<std::string, Level>>;  // factor or extra key → level
+using Assignment = std::vector<std::pair<std::string, Level>>; // factor or extra key → level
 
 const Level* find(const Assignment& assignment, const std::string& name) {
     for (const auto& [n, level] : assignment)
@@ -77,17 +77,17 @@ private:
     // An include/reference names some factors (and maybe extra keys); the block factors it leaves out are
     // expanded over all their levels so that every block gets one; other factors are left at the scene default.
     void addSelection(const Selection& selection, bool reference) {
-        std::vector<Factor> named;  // one factor per named key with the selection's levels
+        std::vector<Factor> named; // one factor per named key with the selection's levels
         for (const auto& [name, levels] : selection.levels) named.push_back(Factor{name, sceneKeyOf(name), levels});
         std::vector<const Factor*> factors;
         for (const auto& f : spec_.factors) {
             auto it = std::find_if(named.begin(), named.end(), [&](const Factor& n) { return n.name == f.name; });
-            bool isBlock = std::find(spec_.blockFactors.begin(), spec_.blockFactors.end(), f.name) !=
-                           spec_.blockFactors.end();
+            bool isBlock =
+                std::find(spec_.blockFactors.begin(), spec_.blockFactors.end(), f.name) != spec_.blockFactors.end();
             if (it != named.end()) factors.push_back(&*it);
             else if (isBlock || f.name == "scene") factors.push_back(&f);
         }
-        for (const auto& n : named)  // extra scene keys, after the factors
+        for (const auto& n : named) // extra scene keys, after the factors
             if (std::none_of(spec_.factors.begin(), spec_.factors.end(),
                              [&](const Factor& f) { return f.name == n.name; }))
                 factors.push_back(&n);

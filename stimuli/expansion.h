@@ -12,12 +12,12 @@ namespace skinlab::stimuli {
 
 struct Stimulus {
     std::string id;
-    std::string block;       // block factors' values joined by '/', e.g. "builtin:head/mid"
-    bool reference = false;  // from a [[reference]] entry
-    std::string scene;       // what RenderRequest::scene gets: "builtin:NAME" or an absolute scene spec path
-    std::vector<std::pair<std::string, Level>> factors;  // factor name → level, in factor order (scene first)
-    std::vector<std::string> overrides;                   // "key=value": fixed parameters, then the levels
-    size_t index = 0;        // position in the full expansion (shards keep it)
+    std::string block;      // block factors' values joined by '/', e.g. "builtin:head/mid"
+    bool reference = false; // from a [[reference]] entry
+    std::string scene;      // what RenderRequest::scene gets: "builtin:NAME" or an absolute scene spec path
+    std::vector<std::pair<std::string, Level>> factors; // factor name → level, in factor order (scene first)
+    std::vector<std::string> overrides;                 // "key=value": fixed parameters, then the levels
+    size_t index = 0;                                   // position in the full expansion (shards keep it)
 };
 
 // Expands the spec. Throws InputError ("SPEC: KEY: message") for an empty factorial, clashing ids, or an

@@ -120,7 +120,7 @@ std::string wallText(const nlohmann::json& j) {
 std::string manifestCsv(const Manifest& m) {
     std::vector<std::string> factorNames;
     for (const auto& f : m.factors) factorNames.push_back(f.at("name").get<std::string>());
-    for (const auto& s : m.stimuli)  // extra keys of [[include]]/[[reference]] entries
+    for (const auto& s : m.stimuli) // extra keys of [[include]]/[[reference]] entries
         for (auto it = s.at("factors").begin(); it != s.at("factors").end(); ++it)
             if (std::find(factorNames.begin(), factorNames.end(), it.key()) == factorNames.end())
                 factorNames.push_back(it.key());
@@ -137,9 +137,10 @@ std::string manifestCsv(const Manifest& m) {
         }
         const auto& timings = s.value("timings_ms", nlohmann::json::object());
         out << ',' << csvField(s.at("files").at("exr").get<std::string>()) << ','
-            << csvField(s.at("files").at("png").get<std::string>()) << ',' << s.at("sha256").at("exr").get<std::string>()
-            << ',' << s.at("sha256").at("png").get<std::string>() << ',' << s.at("width").dump() << ','
-            << s.at("height").dump() << ',' << wallText(timings.value("stimulus_wall", nlohmann::json())) << '\n';
+            << csvField(s.at("files").at("png").get<std::string>()) << ','
+            << s.at("sha256").at("exr").get<std::string>() << ',' << s.at("sha256").at("png").get<std::string>() << ','
+            << s.at("width").dump() << ',' << s.at("height").dump() << ','
+            << wallText(timings.value("stimulus_wall", nlohmann::json())) << '\n';
     }
     return out.str();
 }

@@ -28,14 +28,14 @@ struct Manifest {
     std::string set;
     std::string description;
     std::optional<std::int64_t> seed;
-    std::string specFile;     // file name of the spec (informational)
+    std::string specFile; // file name of the spec (informational)
     std::string specSha256;
-    RendererInfo renderer;    // empty gl strings until something was rendered
-    nlohmann::json fixed = nlohmann::json::object();    // fixed scene key → value
-    nlohmann::json factors = nlohmann::json::array();   // [{name, key, levels: [{value, label}]}]
-    std::optional<Shard> shard;          // present in a shard's folder
-    std::vector<std::string> setIds;     // every id of the whole set, in expansion order (for merge)
-    std::vector<nlohmann::json> stimuli; // entries (contract 2), in expansion order
+    RendererInfo renderer;                            // empty gl strings until something was rendered
+    nlohmann::json fixed = nlohmann::json::object();  // fixed scene key → value
+    nlohmann::json factors = nlohmann::json::array(); // [{name, key, levels: [{value, label}]}]
+    std::optional<Shard> shard;                       // present in a shard's folder
+    std::vector<std::string> setIds;                  // every id of the whole set, in expansion order (for merge)
+    std::vector<nlohmann::json> stimuli;              // entries (contract 2), in expansion order
     // True when `stimuli` holds every stimulus of this folder's selection (the set, or the shard's slice).
     bool complete = false;
 };

@@ -34,7 +34,7 @@ MergeSummary mergeShards(const std::vector<fs::path>& shardDirs, const fs::path&
     const Manifest& first = shards.front();
     // Shards that disagree about the set or the spec (another spec file, another version of it, other --set
     // overrides): name every shard of each version, so the odd ones can be rebuilt.
-    std::map<std::string, std::vector<size_t>> bySpec;  // set + spec_sha256 → shards
+    std::map<std::string, std::vector<size_t>> bySpec; // set + spec_sha256 → shards
     for (size_t i = 0; i < shards.size(); ++i) bySpec[shards[i].set + "\n" + shards[i].specSha256].push_back(i);
     if (bySpec.size() > 1) {
         std::string versions;
@@ -42,10 +42,12 @@ MergeSummary mergeShards(const std::vector<fs::path>& shardDirs, const fs::path&
             const Manifest& m = shards[members.front()];
             versions += (versions.empty() ? "" : "; ") + std::string("set '") + m.set + "' spec '" + m.specFile +
                         "' sha256 " + m.specSha256.substr(0, 12) + " in";
-            for (size_t i : members) versions += " " + shardDirs[i].string() + " (shard " + shardName(*shards[i].shard) + ")";
+            for (size_t i : members)
+                versions += " " + shardDirs[i].string() + " (shard " + shardName(*shards[i].shard) + ")";
         }
-        throwInput("merge", "", "the shards disagree about the spec: " + versions +
-                                    "; rebuild the odd shards from the same spec and --set values");
+        throwInput("merge", "",
+                   "the shards disagree about the spec: " + versions +
+                       "; rebuild the odd shards from the same spec and --set values");
     }
     std::map<int, size_t> byIndex;
     for (size_t i = 0; i < shards.size(); ++i) {
@@ -53,24 +55,27 @@ MergeSummary mergeShards(const std::vector<fs::path>& shardDirs, const fs::path&
         const std::string where = shardDirs[i].string();
         if (m.set != first.set) throwInput(where, "", "holds set '" + m.set + "', not '" + first.set + "'");
         if (m.specSha256 != first.specSha256 || m.setIds != first.setIds)
-            throwInput(where, "", "was built from another version of spec '" + first.specFile + "' (spec_sha256 differs)");
+            throwInput(where, "",
+                       "was built from another version of spec '" + first.specFile + "' (spec_sha256 differs)");
         if (!m.stimuli.empty() && !first.stimuli.empty() && !(m.renderer == first.renderer))
-            throwInput(where, "", "was rendered by '" + m.renderer.glRenderer + "' (skinlab " + m.renderer.skinlabVersion +
-                                      "), the first shard by '" + first.renderer.glRenderer + "' (skinlab " +
-                                      first.renderer.skinlabVersion + "); a set must come from one renderer");
+            throwInput(where, "",
+                       "was rendered by '" + m.renderer.glRenderer + "' (skinlab " + m.renderer.skinlabVersion +
+                           "), the first shard by '" + first.renderer.glRenderer + "' (skinlab " +
+                           first.renderer.skinlabVersion + "); a set must come from one renderer");
         if (m.shard->count != first.shard->count)
-            throwInput(where, "", "is shard " + shardName(*m.shard) + ", the first is shard " + shardName(*first.shard));
-        if (byIndex.count(m.shard->index))
-            throwInput(where, "", "shard " + shardName(*m.shard) + " is given twice");
+            throwInput(where, "",
+                       "is shard " + shardName(*m.shard) + ", the first is shard " + shardName(*first.shard));
+        if (byIndex.count(m.shard->index)) throwInput(where, "", "shard " + shardName(*m.shard) + " is given twice");
         byIndex[m.shard->index] = i;
     }
     for (int k = 1; k <= first.shard->count; ++k)
         if (!byIndex.count(k))
-            throwInput("merge", "", "shard " + std::to_string(k) + "/" + std::to_string(first.shard->count) + " of set '" +
-                                        first.set + "' is missing");
+            throwInput("merge", "",
+                       "shard " + std::to_string(k) + "/" + std::to_string(first.shard->count) + " of set '" +
+                           first.set + "' is missing");
 
     // Gather the entries in the set's order and check every file against its hash before writing anything.
-    std::map<std::string, std::pair<const nlohmann::json*, size_t>> entries;  // id → entry, shard
+    std::map<std::string, std::pair<const nlohmann::json*, size_t>> entries; // id → entry, shard
     for (size_t i = 0; i < shards.size(); ++i)
         for (const auto& s : shards[i].stimuli) entries[s.at("id").get<std::string>()] = {&s, i};
     Manifest merged = first;

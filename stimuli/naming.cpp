@@ -9,9 +9,7 @@
 namespace skinlab::stimuli {
 
 namespace {
-bool isIdChar(char c) {
-    return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '.' || c == '_' || c == '-';
-}
+bool isIdChar(char c) { return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '.' || c == '_' || c == '-'; }
 } // namespace
 
 bool isIdSafe(std::string_view text) {
@@ -38,7 +36,8 @@ std::string sanitizeLabel(std::string_view text) {
 
 std::string sceneLabel(std::string_view scene) {
     constexpr std::string_view builtinPrefix = "builtin:";
-    if (scene.substr(0, builtinPrefix.size()) == builtinPrefix) return sanitizeLabel(scene.substr(builtinPrefix.size()));
+    if (scene.substr(0, builtinPrefix.size()) == builtinPrefix)
+        return sanitizeLabel(scene.substr(builtinPrefix.size()));
     return sanitizeLabel(std::filesystem::path(std::string(scene)).stem().string());
 }
 
@@ -48,7 +47,7 @@ std::string lastKeyComponent(std::string_view key) {
 }
 
 std::string tomlValueText(const toml::node& node) {
-    if (auto* s = node.as_string()) return nlohmann::json(s->get()).dump();  // JSON escapes are valid TOML
+    if (auto* s = node.as_string()) return nlohmann::json(s->get()).dump(); // JSON escapes are valid TOML
     if (auto* i = node.as_integer()) return std::to_string(i->get());
     if (auto* b = node.as_boolean()) return b->get() ? "true" : "false";
     if (auto* f = node.as_floating_point()) {

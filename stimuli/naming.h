@@ -27,7 +27,7 @@ std::string tomlValueText(const toml::node& node);
 struct NamingTemplate {
     struct Part {
         bool placeholder = false;
-        std::string text;  // literal text, or the factor name of a placeholder
+        std::string text; // literal text, or the factor name of a placeholder
     };
     std::vector<Part> parts;
 };

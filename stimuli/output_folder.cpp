@@ -30,7 +30,7 @@ std::optional<Manifest> claimOutputFolder(const fs::path& dir, const std::string
     if (!fs::is_directory(dir, ec)) throwInput(dir.string(), "", "exists and is not a folder");
     std::optional<Manifest> existing = readManifest(dir);
     if (!existing) {
-        bool empty = true;  // a build killed before its first manifest leaves at most its lock file
+        bool empty = true; // a build killed before its first manifest leaves at most its lock file
         for (const auto& entry : fs::directory_iterator(dir, ec))
             if (entry.path().filename() != kBuildLockFile) empty = false;
         if (!empty)
@@ -53,7 +53,8 @@ std::optional<Manifest> claimOutputFolder(const fs::path& dir, const std::string
 OutputFolderLock::OutputFolderLock(const fs::path& dir) {
     const fs::path file = dir / kBuildLockFile;
     fd_ = ::open(file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (fd_ < 0) throwInput(file.string(), "", std::string("cannot create the build lock (") + std::strerror(errno) + ")");
+    if (fd_ < 0)
+        throwInput(file.string(), "", std::string("cannot create the build lock (") + std::strerror(errno) + ")");
     if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
         int error = errno;
         char holder[256] = {};
@@ -75,7 +76,7 @@ OutputFolderLock::OutputFolderLock(const fs::path& dir) {
 }
 
 OutputFolderLock::~OutputFolderLock() {
-    if (fd_ >= 0) ::close(fd_);  // releases the lock; the file stays (removing it would race with the next build)
+    if (fd_ >= 0) ::close(fd_); // releases the lock; the file stays (removing it would race with the next build)
 }
 
 void tidyOutputFolder(const fs::path& dir, const std::vector<std::string>& keepIds) {

@@ -25,8 +25,7 @@ std::string sceneKeyOf(const std::string& factorName) {
 const std::vector<std::string>& alwaysFixedKeys() {
     // Resolution, exposure and tone mapping change how every pixel is displayed: varying them inside a set would
     // favour some conditions by brightness or sharpness rather than by the factor under test.
-    static const std::vector<std::string> keys = {"render.width", "render.height", "render.exposure_ev",
-                                                  "tone_map"};
+    static const std::vector<std::string> keys = {"render.width", "render.height", "render.exposure_ev", "tone_map"};
     return keys;
 }
 
@@ -69,8 +68,7 @@ public:
         spec.fileName = fileName_;
         SpecReader set = reader_.table("set");
         spec.name = set.requiredString("name");
-        if (!isIdSafe(spec.name))
-            set.fail("name", "'" + spec.name + "' is not a valid set name (use a-z 0-9 . _ -)");
+        if (!isIdSafe(spec.name)) set.fail("name", "'" + spec.name + "' is not a valid set name (use a-z 0-9 . _ -)");
         spec.description = set.string("description", "");
         if (set.has("seed")) spec.seed = set.integer("seed", 0, 0, std::numeric_limits<std::int64_t>::max());
         spec.idTemplate = set.string("id", "");
@@ -192,11 +190,12 @@ private:
         Factor factor;
         factor.name = reader.requiredString("name");
         if (!isKeyName(factor.name))
-            reader.fail("name", "'" + factor.name + "' is not a factor name (a scene key like sss.samples, or "
-                                                    "scene, method, view)");
+            reader.fail("name", "'" + factor.name +
+                                    "' is not a factor name (a scene key like sss.samples, or "
+                                    "scene, method, view)");
         factor.key = sceneKeyOf(factor.name);
         for (const auto& other : spec.factors)
-            if (factor.name == "scene") break;  // a second scene is reported by read()
+            if (factor.name == "scene") break; // a second scene is reported by read()
             else if (other.name == factor.name || (!factor.key.empty() && keysOverlap(other.key, factor.key)))
                 reader.fail("name", "'" + factor.name + "' varies the same scene key as factor '" + other.name + "'");
         if (!factor.key.empty()) checkNotFixed(factor.key, spec, reader, "name");
@@ -253,13 +252,13 @@ private:
             for (auto&& [k, v] : table) reader.raw(k.str());
             std::vector<std::pair<std::string, const toml::node*>> leaves;
             flatten(table, "", leaves);
-            if (leaves.empty()) throwInput(reader.file(), selection.where, "is empty (name at least one factor and its level)");
+            if (leaves.empty())
+                throwInput(reader.file(), selection.where, "is empty (name at least one factor and its level)");
             for (auto& [name, node] : leaves) {
                 const Factor* factor = nullptr;
                 for (const auto& f : spec.factors)
                     if (f.name == name || (!f.key.empty() && f.key == sceneKeyOf(name))) factor = &f;
-                if (!factor && factorsOnly)
-                    reader.fail(name, "'" + name + "' is not a factor of this set");
+                if (!factor && factorsOnly) reader.fail(name, "'" + name + "' is not a factor of this set");
                 if (!factor && name == "scene") reader.fail(name, "the scene can only vary as a factor");
                 if (!factor) {
                     if (!isKeyName(name)) reader.fail(name, "'" + name + "' is not a scene key");
@@ -300,8 +299,7 @@ private:
                 if (sameValue || sameLabel) return level;
             }
             std::string shown = node.is_string() ? node.as_string()->get() : text;
-            if (mustBeLevel)
-                reader.fail(name, "'" + shown + "' is not a level of factor '" + factor->name + "'");
+            if (mustBeLevel) reader.fail(name, "'" + shown + "' is not a level of factor '" + factor->name + "'");
             if (factor->name == "scene") {
                 if (!node.is_string()) reader.fail(name, "expected a scene (string), got " + describeNode(node));
                 return sceneLevel(node.as_string()->get(), reader, name);

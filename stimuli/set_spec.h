@@ -15,10 +15,10 @@ namespace skinlab::stimuli {
 
 // One level of a factor, or one fixed value.
 struct Level {
-    std::string overrideText;  // TOML text of the value, used in "key=value" overrides ("\"separable\"", "20")
-    std::string value;         // the value as a person reads it: separable, 20, 0.5, true (manifest "factors")
-    std::string label;         // id-safe label used in stimulus ids ([a-z0-9._-]): separable, samples-20
-    nlohmann::json json;       // the value as JSON (typed)
+    std::string overrideText; // TOML text of the value, used in "key=value" overrides ("\"separable\"", "20")
+    std::string value;        // the value as a person reads it: separable, 20, 0.5, true (manifest "factors")
+    std::string label;        // id-safe label used in stimulus ids ([a-z0-9._-]): separable, samples-20
+    nlohmann::json json;      // the value as JSON (typed)
 };
 
 // A factor of the factorial. `name` is what the spec calls it ("method", "sss.samples", "scene"); `key` is the
@@ -32,29 +32,29 @@ struct Factor {
 // A partial assignment of levels (an [[exclude]], [[include]] or [[reference]] entry): factor name → levels.
 // Names that are not factors of the factorial (allowed in include/reference) are extra scene keys.
 struct Selection {
-    std::string where;  // "exclude[0]" etc., for messages
-    std::vector<std::pair<std::string, std::vector<Level>>> levels;  // in the order written (sorted by name)
+    std::string where;                                              // "exclude[0]" etc., for messages
+    std::vector<std::pair<std::string, std::vector<Level>>> levels; // in the order written (sorted by name)
 };
 
 struct FixedParameter {
-    std::string key;  // dotted scene key ("render.width")
+    std::string key; // dotted scene key ("render.width")
     Level level;
 };
 
 struct SetSpec {
-    std::filesystem::path file;   // the spec file (messages, relative scene paths)
-    std::string fileName;         // as given on the command line, for messages
-    std::string name;             // set.name
-    std::string description;      // set.description
-    std::optional<std::int64_t> seed;  // set.seed: recorded in the manifest for downstream use
-    std::string idTemplate;       // set.id: "{scene}-{view}-{method}"; empty: every factor's label joined by '-'
-    std::vector<std::string> blockFactors;  // set.block: factors naming a block (default scene, view)
-    std::vector<FixedParameter> fixed;      // [fixed], flattened to dotted keys (sorted)
-    std::vector<Factor> factors;            // "scene" first, then [[factor]] in the order written
-    std::vector<Selection> excludes;        // [[exclude]]
-    std::vector<Selection> includes;        // [[include]]
-    std::vector<Selection> references;      // [[reference]]
-    std::string sha256;           // of the spec bytes and the --set overrides
+    std::filesystem::path file;       // the spec file (messages, relative scene paths)
+    std::string fileName;             // as given on the command line, for messages
+    std::string name;                 // set.name
+    std::string description;          // set.description
+    std::optional<std::int64_t> seed; // set.seed: recorded in the manifest for downstream use
+    std::string idTemplate;           // set.id: "{scene}-{view}-{method}"; empty: every factor's label joined by '-'
+    std::vector<std::string> blockFactors; // set.block: factors naming a block (default scene, view)
+    std::vector<FixedParameter> fixed;     // [fixed], flattened to dotted keys (sorted)
+    std::vector<Factor> factors;           // "scene" first, then [[factor]] in the order written
+    std::vector<Selection> excludes;       // [[exclude]]
+    std::vector<Selection> includes;       // [[include]]
+    std::vector<Selection> references;     // [[reference]]
+    std::string sha256;                    // of the spec bytes and the --set overrides
 };
 
 // Friendly factor names: "method" → "sss.method", "view" → "camera.view"; other names are scene keys as written.

@@ -52,8 +52,7 @@ struct ProgramRun {
 // Runs `argv` (argv[0] a full path) and collects its stdout and stderr.
 ProgramRun runProgram(const std::vector<std::string>& argv) {
     int outPipe[2], errPipe[2];
-    if (::pipe(outPipe) != 0 || ::pipe(errPipe) != 0)
-        throw RuntimeError(std::string("pipe: ") + std::strerror(errno));
+    if (::pipe(outPipe) != 0 || ::pipe(errPipe) != 0) throw RuntimeError(std::string("pipe: ") + std::strerror(errno));
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
     posix_spawn_file_actions_adddup2(&actions, outPipe[1], 1);
@@ -122,7 +121,8 @@ fs::path absoluteNormal(const fs::path& p) { return fs::absolute(p).lexically_no
 fs::path ownExecutable() {
     std::error_code ec;
     fs::path self = fs::read_symlink("/proc/self/exe", ec);
-    if (ec) throw RuntimeError(std::string("cannot find the skinlab executable (/proc/self/exe: ") + ec.message() + ")");
+    if (ec)
+        throw RuntimeError(std::string("cannot find the skinlab executable (/proc/self/exe: ") + ec.message() + ")");
     return self;
 }
 
@@ -210,13 +210,14 @@ SlurmScripts slurmScripts(const SlurmOptions& o) {
     checkOption(o.shards >= 1, "--shards", std::to_string(o.shards), "is not a positive number");
     checkOption(o.jobsPerTask >= 1, "--jobs", std::to_string(o.jobsPerTask), "is not a positive number");
     checkOption(o.gpusPerTask >= 0, "--gpus-per-task", std::to_string(o.gpusPerTask), "is negative");
-    for (const auto& [option, value] : {std::pair{"--partition", &o.partition}, {"--time", &o.time},
-                                        {"--account", &o.account}, {"--mem", &o.mem}})
+    for (const auto& [option, value] :
+         {std::pair{"--partition", &o.partition}, {"--time", &o.time}, {"--account", &o.account}, {"--mem", &o.mem}})
         checkWord(option, *value);
     for (const auto& a : o.sbatchArgs) {
         checkOption(a.rfind("-", 0) == 0, "--sbatch", a, "is not an sbatch option (e.g. --qos=high)");
         checkOption(a.find('\n') == std::string::npos, "--sbatch", a, "holds a line break");
-        for (const char* owned : {"--array", "--output", "--error", "--dependency", "--open-mode", "-a", "-o", "-e", "-d"})
+        for (const char* owned :
+             {"--array", "--output", "--error", "--dependency", "--open-mode", "-a", "-o", "-e", "-d"})
             checkOption(a != owned && a.rfind(std::string(owned) + "=", 0) != 0 &&
                             (std::string(owned).size() != 2 || a.rfind(owned, 0) != 0),
                         "--sbatch", a, "is set by skinlab itself");
@@ -228,8 +229,9 @@ SlurmScripts slurmScripts(const SlurmOptions& o) {
     // The spec is checked here, once, rather than failing in every task.
     BuildPlan plan = planBuild(o.spec, o.specOverrides, std::nullopt, o.assetsDir);
     if (static_cast<size_t>(o.shards) > plan.all.size())
-        throwInput("--shards", "", std::to_string(o.shards) + " is more than the " + std::to_string(plan.all.size()) +
-                                       " stimuli of set '" + plan.spec.name + "'");
+        throwInput("--shards", "",
+                   std::to_string(o.shards) + " is more than the " + std::to_string(plan.all.size()) +
+                       " stimuli of set '" + plan.spec.name + "'");
 
     const fs::path out = absoluteNormal(o.outputDir);
     std::error_code ec;
@@ -241,11 +243,13 @@ SlurmScripts slurmScripts(const SlurmOptions& o) {
                        "is not empty and holds no Slurm build (no slurm/jobs.json); choose a new or empty folder");
         if (!jobs.is_null()) {
             if (jobs.value("set", "") != plan.spec.name)
-                throwInput(out.string(), "", "holds a Slurm build of set '" + jobs.value("set", "") + "', not '" +
-                                                 plan.spec.name + "'; choose another folder");
+                throwInput(out.string(), "",
+                           "holds a Slurm build of set '" + jobs.value("set", "") + "', not '" + plan.spec.name +
+                               "'; choose another folder");
             if (jobs.value("shards", 0) != o.shards)
-                throwInput(out.string(), "", "was submitted with --shards " + std::to_string(jobs.value("shards", 0)) +
-                                                 "; use the same number or a new folder");
+                throwInput(out.string(), "",
+                           "was submitted with --shards " + std::to_string(jobs.value("shards", 0)) +
+                               "; use the same number or a new folder");
         }
     }
 
@@ -277,14 +281,14 @@ SlurmScripts slurmScripts(const SlurmOptions& o) {
       << "#SBATCH --output=" << (logs / "build-%A_%a.log").string() << "\n"
       << "#SBATCH --open-mode=append\n"
       << "#SBATCH --requeue\n"
-      << sbatchLines(o, true)
-      << "set -euo pipefail\n"
+      << sbatchLines(o, true) << "set -euo pipefail\n"
       << ": \"${SLURM_ARRAY_TASK_ID:?submit this script with sbatch: it is a job array}\"\n"
       << "n=" << o.shards << "\n"
       << "i=$((SLURM_ARRAY_TASK_ID + 1))\n"
       << "dir=" << shellQuote((out / "shards").string()) << "/$i\n"
       << "echo \"skinlab: shard $i/$n of set '" << plan.spec.name
-      << "' on $(hostname), job ${SLURM_ARRAY_JOB_ID}_${SLURM_ARRAY_TASK_ID}, attempt $((${SLURM_RESTART_COUNT:-0} + 1)),"
+      << "' on $(hostname), job ${SLURM_ARRAY_JOB_ID}_${SLURM_ARRAY_TASK_ID}, attempt $((${SLURM_RESTART_COUNT:-0} + "
+         "1)),"
          " $(date -u +%Y-%m-%dT%H:%M:%SZ)\"\n";
     if (o.assetsDir.empty()) {
         if (const char* assets = std::getenv("SKINLAB_ASSETS"); assets && *assets)
@@ -309,8 +313,7 @@ SlurmScripts slurmScripts(const SlurmOptions& o) {
       << "#SBATCH --job-name=skinlab-" << plan.spec.name << "-merge\n"
       << "#SBATCH --output=" << (logs / "merge-%j.log").string() << "\n"
       << "#SBATCH --open-mode=append\n"
-      << sbatchLines(o, false)
-      << "set -euo pipefail\n"
+      << sbatchLines(o, false) << "set -euo pipefail\n"
       << "echo \"skinlab: merging set '" << plan.spec.name
       << "' on $(hostname), job ${SLURM_JOB_ID}, $(date -u +%Y-%m-%dT%H:%M:%SZ)\"\n"
       << mergeCommand << "\n";
@@ -336,8 +339,13 @@ SlurmSubmission submitSlurm(const SlurmOptions& o) {
 
     nlohmann::json jobs = readJobs(out);
     if (jobs.is_null())
-        jobs = {{"format", kJobsFormat}, {"version", 1}, {"set", submission.scripts.set}, {"spec", absoluteNormal(o.spec).string()},
-                {"shards", o.shards}, {"stimuli", submission.scripts.stimuli}, {"submissions", nlohmann::json::array()}};
+        jobs = {{"format", kJobsFormat},
+                {"version", 1},
+                {"set", submission.scripts.set},
+                {"spec", absoluteNormal(o.spec).string()},
+                {"shards", o.shards},
+                {"stimuli", submission.scripts.stimuli},
+                {"submissions", nlohmann::json::array()}};
     // The new submission has its own merge job; an earlier one still waiting (on a failed shard, whose afterok
     // can never be satisfied, or on tasks now submitted again) is cancelled so that the set is merged once.
     if (!jobs["submissions"].empty()) {
@@ -382,15 +390,15 @@ SlurmSubmission submitSlurm(const SlurmOptions& o) {
 namespace {
 
 struct JobState {
-    std::string state;  // Slurm's word, e.g. RUNNING, PENDING, FAILED
+    std::string state; // Slurm's word, e.g. RUNNING, PENDING, FAILED
     std::string exitCode;
-    std::string reason;  // squeue's reason of a pending job, e.g. Dependency, DependencyNeverSatisfied
+    std::string reason; // squeue's reason of a pending job, e.g. Dependency, DependencyNeverSatisfied
 };
 
 // Slurm's view of the given job ids ("12_3", "13"): squeue for queued and recent jobs, then sacct (accounting),
 // then scontrol (jobs the controller still remembers, MinJobAge) for any id the others did not report.
-std::map<std::string, JobState> queryJobs(const std::vector<std::string>& arrayJobs, const std::vector<std::string>& plainJobs,
-                                          bool& queried) {
+std::map<std::string, JobState> queryJobs(const std::vector<std::string>& arrayJobs,
+                                          const std::vector<std::string>& plainJobs, bool& queried) {
     std::map<std::string, JobState> states;
     std::vector<std::string> all = arrayJobs;
     all.insert(all.end(), plainJobs.begin(), plainJobs.end());
@@ -428,7 +436,7 @@ std::map<std::string, JobState> queryJobs(const std::vector<std::string>& arrayJ
                 std::string field;
                 while (std::getline(fields, field, '|')) f.push_back(trim(field));
                 if (f.size() < 3) continue;
-                std::string word = f[1].substr(0, f[1].find(' '));  // "CANCELLED by 0"
+                std::string word = f[1].substr(0, f[1].find(' ')); // "CANCELLED by 0"
                 if (!states.count(f[0])) states[f[0]] = {word, f[2]};
                 else states[f[0]].exitCode = f[2];
             }
@@ -450,7 +458,7 @@ std::map<std::string, JobState> queryJobs(const std::vector<std::string>& arrayJ
                 std::string key = kv["JobId"];
                 if (kv.count("ArrayJobId") && kv.count("ArrayTaskId")) {
                     const std::string& task = kv["ArrayTaskId"];
-                    if (task.find_first_not_of("0123456789") != std::string::npos) continue;  // a pending range
+                    if (task.find_first_not_of("0123456789") != std::string::npos) continue; // a pending range
                     key = kv["ArrayJobId"] + "_" + task;
                 }
                 if (key.empty()) continue;
@@ -465,9 +473,10 @@ std::map<std::string, JobState> queryJobs(const std::vector<std::string>& arrayJ
 
 std::string shardStateOf(const std::string& slurmState) {
     static const std::map<std::string, std::string> words = {
-        {"PENDING", "pending"},   {"REQUEUED", "pending"},   {"REQUEUE_HOLD", "pending"}, {"REQUEUE_FED", "pending"},
-        {"RESV_DEL_HOLD", "pending"}, {"CONFIGURING", "running"}, {"RUNNING", "running"},   {"COMPLETING", "running"},
-        {"SUSPENDED", "running"}, {"STAGE_OUT", "running"},  {"SIGNALING", "running"},   {"RESIZING", "running"}};
+        {"PENDING", "pending"},     {"REQUEUED", "pending"},      {"REQUEUE_HOLD", "pending"},
+        {"REQUEUE_FED", "pending"}, {"RESV_DEL_HOLD", "pending"}, {"CONFIGURING", "running"},
+        {"RUNNING", "running"},     {"COMPLETING", "running"},    {"SUSPENDED", "running"},
+        {"STAGE_OUT", "running"},   {"SIGNALING", "running"},     {"RESIZING", "running"}};
     auto it = words.find(slurmState);
     return it == words.end() ? "" : it->second;
 }
@@ -489,12 +498,13 @@ SlurmStatus slurmStatus(const fs::path& outArg) {
     const fs::path out = absoluteNormal(outArg);
     nlohmann::json jobs = readJobs(out);
     if (jobs.is_null())
-        throwInput(out.string(), "", "holds no Slurm build (no slurm/jobs.json); submit one with `skinlab stimuli slurm`");
+        throwInput(out.string(), "",
+                   "holds no Slurm build (no slurm/jobs.json); submit one with `skinlab stimuli slurm`");
     SlurmStatus status;
     status.set = jobs.value("set", "");
     status.shards = jobs.value("shards", 0);
 
-    std::map<int, std::string> latestJob;  // shard → ARRAYID_TASK
+    std::map<int, std::string> latestJob; // shard → ARRAYID_TASK
     std::vector<std::string> arrayJobs, mergeJobs;
     for (const auto& sub : jobs["submissions"]) {
         std::string array = sub.value("array_job", "");
@@ -531,7 +541,7 @@ SlurmStatus slurmStatus(const fs::path& outArg) {
             std::string array = s.job.substr(0, s.job.find('_'));
             s.log = slurmFolder(out) / "logs" / ("build-" + s.job + ".log");
             auto state = slurm.find(s.job);
-            if (state == slurm.end()) state = slurm.find(array);  // a pending array not yet split into tasks
+            if (state == slurm.end()) state = slurm.find(array); // a pending array not yet split into tasks
             if (state != slurm.end()) {
                 s.slurmState = state->second.state;
                 if (!state->second.exitCode.empty() && state->second.exitCode != "0:0")
@@ -563,8 +573,7 @@ SlurmStatus slurmStatus(const fs::path& outArg) {
             if (state->second.reason == "DependencyNeverSatisfied")
                 status.mergeState += " (never runs: a shard failed; resubmit it)";
             else if (!state->second.reason.empty()) status.mergeState += " (" + state->second.reason + ")";
-        }
-        else if (merged && merged->complete) status.mergeState = "done";
+        } else if (merged && merged->complete) status.mergeState = "done";
         else if (state != slurm.end()) status.mergeState = "failed (" + state->second.state + ")";
         else status.mergeState = fs::exists(status.mergeLog) ? "failed" : "unknown";
     }

@@ -20,20 +20,20 @@ namespace skinlab::stimuli {
 
 struct SlurmOptions {
     std::filesystem::path spec;
-    std::vector<std::string> specOverrides;  // --set key=value, passed on to every task
+    std::vector<std::string> specOverrides; // --set key=value, passed on to every task
     std::filesystem::path outputDir;
-    std::filesystem::path assetsDir;          // empty: the tasks use $SKINLAB_ASSETS of the submitting shell
+    std::filesystem::path assetsDir; // empty: the tasks use $SKINLAB_ASSETS of the submitting shell
     int shards = 4;
-    int jobsPerTask = 1;                      // `build --jobs` in each task
+    int jobsPerTask = 1; // `build --jobs` in each task
     std::string partition, time, account, mem;
     int gpusPerTask = 0;
     int cpusPerTask = 0;
-    std::vector<std::string> sbatchArgs;      // further #SBATCH lines, e.g. --qos=high, --constraint=a100
-    std::optional<int> onlyShard;             // resubmit this shard alone (and a new merge job)
+    std::vector<std::string> sbatchArgs; // further #SBATCH lines, e.g. --qos=high, --constraint=a100
+    std::optional<int> onlyShard;        // resubmit this shard alone (and a new merge job)
     // Any resubmission cancels the previous submission's merge job if it is still pending.
     bool dryRun = false;
-    std::filesystem::path skinlab;            // the executable the tasks run; empty: this process's own
-    std::string command;                      // the command line, recorded for `status`
+    std::filesystem::path skinlab; // the executable the tasks run; empty: this process's own
+    std::string command;           // the command line, recorded for `status`
 };
 
 // Folder layout (see above).
@@ -43,10 +43,10 @@ std::filesystem::path mergedSetFolder(const std::filesystem::path& out);
 
 struct SlurmScripts {
     std::string set;
-    size_t stimuli = 0;       // in the whole set
+    size_t stimuli = 0; // in the whole set
     std::filesystem::path buildPath, mergePath;
     std::string build, merge;
-    std::vector<int> shards;  // the shards the array runs (1-based)
+    std::vector<int> shards; // the shards the array runs (1-based)
 };
 
 // Checks the spec (like `stimuli list`), the options and the output folder, and writes the two scripts' text.
@@ -55,9 +55,9 @@ SlurmScripts slurmScripts(const SlurmOptions& options);
 
 struct SlurmSubmission {
     SlurmScripts scripts;
-    std::string arrayJob;  // empty in a dry run
+    std::string arrayJob; // empty in a dry run
     std::string mergeJob;
-    std::string cancelledMergeJob;  // an earlier merge job still waiting, cancelled (the new submission merges)
+    std::string cancelledMergeJob; // an earlier merge job still waiting, cancelled (the new submission merges)
 };
 
 // Writes the scripts into OUT/slurm and submits them with `sbatch --parsable` (the merge with
@@ -68,22 +68,22 @@ SlurmSubmission submitSlurm(const SlurmOptions& options);
 
 struct ShardStatus {
     int index = 0;
-    std::string state;       // done, running, pending, failed, not started, not submitted
-    size_t done = 0, total = 0;  // stimuli in the shard's folder / in the shard
-    std::string job;         // ARRAYID_TASK of its latest submission
-    std::string slurmState;  // Slurm's word (RUNNING, FAILED, TIMEOUT, ...) and exit code, when Slurm knows it
-    std::filesystem::path log;    // the task's log file
-    std::string lastError;   // the last "skinlab: error/failure" line of a failed task's log
+    std::string state;          // done, running, pending, failed, not started, not submitted
+    size_t done = 0, total = 0; // stimuli in the shard's folder / in the shard
+    std::string job;            // ARRAYID_TASK of its latest submission
+    std::string slurmState;     // Slurm's word (RUNNING, FAILED, TIMEOUT, ...) and exit code, when Slurm knows it
+    std::filesystem::path log;  // the task's log file
+    std::string lastError;      // the last "skinlab: error/failure" line of a failed task's log
 };
 
 struct SlurmStatus {
     std::string set;
     int shards = 0;
     std::vector<ShardStatus> shard;
-    std::string mergeJob, mergeState;  // the latest merge job and its state (done when OUT/set is complete)
+    std::string mergeJob, mergeState; // the latest merge job and its state (done when OUT/set is complete)
     std::filesystem::path mergeLog;
-    std::string resubmit;              // the recorded command, for resubmitting a failed shard
-    bool slurmQueried = false;         // squeue/sacct/scontrol were found and asked
+    std::string resubmit;      // the recorded command, for resubmitting a failed shard
+    bool slurmQueried = false; // squeue/sacct/scontrol were found and asked
 };
 
 // The state of every shard of OUT, from the shard folders and, when available, squeue, sacct and scontrol.

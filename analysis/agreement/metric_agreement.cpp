@@ -82,9 +82,9 @@ const std::vector<MetricDefinition>& metricDefinitions() {
     return definitions;
 }
 
-std::vector<ConditionMetrics> conditionMetricsFromJson(
-    const nlohmann::json& metrics, const std::string& file,
-    const std::map<std::string, std::pair<std::string, std::string>>& conditionOfStimulus) {
+std::vector<ConditionMetrics>
+conditionMetricsFromJson(const nlohmann::json& metrics, const std::string& file,
+                         const std::map<std::string, std::pair<std::string, std::string>>& conditionOfStimulus) {
     if (!metrics.is_object() || metrics.value("format", "") != "skinlab-metrics" || !metrics.contains("comparisons") ||
         !metrics["comparisons"].is_array())
         throwInput(file, "format", "not a metrics.json written by `skinlab analyze metrics`");
@@ -95,7 +95,8 @@ std::vector<ConditionMetrics> conditionMetricsFromJson(
         auto found = conditionOfStimulus.find(name);
         if (found == conditionOfStimulus.end()) continue;
         ConditionMetrics row{found->second.first, found->second.second, name, {}};
-        for (const MetricDefinition& metric : metricDefinitions()) row.values[metric.key] = lookUp(comparison, metric.key);
+        for (const MetricDefinition& metric : metricDefinitions())
+            row.values[metric.key] = lookUp(comparison, metric.key);
         out.push_back(std::move(row));
     }
     return out;
@@ -141,13 +142,15 @@ AgreementResult computeAgreement(const scaling::Dataset& dataset, const scaling:
         for (const ConditionMetrics& row : metrics) {
             if (row.block != block.name) continue;
             auto it = std::find(block.conditions.begin(), block.conditions.end(), row.condition);
-            if (it != block.conditions.end()) byCondition[static_cast<std::size_t>(it - block.conditions.begin())] = &row;
+            if (it != block.conditions.end())
+                byCondition[static_cast<std::size_t>(it - block.conditions.begin())] = &row;
         }
         int withMetrics = 0;
         for (int i = 0; i < m; ++i) {
             if (byCondition[static_cast<std::size_t>(i)]) ++withMetrics;
             else if (std::any_of(metrics.begin(), metrics.end(), [&](const auto& r) { return r.block == block.name; }))
-                result.warnings.push_back(block.name + ": condition \"" + block.conditions[static_cast<std::size_t>(i)] +
+                result.warnings.push_back(block.name + ": condition \"" +
+                                          block.conditions[static_cast<std::size_t>(i)] +
                                           "\" has no metric values (not compared with a reference)");
         }
         if (withMetrics == 0) {

@@ -29,44 +29,44 @@ struct ConditionMetrics {
     std::string block;
     std::string condition;
     std::string stimulus;
-    std::map<std::string, double> values;  // by MetricDefinition::key
+    std::map<std::string, double> values; // by MetricDefinition::key
 };
 
 // Reads the comparisons of a metrics.json (format "skinlab-metrics"), keeping those whose test name is a key of
 // `conditionOfStimulus` (stimulus id → (block, condition)). Throws InputError naming `file` for a file that is
 // not a metrics.json.
-std::vector<ConditionMetrics> conditionMetricsFromJson(
-    const nlohmann::json& metrics, const std::string& file,
-    const std::map<std::string, std::pair<std::string, std::string>>& conditionOfStimulus);
+std::vector<ConditionMetrics>
+conditionMetricsFromJson(const nlohmann::json& metrics, const std::string& file,
+                         const std::map<std::string, std::pair<std::string, std::string>>& conditionOfStimulus);
 
 struct AgreementOptions {
-    int samples = 1000;      // bootstrap resamples of the observers
+    int samples = 1000; // bootstrap resamples of the observers
     std::uint64_t seed = 1;
-    double level = 0.95;     // two-sided percentile interval
+    double level = 0.95; // two-sided percentile interval
 };
 
 struct MetricAgreement {
     std::string block;
     MetricDefinition metric;
-    int conditions = 0;            // conditions with a finite value of the metric (and a JOD score)
-    double pearson = 0.0, pearsonLow = 0.0, pearsonHigh = 0.0;     // metric vs JOD; NaN when undefined
+    int conditions = 0; // conditions with a finite value of the metric (and a JOD score)
+    double pearson = 0.0, pearsonLow = 0.0, pearsonHigh = 0.0; // metric vs JOD; NaN when undefined
     double spearman = 0.0, spearmanLow = 0.0, spearmanHigh = 0.0;
-    int significantPairs = 0;      // pairs of these conditions separated significantly (scale analysis)
-    int predictedPairs = 0;        // of them, pairs the metric orders as the observers did (ties: not predicted)
-    double predictedShare = 0.0;   // predicted / significant; NaN without a significant pair
-    int bootstrapSamples = 0;      // resamples with a defined correlation
+    int significantPairs = 0;    // pairs of these conditions separated significantly (scale analysis)
+    int predictedPairs = 0;      // of them, pairs the metric orders as the observers did (ties: not predicted)
+    double predictedShare = 0.0; // predicted / significant; NaN without a significant pair
+    int bootstrapSamples = 0;    // resamples with a defined correlation
 };
 
 struct BlockScale {
     std::string block;
     std::vector<std::string> conditions;
-    std::vector<double> jod;  // per condition
+    std::vector<double> jod; // per condition
 };
 
 struct AgreementResult {
     AgreementOptions options;
     std::vector<BlockScale> scales;
-    std::vector<MetricAgreement> rows;  // per block, per metric in metricDefinitions() order
+    std::vector<MetricAgreement> rows; // per block, per metric in metricDefinitions() order
     std::vector<std::string> warnings;
 };
 
@@ -81,7 +81,7 @@ double pearsonCorrelation(const std::vector<double>& x, const std::vector<double
 // Spearman's ρ: Pearson of the ranks, ties sharing their mean rank.
 double spearmanCorrelation(const std::vector<double>& x, const std::vector<double>& y);
 
-nlohmann::json agreementJson(const AgreementResult& result);  // format "skinlab-agreement", version 1
-std::string agreementCsv(const AgreementResult& result);      // one row per block and metric
+nlohmann::json agreementJson(const AgreementResult& result); // format "skinlab-agreement", version 1
+std::string agreementCsv(const AgreementResult& result);     // one row per block and metric
 
 } // namespace skinlab::analysis::agreement

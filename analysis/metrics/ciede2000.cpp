@@ -53,7 +53,7 @@ double ciede2000(const Lab& first, const Lab& second) {
     // Step 3 (Eqs. 12-22): means, weighting functions and the blue-region rotation term.
     double meanLightness = 0.5 * (first.lightness + second.lightness);
     double meanChromaPrime = 0.5 * (chromaPrime1 + chromaPrime2);
-    double meanHue = hue1 + hue2;  // Eq. 14: the sum when either colour is neutral
+    double meanHue = hue1 + hue2; // Eq. 14: the sum when either colour is neutral
     if (!eitherNeutral) {
         if (std::fabs(hue1 - hue2) <= 180.0) meanHue = 0.5 * (hue1 + hue2);
         else if (hue1 + hue2 < 360.0) meanHue = 0.5 * (hue1 + hue2 + 360.0);
@@ -64,7 +64,7 @@ double ciede2000(const Lab& first, const Lab& second) {
                0.32 * std::cos((3.0 * meanHue + 6.0) * radiansPerDegree) -
                0.20 * std::cos((4.0 * meanHue - 63.0) * radiansPerDegree);
     double hueOffset = (meanHue - 275.0) / 25.0;
-    double deltaTheta = 30.0 * std::exp(-hueOffset * hueOffset);  // degrees
+    double deltaTheta = 30.0 * std::exp(-hueOffset * hueOffset); // degrees
     double meanChromaPrime7 = seventhPower(meanChromaPrime);
     double rotationChroma = 2.0 * std::sqrt(meanChromaPrime7 / (meanChromaPrime7 + twentyFiveToTheSeventh));
     double lightnessOffset2 = (meanLightness - 50.0) * (meanLightness - 50.0);
@@ -76,8 +76,8 @@ double ciede2000(const Lab& first, const Lab& second) {
     double lightnessTerm = deltaLightness / weightLightness;
     double chromaTerm = deltaChroma / weightChroma;
     double hueTerm = deltaHue / weightHue;
-    double squared = lightnessTerm * lightnessTerm + chromaTerm * chromaTerm + hueTerm * hueTerm +
-                     rotation * chromaTerm * hueTerm;
+    double squared =
+        lightnessTerm * lightnessTerm + chromaTerm * chromaTerm + hueTerm * hueTerm + rotation * chromaTerm * hueTerm;
     // The rotation term can make the sum a rounding error below zero for identical colours.
     return std::sqrt(squared > 0.0 ? squared : 0.0);
 }

@@ -7,9 +7,9 @@ namespace skinlab::metrics {
 
 // A CIELAB colour: L* in [0, 100], a*, b* unbounded.
 struct Lab {
-    double lightness = 0.0;  // L*
-    double a = 0.0;          // a*
-    double b = 0.0;          // b*
+    double lightness = 0.0; // L*
+    double a = 0.0;         // a*
+    double b = 0.0;         // b*
 };
 
 // ΔE00 between two CIELAB colours with the parametric factors kL = kC = kH = 1 (reference conditions).

@@ -7,21 +7,20 @@ namespace skinlab::metrics {
 namespace {
 
 // IEC 61966-2-1 (sRGB) RGB -> XYZ matrix for D65, to 7 decimals as in Lindbloom's tabulation.
-constexpr double matrix[3][3] = {{0.4124564, 0.3575761, 0.1804375},
-                                 {0.2126729, 0.7151522, 0.0721750},
-                                 {0.0193339, 0.1191920, 0.9503041}};
+constexpr double matrix[3][3] = {
+    {0.4124564, 0.3575761, 0.1804375}, {0.2126729, 0.7151522, 0.0721750}, {0.0193339, 0.1191920, 0.9503041}};
 // The white is the image of RGB (1, 1, 1) through the same matrix, so a neutral grey has a* = b* = 0 to rounding.
 constexpr double whiteX = matrix[0][0] + matrix[0][1] + matrix[0][2];
 constexpr double whiteY = matrix[1][0] + matrix[1][1] + matrix[1][2];
 constexpr double whiteZ = matrix[2][0] + matrix[2][1] + matrix[2][2];
 
-constexpr double epsilon = 216.0 / 24389.0;  // (6/29)^3
-constexpr double kappa = 24389.0 / 27.0;     // (29/3)^3
+constexpr double epsilon = 216.0 / 24389.0; // (6/29)^3
+constexpr double kappa = 24389.0 / 27.0;    // (29/3)^3
 
 double labCompand(double ratio) { return ratio > epsilon ? std::cbrt(ratio) : (kappa * ratio + 16.0) / 116.0; }
 
 double clipUnit(double value) {
-    if (!std::isfinite(value)) return value > 0.0 ? 1.0 : 0.0;  // +inf is over-exposed white; NaN and -inf black
+    if (!std::isfinite(value)) return value > 0.0 ? 1.0 : 0.0; // +inf is over-exposed white; NaN and -inf black
     return std::clamp(value, 0.0, 1.0);
 }
 

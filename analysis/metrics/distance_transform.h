@@ -7,8 +7,8 @@
 namespace skinlab::metrics {
 
 struct DistanceField {
-    cv::Mat distance;  // CV_32FC1: distance to the nearest feature pixel; +inf when the image has no feature
-    cv::Mat nearest;   // CV_32SC1: row-major index y·width + x of that feature pixel; −1 when there is none
+    cv::Mat distance; // CV_32FC1: distance to the nearest feature pixel; +inf when the image has no feature
+    cv::Mat nearest;  // CV_32SC1: row-major index y·width + x of that feature pixel; −1 when there is none
 };
 
 // `features`: CV_8UC1, non-zero marks a feature pixel.

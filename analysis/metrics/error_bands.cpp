@@ -51,7 +51,7 @@ ErrorBands buildErrorBands(const cv::Mat& depth, const cv::Mat& skinMask, const 
         float d1 = depth.at<float>(y1, x1);
         bool valid0 = validDepth(d0);
         bool valid1 = validDepth(d1);
-        if (!valid0 && !valid1) return;  // background next to background
+        if (!valid0 && !valid1) return; // background next to background
         bool jump = valid0 != valid1 || std::fabs(d0 - d1) > radiusWorld;
         if (jump) {
             bands.depthEdges.at<uint8_t>(y0, x0) = 255;

@@ -12,19 +12,19 @@ namespace skinlab::metrics {
 
 enum class Band { halo, bleed, spill, interior };
 inline constexpr std::array<Band, 4> allBands = {Band::halo, Band::bleed, Band::spill, Band::interior};
-std::string_view bandName(Band band);  // "halo", "bleed", "spill", "interior"
+std::string_view bandName(Band band); // "halo", "bleed", "spill", "interior"
 
 struct BandGeometry {
-    double supportRadiusWorld = 0.0;  // r_w = sss_radius_mm / mm_per_unit, world units
-    double focalLengthPixels = 0.0;   // f_px = (H/2) / tan(fovY/2)
+    double supportRadiusWorld = 0.0; // r_w = sss_radius_mm / mm_per_unit, world units
+    double focalLengthPixels = 0.0;  // f_px = (H/2) / tan(fovY/2)
 };
 
 struct ErrorBands {
-    cv::Mat skin;              // CV_8UC1 255 where mask ≥ 0.5
-    cv::Mat projectedRadius;   // CV_32FC1 ρ(p) in pixels; 0 where the depth is not finite and positive
-    cv::Mat depthEdges;        // CV_8UC1 255 on both pixels of every 4-neighbour pair whose depths differ by > r_w
-    cv::Mat materialEdges;     // CV_8UC1 255 on both pixels of every skin/non-skin 4-neighbour pair at continuous depth
-    std::array<cv::Mat, 4> masks;  // CV_8UC1 255 inside the band, indexed by Band; pairwise disjoint
+    cv::Mat skin;            // CV_8UC1 255 where mask ≥ 0.5
+    cv::Mat projectedRadius; // CV_32FC1 ρ(p) in pixels; 0 where the depth is not finite and positive
+    cv::Mat depthEdges;      // CV_8UC1 255 on both pixels of every 4-neighbour pair whose depths differ by > r_w
+    cv::Mat materialEdges;   // CV_8UC1 255 on both pixels of every skin/non-skin 4-neighbour pair at continuous depth
+    std::array<cv::Mat, 4> masks; // CV_8UC1 255 inside the band, indexed by Band; pairwise disjoint
     const cv::Mat& mask(Band band) const { return masks[static_cast<size_t>(band)]; }
 };
 

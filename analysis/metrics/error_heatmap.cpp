@@ -18,16 +18,16 @@ namespace {
 // Outline colours (BGR), chosen to stand apart from the black-purple-orange-yellow inferno ramp.
 cv::Scalar bandColour(Band band) {
     switch (band) {
-    case Band::halo: return {255, 255, 0};      // cyan
-    case Band::bleed: return {0, 255, 0};       // green
-    case Band::spill: return {255, 96, 0};      // blue
-    case Band::interior: return {255, 255, 255};  // white
+    case Band::halo: return {255, 255, 0};       // cyan
+    case Band::bleed: return {0, 255, 0};        // green
+    case Band::spill: return {255, 96, 0};       // blue
+    case Band::interior: return {255, 255, 255}; // white
     }
     return {128, 128, 128};
 }
 
-constexpr int legendWidth = 170;        // pixels; fits "interior" and "10.0+" at the font scale below
-constexpr int legendMinimumHeight = 260;  // the colour bar and the four band keys
+constexpr int legendWidth = 170;         // pixels; fits "interior" and "10.0+" at the font scale below
+constexpr int legendMinimumHeight = 260; // the colour bar and the four band keys
 constexpr double fontScale = 0.45;
 const cv::Scalar legendBackground{40, 40, 40};
 const cv::Scalar textColour{235, 235, 235};
@@ -70,7 +70,8 @@ cv::Mat renderErrorHeatmap(const cv::Mat& deltaE00, const ErrorBands& bands, dou
 
     // Legend: a vertical colour bar (top = scaleMax and above), then the band outline keys.
     const int left = heat.cols + 12;
-    cv::putText(canvas, "dE00 (CIEDE2000)", {left, 18}, cv::FONT_HERSHEY_SIMPLEX, fontScale, textColour, 1, cv::LINE_AA);
+    cv::putText(canvas, "dE00 (CIEDE2000)", {left, 18}, cv::FONT_HERSHEY_SIMPLEX, fontScale, textColour, 1,
+                cv::LINE_AA);
     const int barTop = 30;
     const int barHeight = 120;
     const int barWidth = 18;
@@ -145,6 +146,8 @@ cv::Mat renderFlipHeatmap(const cv::Mat& flip) {
     return canvas;
 }
 
-void writeFlipHeatmap(const std::filesystem::path& path, const cv::Mat& flip) { writePng(path, renderFlipHeatmap(flip)); }
+void writeFlipHeatmap(const std::filesystem::path& path, const cv::Mat& flip) {
+    writePng(path, renderFlipHeatmap(flip));
+}
 
 } // namespace skinlab::metrics

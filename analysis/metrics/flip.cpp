@@ -24,11 +24,11 @@ constexpr double rgbToXyz[3][3] = {{10135552.0 / 24577794.0, 8788810.0 / 2457779
 constexpr double whiteX = 0.950428545, whiteY = 1.0, whiteZ = 1.088900371;
 
 // Perceptual exponents and remapping constants of the paper (§4).
-constexpr double colourExponent = 0.7;    // q_c
-constexpr double featureExponent = 0.5;   // q_f
-constexpr double remapBreak = 0.4;        // p_c
-constexpr double remapTarget = 0.95;      // p_t
-constexpr double featureSigmaDegrees = 0.5 * 0.082;  // σ of the feature detectors: half the 0.082° peak spacing
+constexpr double colourExponent = 0.7;              // q_c
+constexpr double featureExponent = 0.5;             // q_f
+constexpr double remapBreak = 0.4;                  // p_c
+constexpr double remapTarget = 0.95;                // p_t
+constexpr double featureSigmaDegrees = 0.5 * 0.082; // σ of the feature detectors: half the 0.082° peak spacing
 
 struct Vec3 {
     double v[3];
@@ -57,7 +57,8 @@ const Matrix3& xyzToRgb() {
 }
 
 Vec3 multiply(const double m[3][3], const Vec3& x) {
-    return {{m[0][0] * x.v[0] + m[0][1] * x.v[1] + m[0][2] * x.v[2], m[1][0] * x.v[0] + m[1][1] * x.v[1] + m[1][2] * x.v[2],
+    return {{m[0][0] * x.v[0] + m[0][1] * x.v[1] + m[0][2] * x.v[2],
+             m[1][0] * x.v[0] + m[1][1] * x.v[1] + m[1][2] * x.v[2],
              m[2][0] * x.v[0] + m[2][1] * x.v[1] + m[2][2] * x.v[2]}};
 }
 
@@ -180,8 +181,8 @@ FeatureKernels featureKernels(double sigma) {
     for (int i = -radius; i <= radius; ++i) {
         double x = i;
         double g = std::exp(-x * x / (2.0 * sigma * sigma));
-        double edge = -x * g;                                   // ∝ dg/dx
-        double point = (x * x / (sigma * sigma) - 1.0) * g;     // ∝ d²g/dx²
+        double edge = -x * g;                               // ∝ dg/dx
+        double point = (x * x / (sigma * sigma) - 1.0) * g; // ∝ d²g/dx²
         k.gaussian.at<double>(i + radius) = g;
         k.edge.at<double>(i + radius) = edge;
         k.point.at<double>(i + radius) = point;
@@ -200,14 +201,16 @@ FeatureKernels featureKernels(double sigma) {
 }
 
 struct Features {
-    cv::Mat edge, point;  // magnitudes, CV_64FC1
+    cv::Mat edge, point; // magnitudes, CV_64FC1
 };
 
 Features detectFeatures(const cv::Mat& achromatic, const FeatureKernels& k) {
     auto magnitude = [&](const cv::Mat& derivative) {
         cv::Mat alongX, alongY;
-        cv::sepFilter2D(achromatic, alongX, CV_64F, derivative, k.gaussian, cv::Point(-1, -1), 0.0, cv::BORDER_REPLICATE);
-        cv::sepFilter2D(achromatic, alongY, CV_64F, k.gaussian, derivative, cv::Point(-1, -1), 0.0, cv::BORDER_REPLICATE);
+        cv::sepFilter2D(achromatic, alongX, CV_64F, derivative, k.gaussian, cv::Point(-1, -1), 0.0,
+                        cv::BORDER_REPLICATE);
+        cv::sepFilter2D(achromatic, alongY, CV_64F, k.gaussian, derivative, cv::Point(-1, -1), 0.0,
+                        cv::BORDER_REPLICATE);
         cv::Mat result;
         cv::magnitude(alongX, alongY, result);
         return result;
@@ -248,7 +251,7 @@ cv::Mat flipErrorMap(const cv::Mat& referenceLinear, const cv::Mat& testLinear, 
 
     auto prepare = [&](const cv::Mat& linear, cv::Mat& lab, Features& features) {
         std::array<cv::Mat, 3> planes = toYCxCz(linear, exposure);
-        cv::Mat luminance = (planes[0] + 16.0) / 116.0;  // normalised achromatic y, unfiltered
+        cv::Mat luminance = (planes[0] + 16.0) / 116.0; // normalised achromatic y, unfiltered
         features = detectFeatures(luminance, kernels);
         std::array<cv::Mat, 3> filtered = {filterCsf(planes[0], achromatic, radius, ppd),
                                            filterCsf(planes[1], redGreen, radius, ppd),
@@ -271,7 +274,8 @@ cv::Mat flipErrorMap(const cv::Mat& referenceLinear, const cv::Mat& testLinear, 
         const double* pt = featuresTest.point.ptr<double>(y);
         double* out = map.ptr<double>(y);
         for (int x = 0; x < map.cols; ++x) {
-            double colour = std::pow(hyab({{r[x][0], r[x][1], r[x][2]}}, {{t[x][0], t[x][1], t[x][2]}}), colourExponent);
+            double colour =
+                std::pow(hyab({{r[x][0], r[x][1], r[x][2]}}, {{t[x][0], t[x][1], t[x][2]}}), colourExponent);
             double colourError = remapColourDifference(colour, maximum);
             double featureDifference = std::max(std::fabs(er[x] - et[x]), std::fabs(pr[x] - pt[x]));
             double featureError = std::pow(inverseSqrt2 * featureDifference, featureExponent);

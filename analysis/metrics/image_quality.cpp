@@ -9,7 +9,7 @@
 
 namespace skinlab::metrics {
 namespace {
-constexpr double peakValue = 255.0;  // QualityPSNR::MAX_PIXEL_VALUE_DEFAULT, and the scale SSIM's constants assume
+constexpr double peakValue = 255.0; // QualityPSNR::MAX_PIXEL_VALUE_DEFAULT, and the scale SSIM's constants assume
 }
 
 double peakSignalToNoiseRatio(const cv::Mat& reference, const cv::Mat& test, const cv::Mat& mask) {

@@ -86,7 +86,7 @@ namespace {
 struct OpenedRender {
     std::unique_ptr<OIIO::ImageInput> input;
     MetricRender render;
-    int channels[5] = {-1, -1, -1, -1, -1};  // R, G, B, depth.Z, mask.Y
+    int channels[5] = {-1, -1, -1, -1, -1}; // R, G, B, depth.Z, mask.Y
 };
 
 OpenedRender openMetricRender(const std::filesystem::path& path, RenderRole role, ImageEncoding encoding) {
@@ -126,8 +126,7 @@ OpenedRender openMetricRender(const std::filesystem::path& path, RenderRole role
     render.millimetresPerUnit = floatAttribute(spec, file, "skinlab:mm_per_unit", reference);
     // Not required here: `--sss-radius-mm` may stand in for it (prepareReference checks).
     // A test render's radius is never used (a render without SSS stores 0), so only a reference's is checked.
-    if (reference)
-        render.sssRadiusMillimetres = floatAttribute(spec, file, "skinlab:sss_radius_mm", false);
+    if (reference) render.sssRadiusMillimetres = floatAttribute(spec, file, "skinlab:sss_radius_mm", false);
     return opened;
 }
 

@@ -54,9 +54,8 @@ std::string metricsCsv(const std::vector<ComparisonRecord>& records) {
         for (const char* field : {"pixels", "psnr_db", "ssim", "delta_e00_mean", "delta_e00_p95", "flip_mean"})
             out += std::string(",") + region + "_" + field;
     for (Band band : allBands)
-        for (const char* field :
-             {"pixels", "fraction_of_image", "fraction_of_skin", "delta_e00_mean", "delta_e00_p95", "flip_mean", "excess",
-              "leak_energy"})
+        for (const char* field : {"pixels", "fraction_of_image", "fraction_of_skin", "delta_e00_mean", "delta_e00_p95",
+                                  "flip_mean", "excess", "leak_energy"})
             out += "," + std::string(bandName(band)) + "_" + field;
     out += ",heatmap,flip_heatmap,bands_measured\n";
     for (const ComparisonRecord& record : records) {
@@ -67,13 +66,14 @@ std::string metricsCsv(const std::vector<ComparisonRecord>& records) {
             out += "," + csvNumber(v);
         for (const RegionScores* region : {&record.image, &record.skin}) {
             out += "," + std::to_string(region->pixels);
-            for (double v : {region->psnrDecibels, region->ssim, region->deltaE00Mean, region->deltaE00P95, region->flipMean})
+            for (double v :
+                 {region->psnrDecibels, region->ssim, region->deltaE00Mean, region->deltaE00P95, region->flipMean})
                 out += "," + csvNumber(v);
         }
         for (const BandScores& band : record.bands) {
             out += "," + std::to_string(band.pixels);
-            for (double v : {band.fractionOfImage, band.fractionOfSkin, band.deltaE00Mean, band.deltaE00P95, band.flipMean,
-                             band.excess, band.leakEnergy})
+            for (double v : {band.fractionOfImage, band.fractionOfSkin, band.deltaE00Mean, band.deltaE00P95,
+                             band.flipMean, band.excess, band.leakEnergy})
                 out += "," + csvNumber(v);
         }
         out += "," + csvText(record.heatmap) + "," + csvText(record.flipHeatmap) + "," +
@@ -116,9 +116,10 @@ nlohmann::json metricsJson(const std::vector<ComparisonRecord>& records, const R
               {"skin_mask_threshold", 0.5},
               {"percentile", "p95 with linear interpolation between order statistics"},
               {"heatmap_max_delta_e00", settings.heatmapMax},
-              {"flip", {{"variant", "LDR-FLIP (Andersson et al. 2020)"},
-                        {"pixels_per_degree", settings.pixelsPerDegree},
-                        {"input", "linear RGB x exposure, clamped to [0,1]"}}},
+              {"flip",
+               {{"variant", "LDR-FLIP (Andersson et al. 2020)"},
+                {"pixels_per_degree", settings.pixelsPerDegree},
+                {"input", "linear RGB x exposure, clamped to [0,1]"}}},
               {"encoding", imageEncodingName(settings.encoding)}}},
             {"blocks_without_reference", blocksWithoutReference},
             {"comparisons", comparisons}};

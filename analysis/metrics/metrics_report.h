@@ -22,9 +22,9 @@ struct ComparisonRecord {
     RegionScores image;
     RegionScores skin;
     std::array<BandScores, 4> bands;
-    std::string heatmap;  // path relative to the output folder; "" when heat maps are off
-    std::string flipHeatmap;  // the FLIP map, likewise
-    bool bandsMeasured = true;  // false: plain reference, skin and band scores undefined (null / empty cells)
+    std::string heatmap;       // path relative to the output folder; "" when heat maps are off
+    std::string flipHeatmap;   // the FLIP map, likewise
+    bool bandsMeasured = true; // false: plain reference, skin and band scores undefined (null / empty cells)
 };
 
 struct ReportSettings {

@@ -52,17 +52,15 @@ std::vector<ComparisonRecord> runMetrics(const ComparisonPlan& plan, const Metri
     for (const ComparisonJob& job : plan.jobs) {
         auto found = prepared.find(job.referencePath);
         if (found == prepared.end()) {
-            prepared.clear();  // jobs are grouped by reference; keep one in memory at a time
-            auto reference = std::make_shared<const PreparedReference>(
-                prepareReference(loadMetricRender(job.referencePath, RenderRole::reference, options.metric.encoding),
-                                 options.metric));
+            prepared.clear(); // jobs are grouped by reference; keep one in memory at a time
+            auto reference = std::make_shared<const PreparedReference>(prepareReference(
+                loadMetricRender(job.referencePath, RenderRole::reference, options.metric.encoding), options.metric));
             found = prepared.emplace(job.referencePath, reference).first;
         }
         const PreparedReference& reference = *found->second;
         spdlog::info("metrics: {} vs {}", job.testName, job.referenceName);
-        ComparisonResult result =
-            compareWithReference(reference, loadMetricRender(job.testPath, RenderRole::test, options.metric.encoding),
-                                 options.metric);
+        ComparisonResult result = compareWithReference(
+            reference, loadMetricRender(job.testPath, RenderRole::test, options.metric.encoding), options.metric);
 
         ComparisonRecord record;
         record.job = job;
@@ -88,7 +86,8 @@ std::vector<ComparisonRecord> runMetrics(const ComparisonPlan& plan, const Metri
     writeFileAtomic(outputFolder / "metrics.csv", metricsCsv(records));
     ReportSettings settings{options.metric.exposure, options.heatmapMax, options.metric.pixelsPerDegree,
                             options.metric.encoding};
-    writeFileAtomic(outputFolder / "metrics.json", metricsJson(records, settings, plan.blocksWithoutReference).dump(2) + "\n");
+    writeFileAtomic(outputFolder / "metrics.json",
+                    metricsJson(records, settings, plan.blocksWithoutReference).dump(2) + "\n");
     return records;
 }
 

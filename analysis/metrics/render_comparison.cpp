@@ -26,9 +26,9 @@ std::string formatNumber(double value) {
 std::string sizeText(int width, int height) { return std::to_string(width) + "x" + std::to_string(height); }
 
 struct EncodedImage {
-    cv::Mat lab;        // CV_64FC3
-    cv::Mat luminance;  // CV_64FC1
-    cv::Mat display;    // CV_64FC3 on 0–255
+    cv::Mat lab;       // CV_64FC3
+    cv::Mat luminance; // CV_64FC1
+    cv::Mat display;   // CV_64FC3 on 0–255
 };
 
 EncodedImage encode(const cv::Mat& beauty, double exposure) {
@@ -229,7 +229,7 @@ ComparisonResult compareWithReference(const PreparedReference& reference, const 
         scores.leakEnergy = reference.skinLuminanceSum > 0.0 ? leakSum / reference.skinLuminanceSum : notANumber;
     }
     double interiorMean = result.band(Band::interior).deltaE00Mean;
-    for (auto& scores : result.bands) scores.excess = scores.deltaE00Mean - interiorMean;  // NaN propagates
+    for (auto& scores : result.bands) scores.excess = scores.deltaE00Mean - interiorMean; // NaN propagates
     return result;
 }
 

@@ -32,10 +32,10 @@ struct PreparedReference {
     BandGeometry geometry;
     double sssRadiusMillimetres = 0.0;
     ErrorBands bands;
-    cv::Mat lab;        // CV_64FC3 L*, a*, b* of the display encoding
-    cv::Mat luminance;  // CV_64FC1 linear Y (× exposure), unclipped, for the leak energy
-    cv::Mat display;    // CV_64FC3 sRGB-encoded R, G, B on 0–255 for PSNR and SSIM
-    double skinLuminanceSum = 0.0;  // Σ_skin Y_R
+    cv::Mat lab;                   // CV_64FC3 L*, a*, b* of the display encoding
+    cv::Mat luminance;             // CV_64FC1 linear Y (× exposure), unclipped, for the leak energy
+    cv::Mat display;               // CV_64FC3 sRGB-encoded R, G, B on 0–255 for PSNR and SSIM
+    double skinLuminanceSum = 0.0; // Σ_skin Y_R
 };
 
 // Throws InputError "--exposure: V must be a positive number" (or --sss-radius-mm) for a bad option.
@@ -46,31 +46,31 @@ PreparedReference prepareReference(MetricRender reference, const MetricOptions& 
 
 struct RegionScores {
     std::size_t pixels = 0;
-    double psnrDecibels = 0.0;   // +inf when identical on the region
-    double ssim = 0.0;           // mean SSIM over the region
+    double psnrDecibels = 0.0; // +inf when identical on the region
+    double ssim = 0.0;         // mean SSIM over the region
     double deltaE00Mean = 0.0;
-    double deltaE00P95 = 0.0;    // 95th percentile, linear interpolation between order statistics
-    double flipMean = 0.0;       // mean LDR-FLIP over the region (pooled in double)
+    double deltaE00P95 = 0.0; // 95th percentile, linear interpolation between order statistics
+    double flipMean = 0.0;    // mean LDR-FLIP over the region (pooled in double)
 };
 
 struct BandScores {
     std::size_t pixels = 0;
     double fractionOfImage = 0.0;
-    double fractionOfSkin = 0.0;  // band pixels / skin pixels (NaN without skin)
-    double deltaE00Mean = 0.0;    // NaN for an empty band
-    double deltaE00P95 = 0.0;     // NaN for an empty band
-    double flipMean = 0.0;        // mean LDR-FLIP over the band; NaN for an empty band
-    double excess = 0.0;          // band mean − interior mean; NaN if either is empty
-    double leakEnergy = 0.0;      // Σ_band |Y_T − Y_R| / Σ_skin Y_R; NaN without skin luminance
+    double fractionOfSkin = 0.0; // band pixels / skin pixels (NaN without skin)
+    double deltaE00Mean = 0.0;   // NaN for an empty band
+    double deltaE00P95 = 0.0;    // NaN for an empty band
+    double flipMean = 0.0;       // mean LDR-FLIP over the band; NaN for an empty band
+    double excess = 0.0;         // band mean − interior mean; NaN if either is empty
+    double leakEnergy = 0.0;     // Σ_band |Y_T − Y_R| / Σ_skin Y_R; NaN without skin luminance
 };
 
 struct ComparisonResult {
-    bool bandsMeasured = true;        // false for a plain reference: `skin` and `bands` are all NaN (0 pixels)
+    bool bandsMeasured = true; // false for a plain reference: `skin` and `bands` are all NaN (0 pixels)
     RegionScores image;
     RegionScores skin;
-    std::array<BandScores, 4> bands;  // indexed by Band
-    cv::Mat deltaE00;                 // CV_32FC1 per-pixel ΔE00
-    cv::Mat flip;                     // CV_64FC1 per-pixel LDR-FLIP
+    std::array<BandScores, 4> bands; // indexed by Band
+    cv::Mat deltaE00;                // CV_32FC1 per-pixel ΔE00
+    cv::Mat flip;                    // CV_64FC1 per-pixel LDR-FLIP
     const BandScores& band(Band b) const { return bands[static_cast<std::size_t>(b)]; }
 };
 

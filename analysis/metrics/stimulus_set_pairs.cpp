@@ -16,8 +16,9 @@ ComparisonPlan planFileComparisons(const fs::path& reference, const std::vector<
     for (const fs::path& test : tests) {
         std::string name = test.stem().string();
         if (auto [it, inserted] = seen.emplace(name, test); !inserted)
-            throwInput(test.string(), "", "test name '" + name + "' repeats (" + it->second.string() +
-                                              "); heat maps are named after the file stem, so rename one");
+            throwInput(test.string(), "",
+                       "test name '" + name + "' repeats (" + it->second.string() +
+                           "); heat maps are named after the file stem, so rename one");
         plan.jobs.push_back({reference.stem().string(), reference, name, test, "", nlohmann::json::object()});
     }
     return plan;
@@ -48,7 +49,8 @@ std::string stringMember(const nlohmann::json& object, const std::string& key, c
 
 } // namespace
 
-ComparisonPlan planStimulusSetComparisons(const fs::path& stimulusFolder, const std::optional<std::string>& referenceId) {
+ComparisonPlan planStimulusSetComparisons(const fs::path& stimulusFolder,
+                                          const std::optional<std::string>& referenceId) {
     const fs::path manifestPath = stimulusFolder / "manifest.json";
     const std::string file = manifestPath.string();
     std::error_code ec;
@@ -113,8 +115,9 @@ ComparisonPlan planStimulusSetComparisons(const fs::path& stimulusFolder, const 
         for (const StimulusEntry& entry : entries) {
             if (!entry.reference) continue;
             if (auto [it, inserted] = references.emplace(entry.block, &entry); !inserted)
-                throwInput(file, "", "block '" + entry.block + "' has two reference stimuli ('" + it->second->id +
-                                         "' and '" + entry.id + "'); pick one with --reference ID");
+                throwInput(file, "",
+                           "block '" + entry.block + "' has two reference stimuli ('" + it->second->id + "' and '" +
+                               entry.id + "'); pick one with --reference ID");
         }
         if (references.empty())
             throwInput(file, "", "no stimulus has \"reference\": true; name one with --reference ID");

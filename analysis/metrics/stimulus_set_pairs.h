@@ -11,17 +11,17 @@
 namespace skinlab::metrics {
 
 struct ComparisonJob {
-    std::string referenceName;  // file stem or stimulus id
+    std::string referenceName; // file stem or stimulus id
     std::filesystem::path referencePath;
-    std::string testName;       // file stem or stimulus id; names the heat map, so unique within a run
+    std::string testName; // file stem or stimulus id; names the heat map, so unique within a run
     std::filesystem::path testPath;
-    std::string block;          // the stimulus block ("" for files)
-    nlohmann::json factors = nlohmann::json::object();  // the test stimulus's factor levels ({} for files)
+    std::string block;                                 // the stimulus block ("" for files)
+    nlohmann::json factors = nlohmann::json::object(); // the test stimulus's factor levels ({} for files)
 };
 
 struct ComparisonPlan {
     std::vector<ComparisonJob> jobs;
-    std::vector<std::string> blocksWithoutReference;  // stimulus-set blocks that were skipped, in manifest order
+    std::vector<std::string> blocksWithoutReference; // stimulus-set blocks that were skipped, in manifest order
 };
 
 // One reference file against each test file. Throws InputError when two tests share a file stem.

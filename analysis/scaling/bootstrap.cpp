@@ -36,8 +36,8 @@ Eigen::MatrixXd robustCovariance(const BlockData& block, const Eigen::VectorXd& 
         slopeSecond[p] = linkValues(model, -d).slope;
     }
     // Per observer and pair: d/d(q_i − q_j) of that observer's log-likelihood.
-    const Eigen::MatrixXd pairGradient =
-        block.winsFirst.array().rowwise() * slopeFirst.array() - block.winsSecond.array().rowwise() * slopeSecond.array();
+    const Eigen::MatrixXd pairGradient = block.winsFirst.array().rowwise() * slopeFirst.array() -
+                                         block.winsSecond.array().rowwise() * slopeSecond.array();
     Eigen::MatrixXd gradient = Eigen::MatrixXd::Zero(block.observerCount(), m);
     for (Eigen::Index p = 0; p < pairCount; ++p) {
         gradient.col(block.pairs[p].first) += pairGradient.col(p);
@@ -83,7 +83,8 @@ DesignStructure designStructure(const BlockData& block) {
         }
         if (structure.stronglyConnected[i] < 0) {
             for (int j = i; j < m; ++j)
-                if (reachBeat[i][j] && reachBeat[j][i]) structure.stronglyConnected[j] = structure.stronglyConnectedComponents;
+                if (reachBeat[i][j] && reachBeat[j][i])
+                    structure.stronglyConnected[j] = structure.stronglyConnectedComponents;
             ++structure.stronglyConnectedComponents;
         }
     }
@@ -235,7 +236,7 @@ BootstrapResult bootstrapObservers(const BlockData& block, const FitResult& fit,
     // Differences: the same symmetric studentized construction. The p-value reads the spread of |t*| off its
     // 95 % quantile, p = 2Φ(−|t_obs|·1.95996 / |t|*_(0.95)), so p < 0.05 exactly when the 95 % interval excludes 0,
     // and it extrapolates smoothly to the small p-values a Holm correction over many pairs needs.
-    const double normalQuantile975 = 1.959963984540054;  // Φ⁻¹(0.975)
+    const double normalQuantile975 = 1.959963984540054; // Φ⁻¹(0.975)
     int k = 0;
     for (int i = 0; i < m; ++i)
         for (int j = i + 1; j < m; ++j, ++k) {

@@ -33,7 +33,7 @@ struct BootstrapOptions {
     int samples = 1000;
     std::uint64_t seed = 1;
     int threads = 2;
-    double level = 0.95;  // two-sided confidence level
+    double level = 0.95; // two-sided confidence level
 };
 
 // Observer-cluster-robust covariance of the mean-zero scores at `fit`, from observers weighted by `weights`
@@ -44,16 +44,16 @@ Eigen::MatrixXd robustCovariance(const BlockData& block, const Eigen::VectorXd& 
 // Why an interval is not the studentized one (empty: it is). Names as written to scale.json.
 struct IntervalDiagnosis {
     bool fallback = false;
-    std::vector<std::string> reasons;  // "disconnected", "unanimous", "observers-agree", "zero-spread-resamples",
-                                       // "extreme-t", "bound-at-search-cap"
+    std::vector<std::string> reasons; // "disconnected", "unanimous", "observers-agree", "zero-spread-resamples",
+                                      // "extreme-t", "bound-at-search-cap"
 };
 
 struct DifferenceTest {
-    int first = 0, second = 0;  // condition indices, first < second
-    double difference = 0.0;    // q_first − q_second (JOD)
+    int first = 0, second = 0; // condition indices, first < second
+    double difference = 0.0;   // q_first − q_second (JOD)
     double standardError = 0.0;
-    double low = 0.0, high = 0.0;  // studentized interval of the difference (or the fallback, see diagnosis)
-    double pValue = 1.0;           // two-sided, unadjusted (studentized, or the score test for a fallback)
+    double low = 0.0, high = 0.0; // studentized interval of the difference (or the fallback, see diagnosis)
+    double pValue = 1.0;          // two-sided, unadjusted (studentized, or the score test for a fallback)
     IntervalDiagnosis diagnosis;
 };
 
@@ -61,8 +61,8 @@ struct DifferenceTest {
 // connected components of the win graph ("i beat j at least once"). Within a strongly connected component every
 // difference has a finite ML estimate; across two, the data bound it on one side only.
 struct DesignStructure {
-    std::vector<int> component;          // per condition
-    std::vector<int> stronglyConnected;  // per condition
+    std::vector<int> component;         // per condition
+    std::vector<int> stronglyConnected; // per condition
     int components = 0, stronglyConnectedComponents = 0;
 };
 DesignStructure designStructure(const BlockData& block);
@@ -72,11 +72,11 @@ struct BootstrapResult {
     Eigen::VectorXd standardError;      // robust (sandwich) SE of each score
     Eigen::VectorXd low, high;          // studentized bootstrap interval, or the fallback (see scoreDiagnoses)
     Eigen::VectorXd modelStandardError; // from the posterior information (Fisher), for the diagnosis
-    std::vector<IntervalDiagnosis> scoreDiagnoses;  // per condition
-    Eigen::VectorXd percentileLow, percentileHigh;  // pwcmp's construction, for comparison only
+    std::vector<IntervalDiagnosis> scoreDiagnoses; // per condition
+    Eigen::VectorXd percentileLow, percentileHigh; // pwcmp's construction, for comparison only
     Eigen::VectorXd bootstrapMean;
     Eigen::MatrixXd bootstrapCovariance;
-    std::vector<DifferenceTest> differences;  // every pair i < j, compared or not
+    std::vector<DifferenceTest> differences; // every pair i < j, compared or not
 };
 
 // Requires at least 2 observers. Deterministic for a given seed, whatever the thread count.

@@ -35,7 +35,7 @@ BlockData blockFromMatrix(const ResponseTable& table, const DatasetOptions& opti
     block.hasObservers = false;
     block.observers = {"(count matrix)"};
     const size_t m = table.matrixConditions.size();
-    std::vector<int> order(m);  // order[k] = position in the header of the k-th analysed condition
+    std::vector<int> order(m); // order[k] = position in the header of the k-th analysed condition
     if (options.conditionOrder.empty()) {
         block.conditions = table.matrixConditions;
         for (size_t k = 0; k < m; ++k) order[k] = static_cast<int>(k);
@@ -50,9 +50,9 @@ BlockData blockFromMatrix(const ResponseTable& table, const DatasetOptions& opti
             throwInput(table.file, "--conditions", "lists conditions that are not in the count matrix");
         block.conditions = options.conditionOrder;
         for (size_t k = 0; k < m; ++k)
-            order[k] = static_cast<int>(std::find(table.matrixConditions.begin(), table.matrixConditions.end(),
-                                                  options.conditionOrder[k]) -
-                                        table.matrixConditions.begin());
+            order[k] = static_cast<int>(
+                std::find(table.matrixConditions.begin(), table.matrixConditions.end(), options.conditionOrder[k]) -
+                table.matrixConditions.begin());
     }
     std::vector<double> first, second;
     for (size_t i = 0; i < m; ++i)
@@ -103,8 +103,9 @@ Dataset buildDataset(const ResponseTable& table, const DatasetOptions& options) 
     if (table.format == ResponseFormat::CountMatrix) {
         dataset.blocks.push_back(blockFromMatrix(table, options));
         if (!options.onlyBlock.empty() && options.onlyBlock != dataset.blocks.front().name)
-            throwInput(table.file, "--block", "no block '" + options.onlyBlock + "' (a count matrix has one block, '" +
-                                                  dataset.blocks.front().name + "')");
+            throwInput(table.file, "--block",
+                       "no block '" + options.onlyBlock + "' (a count matrix has one block, '" +
+                           dataset.blocks.front().name + "')");
         return dataset;
     }
 
@@ -128,8 +129,7 @@ Dataset buildDataset(const ResponseTable& table, const DatasetOptions& options) 
                 for (const auto& name : options.conditionOrder) conditions[b].add(name);
         }
         const int attentionIndex = allObservers.add(r.observer);
-        if (static_cast<size_t>(attentionIndex) == dataset.attention.size())
-            dataset.attention.push_back({r.observer});
+        if (static_cast<size_t>(attentionIndex) == dataset.attention.size()) dataset.attention.push_back({r.observer});
         ObserverAttention& attention = dataset.attention[attentionIndex];
         if (r.aOnLeft) dataset.hasSides = true;
         if (r.kind == TrialKind::Catch) {
@@ -145,14 +145,15 @@ Dataset buildDataset(const ResponseTable& table, const DatasetOptions& options) 
         for (const auto& [name, column] : {std::pair{&r.conditionA, "condition_A"}, {&r.conditionB, "condition_B"}}) {
             if (!options.conditionOrder.empty() && conditions[b].find(*name) < 0)
                 throwInput(table.file, "line " + std::to_string(r.line) + ": column " + column,
-                           "unknown condition '" + *name + "' (not in --conditions " +
-                               joined(options.conditionOrder) + ")");
+                           "unknown condition '" + *name + "' (not in --conditions " + joined(options.conditionOrder) +
+                               ")");
             conditions[b].add(*name);
         }
         observers[b].add(r.observer);
     }
     if (!options.onlyBlock.empty() && blocks.find(options.onlyBlock) < 0)
-        throwInput(table.file, "--block", "no block '" + options.onlyBlock + "' (blocks: " + joined(blocks.names) + ")");
+        throwInput(table.file, "--block",
+                   "no block '" + options.onlyBlock + "' (blocks: " + joined(blocks.names) + ")");
 
     // Pass 2: counts.
     std::vector<BlockData> built(blocks.names.size());
@@ -199,7 +200,7 @@ Dataset buildDataset(const ResponseTable& table, const DatasetOptions& options) 
     }
     for (size_t b = 0; b < built.size(); ++b) {
         if (!options.onlyBlock.empty() && built[b].name != options.onlyBlock) continue;
-        if (built[b].pairs.empty()) continue;  // a block with only catch/practice trials has nothing to scale
+        if (built[b].pairs.empty()) continue; // a block with only catch/practice trials has nothing to scale
         dataset.blocks.push_back(std::move(built[b]));
     }
     if (dataset.blocks.empty())

@@ -15,7 +15,7 @@ TriadConsistency kendallZeta(const BlockData& block, int observer) {
     for (size_t p = 0; p < block.pairs.size(); ++p) {
         const double first = block.winsFirst(observer, static_cast<Eigen::Index>(p));
         const double second = block.winsSecond(observer, static_cast<Eigen::Index>(p));
-        if (first + second <= 0) return result;  // this observer skipped a pair
+        if (first + second <= 0) return result; // this observer skipped a pair
         const double firstScore = first > second ? 1.0 : (first < second ? 0.0 : 0.5);
         score[block.pairs[p].first] += firstScore;
         score[block.pairs[p].second] += 1.0 - firstScore;
@@ -55,7 +55,8 @@ SideBias estimateSideBias(const BlockData& block, const Eigen::VectorXd& scores,
             const double d = scores[block.pairs[p].first] - scores[block.pairs[p].second];
             const double b = result.bias;
             // (count, argument of F, sign of ∂argument/∂b)
-            const double terms[4][3] = {{c[0], d + b, 1.0}, {c[1], -d - b, -1.0}, {c[2], d - b, -1.0}, {c[3], -d + b, 1.0}};
+            const double terms[4][3] = {
+                {c[0], d + b, 1.0}, {c[1], -d - b, -1.0}, {c[2], d - b, -1.0}, {c[3], -d + b, 1.0}};
             for (const auto& term : terms) {
                 if (term[0] <= 0) continue;
                 const LinkValues v = linkValues(model, term[1]);

@@ -17,22 +17,22 @@
 namespace skinlab::analysis::scaling {
 
 struct TriadConsistency {
-    bool complete = false;          // the observer judged every pair of the block
-    double circularTriads = 0.0;    // c (can be fractional with ties)
-    double maximumTriads = 0.0;     // c_max
-    std::optional<double> zeta;     // 1 − c/c_max; absent if incomplete or m < 3
+    bool complete = false;       // the observer judged every pair of the block
+    double circularTriads = 0.0; // c (can be fractional with ties)
+    double maximumTriads = 0.0;  // c_max
+    std::optional<double> zeta;  // 1 − c/c_max; absent if incomplete or m < 3
 };
 TriadConsistency kendallZeta(const BlockData& block, int observer);
 
-std::optional<double> kendallU(const BlockData& block);  // absent when no pair has ≥ 2 judgments
+std::optional<double> kendallU(const BlockData& block); // absent when no pair has ≥ 2 judgments
 
 struct SideBias {
-    bool available = false;    // trials with a known side exist
+    bool available = false; // trials with a known side exist
     double trials = 0.0;
-    double leftRate = 0.0;     // fraction of those trials answered "left"
-    double bias = 0.0;         // JOD added to the left stimulus (positive: left preferred)
+    double leftRate = 0.0; // fraction of those trials answered "left"
+    double bias = 0.0;     // JOD added to the left stimulus (positive: left preferred)
     double standardError = 0.0;
-    double pValue = 1.0;       // two-sided Wald test of b = 0
+    double pValue = 1.0; // two-sided Wald test of b = 0
 };
 SideBias estimateSideBias(const BlockData& block, const Eigen::VectorXd& scores, Model model);
 

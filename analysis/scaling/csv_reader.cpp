@@ -9,17 +9,17 @@ std::vector<CsvRecord> parseCsv(std::string_view text, const std::string& file) 
     size_t position = 0;
     // A UTF-8 byte-order mark (spreadsheet exports) is not part of the first column name.
     if (text.substr(0, 3) == "\xEF\xBB\xBF") position = 3;
-    int line = 1;  // line of the character at `position`
+    int line = 1; // line of the character at `position`
     while (position < text.size()) {
         CsvRecord record;
         record.line = line;
         std::string field;
-        bool quoted = false;      // inside double quotes
-        bool wasQuoted = false;   // the current field had a quoted part (its spaces are kept)
-        bool blank = true;        // only spaces and tabs so far
+        bool quoted = false;    // inside double quotes
+        bool wasQuoted = false; // the current field had a quoted part (its spaces are kept)
+        bool blank = true;      // only spaces and tabs so far
         int quoteLine = line;
         auto finishField = [&] {
-            if (!wasQuoted) {  // trim spaces around unquoted values
+            if (!wasQuoted) { // trim spaces around unquoted values
                 const size_t first = field.find_first_not_of(" \t");
                 const size_t last = field.find_last_not_of(" \t");
                 field = first == std::string::npos ? std::string() : field.substr(first, last - first + 1);
@@ -38,7 +38,7 @@ std::vector<CsvRecord> parseCsv(std::string_view text, const std::string& file) 
                 } else if (c == '"') {
                     quoted = false;
                 } else {
-                    if (c == '\n') ++line;  // a quoted line break is part of the field
+                    if (c == '\n') ++line; // a quoted line break is part of the field
                     field += c;
                 }
                 continue;
@@ -61,7 +61,7 @@ std::vector<CsvRecord> parseCsv(std::string_view text, const std::string& file) 
             }
         }
         if (quoted) throwInput(file, "line " + std::to_string(quoteLine), "unterminated double quote");
-        if (blank) continue;  // blank line
+        if (blank) continue; // blank line
         finishField();
         records.push_back(std::move(record));
     }

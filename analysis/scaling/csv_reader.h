@@ -8,7 +8,7 @@
 namespace skinlab::analysis::scaling {
 
 struct CsvRecord {
-    int line = 0;  // 1-based line number in the file
+    int line = 0; // 1-based line number in the file
     std::vector<std::string> fields;
 };
 

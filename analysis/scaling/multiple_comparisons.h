@@ -9,7 +9,7 @@ namespace skinlab::analysis::scaling {
 
 enum class Correction { Holm, Bonferroni, None };
 const char* correctionName(Correction correction);
-Correction parseCorrection(const std::string& name);  // throws InputError for anything else
+Correction parseCorrection(const std::string& name); // throws InputError for anything else
 
 // Adjusted p-values (reject when adjusted < α), in the input order.
 std::vector<double> adjustPValues(const std::vector<double>& pValues, Correction correction);

@@ -15,9 +15,9 @@ constexpr double kProbitClamp = 35.0;
 
 LinkValues probit(double difference) {
     const double x = std::clamp(difference / kThurstoneSigma, -kProbitClamp, kProbitClamp);
-    const double cdf = 0.5 * std::erfc(-x * kInverseSqrt2);  // accurate in the lower tail, unlike 1 − erfc
+    const double cdf = 0.5 * std::erfc(-x * kInverseSqrt2); // accurate in the lower tail, unlike 1 − erfc
     const double density = kInverseSqrt2Pi * std::exp(-0.5 * x * x);
-    const double mills = density / cdf;  // inverse Mills ratio λ(x) = φ(x)/Φ(x)
+    const double mills = density / cdf; // inverse Mills ratio λ(x) = φ(x)/Φ(x)
     return {std::log(cdf), mills / kThurstoneSigma, -mills * (x + mills) / (kThurstoneSigma * kThurstoneSigma)};
 }
 
@@ -80,7 +80,8 @@ void assemble(const PairCounts& counts, const FitOptions& options, const Eigen::
     const double sum = q.sum();
     // prior: −τ/2 Σ_{i<j}(q_i − q_j)²  ⇒  gradient −τ(m q − Σq), negative Hessian τ(m I − 1 1ᵀ);
     // mean penalty −½(Σq)²  ⇒  gradient −Σq, negative Hessian 1 1ᵀ.
-    gradient = -options.priorPrecision * (md * q - Eigen::VectorXd::Constant(m, sum)) - Eigen::VectorXd::Constant(m, sum);
+    gradient =
+        -options.priorPrecision * (md * q - Eigen::VectorXd::Constant(m, sum)) - Eigen::VectorXd::Constant(m, sum);
     information.setConstant(m, m, 1.0 - options.priorPrecision);
     information.diagonal().array() += options.priorPrecision * md;
     for (size_t p = 0; p < counts.pairs.size(); ++p) {
@@ -117,7 +118,7 @@ FitResult fitScores(const PairCounts& counts, const FitOptions& options, const E
     FitResult result;
     result.scores = start ? *start : Eigen::VectorXd::Zero(m);
     Eigen::VectorXd gradient(m);
-    Eigen::MatrixXd information(m, m);  // negative Hessian of the log posterior, plus 1 1ᵀ for the mean
+    Eigen::MatrixXd information(m, m); // negative Hessian of the log posterior, plus 1 1ᵀ for the mean
     double current = objective(counts, options, result.scores, nullptr);
     const double md = static_cast<double>(m);
 

@@ -15,8 +15,8 @@ namespace skinlab::analysis::scaling {
 inline constexpr double kThurstoneSigma = 1.4826;
 
 enum class Model {
-    Thurstone,    // probit link, σ = 1.4826 (JOD)
-    BradleyTerry  // logistic link P = 1/(1 + 3^(−d)), so 1 JOD is also exactly 75 %
+    Thurstone,   // probit link, σ = 1.4826 (JOD)
+    BradleyTerry // logistic link P = 1/(1 + 3^(−d)), so 1 JOD is also exactly 75 %
 };
 
 const char* modelName(Model model);
@@ -24,9 +24,9 @@ const char* modelName(Model model);
 // Link function of a model in JOD units: F(d) = P(i ≻ j) for d = q_i − q_j, with the first two derivatives of
 // log F, which are all Newton's method needs.
 struct LinkValues {
-    double logProbability;  // log F(d)
-    double slope;           // d/dd log F(d)
-    double curvature;       // d²/dd² log F(d)   (≤ 0: the log-likelihood is concave)
+    double logProbability; // log F(d)
+    double slope;          // d/dd log F(d)
+    double curvature;      // d²/dd² log F(d)   (≤ 0: the log-likelihood is concave)
 };
 LinkValues linkValues(Model model, double difference);
 double preferenceProbability(Model model, double difference);
@@ -47,14 +47,14 @@ struct FitOptions {
     // yet bounds a unanimous 10:0 pair (at 4.96 JOD) and ties the components of a disconnected design together.
     double priorPrecision = 0.002;
     int maxIterations = 100;
-    double tolerance = 1e-10;  // stop when the largest Newton step is below this (JOD)
+    double tolerance = 1e-10; // stop when the largest Newton step is below this (JOD)
 };
 
 struct FitResult {
-    Eigen::VectorXd scores;               // JOD, mean 0
-    Eigen::MatrixXd inverseInformation;   // (−∇² log posterior + 1 1ᵀ)⁻¹ at the optimum; its diagonal is the
-                                          // Fisher (model-based) variance of the mean-zero scores
-    double logLikelihood = 0.0;           // data term only (no prior)
+    Eigen::VectorXd scores;             // JOD, mean 0
+    Eigen::MatrixXd inverseInformation; // (−∇² log posterior + 1 1ᵀ)⁻¹ at the optimum; its diagonal is the
+                                        // Fisher (model-based) variance of the mean-zero scores
+    double logLikelihood = 0.0;         // data term only (no prior)
     int iterations = 0;
     bool converged = false;
 };
@@ -70,8 +70,8 @@ double logPosterior(const PairCounts& counts, const FitOptions& options, const E
 struct ConstrainedFit {
     Eigen::VectorXd scores;
     double logPosterior = 0.0;
-    Eigen::VectorXd gradient;      // of the log posterior at `scores` (parallel to a at the optimum)
-    Eigen::MatrixXd information;   // negative Hessian of the log posterior plus 1 1ᵀ, at `scores`
+    Eigen::VectorXd gradient;    // of the log posterior at `scores` (parallel to a at the optimum)
+    Eigen::MatrixXd information; // negative Hessian of the log posterior plus 1 1ᵀ, at `scores`
     bool converged = false;
 };
 ConstrainedFit fitConstrained(const PairCounts& counts, const FitOptions& options, const Eigen::VectorXd& contrast,

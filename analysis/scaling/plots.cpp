@@ -13,7 +13,7 @@ namespace skinlab::analysis::scaling {
 namespace {
 
 const cv::Scalar kBlack(0, 0, 0), kGrey(150, 150, 150), kLightGrey(225, 225, 225), kWhite(255, 255, 255);
-const cv::Scalar kBlue(180, 90, 30), kOrange(0, 120, 230);  // BGR
+const cv::Scalar kBlue(180, 90, 30), kOrange(0, 120, 230); // BGR
 constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 
 // OpenCV's Hershey fonts draw ASCII only; other bytes become '?'. Long labels are shortened with "..".
@@ -79,7 +79,8 @@ cv::Mat plotScores(const BlockAnalysis& block) {
         low = std::min(low, clip(block.low[i], windowLow));
         high = std::max(high, clip(block.high[i], windowHigh));
         anyClipped = anyClipped || clipped(block.low[i]) || clipped(block.high[i]);
-        anyFallback = anyFallback || (static_cast<size_t>(i) < block.intervalFlags.size() && block.intervalFlags[i].fallback);
+        anyFallback =
+            anyFallback || (static_cast<size_t>(i) < block.intervalFlags.size() && block.intervalFlags[i].fallback);
     }
     const double range = std::max(high - low, 0.5);
     low -= 0.08 * range;
@@ -94,7 +95,8 @@ cv::Mat plotScores(const BlockAnalysis& block) {
     const double first = std::ceil(low / step);
     for (int g = 0; g <= 13 && (first + g) * step <= high; ++g) {
         const double value = (first + g) * step;
-        cv::line(image, {left, y(value)}, {width - right, y(value)}, std::abs(value) < 0.5 * step ? kGrey : kLightGrey, 1);
+        cv::line(image, {left, y(value)}, {width - right, y(value)}, std::abs(value) < 0.5 * step ? kGrey : kLightGrey,
+                 1);
         text(image, format(step < 1.0 ? "%.1f" : "%.0f", value), {left - 8, y(value) + 5}, 0.45, kBlack, 2);
     }
     cv::rectangle(image, {left, plotTop}, {width - right, plotBottom}, kBlack, 1);
@@ -109,13 +111,13 @@ cv::Mat plotScores(const BlockAnalysis& block) {
         cv::line(image, {x, yLow}, {x, yHigh}, colour, 2, cv::LINE_AA);
         // A bound inside the axis ends in a cap; a clipped one in an arrow head pointing off the axis.
         if (clipped(block.low[i]))
-            cv::fillConvexPoly(image, std::vector<cv::Point>{{x - 7, yLow - 10}, {x + 7, yLow - 10}, {x, yLow}}, colour, cv::LINE_AA);
-        else
-            cv::line(image, {x - 8, yLow}, {x + 8, yLow}, colour, 2, cv::LINE_AA);
+            cv::fillConvexPoly(image, std::vector<cv::Point>{{x - 7, yLow - 10}, {x + 7, yLow - 10}, {x, yLow}}, colour,
+                               cv::LINE_AA);
+        else cv::line(image, {x - 8, yLow}, {x + 8, yLow}, colour, 2, cv::LINE_AA);
         if (clipped(block.high[i]))
-            cv::fillConvexPoly(image, std::vector<cv::Point>{{x - 7, yHigh + 10}, {x + 7, yHigh + 10}, {x, yHigh}}, colour, cv::LINE_AA);
-        else
-            cv::line(image, {x - 8, yHigh}, {x + 8, yHigh}, colour, 2, cv::LINE_AA);
+            cv::fillConvexPoly(image, std::vector<cv::Point>{{x - 7, yHigh + 10}, {x + 7, yHigh + 10}, {x, yHigh}},
+                               colour, cv::LINE_AA);
+        else cv::line(image, {x - 8, yHigh}, {x + 8, yHigh}, colour, 2, cv::LINE_AA);
         if (std::isfinite(block.thurstone.scores[i]))
             cv::circle(image, {x, y(block.thurstone.scores[i])}, 5, kBlack, cv::FILLED, cv::LINE_AA);
         // Alternate label rows so long names of neighbours do not overlap.
@@ -128,7 +130,8 @@ cv::Mat plotScores(const BlockAnalysis& block) {
              kOrange);
         legend += 18;
     }
-    if (anyClipped) text(image, "arrow: the interval continues beyond the axis (values in the table)", {left, legend}, 0.4, kBlack);
+    if (anyClipped)
+        text(image, "arrow: the interval continues beyond the axis (values in the table)", {left, legend}, 0.4, kBlack);
     return image;
 }
 
@@ -142,8 +145,8 @@ cv::Mat plotPreferenceMatrix(const BlockAnalysis& block) {
     for (int i = 0; i < m; ++i) {
         text(image, label(block.conditions[i], 18), {left - 8, top + i * cell + cell / 2 + 5}, 0.42, kBlack, 2);
         // Column labels: staggered in two rows above the matrix.
-        text(image, label(block.conditions[i], cell >= 64 ? 9 : 6), {left + i * cell + cell / 2, top - 14 - (i % 2) * 22},
-             0.4, kBlack, 1);
+        text(image, label(block.conditions[i], cell >= 64 ? 9 : 6),
+             {left + i * cell + cell / 2, top - 14 - (i % 2) * 22}, 0.4, kBlack, 1);
         for (int j = 0; j < m; ++j) {
             const cv::Rect rect(left + j * cell, top + i * cell, cell, cell);
             const double wins = block.counts(i, j), total = block.counts(i, j) + block.counts(j, i);
@@ -155,7 +158,8 @@ cv::Mat plotPreferenceMatrix(const BlockAnalysis& block) {
                 const cv::Scalar ink = std::abs(probability - 0.5) > 0.3 ? kWhite : kBlack;
                 text(image, format("%.0f%%", 100.0 * probability), {rect.x + cell / 2, rect.y + cell / 2}, fontScale,
                      ink, 1);
-                text(image, format("n=%.0f", total), {rect.x + cell / 2, rect.y + cell / 2 + 16}, fontScale * 0.8, ink, 1);
+                text(image, format("n=%.0f", total), {rect.x + cell / 2, rect.y + cell / 2 + 16}, fontScale * 0.8, ink,
+                     1);
             }
             cv::rectangle(image, rect, kGrey, 1);
         }
@@ -163,7 +167,8 @@ cv::Mat plotPreferenceMatrix(const BlockAnalysis& block) {
     // Colour bar 0 % .. 100 %.
     const int barX = left + cell * m + 20, barTop = top, barHeight = cell * m;
     for (int r = 0; r < barHeight; ++r)
-        cv::line(image, {barX, barTop + r}, {barX + 16, barTop + r}, diverging(1.0 - static_cast<double>(r) / barHeight));
+        cv::line(image, {barX, barTop + r}, {barX + 16, barTop + r},
+                 diverging(1.0 - static_cast<double>(r) / barHeight));
     cv::rectangle(image, {barX, barTop}, {barX + 16, barTop + barHeight}, kGrey, 1);
     text(image, "100%", {barX, barTop - 6}, 0.38, kBlack);
     text(image, "0%", {barX, barTop + barHeight + 16}, 0.38, kBlack);

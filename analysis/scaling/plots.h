@@ -13,6 +13,6 @@ namespace skinlab::analysis::scaling {
 
 cv::Mat plotScores(const BlockAnalysis& block);
 cv::Mat plotPreferenceMatrix(const BlockAnalysis& block);
-std::string encodePng(const cv::Mat& image);  // PNG bytes
+std::string encodePng(const cv::Mat& image); // PNG bytes
 
 } // namespace skinlab::analysis::scaling

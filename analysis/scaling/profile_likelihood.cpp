@@ -11,10 +11,8 @@ double normalQuantile(double probability) {
     double low = -40.0, high = 40.0;
     for (int iteration = 0; iteration < 200 && high - low > 1e-14; ++iteration) {
         const double middle = 0.5 * (low + high);
-        if (0.5 * std::erfc(-middle / std::sqrt(2.0)) < probability)
-            low = middle;
-        else
-            high = middle;
+        if (0.5 * std::erfc(-middle / std::sqrt(2.0)) < probability) low = middle;
+        else high = middle;
     }
     return 0.5 * (low + high);
 }
@@ -22,7 +20,7 @@ double normalQuantile(double probability) {
 ProfileInterval profileInterval(const PairCounts& counts, const FitOptions& options, const FitResult& fit,
                                 const Eigen::VectorXd& contrast, double level) {
     const double z = normalQuantile(0.5 + 0.5 * level);
-    const double target = z * z;  // χ²₁ quantile at `level`
+    const double target = z * z; // χ²₁ quantile at `level`
     const double top = logPosterior(counts, options, fit.scores);
     const double estimate = contrast.dot(fit.scores);
     const double wald = std::sqrt(std::max(contrast.dot(fit.inverseInformation * contrast), 0.0));
@@ -30,7 +28,8 @@ ProfileInterval profileInterval(const PairCounts& counts, const FitOptions& opti
     for (const int side : {-1, 1}) {
         Eigen::VectorXd warm = fit.scores;
         auto drop = [&](double offset) {
-            const ConstrainedFit constrained = fitConstrained(counts, options, contrast, estimate + side * offset, warm);
+            const ConstrainedFit constrained =
+                fitConstrained(counts, options, contrast, estimate + side * offset, warm);
             warm = constrained.scores;
             return 2.0 * (top - constrained.logPosterior);
         };
@@ -50,10 +49,8 @@ ProfileInterval profileInterval(const PairCounts& counts, const FitOptions& opti
         if (bracketed) {
             for (int step = 0; step < 60 && outside - inside > 1e-5; ++step) {
                 const double middle = 0.5 * (inside + outside);
-                if (drop(middle) >= target)
-                    outside = middle;
-                else
-                    inside = middle;
+                if (drop(middle) >= target) outside = middle;
+                else inside = middle;
             }
         }
         const double bound = estimate + side * outside;

@@ -17,11 +17,11 @@
 namespace skinlab::analysis::scaling {
 
 // Bounds farther than this from the estimate are not searched for: the bound is reported at the cap, flagged.
-inline constexpr double kProfileSearchCap = 200.0;  // JOD
+inline constexpr double kProfileSearchCap = 200.0; // JOD
 
 struct ProfileInterval {
     double low = 0.0, high = 0.0;
-    bool lowAtCap = false, highAtCap = false;  // the posterior did not fall enough within kProfileSearchCap
+    bool lowAtCap = false, highAtCap = false; // the posterior did not fall enough within kProfileSearchCap
 };
 
 // Profile interval of θ = aᵀq at the given two-sided level; `fit` is the unconstrained maximum of `counts`.

@@ -18,16 +18,16 @@
 namespace skinlab::analysis::scaling {
 namespace {
 
-const std::array<const char*, 9> kSkinlabColumns = {"observer",      "scene",     "condition_A",
-                                                    "condition_B",   "is_A_selected", "A_on_left",
-                                                    "trial_kind",    "correct",   "response_ms"};
+const std::array<const char*, 9> kSkinlabColumns = {"observer",    "scene",         "condition_A",
+                                                    "condition_B", "is_A_selected", "A_on_left",
+                                                    "trial_kind",  "correct",       "response_ms"};
 const std::array<const char*, 5> kPwcmpColumns = {"observer", "scene", "condition_A", "condition_B", "is_A_selected"};
 // Columns `skinlab study export` appends to both CSV formats (online studies); accepted after either set.
 const std::array<const char*, 20> kOnlineColumns = {
-    "flagged",          "page_hidden",      "focus_lost",       "fullscreen",          "device_pixel_ratio",
-    "dpr_changed",      "viewport_width",   "viewport_height",  "screen_width",        "screen_height",
-    "screen_width_px",  "screen_height_px", "colour_depth",     "pixels_per_mm",       "viewing_distance_mm",
-    "pixels_per_degree", "platform",        "external_id",      "external_study_id",   "external_session_id"};
+    "flagged",           "page_hidden",      "focus_lost",      "fullscreen",        "device_pixel_ratio",
+    "dpr_changed",       "viewport_width",   "viewport_height", "screen_width",      "screen_height",
+    "screen_width_px",   "screen_height_px", "colour_depth",    "pixels_per_mm",     "viewing_distance_mm",
+    "pixels_per_degree", "platform",         "external_id",     "external_study_id", "external_session_id"};
 
 std::string where(int line, std::string_view column) {
     std::string out = "line " + std::to_string(line);
@@ -141,13 +141,13 @@ void readCountMatrix(ResponseTable& table, const std::vector<CsvRecord>& records
             throwInput(table.file, where(record.line, "condition"),
                        "unknown condition '" + record.fields[0] + "' (not in the header: " + joined(names) + ")");
         const size_t row = found->second;
-        if (seen[row]) throwInput(table.file, where(record.line, "condition"), "row '" + names[row] + "' appears twice");
+        if (seen[row])
+            throwInput(table.file, where(record.line, "condition"), "row '" + names[row] + "' appears twice");
         seen[row] = true;
         for (size_t col = 0; col < m; ++col) {
             const double count = parseNumber(table.file, record.line, names[col], record.fields[col + 1]);
             if (count < 0)
-                throwInput(table.file, where(record.line, names[col]),
-                           "negative count " + record.fields[col + 1]);
+                throwInput(table.file, where(record.line, names[col]), "negative count " + record.fields[col + 1]);
             if (row == col && count != 0)
                 throwInput(table.file, where(record.line, names[col]),
                            "condition '" + names[row] + "' is compared with itself (diagonal count " +
@@ -193,15 +193,14 @@ ResponseTable readCsv(const std::filesystem::path& path) {
                                " or a count matrix header 'condition,<names>'");
         for (const auto& name : expected)
             if (!headerSet.count(name))
-                throwInput(table.file, where(records.front().line, name), "missing column; expected the columns " +
+                throwInput(table.file, where(records.front().line, name),
+                           "missing column; expected the columns " +
                                (closerToPwcmp ? joined(kPwcmpColumns) : joined(kSkinlabColumns)));
         throwInput(table.file, where(records.front().line, ""), "unrecognised header");
     }
     if (records.size() < 2) throwInput(table.file, "", "no responses after the header line");
-    if (table.format == ResponseFormat::CountMatrix)
-        readCountMatrix(table, records);
-    else
-        readLongCsv(table, records);
+    if (table.format == ResponseFormat::CountMatrix) readCountMatrix(table, records);
+    else readLongCsv(table, records);
     return table;
 }
 
@@ -235,7 +234,8 @@ ResponseTable readJson(const std::filesystem::path& path) {
             }
             const nlohmann::json& v = entry[key];
             if (v.is_boolean()) return v.get<bool>();
-            if (v.is_number_integer() && (v.get<std::int64_t>() == 0 || v.get<std::int64_t>() == 1)) return v.get<std::int64_t>() == 1;
+            if (v.is_number_integer() && (v.get<std::int64_t>() == 0 || v.get<std::int64_t>() == 1))
+                return v.get<std::int64_t>() == 1;
             throwInput(table.file, at + "." + key, "'" + v.dump() + "' is not 0 or 1");
         };
         Response response;
@@ -276,13 +276,14 @@ ResponseTable readDatabase(const std::filesystem::path& path) {
             sqlite3_close(database);
         }
     } closer{database};
-    sqlite3_busy_timeout(database, 5000);  // the study server may be writing
+    sqlite3_busy_timeout(database, 5000); // the study server may be writing
     // `flagged` (online studies) is in the view of study files written or opened by a newer skinlab.
     bool hasFlagged = false;
     {
         sqlite3_stmt* probe = nullptr;
-        if (sqlite3_prepare_v2(database, "SELECT COUNT(*) FROM pragma_table_info('responses_long') WHERE name = 'flagged'",
-                               -1, &probe, nullptr) == SQLITE_OK &&
+        if (sqlite3_prepare_v2(database,
+                               "SELECT COUNT(*) FROM pragma_table_info('responses_long') WHERE name = 'flagged'", -1,
+                               &probe, nullptr) == SQLITE_OK &&
             sqlite3_step(probe) == SQLITE_ROW)
             hasFlagged = sqlite3_column_int(probe, 0) == 1;
         sqlite3_finalize(probe);
@@ -298,7 +299,8 @@ ResponseTable readDatabase(const std::filesystem::path& path) {
     closer.statement = nullptr;
     const std::string query =
         std::string("SELECT observer, scene, condition_A, condition_B, is_A_selected, A_on_left, trial_kind, correct, "
-                    "response_ms") + (hasFlagged ? ", flagged" : "") + " FROM responses_long";
+                    "response_ms") +
+        (hasFlagged ? ", flagged" : "") + " FROM responses_long";
     if (sqlite3_prepare_v2(database, query.c_str(), -1, &closer.statement, nullptr) != SQLITE_OK)
         throwInput(table.file, "responses_long",
                    std::string("cannot read the responses view: ") + sqlite3_errmsg(database));

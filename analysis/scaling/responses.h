@@ -21,23 +21,23 @@ const char* trialKindName(TrialKind kind);
 
 struct Response {
     std::string observer;
-    std::string block;  // contract 3's column `scene` (the block name, e.g. "builtin:head/mid")
+    std::string block; // contract 3's column `scene` (the block name, e.g. "builtin:head/mid")
     std::string conditionA;
     std::string conditionB;
     bool aSelected = false;
-    std::optional<bool> aOnLeft;  // unknown in pwcmp files
+    std::optional<bool> aOnLeft; // unknown in pwcmp files
     TrialKind kind = TrialKind::Test;
-    std::optional<bool> correct;  // catch trials only
+    std::optional<bool> correct; // catch trials only
     std::optional<double> responseMs;
-    std::optional<bool> flagged;  // page hidden or focus lost while shown (online studies); unknown when absent
-    int line = 0;  // 1-based line (CSV) or row (SQLite) it came from, for error messages
+    std::optional<bool> flagged; // page hidden or focus lost while shown (online studies); unknown when absent
+    int line = 0;                // 1-based line (CSV) or row (SQLite) it came from, for error messages
 };
 
 enum class ResponseFormat { StudyDatabase, SkinlabCsv, PwcmpCsv, CountMatrix, SkinlabJson };
 const char* responseFormatName(ResponseFormat format);
 
 struct ResponseTable {
-    std::string file;  // as given, used as the prefix of every error message
+    std::string file; // as given, used as the prefix of every error message
     ResponseFormat format = ResponseFormat::SkinlabCsv;
     std::vector<Response> responses;
     // Count-matrix files only: the block's conditions (header order) and the counts D (row-major, m × m).

@@ -114,7 +114,8 @@ BlockAnalysis analyzeBlock(const BlockData& block, const AnalysisOptions& option
     // Intervals and tests.
     std::vector<double> pValues;
     if (n >= 2 && options.intervals == IntervalMethod::bootstrap) {
-        const BootstrapResult bootstrap = bootstrapObservers(block, result.thurstone, thurstoneOptions, options.bootstrap);
+        const BootstrapResult bootstrap =
+            bootstrapObservers(block, result.thurstone, thurstoneOptions, options.bootstrap);
         result.intervalMethod = "studentized-bootstrap";
         result.bootstrapSamples = bootstrap.samples;
         result.standardError = bootstrap.standardError;
@@ -143,7 +144,8 @@ BlockAnalysis analyzeBlock(const BlockData& block, const AnalysisOptions& option
             for (const auto& [reason, count] : reasons) why += (why.empty() ? "" : ", ") + reason;
             result.warnings.push_back(std::to_string(fallbacks) + " of " + std::to_string(m) +
                                       " score intervals are percentile+profile intervals instead of studentized "
-                                      "ones (" + why + ")");
+                                      "ones (" +
+                                      why + ")");
         }
     } else {
         // One observer or a bare count matrix: nothing to resample; or an adaptive design, where resampling
@@ -163,7 +165,8 @@ BlockAnalysis analyzeBlock(const BlockData& block, const AnalysisOptions& option
                 profileInterval(totals, thurstoneOptions, result.thurstone, contrast, options.bootstrap.level);
             result.low[i] = profile.low;
             result.high[i] = profile.high;
-            if (profile.lowAtCap || profile.highAtCap) result.intervalFlags[i].reasons.emplace_back("bound-at-search-cap");
+            if (profile.lowAtCap || profile.highAtCap)
+                result.intervalFlags[i].reasons.emplace_back("bound-at-search-cap");
         }
         result.percentileLow = Eigen::VectorXd::Constant(m, NAN);
         result.percentileHigh = Eigen::VectorXd::Constant(m, NAN);
@@ -183,14 +186,16 @@ BlockAnalysis analyzeBlock(const BlockData& block, const AnalysisOptions& option
                 test.low = profile.low;
                 test.high = profile.high;
                 if (profile.lowAtCap || profile.highAtCap) test.diagnosis.reasons.emplace_back("bound-at-search-cap");
-                test.pValue = scoreTestPValue(n >= 2 ? &block : nullptr, totals, thurstoneOptions, result.thurstone, i, j);
+                test.pValue =
+                    scoreTestPValue(n >= 2 ? &block : nullptr, totals, thurstoneOptions, result.thurstone, i, j);
                 result.pairs.push_back({test});
             }
         if (block.hasObservers && n < 2)
             result.warnings.push_back("a single observer: intervals are profile-likelihood intervals");
     }
     for (PairTest& pair : result.pairs) {
-        pair.comparisons = result.counts(pair.test.first, pair.test.second) + result.counts(pair.test.second, pair.test.first);
+        pair.comparisons =
+            result.counts(pair.test.first, pair.test.second) + result.counts(pair.test.second, pair.test.first);
         pValues.push_back(pair.test.pValue);
     }
     const std::vector<double> adjusted = adjustPValues(pValues, options.correction);

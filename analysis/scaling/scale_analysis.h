@@ -22,25 +22,25 @@ namespace skinlab::analysis::scaling {
 enum class IntervalMethod { bootstrap, profile };
 
 struct AnalysisOptions {
-    FitOptions fit;                    // fit.model is ignored: both models are always fitted
+    FitOptions fit; // fit.model is ignored: both models are always fitted
     IntervalMethod intervals = IntervalMethod::bootstrap;
-    std::string intervalReason;        // why `intervals` was chosen (e.g. "active design"), reported in scale.json
+    std::string intervalReason; // why `intervals` was chosen (e.g. "active design"), reported in scale.json
     BootstrapOptions bootstrap;
     Correction correction = Correction::Holm;
-    double alpha = 0.05;               // significance level after correction
-    double screeningWhisker = 1.5;     // inter-quartile rule factor w
+    double alpha = 0.05;           // significance level after correction
+    double screeningWhisker = 1.5; // inter-quartile rule factor w
 };
 
 struct PairTest {
     DifferenceTest test;
-    double comparisons = 0.0;  // trials of this pair in the block (0: never compared directly)
+    double comparisons = 0.0; // trials of this pair in the block (0: never compared directly)
     double adjustedPValue = 1.0;
     bool significant = false;
 };
 
 struct ObserverInBlock {
     double trials = 0.0;
-    double heldOutLogLikelihood = 0.0;  // nats, sum over the observer's trials
+    double heldOutLogLikelihood = 0.0; // nats, sum over the observer's trials
     TriadConsistency consistency;
     double sideTrials = 0.0;
     double leftChosen = 0.0;
@@ -50,19 +50,19 @@ struct BlockAnalysis {
     std::string name;
     std::vector<std::string> conditions;
     std::vector<std::string> observers;
-    Eigen::MatrixXd counts;  // D(i, j) = times i chosen over j
+    Eigen::MatrixXd counts; // D(i, j) = times i chosen over j
     FitResult thurstone;
     FitResult bradleyTerry;
     Eigen::VectorXd bradleyTerryStandardError;
-    std::string intervalMethod;         // "studentized-bootstrap", or "profile-likelihood" (fewer than 2 observers)
-    std::vector<IntervalDiagnosis> intervalFlags;  // per condition: fell back to percentile+profile, and why
+    std::string intervalMethod; // "studentized-bootstrap", or "profile-likelihood" (fewer than 2 observers)
+    std::vector<IntervalDiagnosis> intervalFlags; // per condition: fell back to percentile+profile, and why
     int bootstrapSamples = 0;
-    Eigen::VectorXd standardError, low, high;             // Thurstone, JOD
-    Eigen::VectorXd percentileLow, percentileHigh;        // pwcmp-style percentile interval (reference only)
-    std::vector<PairTest> pairs;                           // every i < j
-    std::vector<std::vector<int>> components;              // connected components of the comparison graph
-    bool mleExists = true;  // win graph strongly connected (Ford 1957); otherwise the prior sets some distances
-    std::vector<std::pair<int, int>> unanimousPairs;       // compared pairs where one side never won
+    Eigen::VectorXd standardError, low, high;      // Thurstone, JOD
+    Eigen::VectorXd percentileLow, percentileHigh; // pwcmp-style percentile interval (reference only)
+    std::vector<PairTest> pairs;                   // every i < j
+    std::vector<std::vector<int>> components;      // connected components of the comparison graph
+    bool mleExists = true; // win graph strongly connected (Ford 1957); otherwise the prior sets some distances
+    std::vector<std::pair<int, int>> unanimousPairs; // compared pairs where one side never won
     std::optional<double> kendallU;
     SideBias sideBias;
     std::vector<ObserverInBlock> observerStats;
@@ -72,8 +72,8 @@ struct BlockAnalysis {
 struct ObserverSummary {
     std::string observer;
     double trials = 0.0;
-    double heldOutPerTrial = NAN;  // mean held-out log-likelihood per trial over all blocks (nats)
-    bool flagged = false;          // low outlier by the inter-quartile rule
+    double heldOutPerTrial = NAN; // mean held-out log-likelihood per trial over all blocks (nats)
+    bool flagged = false;         // low outlier by the inter-quartile rule
     int catchTrials = 0;
     int catchFailures = 0;
     double sideTrials = 0.0;
@@ -87,7 +87,7 @@ struct Analysis {
     std::vector<BlockAnalysis> blocks;
     std::vector<ObserverSummary> observers;
     OutlierRule screeningRule;
-    std::vector<std::string> warnings;  // every block's warnings too, prefixed by the block name
+    std::vector<std::string> warnings; // every block's warnings too, prefixed by the block name
 };
 
 BlockAnalysis analyzeBlock(const BlockData& block, const AnalysisOptions& options);

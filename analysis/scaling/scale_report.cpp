@@ -30,21 +30,21 @@ std::string fixed(double value, int decimals) {
 
 nlohmann::json finite(double value) { return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(); }
 
-
 std::string base64(const std::string& bytes) {
     static const char* alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     std::string out;
     size_t k = 0;
     for (; k + 2 < bytes.size(); k += 3) {
-        const unsigned v = (static_cast<unsigned char>(bytes[k]) << 16) | (static_cast<unsigned char>(bytes[k + 1]) << 8) |
-                           static_cast<unsigned char>(bytes[k + 2]);
+        const unsigned v = (static_cast<unsigned char>(bytes[k]) << 16) |
+                           (static_cast<unsigned char>(bytes[k + 1]) << 8) | static_cast<unsigned char>(bytes[k + 2]);
         out += {alphabet[(v >> 18) & 63], alphabet[(v >> 12) & 63], alphabet[(v >> 6) & 63], alphabet[v & 63]};
     }
     if (k + 1 == bytes.size()) {
         const unsigned v = static_cast<unsigned char>(bytes[k]) << 16;
         out += {alphabet[(v >> 18) & 63], alphabet[(v >> 12) & 63], '=', '='};
     } else if (k + 2 == bytes.size()) {
-        const unsigned v = (static_cast<unsigned char>(bytes[k]) << 16) | (static_cast<unsigned char>(bytes[k + 1]) << 8);
+        const unsigned v =
+            (static_cast<unsigned char>(bytes[k]) << 16) | (static_cast<unsigned char>(bytes[k + 1]) << 8);
         out += {alphabet[(v >> 18) & 63], alphabet[(v >> 12) & 63], alphabet[(v >> 6) & 63], '='};
     }
     return out;
@@ -52,7 +52,8 @@ std::string base64(const std::string& bytes) {
 
 // Per-interval method: the block's method unless the interval fell back (bootstrap.h).
 std::string scoreMethod(const BlockAnalysis& block, size_t i) {
-    return i < block.intervalFlags.size() && block.intervalFlags[i].fallback ? "percentile+profile" : block.intervalMethod;
+    return i < block.intervalFlags.size() && block.intervalFlags[i].fallback ? "percentile+profile"
+                                                                             : block.intervalMethod;
 }
 std::string pairMethod(const BlockAnalysis& block, const PairTest& pair) {
     return pair.test.diagnosis.fallback ? "percentile+profile" : block.intervalMethod;
@@ -68,7 +69,7 @@ std::vector<std::string> scoreReasons(const BlockAnalysis& block, size_t i) {
 
 std::string plotName(size_t index, const std::string& kind, const std::string& block) {
     char prefix[16];
-    std::snprintf(prefix, sizeof prefix, "%02zu-", index + 1);  // the index keeps names unique after slugging
+    std::snprintf(prefix, sizeof prefix, "%02zu-", index + 1); // the index keeps names unique after slugging
     return "plots/" + kind + "_" + prefix + blockSlug(block) + ".png";
 }
 
@@ -78,10 +79,8 @@ std::string blockSlug(const std::string& name) {
     std::string slug;
     for (unsigned char c : name) {
         const bool keep = std::isalnum(c) || c == '_' || c == '.';
-        if (keep)
-            slug += static_cast<char>(c);
-        else if (!slug.empty() && slug.back() != '-')
-            slug += '-';
+        if (keep) slug += static_cast<char>(c);
+        else if (!slug.empty() && slug.back() != '-') slug += '-';
     }
     while (!slug.empty() && slug.back() == '-') slug.pop_back();
     return slug.empty() ? "block" : slug;
@@ -169,12 +168,13 @@ nlohmann::json analysisJson(const Analysis& analysis) {
                                   {"p_adjusted", pair.adjustedPValue},
                                   {"significant", pair.significant}});
         b["kendall_u"] = block.kendallU ? nlohmann::json(*block.kendallU) : nlohmann::json();
-        b["side_bias"] = {{"available", block.sideBias.available},
-                          {"trials", block.sideBias.trials},
-                          {"left_rate", block.sideBias.available ? nlohmann::json(block.sideBias.leftRate) : nlohmann::json()},
-                          {"bias_jod", block.sideBias.available ? nlohmann::json(block.sideBias.bias) : nlohmann::json()},
-                          {"standard_error", block.sideBias.available ? finite(block.sideBias.standardError) : nlohmann::json()},
-                          {"p_value", block.sideBias.available ? nlohmann::json(block.sideBias.pValue) : nlohmann::json()}};
+        b["side_bias"] = {
+            {"available", block.sideBias.available},
+            {"trials", block.sideBias.trials},
+            {"left_rate", block.sideBias.available ? nlohmann::json(block.sideBias.leftRate) : nlohmann::json()},
+            {"bias_jod", block.sideBias.available ? nlohmann::json(block.sideBias.bias) : nlohmann::json()},
+            {"standard_error", block.sideBias.available ? finite(block.sideBias.standardError) : nlohmann::json()},
+            {"p_value", block.sideBias.available ? nlohmann::json(block.sideBias.pValue) : nlohmann::json()}};
         b["observer_stats"] = nlohmann::json::array();
         for (size_t k = 0; k < block.observerStats.size(); ++k) {
             const ObserverInBlock& s = block.observerStats[k];
@@ -185,7 +185,8 @@ nlohmann::json analysisJson(const Analysis& analysis) {
                                                    ? nlohmann::json(s.heldOutLogLikelihood / s.trials)
                                                    : nlohmann::json()},
                  {"complete", s.consistency.complete},
-                 {"circular_triads", s.consistency.complete ? nlohmann::json(s.consistency.circularTriads) : nlohmann::json()},
+                 {"circular_triads",
+                  s.consistency.complete ? nlohmann::json(s.consistency.circularTriads) : nlohmann::json()},
                  {"zeta", s.consistency.zeta ? nlohmann::json(*s.consistency.zeta) : nlohmann::json()}});
         }
         b["warnings"] = block.warnings;
@@ -193,13 +194,14 @@ nlohmann::json analysisJson(const Analysis& analysis) {
     }
     json["observers"] = nlohmann::json::array();
     for (const ObserverSummary& s : analysis.observers)
-        json["observers"].push_back({{"observer", s.observer},
-                                     {"trials", s.trials},
-                                     {"held_out_loglik_per_trial", finite(s.heldOutPerTrial)},
-                                     {"flagged", s.flagged},
-                                     {"catch_trials", s.catchTrials},
-                                     {"catch_failures", s.catchFailures},
-                                     {"left_rate", s.sideTrials > 0 ? nlohmann::json(s.leftChosen / s.sideTrials) : nlohmann::json()}});
+        json["observers"].push_back(
+            {{"observer", s.observer},
+             {"trials", s.trials},
+             {"held_out_loglik_per_trial", finite(s.heldOutPerTrial)},
+             {"flagged", s.flagged},
+             {"catch_trials", s.catchTrials},
+             {"catch_failures", s.catchFailures},
+             {"left_rate", s.sideTrials > 0 ? nlohmann::json(s.leftChosen / s.sideTrials) : nlohmann::json()}});
     json["screening"] = {{"first_quartile", finite(analysis.screeningRule.firstQuartile)},
                          {"third_quartile", finite(analysis.screeningRule.thirdQuartile)},
                          {"threshold", finite(analysis.screeningRule.threshold)},
@@ -220,16 +222,16 @@ std::string reportSectionHtml(const Analysis& analysis) {
                        std::to_string(o.bootstrap.samples) + " samples, seed " + std::to_string(o.bootstrap.seed) +
                        "); where studentization is degenerate (marked †) the hull of the percentile and "
                        "profile-posterior intervals, and a score test; ")
-         << "pairwise tests with "
-         << correctionName(o.correction) << " correction at α = " << o.alpha << ".</p>\n";
+         << "pairwise tests with " << correctionName(o.correction) << " correction at α = " << o.alpha << ".</p>\n";
     for (size_t b = 0; b < analysis.blocks.size(); ++b) {
         const BlockAnalysis& block = analysis.blocks[b];
         html << "<h3>" << escapeHtml(block.name) << "</h3>\n<p>" << block.observers.size() << " observer(s), "
              << block.conditions.size() << " conditions, intervals: " << block.intervalMethod;
         if (block.kendallU) html << ", Kendall's u = " << fixed(*block.kendallU, 3);
         if (block.sideBias.available)
-            html << ", side bias " << fixed(block.sideBias.bias, 3) << " JOD toward the left (p = "
-                 << fixed(block.sideBias.pValue, 3) << ", left chosen " << fixed(100 * block.sideBias.leftRate, 1) << " %)";
+            html << ", side bias " << fixed(block.sideBias.bias, 3)
+                 << " JOD toward the left (p = " << fixed(block.sideBias.pValue, 3) << ", left chosen "
+                 << fixed(100 * block.sideBias.leftRate, 1) << " %)";
         html << ".</p>\n";
         for (const std::string& warning : block.warnings)
             html << "<p class=\"warning\"><strong>Warning:</strong> " << escapeHtml(warning) << "</p>\n";
@@ -248,8 +250,10 @@ std::string reportSectionHtml(const Analysis& analysis) {
                                                     : " † (" + escapeHtml(joined(scoreReasons(block, i), ", ")) + ")")
                  << "</td><td>" << fixed(block.bradleyTerry.scores[k], 3) << "</td></tr>\n";
         }
-        html << "</table>\n<table>\n<tr><th>A</th><th>B</th><th>A − B (JOD)</th><th>95 % interval</th><th>method</th><th>p</th>"
-                "<th>p (" << correctionName(o.correction) << ")</th><th>significant</th></tr>\n";
+        html << "</table>\n<table>\n<tr><th>A</th><th>B</th><th>A − B (JOD)</th><th>95 % "
+                "interval</th><th>method</th><th>p</th>"
+                "<th>p ("
+             << correctionName(o.correction) << ")</th><th>significant</th></tr>\n";
         for (const PairTest& pair : block.pairs)
             html << "<tr><td>" << escapeHtml(block.conditions[pair.test.first]) << "</td><td>"
                  << escapeHtml(block.conditions[pair.test.second]) << "</td><td>" << fixed(pair.test.difference, 3)
@@ -258,8 +262,8 @@ std::string reportSectionHtml(const Analysis& analysis) {
                  << (pair.test.diagnosis.reasons.empty()
                          ? std::string()
                          : " † (" + escapeHtml(joined(pair.test.diagnosis.reasons, ", ")) + ")")
-                 << "</td><td>" << number(pair.test.pValue, 3) << "</td><td>" << number(pair.adjustedPValue, 3) << "</td><td>"
-                 << (pair.significant ? "yes" : "no") << "</td></tr>\n";
+                 << "</td><td>" << number(pair.test.pValue, 3) << "</td><td>" << number(pair.adjustedPValue, 3)
+                 << "</td><td>" << (pair.significant ? "yes" : "no") << "</td></tr>\n";
         html << "</table>\n";
     }
     html << "<h3>Observers</h3>\n<table>\n<tr><th>observer</th><th>trials</th><th>held-out log-likelihood / trial</th>"
@@ -310,11 +314,12 @@ void writeScaleOutputs(const Analysis& analysis, const std::filesystem::path& fo
                      pairMethod(block, pair) + "," + csvField(joined(pair.test.diagnosis.reasons, ";")) + "\n";
         for (size_t k = 0; k < block.observerStats.size(); ++k) {
             const ObserverInBlock& s = block.observerStats[k];
-            consistency += name + "," + csvField(block.observers[k]) + "," + number(s.trials, 10) + "," +
-                           (s.trials > 0 && block.observers.size() > 1 ? number(s.heldOutLogLikelihood / s.trials, 8) : "") +
-                           "," + (s.consistency.complete ? "1" : "0") + "," +
-                           (s.consistency.complete ? number(s.consistency.circularTriads, 6) : "") + "," +
-                           (s.consistency.zeta ? number(*s.consistency.zeta, 6) : "") + "\n";
+            consistency +=
+                name + "," + csvField(block.observers[k]) + "," + number(s.trials, 10) + "," +
+                (s.trials > 0 && block.observers.size() > 1 ? number(s.heldOutLogLikelihood / s.trials, 8) : "") + "," +
+                (s.consistency.complete ? "1" : "0") + "," +
+                (s.consistency.complete ? number(s.consistency.circularTriads, 6) : "") + "," +
+                (s.consistency.zeta ? number(*s.consistency.zeta, 6) : "") + "\n";
         }
         writeFileAtomic(folder / plotName(b, "scores", block.name), encodePng(plotScores(block)));
         writeFileAtomic(folder / plotName(b, "matrix", block.name), encodePng(plotPreferenceMatrix(block)));
@@ -335,7 +340,7 @@ void writeScaleOutputs(const Analysis& analysis, const std::filesystem::path& fo
     for (size_t b = 0; b < analysis.blocks.size(); ++b)
         json["blocks"][b]["plots"] = {{"scores", plotName(b, "scores", analysis.blocks[b].name)},
                                       {"matrix", plotName(b, "matrix", analysis.blocks[b].name)}};
-    writeFileAtomic(folder / "scale.json", json.dump(2) + "\n");  // last: marks the folder complete
+    writeFileAtomic(folder / "scale.json", json.dump(2) + "\n"); // last: marks the folder complete
 }
 
 } // namespace skinlab::analysis::scaling

@@ -32,7 +32,7 @@ std::vector<bool> lowOutliers(const std::vector<double>& values, double whisker,
     OutlierRule computed;
     computed.whisker = whisker;
     std::vector<bool> flags(values.size(), false);
-    if (sorted.size() >= 4) {  // quartiles of fewer than 4 values say nothing about outliers
+    if (sorted.size() >= 4) { // quartiles of fewer than 4 values say nothing about outliers
         computed.firstQuartile = sortedQuantile(sorted, 0.25);
         computed.thirdQuartile = sortedQuantile(sorted, 0.75);
         computed.threshold = computed.firstQuartile - whisker * (computed.thirdQuartile - computed.firstQuartile);

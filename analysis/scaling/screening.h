@@ -13,8 +13,8 @@
 namespace skinlab::analysis::scaling {
 
 struct HeldOutLikelihood {
-    Eigen::VectorXd logLikelihood;  // per observer: Σ log P(answer) under the leave-one-out scale (nats)
-    Eigen::VectorXd trials;         // per observer: scaled trials in this block
+    Eigen::VectorXd logLikelihood; // per observer: Σ log P(answer) under the leave-one-out scale (nats)
+    Eigen::VectorXd trials;        // per observer: scaled trials in this block
 };
 
 // One warm-started fit per observer. Needs ≥ 2 observers (otherwise all zeros).
@@ -23,7 +23,7 @@ HeldOutLikelihood heldOutLikelihood(const BlockData& block, const FitResult& ful
 struct OutlierRule {
     double firstQuartile = 0.0;
     double thirdQuartile = 0.0;
-    double threshold = 0.0;  // values below are outliers
+    double threshold = 0.0; // values below are outliers
     double whisker = 1.5;
 };
 

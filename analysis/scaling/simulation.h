@@ -14,13 +14,13 @@ namespace skinlab::analysis::scaling {
 enum class SimulatedObserverKind { Genuine, Random, Inverted };
 
 struct SimulationDesign {
-    std::vector<double> trueScores;      // JOD
-    int observers = 20;                  // in all, bad ones included
-    int trialsPerPair = 4;               // per observer and pair; the sides alternate (half with each on the left)
-    double lapseRate = 0.0;              // genuine observers' probability of a random answer
-    double sideBiasStandardDeviation = 0.0;  // JOD; each genuine observer draws b ~ N(0, sd²)
-    int randomObservers = 0;             // of `observers`
-    int invertedObservers = 0;           // of `observers`
+    std::vector<double> trueScores;         // JOD
+    int observers = 20;                     // in all, bad ones included
+    int trialsPerPair = 4;                  // per observer and pair; the sides alternate (half with each on the left)
+    double lapseRate = 0.0;                 // genuine observers' probability of a random answer
+    double sideBiasStandardDeviation = 0.0; // JOD; each genuine observer draws b ~ N(0, sd²)
+    int randomObservers = 0;                // of `observers`
+    int invertedObservers = 0;              // of `observers`
     // Incomplete designs: each observer judges each pair with this probability (1: every pair), and the
     // conditions fall into `groups` contiguous groups never compared with each other (1: connected).
     double pairFraction = 1.0;
@@ -29,7 +29,7 @@ struct SimulationDesign {
 
 struct SimulatedBlock {
     BlockData block;
-    std::vector<SimulatedObserverKind> kinds;  // per observer
+    std::vector<SimulatedObserverKind> kinds; // per observer
 };
 
 // Every within-group pair, each observer judging it with probability pairFraction (the full design by default). Deterministic for a given seed.

@@ -74,7 +74,8 @@ BlockData withoutObservers(const BlockData& block, const std::vector<bool>& drop
 
 // The "active" scenario's data: Case V observers one after another, each answering activeTrials trials in batches
 // the planner chose from all earlier answers; sides alternate within an observer.
-BlockData simulateActive(const ValidationOptions& options, const std::vector<double>& truth, int observers, std::uint64_t seed) {
+BlockData simulateActive(const ValidationOptions& options, const std::vector<double>& truth, int observers,
+                         std::uint64_t seed) {
     const int m = static_cast<int>(truth.size());
     const int perObserver = options.activeTrials > 0 ? options.activeTrials : options.trialsPerPair * m * (m - 1) / 2;
     std::mt19937_64 random(seed);
@@ -88,7 +89,8 @@ BlockData simulateActive(const ValidationOptions& options, const std::vector<dou
     for (int k = 0; k < observers; ++k) {
         int done = 0;
         for (std::uint64_t batch = 0; done < perObserver; ++batch) {
-            const auto pairs = options.activePlanner(m, answers, mixSeed(seed, static_cast<std::uint64_t>(k) * 100000 + batch));
+            const auto pairs =
+                options.activePlanner(m, answers, mixSeed(seed, static_cast<std::uint64_t>(k) * 100000 + batch));
             if (pairs.empty()) throw RuntimeError("validate: the active planner returned no pairs");
             for (auto [i, j] : pairs) {
                 if (done == perObserver) break;
@@ -110,7 +112,8 @@ BlockData simulateActive(const ValidationOptions& options, const std::vector<dou
     }
     std::map<std::pair<int, int>, int> column;
     for (const Trial& t : trials)
-        if (column.emplace(std::make_pair(t.i, t.j), static_cast<int>(block.pairs.size())).second) block.pairs.emplace_back(t.i, t.j);
+        if (column.emplace(std::make_pair(t.i, t.j), static_cast<int>(block.pairs.size())).second)
+            block.pairs.emplace_back(t.i, t.j);
     const auto pairCount = static_cast<Eigen::Index>(block.pairs.size());
     block.winsFirst = Eigen::MatrixXd::Zero(observers, pairCount);
     block.winsSecond = Eigen::MatrixXd::Zero(observers, pairCount);
@@ -155,7 +158,8 @@ Tally runActiveExperiment(const ValidationOptions& options, int observers, std::
         tally.intervals += 1;
         tally.covered += analysis.low[i] <= truth[i] && truth[i] <= analysis.high[i];
         tally.width += analysis.high[i] - analysis.low[i];
-        tally.maximumHalfWidth = std::max({tally.maximumHalfWidth, fit[i] - analysis.low[i], analysis.high[i] - fit[i]});
+        tally.maximumHalfWidth =
+            std::max({tally.maximumHalfWidth, fit[i] - analysis.low[i], analysis.high[i] - fit[i]});
         tally.bootstrapCovered += bootstrap.low[i] <= truth[i] && truth[i] <= bootstrap.high[i];
         tally.percentileCovered += bootstrap.percentileLow[i] <= truth[i] && truth[i] <= bootstrap.percentileHigh[i];
         tally.percentileWidth += bootstrap.percentileHigh[i] - bootstrap.percentileLow[i];
@@ -169,10 +173,8 @@ Tally runActiveExperiment(const ValidationOptions& options, int observers, std::
         const double trueDifference = truth[pair.test.first] - truth[pair.test.second];
         tally.pairs += 1;
         if (!pair.significant || trueDifference == 0.0) continue;
-        if ((pair.test.difference > 0) == (trueDifference > 0))
-            tally.significantCorrect += 1;
-        else
-            tally.significantReversed += 1;
+        if ((pair.test.difference > 0) == (trueDifference > 0)) tally.significantCorrect += 1;
+        else tally.significantReversed += 1;
     }
     return tally;
 }
@@ -208,9 +210,8 @@ Tally runExperiment(const ValidationOptions& options, const std::string& scenari
         design.randomObservers = options.randomObservers;
         design.invertedObservers = options.invertedObservers;
     }
-    const std::uint64_t scenarioIndex =
-        static_cast<std::uint64_t>(std::find(options.scenarios.begin(), options.scenarios.end(), scenario) -
-                                   options.scenarios.begin());
+    const std::uint64_t scenarioIndex = static_cast<std::uint64_t>(
+        std::find(options.scenarios.begin(), options.scenarios.end(), scenario) - options.scenarios.begin());
     const std::uint64_t stream = (scenarioIndex * 1000 + static_cast<std::uint64_t>(observers)) * 1000000 +
                                  static_cast<std::uint64_t>(experiment);
     const std::uint64_t seed = mixSeed(options.seed, stream);
@@ -231,17 +232,19 @@ Tally runExperiment(const ValidationOptions& options, const std::string& scenari
             switch (simulated.kinds[k]) {
             case SimulatedObserverKind::Genuine: tally.genuineObservers += 1, tally.genuineFlagged += flags[k]; break;
             case SimulatedObserverKind::Random: tally.randomObservers += 1, tally.randomFlagged += flags[k]; break;
-            case SimulatedObserverKind::Inverted: tally.invertedObservers += 1, tally.invertedFlagged += flags[k]; break;
+            case SimulatedObserverKind::Inverted:
+                tally.invertedObservers += 1, tally.invertedFlagged += flags[k];
+                break;
             }
         }
-        block = withoutObservers(block, flags);  // the intervals below are those of the screened data
+        block = withoutObservers(block, flags); // the intervals below are those of the screened data
     }
 
     const FitResult fit = fitScores(block.totalCounts(), fitOptions);
     BootstrapOptions bootstrapOptions;
     bootstrapOptions.samples = options.bootstrapSamples;
     bootstrapOptions.seed = mixSeed(seed, 1);
-    bootstrapOptions.threads = 1;  // experiments already run in parallel
+    bootstrapOptions.threads = 1; // experiments already run in parallel
     const BootstrapResult bootstrap = bootstrapObservers(block, fit, fitOptions, bootstrapOptions);
 
     Eigen::VectorXd truth = Eigen::Map<const Eigen::VectorXd>(design.trueScores.data(), m);
@@ -270,10 +273,8 @@ Tally runExperiment(const ValidationOptions& options, const std::string& scenari
         const double trueDifference = truth[test.first] - truth[test.second];
         tally.pairs += 1;
         if (adjusted[k] >= options.alpha || trueDifference == 0.0) continue;
-        if ((test.difference > 0) == (trueDifference > 0))
-            tally.significantCorrect += 1;
-        else
-            tally.significantReversed += 1;
+        if ((test.difference > 0) == (trueDifference > 0)) tally.significantCorrect += 1;
+        else tally.significantReversed += 1;
     }
     return tally;
 }
@@ -281,8 +282,8 @@ Tally runExperiment(const ValidationOptions& options, const std::string& scenari
 } // namespace
 
 const std::vector<std::string>& validationScenarios() {
-    static const std::vector<std::string> names = {"thurstone",    "lapses+side-bias", "screening",
-                                                   "sparse",       "disconnected",     "near-unanimous", "active"};
+    static const std::vector<std::string> names = {"thurstone",    "lapses+side-bias", "screening", "sparse",
+                                                   "disconnected", "near-unanimous",   "active"};
     return names;
 }
 
@@ -303,7 +304,7 @@ ValidationReport runValidation(const ValidationOptions& options) {
             work();
             for (auto& thread : pool) thread.join();
             Tally total;
-            for (const Tally& tally : tallies) total.add(tally);  // fixed order: same sums on any thread count
+            for (const Tally& tally : tallies) total.add(tally); // fixed order: same sums on any thread count
 
             ValidationRow row;
             row.scenario = scenario;
@@ -345,24 +346,24 @@ std::string validationMarkdown(const ValidationReport& report) {
             bootstrapCoverages += cell;
         }
     if (bootstrapCoverages.empty()) bootstrapCoverages = "not run";
-    std::snprintf(line, sizeof line,
-                  "True scores [%s] JOD, full design, %d trials per pair per observer (each order %s), %d "
-                  "experiments per row, %d bootstrap samples, %s correction at alpha = %.2f, seed %llu.\n"
-                  "Lapses %.3f and side-bias sd %.2f JOD in the 'lapses+side-bias' and 'screening' scenarios; "
-                  "'screening' adds %d random and %d inverted observer(s) and scores the remaining ones. "
-                  "'sparse': each observer judges %.0f %% of the pairs; 'disconnected': %d groups never compared "
-                  "(truth centred per group); 'near-unanimous': true scores x %.1f. 'active': observers one after "
-                  "another on true scores x %.1f, %d trials each in batches chosen from all earlier answers, "
-                  "profile-likelihood intervals and score tests (as `analyze scale` for an active study); its "
-                  "studentized observer bootstrap on the same data covers: %s.\n\n",
-                  scores.c_str(), o.trialsPerPair, o.trialsPerPair % 2 == 0 ? "equally often" : "alternating",
-                  o.experiments, o.bootstrapSamples, correctionName(o.correction), o.alpha,
-                  static_cast<unsigned long long>(o.seed), o.lapseRate, o.sideBiasStandardDeviation,
-                  o.randomObservers, o.invertedObservers, 100.0 * o.sparsePairFraction, o.disconnectedGroups,
-                  o.nearUnanimousStretch, o.activeStretch,
-                  o.activeTrials > 0 ? o.activeTrials
-                                     : o.trialsPerPair * static_cast<int>(o.trueScores.size() * (o.trueScores.size() - 1) / 2),
-                  bootstrapCoverages.c_str());
+    std::snprintf(
+        line, sizeof line,
+        "True scores [%s] JOD, full design, %d trials per pair per observer (each order %s), %d "
+        "experiments per row, %d bootstrap samples, %s correction at alpha = %.2f, seed %llu.\n"
+        "Lapses %.3f and side-bias sd %.2f JOD in the 'lapses+side-bias' and 'screening' scenarios; "
+        "'screening' adds %d random and %d inverted observer(s) and scores the remaining ones. "
+        "'sparse': each observer judges %.0f %% of the pairs; 'disconnected': %d groups never compared "
+        "(truth centred per group); 'near-unanimous': true scores x %.1f. 'active': observers one after "
+        "another on true scores x %.1f, %d trials each in batches chosen from all earlier answers, "
+        "profile-likelihood intervals and score tests (as `analyze scale` for an active study); its "
+        "studentized observer bootstrap on the same data covers: %s.\n\n",
+        scores.c_str(), o.trialsPerPair, o.trialsPerPair % 2 == 0 ? "equally often" : "alternating", o.experiments,
+        o.bootstrapSamples, correctionName(o.correction), o.alpha, static_cast<unsigned long long>(o.seed), o.lapseRate,
+        o.sideBiasStandardDeviation, o.randomObservers, o.invertedObservers, 100.0 * o.sparsePairFraction,
+        o.disconnectedGroups, o.nearUnanimousStretch, o.activeStretch,
+        o.activeTrials > 0 ? o.activeTrials
+                           : o.trialsPerPair * static_cast<int>(o.trueScores.size() * (o.trueScores.size() - 1) / 2),
+        bootstrapCoverages.c_str());
     out += line;
     out += "| scenario | observers | coverage | mean width | fallback share | largest half-width | "
            "coverage (percentile, pwcmp) | "
@@ -376,12 +377,13 @@ std::string validationMarkdown(const ValidationReport& report) {
         return std::string(buffer);
     };
     for (const ValidationRow& r : report.rows) {
-        std::snprintf(line, sizeof line,
-                      "| %s | %d | %.4f | %.3f | %.3f | %.2f | %.4f | %.3f | %.4f | %.4f | %.4f | %.4f | %s | %s | %s |\n",
-                      r.scenario.c_str(), r.observers, r.coverage, r.meanWidth, r.fallbackShare, r.maximumHalfWidth,
-                      r.percentileCoverage,
-                      r.percentileMeanWidth, r.rmse, r.rankCorrelation, r.significantCorrect, r.significantReversed,
-                      rate(r.randomHitRate).c_str(), rate(r.invertedHitRate).c_str(), rate(r.falseAlarmRate).c_str());
+        std::snprintf(
+            line, sizeof line,
+            "| %s | %d | %.4f | %.3f | %.3f | %.2f | %.4f | %.3f | %.4f | %.4f | %.4f | %.4f | %s | %s | %s |\n",
+            r.scenario.c_str(), r.observers, r.coverage, r.meanWidth, r.fallbackShare, r.maximumHalfWidth,
+            r.percentileCoverage, r.percentileMeanWidth, r.rmse, r.rankCorrelation, r.significantCorrect,
+            r.significantReversed, rate(r.randomHitRate).c_str(), rate(r.invertedHitRate).c_str(),
+            rate(r.falseAlarmRate).c_str());
         out += line;
     }
     return out;
@@ -392,16 +394,25 @@ nlohmann::json validationJson(const ValidationReport& report) {
     nlohmann::json json;
     json["format"] = "skinlab-scaling-validation";
     json["version"] = 1;
-    json["options"] = {{"true_scores", o.trueScores},       {"observer_counts", o.observerCounts},
-                       {"experiments", o.experiments},      {"trials_per_pair", o.trialsPerPair},
-                       {"bootstrap_samples", o.bootstrapSamples}, {"seed", o.seed},
-                       {"lapse_rate", o.lapseRate},         {"side_bias_sd", o.sideBiasStandardDeviation},
-                       {"random_observers", o.randomObservers}, {"inverted_observers", o.invertedObservers},
-                       {"correction", correctionName(o.correction)}, {"alpha", o.alpha},
-                       {"screening_whisker", o.screeningWhisker}, {"scenarios", o.scenarios},
-                       {"sparse_pair_fraction", o.sparsePairFraction}, {"disconnected_groups", o.disconnectedGroups},
+    json["options"] = {{"true_scores", o.trueScores},
+                       {"observer_counts", o.observerCounts},
+                       {"experiments", o.experiments},
+                       {"trials_per_pair", o.trialsPerPair},
+                       {"bootstrap_samples", o.bootstrapSamples},
+                       {"seed", o.seed},
+                       {"lapse_rate", o.lapseRate},
+                       {"side_bias_sd", o.sideBiasStandardDeviation},
+                       {"random_observers", o.randomObservers},
+                       {"inverted_observers", o.invertedObservers},
+                       {"correction", correctionName(o.correction)},
+                       {"alpha", o.alpha},
+                       {"screening_whisker", o.screeningWhisker},
+                       {"scenarios", o.scenarios},
+                       {"sparse_pair_fraction", o.sparsePairFraction},
+                       {"disconnected_groups", o.disconnectedGroups},
                        {"near_unanimous_stretch", o.nearUnanimousStretch},
-                       {"active_trials", o.activeTrials}, {"active_stretch", o.activeStretch}};
+                       {"active_trials", o.activeTrials},
+                       {"active_stretch", o.activeStretch}};
     json["seconds"] = report.seconds;
     for (const ValidationRow& r : report.rows) {
         nlohmann::json row = {{"scenario", r.scenario},

@@ -29,23 +29,23 @@ struct PlannerAnswer {
 };
 // The next batch of pairs (i, j) given every answer so far: the study server's planner, supplied by the caller
 // (the analysis does not link the server; `skinlab analyze validate` passes experiments/active_sampling's).
-using ActivePlanner = std::function<std::vector<std::pair<int, int>>(int conditions, const std::vector<PlannerAnswer>& answers,
-                                                                     std::uint64_t seed)>;
+using ActivePlanner = std::function<std::vector<std::pair<int, int>>(
+    int conditions, const std::vector<PlannerAnswer>& answers, std::uint64_t seed)>;
 
 struct ValidationOptions {
-    std::vector<double> trueScores = {0.0, 0.3, 0.9, 1.0, 1.8, 2.5};  // JOD
+    std::vector<double> trueScores = {0.0, 0.3, 0.9, 1.0, 1.8, 2.5}; // JOD
     std::vector<int> observerCounts = {10, 20, 30};
-    int experiments = 200;          // simulated experiments per scenario and observer count
+    int experiments = 200; // simulated experiments per scenario and observer count
     // Per observer and pair, each order 3 times (90 trials per observer for 6 conditions, ~8 minutes at 5 s a
     // trial). With 4, screening caught only 87 % of random observers at 10 observers (docs/analysis.md).
     int trialsPerPair = 6;
     int bootstrapSamples = 1000;
     std::uint64_t seed = 1;
     int threads = 2;
-    double lapseRate = 0.02;        // "lapses+side-bias" and "screening" scenarios
-    double sideBiasStandardDeviation = 0.3;  // JOD
-    int randomObservers = 1;        // "screening" scenario
-    int invertedObservers = 1;      // "screening" scenario
+    double lapseRate = 0.02;                // "lapses+side-bias" and "screening" scenarios
+    double sideBiasStandardDeviation = 0.3; // JOD
+    int randomObservers = 1;                // "screening" scenario
+    int invertedObservers = 1;              // "screening" scenario
     Correction correction = Correction::Holm;
     double alpha = 0.05;
     double screeningWhisker = 1.5;
@@ -53,10 +53,10 @@ struct ValidationOptions {
     int disconnectedGroups = 2;        // "disconnected": groups of conditions, never compared across
     double nearUnanimousStretch = 3.0; // "near-unanimous": true scores multiplied by this
     std::vector<std::string> scenarios = {"thurstone", "lapses+side-bias", "screening",
-                                          "sparse", "disconnected", "near-unanimous"};
+                                          "sparse",    "disconnected",     "near-unanimous"};
     // "active": trials per observer (0: as many as the full design, trialsPerPair per pair), and the planner.
     int activeTrials = 0;
-    double activeStretch = 1.0;  // "active": true scores multiplied by this
+    double activeStretch = 1.0; // "active": true scores multiplied by this
     ActivePlanner activePlanner;
 };
 
@@ -67,11 +67,11 @@ struct ValidationRow {
     std::string scenario;
     int observers = 0;
     int experiments = 0;
-    double coverage = 0.0;            // the reported intervals (studentized, or the flagged fallback), 95 % nominal
-    double meanWidth = 0.0;           // JOD
-    double fallbackShare = 0.0;       // share of score intervals that fell back to percentile+profile
-    double maximumHalfWidth = 0.0;    // JOD, largest distance from a score to one of its bounds
-    double percentileCoverage = 0.0;  // pwcmp's percentile bootstrap on the same resamples
+    double coverage = 0.0;           // the reported intervals (studentized, or the flagged fallback), 95 % nominal
+    double meanWidth = 0.0;          // JOD
+    double fallbackShare = 0.0;      // share of score intervals that fell back to percentile+profile
+    double maximumHalfWidth = 0.0;   // JOD, largest distance from a score to one of its bounds
+    double percentileCoverage = 0.0; // pwcmp's percentile bootstrap on the same resamples
     double percentileMeanWidth = 0.0;
     double bootstrapCoverage = -1.0;  // "active" only: the studentized observer bootstrap on the same data
     double rmse = 0.0;                // JOD, mean-zero scores against mean-zero truth

@@ -59,11 +59,11 @@ struct Settings {
     int bootstrap = 200;
     double spread = 1.0; // true scores ~ N(0, spread²) JOD, or uniform with this sd
     std::string truth = "normal";
-    double priorSd = 1.0;           // prior sd of the active design's posterior (JOD)
-    std::string selection = "mst";  // active batches: spanning tree over 1/gain, or greedy with updates
+    double priorSd = 1.0;          // prior sd of the active design's posterior (JOD)
+    std::string selection = "mst"; // active batches: spanning tree over 1/gain, or greedy with updates
     bool timing = true;
     std::vector<double> coverageRounds = {0.6, 1.0, 1.2, 2.0, 2.4}; // coverage budgets, in full rounds
-    int rounds = 4;      // longest design, in full-design rounds m(m−1)/2
+    int rounds = 4;                                                 // longest design, in full-design rounds m(m−1)/2
     int threads = 2;
     std::uint64_t seed = 1;
     std::string plot;
@@ -86,7 +86,8 @@ sc::BlockData blockOf(const std::vector<Trial>& trials, std::size_t count, int m
     sc::BlockData block;
     block.name = "simulated";
     for (int i = 0; i < m; ++i) block.conditions.push_back("c" + std::to_string(i));
-    const int observers = static_cast<int>((count + static_cast<std::size_t>(perObserver) - 1) / static_cast<std::size_t>(perObserver));
+    const int observers =
+        static_cast<int>((count + static_cast<std::size_t>(perObserver) - 1) / static_cast<std::size_t>(perObserver));
     for (int k = 0; k < observers; ++k) block.observers.push_back("o" + std::to_string(k));
     std::map<std::pair<int, int>, int> column;
     for (std::size_t t = 0; t < count; ++t) {
@@ -141,10 +142,10 @@ std::vector<Trial> simulateDesign(int design, const std::vector<double>& truth, 
         while (trials.size() < length) {
             const ac::ScorePosterior posterior = ac::fitPosterior(m, answers, posteriorOptions);
             const std::uint64_t tieSeed = seed * 1000003u + batch++;
-            const auto pairs = settings.selection == "greedy"   ? ac::greedyBatch(posterior, m - 1, tieSeed)
-                               : settings.selection == "variance" ? ac::greedyBatch(posterior, m - 1, tieSeed,
-                                                                                    ac::BatchCriterion::varianceReduction)
-                                                                  : ac::spanningTreeBatch(posterior, tieSeed);
+            const auto pairs = settings.selection == "greedy" ? ac::greedyBatch(posterior, m - 1, tieSeed)
+                               : settings.selection == "variance"
+                                   ? ac::greedyBatch(posterior, m - 1, tieSeed, ac::BatchCriterion::varianceReduction)
+                                   : ac::spanningTreeBatch(posterior, tieSeed);
             for (const auto& [i, j] : pairs) {
                 if (trials.size() >= length) break;
                 const Trial t = make(random, truth, i, j);
@@ -171,7 +172,8 @@ double fisherSavingBound(const std::vector<double>& truth) {
     Eigen::MatrixXd laplacian = Eigen::MatrixXd::Zero(m, m);
     for (int i = 0; i < m; ++i)
         for (int j = i + 1; j < m; ++j) {
-            const double w = comparisonInformation(truth[static_cast<std::size_t>(i)] - truth[static_cast<std::size_t>(j)]);
+            const double w =
+                comparisonInformation(truth[static_cast<std::size_t>(i)] - truth[static_cast<std::size_t>(j)]);
             laplacian(i, i) += w;
             laplacian(j, j) += w;
             laplacian(i, j) -= w;
@@ -227,8 +229,9 @@ struct CoverageCell {
     }
 };
 
-void drawPlot(const std::string& file, const std::vector<int>& ms, const std::vector<std::vector<std::vector<double>>>& curves,
-              const std::vector<std::vector<double>>& xs, const Settings& settings) {
+void drawPlot(const std::string& file, const std::vector<int>& ms,
+              const std::vector<std::vector<std::vector<double>>>& curves, const std::vector<std::vector<double>>& xs,
+              const Settings& settings) {
     const int panelW = 420, panelH = 340, left = 70, top = 50, bottom = 60;
     cv::Mat image(panelH + top + bottom, static_cast<int>(ms.size()) * panelW + 20, CV_8UC3, cv::Scalar(255, 255, 255));
     const cv::Scalar colours[] = {cv::Scalar(40, 40, 40), cv::Scalar(30, 140, 230), cv::Scalar(180, 90, 30)};
@@ -264,10 +267,10 @@ void drawPlot(const std::string& file, const std::vector<int>& ms, const std::ve
             const auto& c = curves[p][d];
             for (std::size_t k = 1; k < c.size(); ++k)
                 cv::line(image, {px(xs[p][k - 1]), py(c[k - 1])}, {px(xs[p][k]), py(c[k])}, colours[d], 2, cv::LINE_AA);
-            cv::line(image, {x0 + w - 110, y0 + 18 + 18 * static_cast<int>(d)}, {x0 + w - 85, y0 + 18 + 18 * static_cast<int>(d)},
-                     colours[d], 2, cv::LINE_AA);
-            cv::putText(image, kDesigns[d], {x0 + w - 78, y0 + 22 + 18 * static_cast<int>(d)}, font, 0.45, colours[d], 1,
-                        cv::LINE_AA);
+            cv::line(image, {x0 + w - 110, y0 + 18 + 18 * static_cast<int>(d)},
+                     {x0 + w - 85, y0 + 18 + 18 * static_cast<int>(d)}, colours[d], 2, cv::LINE_AA);
+            cv::putText(image, kDesigns[d], {x0 + w - 78, y0 + 22 + 18 * static_cast<int>(d)}, font, 0.45, colours[d],
+                        1, cv::LINE_AA);
         }
         std::snprintf(buf, sizeof buf, "m = %d (grid: full rounds)", ms[p]);
         cv::putText(image, buf, {x0 + 10, y0 + h + 42}, font, 0.5, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
@@ -302,24 +305,25 @@ int main(int argc, char** argv) {
                 p = *end == ',' ? end + 1 : end;
                 if (end == p && *p) break;
             }
-        }
-        else {
+        } else {
             std::fprintf(stderr, "bench_active_sampling: unknown option %s\n", key.c_str());
             return 2;
         }
     }
     const auto start = std::chrono::steady_clock::now();
-    std::printf("hardware threads %u; %d experiments per m (coverage: %d, %d bootstrap samples); true scores ~ "
-                "%s with sd %.2f JOD; designs up to %d full rounds; observers answer m-1 trials each; active: %s batches, "
-                "prior sd %.2f JOD\n\n",
-                std::thread::hardware_concurrency(), s.experiments, s.coverageExperiments, s.bootstrap, s.truth.c_str(),
-                s.spread, s.rounds, s.selection.c_str(), s.priorSd);
+    std::printf(
+        "hardware threads %u; %d experiments per m (coverage: %d, %d bootstrap samples); true scores ~ "
+        "%s with sd %.2f JOD; designs up to %d full rounds; observers answer m-1 trials each; active: %s batches, "
+        "prior sd %.2f JOD\n\n",
+        std::thread::hardware_concurrency(), s.experiments, s.coverageExperiments, s.bootstrap, s.truth.c_str(),
+        s.spread, s.rounds, s.selection.c_str(), s.priorSd);
     const std::vector<int> ms = {10, 20, 30};
     // Coverage budgets, in full rounds.
     const std::vector<double>& coverageRounds = s.coverageRounds;
     std::vector<std::vector<std::vector<double>>> allCurves;
     std::vector<std::vector<double>> allX;
-    std::printf("| m | full rounds | comparisons (full) | RMSE full | RMSE random | RMSE active | active reaches full's RMSE at | "
+    std::printf("| m | full rounds | comparisons (full) | RMSE full | RMSE random | RMSE active | active reaches "
+                "full's RMSE at | "
                 "saving | random reaches it at |\n|---|---|---|---|---|---|---|---|---|\n");
     std::vector<std::string> coverageLines, profileLines;
     for (const int m : ms) {
@@ -327,7 +331,8 @@ int main(int argc, char** argv) {
         const int step = m - 1;
         const std::size_t length = static_cast<std::size_t>(s.rounds * M);
         std::vector<double> x;
-        for (std::size_t c = static_cast<std::size_t>(step); c <= length; c += static_cast<std::size_t>(step)) x.push_back(static_cast<double>(c));
+        for (std::size_t c = static_cast<std::size_t>(step); c <= length; c += static_cast<std::size_t>(step))
+            x.push_back(static_cast<double>(c));
         std::vector<std::vector<double>> sumSquared(3, std::vector<double>(x.size(), 0.0));
         std::map<std::pair<int, int>, CoverageCell> coverage, profileCoverage; // (design, budget index)
         double fisherRatio = 0.0;
@@ -346,8 +351,8 @@ int main(int argc, char** argv) {
             for (double& q : truth) q -= mean;
             fisherRatio += fisherSavingBound(truth);
             for (int d = 0; d < 3; ++d) {
-                const std::vector<Trial> trials =
-                    simulateDesign(d, truth, length, sc::mixSeed(s.seed + 17, static_cast<std::uint64_t>(m * 100000 + e * 3 + d)), s);
+                const std::vector<Trial> trials = simulateDesign(
+                    d, truth, length, sc::mixSeed(s.seed + 17, static_cast<std::uint64_t>(m * 100000 + e * 3 + d)), s);
                 for (std::size_t k = 0; k < x.size(); ++k) {
                     const sc::BlockData block = blockOf(trials, static_cast<std::size_t>(x[k]), m, step);
                     const sc::FitResult fit = sc::fitScores(block.totalCounts(), fitOptions);
@@ -357,7 +362,8 @@ int main(int argc, char** argv) {
                 if (e < s.coverageExperiments) {
                     for (std::size_t b = 0; b < coverageRounds.size(); ++b) {
                         // Budget rounded to whole observers.
-                        const std::size_t count = static_cast<std::size_t>(std::lround(coverageRounds[b] * M / step)) * static_cast<std::size_t>(step);
+                        const std::size_t count = static_cast<std::size_t>(std::lround(coverageRounds[b] * M / step)) *
+                                                  static_cast<std::size_t>(step);
                         const sc::BlockData block = blockOf(trials, count, m, step);
                         const sc::FitResult fit = sc::fitScores(block.totalCounts(), fitOptions);
                         bootOptions.seed = sc::mixSeed(s.seed, static_cast<std::uint64_t>(e * 7 + d));
@@ -372,7 +378,8 @@ int main(int argc, char** argv) {
                             cell.total += 1;
                             Eigen::VectorXd contrast = Eigen::VectorXd::Constant(m, -1.0 / m);
                             contrast[i] += 1.0;
-                            const sc::ProfileInterval profile = sc::profileInterval(totals, fitOptions, fit, contrast, 0.95);
+                            const sc::ProfileInterval profile =
+                                sc::profileInterval(totals, fitOptions, fit, contrast, 0.95);
                             profileCell.covered += (profile.low <= q && q <= profile.high) ? 1 : 0;
                             profileCell.widths.push_back(profile.high - profile.low);
                             profileCell.total += 1;
@@ -384,39 +391,48 @@ int main(int argc, char** argv) {
         std::vector<std::vector<double>> curves(3, std::vector<double>(x.size()));
         for (int d = 0; d < 3; ++d)
             for (std::size_t k = 0; k < x.size(); ++k)
-                curves[static_cast<std::size_t>(d)][k] = std::sqrt(sumSquared[static_cast<std::size_t>(d)][k] / s.experiments);
+                curves[static_cast<std::size_t>(d)][k] =
+                    std::sqrt(sumSquared[static_cast<std::size_t>(d)][k] / s.experiments);
         for (int r = 1; r <= s.rounds; ++r) {
             const std::size_t k = static_cast<std::size_t>(r * M / step) - 1; // x[k] = r·M
             const double target = curves[0][k];
             const double active = reachedAt(x, curves[2], target);
             const double random = reachedAt(x, curves[1], target);
             char activeText[64], randomText[64], saving[32];
-            if (active > 0) std::snprintf(activeText, sizeof activeText, "%.0f", active); else std::snprintf(activeText, sizeof activeText, "> %zu", length);
-            if (random > 0) std::snprintf(randomText, sizeof randomText, "%.0f", random); else std::snprintf(randomText, sizeof randomText, "> %zu", length);
-            if (active > 0) std::snprintf(saving, sizeof saving, "%.0f %%", 100.0 * (1.0 - active / (r * M))); else std::snprintf(saving, sizeof saving, "n/a");
-            std::printf("| %d | %d | %d | %.3f | %.3f | %.3f | %s | %s | %s |\n", m, r, r * M, target, curves[1][k], curves[2][k],
-                        activeText, saving, randomText);
+            if (active > 0) std::snprintf(activeText, sizeof activeText, "%.0f", active);
+            else std::snprintf(activeText, sizeof activeText, "> %zu", length);
+            if (random > 0) std::snprintf(randomText, sizeof randomText, "%.0f", random);
+            else std::snprintf(randomText, sizeof randomText, "> %zu", length);
+            if (active > 0) std::snprintf(saving, sizeof saving, "%.0f %%", 100.0 * (1.0 - active / (r * M)));
+            else std::snprintf(saving, sizeof saving, "n/a");
+            std::printf("| %d | %d | %d | %.3f | %.3f | %.3f | %s | %s | %s |\n", m, r, r * M, target, curves[1][k],
+                        curves[2][k], activeText, saving, randomText);
         }
         for (std::size_t b = 0; b < coverageRounds.size(); ++b) {
-            const std::size_t count = static_cast<std::size_t>(std::lround(coverageRounds[b] * M / step)) * static_cast<std::size_t>(step);
+            const std::size_t count =
+                static_cast<std::size_t>(std::lround(coverageRounds[b] * M / step)) * static_cast<std::size_t>(step);
             char line[256];
             const CoverageCell& f = coverage[{0, static_cast<int>(b)}];
             const CoverageCell& r = coverage[{1, static_cast<int>(b)}];
             const CoverageCell& a = coverage[{2, static_cast<int>(b)}];
-            std::snprintf(line, sizeof line, "| %d | %zu (%.1f rounds, %zu observers) | %.3f (%.2f) | %.3f (%.2f) | %.3f (%.2f) |", m, count,
-                          coverageRounds[b], count / static_cast<std::size_t>(step), f.covered / f.total, f.medianWidth(),
-                          r.covered / r.total, r.medianWidth(), a.covered / a.total, a.medianWidth());
+            std::snprintf(line, sizeof line,
+                          "| %d | %zu (%.1f rounds, %zu observers) | %.3f (%.2f) | %.3f (%.2f) | %.3f (%.2f) |", m,
+                          count, coverageRounds[b], count / static_cast<std::size_t>(step), f.covered / f.total,
+                          f.medianWidth(), r.covered / r.total, r.medianWidth(), a.covered / a.total, a.medianWidth());
             coverageLines.push_back(line);
             const CoverageCell& pf = profileCoverage[{0, static_cast<int>(b)}];
             const CoverageCell& pr = profileCoverage[{1, static_cast<int>(b)}];
             const CoverageCell& pa = profileCoverage[{2, static_cast<int>(b)}];
-            std::snprintf(line, sizeof line, "| %d | %zu (%.1f rounds, %zu observers) | %.3f (%.2f) | %.3f (%.2f) | %.3f (%.2f) |", m, count,
-                          coverageRounds[b], count / static_cast<std::size_t>(step), pf.covered / pf.total, pf.medianWidth(),
-                          pr.covered / pr.total, pr.medianWidth(), pa.covered / pa.total, pa.medianWidth());
+            std::snprintf(line, sizeof line,
+                          "| %d | %zu (%.1f rounds, %zu observers) | %.3f (%.2f) | %.3f (%.2f) | %.3f (%.2f) |", m,
+                          count, coverageRounds[b], count / static_cast<std::size_t>(step), pf.covered / pf.total,
+                          pf.medianWidth(), pr.covered / pr.total, pr.medianWidth(), pa.covered / pa.total,
+                          pa.medianWidth());
             profileLines.push_back(line);
         }
-        std::printf("| %d | Fisher bound: any design needs at least %.0f %% of the full design's comparisons (saving <= %.0f %%) |\n", m,
-                    100.0 * fisherRatio / s.experiments, 100.0 * (1.0 - fisherRatio / s.experiments));
+        std::printf("| %d | Fisher bound: any design needs at least %.0f %% of the full design's comparisons (saving "
+                    "<= %.0f %%) |\n",
+                    m, 100.0 * fisherRatio / s.experiments, 100.0 * (1.0 - fisherRatio / s.experiments));
         std::fflush(stdout);
         allCurves.push_back(curves);
         allX.push_back(x);
@@ -458,7 +474,8 @@ int main(int argc, char** argv) {
             if (batch.size() != static_cast<std::size_t>(m - 1)) return 1;
         }
         std::sort(times.begin(), times.end());
-        std::printf("| %d | %zu | %d | %.1f | %.1f |\n", participants, answers.size(), sweeps, times[times.size() / 2], times.front());
+        std::printf("| %d | %zu | %d | %.1f | %.1f |\n", participants, answers.size(), sweeps, times[times.size() / 2],
+                    times.front());
     }
     if (!s.plot.empty()) {
         drawPlot(s.plot, ms, allCurves, allX, s);

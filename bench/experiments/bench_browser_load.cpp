@@ -78,9 +78,14 @@ void writeSet(const fs::path& folder, int imageKiB) {
         std::string bytes(static_cast<std::size_t>(imageKiB) * 1024, '\0');
         for (char& c : bytes) c = static_cast<char>(random());
         skinlab::writeFileAtomic(folder / "png" / (id + ".png"), bytes);
-        manifest["stimuli"].push_back({{"id", id}, {"files", {{"png", "png/" + id + ".png"}}},
-                                       {"sha256", {{"png", skinlab::sha256Hex(bytes)}}}, {"factors", {{"method", id}}},
-                                       {"block", "bench"}, {"reference", false}, {"width", 1280}, {"height", 720}});
+        manifest["stimuli"].push_back({{"id", id},
+                                       {"files", {{"png", "png/" + id + ".png"}}},
+                                       {"sha256", {{"png", skinlab::sha256Hex(bytes)}}},
+                                       {"factors", {{"method", id}}},
+                                       {"block", "bench"},
+                                       {"reference", false},
+                                       {"width", 1280},
+                                       {"height", 720}});
     }
     skinlab::writeFileAtomic(folder / "manifest.json", manifest.dump());
 }
@@ -139,8 +144,8 @@ struct Server {
 
 struct Stats {
     std::vector<double> all, answers, slowSideNormal;
-    int errors = 0;        // HTTP answers other than 2xx/304
-    int retries = 0;       // requests re-sent after no answer
+    int errors = 0;  // HTTP answers other than 2xx/304
+    int retries = 0; // requests re-sent after no answer
     std::map<int, int> statuses;
 };
 
@@ -170,24 +175,44 @@ private:
     // The page's sequence, one request at a time.
     void step() {
         switch (stage_) {
-        case 0: return send("GET", "/", "", [this](const std::string&) { stage_ = 1; step(); });
-        case 1: return send("GET", "/app.js", "", [this](const std::string&) { stage_ = 2; step(); });
-        case 2: return send("GET", "/style.css", "", [this](const std::string&) { stage_ = 3; step(); });
-        case 3: return send("GET", "/api/study", "", [this](const std::string&) { stage_ = 4; step(); });
-        case 4:
-            return send("POST", "/api/join", json{{"join_key", "bench-" + std::to_string(index_)}}.dump(), [this](const std::string& body) {
-                token = json::parse(body)["token"];
-                stage_ = 5;
+        case 0:
+            return send("GET", "/", "", [this](const std::string&) {
+                stage_ = 1;
                 step();
             });
-        case 5:
-            return send("POST", "/api/session", json{{"token", token}, {"viewport_width", 1920}, {"viewport_height", 1080}, {"device_pixel_ratio", 1.0}}.dump(),
+        case 1:
+            return send("GET", "/app.js", "", [this](const std::string&) {
+                stage_ = 2;
+                step();
+            });
+        case 2:
+            return send("GET", "/style.css", "", [this](const std::string&) {
+                stage_ = 3;
+                step();
+            });
+        case 3:
+            return send("GET", "/api/study", "", [this](const std::string&) {
+                stage_ = 4;
+                step();
+            });
+        case 4:
+            return send("POST", "/api/join", json{{"join_key", "bench-" + std::to_string(index_)}}.dump(),
                         [this](const std::string& body) {
-                            state_ = json::parse(body);
-                            session_ = state_["session"];
-                            stage_ = 6;
+                            token = json::parse(body)["token"];
+                            stage_ = 5;
                             step();
                         });
+        case 5:
+            return send(
+                "POST", "/api/session",
+                json{{"token", token}, {"viewport_width", 1920}, {"viewport_height", 1080}, {"device_pixel_ratio", 1.0}}
+                    .dump(),
+                [this](const std::string& body) {
+                    state_ = json::parse(body);
+                    session_ = state_["session"];
+                    stage_ = 6;
+                    step();
+                });
         default: return trial();
         }
     }
@@ -211,15 +236,18 @@ private:
     void answer() {
         const std::int64_t trial = state_["trial"]["id"];
         const std::string side = random_() % 2 ? "left" : "right";
-        json body{{"token", token}, {"trial", trial}, {"side", side}, {"session", session_}, {"response_ms", 900.0},
-                  {"client_time", "2026-12-01T00:00:00.000Z"}, {"viewport_width", 1920}, {"viewport_height", 1080},
-                  {"device_pixel_ratio", 1.0}};
-        send("POST", "/api/response", body.dump(), [this, trial, side](const std::string& reply) {
-            acknowledged.emplace_back(trial, side);
-            ++answered_;
-            state_ = json::parse(reply);
-            this->trial();
-        }, true);
+        json body{{"token", token},         {"trial", trial},          {"side", side},
+                  {"session", session_},    {"response_ms", 900.0},    {"client_time", "2026-12-01T00:00:00.000Z"},
+                  {"viewport_width", 1920}, {"viewport_height", 1080}, {"device_pixel_ratio", 1.0}};
+        send(
+            "POST", "/api/response", body.dump(),
+            [this, trial, side](const std::string& reply) {
+                acknowledged.emplace_back(trial, side);
+                ++answered_;
+                state_ = json::parse(reply);
+                this->trial();
+            },
+            true);
     }
 
     void send(const std::string& method, const std::string& target, const std::string& body,
@@ -282,8 +310,8 @@ private:
         }
         if (status >= 400) {
             ++stats_.errors;
-            std::fprintf(stderr, "participant %d: %s -> %d %s\n", index_, std::string(request_.target()).c_str(), status,
-                         res.body().substr(0, 200).c_str());
+            std::fprintf(stderr, "participant %d: %s -> %d %s\n", index_, std::string(request_.target()).c_str(),
+                         status, res.body().substr(0, 200).c_str());
             close();
             return;
         }
@@ -359,7 +387,8 @@ public:
 
 private:
     void line() {
-        const std::string text = lines_ == 0 ? "GET /api/study HTTP/1.1\r\n" : "X-Slow-" + std::to_string(lines_) + ": 1\r\n";
+        const std::string text =
+            lines_ == 0 ? "GET /api/study HTTP/1.1\r\n" : "X-Slow-" + std::to_string(lines_) + ": 1\r\n";
         ++lines_;
         auto bytes = std::make_shared<std::string>(text);
         asio::async_write(*socket_, asio::buffer(*bytes), [bytes](beast::error_code, std::size_t) {});
@@ -406,7 +435,8 @@ void chunkedFlood(int& port, std::atomic<bool>& stop, std::atomic<long>& refused
         const std::string head = "POST /api/join HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) +
                                  "\r\nContent-Type: application/json\r\nTransfer-Encoding: chunked\r\n\r\n";
         asio::write(socket, asio::buffer(head), ec);
-        for (std::size_t sent = 0; !ec && !stop && sent < (500u << 20); sent += 65536) asio::write(socket, asio::buffer(chunk), ec);
+        for (std::size_t sent = 0; !ec && !stop && sent < (500u << 20); sent += 65536)
+            asio::write(socket, asio::buffer(chunk), ec);
         ++refused;
         std::this_thread::sleep_for(std::chrono::milliseconds(50));
     }
@@ -421,7 +451,8 @@ int main(int argc, char** argv) {
         if (key == "--participants") o.participants = std::stoi(value);
         else if (key == "--think-ms") {
             o.thinkMin = std::stod(value);
-            o.thinkMax = value.find(':') != std::string::npos ? std::stod(value.substr(value.find(':') + 1)) : o.thinkMin;
+            o.thinkMax =
+                value.find(':') != std::string::npos ? std::stod(value.substr(value.find(':') + 1)) : o.thinkMin;
         } else if (key == "--ramp-s") o.rampSeconds = std::stod(value);
         else if (key == "--slow-headers") o.slowHeaders = std::stoi(value);
         else if (key == "--chunked-floods") o.chunkedFloods = std::stoi(value);
@@ -449,7 +480,8 @@ int main(int argc, char** argv) {
     int port = server.port;
     std::printf("server pid %d on port %d; %d participants, think %.0f–%.0f ms, ramp %.0f s, %d slow-header "
                 "connections, %d chunked floods, images %d KiB\n",
-                server.pid, port, o.participants, o.thinkMin, o.thinkMax, o.rampSeconds, o.slowHeaders, o.chunkedFloods, o.imageKiB);
+                server.pid, port, o.participants, o.thinkMin, o.thinkMax, o.rampSeconds, o.slowHeaders, o.chunkedFloods,
+                o.imageKiB);
     std::fflush(stdout);
 
     asio::io_context io;
@@ -526,18 +558,21 @@ int main(int argc, char** argv) {
         }
     }
     const long stored = store.responseCount();
-    std::printf("%.1f s: %ld/%d participants completed; %ld answers acknowledged, %ld stored (%ld lost, %ld stored "
-                "differently, %ld stored without acknowledgement); %d kills; %d HTTP errors, %d re-sent after no answer\n",
-                seconds, completed, o.participants, acknowledged, stored, lost, mismatched, stored - acknowledged + lost, kills,
-                stats.errors, stats.retries);
+    std::printf(
+        "%.1f s: %ld/%d participants completed; %ld answers acknowledged, %ld stored (%ld lost, %ld stored "
+        "differently, %ld stored without acknowledgement); %d kills; %d HTTP errors, %d re-sent after no answer\n",
+        seconds, completed, o.participants, acknowledged, stored, lost, mismatched, stored - acknowledged + lost, kills,
+        stats.errors, stats.retries);
     std::printf("statuses:");
     for (const auto& [status, n] : stats.statuses) std::printf(" %d×%d", status, n);
-    std::printf("\nslow-header connections cut by the server: %d; chunked floods refused: %ld\n", slowCut.load(), floodsRefused.load());
+    std::printf("\nslow-header connections cut by the server: %d; chunked floods refused: %ld\n", slowCut.load(),
+                floodsRefused.load());
     std::printf("| %d | %.0f–%.0f | %d | %d | %zu | %.1f | %.1f | %.1f | %.1f | %.1f | %.0f | %ld |\n", o.participants,
                 o.thinkMin, o.thinkMax, o.slowHeaders, o.chunkedFloods, stats.all.size(), percentile(stats.all, 50),
                 percentile(stats.all, 99), percentile(stats.answers, 50), percentile(stats.answers, 99),
                 percentile(stats.all, 100), static_cast<double>(stats.answers.size()) / seconds, peakRss / 1024);
-    std::printf("(participants | think ms | slow headers | floods | requests | p50 all ms | p99 all ms | p50 answer ms | "
-                "p99 answer ms | max ms | answers/s | server peak RSS MiB)\n");
+    std::printf(
+        "(participants | think ms | slow headers | floods | requests | p50 all ms | p99 all ms | p50 answer ms | "
+        "p99 answer ms | max ms | answers/s | server peak RSS MiB)\n");
     return lost == 0 && mismatched == 0 && completed == o.participants ? 0 : 1;
 }

@@ -37,15 +37,20 @@ int activeConditions = 0; // --active M (0: the fixed five-condition design)
 
 void writeSet(const fs::path& folder) {
     fs::create_directories(folder / "png");
-    nlohmann::json manifest{{"format", "skinlab-stimuli"}, {"version", 1}, {"set", "bench"}, {"stimuli", nlohmann::json::array()}};
+    nlohmann::json manifest{
+        {"format", "skinlab-stimuli"}, {"version", 1}, {"set", "bench"}, {"stimuli", nlohmann::json::array()}};
     for (int m = 0; m < (activeConditions > 0 ? activeConditions : 5); ++m) {
         const std::string id = "c" + std::to_string(m);
         const std::string bytes = "placeholder image " + id;
         skinlab::writeFileAtomic(folder / "png" / (id + ".png"), bytes);
-        manifest["stimuli"].push_back({{"id", id}, {"files", {{"png", "png/" + id + ".png"}}},
+        manifest["stimuli"].push_back({{"id", id},
+                                       {"files", {{"png", "png/" + id + ".png"}}},
                                        {"sha256", {{"png", skinlab::sha256Hex(bytes)}}},
-                                       {"factors", {{"method", id}}}, {"block", "bench"}, {"reference", false},
-                                       {"width", 256}, {"height", 256}});
+                                       {"factors", {{"method", id}}},
+                                       {"block", "bench"},
+                                       {"reference", false},
+                                       {"width", 256},
+                                       {"height", 256}});
     }
     skinlab::writeFileAtomic(folder / "manifest.json", manifest.dump());
 }
@@ -62,10 +67,12 @@ Run measure(const fs::path& root, int observers, double thinkMin, double thinkMa
     const fs::path folder = root / ("run-" + std::to_string(run));
     fs::remove_all(folder);
     writeSet(folder / "stimuli");
-    const std::string pairs = activeConditions > 0 ? "pairs = \"active\"\ntrials_per_participant = " +
-                                                         std::to_string(2 * (activeConditions - 1)) + "\n"
-                                                   : "repetitions = 2\n";
-    skinlab::writeFileAtomic(folder / "design.toml", "seed = 1\n" + pairs + "[practice]\ntrials = 0\n[catch]\nblank = 2\n");
+    const std::string pairs =
+        activeConditions > 0
+            ? "pairs = \"active\"\ntrials_per_participant = " + std::to_string(2 * (activeConditions - 1)) + "\n"
+            : "repetitions = 2\n";
+    skinlab::writeFileAtomic(folder / "design.toml",
+                             "seed = 1\n" + pairs + "[practice]\ntrials = 0\n[catch]\nblank = 2\n");
     createStudy(folder / "stimuli", folder / "design.toml", {}, folder / "study.db");
     StudyStore store(folder / "study.db");
     ServerOptions options;
@@ -115,7 +122,8 @@ int main(int argc, char** argv) {
             while (std::getline(ss, item, ',')) counts.push_back(std::stoi(item));
         } else if (key == "--think-ms") {
             const auto colon = value.find(':');
-            thinks = {{std::stod(value.substr(0, colon)), std::stod(colon == std::string::npos ? value : value.substr(colon + 1))}};
+            thinks = {{std::stod(value.substr(0, colon)),
+                       std::stod(colon == std::string::npos ? value : value.substr(colon + 1))}};
         } else if (key == "--active") {
             activeConditions = std::stoi(value);
         } else if (key == "--folder") {
@@ -127,7 +135,8 @@ int main(int argc, char** argv) {
     }
     fs::create_directories(root);
     spdlog::set_level(spdlog::level::warn); // no "participant joined" lines in the table
-    std::printf("| participants | pause before each answer | responses | p50 ms | p99 ms | max ms | rejected | re-sent | lost | responses/s |\n");
+    std::printf("| participants | pause before each answer | responses | p50 ms | p99 ms | max ms | rejected | re-sent "
+                "| lost | responses/s |\n");
     std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
     int run = 0;
     for (const auto& [thinkMin, thinkMax] : thinks)
@@ -139,11 +148,12 @@ int main(int argc, char** argv) {
             if (thinkMax > 0) std::snprintf(pause, sizeof pause, "%.0f–%.0f ms", thinkMin, thinkMax);
             else std::snprintf(pause, sizeof pause, "none (back to back)");
             std::printf("| %d | %s | %lld | %.2f | %.2f | %.2f | %d | %d | %zu | %.0f |\n", n, pause,
-                        static_cast<long long>(r.stored), r.report.latencyPercentile(50), r.report.latencyPercentile(99),
-                        worst, r.report.rejected(), r.report.transportRetries(), r.lost,
+                        static_cast<long long>(r.stored), r.report.latencyPercentile(50),
+                        r.report.latencyPercentile(99), worst, r.report.rejected(), r.report.transportRetries(), r.lost,
                         static_cast<double>(r.report.acknowledged()) / r.report.wallSeconds);
             std::fflush(stdout);
-            if (r.report.completed() != n) std::fprintf(stderr, "only %d of %d observers completed\n", r.report.completed(), n);
+            if (r.report.completed() != n)
+                std::fprintf(stderr, "only %d of %d observers completed\n", r.report.completed(), n);
         }
     fs::remove_all(root);
     return 0;

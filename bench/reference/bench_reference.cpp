@@ -35,7 +35,8 @@ void run(const char* name, const Model& model, float edgeMm, int repeats) {
         auto start = std::chrono::steady_clock::now();
         const Model fine = tessellateSkin(model, edgeMm, 1.0f);
         const SurfaceSamples samples = gatherSurfaceSamples(fine, 1.0f);
-        tessellateMs.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+        tessellateMs.push_back(
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
         std::vector<glm::vec3> irradiance(samples.size());
         const glm::vec3 light = glm::normalize(glm::vec3(0.45f, 0.45f, 0.77f));
         for (std::size_t i = 0; i < samples.size(); ++i)
@@ -45,7 +46,8 @@ void run(const char* name, const Model& model, float edgeMm, int repeats) {
         start = std::chrono::steady_clock::now();
         const std::clock_t cpuStart = std::clock();
         const auto out = convolveSurface(samples, irradiance, *profile, settings, nullptr, &report);
-        convolveMs.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+        convolveMs.push_back(
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
         convolveCpuMs.push_back(1000.0 * double(std::clock() - cpuStart) / CLOCKS_PER_SEC);
         skinSamples = report.receivers;
         if (out.empty()) std::abort();
@@ -58,8 +60,9 @@ void run(const char* name, const Model& model, float edgeMm, int repeats) {
 
 int main(int argc, char** argv) {
     const int repeats = argc > 1 ? std::max(1, std::atoi(argv[1])) : 3;
-    std::printf("| model | edge (mm) | skin samples | sources per sample | tessellate + gather, wall (ms) | convolve, wall "
-                "(ms) | convolve, CPU (ms) |\n");
+    std::printf(
+        "| model | edge (mm) | skin samples | sources per sample | tessellate + gather, wall (ms) | convolve, wall "
+        "(ms) | convolve, CPU (ms) |\n");
     std::printf("|---|---|---|---|---|---|---|\n");
     const Model halo = makeHaloScene(200.0f);
     for (const float edge : {2.0f, 1.0f, 0.5f}) run("builtin:halo sphere", halo, edge, repeats);

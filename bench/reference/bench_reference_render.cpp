@@ -26,14 +26,16 @@ int main(int argc, char** argv) {
     };
     std::vector<Case> cases = {{"builtin:halo-grey-backdrop (mid view)", "builtin:halo-grey-backdrop", {}}};
     if (assets && std::filesystem::exists(std::filesystem::path(assets) / "LeePerrySmith/LeePerrySmith.glb"))
-        cases.push_back({"scanned head (close view)", std::string(SKINLAB_SOURCE_DIR) + "/renderer/scenes/lee-perry-smith.toml",
+        cases.push_back({"scanned head (close view)",
+                         std::string(SKINLAB_SOURCE_DIR) + "/renderer/scenes/lee-perry-smith.toml",
                          {"camera.view=close"}});
-    else
-        std::fprintf(stderr, "SKINLAB_ASSETS does not hold LeePerrySmith/: the scanned head is left out\n");
+    else std::fprintf(stderr, "SKINLAB_ASSETS does not hold LeePerrySmith/: the scanned head is left out\n");
     const auto output = std::filesystem::temp_directory_path() / "bench_reference_render.exr";
     Renderer renderer;
-    std::printf("| scene | edge (mm) | render | samples (skin) | sources per sample | tessellate (ms) | bake + read back "
-                "(ms) | convolve (ms) | sss pass, wall (ms) | render, wall (ms) |\n|---|---|---|---|---|---|---|---|---|---|\n");
+    std::printf(
+        "| scene | edge (mm) | render | samples (skin) | sources per sample | tessellate (ms) | bake + read back "
+        "(ms) | convolve (ms) | sss pass, wall (ms) | render, wall (ms) "
+        "|\n|---|---|---|---|---|---|---|---|---|---|\n");
     for (const Case& c : cases)
         for (const char* edge : {"2", "1"})
             for (int repeat = 0; repeat < 2; ++repeat) {
@@ -51,12 +53,12 @@ int main(int argc, char** argv) {
                 const double wallMs =
                     std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
                 const auto& run = result.timingsMs.at("reference");
-                std::printf("| %s | %s | %s | %d (%d) | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f |\n", c.name.c_str(), edge,
-                            repeat == 0 ? "first" : "cached", run.at("samples").get<int>(),
+                std::printf("| %s | %s | %s | %d (%d) | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f |\n", c.name.c_str(),
+                            edge, repeat == 0 ? "first" : "cached", run.at("samples").get<int>(),
                             run.at("skin_samples").get<int>(), run.at("sources_per_sample").get<double>(),
                             run.at("tessellate_ms").get<double>(), run.at("bake_readback_ms").get<double>(),
-                            run.at("convolve_ms").get<double>(), result.timingsMs.at("passes_wall").at("sss").get<double>(),
-                            wallMs);
+                            run.at("convolve_ms").get<double>(),
+                            result.timingsMs.at("passes_wall").at("sss").get<double>(), wallMs);
                 std::fflush(stdout);
             }
     std::filesystem::remove(output);

@@ -51,7 +51,8 @@ int main(int argc, char** argv) {
         if (const char* environment = std::getenv("SKINLAB_ASSETS")) assets = environment;
 
     std::vector<std::string> scenes = {"builtin:head"};
-    const std::filesystem::path scanned = std::filesystem::path(SKINLAB_SOURCE_DIR) / "renderer/scenes/lee-perry-smith.toml";
+    const std::filesystem::path scanned =
+        std::filesystem::path(SKINLAB_SOURCE_DIR) / "renderer/scenes/lee-perry-smith.toml";
     if (!assets.empty()) scenes.push_back(scanned.string());
     else std::fprintf(stderr, "bench_render: no assets folder (--assets or SKINLAB_ASSETS): scanned head skipped\n");
 
@@ -61,7 +62,7 @@ int main(int argc, char** argv) {
     std::string csv = "scene,pass,gpu_ms_median,wall_ms_median,frames,width,height,gl_renderer\n";
     std::printf("GL_RENDERER: %s\nGL_VERSION: %s\n%d×%d, median of %d frames after one warm-up\n\n",
                 renderer.glRenderer().c_str(), renderer.glVersion().c_str(), width, height, frames);
-    const std::vector<std::string> passes = {"shadow",        "main", "background", "surface_aovs",
+    const std::vector<std::string> passes = {"shadow",        "main", "background",   "surface_aovs",
                                              "transmittance", "sss",  "add_specular", "tone_map"};
     for (const std::string& scene : scenes) {
         skinlab::renderer::RenderRequest request;
@@ -75,7 +76,7 @@ int main(int argc, char** argv) {
         std::vector<double> totals, totalsWall, readback;
         for (int frame = 0; frame <= frames; ++frame) {
             const auto result = renderer.render(request);
-            if (frame == 0) continue;  // warm-up: shader compilation, model/texture loading
+            if (frame == 0) continue; // warm-up: shader compilation, model/texture loading
             for (const auto& pass : passes) {
                 gpu[pass].push_back(result.timingsMs["passes"][pass].get<double>());
                 wall[pass].push_back(result.timingsMs["passes_wall"][pass].get<double>());
@@ -88,9 +89,9 @@ int main(int argc, char** argv) {
         std::printf("%s\n  %-14s %10s %10s\n", label.c_str(), "pass", "GPU ms", "wall ms");
         for (const auto& pass : passes) {
             std::printf("  %-14s %10.2f %10.2f\n", pass.c_str(), median(gpu[pass]), median(wall[pass]));
-            csv += label + "," + pass + "," + std::to_string(median(gpu[pass])) + "," + std::to_string(median(wall[pass])) +
-                   "," + std::to_string(frames) + "," + std::to_string(width) + "," + std::to_string(height) + ",\"" +
-                   renderer.glRenderer() + "\"\n";
+            csv += label + "," + pass + "," + std::to_string(median(gpu[pass])) + "," +
+                   std::to_string(median(wall[pass])) + "," + std::to_string(frames) + "," + std::to_string(width) +
+                   "," + std::to_string(height) + ",\"" + renderer.glRenderer() + "\"\n";
         }
         std::printf("  %-14s %10.2f %10.2f\n", "frame total", median(totals), median(totalsWall));
         std::printf("  %-14s %10s %10.2f\n\n", "AOV readback", "", median(readback));

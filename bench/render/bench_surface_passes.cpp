@@ -50,7 +50,8 @@ int main(int argc, char** argv) {
     if (assets.empty())
         if (const char* environment = std::getenv("SKINLAB_ASSETS")) assets = environment;
     std::vector<std::string> scenes = {"builtin:head"};
-    const std::filesystem::path scanned = std::filesystem::path(SKINLAB_SOURCE_DIR) / "renderer/scenes/lee-perry-smith.toml";
+    const std::filesystem::path scanned =
+        std::filesystem::path(SKINLAB_SOURCE_DIR) / "renderer/scenes/lee-perry-smith.toml";
     if (!assets.empty()) scenes.push_back(scanned.string());
 
     skinlab::renderer::Renderer renderer;
@@ -73,7 +74,7 @@ int main(int argc, char** argv) {
             const auto withoutTransmittance = renderer.render(request);
             request.overrides = {"transmittance.enabled=true"};
             const auto withTransmittance = renderer.render(request);
-            if (round == 0) continue;  // warm-up: shader compilation, file loading
+            if (round == 0) continue; // warm-up: shader compilation, file loading
             for (const auto& pass : passes) {
                 off[pass].push_back(withoutTransmittance.timingsMs["passes"][pass].get<double>());
                 on[pass].push_back(withTransmittance.timingsMs["passes"][pass].get<double>());

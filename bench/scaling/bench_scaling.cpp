@@ -38,9 +38,10 @@ int main(int argc, char** argv) {
     }
     std::printf("hardware threads %u, bootstrap threads %d, %d samples, %d repeats\n",
                 std::thread::hardware_concurrency(), threads, samples, repeat);
-    std::printf("| conditions | observers | trials/pair/observer | bootstrap wall median (s) | bootstrap wall min (s) | "
-                "bootstrap CPU median (s) | whole block wall median (s) | whole block wall min (s) |\n"
-                "|---|---|---|---|---|---|---|---|\n");
+    std::printf(
+        "| conditions | observers | trials/pair/observer | bootstrap wall median (s) | bootstrap wall min (s) | "
+        "bootstrap CPU median (s) | whole block wall median (s) | whole block wall min (s) |\n"
+        "|---|---|---|---|---|---|---|---|\n");
     for (const int conditions : {6, 20}) {
         SimulationDesign design;
         for (int i = 0; i < conditions; ++i) design.trueScores.push_back(0.15 * i);

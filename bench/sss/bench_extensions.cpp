@@ -34,7 +34,7 @@ std::vector<std::string> split(const std::string& text) {
 
 struct ExtensionSet {
     const char* name;
-    std::vector<std::string> overrides;  // β is set per method below
+    std::vector<std::string> overrides; // β is set per method below
     bool lab;
 };
 
@@ -58,12 +58,11 @@ int main(int argc, char** argv) {
             return 2;
         }
     }
-    const std::vector<ExtensionSet> sets{
-        {"follow-surface", {}, false},
-        {"+cbf", {"sss.cbf=true"}, false},
-        {"+lab_weight", {}, true},
-        {"+curvature", {"sss.curvature=\"reduce-floor\""}, false},
-        {"all", {"sss.cbf=true", "sss.curvature=\"reduce-floor\""}, true}};
+    const std::vector<ExtensionSet> sets{{"follow-surface", {}, false},
+                                         {"+cbf", {"sss.cbf=true"}, false},
+                                         {"+lab_weight", {}, true},
+                                         {"+curvature", {"sss.curvature=\"reduce-floor\""}, false},
+                                         {"all", {"sss.cbf=true", "sss.curvature=\"reduce-floor\""}, true}};
     const std::filesystem::path scratch =
         std::filesystem::temp_directory_path() / ("skinlab-bench-extensions-" + std::to_string(::getpid()));
     std::filesystem::create_directories(scratch);
@@ -85,7 +84,8 @@ int main(int argc, char** argv) {
             request.overrides = {"camera.view=\"" + view + "\""};
             request.overrides.insert(request.overrides.end(), set.overrides.begin(), set.overrides.end());
             // The thesis' β: 0.5 for the sum of Gaussians, 0.09 for the others.
-            if (set.lab) request.overrides.push_back(method == "gaussian-sum" ? "sss.lab_weight=0.5" : "sss.lab_weight=0.09");
+            if (set.lab)
+                request.overrides.push_back(method == "gaussian-sum" ? "sss.lab_weight=0.5" : "sss.lab_weight=0.09");
             request.width = width;
             request.height = height;
             request.assetsDir = assets;

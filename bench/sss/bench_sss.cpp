@@ -84,7 +84,7 @@ int main(int argc, char** argv) {
     std::string csv = "scene,view,skin_share,method,samples,sss_gpu_ms_median,sss_wall_ms_median,frames,width,height,"
                       "gl_renderer,sss_gpu_ms_min\n";
     std::vector<std::pair<std::string, std::vector<skinlab::bench::SssSeries>>> panels;
-    double gpuMinimum = 0.0;  // of the last measure()
+    double gpuMinimum = 0.0; // of the last measure()
     auto measure = [&](const std::string& view, const std::string& method, int n, double& wallMs) {
         skinlab::renderer::RenderRequest request;
         request.scene = scene;
@@ -126,8 +126,9 @@ int main(int argc, char** argv) {
                 std::printf(" %9.2f", ms);
                 std::fflush(stdout);
                 char row[512];
-                std::snprintf(row, sizeof row, "%s,%s,%.4f,%s,%d,%.3f,%.3f,%d,%d,%d,\"%s\",%.3f\n", scene.c_str(), view.c_str(),
-                              share, method.c_str(), n, ms, wall, frames, width, height, renderer.glRenderer().c_str(), gpuMinimum);
+                std::snprintf(row, sizeof row, "%s,%s,%.4f,%s,%d,%.3f,%.3f,%d,%d,%d,\"%s\",%.3f\n", scene.c_str(),
+                              view.c_str(), share, method.c_str(), n, ms, wall, frames, width, height,
+                              renderer.glRenderer().c_str(), gpuMinimum);
                 csv += row;
             }
             std::printf("\n  %-13s", (method + " min").c_str());
@@ -140,8 +141,8 @@ int main(int argc, char** argv) {
     }
     std::filesystem::remove_all(scratch);
     skinlab::writeFileAtomic(std::filesystem::path(out) / "sss.csv", csv);
-    const std::string title = "SSS stage, " + scene + " " + std::to_string(width) + "x" + std::to_string(height) + ", " +
-                              renderer.glRenderer();
+    const std::string title = "SSS stage, " + scene + " " + std::to_string(width) + "x" + std::to_string(height) +
+                              ", " + renderer.glRenderer();
     skinlab::writeFileAtomic(std::filesystem::path(out) / "sss.png", skinlab::bench::plotSssTimings(panels, title));
     std::printf("wrote %s/sss.csv and %s/sss.png\n", out.c_str(), out.c_str());
     return 0;

@@ -77,7 +77,7 @@ FrozenFrame freeze(const std::filesystem::path& exr) {
     FrozenFrame frame;
     const auto diffuse = gather({"diffuse.R", "diffuse.G", "diffuse.B", "mask.Y"}, 0.0f);
     frame.diffuse = upload(diffuse);
-    frame.depth = upload(gather({"depth.Z"}, 0.0f));  // the passes read .r
+    frame.depth = upload(gather({"depth.Z"}, 0.0f)); // the passes read .r
     frame.albedo = upload(gather({"albedo.R", "albedo.G", "albedo.B", "mask.Y"}, 0.0f));
     frame.mask = upload(gather({"mask.Y"}, 0.0f));
     frame.geometricNormal = upload(gather({"geonormal.X", "geonormal.Y", "geonormal.Z"}, 0.0f));
@@ -127,7 +127,7 @@ int main(int argc, char** argv) {
         }
     }
     skinlab::ensureDirectory(out);
-    Renderer renderer;  // owns the EGL context, current on this thread from here on
+    Renderer renderer; // owns the EGL context, current on this thread from here on
     const std::filesystem::path scratch = std::filesystem::temp_directory_path() / "skinlab-bench-sss-stage";
     std::filesystem::create_directories(scratch);
     gl::ShaderLibrary shaders;
@@ -135,7 +135,8 @@ int main(int argc, char** argv) {
     std::printf("GL_RENDERER: %s\nscene %s, %d×%d; SSS stage alone, methods interleaved; min and median of %d repeats "
                 "after one warm-up, ms\n\n",
                 renderer.glRenderer().c_str(), scene.c_str(), width, height, repeats - 1);
-    std::string csv = "scene,view,skin_share,method,samples,sss_ms_min,sss_ms_median,repeats,width,height,gl_renderer\n";
+    std::string csv =
+        "scene,view,skin_share,method,samples,sss_ms_min,sss_ms_median,repeats,width,height,gl_renderer\n";
     for (const auto& view : views) {
         RenderRequest request;
         request.scene = scene;
@@ -170,8 +171,8 @@ int main(int argc, char** argv) {
                     std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
                 if (repeat > 0) config.milliseconds.push_back(ms);
             }
-        std::printf("view %s (skin %.1f %% of the pixels)\n  %-10s %7s %9s %9s\n", view.c_str(), 100.0 * frame.skinShare,
-                    "method", "samples", "min", "median");
+        std::printf("view %s (skin %.1f %% of the pixels)\n  %-10s %7s %9s %9s\n", view.c_str(),
+                    100.0 * frame.skinShare, "method", "samples", "min", "median");
         for (const auto& config : configs) {
             const double minimum = *std::min_element(config.milliseconds.begin(), config.milliseconds.end());
             const double middle = median(config.milliseconds);

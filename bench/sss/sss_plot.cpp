@@ -11,7 +11,7 @@ namespace skinlab::bench {
 
 namespace {
 const cv::Scalar kColours[] = {cv::Scalar(40, 40, 200), cv::Scalar(40, 150, 40), cv::Scalar(200, 90, 30),
-                               cv::Scalar(150, 40, 150)};  // BGR
+                               cv::Scalar(150, 40, 150)}; // BGR
 
 std::string label(double v) {
     char text[32];
@@ -46,7 +46,7 @@ std::string plotSssTimings(const std::vector<std::pair<std::string, std::vector<
     const double xMax = maxSamples;
     for (size_t p = 0; p < panels.size(); ++p) {
         const int x0 = left + static_cast<int>(p) * (panelWidth + right);
-        const int y0 = top + panelHeight;  // origin (bottom-left)
+        const int y0 = top + panelHeight; // origin (bottom-left)
         auto toPixel = [&](double samples, double ms) {
             return cv::Point(x0 + static_cast<int>(std::lround(samples / xMax * panelWidth)),
                              y0 - static_cast<int>(std::lround(ms / yMax * panelHeight)));
@@ -57,8 +57,8 @@ std::string plotSssTimings(const std::vector<std::pair<std::string, std::vector<
             const cv::Point a = toPixel(0, ms);
             cv::line(image, a, toPixel(xMax, ms), cv::Scalar(225, 225, 225), 1);
             if (p == 0)
-                cv::putText(image, label(ms), cv::Point(5, a.y + 5), cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(0, 0, 0), 1,
-                            cv::LINE_AA);
+                cv::putText(image, label(ms), cv::Point(5, a.y + 5), cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(0, 0, 0),
+                            1, cv::LINE_AA);
         }
         for (int n = 0; n <= maxSamples; n += maxSamples > 50 ? 20 : 10) {
             const cv::Point a = toPixel(n, 0);

@@ -64,8 +64,8 @@ int main(int argc, char** argv) {
         std::string csv = "spec,gl_renderer,cpu_threads,jobs,stimuli,cold_build_s,stimuli_per_minute,noop_rebuild_s\n";
         csv += "\"" + options.spec.filename().string() + "\",\"" + glRenderer + "\"," +
                std::to_string(std::thread::hardware_concurrency()) + "," + std::to_string(options.jobs) + "," +
-               std::to_string(cold.stimuli) + "," + std::to_string(cold.wallSeconds) + "," +
-               std::to_string(perMinute) + "," + std::to_string(warm.wallSeconds) + "\n";
+               std::to_string(cold.stimuli) + "," + std::to_string(cold.wallSeconds) + "," + std::to_string(perMinute) +
+               "," + std::to_string(warm.wallSeconds) + "\n";
         skinlab::writeFileAtomic(out / "bench_stimuli.csv", csv);
         std::printf("written         %s\n", (out / "bench_stimuli.csv").string().c_str());
     } catch (const std::exception& e) {

@@ -9,8 +9,8 @@ namespace skinlab::renderer::gl {
 
 struct BackgroundSettings {
     CameraPose camera;
-    GLuint environmentMap = 0;         // 0: use `color`
-    glm::vec3 color{0.0f};             // radiance
+    GLuint environmentMap = 0; // 0: use `color`
+    glm::vec3 color{0.0f};     // radiance
     float environmentIntensity = 1.0f;
     float exposure = 1.0f;
     glm::mat3 environmentFromWorld{1.0f};

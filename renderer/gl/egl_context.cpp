@@ -66,9 +66,9 @@ EGLContext createContext(EGLDisplay display, std::string& failure) {
     EGLint count = 0;
     // Surfaceless contexts need no config (EGL_KHR_no_config_context); use one if available, else none.
     if (!eglChooseConfig(display, configAttributes, &config, 1, &count) || count == 0) config = EGL_NO_CONFIG_KHR;
-    const EGLint contextAttributes[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
-                                        EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
-                                        EGL_NONE};
+    const EGLint contextAttributes[] = {
+        EGL_CONTEXT_MAJOR_VERSION,           4,       EGL_CONTEXT_MINOR_VERSION, 5, EGL_CONTEXT_OPENGL_PROFILE_MASK,
+        EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
     EGLContext context = eglCreateContext(display, config, EGL_NO_CONTEXT, contextAttributes);
     if (context == EGL_NO_CONTEXT) {
         failure = "eglCreateContext(OpenGL 4.5 core): " + eglErrorName(eglGetError());
@@ -109,13 +109,14 @@ EglContext::EglContext() {
         if (queryDevices && queryDevices(16, devices, &deviceCount)) {
             int hardwareDevices = 0;
             for (EGLint i = 0; i < deviceCount && !context_; ++i) {
-                const char* deviceExtensions = queryDeviceString ? queryDeviceString(devices[i], EGL_EXTENSIONS) : nullptr;
+                const char* deviceExtensions =
+                    queryDeviceString ? queryDeviceString(devices[i], EGL_EXTENSIONS) : nullptr;
                 if (hasExtension(deviceExtensions, "EGL_MESA_device_software")) continue;
                 ++hardwareDevices;
                 EGLDisplay display = getPlatformDisplay(EGL_PLATFORM_DEVICE_EXT, devices[i], nullptr);
                 if (display == EGL_NO_DISPLAY) {
-                    attempts.push_back("device " + std::to_string(i) + ": eglGetPlatformDisplayEXT: " +
-                                       eglErrorName(eglGetError()));
+                    attempts.push_back("device " + std::to_string(i) +
+                                       ": eglGetPlatformDisplayEXT: " + eglErrorName(eglGetError()));
                     continue;
                 }
                 std::string failure;

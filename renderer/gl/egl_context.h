@@ -16,13 +16,13 @@ public:
     EglContext& operator=(const EglContext&) = delete;
 
     void makeCurrent();
-    const std::string& renderer() const { return renderer_; }   // GL_RENDERER
-    const std::string& version() const { return version_; }     // GL_VERSION
-    const std::string& platform() const { return platform_; }   // "device" or "surfaceless"
+    const std::string& renderer() const { return renderer_; } // GL_RENDERER
+    const std::string& version() const { return version_; }   // GL_VERSION
+    const std::string& platform() const { return platform_; } // "device" or "surfaceless"
 
 private:
-    void* display_ = nullptr;  // EGLDisplay
-    void* context_ = nullptr;  // EGLContext
+    void* display_ = nullptr; // EGLDisplay
+    void* context_ = nullptr; // EGLContext
     std::string renderer_;
     std::string version_;
     std::string platform_;

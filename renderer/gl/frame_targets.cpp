@@ -24,8 +24,8 @@ void FrameTargets::resize(int newWidth, int newHeight) {
     scatteredDiffuse = createTexture2D(GL_RGBA32F, width, height);
     beauty = createTexture2D(GL_RGBA32F, width, height);
     display = createTexture2D(GL_RGBA32F, width, height);
-    const GLuint mainColours[] = {diffuse.get(), specular.get(), albedo.get(), linearDepth.get(),
-                                  normal.get(),  geometricNormal.get(), mask.get(), transmittance.get()};
+    const GLuint mainColours[] = {diffuse.get(), specular.get(),        albedo.get(), linearDepth.get(),
+                                  normal.get(),  geometricNormal.get(), mask.get(),   transmittance.get()};
     mainFramebuffer = createFramebuffer("main pass", mainColours, 8, depthBuffer.get());
     const GLuint backgroundColours[] = {diffuse.get()};
     backgroundFramebuffer = createFramebuffer("background pass", backgroundColours, 1, depthBuffer.get());

@@ -22,7 +22,8 @@ void checkGl(std::string_view where) {
     const GLenum error = glGetError();
     if (error == GL_NO_ERROR) return;
     // Drain further queued errors so the next check reports its own.
-    while (glGetError() != GL_NO_ERROR) {}
+    while (glGetError() != GL_NO_ERROR) {
+    }
     throw RuntimeError(glErrorName(error) + " after " + std::string(where));
 }
 

@@ -33,7 +33,8 @@ void GpuScene::uploadModel(const Model& model, const std::vector<GpuMaterial>& p
     GLuint name = 0;
     glCreateBuffers(1, &name);
     vertexBuffer_ = Buffer(name);
-    glNamedBufferStorage(name, static_cast<GLsizeiptr>(model.vertices.size() * sizeof(Vertex)), model.vertices.data(), 0);
+    glNamedBufferStorage(name, static_cast<GLsizeiptr>(model.vertices.size() * sizeof(Vertex)), model.vertices.data(),
+                         0);
     glCreateBuffers(1, &name);
     indexBuffer_ = Buffer(name);
     glNamedBufferStorage(name, static_cast<GLsizeiptr>(model.indices.size() * sizeof(std::uint32_t)),
@@ -89,7 +90,8 @@ void GpuScene::uploadMaps(const Image* albedo, const Image* normal, const Image*
     }
 }
 
-void GpuScene::uploadEnvironment(const Environment* environment, const std::array<glm::vec3, 9>& irradianceCoefficients) {
+void GpuScene::uploadEnvironment(const Environment* environment,
+                                 const std::array<glm::vec3, 9>& irradianceCoefficients) {
     irradiance_ = irradianceCoefficients;
     environmentMap_.reset();
     if (!environment) return;
@@ -98,15 +100,16 @@ void GpuScene::uploadEnvironment(const Environment* environment, const std::arra
                         environment->pixels.data());
     glTextureParameteri(environmentMap_.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
     glTextureParameteri(environmentMap_.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTextureParameteri(environmentMap_.get(), GL_TEXTURE_WRAP_S, GL_REPEAT);  // u wraps around the horizon
+    glTextureParameteri(environmentMap_.get(), GL_TEXTURE_WRAP_S, GL_REPEAT); // u wraps around the horizon
     checkGl("uploading the environment");
 }
 
 void GpuScene::drawAll() const {
     glBindVertexArray(vertexArray_.get());
     for (const GpuPart& part : parts_)
-        glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(part.indexCount), GL_UNSIGNED_INT,
-                       reinterpret_cast<const void*>(static_cast<std::uintptr_t>(part.firstIndex) * sizeof(std::uint32_t)));
+        glDrawElements(
+            GL_TRIANGLES, static_cast<GLsizei>(part.indexCount), GL_UNSIGNED_INT,
+            reinterpret_cast<const void*>(static_cast<std::uintptr_t>(part.firstIndex) * sizeof(std::uint32_t)));
     glBindVertexArray(0);
 }
 

@@ -17,8 +17,8 @@ struct Environment;
 namespace skinlab::renderer::gl {
 
 struct GpuMaterial {
-    glm::vec3 albedo{1.0f};   // linear
-    float skin = 1.0f;        // 0 or 1 (multiplied with vertex skin and the mask map)
+    glm::vec3 albedo{1.0f}; // linear
+    float skin = 1.0f;      // 0 or 1 (multiplied with vertex skin and the mask map)
     float glossiness = 0.6f;
     float specularIntensity = 1.0f;
 };
@@ -30,17 +30,17 @@ struct GpuPart {
 };
 
 struct GpuLight {
-    int type = 0;                    // 0 directional, 1 spot
-    glm::vec3 direction{0, 0, -1};   // travel direction / spot axis (unit)
+    int type = 0;                  // 0 directional, 1 spot
+    glm::vec3 direction{0, 0, -1}; // travel direction / spot axis (unit)
     glm::vec3 position{0.0f};
-    glm::vec3 radiance{1.0f};        // colour * intensity
-    float referenceDistance = 1.0f;  // spot
+    glm::vec3 radiance{1.0f};       // colour * intensity
+    float referenceDistance = 1.0f; // spot
     float cosInner = 1.0f;
     float cosOuter = 0.0f;
     bool castsShadow = false;
-    int shadowLayer = -1;            // layer of the shadow map array, -1: none (set by ShadowMapPass)
-    glm::mat4 viewProjection{1.0f};  // world → light clip space (shadow casting lights)
-    float normalOffset = 0.0f;       // world units
+    int shadowLayer = -1;           // layer of the shadow map array, -1: none (set by ShadowMapPass)
+    glm::mat4 viewProjection{1.0f}; // world → light clip space (shadow casting lights)
+    float normalOffset = 0.0f;      // world units
 };
 
 // A vertex array over a buffer of renderer::Vertex with the attribute layout main_pass.vert reads (locations 0–5:
@@ -57,7 +57,7 @@ public:
     // Equirect radiance texture (for the background) and the irradiance SH coefficients (A_l L_lm).
     void uploadEnvironment(const Environment* environment, const std::array<glm::vec3, 9>& irradianceCoefficients);
 
-    void drawAll() const;               // all parts, no material uniforms (shadow pass)
+    void drawAll() const; // all parts, no material uniforms (shadow pass)
     const std::vector<GpuPart>& parts() const { return parts_; }
     void drawPart(const GpuPart& part) const;
 
@@ -67,7 +67,7 @@ public:
     GLuint occlusionMap() const { return occlusionMap_.get(); }
     GLuint skinMaskMap() const { return skinMaskMap_.get(); }
     GLuint environmentMap() const { return environmentMap_.get(); }
-    GLuint fallbackMap() const { return fallbackMap_.get(); }  // 1×1 white, bound where a map is absent
+    GLuint fallbackMap() const { return fallbackMap_.get(); } // 1×1 white, bound where a map is absent
     const std::array<glm::vec3, 9>& irradianceCoefficients() const { return irradiance_; }
 
     std::vector<GpuLight> lights;

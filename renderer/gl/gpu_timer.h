@@ -18,7 +18,7 @@ namespace skinlab::renderer::gl {
 
 class PassTimer {
 public:
-    PassTimer();  // issues and discards the context's first timer query
+    PassTimer(); // issues and discards the context's first timer query
 
     void begin(const std::string& pass);
     void end();

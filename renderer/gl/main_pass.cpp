@@ -50,8 +50,8 @@ void MainPass::bindShading(GLuint program, const GpuScene& scene, GLuint shadowM
     setUniform(program, "transmittanceCurvatureScale",
                settings.camera.focalLengthPixels / 8.0f * settings.curvatureReferenceMm / settings.mmPerUnit);
     setUniform(program, "transmittanceScale",
-               static_cast<float>(sss::transmittanceScalePerUnit(settings.translucency,
-                                                                 std::max(settings.sssWidthMm, 1e-6f), settings.mmPerUnit)));
+               static_cast<float>(sss::transmittanceScalePerUnit(
+                   settings.translucency, std::max(settings.sssWidthMm, 1e-6f), settings.mmPerUnit)));
 
     const GLuint fallback = scene.fallbackMap();
     const GLuint maps[] = {scene.albedoMap(), scene.normalMap(), scene.specularMap(), scene.occlusionMap(),
@@ -98,10 +98,10 @@ void MainPass::run(FrameTargets& targets, const GpuScene& scene, GLuint shadowMa
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glDepthMask(GL_TRUE);
-    glDisable(GL_CULL_FACE);  // thin and open surfaces (backdrop, fin) are seen from both sides
+    glDisable(GL_CULL_FACE); // thin and open surfaces (backdrop, fin) are seen from both sides
 
     bindShading(program, scene, shadowMaps, settings);
-    setUniform(program, "projection", settings.camera.projection);  // main_pass.vert (the bake's vertex stage has none)
+    setUniform(program, "projection", settings.camera.projection); // main_pass.vert (the bake's vertex stage has none)
     for (const GpuPart& part : scene.parts()) {
         setMaterial(program, part.material);
         scene.drawPart(part);

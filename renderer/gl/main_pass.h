@@ -15,7 +15,7 @@ inline constexpr float kTransmittanceShrinkMm = 0.24f;
 
 struct MainPassSettings {
     CameraPose camera;
-    float exposure = 1.0f;             // 2^exposure_ev
+    float exposure = 1.0f; // 2^exposure_ev
     float normalStrength = 1.0f;
     int pcfRadius = 1;
     glm::mat3 environmentFromWorld{1.0f};
@@ -23,9 +23,9 @@ struct MainPassSettings {
     // the scene's mm_per_unit. Scaled thickness s = thickness_mm · 16.5 (1 − translucency) / width_mm, the demo's
     // 8.25 (1 − translucency) / sssWidth with width_mm = 2 · sssWidth · mm_per_unit (sss::transmittanceScalePerUnit).
     bool transmittanceEnabled = false;
-    float translucency = 0.5f;         // 0 opaque … 1 fully translucent (s = 0, T = 1)
-    float sssWidthMm = 3.0f;           // mm, > 0
-    float mmPerUnit = 1.0f;            // millimetres per world unit
+    float translucency = 0.5f; // 0 opaque … 1 fully translucent (s = 0, T = 1)
+    float sssWidthMm = 3.0f;   // mm, > 0
+    float mmPerUnit = 1.0f;    // millimetres per world unit
     // transmittance.curvature with curvature_form "thesis": s / (1 + 2c), c = κ · curvature_reference_mm / mm_per_unit
     // uncapped, κ the thesis' screen-space curvature from dFdx / dFdy of the view-space geometric normal (1/world
     // unit: × f_px / 8, as in surface_aovs.frag).

@@ -18,7 +18,7 @@ constexpr GLuint kDepthUnit = 1;
 constexpr GLuint kNormalUnit = 2;
 constexpr GLuint kUnblurredUnit = 3;
 constexpr GLuint kFirstExtensionUnit = 4;
-constexpr int kMaxTaps = 101;  // PSCBF_MAX_TAPS of the shader (sss.samples ≤ 101)
+constexpr int kMaxTaps = 101; // PSCBF_MAX_TAPS of the shader (sss.samples ≤ 101)
 } // namespace
 
 PscbfMethod::PscbfMethod(ShaderLibrary& shaders) : shaders_(shaders) {}
@@ -46,7 +46,8 @@ void PscbfMethod::run(const SssStageInputs& inputs, const sss::SssParams& params
     if (output == inputs.diffuse) throw RuntimeError("pscbf method: output texture must differ from the diffuse input");
     ensureScratch(inputs.width, inputs.height);
 
-    SssExtensionSettings extensions = SssExtensionSettings::fromParams(params, inputs.albedo, inputs.aux, inputs.curvature);
+    SssExtensionSettings extensions =
+        SssExtensionSettings::fromParams(params, inputs.albedo, inputs.aux, inputs.curvature);
     // The spike is what the broad stage's accumulate weights leave (kernel.cpp: accumulate = 1 − spike).
     const glm::vec3 spike(static_cast<float>(1.0 - stage.accumulate[0]), static_cast<float>(1.0 - stage.accumulate[1]),
                           static_cast<float>(1.0 - stage.accumulate[2]));
@@ -79,7 +80,7 @@ void PscbfMethod::run(const SssStageInputs& inputs, const sss::SssParams& params
         glBindTextureUnit(kDepthUnit, inputs.linearDepth);
         glBindTextureUnit(kNormalUnit, inputs.geometricNormal);
         glBindTextureUnit(kUnblurredUnit, inputs.diffuse);
-        extensions.litTexture = horizontal ? inputs.diffuse : scratch;  // sss.extension_input = "lit"
+        extensions.litTexture = horizontal ? inputs.diffuse : scratch; // sss.extension_input = "lit"
         extensions.bind(program, kFirstExtensionUnit);
         shaders_.drawFullscreenTriangle();
         extensions.unbind(kFirstExtensionUnit);

@@ -53,22 +53,22 @@ std::unique_ptr<reference::RadialProfile> profileOf(const sss::SssParams& params
 // A tessellated model with its samples and GL buffers, cached by source model, edge length, mm per unit and
 // the parts' skin flags.
 struct TessellatedModel {
-    std::shared_ptr<const Model> source;  // held, so the key's pointer cannot be reused by another model
+    std::shared_ptr<const Model> source; // held, so the key's pointer cannot be reused by another model
     float edgeMm = 0.0f;
     float mmPerUnit = 0.0f;
     std::vector<bool> skinParts;
-    std::vector<SubMesh> parts;  // of the tessellated model (same order as the source's parts)
+    std::vector<SubMesh> parts; // of the tessellated model (same order as the source's parts)
     reference::SurfaceSamples samples;
     reference::TessellationStatistics statistics;
     double tessellateMs = 0.0;
-    int renders = 0;  // runs that used this entry
+    int renders = 0; // runs that used this entry
     Buffer vertexBuffer, indexBuffer;
     VertexArray vertexArray;
     // The bake draws every vertex of a skin part once: the part's distinct vertex indices (a triangle list names
     // each vertex about six times, and llvmpipe's cost is per point), ranges per part into pointIndexBuffer.
     Buffer pointIndexBuffer;
     VertexArray pointVertexArray;
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> pointRanges;  // per part: first, count
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> pointRanges; // per part: first, count
 
     bool matches(const ReferenceInputs& inputs, float edge, const std::vector<bool>& skin) const {
         return source == inputs.model && edgeMm == edge && mmPerUnit == inputs.mmPerUnit && skinParts == skin;
@@ -79,12 +79,12 @@ struct TessellatedModel {
 
 struct ReferenceMethod::Impl {
     ShaderLibrary& shaders;
-    std::deque<std::unique_ptr<TessellatedModel>> cache;  // most recent first
+    std::deque<std::unique_ptr<TessellatedModel>> cache; // most recent first
     Texture bakeDiffuse, bakeTransmittance;
     Framebuffer bakeFramebuffer;
     int bakeHeight = 0;
     Buffer convolvedBuffer;
-    Texture drawDepth;  // the draw's own depth buffer (the depth mismatch), frame size
+    Texture drawDepth; // the draw's own depth buffer (the depth mismatch), frame size
     int drawDepthWidth = 0, drawDepthHeight = 0;
     std::size_t convolvedCapacity = 0;
 
@@ -134,14 +134,16 @@ struct ReferenceMethod::Impl {
         GLuint name = 0;
         glCreateBuffers(1, &name);
         entry->vertexBuffer = Buffer(name);
-        glNamedBufferStorage(name, static_cast<GLsizeiptr>(model.vertices.size() * sizeof(Vertex)), model.vertices.data(), 0);
+        glNamedBufferStorage(name, static_cast<GLsizeiptr>(model.vertices.size() * sizeof(Vertex)),
+                             model.vertices.data(), 0);
         glCreateBuffers(1, &name);
         entry->indexBuffer = Buffer(name);
         glNamedBufferStorage(name, static_cast<GLsizeiptr>(model.indices.size() * sizeof(std::uint32_t)),
                              model.indices.data(), 0);
         glCreateBuffers(1, &name);
         entry->pointIndexBuffer = Buffer(name);
-        glNamedBufferStorage(name, static_cast<GLsizeiptr>(std::max<std::size_t>(points.size(), 1) * sizeof(std::uint32_t)),
+        glNamedBufferStorage(name,
+                             static_cast<GLsizeiptr>(std::max<std::size_t>(points.size(), 1) * sizeof(std::uint32_t)),
                              points.empty() ? nullptr : points.data(), 0);
         // Two vertex arrays over the same vertices, with main_pass.vert's layout: triangles for the draw, points
         // for the bake.
@@ -168,8 +170,8 @@ struct ReferenceMethod::Impl {
             // main_pass.frag's locations 0 (diffuse) and 7 (transmittance); its other outputs are dropped.
             glNamedFramebufferTexture(name, GL_COLOR_ATTACHMENT0, bakeDiffuse.get(), 0);
             glNamedFramebufferTexture(name, GL_COLOR_ATTACHMENT7, bakeTransmittance.get(), 0);
-            const GLenum drawBuffers[8] = {GL_COLOR_ATTACHMENT0, GL_NONE, GL_NONE, GL_NONE,
-                                           GL_NONE,              GL_NONE, GL_NONE, GL_COLOR_ATTACHMENT7};
+            const GLenum drawBuffers[8] = {GL_COLOR_ATTACHMENT0, GL_NONE, GL_NONE, GL_NONE, GL_NONE, GL_NONE, GL_NONE,
+                                           GL_COLOR_ATTACHMENT7};
             glNamedFramebufferDrawBuffers(name, 8, drawBuffers);
             if (glCheckNamedFramebufferStatus(name, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
                 throw RuntimeError("reference: bake framebuffer incomplete (" + std::to_string(kBakeWidth) + " x " +
@@ -194,13 +196,13 @@ void ReferenceMethod::prepare(const ReferenceInputs& inputs, const sss::SssParam
 void ReferenceMethod::run(const ReferenceInputs& inputs, const sss::SssParams& params, GLuint output) {
     Impl& impl = *impl_;
     const FrameTargets& targets = *inputs.targets;
-    const auto profile = profileOf(params, inputs.source);  // refuse a tabulated profile before any work
+    const auto profile = profileOf(params, inputs.source); // refuse a tabulated profile before any work
     const float edgeMm = static_cast<float>(params.referenceEdgeMm);
 
     // --- 1. tessellation and samples (cached) ---
     bool cached = false;
     TessellatedModel& mesh = impl.tessellated(inputs, edgeMm, cached);
-    cached = mesh.renders > 0;  // prepare() of this render may have made the entry: count it as this render's
+    cached = mesh.renders > 0; // prepare() of this render may have made the entry: count it as this render's
     ++mesh.renders;
     const std::size_t vertexCount = mesh.samples.size();
 
@@ -252,7 +254,7 @@ void ReferenceMethod::run(const ReferenceInputs& inputs, const sss::SssParams& p
         // light of a lit back face through thin parts (the effect transmittance approximates in screen space), so
         // adding it would count that light twice. docs/extensions.md, "The object-space reference".
         radiance[i] = glm::vec3(d[0], d[1], d[2]);
-        samples.albedo[i] = glm::vec3(1.0f);  // the bake is E · α already
+        samples.albedo[i] = glm::vec3(1.0f); // the bake is E · α already
         // The baked mask (alpha) carries the skin-mask map too; partly masked vertices count as skin from 0.5.
         samples.skin[i] = samples.skin[i] && d[3] >= 0.5f ? 1 : 0;
         skinSamples += samples.skin[i];
@@ -260,8 +262,8 @@ void ReferenceMethod::run(const ReferenceInputs& inputs, const sss::SssParams& p
     reference::ConvolutionSettings convolution;
     convolution.cutoffTail = kCutoffTail;
     reference::ConvolutionReport report;
-    const std::vector<glm::vec3> convolved = reference::convolveSurface(samples, radiance, *profile, convolution,
-                                                                        nullptr, &report);
+    const std::vector<glm::vec3> convolved =
+        reference::convolveSurface(samples, radiance, *profile, convolution, nullptr, &report);
     const double convolveMs = millisecondsSince(convolveStart);
 
     // --- 4. draw the tessellated skin with the convolved radiance over the main pass's diffuse ---
@@ -311,7 +313,8 @@ void ReferenceMethod::run(const ReferenceInputs& inputs, const sss::SssParams& p
     for (std::size_t p = 0; p < mesh.parts.size(); ++p) {
         if (!mesh.skinParts[p]) continue;
         glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(mesh.parts[p].indexCount), GL_UNSIGNED_INT,
-                       reinterpret_cast<const void*>(static_cast<std::uintptr_t>(mesh.parts[p].firstIndex) * sizeof(std::uint32_t)));
+                       reinterpret_cast<const void*>(static_cast<std::uintptr_t>(mesh.parts[p].firstIndex) *
+                                                     sizeof(std::uint32_t)));
     }
     glBindVertexArray(0);
     glBindTextureUnit(0, 0);

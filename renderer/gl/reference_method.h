@@ -37,14 +37,14 @@
 namespace skinlab::renderer::gl {
 
 struct ReferenceInputs {
-    std::shared_ptr<const Model> model;      // the model the main pass drew (world units)
-    std::vector<GpuMaterial> partMaterials;  // per part, after the spec's material overrides (skin flags included)
-    const GpuScene* scene = nullptr;         // maps, lights, irradiance of the main pass
+    std::shared_ptr<const Model> model;     // the model the main pass drew (world units)
+    std::vector<GpuMaterial> partMaterials; // per part, after the spec's material overrides (skin flags included)
+    const GpuScene* scene = nullptr;        // maps, lights, irradiance of the main pass
     GLuint shadowMaps = 0;
-    MainPassSettings mainSettings;           // camera, exposure, ... of the main pass
-    const FrameTargets* targets = nullptr;   // diffuse, mask and depthBuffer of the main pass
+    MainPassSettings mainSettings;         // camera, exposure, ... of the main pass
+    const FrameTargets* targets = nullptr; // diffuse, mask and depthBuffer of the main pass
     float mmPerUnit = 1.0f;
-    std::string source;                      // scene spec file, for error messages
+    std::string source; // scene spec file, for error messages
 };
 
 class ReferenceMethod {

@@ -45,12 +45,12 @@ std::string ShaderLibrary::source(const std::string& name, const ShaderDefines& 
     std::string out;
     std::string line;
     bool versionSeen = false;
-    int lineNumber = 0;  // of `line` in the file
-    int includes = 0;    // source string numbers given to included files so far
+    int lineNumber = 0; // of `line` in the file
+    int includes = 0;   // source string numbers given to included files so far
     while (std::getline(in, line)) {
         ++lineNumber;
         if (line.rfind("#extension GL_GOOGLE_include_directive", 0) == 0) {
-            out += "\n";  // keep line numbers of the info log aligned with the file
+            out += "\n"; // keep line numbers of the info log aligned with the file
             continue;
         }
         if (line.rfind("#include \"", 0) == 0) {
@@ -117,7 +117,7 @@ std::vector<std::string> declaredUniforms(const std::string& text) {
             words.push_back(word);
             if (word.find(';') != std::string::npos || word.find('[') != std::string::npos) break;
         }
-        if (words.size() < 3) continue;  // "uniform Block {" and the like
+        if (words.size() < 3) continue; // "uniform Block {" and the like
         std::string name = words.back();
         name = name.substr(0, name.find_first_of("[;="));
         if (name.empty() && words.size() >= 4) name = words[words.size() - 2];
@@ -169,8 +169,8 @@ const std::vector<ShaderVariant>& shaderVariants() {
         v.push_back({"shadow_map.vert", "shadow_map.frag", {}});
         // The blur passes: the extension weights (SssExtensionSettings::defines) × the pass's own switch.
         for (const bool weights : {false, true})
-            for (const auto& [fragment, own] : {std::pair{"sss_blur.frag", "SSS_ACCUMULATE"},
-                                                std::pair{"pscbf_blur.frag", "PSCBF_FINAL_PASS"}})
+            for (const auto& [fragment, own] :
+                 {std::pair{"sss_blur.frag", "SSS_ACCUMULATE"}, std::pair{"pscbf_blur.frag", "PSCBF_FINAL_PASS"}})
                 for (const bool last : {false, true}) {
                     ShaderDefines defines;
                     if (weights) defines.emplace_back("SSS_EXTENSION_WEIGHTS", "1");
@@ -191,7 +191,8 @@ GLuint ShaderLibrary::program(const std::string& vertexName, const std::string& 
     if (std::none_of(variants.begin(), variants.end(), [&](const ShaderVariant& variant) {
             return variant.vertex == vertexName && variant.fragment == fragmentName && variant.defines == defines;
         }))
-        throw RuntimeError("shaders " + key + ": not a variant listed in shaderVariants() (renderer/gl/shader_library.cpp)");
+        throw RuntimeError("shaders " + key +
+                           ": not a variant listed in shaderVariants() (renderer/gl/shader_library.cpp)");
 
     const std::string vertexText = source(vertexName, defines);
     const std::string fragmentText = source(fragmentName, defines);
@@ -226,7 +227,7 @@ GLuint ShaderLibrary::program(const std::string& vertexName, const std::string& 
     for (const std::string* text : {&vertexText, &fragmentText})
         for (const std::string& uniform : declaredUniforms(*text))
             table.locations[uniform] = glGetUniformLocation(name, uniform.c_str());
-    uniformTables()[name] = std::move(table);  // replaces the table of a deleted program of the same name
+    uniformTables()[name] = std::move(table); // replaces the table of a deleted program of the same name
     programs_.emplace(key, std::move(program));
     return name;
 }

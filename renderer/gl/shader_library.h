@@ -55,5 +55,4 @@ void setUniform(GLuint program, const char* name, const glm::mat4& value);
 void setUniform(GLuint program, const char* name, const glm::mat3& value);
 void setUniformArray(GLuint program, const char* name, const glm::vec3* values, int count);
 
-
 } // namespace skinlab::renderer::gl

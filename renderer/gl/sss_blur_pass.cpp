@@ -27,8 +27,8 @@ void setTapUniforms(GLuint program, const sss::KernelStage& stage) {
 
 SssBlurPass::SssBlurPass(ShaderLibrary& shaders) : shaders_(shaders) {}
 
-void SssBlurPass::run(const SssBlurPassInputs& inputs, const sss::KernelStage& stage, bool horizontal,
-                      GLuint target, bool accumulate) {
+void SssBlurPass::run(const SssBlurPassInputs& inputs, const sss::KernelStage& stage, bool horizontal, GLuint target,
+                      bool accumulate) {
     if (stage.taps.empty() || stage.taps.size() > 101)
         throw RuntimeError("SSS blur pass: " + std::to_string(stage.taps.size()) + " taps (supported: 1…101)");
     ShaderDefines defines = inputs.extensions.defines();
@@ -47,7 +47,7 @@ void SssBlurPass::run(const SssBlurPassInputs& inputs, const sss::KernelStage& s
     // First of the state changes: it throws (a pipeline bug) before touching any GL state when a switched-on
     // extension has no texture.
     SssExtensionSettings extensions = inputs.extensions;
-    extensions.litTexture = inputs.source;  // sss.extension_input = "lit": the colour this pass blurs
+    extensions.litTexture = inputs.source; // sss.extension_input = "lit": the colour this pass blurs
     extensions.bind(program, kFirstExtensionTextureUnit);
     glUseProgram(program);
     glBindFramebuffer(GL_FRAMEBUFFER, target);

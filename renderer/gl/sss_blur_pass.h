@@ -14,15 +14,15 @@ namespace skinlab::renderer::gl {
 class ShaderLibrary;
 
 struct SssBlurPassInputs {
-    GLuint source = 0;       // GL_RGBA32F, rgb = colour, a = skin mask 0…1
-    GLuint linearDepth = 0;  // GL_R32F, world units, +inf on background
+    GLuint source = 0;      // GL_RGBA32F, rgb = colour, a = skin mask 0…1
+    GLuint linearDepth = 0; // GL_R32F, world units, +inf on background
     int width = 0;
     int height = 0;
     float focalLengthPixels = 0.0f;
     float mmPerUnit = 1.0f;
     bool followSurface = true;
-    float followSurfaceK = 0.5f;  // 1/mm
-    SssExtensionSettings extensions;  // sss.cbf, sss.lab_weight, sss.curvature and their textures (default: all off)
+    float followSurfaceK = 0.5f;     // 1/mm
+    SssExtensionSettings extensions; // sss.cbf, sss.lab_weight, sss.curvature and their textures (default: all off)
 };
 
 // Uploads a stage's taps to the `taps` (vec4: xyz = RGB weight, w = offset in mm) and `tapCount` uniforms of a

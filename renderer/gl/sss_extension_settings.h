@@ -19,17 +19,17 @@ namespace skinlab::renderer::gl {
 
 struct SssExtensionSettings {
     bool cbf = false;
-    float cbfLambda = 10.0f;  // λ, dimensionless
-    float labWeight = 0.0f;   // β, 1/ΔE*ab; 0 = off
+    float cbfLambda = 10.0f; // λ, dimensionless
+    float labWeight = 0.0f;  // β, 1/ΔE*ab; 0 = off
     sss::CurvatureStrategy curvature = sss::CurvatureStrategy::Off;
-    float curvatureFloor = 0.5f;  // [0, 1], reduce-floor only
-    float curvatureReferenceMm = sss::kCurvatureReferenceRadiusMm;  // sss.curvature_reference_mm
-    sss::ExtensionInput input = sss::ExtensionInput::Albedo;  // sss.extension_input (E1/E2)
+    float curvatureFloor = 0.5f;                                   // [0, 1], reduce-floor only
+    float curvatureReferenceMm = sss::kCurvatureReferenceRadiusMm; // sss.curvature_reference_mm
+    sss::ExtensionInput input = sss::ExtensionInput::Albedo;       // sss.extension_input (E1/E2)
 
-    GLuint albedoTexture = 0;     // GL_RGBA32F, rgb = linear albedo (SssStageInputs::albedo)
-    GLuint auxTexture = 0;        // GL_R32F, F (SssStageInputs::aux)
-    GLuint curvatureTexture = 0;  // GL_R32F, κ in 1/world unit (SssStageInputs::curvature)
-    GLuint litTexture = 0;        // the colour the pass blurs (its source), read with input = lit; set per pass
+    GLuint albedoTexture = 0;    // GL_RGBA32F, rgb = linear albedo (SssStageInputs::albedo)
+    GLuint auxTexture = 0;       // GL_R32F, F (SssStageInputs::aux)
+    GLuint curvatureTexture = 0; // GL_R32F, κ in 1/world unit (SssStageInputs::curvature)
+    GLuint litTexture = 0;       // the colour the pass blurs (its source), read with input = lit; set per pass
 
     // The switches of resolved [sss] parameters (textures left 0: set them from SssStageInputs).
     static SssExtensionSettings fromParams(const sss::SssParams& params);

@@ -2,7 +2,7 @@
 
 #include "common/error.h"
 #include "renderer/gl/gl_resources.h"
-#include "renderer/gl/pscbf_method.h"  // pscbf (Mikkelsen 2010)
+#include "renderer/gl/pscbf_method.h" // pscbf (Mikkelsen 2010)
 #include "renderer/gl/shader_library.h"
 #include "renderer/gl/sss_kernel_method.h"
 #include "renderer/sss/kernel.h"
@@ -67,7 +67,7 @@ void SssStage::run(const SssStageInputs& inputs, const SssStageSettings& setting
         return;
     }
     case sss::SssMethod::None:
-    case sss::SssMethod::Pathtraced:  // Cycles replaces the image afterwards (renderer.cpp); copy through
+    case sss::SssMethod::Pathtraced: // Cycles replaces the image afterwards (renderer.cpp); copy through
         break;
     }
     // A framebuffer per run: texture names are recycled when the frame is resized, so caching one by name

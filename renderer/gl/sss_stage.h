@@ -27,22 +27,22 @@ class ShaderLibrary;
 
 // Textures the main pass hands to the SSS stage (all owned by the pipeline, read-only for the stage).
 struct SssStageInputs {
-    GLuint diffuse = 0;          // GL_RGBA32F: rgb = lights + IBL irradiance × AO × albedo (+ transmittance), a = mask
-    GLuint linearDepth = 0;      // GL_R32F: view-space depth along -Z, world units, +inf on background
-    GLuint albedo = 0;           // GL_RGBA32F: rgb = linear albedo (texture × vertex colour × material), a = mask
-    GLuint skinMask = 0;         // GL_R32F: 0..1, 0 on background
-    GLuint normal = 0;           // GL_RGBA32F: xyz = world-space normal after normal mapping, unit length
-    GLuint geometricNormal = 0;  // GL_RGBA32F: xyz = world-space interpolated geometric normal, unit length
-    GLuint aux = 0;              // GL_R32F: Mikkelsen's auxiliary image F (sss.cbf), 0 off skin
-    GLuint curvature = 0;        // GL_R32F: smoothed curvature, 1/world unit, ≥ 0 (sss.curvature)
-    int width = 0;               // pixels
-    int height = 0;              // pixels
-    float focalLengthPixels = 0; // f_px = (height/2) / tan(fovY/2); a kernel offset of o mm at depth z covers
-                                 // o / mmPerUnit * f_px / z pixels (docs/methods.md, same scale on both axes)
-    float mmPerUnit = 1;         // millimetres per world unit of the scene
-    glm::mat4 view{1.0f};        // world → view (camera looks down -Z)
-    glm::mat4 projection{1.0f};  // view → clip (OpenGL convention)
-    glm::vec3 cameraPosition{0.0f};  // world units
+    GLuint diffuse = 0;         // GL_RGBA32F: rgb = lights + IBL irradiance × AO × albedo (+ transmittance), a = mask
+    GLuint linearDepth = 0;     // GL_R32F: view-space depth along -Z, world units, +inf on background
+    GLuint albedo = 0;          // GL_RGBA32F: rgb = linear albedo (texture × vertex colour × material), a = mask
+    GLuint skinMask = 0;        // GL_R32F: 0..1, 0 on background
+    GLuint normal = 0;          // GL_RGBA32F: xyz = world-space normal after normal mapping, unit length
+    GLuint geometricNormal = 0; // GL_RGBA32F: xyz = world-space interpolated geometric normal, unit length
+    GLuint aux = 0;             // GL_R32F: Mikkelsen's auxiliary image F (sss.cbf), 0 off skin
+    GLuint curvature = 0;       // GL_R32F: smoothed curvature, 1/world unit, ≥ 0 (sss.curvature)
+    int width = 0;              // pixels
+    int height = 0;             // pixels
+    float focalLengthPixels = 0;    // f_px = (height/2) / tan(fovY/2); a kernel offset of o mm at depth z covers
+                                    // o / mmPerUnit * f_px / z pixels (docs/methods.md, same scale on both axes)
+    float mmPerUnit = 1;            // millimetres per world unit of the scene
+    glm::mat4 view{1.0f};           // world → view (camera looks down -Z)
+    glm::mat4 projection{1.0f};     // view → clip (OpenGL convention)
+    glm::vec3 cameraPosition{0.0f}; // world units
 };
 
 // The scene's typed [sss] and [transmittance] parameters (renderer/sss/sss_params.h). The method is sss.method.

@@ -24,8 +24,9 @@ void SurfaceAovPass::run(FrameTargets& targets, const SurfaceAovSettings& settin
     glUseProgram(program);
     glBindFramebuffer(GL_FRAMEBUFFER, first.get());
     const glm::mat4& projection = settings.camera.projection;
-    setUniform(program, "ndcToView", glm::vec4(1.0f / projection[0][0], 1.0f / projection[1][1],
-                                               projection[2][0] / projection[0][0], projection[2][1] / projection[1][1]));
+    setUniform(program, "ndcToView",
+               glm::vec4(1.0f / projection[0][0], 1.0f / projection[1][1], projection[2][0] / projection[0][0],
+                         projection[2][1] / projection[1][1]));
     setUniform(program, "viewFromWorld", glm::mat3(settings.camera.view));
     setUniform(program, "viewportSize", viewport);
     setUniform(program, "focalLengthPixels", settings.camera.focalLengthPixels);

@@ -26,7 +26,7 @@ inline constexpr float kSurfaceDepthStepPixels = 8.0f;
 inline constexpr int kCurvatureSmoothingRadius = 3;
 
 struct SurfaceAovSettings {
-    CameraPose camera;  // view, projection, focal length in pixels
+    CameraPose camera; // view, projection, focal length in pixels
     // sss.curvature_measure = "screen": the thesis' screen-space curvature instead of the 3-D normal curvature
     // (surface_aovs.frag; docs/extensions.md E3).
     bool screenCurvature = false;

@@ -14,7 +14,7 @@ void TransmittancePass::run(FrameTargets& targets, const TransmittanceSettings& 
     glEnable(GL_BLEND);
     glBlendEquation(GL_FUNC_ADD);
     glBlendFunc(GL_ONE, GL_ONE);
-    glColorMaski(0, GL_TRUE, GL_TRUE, GL_TRUE, GL_FALSE);  // diffuse alpha is the skin mask: keep it
+    glColorMaski(0, GL_TRUE, GL_TRUE, GL_TRUE, GL_FALSE); // diffuse alpha is the skin mask: keep it
     setUniform(program, "curvatureEnabled", settings.curvature && !settings.thesisForm ? 1 : 0);
     setUniform(program, "curvatureReferenceMm", settings.curvatureReferenceMm);
     setUniform(program, "mmPerUnit", settings.mmPerUnit);

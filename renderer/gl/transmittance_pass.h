@@ -17,7 +17,7 @@ struct TransmittanceSettings {
     bool curvature = false;  // transmittance.curvature
     float mmPerUnit = 1.0f;  // millimetres per world unit (the curvature AOV is in 1/world unit)
     bool thesisForm = false; // transmittance.curvature_form = "thesis": applied in the main pass instead
-    float curvatureReferenceMm = 20.0f;  // sss.curvature_reference_mm
+    float curvatureReferenceMm = 20.0f; // sss.curvature_reference_mm
 };
 
 class TransmittancePass {

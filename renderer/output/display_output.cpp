@@ -23,7 +23,7 @@ std::vector<std::uint8_t> encodeDisplaySrgb8(const std::vector<float>& linearRgb
 void writePng(const std::filesystem::path& path, int width, int height, const std::vector<std::uint8_t>& rgb) {
     OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
     spec.attribute("oiio:ColorSpace", "sRGB");
-    spec.attribute("DateTime", "");  // no timestamp (OpenImageIO adds the current time to an absent DateTime)
+    spec.attribute("DateTime", ""); // no timestamp (OpenImageIO adds the current time to an absent DateTime)
     AtomicOutput output(path);
     auto writer = OIIO::ImageOutput::create("png");
     if (!writer) throw RuntimeError("OpenImageIO has no PNG writer: " + OIIO::geterror());

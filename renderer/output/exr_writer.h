@@ -11,8 +11,8 @@
 namespace skinlab::renderer {
 
 struct ExrChannel {
-    std::string name;           // "R", "diffuse.G", "depth.Z", ...
-    std::vector<float> values;  // width * height, top row first
+    std::string name;          // "R", "diffuse.G", "depth.Z", ...
+    std::vector<float> values; // width * height, top row first
 };
 
 struct ExrMetadata {

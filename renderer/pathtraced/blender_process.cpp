@@ -27,7 +27,8 @@ std::filesystem::path findProgram(const std::string& program) {
         if (folder.empty()) folder = ".";
         const std::filesystem::path candidate = std::filesystem::path(folder) / program;
         std::error_code error;
-        if (std::filesystem::is_regular_file(candidate, error) && ::access(candidate.c_str(), X_OK) == 0) return candidate;
+        if (std::filesystem::is_regular_file(candidate, error) && ::access(candidate.c_str(), X_OK) == 0)
+            return candidate;
     }
     return {};
 }
@@ -55,8 +56,7 @@ int runProcess(const std::filesystem::path& program, const std::vector<std::stri
     posix_spawn_file_actions_destroy(&actions);
     ::close(log);
     if (devNull >= 0) ::close(devNull);
-    if (spawnError != 0)
-        throw InputError(program.string() + ": cannot start (" + std::strerror(spawnError) + ")");
+    if (spawnError != 0) throw InputError(program.string() + ": cannot start (" + std::strerror(spawnError) + ")");
     int status = 0;
     while (::waitpid(pid, &status, 0) < 0) {
         if (errno != EINTR) throw RuntimeError(program.string() + ": waitpid failed (" + std::strerror(errno) + ")");
@@ -90,13 +90,13 @@ void runBlender(const std::string& program, const std::filesystem::path& script,
     if (found.empty())
         throw InputError("pathtraced.blender: program '" + program +
                          "' not found (install the Debian package blender, or set pathtraced.blender to its path)");
-    std::vector<std::string> all = {"-b", "--factory-startup", "-noaudio", "--python-exit-code", "1",
-                                    "--python", script.string(), "--"};
+    std::vector<std::string> all = {"-b", "--factory-startup", "-noaudio",      "--python-exit-code",
+                                    "1",  "--python",          script.string(), "--"};
     all.insert(all.end(), args.begin(), args.end());
     const int status = runProcess(found, all, workingDirectory, logPath);
     if (status != 0)
-        throw InputError(found.string() + " failed (exit status " + std::to_string(status) + "): " +
-                         lastErrorLine(logPath) + " (log: " + logPath.string() + ")");
+        throw InputError(found.string() + " failed (exit status " + std::to_string(status) +
+                         "): " + lastErrorLine(logPath) + " (log: " + logPath.string() + ")");
 }
 
 } // namespace skinlab::renderer::pathtraced

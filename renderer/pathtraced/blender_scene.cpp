@@ -21,7 +21,7 @@ namespace skinlab::renderer::pathtraced {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr float kSkinF0 = 0.028f;  // renderer/shaders/specular_brdf.glsl
+constexpr float kSkinF0 = 0.028f; // renderer/shaders/specular_brdf.glsl
 
 nlohmann::json vec3Json(const glm::vec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); }
 
@@ -51,7 +51,7 @@ bool isClosedSurface(const Model& model, const SubMesh& part) {
     for (std::uint32_t t = part.firstIndex; t + 2 < part.firstIndex + part.indexCount; t += 3) {
         const std::uint32_t a = id(model.indices[t]), b = id(model.indices[t + 1]), c = id(model.indices[t + 2]);
         for (auto [u, v] : {std::pair{a, b}, std::pair{b, c}, std::pair{c, a}}) {
-            if (u == v) continue;  // degenerate (a pole of a UV sphere)
+            if (u == v) continue; // degenerate (a pole of a UV sphere)
             ++edges[{std::min(u, v), std::max(u, v)}];
         }
     }
@@ -78,12 +78,8 @@ nlohmann::json blenderSceneJson(const BlenderSceneInputs& inputs, std::string_vi
     const SceneSpec& spec = *inputs.spec;
     const PathtracedParams& p = inputs.params;
     nlohmann::json scene;
-    scene["settings"] = {{"width", spec.width},
-                         {"height", spec.height},
-                         {"samples", p.samples},
-                         {"seed", p.seed},
-                         {"max_bounces", p.maxBounces},
-                         {"filter_width_px", p.filterWidthPx},
+    scene["settings"] = {{"width", spec.width}, {"height", spec.height},       {"samples", p.samples},
+                         {"seed", p.seed},      {"max_bounces", p.maxBounces}, {"filter_width_px", p.filterWidthPx},
                          {"threads", p.threads}};
     // One object per part (cycles_scene.py), each with its own vertices, in Model::parts order in the file.
     nlohmann::json parts = nlohmann::json::array();
@@ -110,13 +106,15 @@ nlohmann::json blenderSceneJson(const BlenderSceneInputs& inputs, std::string_vi
     nlohmann::json materials = nlohmann::json::array();
     for (std::size_t i = 0; i < inputs.partMaterials.size(); ++i) {
         const PartMaterial& m = inputs.partMaterials[i];
-        materials.push_back({{"name", "part" + std::to_string(i)},
-                             {"albedo", vec3Json(m.albedo)},
-                             {"skin", m.skin},
-                             {"sss", p.sss},
-                             {"radius", {p.radiusMm[0] * radiusScale, p.radiusMm[1] * radiusScale, p.radiusMm[2] * radiusScale}},
-                             {"roughness", principledRoughness(m.glossiness)},
-                             {"specular", p.specular && p.specularSource == "cycles" ? principledSpecular(kSkinF0) * m.specularIntensity : 0.0}});
+        materials.push_back(
+            {{"name", "part" + std::to_string(i)},
+             {"albedo", vec3Json(m.albedo)},
+             {"skin", m.skin},
+             {"sss", p.sss},
+             {"radius", {p.radiusMm[0] * radiusScale, p.radiusMm[1] * radiusScale, p.radiusMm[2] * radiusScale}},
+             {"roughness", principledRoughness(m.glossiness)},
+             {"specular",
+              p.specular && p.specularSource == "cycles" ? principledSpecular(kSkinF0) * m.specularIntensity : 0.0}});
     }
     scene["materials"] = materials;
     scene["textures"] = {{"albedo", spec.textures.albedo.string()},
@@ -163,7 +161,7 @@ nlohmann::json blenderSceneJson(const BlenderSceneInputs& inputs, std::string_vi
     if (!e.file.empty()) {
         const glm::mat3 environmentFromWorld(
             glm::rotate(glm::mat4(1.0f), static_cast<float>(-e.rotationDeg * kPi / 180.0), glm::vec3(0, 1, 0)));
-        const glm::mat3 m = glm::transpose(glm::mat3(0, 0, -1, -1, 0, 0, 0, 1, 0));  // rows as written above
+        const glm::mat3 m = glm::transpose(glm::mat3(0, 0, -1, -1, 0, 0, 0, 1, 0)); // rows as written above
         const glm::mat3 lookup = m * environmentFromWorld;
         nlohmann::json rows = nlohmann::json::array();
         for (int r = 0; r < 3; ++r) rows.push_back({lookup[0][r], lookup[1][r], lookup[2][r]});
@@ -208,7 +206,7 @@ void writeBlenderScene(const std::filesystem::path& folder, const BlenderSceneIn
             const Vertex& v = model.vertices[index];
             positions.insert(positions.end(), {v.position.x, v.position.y, v.position.z});
             normals.insert(normals.end(), {v.normal.x, v.normal.y, v.normal.z});
-            uvs.insert(uvs.end(), {v.uv.x, 1.0f - v.uv.y});  // Model: v = 0 at the image top; Blender: at the bottom
+            uvs.insert(uvs.end(), {v.uv.x, 1.0f - v.uv.y}); // Model: v = 0 at the image top; Blender: at the bottom
             colors.insert(colors.end(), {v.color.x, v.color.y, v.color.z});
             skin.push_back(v.skin);
         }

@@ -24,10 +24,10 @@ struct PartMaterial {
 struct BlenderSceneInputs {
     const SceneSpec* spec = nullptr;
     const Model* model = nullptr;
-    std::vector<PartMaterial> partMaterials;  // one per Model::parts entry
+    std::vector<PartMaterial> partMaterials; // one per Model::parts entry
     CameraPose camera;
     PathtracedParams params;
-    double sssWidthMm = 3.0;                  // sss.width_mm: radii scale by width_mm / 3
+    double sssWidthMm = 3.0; // sss.width_mm: radii scale by width_mm / 3
 };
 
 // Principled roughness (GGX α = roughness²) for the rasterizer's glossiness s (normalised Blinn-Phong exponent

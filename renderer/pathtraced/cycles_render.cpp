@@ -38,7 +38,8 @@ std::map<std::string, std::vector<float>> readExrChannels(const std::filesystem:
     std::map<std::string, std::vector<float>> channels;
     for (int c = 0; c < channelCount; ++c) {
         std::vector<float> values(pixels);
-        for (std::size_t p = 0; p < pixels; ++p) values[p] = all[p * static_cast<std::size_t>(channelCount) + static_cast<std::size_t>(c)];
+        for (std::size_t p = 0; p < pixels; ++p)
+            values[p] = all[p * static_cast<std::size_t>(channelCount) + static_cast<std::size_t>(c)];
         channels[spec.channel_name(c)] = std::move(values);
     }
     return channels;
@@ -74,8 +75,9 @@ CyclesImage renderWithCycles(const BlenderSceneInputs& inputs, float exposure) {
     const std::filesystem::path exr = folder / "cycles.exr";
     const auto channels = readExrChannels(exr, image.width, image.height);
     if (image.width != inputs.spec->width || image.height != inputs.spec->height)
-        throw InputError(exr.string() + ": Cycles wrote " + std::to_string(image.width) + "x" + std::to_string(image.height) +
-                         ", expected " + std::to_string(inputs.spec->width) + "x" + std::to_string(inputs.spec->height));
+        throw InputError(exr.string() + ": Cycles wrote " + std::to_string(image.width) + "x" +
+                         std::to_string(image.height) + ", expected " + std::to_string(inputs.spec->width) + "x" +
+                         std::to_string(inputs.spec->height));
     const std::size_t pixels = static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
     const char* rgb[] = {"R", "G", "B"};
     image.beauty.resize(pixels * 3);

@@ -15,14 +15,14 @@ struct CyclesImage {
     int width = 0;
     int height = 0;
     // Top row first. RGB interleaved, linear, exposure applied.
-    std::vector<float> beauty;    // Cycles' Combined pass
-    std::vector<float> diffuse;   // (DiffDir + DiffInd) × DiffCol: subsurface light is part of it in Cycles 3.x
-    std::vector<float> specular;  // (GlossDir + GlossInd) × GlossCol
-    std::vector<float> depth;     // view-axis depth, world units; +inf where no surface
-    std::vector<float> mask;      // 1 where the first hit is a skin material (material index pass), else 0
+    std::vector<float> beauty;   // Cycles' Combined pass
+    std::vector<float> diffuse;  // (DiffDir + DiffInd) × DiffCol: subsurface light is part of it in Cycles 3.x
+    std::vector<float> specular; // (GlossDir + GlossInd) × GlossCol
+    std::vector<float> depth;    // view-axis depth, world units; +inf where no surface
+    std::vector<float> mask;     // 1 where the first hit is a skin material (material index pass), else 0
     std::string blenderVersion;
-    double renderSeconds = 0.0;   // Cycles' render call, as timed by the script
-    double wallSeconds = 0.0;     // the whole Blender run (start-up, scene building, render, EXR write)
+    double renderSeconds = 0.0; // Cycles' render call, as timed by the script
+    double wallSeconds = 0.0;   // the whole Blender run (start-up, scene building, render, EXR write)
 };
 
 // A temporary folder of its own (mkdtemp under the system temporary folder).

@@ -34,12 +34,17 @@ PathtracedParams readTable(const SpecReader& t) {
 } // namespace
 
 nlohmann::json PathtracedParams::toJson() const {
-    return {{"samples", samples},         {"seed", seed},
-            {"max_bounces", maxBounces},  {"sss", sss},
-            {"specular", specular},       {"specular_source", specularSource},
+    return {{"samples", samples},
+            {"seed", seed},
+            {"max_bounces", maxBounces},
+            {"sss", sss},
+            {"specular", specular},
+            {"specular_source", specularSource},
             {"radius_mm", radiusMm},
-            {"sun_angle_deg", sunAngleDeg}, {"filter_width_px", filterWidthPx},
-            {"threads", threads},         {"blender", blender}};
+            {"sun_angle_deg", sunAngleDeg},
+            {"filter_width_px", filterWidthPx},
+            {"threads", threads},
+            {"blender", blender}};
 }
 
 PathtracedParams readPathtracedParams(const SpecReader& scene) {

@@ -19,11 +19,11 @@ namespace skinlab::renderer::pathtraced {
 std::array<double, 3> fittedRadiusMm();
 
 struct PathtracedParams {
-    int samples = 64;          // camera samples per pixel (no adaptive sampling, no denoising)
-    int seed = 0;              // Cycles' sampling seed
-    int maxBounces = 8;        // total, diffuse and glossy bounce limits (0: direct light only)
-    bool sss = true;           // random-walk subsurface scattering on skin (false: a plain Principled surface)
-    bool specular = true;      // the specular lobe (false: Principled specular 0)
+    int samples = 64;     // camera samples per pixel (no adaptive sampling, no denoising)
+    int seed = 0;         // Cycles' sampling seed
+    int maxBounces = 8;   // total, diffuse and glossy bounce limits (0: direct light only)
+    bool sss = true;      // random-walk subsurface scattering on skin (false: a plain Principled surface)
+    bool specular = true; // the specular lobe (false: Principled specular 0)
     // Where the specular layer comes from: "cycles" (Cycles' GGX lobe, environment reflections included) or
     // "rasterizer" (Cycles renders no specular; the beauty is Cycles' diffuse + the rasterizer's specular pass of
     // the same camera), so that a reference differs from a screen-space render in the subsurface transport only.
@@ -31,10 +31,10 @@ struct PathtracedParams {
     // Random-walk radii per channel (mm) at the profile's own scale; scaled by sss.width_mm / 3 like every
     // screen-space kernel, then divided by mm_per_unit (Cycles takes them in scene units).
     std::array<double, 3> radiusMm = fittedRadiusMm();
-    double sunAngleDeg = 0.0;    // angular diameter of directional lights (0: a hard sun, as the shadow map)
-    double filterWidthPx = 0.01; // pixel filter width; 0.01 point-samples the pixel centre like the rasterizer
-    int threads = 0;             // Cycles threads (0: all cores); pixels do not depend on it
-    std::string blender = "blender";  // the Blender program (a name on PATH or a path)
+    double sunAngleDeg = 0.0;        // angular diameter of directional lights (0: a hard sun, as the shadow map)
+    double filterWidthPx = 0.01;     // pixel filter width; 0.01 point-samples the pixel centre like the rasterizer
+    int threads = 0;                 // Cycles threads (0: all cores); pixels do not depend on it
+    std::string blender = "blender"; // the Blender program (a name on PATH or a path)
 
     nlohmann::json toJson() const;
 };

@@ -14,19 +14,26 @@
 namespace skinlab::renderer::pathtraced {
 
 EdgeResponse measureEdgeResponse(const EdgeMeasurementSettings& s) {
-    if (s.pixels < 16 || s.pixels % 2 != 0) throwInput("fit-profile", "pixels", std::to_string(s.pixels) + " must be even and at least 16");
-    if (s.rows < 4) throwInput("fit-profile", "rows", std::to_string(s.rows) + " is below Blender's smallest image (4 rows)");
+    if (s.pixels < 16 || s.pixels % 2 != 0)
+        throwInput("fit-profile", "pixels", std::to_string(s.pixels) + " must be even and at least 16");
+    if (s.rows < 4)
+        throwInput("fit-profile", "rows", std::to_string(s.rows) + " is below Blender's smallest image (4 rows)");
     const std::filesystem::path folder = makeWorkFolder("skinlab-profile");
-    const nlohmann::json description = {
-        {"settings", {{"width", s.pixels}, {"height", s.rows}, {"samples", s.samples}, {"seed", s.seed},
-                      {"max_bounces", 8}, {"filter_width_px", 0.01}, {"threads", s.threads}}},
-        {"albedo", s.albedo},
-        {"radius", {1.0, 1.0, 1.0}},
-        {"slab_size", 20.0 * s.halfLengthMm},
-        {"strip_length", 2.0 * s.halfLengthMm},
-        {"strip_centre", 0.0},
-        {"output", "cycles.exr"},
-        {"record", "cycles.json"}};
+    const nlohmann::json description = {{"settings",
+                                         {{"width", s.pixels},
+                                          {"height", s.rows},
+                                          {"samples", s.samples},
+                                          {"seed", s.seed},
+                                          {"max_bounces", 8},
+                                          {"filter_width_px", 0.01},
+                                          {"threads", s.threads}}},
+                                        {"albedo", s.albedo},
+                                        {"radius", {1.0, 1.0, 1.0}},
+                                        {"slab_size", 20.0 * s.halfLengthMm},
+                                        {"strip_length", 2.0 * s.halfLengthMm},
+                                        {"strip_centre", 0.0},
+                                        {"output", "cycles.exr"},
+                                        {"record", "cycles.json"}};
     writeFileAtomic(folder / "profile.json", description.dump(1));
     writeFileAtomic(folder / "cycles_scene.py", cyclesScript());
     runBlender(s.blender, folder / "cycles_scene.py", {"profile", (folder / "profile.json").string()}, folder,
@@ -49,7 +56,8 @@ EdgeResponse measureEdgeResponse(const EdgeMeasurementSettings& s) {
         std::vector<double> column(static_cast<std::size_t>(s.pixels), 0.0);
         for (int y = 0; y < s.rows; ++y)
             for (int x = 0; x < s.pixels; ++x) {
-                const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(s.pixels) + static_cast<std::size_t>(x);
+                const std::size_t p =
+                    static_cast<std::size_t>(y) * static_cast<std::size_t>(s.pixels) + static_cast<std::size_t>(x);
                 column[static_cast<std::size_t>(x)] += (direct[p] + indirect[p]) * color[p] / s.rows;
             }
         // Pixel half + k has its centre at (k + 0.5) · pixel; its mirror is half − 1 − k.
@@ -65,7 +73,8 @@ EdgeResponse measureEdgeResponse(const EdgeMeasurementSettings& s) {
         if (!(plateau > 0.0)) throw InputError(exr.string() + ": the lit slab is black in channel " + n);
         auto& values = response.value[static_cast<std::size_t>(c)];
         values.resize(static_cast<std::size_t>(half));
-        for (int k = 0; k < half; ++k) values[static_cast<std::size_t>(k)] = dark[static_cast<std::size_t>(k)] / plateau;
+        for (int k = 0; k < half; ++k)
+            values[static_cast<std::size_t>(k)] = dark[static_cast<std::size_t>(k)] / plateau;
     }
     for (int k = 0; k < half; ++k) response.xMm.push_back((k + 0.5) * pixelMm);
     const nlohmann::json record = readRecord(folder / "cycles.json");
@@ -119,7 +128,8 @@ Errors fitErrors(const EdgeResponse& response, int channel, double radius, doubl
 }
 } // namespace
 
-ProfileFit fitRadii(const EdgeResponse& response, const std::array<double, 3>& initialRadiusMm, double range, double step) {
+ProfileFit fitRadii(const EdgeResponse& response, const std::array<double, 3>& initialRadiusMm, double range,
+                    double step) {
     ProfileFit fit;
     for (int c = 0; c < 3; ++c) {
         auto cost = [&](double logRadius) { return fitErrors(response, c, std::exp(logRadius), range, step).rms; };
@@ -151,7 +161,8 @@ ProfileFit fitRadii(const EdgeResponse& response, const std::array<double, 3>& i
     return fit;
 }
 
-void writeFitPlot(const std::filesystem::path& path, const EdgeResponse& response, const ProfileFit& fit, double rangeMm) {
+void writeFitPlot(const std::filesystem::path& path, const EdgeResponse& response, const ProfileFit& fit,
+                  double rangeMm) {
     const int width = 720, height = 480, left = 60, right = 20, top = 20, bottom = 40;
     std::vector<std::uint8_t> rgb(static_cast<std::size_t>(width * height * 3), 255);
     auto plot = [&](int x, int y, std::array<std::uint8_t, 3> color) {
@@ -160,14 +171,18 @@ void writeFitPlot(const std::filesystem::path& path, const EdgeResponse& respons
         p[0] = color[0], p[1] = color[1], p[2] = color[2];
     };
     const double logLow = std::log10(1e-4), logHigh = std::log10(0.5);
-    auto toPixelX = [&](double x) { return left + static_cast<int>(std::lround(x / rangeMm * (width - left - right))); };
+    auto toPixelX = [&](double x) {
+        return left + static_cast<int>(std::lround(x / rangeMm * (width - left - right)));
+    };
     auto toPixelY = [&](double e) {
         const double l = std::clamp(std::log10(std::max(e, 1e-6)), logLow, logHigh);
         return top + static_cast<int>(std::lround((logHigh - l) / (logHigh - logLow) * (height - top - bottom)));
     };
     // Axes, a grid line per mm and per decade.
     for (int mm = 0; mm <= static_cast<int>(rangeMm); ++mm)
-        for (int y = top; y < height - bottom; ++y) plot(toPixelX(mm), y, mm == 0 ? std::array<std::uint8_t, 3>{0, 0, 0} : std::array<std::uint8_t, 3>{220, 220, 220});
+        for (int y = top; y < height - bottom; ++y)
+            plot(toPixelX(mm), y,
+                 mm == 0 ? std::array<std::uint8_t, 3>{0, 0, 0} : std::array<std::uint8_t, 3>{220, 220, 220});
     for (int decade = -4; decade <= -1; ++decade)
         for (int x = left; x < width - right; ++x) plot(x, toPixelY(std::pow(10.0, decade)), {220, 220, 220});
     for (int x = left; x < width - right; ++x) plot(x, height - bottom, {0, 0, 0});
@@ -176,7 +191,8 @@ void writeFitPlot(const std::filesystem::path& path, const EdgeResponse& respons
         int previousMeasured = -1, previousDeon = -1;
         for (int px = left; px < width - right; ++px) {
             const double x = (px - left) * rangeMm / (width - left - right);
-            const int measured = toPixelY(scaledEdgeResponse(response, c, fit.radiusMm[static_cast<std::size_t>(c)], x));
+            const int measured =
+                toPixelY(scaledEdgeResponse(response, c, fit.radiusMm[static_cast<std::size_t>(c)], x));
             const int deon = toPixelY(deonEdgeResponse(c, x));
             auto segment = [&](int from, int to, bool dashed) {
                 if (dashed && ((px / 6) % 2 == 1)) return;

@@ -21,20 +21,20 @@ namespace skinlab::renderer::pathtraced {
 struct EdgeMeasurementSettings {
     int samples = 256;
     int seed = 0;
-    int pixels = 2048;               // along the strip
-    int rows = 8;                    // across it (averaged; Blender renders at least 4)
+    int pixels = 2048; // along the strip
+    int rows = 8;      // across it (averaged; Blender renders at least 4)
     // The strip covers x in [−half, +half] at radius 1 mm; a skin-coloured walk of radius 1 mm leaves E < 1e-4
     // beyond 1 mm, so ±4 mm holds the whole response at 0.004 mm pixels.
     double halfLengthMm = 4.0;
-    std::array<double, 3> albedo{0.60, 0.42, 0.34};  // subsurface colour (the built-in scenes' skin)
+    std::array<double, 3> albedo{0.60, 0.42, 0.34}; // subsurface colour (the built-in scenes' skin)
     std::string blender = "blender";
     int threads = 0;
 };
 
 struct EdgeResponse {
-    std::vector<double> xMm;                   // pixel centres x > 0 (radius 1 mm)
-    std::array<std::vector<double>, 3> value;  // E(x) per channel
-    std::array<double, 3> plateau{};           // L(x) + L(−x), averaged: the lit slab's diffuse radiance
+    std::vector<double> xMm;                  // pixel centres x > 0 (radius 1 mm)
+    std::array<std::vector<double>, 3> value; // E(x) per channel
+    std::array<double, 3> plateau{};          // L(x) + L(−x), averaged: the lit slab's diffuse radiance
     std::string blenderVersion;
     double renderSeconds = 0.0;
 };
@@ -46,15 +46,15 @@ EdgeResponse measureEdgeResponse(const EdgeMeasurementSettings& settings);
 double deonEdgeResponse(int channel, double xMm);
 
 struct ProfileFit {
-    std::array<double, 3> radiusMm{};        // fitted radius per channel
-    std::array<double, 3> rmsError{};        // RMS of E_fit − E_dEon over the fit range
+    std::array<double, 3> radiusMm{}; // fitted radius per channel
+    std::array<double, 3> rmsError{}; // RMS of E_fit − E_dEon over the fit range
     std::array<double, 3> maxError{};
     std::array<double, 3> initialRmsError{}; // the same with the radii before the fit (for comparison)
 };
 
 // Fits the radius of each channel (golden-section search on log r after a coarse scan).
-ProfileFit fitRadii(const EdgeResponse& response, const std::array<double, 3>& initialRadiusMm,
-                    double fitRangeMm = 8.0, double stepMm = 0.01);
+ProfileFit fitRadii(const EdgeResponse& response, const std::array<double, 3>& initialRadiusMm, double fitRangeMm = 8.0,
+                    double stepMm = 0.01);
 
 // E_1(x / r) by linear interpolation (0 beyond the measured range).
 double scaledEdgeResponse(const EdgeResponse& response, int channel, double radiusMm, double xMm);

@@ -14,7 +14,8 @@ namespace {
 // d'Eon's sum of Gaussians: the radial CDF of G(v, ·) is 1 − exp(−r²/(2v)).
 class GaussianSumRadial final : public RadialProfile {
 public:
-    explicit GaussianSumRadial(double scale) : profile_(sss::deonSkinLobes(), "d'Eon six-Gaussian skin profile"), scale_(scale) {
+    explicit GaussianSumRadial(double scale)
+        : profile_(sss::deonSkinLobes(), "d'Eon six-Gaussian skin profile"), scale_(scale) {
         for (const auto& lobe : profile_.lobes())
             for (int c = 0; c < 3; ++c) totals_[c] += lobe.weight[c];
     }

@@ -24,9 +24,7 @@ SpatialHashGrid::SpatialHashGrid(const std::vector<glm::vec3>& points, const std
     }
 }
 
-glm::ivec3 SpatialHashGrid::cellOf(const glm::vec3& p) const {
-    return glm::ivec3(glm::floor(p / cellSize_));
-}
+glm::ivec3 SpatialHashGrid::cellOf(const glm::vec3& p) const { return glm::ivec3(glm::floor(p / cellSize_)); }
 
 std::uint64_t SpatialHashGrid::key(const glm::ivec3& cell) {
     // 21 bits per axis (±2^20 cells: ±1 km at 1 mm cells), offset to unsigned.

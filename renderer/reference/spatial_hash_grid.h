@@ -41,8 +41,8 @@ private:
 
     const std::vector<glm::vec3>* points_;
     float cellSize_;
-    std::vector<std::uint32_t> sorted_;  // members sorted by cell key, then index
-    std::unordered_map<std::uint64_t, std::pair<std::uint32_t, std::uint32_t>> cells_;  // key → [begin, end) in sorted_
+    std::vector<std::uint32_t> sorted_; // members sorted by cell key, then index
+    std::unordered_map<std::uint64_t, std::pair<std::uint32_t, std::uint32_t>> cells_; // key → [begin, end) in sorted_
 };
 
 } // namespace skinlab::renderer::reference

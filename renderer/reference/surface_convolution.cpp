@@ -44,7 +44,7 @@ std::vector<glm::vec3> convolveSurface(const SurfaceSamples& samples, const std:
     std::vector<std::array<float, 3>> table(kProfileTableSize + 2);
     for (int k = 0; k < kProfileTableSize + 2; ++k)
         for (int c = 0; c < 3; ++c)
-            table[k][c] = static_cast<float>(profile.radial(c, std::max(k, 1) * step));  // r = 0 → first step
+            table[k][c] = static_cast<float>(profile.radial(c, std::max(k, 1) * step)); // r = 0 → first step
     const float inverseStep = static_cast<float>(1.0 / step);
     std::vector<std::size_t> sourceCounts(targets.size(), 0);
 
@@ -56,7 +56,7 @@ std::vector<glm::vec3> convolveSurface(const SurfaceSamples& samples, const std:
         std::array<double, 3> weightSum{0.0, 0.0, 0.0};
         std::size_t sources = 0;
         grid.forEachWithin(centre, static_cast<float>(cutoff), [&](std::uint32_t q) {
-            bool facing = true;  // q lies on the receiver's side of the surface (counts in the normaliser)
+            bool facing = true; // q lies on the receiver's side of the surface (counts in the normaliser)
             if (settings.transport == Transport::ThroughTissue && q != p) {
                 // The chord p → q must run inside the body: it may not leave p's surface outwards, nor reach q
                 // from outside, steeper than 10° (a flat or convex neighbour gives ≤ 0, a concave one a little
@@ -87,7 +87,7 @@ std::vector<glm::vec3> convolveSurface(const SurfaceSamples& samples, const std:
             }
             ++sources;
         });
-        glm::vec3 result = output[p];  // no weight at all (an isolated sample): keep E·α
+        glm::vec3 result = output[p]; // no weight at all (an isolated sample): keep E·α
         for (int c = 0; c < 3; ++c)
             if (weightSum[c] > 0.0) result[c] = static_cast<float>(weighted[c] / weightSum[c]);
         output[p] = result;

@@ -37,19 +37,19 @@ namespace skinlab::renderer::reference {
 //    stays unchanged, the energy of tails and non-skin neighbours is still handed back, and the light of a thin
 //    part's back face adds to its front (through-light) instead of averaging with it.
 enum class Transport { Euclidean, ThroughTissue };
-inline constexpr float kAirGapSine = 0.17364818f;  // sin 10°
+inline constexpr float kAirGapSine = 0.17364818f; // sin 10°
 
 struct ConvolutionSettings {
     Transport transport = Transport::ThroughTissue;
-    double cutoffTail = 1e-3;  // share of each channel's energy allowed outside the cutoff radius
-    unsigned threads = 0;      // worker threads; 0: std::thread::hardware_concurrency()
+    double cutoffTail = 1e-3; // share of each channel's energy allowed outside the cutoff radius
+    unsigned threads = 0;     // worker threads; 0: std::thread::hardware_concurrency()
 };
 
 struct ConvolutionReport {
     double cutoffRadiusMm = 0.0;
-    std::array<double, 3> energyBeyondCutoff{};  // 1 − cumulative(c, r_c) per channel (renormalised away)
-    std::size_t receivers = 0;                   // skin samples convolved
-    double meanSources = 0.0;                    // mean number of skin sources per receiver
+    std::array<double, 3> energyBeyondCutoff{}; // 1 − cumulative(c, r_c) per channel (renormalised away)
+    std::size_t receivers = 0;                  // skin samples convolved
+    double meanSources = 0.0;                   // mean number of skin sources per receiver
 };
 
 // irradiance: per sample, linear RGB (same size as samples). receivers: indices of the samples to convolve (all

@@ -25,7 +25,7 @@ SurfaceSamples gatherSurfaceSamples(const Model& model, float mmPerUnit) {
             const glm::vec3& a = samples.positionMm[triangle[0]];
             const glm::vec3& b = samples.positionMm[triangle[1]];
             const glm::vec3& c = samples.positionMm[triangle[2]];
-            const float third = glm::length(glm::cross(b - a, c - a)) / 6.0f;  // (area / 3), mm²
+            const float third = glm::length(glm::cross(b - a, c - a)) / 6.0f; // (area / 3), mm²
             for (int k = 0; k < 3; ++k) {
                 const std::uint32_t v = triangle[k];
                 if (materialOf[v] == unassigned) materialOf[v] = part.material;

@@ -10,11 +10,11 @@
 namespace skinlab::renderer::reference {
 
 struct SurfaceSamples {
-    std::vector<glm::vec3> positionMm;  // world position × mm_per_unit
-    std::vector<glm::vec3> normal;      // unit, world space (the vertex's smooth geometric normal)
-    std::vector<glm::vec3> albedo;      // linear Rec.709: material albedo × vertex colour (textures not applied)
-    std::vector<float> areaMm2;         // area represented by the sample, mm²
-    std::vector<std::uint8_t> skin;     // 1: skin (scatters and receives), 0: not
+    std::vector<glm::vec3> positionMm; // world position × mm_per_unit
+    std::vector<glm::vec3> normal;     // unit, world space (the vertex's smooth geometric normal)
+    std::vector<glm::vec3> albedo;     // linear Rec.709: material albedo × vertex colour (textures not applied)
+    std::vector<float> areaMm2;        // area represented by the sample, mm²
+    std::vector<std::uint8_t> skin;    // 1: skin (scatters and receives), 0: not
 
     std::size_t size() const { return positionMm.size(); }
 };

@@ -20,7 +20,7 @@ Vertex midpoint(const Vertex& a, const Vertex& b) {
     Vertex m;
     m.position = 0.5f * (a.position + b.position);
     const glm::vec3 normal = a.normal + b.normal;
-    m.normal = glm::length(normal) > 0.0f ? glm::normalize(normal) : a.normal;  // opposite normals: keep a's
+    m.normal = glm::length(normal) > 0.0f ? glm::normalize(normal) : a.normal; // opposite normals: keep a's
     m.uv = 0.5f * (a.uv + b.uv);
     const glm::vec3 tangent = glm::vec3(a.tangent) + glm::vec3(b.tangent);
     m.tangent = glm::vec4(glm::length(tangent) > 0.0f ? glm::normalize(tangent) : glm::vec3(a.tangent), a.tangent.w);
@@ -47,7 +47,7 @@ std::uint64_t edgeKey(std::uint32_t a, std::uint32_t b) {
 // A marked edge gets one midpoint through the edge map, used by both triangles sharing it: the mesh stays
 // conforming. Returns the number of marked edges (0: nothing was split).
 struct EdgeTable {
-    std::unordered_map<std::uint64_t, std::uint32_t> midpoint;  // marked edge → its new vertex (assigned later)
+    std::unordered_map<std::uint64_t, std::uint32_t> midpoint; // marked edge → its new vertex (assigned later)
     std::unordered_map<std::uint64_t, float> lengthSquared;
 };
 
@@ -90,7 +90,8 @@ std::unordered_map<std::uint64_t, std::uint32_t> markEdges(const Model& model, f
     const float targetSquared = targetUnits * targetUnits;
     forEachSkinTriangle(model, [&](const std::uint32_t* t) {
         for (int k = 0; k < 3; ++k)
-            if (lengthSquared(model, t[k], t[(k + 1) % 3]) > targetSquared) marked.emplace(edgeKey(t[k], t[(k + 1) % 3]), 0u);
+            if (lengthSquared(model, t[k], t[(k + 1) % 3]) > targetSquared)
+                marked.emplace(edgeKey(t[k], t[(k + 1) % 3]), 0u);
     });
     // Closure: marks only grow, so this ends (at the latest when every edge is marked).
     for (bool changed = !marked.empty(); changed;) {
@@ -138,13 +139,14 @@ void splitMarked(Model& model, std::unordered_map<std::uint64_t, std::uint32_t>&
                 const std::uint32_t a = model.indices[i + r], b = model.indices[i + (r + 1) % 3],
                                     c = model.indices[i + (r + 2) % 3];
                 const std::uint32_t ab = midpointIndex(a, b);
-                if (ab == none) {  // no marked edge (the closure marks the longest edge of every split triangle):
+                if (ab == none) { // no marked edge (the closure marks the longest edge of every split triangle):
                     // kept exactly as it was, vertex order included
                     indices.insert(indices.end(), model.indices.begin() + i, model.indices.begin() + i + 3);
                     continue;
                 }
                 const std::uint32_t bc = midpointIndex(b, c), ca = midpointIndex(c, a);
-                if (bc != none && ca != none) indices.insert(indices.end(), {a, ab, ca, ab, b, bc, ca, bc, c, ab, bc, ca});
+                if (bc != none && ca != none)
+                    indices.insert(indices.end(), {a, ab, ca, ab, b, bc, ca, bc, c, ab, bc, ca});
                 else if (bc != none) indices.insert(indices.end(), {a, ab, c, ab, b, bc, ab, bc, c});
                 else if (ca != none) indices.insert(indices.end(), {a, ab, ca, ab, c, ca, ab, b, c});
                 else indices.insert(indices.end(), {a, ab, c, ab, b, c});
@@ -183,7 +185,8 @@ Model tessellateSkin(const Model& model, float targetEdgeMm, float mmPerUnit, Te
     forEachSkinTrianglePositions(model, [&](const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
         skinAreaMm2 += 0.5 * double(glm::length(glm::cross(b - a, c - a))) * double(mmPerUnit) * double(mmPerUnit);
     });
-    const double fewestVertices = 0.5 * skinAreaMm2 / (0.25 * std::sqrt(3.0) * double(targetEdgeMm) * double(targetEdgeMm));
+    const double fewestVertices =
+        0.5 * skinAreaMm2 / (0.25 * std::sqrt(3.0) * double(targetEdgeMm) * double(targetEdgeMm));
     if (fewestVertices > double(maxVertices))
         throwInput("reference", "edge_mm",
                    std::to_string(targetEdgeMm) + " mm needs more than " + std::to_string(maxVertices) +
@@ -195,13 +198,13 @@ Model tessellateSkin(const Model& model, float targetEdgeMm, float mmPerUnit, Te
     float longest = longestSkinEdgeMm(result, mmPerUnit);
     while (longest > targetEdgeMm) {
         auto marked = markEdges(result, targetUnits);
-        if (marked.empty()) break;  // every edge within the target in world units (rounding at the boundary)
+        if (marked.empty()) break; // every edge within the target in world units (rounding at the boundary)
         const std::size_t next = result.vertices.size() + marked.size();
         if (next > maxVertices)
             throwInput("reference", "edge_mm",
                        std::to_string(targetEdgeMm) + " mm needs more than " + std::to_string(maxVertices) +
-                           " vertices (longest skin edge is still " + std::to_string(longest) +
-                           " mm after " + std::to_string(rounds) + " rounds); use a larger edge length");
+                           " vertices (longest skin edge is still " + std::to_string(longest) + " mm after " +
+                           std::to_string(rounds) + " rounds); use a larger edge length");
         splitMarked(result, marked);
         ++rounds;
         longest = longestSkinEdgeMm(result, mmPerUnit);

@@ -50,9 +50,7 @@ void addGrid(Surface& surface, int columns, int rows, bool wrapColumns,
             surface.vertices.push_back(vertex);
         }
     }
-    const auto at = [&](int i, int j) {
-        return base + static_cast<std::uint32_t>(j * (columns + 1) + i);
-    };
+    const auto at = [&](int i, int j) { return base + static_cast<std::uint32_t>(j * (columns + 1) + i); };
     const auto addTriangle = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
         const glm::vec3 cross = glm::cross(surface.vertices[b].position - surface.vertices[a].position,
                                            surface.vertices[c].position - surface.vertices[a].position);
@@ -194,9 +192,9 @@ Surface makeFin(float halfWidth, float halfHeight, float thickness, float bendRa
     const auto position = [=](float s, float t) {
         const float phi = 2.0f * kPi * s;
         const glm::vec2 outline(halfWidth * std::cos(phi), halfHeight * std::sin(phi));
-        const float boundary = glm::length(outline);   // distance from the centre to the outline, mm
+        const float boundary = glm::length(outline); // distance from the centre to the outline, mm
         const glm::vec2 direction = outline / boundary;
-        const float flat = boundary - half;              // where the rim starts
+        const float flat = boundary - half; // where the rim starts
         const float row = t * static_cast<float>(rows);
         float radial = 0.0f;
         float offset = 0.0f;
@@ -213,9 +211,9 @@ Surface makeFin(float halfWidth, float halfHeight, float thickness, float bendRa
         }
         // Exact ends of the rim and poles, so that positions weld bit-identically.
         if (row >= static_cast<float>(rows)) radial = 0.0f;
-        const glm::vec2 planar = radial * direction;    // (arc length, height)
-        const float alpha = planar.x / bendRadius;       // bend angle, rad
-        const float distance = bendRadius - offset;      // distance from the bend axis
+        const glm::vec2 planar = radial * direction; // (arc length, height)
+        const float alpha = planar.x / bendRadius;   // bend angle, rad
+        const float distance = bendRadius - offset;  // distance from the bend axis
         return glm::vec3(distance * std::sin(alpha), planar.y, bendRadius - distance * std::cos(alpha));
     };
     Surface surface;
@@ -299,8 +297,7 @@ Model makeBleedScene() {
     };
     for (const std::uint32_t material : {skin, dark, bright}) {
         Surface surface;
-        addGrid(surface, cells, cells, false, position,
-                [&](int i, int j) { return regionOf(i, j) == material; });
+        addGrid(surface, cells, cells, false, position, [&](int i, int j) { return regionOf(i, j) == material; });
         removeUnreferenced(surface);
         orient(surface, [](const glm::vec3&) { return glm::vec3(0.0f, 0.0f, 1.0f); });
         smoothNormals(surface);
@@ -316,7 +313,7 @@ Model makeEarScene(float thicknessMm) {
     }
     Model model;
     const std::uint32_t skin = addMaterial(model, "skin", kSkinAlbedo, true, 0.6f);
-    const float halfWidth = 0.5f * kEarBendRadiusMm * kEarArcDeg * kPi / 180.0f;  // half the arc length, mm
+    const float halfWidth = 0.5f * kEarBendRadiusMm * kEarArcDeg * kPi / 180.0f; // half the arc length, mm
     // 128 columns around the outline, 40 rows per face (0.7 mm radial steps) and 16 across the rim.
     Surface fin = makeFin(halfWidth, 0.5f * kEarHeightMm, thicknessMm, kEarBendRadiusMm, 128, 40, 16);
     smoothNormals(fin);
@@ -340,7 +337,7 @@ constexpr float kMouthY = -66.0f;
 
 // Point of the head surface for unit direction d of the base ellipsoid (front = +Z, up = +Y).
 glm::vec3 headSurface(const glm::vec3& d) {
-    const glm::vec3 n = glm::normalize(d / kHeadSemiAxes);  // normal of the base ellipsoid
+    const glm::vec3 n = glm::normalize(d / kHeadSemiAxes); // normal of the base ellipsoid
     // A superellipsoid (|x|^e + |y|^e + |z|^e = 1 in units of the semi-axes) with e = 2.5 instead of an
     // ellipsoid: c -> sign(c) |c|^(2/e) maps the unit sphere onto it. Fuller temples and crown: a plain
     // ellipsoid of these proportions reads as an egg.
@@ -361,15 +358,15 @@ glm::vec3 headSurface(const glm::vec3& d) {
     // Nose: a ridge from the bridge (y ≈ +8) to the tip (y ≈ −30), widening downwards, ending in a rounded
     // tip; then a sharp drop to the upper lip. Heights along the base normal, mm.
     {
-        const float along = std::clamp((8.0f - p.y) / 38.0f, 0.0f, 1.0f);   // 0 at the bridge, 1 at the tip
-        const float ridge = (5.0f + 14.0f * along * along) * smoothStep(14.0f, 4.0f, p.y) *
-                            smoothStep(-44.0f, -30.0f, p.y);
+        const float along = std::clamp((8.0f - p.y) / 38.0f, 0.0f, 1.0f); // 0 at the bridge, 1 at the tip
+        const float ridge =
+            (5.0f + 14.0f * along * along) * smoothStep(14.0f, 4.0f, p.y) * smoothStep(-44.0f, -30.0f, p.y);
         const float tip = 6.0f * gaussian(p.y, -28.0f, 6.0f);
-        const float width = 7.0f + 7.0f * along;                            // half width, mm
+        const float width = 7.0f + 7.0f * along; // half width, mm
         displacement += (ridge + tip) * gaussian(p.x, 0.0f, width) * front;
         // Nostril wings (alae): small bulges either side of the tip.
-        displacement += 7.0f * (gaussian(p.x, -13.0f, 4.5f) + gaussian(p.x, 13.0f, 4.5f)) *
-                        gaussian(p.y, -35.0f, 4.5f) * front;
+        displacement +=
+            7.0f * (gaussian(p.x, -13.0f, 4.5f) + gaussian(p.x, 13.0f, 4.5f)) * gaussian(p.y, -35.0f, 4.5f) * front;
     }
     // Brow ridge above the eyes.
     displacement += 6.0f * gaussian(p.y, 22.0f, 6.0f) * gaussian(p.x, 0.0f, 34.0f) * front;
@@ -377,8 +374,8 @@ glm::vec3 headSurface(const glm::vec3& d) {
     displacement -= 13.0f * (gaussian(p.x, -kEyeCentre.x, 12.0f) + gaussian(p.x, kEyeCentre.x, 12.0f)) *
                     gaussian(p.y, kEyeCentre.y, 9.0f) * front;
     // Cheekbones.
-    displacement += 7.0f * (gaussian(p.x, -46.0f, 13.0f) + gaussian(p.x, 46.0f, 13.0f)) *
-                    gaussian(p.y, -18.0f, 12.0f) * front;
+    displacement +=
+        7.0f * (gaussian(p.x, -46.0f, 13.0f) + gaussian(p.x, 46.0f, 13.0f)) * gaussian(p.y, -18.0f, 12.0f) * front;
     // Lips: upper and lower lip bulges with a small gap between them at the mouth line.
     displacement += 7.0f * gaussian(p.x, 0.0f, 20.0f) *
                     (gaussian(p.y, kMouthY + 6.0f, 4.0f) + gaussian(p.y, kMouthY - 6.5f, 4.5f)) * front;
@@ -400,8 +397,8 @@ glm::vec3 headColour(const glm::vec3& p) {
     for (const float side : {-1.0f, 1.0f}) {
         const float x = side * p.x;
         const float arcY = 19.0f + 4.0f * std::sin(kPi * std::clamp((x - 12.0f) / 40.0f, 0.0f, 1.0f));
-        const float brow = smoothStep(4.5f, 2.5f, std::abs(p.y - arcY)) * smoothStep(10.0f, 14.0f, x) *
-                           smoothStep(54.0f, 48.0f, x);
+        const float brow =
+            smoothStep(4.5f, 2.5f, std::abs(p.y - arcY)) * smoothStep(10.0f, 14.0f, x) * smoothStep(54.0f, 48.0f, x);
         colour = glm::mix(colour, glm::vec3(0.30f, 0.26f, 0.24f), brow);
     }
     return colour;
@@ -439,7 +436,7 @@ Model makeHeadScene(bool skinDetail) {
         transform = glm::translate(transform, glm::vec3(side * 72.0f, -12.0f, -8.0f));
         transform = glm::scale(transform, glm::vec3(side, 1.0f, 1.0f));
         transform = glm::rotate(transform, glm::radians(65.0f), glm::vec3(0.0f, 1.0f, 0.0f));
-        transform = glm::rotate(transform, glm::radians(-8.0f), glm::vec3(1.0f, 0.0f, 0.0f));  // top leans back
+        transform = glm::rotate(transform, glm::radians(-8.0f), glm::vec3(1.0f, 0.0f, 0.0f)); // top leans back
         transformPositions(ear, transform);
         const glm::vec3 centre(transform[3]);
         orient(ear, [centre](const glm::vec3& p) { return p - centre; });
@@ -456,9 +453,8 @@ Model makeHeadScene(bool skinDetail) {
         const float dy = kEyeCentre.y / kHeadSemiAxes.y;
         const glm::vec3 socket = headSurface(glm::vec3(dx, dy, std::sqrt(1.0f - dx * dx - dy * dy)));
         Surface ball = makeSphere(kEyeRadius, 32, 16);
-        transformPositions(ball, glm::translate(glm::mat4(1.0f),
-                                                glm::vec3(side * kEyeCentre.x, kEyeCentre.y,
-                                                          socket.z - kEyeRadius + 3.0f)));
+        transformPositions(ball, glm::translate(glm::mat4(1.0f), glm::vec3(side * kEyeCentre.x, kEyeCentre.y,
+                                                                           socket.z - kEyeRadius + 3.0f)));
         smoothNormals(ball);
         // One texel of the maps' flat row 0: the skin detail does not reach the eyes.
         for (Vertex& vertex : ball.vertices) vertex.uv = glm::vec2(0.5f, 0.5f / static_cast<float>(kHeadDetailHeight));
@@ -478,7 +474,7 @@ Model makeHeadScene(bool skinDetail) {
         });
         orient(side, [=](const glm::vec3& p) { return glm::vec3(p.x, 0.0f, p.z - centreZ); });
         smoothNormals(side);
-        remapUVs(side, 0.25f, 0.75f, 0.72f, 0.80f);  // the back of the lower head's chart: generic skin
+        remapUVs(side, 0.25f, 0.75f, 0.72f, 0.80f); // the back of the lower head's chart: generic skin
         appendPart(model, side, skin);
         Surface cap;
         addGrid(cap, 64, 4, true, [=](float s, float t) {

@@ -16,15 +16,15 @@ constexpr float kPi = std::numbers::pi_v<float>;
 
 [[noreturn]] void failEnvironment(const std::filesystem::path& path, const std::string& why) {
     std::string message = why;
-    std::replace(message.begin(), message.end(), '\n', ' ');  // keep the error on one line
+    std::replace(message.begin(), message.end(), '\n', ' '); // keep the error on one line
     throw InputError(path.string() + ": cannot read environment (" + message + ")");
 }
 
 } // namespace
 
 glm::vec3 equirectDirection(float u, float v) {
-    const float theta = kPi * v;                // polar angle from +Y
-    const float phi = 2.0f * kPi * (u - 0.5f);  // 0 at the image centre (-Z), +pi/2 at +X
+    const float theta = kPi * v;               // polar angle from +Y
+    const float phi = 2.0f * kPi * (u - 0.5f); // 0 at the image centre (-Z), +pi/2 at +X
     const float sinTheta = std::sin(theta);
     return {sinTheta * std::sin(phi), std::cos(theta), -sinTheta * std::cos(phi)};
 }
@@ -64,8 +64,8 @@ Environment loadEnvironment(const std::filesystem::path& path) {
     const int channels = spec.nchannels;
     if (spec.width <= 0 || spec.height <= 0 || channels <= 0) failEnvironment(path, "empty image");
     if (std::abs(spec.width - 2 * spec.height) > 1) {
-        failEnvironment(path, "not equirectangular: " + std::to_string(spec.width) + "x" +
-                                  std::to_string(spec.height) + ", expected width = 2 * height");
+        failEnvironment(path, "not equirectangular: " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                                  ", expected width = 2 * height");
     }
     std::vector<float> raw(static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height) *
                            static_cast<std::size_t>(channels));
@@ -86,8 +86,9 @@ Environment loadEnvironment(const std::filesystem::path& path) {
         environment.pixels[i] = grey ? glm::vec3(source[0]) : glm::vec3(source[0], source[1], source[2]);
         if (!std::isfinite(environment.pixels[i].x) || !std::isfinite(environment.pixels[i].y) ||
             !std::isfinite(environment.pixels[i].z)) {
-            failEnvironment(path, "non-finite radiance at pixel (" + std::to_string(i % static_cast<std::size_t>(spec.width)) +
-                                      ", " + std::to_string(i / static_cast<std::size_t>(spec.width)) + ")");
+            failEnvironment(path, "non-finite radiance at pixel (" +
+                                      std::to_string(i % static_cast<std::size_t>(spec.width)) + ", " +
+                                      std::to_string(i / static_cast<std::size_t>(spec.width)) + ")");
         }
     }
     return environment;
@@ -104,11 +105,11 @@ Environment makeConstantEnvironment(const glm::vec3& radiance, int width, int he
 
 std::array<float, 9> shBasis9(const glm::vec3& d) {
     // Real SH normalisation constants (R&H 2001, Eq. 3).
-    constexpr float c0 = 0.282095f;  // sqrt(1 / 4pi)
-    constexpr float c1 = 0.488603f;  // sqrt(3 / 4pi)
-    constexpr float c2 = 1.092548f;  // sqrt(15 / 4pi)
-    constexpr float c3 = 0.315392f;  // sqrt(5 / 16pi)
-    constexpr float c4 = 0.546274f;  // sqrt(15 / 16pi)
+    constexpr float c0 = 0.282095f; // sqrt(1 / 4pi)
+    constexpr float c1 = 0.488603f; // sqrt(3 / 4pi)
+    constexpr float c2 = 1.092548f; // sqrt(15 / 4pi)
+    constexpr float c3 = 0.315392f; // sqrt(5 / 16pi)
+    constexpr float c4 = 0.546274f; // sqrt(15 / 16pi)
     return {c0,
             c1 * d.y,
             c1 * d.z,
@@ -125,7 +126,7 @@ std::array<glm::vec3, 9> projectSH9(const Environment& environment) {
     std::array<glm::dvec3, 9> sums{};
     const int width = environment.width;
     const int height = environment.height;
-    const double texelWidth = 2.0 * std::numbers::pi / width;  // Δφ of one column
+    const double texelWidth = 2.0 * std::numbers::pi / width; // Δφ of one column
     for (int y = 0; y < height; ++y) {
         // Exact solid angle of a texel of this row: Δφ · (cos θ_top − cos θ_bottom); summed over the whole
         // image this is exactly 4π (a sin θ · Δθ approximation is not, near the poles).

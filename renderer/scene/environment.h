@@ -22,7 +22,7 @@ namespace skinlab::renderer {
 struct Environment {
     int width = 0;
     int height = 0;
-    std::vector<glm::vec3> pixels;  // width * height radiance values
+    std::vector<glm::vec3> pixels; // width * height radiance values
 
     const glm::vec3& texel(int x, int y) const {
         return pixels[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)];

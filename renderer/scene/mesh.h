@@ -13,26 +13,26 @@ struct Image;
 
 struct Vertex {
     glm::vec3 position{0.0f};
-    glm::vec3 normal{0.0f, 0.0f, 1.0f};  // geometric (smooth) normal, unit length
+    glm::vec3 normal{0.0f, 0.0f, 1.0f}; // geometric (smooth) normal, unit length
     glm::vec2 uv{0.0f};
-    glm::vec4 tangent{1.0f, 0.0f, 0.0f, 1.0f};  // xyz unit tangent, w = handedness (±1) of the bitangent
-    glm::vec3 color{1.0f};   // linear albedo multiplier (procedural albedo: lips, brows); 1 for scanned assets
-    float skin = 1.0f;       // skin mask multiplier in [0, 1] (multiplied with the material's flag)
+    glm::vec4 tangent{1.0f, 0.0f, 0.0f, 1.0f}; // xyz unit tangent, w = handedness (±1) of the bitangent
+    glm::vec3 color{1.0f}; // linear albedo multiplier (procedural albedo: lips, brows); 1 for scanned assets
+    float skin = 1.0f;     // skin mask multiplier in [0, 1] (multiplied with the material's flag)
 };
 
 // A range of indices drawn with one material.
 struct SubMesh {
     std::uint32_t firstIndex = 0;
     std::uint32_t indexCount = 0;
-    std::uint32_t material = 0;  // index into Model::materials
+    std::uint32_t material = 0; // index into Model::materials
 };
 
 // Material as found in the model; the scene spec may override or extend it by name.
 struct MeshMaterial {
     std::string name;
-    glm::vec3 albedo{1.0f};      // linear
+    glm::vec3 albedo{1.0f}; // linear
     bool skin = true;
-    float glossiness = 0.6f;     // thesis Eq. 4.5: alpha = 8192 * glossiness^5
+    float glossiness = 0.6f; // thesis Eq. 4.5: alpha = 8192 * glossiness^5
     float specularIntensity = 1.0f;
 };
 

@@ -18,17 +18,14 @@ namespace {
 
 [[noreturn]] void failModel(const std::filesystem::path& path, const std::string& why) {
     std::string message = why;
-    std::replace(message.begin(), message.end(), '\n', ' ');  // keep the error on one line
+    std::replace(message.begin(), message.end(), '\n', ' '); // keep the error on one line
     while (!message.empty() && (message.back() == ' ' || message.back() == '\r')) message.pop_back();
     throw InputError(path.string() + ": cannot load model (" + message + ")");
 }
 
 glm::mat4 toGlm(const aiMatrix4x4& m) {
     // aiMatrix4x4 is row-major (a1..a4 is the first row); glm is column-major.
-    return glm::mat4(m.a1, m.b1, m.c1, m.d1,
-                     m.a2, m.b2, m.c2, m.d2,
-                     m.a3, m.b3, m.c3, m.d3,
-                     m.a4, m.b4, m.c4, m.d4);
+    return glm::mat4(m.a1, m.b1, m.c1, m.d1, m.a2, m.b2, m.c2, m.d2, m.a3, m.b3, m.c3, m.d3, m.a4, m.b4, m.c4, m.d4);
 }
 
 MeshMaterial convertMaterial(const aiMaterial& source, unsigned index) {
@@ -46,7 +43,7 @@ MeshMaterial convertMaterial(const aiMaterial& source, unsigned index) {
         source.Get(AI_MATKEY_COLOR_DIFFUSE, colour) == AI_SUCCESS) {
         material.albedo = glm::vec3(colour.r, colour.g, colour.b);
     }
-    material.skin = true;  // the scene spec decides which materials are skin
+    material.skin = true; // the scene spec decides which materials are skin
     return material;
 }
 
@@ -83,7 +80,7 @@ struct Collector {
             const auto first = static_cast<std::uint32_t>(model.indices.size());
             for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
                 const aiFace& face = mesh.mFaces[f];
-                if (face.mNumIndices != 3) continue;  // points and lines left by SortByPType
+                if (face.mNumIndices != 3) continue; // points and lines left by SortByPType
                 model.indices.push_back(base + face.mIndices[0]);
                 model.indices.push_back(base + face.mIndices[mirrored ? 2 : 1]);
                 model.indices.push_back(base + face.mIndices[mirrored ? 1 : 2]);
@@ -120,7 +117,8 @@ Model loadModel(const std::filesystem::path& path, const ModelLoadOptions& optio
     }
 
     Model model;
-    for (unsigned m = 0; m < scene->mNumMaterials; ++m) model.materials.push_back(convertMaterial(*scene->mMaterials[m], m));
+    for (unsigned m = 0; m < scene->mNumMaterials; ++m)
+        model.materials.push_back(convertMaterial(*scene->mMaterials[m], m));
     if (model.materials.empty()) model.materials.push_back(MeshMaterial{.name = "material-0"});
     Collector{*scene, model}.visit(*scene->mRootNode, glm::mat4(1.0f));
     if (model.indices.empty()) failModel(path, "no triangle meshes");
@@ -130,7 +128,7 @@ Model loadModel(const std::filesystem::path& path, const ModelLoadOptions& optio
     if (options.flipV) {
         for (Vertex& vertex : model.vertices) vertex.uv.y = 1.0f - vertex.uv.y;
     }
-    computeTangents(model);  // after any flip: the handedness depends on the direction of v
+    computeTangents(model); // after any flip: the handedness depends on the direction of v
     model.computeBounds();
     return model;
 }

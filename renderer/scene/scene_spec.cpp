@@ -97,7 +97,8 @@ SceneSpec loadSceneSpec(const std::string& scene, const std::vector<std::string>
         const SpecReader model = root.table("model");
         const std::string source = model.requiredString("source");
         if (source.rfind("builtin:", 0) == 0) {
-            static const std::vector<std::string> known = {"builtin:halo", "builtin:bleed", "builtin:ear", "builtin:head"};
+            static const std::vector<std::string> known = {"builtin:halo", "builtin:bleed", "builtin:ear",
+                                                           "builtin:head"};
             bool found = false;
             for (const auto& k : known) found = found || k == source;
             if (!found)
@@ -143,8 +144,9 @@ SceneSpec loadSceneSpec(const std::string& scene, const std::vector<std::string>
         spec.textures.occlusion = paths.resolve(textures, "occlusion", occlusion);
         spec.textures.skinMask = paths.resolve(textures, "skin_mask", skinMask);
         spec.textures.normalStrength = textures.number("normal_strength", 1.0, 0.0, 4.0);
-        resolved["textures"] = {{"albedo", albedo},     {"normal", normal},        {"specular", specular},
-                                {"occlusion", occlusion}, {"skin_mask", skinMask}, {"normal_strength", spec.textures.normalStrength}};
+        resolved["textures"] = {{"albedo", albedo},      {"normal", normal},
+                                {"specular", specular},  {"occlusion", occlusion},
+                                {"skin_mask", skinMask}, {"normal_strength", spec.textures.normalStrength}};
     }
 
     // [[materials]]
@@ -158,9 +160,11 @@ SceneSpec loadSceneSpec(const std::string& scene, const std::vector<std::string>
             entry["albedo"] = jsonVec3(*m.albedo);
         }
         if (material.has("skin")) entry["skin"] = *(m.skin = material.boolean("skin", true));
-        if (material.has("glossiness")) entry["glossiness"] = *(m.glossiness = material.number("glossiness", 0.6, 0.0, 1.0));
+        if (material.has("glossiness"))
+            entry["glossiness"] = *(m.glossiness = material.number("glossiness", 0.6, 0.0, 1.0));
         if (material.has("specular_intensity"))
-            entry["specular_intensity"] = *(m.specularIntensity = material.number("specular_intensity", 1.0, 0.0, 100.0));
+            entry["specular_intensity"] =
+                *(m.specularIntensity = material.number("specular_intensity", 1.0, 0.0, 100.0));
         spec.materials.push_back(m);
         resolved["materials"].push_back(entry);
     }
@@ -174,8 +178,10 @@ SceneSpec loadSceneSpec(const std::string& scene, const std::vector<std::string>
         nlohmann::json& r = resolved["camera"];
         r = {{"view", c.view}, {"fov_deg", c.fovDeg}};
         if (c.view == "explicit") {
-            if (!camera.has("position")) camera.fail("position", "missing (camera.view = explicit needs position and target)");
-            if (!camera.has("target")) camera.fail("target", "missing (camera.view = explicit needs position and target)");
+            if (!camera.has("position"))
+                camera.fail("position", "missing (camera.view = explicit needs position and target)");
+            if (!camera.has("target"))
+                camera.fail("target", "missing (camera.view = explicit needs position and target)");
             c.position = toVec3(camera.vec3("position", {0, 0, 1}, -kHuge, kHuge));
             c.target = toVec3(camera.vec3("target", {0, 0, 0}, -kHuge, kHuge));
             c.up = toVec3(camera.vec3("up", {0, 1, 0}, -kHuge, kHuge));
@@ -206,7 +212,8 @@ SceneSpec loadSceneSpec(const std::string& scene, const std::vector<std::string>
         l.color = toVec3(light.vec3("color", {1, 1, 1}, 0.0, 1e6));
         l.intensity = light.number("intensity", 1.0, 0.0, 1e6);
         l.shadow = light.boolean("shadow", true);
-        nlohmann::json entry = {{"type", l.type}, {"color", jsonVec3(l.color)}, {"intensity", l.intensity}, {"shadow", l.shadow}};
+        nlohmann::json entry = {
+            {"type", l.type}, {"color", jsonVec3(l.color)}, {"intensity", l.intensity}, {"shadow", l.shadow}};
         if (l.type == "directional") {
             for (const char* key : {"position", "target", "inner_angle_deg", "outer_angle_deg"})
                 if (light.has(key)) light.fail(key, "only applies to type = spot");
@@ -215,7 +222,8 @@ SceneSpec loadSceneSpec(const std::string& scene, const std::vector<std::string>
             l.direction = glm::normalize(l.direction);
             entry["direction"] = jsonVec3(l.direction);
         } else {
-            if (light.has("direction")) light.fail("direction", "does not apply to type = spot (give position and target)");
+            if (light.has("direction"))
+                light.fail("direction", "does not apply to type = spot (give position and target)");
             if (!light.has("position")) light.fail("position", "missing (a spot light needs position and target)");
             l.position = toVec3(light.vec3("position", {0, 0, 1}, -kHuge, kHuge));
             l.target = toVec3(light.vec3("target", {0, 0, 0}, -kHuge, kHuge));
@@ -223,7 +231,8 @@ SceneSpec loadSceneSpec(const std::string& scene, const std::vector<std::string>
             l.innerAngleDeg = light.number("inner_angle_deg", 20.0, 0.0, 89.0);
             l.outerAngleDeg = light.number("outer_angle_deg", 30.0, 0.1, 89.0);
             if (l.outerAngleDeg <= l.innerAngleDeg)
-                light.fail("outer_angle_deg", "must be larger than inner_angle_deg (" + std::to_string(l.innerAngleDeg) + ")");
+                light.fail("outer_angle_deg",
+                           "must be larger than inner_angle_deg (" + std::to_string(l.innerAngleDeg) + ")");
             entry["position"] = jsonVec3(l.position);
             entry["target"] = jsonVec3(l.target);
             entry["inner_angle_deg"] = l.innerAngleDeg;
@@ -257,12 +266,9 @@ SceneSpec loadSceneSpec(const std::string& scene, const std::vector<std::string>
         if (e.background != "color" && environment.has("background_color"))
             environment.fail("background_color", "only applies to environment.background = color");
         e.backgroundColor = toVec3(environment.vec3("background_color", {0, 0, 0}, 0.0, 1e6));
-        resolved["environment"] = {{"file", environmentFile},
-                                   {"radiance", jsonVec3(e.radiance)},
-                                   {"intensity", e.intensity},
-                                   {"rotation_deg", e.rotationDeg},
-                                   {"background", e.background},
-                                   {"background_color", jsonVec3(e.backgroundColor)}};
+        resolved["environment"] = {{"file", environmentFile},    {"radiance", jsonVec3(e.radiance)},
+                                   {"intensity", e.intensity},   {"rotation_deg", e.rotationDeg},
+                                   {"background", e.background}, {"background_color", jsonVec3(e.backgroundColor)}};
     }
 
     // [render]

@@ -19,84 +19,84 @@
 namespace skinlab::renderer {
 
 struct CameraSpec {
-    std::string view = "mid";        // close | mid | far | explicit
-    double fovDeg = 30.0;            // vertical field of view, degrees
-    double yawDeg = 0.0;             // named views: orbit about +Y (positive: camera moves towards +X)
-    double pitchDeg = 0.0;           // named views: orbit upwards (positive: camera above the target)
-    glm::vec3 position{0, 0, 1};     // explicit view, world units
-    glm::vec3 target{0, 0, 0};       // explicit view, world units
-    glm::vec3 up{0, 1, 0};           // explicit view
+    std::string view = "mid";    // close | mid | far | explicit
+    double fovDeg = 30.0;        // vertical field of view, degrees
+    double yawDeg = 0.0;         // named views: orbit about +Y (positive: camera moves towards +X)
+    double pitchDeg = 0.0;       // named views: orbit upwards (positive: camera above the target)
+    glm::vec3 position{0, 0, 1}; // explicit view, world units
+    glm::vec3 target{0, 0, 0};   // explicit view, world units
+    glm::vec3 up{0, 1, 0};       // explicit view
 };
 
 struct LightSpec {
-    std::string type = "directional";  // directional | spot
-    glm::vec3 direction{0, 0, -1};     // directional: the direction light travels (towards the scene)
-    glm::vec3 position{0, 0, 1};       // spot: world units
-    glm::vec3 target{0, 0, 0};         // spot: the point it aims at; intensity is specified there
-    glm::vec3 color{1, 1, 1};          // linear Rec.709 multiplier
+    std::string type = "directional"; // directional | spot
+    glm::vec3 direction{0, 0, -1};    // directional: the direction light travels (towards the scene)
+    glm::vec3 position{0, 0, 1};      // spot: world units
+    glm::vec3 target{0, 0, 0};        // spot: the point it aims at; intensity is specified there
+    glm::vec3 color{1, 1, 1};         // linear Rec.709 multiplier
     // Outgoing radiance of a white Lambertian surface facing the light (directional: anywhere; spot: at the
     // target distance, inverse-square elsewhere) = irradiance / π. The thesis' "light colour" L_c.
     double intensity = 1.0;
     bool shadow = true;
-    double innerAngleDeg = 20.0;       // spot: full intensity inside this half-angle
-    double outerAngleDeg = 30.0;       // spot: zero outside this half-angle (smooth in between)
+    double innerAngleDeg = 20.0; // spot: full intensity inside this half-angle
+    double outerAngleDeg = 30.0; // spot: zero outside this half-angle (smooth in between)
 };
 
 struct MaterialSpec {
-    std::string name;                  // a material of the model, or "*" for all
-    std::optional<glm::vec3> albedo;   // linear; multiplies the albedo texture and vertex colours
+    std::string name;                // a material of the model, or "*" for all
+    std::optional<glm::vec3> albedo; // linear; multiplies the albedo texture and vertex colours
     std::optional<bool> skin;
-    std::optional<double> glossiness;  // s in [0, 1]: thesis Eq. 4.5, alpha = 8192 s^5
-    std::optional<double> specularIntensity;  // multiplies the specular lobe (and the specular map)
+    std::optional<double> glossiness;        // s in [0, 1]: thesis Eq. 4.5, alpha = 8192 s^5
+    std::optional<double> specularIntensity; // multiplies the specular lobe (and the specular map)
 };
 
 struct TexturesSpec {
-    std::filesystem::path albedo;      // colour, sRGB-encoded; empty: none
-    std::filesystem::path normal;      // tangent-space normal map (data)
-    std::filesystem::path specular;    // specular intensity map (data, red channel)
-    std::filesystem::path occlusion;   // ambient occlusion map (data, red channel), multiplies IBL
-    std::filesystem::path skinMask;    // skin mask (data, red channel), multiplies the material's skin flag
-    double normalStrength = 1.0;       // 0: geometric normal, 1: the map as authored
+    std::filesystem::path albedo;    // colour, sRGB-encoded; empty: none
+    std::filesystem::path normal;    // tangent-space normal map (data)
+    std::filesystem::path specular;  // specular intensity map (data, red channel)
+    std::filesystem::path occlusion; // ambient occlusion map (data, red channel), multiplies IBL
+    std::filesystem::path skinMask;  // skin mask (data, red channel), multiplies the material's skin flag
+    double normalStrength = 1.0;     // 0: geometric normal, 1: the map as authored
 };
 
 struct EnvironmentSpec {
-    std::filesystem::path file;        // equirectangular HDR; empty: constant radiance
-    glm::vec3 radiance{0, 0, 0};       // constant environment radiance when no file
-    double intensity = 1.0;            // multiplies the environment (lighting and background)
-    double rotationDeg = 0.0;          // about +Y
-    std::string background = "environment";  // environment | color
-    glm::vec3 backgroundColor{0, 0, 0};       // radiance when background = color
+    std::filesystem::path file;             // equirectangular HDR; empty: constant radiance
+    glm::vec3 radiance{0, 0, 0};            // constant environment radiance when no file
+    double intensity = 1.0;                 // multiplies the environment (lighting and background)
+    double rotationDeg = 0.0;               // about +Y
+    std::string background = "environment"; // environment | color
+    glm::vec3 backgroundColor{0, 0, 0};     // radiance when background = color
 };
 
 struct SceneSpec {
-    std::string source;                // spec path or builtin:NAME, as given
-    std::string modelSource;           // "builtin:NAME" or the model file path (resolved)
-    double depthGapMm = 200.0;         // builtin:halo only
-    double thicknessMm = 2.5;          // builtin:ear only
-    bool skinDetail = true;            // builtin:head only: its procedural skin maps (skin_detail.h)
-    bool flipV = false;                // model files whose UVs are upside down (v = 1 - v), e.g. the scan
+    std::string source;        // spec path or builtin:NAME, as given
+    std::string modelSource;   // "builtin:NAME" or the model file path (resolved)
+    double depthGapMm = 200.0; // builtin:halo only
+    double thicknessMm = 2.5;  // builtin:ear only
+    bool skinDetail = true;    // builtin:head only: its procedural skin maps (skin_detail.h)
+    bool flipV = false;        // model files whose UVs are upside down (v = 1 - v), e.g. the scan
     double mmPerUnit = 1.0;
     TexturesSpec textures;
     std::vector<MaterialSpec> materials;
     CameraSpec camera;
     std::vector<LightSpec> lights;
-    int shadowResolution = 2048;       // texels, square
-    int shadowPcfRadius = 1;           // PCF taps: (2r+1)^2
+    int shadowResolution = 2048; // texels, square
+    int shadowPcfRadius = 1;     // PCF taps: (2r+1)^2
     EnvironmentSpec environment;
     int width = 512;
     int height = 512;
-    double exposureEv = 0.0;           // beauty and AOVs are scaled by 2^exposure_ev
-    std::string toneMapper = "filmic"; // linear | exponential | reinhard | reinhard-rgb | filmic
-    double exponentialK = 1.0;         // exponential: 1 - exp(-k x)
-    double filmicWhite = 11.2;         // filmic (Hable 2010): linear value mapped to display white
-    double reinhardKey = 0.18;         // reinhard (Reinhard et al. 2002, Eq. 2): the key a
-    sss::SssParams sss;                      // [sss], typed; the method's keys only (sss::methodTable())
-    sss::TransmittanceParams transmittance;  // [transmittance], typed
+    double exposureEv = 0.0;                // beauty and AOVs are scaled by 2^exposure_ev
+    std::string toneMapper = "filmic";      // linear | exponential | reinhard | reinhard-rgb | filmic
+    double exponentialK = 1.0;              // exponential: 1 - exp(-k x)
+    double filmicWhite = 11.2;              // filmic (Hable 2010): linear value mapped to display white
+    double reinhardKey = 0.18;              // reinhard (Reinhard et al. 2002, Eq. 2): the key a
+    sss::SssParams sss;                     // [sss], typed; the method's keys only (sss::methodTable())
+    sss::TransmittanceParams transmittance; // [transmittance], typed
     // Resolved [pathtraced] table (renderer/pathtraced/pathtraced_params.h); read for every scene, recorded in
     // `resolved` only when sss.method = "pathtraced" (the other methods do not depend on it).
     nlohmann::json pathtraced = nlohmann::json::object();
 
-    nlohmann::json resolved;           // every parameter after defaults and overrides
+    nlohmann::json resolved; // every parameter after defaults and overrides
 };
 
 // Loads and validates a scene: `scene` is "builtin:NAME" or a TOML path; overrides are "key=value".
@@ -110,11 +110,11 @@ struct CameraPose {
     glm::vec3 target{0.0f};
     glm::vec3 up{0, 1, 0};
     float fovYRadians = 0.5f;
-    float nearPlane = 0.01f;   // world units
-    float farPlane = 100.0f;   // world units
+    float nearPlane = 0.01f; // world units
+    float farPlane = 100.0f; // world units
     glm::mat4 view{1.0f};
     glm::mat4 projection{1.0f};
-    float focalLengthPixels = 1.0f;  // (height / 2) / tan(fovY / 2)
+    float focalLengthPixels = 1.0f; // (height / 2) / tan(fovY / 2)
 };
 
 // Named views look at the bounding sphere of the `frame` bounds (the skin parts of the model; all of it when

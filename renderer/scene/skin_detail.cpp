@@ -83,7 +83,8 @@ float cellular(const glm::vec3& p, float cellMm, float presence, float minRadius
     const glm::vec3 q = p / cellMm;
     const glm::vec3 base = glm::floor(q);
     const glm::vec3 f = q - base;
-    const int start[3] = {static_cast<int>(base.x) - (f.x < 0.5f ? 1 : 0), static_cast<int>(base.y) - (f.y < 0.5f ? 1 : 0),
+    const int start[3] = {static_cast<int>(base.x) - (f.x < 0.5f ? 1 : 0),
+                          static_cast<int>(base.y) - (f.y < 0.5f ? 1 : 0),
                           static_cast<int>(base.z) - (f.z < 0.5f ? 1 : 0)};
     float best = 0.0f;
     for (int dz = 0; dz < 2; ++dz)
@@ -94,7 +95,8 @@ float cellular(const glm::vec3& p, float cellMm, float presence, float minRadius
                 if (unit(h, 0) >= presence) continue;
                 const glm::vec3 centre =
                     (glm::vec3(static_cast<float>(cx), static_cast<float>(cy), static_cast<float>(cz)) +
-                     glm::vec3(unit(h, 1), unit(h, 2), unit(h, 3))) * cellMm;
+                     glm::vec3(unit(h, 1), unit(h, 2), unit(h, 3))) *
+                    cellMm;
                 const float radius = minRadius + (maxRadius - minRadius) * unit(h, 4);
                 const float d2 = glm::dot(p - centre, p - centre) / (radius * radius);
                 if (d2 >= 1.0f) continue;
@@ -114,8 +116,8 @@ float segmentDistance(const glm::vec2& p, const glm::vec2& a, const glm::vec2& b
 float groove(float d, float w) { return std::exp(-(d / w) * (d / w)); }
 
 struct TexelDetail {
-    float height = 0.0f;      // mm, outwards
-    glm::vec3 albedo{1.0f};   // linear multiplier
+    float height = 0.0f;    // mm, outwards
+    glm::vec3 albedo{1.0f}; // linear multiplier
 };
 
 // How much a point belongs to the face (front of the head).
@@ -156,7 +158,8 @@ TexelDetail detailAt(const glm::vec3& p) {
         const float y = p.y + wave;
         float creases = 0.0f;
         for (int k = 0; k < 4; ++k)
-            creases += (1.0f - 0.15f * static_cast<float>(k)) * groove(y - (44.0f + 9.0f * static_cast<float>(k)), 0.6f);
+            creases +=
+                (1.0f - 0.15f * static_cast<float>(k)) * groove(y - (44.0f + 9.0f * static_cast<float>(k)), 0.6f);
         out.height -= 0.10f * creases * smoothStep(50.0f, 28.0f, ax) * front;
     }
     // Crow's feet: lines fanning out from the outer eye corners.
@@ -167,7 +170,8 @@ TexelDetail detailAt(const glm::vec3& p) {
         const float spacing = 14.0f * kPi / 180.0f;
         const float jitter = 0.25f * spacing * valueNoise(glm::vec3(r / 4.0f, p.x > 0 ? 1.0f : 5.0f, 0.5f), 302u);
         const float offset = theta + jitter - spacing * std::round((theta + jitter) / spacing);
-        const float lines = groove(r * std::abs(offset), 0.45f) * smoothStep(3.0f, 6.0f, r) * smoothStep(18.0f, 11.0f, r) *
+        const float lines = groove(r * std::abs(offset), 0.45f) * smoothStep(3.0f, 6.0f, r) *
+                            smoothStep(18.0f, 11.0f, r) *
                             smoothStep(65.0f * kPi / 180.0f, 45.0f * kPi / 180.0f, std::abs(theta));
         out.height -= 0.09f * lines * smoothStep(0.2f, 0.5f, front + 0.2f);
     }
@@ -196,7 +200,8 @@ TexelDetail detailAt(const glm::vec3& p) {
     albedo *= glm::vec3(1.0f + 0.04f * mottle, 1.0f - 0.04f * mottle, 1.0f - 0.05f * mottle);
     // Flush of the cheeks and the nose.
     const float flush = std::min(1.0f, gaussian(ax, 44.0f, 14.0f) * gaussian(p.y, -20.0f, 13.0f) +
-                                           0.8f * gaussian(p.x, 0.0f, 9.0f) * gaussian(p.y, -28.0f, 9.0f)) * front;
+                                           0.8f * gaussian(p.x, 0.0f, 9.0f) * gaussian(p.y, -28.0f, 9.0f)) *
+                        front;
     albedo *= glm::mix(glm::vec3(1.0f), glm::vec3(1.04f, 0.88f, 0.90f), 0.8f * flush);
     // Sparse spots (freckles, small naevi).
     const float spot = cellular(p, 5.0f, 0.2f, 0.4f, 0.9f, 403u);
@@ -209,8 +214,8 @@ TexelDetail detailAt(const glm::vec3& p) {
     if (p.z > 40.0f) {
         const float x = ax;
         const float arcY = 19.0f + 4.0f * std::sin(kPi * std::clamp((x - 12.0f) / 40.0f, 0.0f, 1.0f));
-        const float brow = smoothStep(5.5f, 3.0f, std::abs(p.y - arcY)) * smoothStep(9.0f, 14.0f, x) *
-                           smoothStep(55.0f, 48.0f, x);
+        const float brow =
+            smoothStep(5.5f, 3.0f, std::abs(p.y - arcY)) * smoothStep(9.0f, 14.0f, x) * smoothStep(55.0f, 48.0f, x);
         if (brow > 0.0f) {
             const glm::vec2 across = glm::normalize(glm::vec2(1.0f, -0.35f));
             const float phase = glm::dot(glm::vec2(x, p.y), across) / 0.7f + 1.2f * valueNoise(p / 2.0f, 404u);
@@ -249,11 +254,12 @@ SkinDetailMaps makeHeadSkinDetail(int width, int height) {
     forRows(height, [&](int y) {
         const float v = (static_cast<float>(y) + 0.5f) / static_cast<float>(height);
         for (int x = 0; x < width; ++x) {
-            const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x);
+            const std::size_t i =
+                static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x);
             const float u = (static_cast<float>(x) + 0.5f) / static_cast<float>(width);
             points[i] = headSurfaceAt(u, v);
             if (y == 0) {
-                heights[i] = 0.0f;  // row 0: flat, albedo 1 (the eyes sample it)
+                heights[i] = 0.0f; // row 0: flat, albedo 1 (the eyes sample it)
                 continue;
             }
             const TexelDetail detail = detailAt(points[i]);
@@ -266,7 +272,8 @@ SkinDetailMaps makeHeadSkinDetail(int width, int height) {
     });
     forRows(height, [&](int y) {
         for (int x = 0; x < width; ++x) {
-            const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x);
+            const std::size_t i =
+                static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x);
             float* n = &maps.normal.pixels[i * 4];
             glm::vec3 normal(0.0f, 0.0f, 1.0f);
             if (y > 0) {

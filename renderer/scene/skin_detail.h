@@ -26,8 +26,8 @@ inline constexpr int kHeadDetailWidth = 2048;
 inline constexpr int kHeadDetailHeight = 1024;
 
 struct SkinDetailMaps {
-    Image albedo;  // linear RGB multiplier, alpha 1
-    Image normal;  // tangent-space normal, 0.5 + 0.5 n, alpha 1
+    Image albedo; // linear RGB multiplier, alpha 1
+    Image normal; // tangent-space normal, 0.5 + 0.5 n, alpha 1
 };
 
 // The maps at width × height texels (width, height ≥ 4). Deterministic: the same size gives bit-identical maps.

@@ -49,7 +49,7 @@ void applyRgb(const OCIO::ConstCPUProcessorRcPtr& processor, float* rgb, std::si
 
 [[noreturn]] void failTexture(const std::filesystem::path& path, const std::string& why) {
     std::string message = why;
-    std::replace(message.begin(), message.end(), '\n', ' ');  // keep the error on one line
+    std::replace(message.begin(), message.end(), '\n', ' '); // keep the error on one line
     throw InputError(path.string() + ": cannot read texture (" + message + ")");
 }
 

@@ -8,8 +8,8 @@ namespace skinlab::renderer {
 
 // How a texture file's values are to be read.
 enum class ColorEncoding {
-    sRGB,  // colour (albedo): sRGB-encoded in the file, decoded to linear Rec.709 (the sRGB EOTF, IEC 61966-2-1)
-    Data,  // numbers (normal, specular, AO maps): values untouched, only scaled to [0, 1] for integer files
+    sRGB, // colour (albedo): sRGB-encoded in the file, decoded to linear Rec.709 (the sRGB EOTF, IEC 61966-2-1)
+    Data, // numbers (normal, specular, AO maps): values untouched, only scaled to [0, 1] for integer files
 };
 
 // A float RGBA image, rows stored top row first (the file's first row), pixels row-major, 4 floats each.
@@ -18,11 +18,11 @@ enum class ColorEncoding {
 struct Image {
     int width = 0;
     int height = 0;
-    std::vector<float> pixels;  // width * height * 4 floats: R, G, B, A
+    std::vector<float> pixels; // width * height * 4 floats: R, G, B, A
 
     glm::vec4 texel(int x, int y) const {
-        const float* p = &pixels[(static_cast<std::size_t>(y) * static_cast<std::size_t>(width) +
-                                  static_cast<std::size_t>(x)) * 4];
+        const float* p =
+            &pixels[(static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)) * 4];
         return {p[0], p[1], p[2], p[3]};
     }
 };

@@ -17,13 +17,13 @@ inline float fresnelSchlick(float f0, float lightDotHalf) {
 }
 
 // Unit vectors: surface normal, direction to the light, direction to the viewer.
-inline float specularEq45(const glm::vec3& normal, const glm::vec3& toLight, const glm::vec3& toViewer, float glossiness,
-                          float f0 = kSkinF0) {
+inline float specularEq45(const glm::vec3& normal, const glm::vec3& toLight, const glm::vec3& toViewer,
+                          float glossiness, float f0 = kSkinF0) {
     const float normalDotLight = glm::dot(normal, toLight);
     if (normalDotLight <= 0.0f) return 0.0f;
     const glm::vec3 halfVector = glm::normalize(toLight + toViewer);
     const float alpha = 8192.0f * std::pow(glossiness, 5.0f);
-    const float normalDotHalf = std::max(glm::dot(normal, halfVector), 1e-8f);  // as the shader (pow(0, 0))
+    const float normalDotHalf = std::max(glm::dot(normal, halfVector), 1e-8f); // as the shader (pow(0, 0))
     return (alpha + 2.0f) / 8.0f * std::pow(normalDotHalf, alpha) * fresnelSchlick(f0, glm::dot(toLight, halfVector)) *
            normalDotLight;
 }

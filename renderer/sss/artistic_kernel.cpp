@@ -42,8 +42,8 @@ std::vector<KernelTap> artisticTaps(int samples, const std::array<double, 3>& st
     normaliseChannels(taps);
     for (int i = 0; i < samples; ++i)
         for (int c = 0; c < 3; ++c)
-            taps[i].weight[c] = i == half ? (1.0 - strength[c]) + strength[c] * taps[i].weight[c]
-                                          : strength[c] * taps[i].weight[c];
+            taps[i].weight[c] =
+                i == half ? (1.0 - strength[c]) + strength[c] * taps[i].weight[c] : strength[c] * taps[i].weight[c];
     return taps;
 }
 

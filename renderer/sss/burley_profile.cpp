@@ -63,7 +63,7 @@ public:
     }
     double operator()(double z) const {
         if (z <= 0.0) return 0.0;
-        if (z >= kMax) return std::numbers::pi / 2.0;  // K0(100) ≈ 5e-45: the rest of the integral is nil
+        if (z >= kMax) return std::numbers::pi / 2.0; // K0(100) ≈ 5e-45: the rest of the integral is nil
         if (z < node(1)) return series(z);
         const int k = std::min(kNodes - 1, static_cast<int>(kNodes * std::sqrt(z / kMax)));
         const double a = node(k), b = node(k + 1), h = b - a, t = (z - a) / h;

@@ -24,9 +24,9 @@ public:
     double cumulativeByStrip(int channel, double xMm) const;
 
     std::string description() const override { return description_; }
-    double density(int channel, double xMm) const override;  // K0 closed form; +inf at x = 0
-    double cumulative(int channel, double xMm) const override;  // closed form in ∫K0 (tabulated once)
-    double secondMoment(int channel) const override;  // 7 d² (half of the radial ∫r² = 14 d²)
+    double density(int channel, double xMm) const override;    // K0 closed form; +inf at x = 0
+    double cumulative(int channel, double xMm) const override; // closed form in ∫K0 (tabulated once)
+    double secondMoment(int channel) const override;           // 7 d² (half of the radial ∫r² = 14 d²)
     double searchRadiusMm() const override;
 
 private:

@@ -45,7 +45,8 @@ std::vector<Rgb> blurPass(const SurfaceBuffers& surface, const std::vector<Rgb>&
             const glm::vec3 labCentre = weighsTaps && settings.labWeight > 0.0f
                                             ? linearRec709ToLab(extensionColour(surface, input, index, settings))
                                             : glm::vec3(0.0f);
-            const float auxCentre = weighsTaps && settings.cbf ? extensionAuxiliary(surface, input, index, settings) : 0.0f;
+            const float auxCentre =
+                weighsTaps && settings.cbf ? extensionAuxiliary(surface, input, index, settings) : 0.0f;
             auto texelWeight = [&](size_t texel) {
                 float weight = 1.0f;
                 if (settings.labWeight > 0.0f)
@@ -74,10 +75,10 @@ std::vector<Rgb> blurPass(const SurfaceBuffers& surface, const std::vector<Rgb>&
                     const float texelMask = surface.mask[texels[t]];
                     float s = 1.0f - texelMask;
                     if (settings.followSurface && texelMask > 0.0f)
-                        s = std::max(s, std::clamp(settings.followSurfaceK *
-                                                       std::abs(centreDepth - surface.depth[texels[t]]) *
-                                                       surface.mmPerUnit,
-                                                   0.0f, 1.0f));
+                        s = std::max(
+                            s, std::clamp(settings.followSurfaceK * std::abs(centreDepth - surface.depth[texels[t]]) *
+                                              surface.mmPerUnit,
+                                          0.0f, 1.0f));
                     for (int c = 0; c < 3; ++c) values[t][c] = mix(input[texels[t]][c], centre[c], s);
                 }
                 if (!weighsTaps) {

@@ -41,26 +41,26 @@ using Rgb = std::array<float, 3>;
 struct SurfaceBuffers {
     int width = 0;
     int height = 0;
-    std::vector<float> depth;  // linear view depth, world units, +inf on background; row-major, row 0 at the bottom
-    std::vector<float> mask;   // skin mask 0…1
-    float focalLengthPixels = 0.0f;  // f_px = (H/2) / tan(fovY/2)
+    std::vector<float> depth; // linear view depth, world units, +inf on background; row-major, row 0 at the bottom
+    std::vector<float> mask;  // skin mask 0…1
+    float focalLengthPixels = 0.0f; // f_px = (H/2) / tan(fovY/2)
     float mmPerUnit = 1.0f;
     // Extension inputs, read only while the matching switch of BlurSettings is on (may stay empty otherwise):
-    std::vector<Rgb> albedo;       // linear albedo (sss.lab_weight; the albedo AOV)
-    std::vector<float> aux;        // Mikkelsen's auxiliary image F (sss.cbf; the aux.Y AOV)
-    std::vector<float> curvature;  // curvature κ, 1/world unit, ≥ 0 (sss.curvature; the curvature.Y AOV)
+    std::vector<Rgb> albedo;      // linear albedo (sss.lab_weight; the albedo AOV)
+    std::vector<float> aux;       // Mikkelsen's auxiliary image F (sss.cbf; the aux.Y AOV)
+    std::vector<float> curvature; // curvature κ, 1/world unit, ≥ 0 (sss.curvature; the curvature.Y AOV)
 };
 
 struct BlurSettings {
     bool followSurface = true;
-    float followSurfaceK = 0.5f;  // 1/mm
-    bool cbf = false;             // E1
-    float cbfLambda = 10.0f;      // λ, dimensionless
-    float labWeight = 0.0f;       // E2: β in 1/ΔE*ab, 0 = off
-    ExtensionInput input = ExtensionInput::Albedo;  // E1/E2: albedo AOV or the colour this pass blurs
-    CurvatureStrategy curvature = CurvatureStrategy::Off;  // E3
-    float curvatureFloor = 0.5f;  // [0, 1]
-    float curvatureReferenceMm = kCurvatureReferenceRadiusMm;  // sss.curvature_reference_mm
+    float followSurfaceK = 0.5f;                              // 1/mm
+    bool cbf = false;                                         // E1
+    float cbfLambda = 10.0f;                                  // λ, dimensionless
+    float labWeight = 0.0f;                                   // E2: β in 1/ΔE*ab, 0 = off
+    ExtensionInput input = ExtensionInput::Albedo;            // E1/E2: albedo AOV or the colour this pass blurs
+    CurvatureStrategy curvature = CurvatureStrategy::Off;     // E3
+    float curvatureFloor = 0.5f;                              // [0, 1]
+    float curvatureReferenceMm = kCurvatureReferenceRadiusMm; // sss.curvature_reference_mm
 
     bool weighsTaps() const { return cbf || labWeight > 0.0f; }
 };

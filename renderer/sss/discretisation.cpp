@@ -22,7 +22,7 @@ std::vector<KernelTap> quadraticTaps(const Marginal& marginal, int samples) {
     std::vector<KernelTap> taps(static_cast<size_t>(samples));
     const int half = samples / 2;
     for (int i = 0; i < samples; ++i) {
-        const double t = double(i - half) / double(half);  // [−1, 1]
+        const double t = double(i - half) / double(half); // [−1, 1]
         taps[i].offsetMm = range * (t < 0 ? -1.0 : 1.0) * t * t;
     }
     for (int i = 0; i < samples; ++i) {
@@ -32,9 +32,9 @@ std::vector<KernelTap> quadraticTaps(const Marginal& marginal, int samples) {
         const double area = 0.5 * (left + right);
         for (int c = 0; c < kChannels; ++c) {
             const double a = marginal.density(c, o);
-            taps[i].weight[c] = std::isfinite(a) ? a * area
-                                                 : marginal.cumulative(c, o + 0.5 * right) -
-                                                       marginal.cumulative(c, o - 0.5 * left);
+            taps[i].weight[c] = std::isfinite(a)
+                                    ? a * area
+                                    : marginal.cumulative(c, o + 0.5 * right) - marginal.cumulative(c, o - 0.5 * left);
         }
     }
     normaliseChannels(taps);
@@ -56,7 +56,7 @@ std::vector<KernelTap> importanceTaps(const Marginal& marginal, int samples) {
         bounds[samples - k] = -bounds[k];
     }
     std::vector<KernelTap> taps(static_cast<size_t>(samples));
-    taps[half].offsetMm = 0.0;  // the median of the centre cell of a symmetric density
+    taps[half].offsetMm = 0.0; // the median of the centre cell of a symmetric density
     for (int k = half + 1; k < samples; ++k) {
         taps[k].offsetMm = marginal.quantile(widest, (k + 0.5) / samples);
         taps[samples - 1 - k].offsetMm = -taps[k].offsetMm;
@@ -69,8 +69,7 @@ std::vector<KernelTap> importanceTaps(const Marginal& marginal, int samples) {
 }
 
 std::vector<KernelTap> discretise(const Marginal& marginal, int samples, TapPlacement placement) {
-    return placement == TapPlacement::Quadratic ? quadraticTaps(marginal, samples)
-                                                : importanceTaps(marginal, samples);
+    return placement == TapPlacement::Quadratic ? quadraticTaps(marginal, samples) : importanceTaps(marginal, samples);
 }
 
 } // namespace skinlab::renderer::sss

@@ -40,10 +40,10 @@ float labWeight(const glm::vec3& labCentre, const glm::vec3& labTap, float beta)
 
 float auxiliaryValue(const glm::vec3& viewPosition, const glm::vec3& viewNormal) {
     const float distance = glm::length(viewPosition);
-    if (!(distance > 0.0f)) return 1.0f;  // the eye itself: both angles 0
+    if (!(distance > 0.0f)) return 1.0f; // the eye itself: both angles 0
     const glm::vec3 toViewer = -viewPosition / distance;
-    const float cosViewAxis = std::max(toViewer.z, 0.0f);  // cos φ_i: view axis is −Z, ray direction −toViewer
-    const float cosNormal = std::max(glm::dot(viewNormal, toViewer), kAuxiliaryMinCosine);  // cos φ_j
+    const float cosViewAxis = std::max(toViewer.z, 0.0f); // cos φ_i: view axis is −Z, ray direction −toViewer
+    const float cosNormal = std::max(glm::dot(viewNormal, toViewer), kAuxiliaryMinCosine); // cos φ_j
     return cosViewAxis / cosNormal;
 }
 
@@ -90,7 +90,8 @@ CurvatureStrategy curvatureStrategyFromName(std::string_view name, std::string_v
     if (name == "increase") return CurvatureStrategy::Increase;
     if (name == "reduce") return CurvatureStrategy::Reduce;
     if (name == "reduce-floor") return CurvatureStrategy::ReduceFloor;
-    throwInput(source, "sss.curvature", "'" + std::string(name) + "' is not one of: off, increase, reduce, reduce-floor");
+    throwInput(source, "sss.curvature",
+               "'" + std::string(name) + "' is not one of: off, increase, reduce, reduce-floor");
 }
 
 float normalisedCurvature(float curvaturePerUnit, float mmPerUnit, float referenceRadiusMm) {

@@ -67,23 +67,24 @@ glm::vec3 resolveWeightedSum(const glm::vec3& weightedSum, float weightSum, cons
 // --- E3: curvature -------------------------------------------------------------------------------------------
 
 enum class CurvatureStrategy {
-    Off,          // width × 1
-    Increase,     // width × (1 + c): the thesis's (a): strongest at silhouettes, worse halos
-    Reduce,       // width × c: the thesis's (b): flat areas lose SSS
-    ReduceFloor,  // width × (floor + (1 − floor) c): the thesis's (c), the good one
+    Off,         // width × 1
+    Increase,    // width × (1 + c): the thesis's (a): strongest at silhouettes, worse halos
+    Reduce,      // width × c: the thesis's (b): flat areas lose SSS
+    ReduceFloor, // width × (floor + (1 − floor) c): the thesis's (c), the good one
 };
 std::string_view curvatureStrategyName(CurvatureStrategy strategy);
-const std::vector<std::string>& curvatureStrategyNames();  // "off", "increase", "reduce", "reduce-floor"
+const std::vector<std::string>& curvatureStrategyNames(); // "off", "increase", "reduce", "reduce-floor"
 // Throws InputError("<source>: sss.curvature: ...") for an unknown name.
 CurvatureStrategy curvatureStrategyFromName(std::string_view name, std::string_view source);
 
 // A surface of radius kCurvatureReferenceRadiusMm or tighter counts as fully curved (c = 1). 20 mm: the radius
 // of the nose tip, ears and lips is below it, the cheeks and forehead (60–100 mm) give c = 0.2–0.33.
-inline constexpr float kCurvatureReferenceRadiusMm = 20.0f;  // the default of sss.curvature_reference_mm
+inline constexpr float kCurvatureReferenceRadiusMm = 20.0f; // the default of sss.curvature_reference_mm
 
 // Normalised curvature c = saturate(κ · mm-per-unit⁻¹ · reference radius): κ is the curvature AOV (1/world unit,
 // ≈ 1/radius, ≥ 0).
-float normalisedCurvature(float curvaturePerUnit, float mmPerUnit, float referenceRadiusMm = kCurvatureReferenceRadiusMm);
+float normalisedCurvature(float curvaturePerUnit, float mmPerUnit,
+                          float referenceRadiusMm = kCurvatureReferenceRadiusMm);
 // Multiplier of the kernel's width (its footprint in pixels) at a pixel of normalised curvature c ∈ [0, 1].
 // floor ∈ [0, 1] is sss.curvature_floor (used by reduce-floor only).
 float curvatureWidthScale(CurvatureStrategy strategy, float normalisedCurvature, float floor);

@@ -10,8 +10,8 @@
 namespace skinlab::renderer::sss {
 
 struct GaussianLobe {
-    double varianceMm2;             // v_i, mm²
-    std::array<double, 3> weight;   // w_i per channel (R, G, B)
+    double varianceMm2;           // v_i, mm²
+    std::array<double, 3> weight; // w_i per channel (R, G, B)
 };
 
 // d'Eon's six lobes for skin, ascending variance; each channel's weights sum to 1 (blue 0.649, the published value).

@@ -34,8 +34,8 @@ std::unique_ptr<Marginal> makeMarginal(const SssParams& params) {
                                                "Burley normalized diffusion, material " + params.material);
     if (params.profile == "deon") {
         if (params.material != "skin")
-            throwInput("", "sss.material", "'" + params.material +
-                                               "' has no d'Eon profile (only 'skin'); use sss.profile = \"burley\"");
+            throwInput("", "sss.material",
+                       "'" + params.material + "' has no d'Eon profile (only 'skin'); use sss.profile = \"burley\"");
         return std::make_unique<GaussianSumProfile>(deonSkinLobes(), "d'Eon six-Gaussian skin profile");
     }
     throwInput("", "sss.profile", "'" + params.profile + "' is not one of: deon, burley, file:PATH");
@@ -48,9 +48,7 @@ Kernel makeKernel(const SssParams& params) {
     kernel.method = params.method;
     const double scale = widthScale(params);
     switch (params.method) {
-    case SssMethod::None:
-        kernel.source = "none";
-        break;
+    case SssMethod::None: kernel.source = "none"; break;
     case SssMethod::Pathtraced:
         // Rendered by Blender Cycles (renderer/pathtraced): no screen-space taps.
         kernel.source = "path-traced (Blender Cycles, random walk)";
@@ -76,8 +74,8 @@ Kernel makeKernel(const SssParams& params) {
         stage.taps = discretise(*marginal, params.samples, params.placement);
         scaleOffsets(stage.taps, scale);
         stage.accumulate = {1.0, 1.0, 1.0};
-        kernel.source = marginal->description() + " (marginal, " + std::string(placementName(params.placement)) +
-                        " placement)";
+        kernel.source =
+            marginal->description() + " (marginal, " + std::string(placementName(params.placement)) + " placement)";
         kernel.stages.push_back(std::move(stage));
         break;
     }

@@ -18,19 +18,19 @@
 namespace skinlab::renderer::sss {
 
 struct KernelTap {
-    double offsetMm;               // signed offset on the surface, mm
-    std::array<double, 3> weight;  // R, G, B
+    double offsetMm;              // signed offset on the surface, mm
+    std::array<double, 3> weight; // R, G, B
 };
 
 struct KernelStage {
-    std::vector<KernelTap> taps;        // ascending offsets, symmetric, odd count, centre tap at offset 0
-    std::array<double, 3> accumulate;   // weight of this stage's result in the output, per channel
-    double varianceMm2 = 0.0;           // gaussian-sum: variance of this stage's own Gaussian; 0 otherwise
+    std::vector<KernelTap> taps;      // ascending offsets, symmetric, odd count, centre tap at offset 0
+    std::array<double, 3> accumulate; // weight of this stage's result in the output, per channel
+    double varianceMm2 = 0.0;         // gaussian-sum: variance of this stage's own Gaussian; 0 otherwise
 };
 
 struct Kernel {
     SssMethod method = SssMethod::None;
-    std::string source;  // what the taps were computed from, e.g. "d'Eon six-Gaussian skin profile (marginal)"
+    std::string source; // what the taps were computed from, e.g. "d'Eon six-Gaussian skin profile (marginal)"
     std::vector<KernelStage> stages;
 
     // Support radius on the surface, mm (EXR attribute skinlab:sss_radius_mm): the largest tap offset; for cascaded

@@ -6,7 +6,7 @@
 
 namespace skinlab::renderer::sss {
 
-constexpr int kChannels = 3;  // R, G, B (linear Rec.709)
+constexpr int kChannels = 3; // R, G, B (linear Rec.709)
 
 class Marginal {
 public:

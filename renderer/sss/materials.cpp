@@ -20,7 +20,7 @@ const std::vector<MeasuredMedium>& measuredMedia() {
     };
     return media;
 }
-constexpr double kRelativeIndex = 1.3;  // η used by Jensen et al. 2001 for all their media
+constexpr double kRelativeIndex = 1.3; // η used by Jensen et al. 2001 for all their media
 } // namespace
 
 const std::vector<std::string>& materialNames() {

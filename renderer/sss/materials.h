@@ -12,8 +12,8 @@ namespace skinlab::renderer::sss {
 
 struct MeasuredMedium {
     std::string name;
-    std::array<double, 3> reducedScattering;  // σs', 1/mm (R, G, B)
-    std::array<double, 3> absorption;         // σa, 1/mm
+    std::array<double, 3> reducedScattering; // σs', 1/mm (R, G, B)
+    std::array<double, 3> absorption;        // σa, 1/mm
 };
 
 // Names accepted by sss.material, "skin" first.

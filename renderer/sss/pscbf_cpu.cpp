@@ -9,7 +9,7 @@
 namespace skinlab::renderer::sss {
 
 namespace {
-constexpr float kMinAxisScale = 0.05f;  // kPscbfMinAxisScale of pscbf_blur.frag
+constexpr float kMinAxisScale = 0.05f; // kPscbfMinAxisScale of pscbf_blur.frag
 float mix(float x, float y, float a) { return x * (1.0f - a) + y * a; }
 glm::vec3 toVec3(const Rgb& rgb) { return glm::vec3(rgb[0], rgb[1], rgb[2]); }
 } // namespace
@@ -125,7 +125,7 @@ std::vector<Rgb> pscbfPass(const PscbfCpuInputs& inputs, const std::vector<Rgb>&
                 if (horizontal) {
                     output[index][c] = mix(centre[c], blurred[c], centreMask);
                 } else {
-                    const float spike = static_cast<float>(1.0 - stage.accumulate[c]);  // as PscbfMethod sets it
+                    const float spike = static_cast<float>(1.0 - stage.accumulate[c]); // as PscbfMethod sets it
                     const float original = unblurred[index][c];
                     output[index][c] = mix(original, spike * original + (1.0f - spike) * blurred[c], centreMask);
                 }

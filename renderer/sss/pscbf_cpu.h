@@ -22,11 +22,11 @@
 namespace skinlab::renderer::sss {
 
 struct PscbfCpuInputs {
-    const SurfaceBuffers* surface = nullptr;  // depth, mask, f_px, mm per unit, extension AOVs; rows bottom first
-    std::vector<Rgb> viewNormal;              // unit geometric normal in view space per pixel; empty: facing (0,0,1)
-    bool depthWeight = true;                  // sss.follow_surface
-    Rgb depthSigmaMm{1.0f, 1.0f, 1.0f};       // σ_c, mm (PscbfMethod::depthSigmaMm)
-    BlurSettings extensions;                  // cbf, lab_weight, curvature (its follow-surface fields are unused)
+    const SurfaceBuffers* surface = nullptr; // depth, mask, f_px, mm per unit, extension AOVs; rows bottom first
+    std::vector<Rgb> viewNormal;             // unit geometric normal in view space per pixel; empty: facing (0,0,1)
+    bool depthWeight = true;                 // sss.follow_surface
+    Rgb depthSigmaMm{1.0f, 1.0f, 1.0f};      // σ_c, mm (PscbfMethod::depthSigmaMm)
+    BlurSettings extensions;                 // cbf, lab_weight, curvature (its follow-surface fields are unused)
 };
 
 // One pass of the broad stage along `axis`. `unblurred` is used by the vertical pass only (the spike).

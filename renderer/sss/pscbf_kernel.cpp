@@ -10,9 +10,7 @@ namespace skinlab::renderer::sss {
 
 namespace {
 // Standard normal cumulative of x/σ.
-double normalCumulative(double xMm, double varianceMm2) {
-    return 0.5 * std::erfc(-xMm / std::sqrt(2.0 * varianceMm2));
-}
+double normalCumulative(double xMm, double varianceMm2) { return 0.5 * std::erfc(-xMm / std::sqrt(2.0 * varianceMm2)); }
 
 // Inverse of pscbfTruncatedCumulative for one channel by bisection (monotone on [−r_max, r_max]); 200 halvings
 // reach double precision long before the loop ends, so the result does not depend on a tolerance.
@@ -59,7 +57,7 @@ PscbfKernel makePscbfKernel(const PscbfProfile& profile, int samples) {
         SKINLAB_CHECK_GE(profile.spike[c], 0.0);
         SKINLAB_CHECK_LT(profile.spike[c], 1.0);
     }
-    constexpr int red = 0;  // Mikkelsen places the taps on the red (widest) channel's distribution
+    constexpr int red = 0; // Mikkelsen places the taps on the red (widest) channel's distribution
     const int half = samples / 2;
     std::vector<double> bounds(static_cast<size_t>(samples) + 1);
     bounds.front() = -profile.maxRadiusMm;

@@ -24,15 +24,15 @@
 namespace skinlab::renderer::sss {
 
 struct PscbfProfile {
-    std::array<double, 3> spike;        // share of the unblurred irradiance per channel (R, G, B), in [0, 1)
-    std::array<double, 3> varianceMm2;  // v_c of the broad Gaussian, mm²
-    double maxRadiusMm;                 // r_max: radius of the filter disc on the surface, mm
+    std::array<double, 3> spike;       // share of the unblurred irradiance per channel (R, G, B), in [0, 1)
+    std::array<double, 3> varianceMm2; // v_c of the broad Gaussian, mm²
+    double maxRadiusMm;                // r_max: radius of the filter disc on the surface, mm
 };
 
 // Mikkelsen 2010, Table 1, for skin: spike (0.15, 0.18, 0.20), r_max 4.5 mm, and 2.3 / 1.4 / 1.1 read as the
 // variance v in mm² (PscbfSigma::Variance, the default) or as the standard deviation in mm (v = 5.29 / 1.96 / 1.21).
 const PscbfProfile& mikkelsenSkinProfile(PscbfSigma reading = PscbfSigma::Variance);
-inline constexpr int kPscbfSamples = 13;  // taps per axis in the paper
+inline constexpr int kPscbfSamples = 13; // taps per axis in the paper
 
 // The broad part's radial density G(v_c, r) in 1/mm² (unit integral; the spike excluded).
 double pscbfBroadRadial(const PscbfProfile& profile, int channel, double rMm);
@@ -41,7 +41,7 @@ double pscbfTruncatedCumulative(const PscbfProfile& profile, int channel, double
 
 struct PscbfKernel {
     PscbfProfile profile;
-    std::vector<KernelTap> taps;  // one axis, ascending offsets in mm, symmetric, each channel sums to 1
+    std::vector<KernelTap> taps; // one axis, ascending offsets in mm, symmetric, each channel sums to 1
 
     // The broad part as one stage of kernel.h (accumulate = 1 − spike), so that cpu_blur's passes can run it.
     KernelStage broadStage() const;

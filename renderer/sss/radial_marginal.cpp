@@ -22,7 +22,9 @@ double stripEnergy(const std::function<double(double)>& radialCdf, const std::fu
                    double halfWidthMm, double scaleMm) {
     const double X = std::abs(halfWidthMm);
     if (X == 0.0) return 0.0;
-    auto outside = [&](double r) { return radialDensity(r) * (2.0 / std::numbers::pi) * std::asin(std::min(1.0, X / r)); };
+    auto outside = [&](double r) {
+        return radialDensity(r) * (2.0 / std::numbers::pi) * std::asin(std::min(1.0, X / r));
+    };
     return radialCdf(X) + integrateToInfinity(outside, X, scaleMm, 1e-12);
 }
 

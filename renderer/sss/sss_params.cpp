@@ -11,23 +11,39 @@ namespace skinlab::renderer::sss {
 
 namespace {
 // The screen-space blur methods' shared keys: follow-surface and the thesis' extensions (docs/extensions.md).
-#define SKINLAB_BLUR_KEYS "follow_surface", "cbf", "cbf_lambda", "lab_weight", "extension_input", "curvature", \
-                          "curvature_floor"
+#define SKINLAB_BLUR_KEYS                                                                                              \
+    "follow_surface", "cbf", "cbf_lambda", "lab_weight", "extension_input", "curvature", "curvature_floor"
 
 const std::vector<MethodInfo> kMethods{
     {SssMethod::None, "none", false, false, "no SSS: the diffuse buffer is copied through", {}},
-    {SssMethod::GaussianSum, "gaussian-sum", true, true,
+    {SssMethod::GaussianSum,
+     "gaussian-sum",
+     true,
+     true,
      "Jimenez & Gutierrez 2010: d'Eon's six Gaussians as incremental separable blurs (12 passes)",
      {"samples", "sampling", "follow_surface_k", SKINLAB_BLUR_KEYS}},
-    {SssMethod::Separable, "separable", true, true,
+    {SssMethod::Separable,
+     "separable",
+     true,
+     true,
      "Jimenez et al. 2015: two passes with the marginal of a physical profile (d'Eon, Burley or a file)",
      {"samples", "sampling", "follow_surface_k", "profile", "material", SKINLAB_BLUR_KEYS}},
-    {SssMethod::Artistic, "artistic", true, true, "Jimenez's demo kernel (per-channel strength and falloff), two passes",
+    {SssMethod::Artistic,
+     "artistic",
+     true,
+     true,
+     "Jimenez's demo kernel (per-channel strength and falloff), two passes",
      {"samples", "follow_surface_k", "artistic_strength", "artistic_falloff", SKINLAB_BLUR_KEYS}},
-    {SssMethod::Pscbf, "pscbf", true, false,
+    {SssMethod::Pscbf,
+     "pscbf",
+     true,
+     false,
      "Mikkelsen 2010: pseudo-separable cross-bilateral filter, spike + one Gaussian per channel",
      {"samples", "pscbf_sigma", SKINLAB_BLUR_KEYS}},
-    {SssMethod::Reference, "reference", false, false,
+    {SssMethod::Reference,
+     "reference",
+     false,
+     false,
      "object-space SSS on the tessellated surface (the ground truth of the metrics)",
      {"profile", "material", "reference_edge_mm"}},
     {SssMethod::Pathtraced, "pathtraced", false, false, "Blender Cycles' random-walk SSS ([pathtraced] table)", {}},
@@ -79,10 +95,11 @@ SssParams readSssTable(const SpecReader& sss) {
     if (p.method == SssMethod::Pscbf) p.samples = SssParams::kDefaultPscbfSamples;
     p.samples = static_cast<int>(sss.integer("samples", p.samples, 3, 101));
     if (p.samples % 2 == 0)
-        sss.fail("samples", std::to_string(p.samples) + " is even; a symmetric kernel needs an odd number of taps (3…101)");
+        sss.fail("samples",
+                 std::to_string(p.samples) + " is even; a symmetric kernel needs an odd number of taps (3…101)");
     p.widthMm = sss.number("width_mm", p.widthMm, 0.01, 100.0);
     p.placement = sss.choice("sampling", "quadratic", kPlacementNames) == "importance" ? TapPlacement::Importance
-                                                                                        : TapPlacement::Quadratic;
+                                                                                       : TapPlacement::Quadratic;
     p.followSurface = sss.boolean("follow_surface", p.followSurface);
     p.followSurfaceK = sss.number("follow_surface_k", p.followSurfaceK, 0.0, 1000.0);
     p.profile = sss.string("profile", p.profile);
@@ -110,7 +127,7 @@ SssParams readSssTable(const SpecReader& sss) {
     p.curvatureMeasure = sss.choice("curvature_measure", p.curvatureMeasure, kCurvatureMeasureNames);
     p.curvatureReferenceMm = sss.number("curvature_reference_mm", p.curvatureReferenceMm, 0.1, 1000.0);
     p.pscbfSigma = sss.choice("pscbf_sigma", "variance", kPscbfSigmaNames) == "std-dev" ? PscbfSigma::StdDev
-                                                                                      : PscbfSigma::Variance;
+                                                                                        : PscbfSigma::Variance;
     p.referenceEdgeMm = sss.number("reference_edge_mm", p.referenceEdgeMm, 0.05, 50.0);
     return p;
 }
@@ -183,9 +200,7 @@ std::string notAParameterMessage(SssMethod method) {
 
 std::string_view methodName(SssMethod method) { return methodInfo(method).name; }
 
-std::string_view pscbfSigmaName(PscbfSigma reading) {
-    return reading == PscbfSigma::StdDev ? "std-dev" : "variance";
-}
+std::string_view pscbfSigmaName(PscbfSigma reading) { return reading == PscbfSigma::StdDev ? "std-dev" : "variance"; }
 
 std::string_view placementName(TapPlacement placement) {
     return placement == TapPlacement::Importance ? "importance" : "quadratic";
@@ -193,25 +208,25 @@ std::string_view placementName(TapPlacement placement) {
 
 nlohmann::json SssParams::toJson() const {
     const nlohmann::json all = {{"method", std::string(methodName(method))},
-            {"samples", samples},
-            {"width_mm", widthMm},
-            {"sampling", std::string(placementName(placement))},
-            {"follow_surface", followSurface},
-            {"follow_surface_k", followSurfaceK},
-            {"profile", profile},
-            {"material", material},
-            {"artistic_strength", artisticStrength},
-            {"artistic_falloff", artisticFalloff},
-            {"cbf", cbf},
-            {"cbf_lambda", cbfLambda},
-            {"lab_weight", labWeight},
-            {"extension_input", extensionInput},
-            {"curvature", curvature},
-            {"curvature_floor", curvatureFloor},
-            {"curvature_measure", curvatureMeasure},
-            {"curvature_reference_mm", curvatureReferenceMm},
-            {"pscbf_sigma", std::string(pscbfSigmaName(pscbfSigma))},
-            {"reference_edge_mm", referenceEdgeMm}};
+                                {"samples", samples},
+                                {"width_mm", widthMm},
+                                {"sampling", std::string(placementName(placement))},
+                                {"follow_surface", followSurface},
+                                {"follow_surface_k", followSurfaceK},
+                                {"profile", profile},
+                                {"material", material},
+                                {"artistic_strength", artisticStrength},
+                                {"artistic_falloff", artisticFalloff},
+                                {"cbf", cbf},
+                                {"cbf_lambda", cbfLambda},
+                                {"lab_weight", labWeight},
+                                {"extension_input", extensionInput},
+                                {"curvature", curvature},
+                                {"curvature_floor", curvatureFloor},
+                                {"curvature_measure", curvatureMeasure},
+                                {"curvature_reference_mm", curvatureReferenceMm},
+                                {"pscbf_sigma", std::string(pscbfSigmaName(pscbfSigma))},
+                                {"reference_edge_mm", referenceEdgeMm}};
     nlohmann::json own = nlohmann::json::object();
     for (const auto& [key, value] : all.items())
         if (methodUsesKey(method, key)) own[key] = value;
@@ -254,7 +269,7 @@ TransmittanceParams transmittanceParamsFromJson(const nlohmann::json& transmitta
 double widthMmFromDemoSssWidth(double sssWidth, double mmPerUnit) { return 2.0 * sssWidth * mmPerUnit; }
 
 double transmittanceScalePerUnit(double translucency, double widthMm, double mmPerUnit) {
-    const double demoSssWidth = widthMm / (2.0 * mmPerUnit);  // world units
+    const double demoSssWidth = widthMm / (2.0 * mmPerUnit); // world units
     return 8.25 * (1.0 - translucency) / demoSssWidth;
 }
 

@@ -15,19 +15,19 @@ class SpecReader;
 namespace skinlab::renderer::sss {
 
 enum class SssMethod {
-    None,         // diffuse copied through
-    GaussianSum,  // Jimenez & Gutierrez 2010: six incremental Gaussian blurs, 12 passes
-    Separable,    // Jimenez et al. 2015: two passes with the marginal of a physical profile
-    Artistic,     // Jimenez's demo kernel (width, strength, falloff), two passes
-    Pscbf,        // Mikkelsen 2010: pseudo-separable cross-bilateral filter, spike + one Gaussian per channel
-    Reference,    // object-space SSS on the tessellated surface (the ground truth of the metrics)
-    Pathtraced,   // Blender Cycles' random walk (renderer/pathtraced; the screen-space stage copies through)
+    None,        // diffuse copied through
+    GaussianSum, // Jimenez & Gutierrez 2010: six incremental Gaussian blurs, 12 passes
+    Separable,   // Jimenez et al. 2015: two passes with the marginal of a physical profile
+    Artistic,    // Jimenez's demo kernel (width, strength, falloff), two passes
+    Pscbf,       // Mikkelsen 2010: pseudo-separable cross-bilateral filter, spike + one Gaussian per channel
+    Reference,   // object-space SSS on the tessellated surface (the ground truth of the metrics)
+    Pathtraced,  // Blender Cycles' random walk (renderer/pathtraced; the screen-space stage copies through)
 };
 
 // How a continuous 1-D kernel is discretised into taps (docs/methods.md, "Discretisation").
 enum class TapPlacement {
-    Quadratic,   // offsets R·t²/T² (dense near the centre), trapezoid weights (Jimenez's demo)
-    Importance,  // equal-probability cells of the widest channel (Mikkelsen 2010), other channels re-weighted
+    Quadratic,  // offsets R·t²/T² (dense near the centre), trapezoid weights (Jimenez's demo)
+    Importance, // equal-probability cells of the widest channel (Mikkelsen 2010), other channels re-weighted
 };
 
 // Mikkelsen 2010, Table 1 lists 2.3 / 1.4 / 1.1 for the broad Gaussian and calls the value a "variance" (Eq. 7:
@@ -35,8 +35,8 @@ enum class TapPlacement {
 // deviation (mm). Default: variance, the reading the paper's own filter extent r_max = 4.5 mm supports (3 standard
 // deviations of the red Gaussian, 3·√2.3 = 4.55 mm; under the other reading r_max would cut the red Gaussian at 1.96 σ).
 enum class PscbfSigma {
-    Variance,  // v_c = 2.3 / 1.4 / 1.1 mm²
-    StdDev,    // σ_c = 2.3 / 1.4 / 1.1 mm, v_c = σ_c²
+    Variance, // v_c = 2.3 / 1.4 / 1.1 mm²
+    StdDev,   // σ_c = 2.3 / 1.4 / 1.1 mm, v_c = σ_c²
 };
 
 // The method table: one row per SSS method, the single list the CLI (`skinlab methods`), the scene reader, the
@@ -45,17 +45,17 @@ enum class PscbfSigma {
 // reads (kCommonSssKeys); any other [sss] key given with the method is an error naming the key and the method.
 struct MethodInfo {
     SssMethod method;
-    std::string_view name;        // sss.method value
-    bool screenSpace;             // runs in the screen-space SSS stage on the frame's buffers (a 1-D tap kernel)
-    bool blurPasses;              // its kernel runs through the shared 1-D blur passes (renderer/gl/sss_blur_pass.h)
-    std::string_view summary;     // one line for `skinlab methods`
+    std::string_view name;    // sss.method value
+    bool screenSpace;         // runs in the screen-space SSS stage on the frame's buffers (a 1-D tap kernel)
+    bool blurPasses;          // its kernel runs through the shared 1-D blur passes (renderer/gl/sss_blur_pass.h)
+    std::string_view summary; // one line for `skinlab methods`
     std::vector<std::string_view> keys;
 };
 
 // [sss] keys every method reads: the main pass's transmittance scale (width_mm), the curvature AOV's measure and
 // the curvature scale shared by the extensions and the transmittance.
 inline constexpr std::array<std::string_view, 4> kCommonSssKeys{"method", "width_mm", "curvature_measure",
-                                                               "curvature_reference_mm"};
+                                                                "curvature_reference_mm"};
 
 // Every method, in the order of the SssMethod enum.
 const std::vector<MethodInfo>& methodTable();
@@ -98,7 +98,7 @@ struct SssParams {
     // s), with Δz the linear-depth difference centre−tap in world units, so k is in 1/mm: a depth step of 1/k mm
     // stops all light crossing it.
     bool followSurface = true;
-    double followSurfaceK = 0.5;  // 1/mm
+    double followSurfaceK = 0.5; // 1/mm
     // Profile of the separable method: "deon" (six Gaussians), "burley" (normalized diffusion) or "file:PATH"
     // (a tabulated .bn kernel, Jimenez et al. 2015 supplementary format).
     std::string profile = "deon";
@@ -113,15 +113,15 @@ struct SssParams {
     // E1: cross-bilateral weights exp(−λ |F_c − F_tap|) on Mikkelsen's auxiliary image (AOV aux.Y), combined
     // with the follow-surface correction, renormalised, falling back to the unblurred colour where they vanish.
     bool cbf = false;
-    double cbfLambda = 10.0;  // λ, dimensionless (thesis code: 10)
+    double cbfLambda = 10.0; // λ, dimensionless (thesis code: 10)
     // E2: CIELAB weight exp(−β ΔE*ab) on the albedos of centre and tap; β in 1/ΔE, 0 = off.
     double labWeight = 0.0;
     // E1/E2 input: "albedo" (the albedo AOV; the thesis' final separable shader) or "lit" (the colour each pass
     // blurs; the thesis text, Eq. 3.13, its sum-of-Gaussians passes and earlier separable shaders).
     std::string extensionInput = "albedo";
     // E3: curvature modulation of the kernel width from the curvature AOV (curvature.Y).
-    std::string curvature = "off";  // off | increase | reduce | reduce-floor
-    double curvatureFloor = 0.5;    // reduce-floor: width share kept on flat skin, [0, 1]
+    std::string curvature = "off"; // off | increase | reduce | reduce-floor
+    double curvatureFloor = 0.5;   // reduce-floor: width share kept on flat skin, [0, 1]
     // How the curvature AOV is measured: "normal" (3-D normal curvature, ≈ 1/radius) or "screen" (the thesis'
     // screen-space measure from the per-pixel change of the view normal; grows at silhouettes).
     std::string curvatureMeasure = "normal";

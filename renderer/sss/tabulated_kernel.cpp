@@ -32,11 +32,13 @@ std::vector<TabulatedRow> readTabulatedKernel(const std::filesystem::path& path)
         throwInput(where, "", "not a .bn kernel: " + std::to_string(count) + " floats is not a multiple of 4");
     const size_t available = (bytes.size() - 4) / 4;
     if (available < count || (bytes.size() - 4) % 4 != 0)
-        throwInput(where, "", "truncated: header says " + std::to_string(count) + " floats, file holds " +
-                                  std::to_string(available));
+        throwInput(where, "",
+                   "truncated: header says " + std::to_string(count) + " floats, file holds " +
+                       std::to_string(available));
     if (available > count)
-        throwInput(where, "", "not a .bn kernel: " + std::to_string(available - count) +
-                                  " floats after the " + std::to_string(count) + " the header announces");
+        throwInput(where, "",
+                   "not a .bn kernel: " + std::to_string(available - count) + " floats after the " +
+                       std::to_string(count) + " the header announces");
     const size_t rowCount = count / 4;
     if (rowCount < 3) throwInput(where, "", "not a .bn kernel: " + std::to_string(rowCount) + " rows (need ≥ 3)");
 
@@ -45,8 +47,9 @@ std::vector<TabulatedRow> readTabulatedKernel(const std::filesystem::path& path)
         for (int c = 0; c < 3; ++c) {
             const float w = readFloat(bytes, 1 + 4 * j + c);
             if (!std::isfinite(w) || w < 0.0f)
-                throwInput(where, "", "row " + std::to_string(j) + ": weight " + std::to_string(w) +
-                                          " is not a finite non-negative number");
+                throwInput(where, "",
+                           "row " + std::to_string(j) + ": weight " + std::to_string(w) +
+                               " is not a finite non-negative number");
             rows[j].weight[c] = w;
         }
         const float x = readFloat(bytes, 1 + 4 * j + 3);
@@ -105,7 +108,8 @@ double TabulatedMarginal::cumulative(int channel, double xMm) const {
 double TabulatedMarginal::secondMoment(int channel) const {
     // Piecewise-constant density: each cell adds w (x_j² + Δx²/12).
     double sum = 0.0;
-    for (const auto& row : rows_) sum += row.weight[channel] * (row.offsetMm * row.offsetMm + spacing_ * spacing_ / 12.0);
+    for (const auto& row : rows_)
+        sum += row.weight[channel] * (row.offsetMm * row.offsetMm + spacing_ * spacing_ / 12.0);
     return sum;
 }
 

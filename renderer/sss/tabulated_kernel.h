@@ -12,7 +12,7 @@
 namespace skinlab::renderer::sss {
 
 struct TabulatedRow {
-    std::array<double, 3> weight;  // per channel
+    std::array<double, 3> weight; // per channel
     double offsetMm;
 };
 
@@ -37,9 +37,9 @@ public:
 
 private:
     std::vector<TabulatedRow> rows_;
-    std::vector<std::array<double, 3>> cumulativeBefore_;  // Σ of weights of rows before j
+    std::vector<std::array<double, 3>> cumulativeBefore_; // Σ of weights of rows before j
     double spacing_ = 0.0;
-    double start_ = 0.0;  // left edge of row 0's cell
+    double start_ = 0.0; // left edge of row 0's cell
     std::string description_;
 };
 

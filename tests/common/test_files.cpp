@@ -15,7 +15,10 @@ TEST(Files, AtomicWriteReplacesAndLeavesNoTemporary) {
     skinlab::writeFileAtomic(dir / "a.txt", "second");
     EXPECT_EQ(skinlab::readFile(dir / "a.txt"), "second");
     int n = 0;
-    for (auto& e : fs::directory_iterator(dir)) { (void)e; ++n; }
+    for (auto& e : fs::directory_iterator(dir)) {
+        (void)e;
+        ++n;
+    }
     EXPECT_EQ(n, 1);
     fs::remove_all(dir);
 }

@@ -45,7 +45,9 @@ TEST(Spec, ErrorsNameFileAndKeyWordForWord) {
               "scene.toml: camera.fov_deg: 30 is out of range [1, 20]");
     EXPECT_EQ(errorOf([&] { r.table("camera").number("view", 40, 1, 20); }),
               "scene.toml: camera.view: expected a number, got string \"close\"");
-    EXPECT_EQ(errorOf([&] { r.table("camera").choice("view", "mid", {"mid", "far"}); }),
+    EXPECT_EQ(errorOf([&] {
+                  r.table("camera").choice("view", "mid", {"mid", "far"});
+              }),
               "scene.toml: camera.view: 'close' is not one of: mid, far");
     EXPECT_EQ(errorOf([&] { r.tables("lights")[0].integer("intensity", 1, 0, 9); }),
               "scene.toml: lights[0].intensity: expected an integer, got float 3.5");
@@ -84,7 +86,7 @@ TEST(Spec, OverridesIndexExistingArrays) {
     ASSERT_EQ(lights.size(), 1u);
     EXPECT_DOUBLE_EQ(lights[0].number("intensity", 1, 0, 100), 2.0);
     EXPECT_FALSE(lights[0].boolean("shadow", true));
-    EXPECT_EQ(lights[0].string("type", ""), "directional");  // the rest of the light is kept
+    EXPECT_EQ(lights[0].string("type", ""), "directional"); // the rest of the light is kept
     EXPECT_EQ(r.table("camera").vec3("position", {0, 0, 0}, -100, 100)[2], 30.0);
     EXPECT_EQ(r.table("camera").vec3("position", {0, 0, 0}, -100, 100)[0], 1.0);
     EXPECT_EQ(errorOf([&] { skinlab::applyOverride(t, "lights[1].intensity=2"); }),

@@ -26,10 +26,13 @@ TemporaryFolder::~TemporaryFolder() {
 
 void writeStimulusSet(const fs::path& folder, const StimulusSetSpec& spec) {
     fs::create_directories(folder / "png");
-    nlohmann::json manifest{{"format", "skinlab-stimuli"}, {"version", 1}, {"set", "test-set"},
-                            {"spec_sha256", std::string(64, '0')},
-                            {"renderer", {{"gl_renderer", "none (test fixture)"}, {"gl_version", ""}, {"skinlab_version", ""}}},
-                            {"stimuli", nlohmann::json::array()}};
+    nlohmann::json manifest{
+        {"format", "skinlab-stimuli"},
+        {"version", 1},
+        {"set", "test-set"},
+        {"spec_sha256", std::string(64, '0')},
+        {"renderer", {{"gl_renderer", "none (test fixture)"}, {"gl_version", ""}, {"skinlab_version", ""}}},
+        {"stimuli", nlohmann::json::array()}};
     int serial = 0;
     for (std::size_t b = 0; b < spec.blocks.size(); ++b) {
         std::vector<std::string> methods = spec.methods;

@@ -33,7 +33,8 @@ std::vector<Comparison> simulate(const std::vector<double>& truth, int perPair, 
     for (int r = 0; r < perPair; ++r)
         for (int i = 0; i < m; ++i)
             for (int j = i + 1; j < m; ++j) {
-                const bool iWins = truth[static_cast<std::size_t>(i)] + noise(random) > truth[static_cast<std::size_t>(j)] + noise(random);
+                const bool iWins = truth[static_cast<std::size_t>(i)] + noise(random) >
+                                   truth[static_cast<std::size_t>(j)] + noise(random);
                 out.push_back(iWins ? Comparison{i, j} : Comparison{j, i});
             }
     return out;
@@ -43,7 +44,9 @@ bool connected(int m, const std::vector<std::pair<int, int>>& edges) {
     std::vector<int> parent(static_cast<std::size_t>(m));
     std::iota(parent.begin(), parent.end(), 0);
     auto find = [&](int x) {
-        while (parent[static_cast<std::size_t>(x)] != x) x = parent[static_cast<std::size_t>(x)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
+        while (parent[static_cast<std::size_t>(x)] != x)
+            x = parent[static_cast<std::size_t>(x)] =
+                parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
         return x;
     };
     for (const auto& [a, b] : edges) parent[static_cast<std::size_t>(find(a))] = find(b);
@@ -118,7 +121,9 @@ TEST(ActiveSampling, PosteriorDependsOnlyOnTheAnswersNotTheirOrder) {
     // Before any answer: the prior.
     const ScorePosterior prior = fitPosterior(3, {});
     EXPECT_EQ(prior.mean, std::vector<double>(3, 0.0));
-    EXPECT_EQ(prior.covariance, ScorePosterior::independent({0, 0, 0}, std::vector<double>(3, PosteriorOptions{}.priorVariance)).covariance);
+    EXPECT_EQ(
+        prior.covariance,
+        ScorePosterior::independent({0, 0, 0}, std::vector<double>(3, PosteriorOptions{}.priorVariance)).covariance);
     EXPECT_THROW(fitPosterior(3, {{0, 3}}), skinlab::RuntimeError);
     // The same answers as counts per pair (how the server keeps them in memory): the identical posterior.
     std::map<std::pair<int, int>, std::pair<double, double>> counted;
@@ -233,14 +238,15 @@ TEST(ActiveSampling, DesignKeysAreCheckedStrictly) {
               "trials_per_participant)");
     EXPECT_EQ(designError("pairs = \"active\"\ntrials_per_participant = 10\nblock_order = \"grouped\"\n"),
               "D.toml: block_order: not used with pairs = \"active\" (each batch is planned for one block)");
-    EXPECT_EQ(designError("trials_per_participant = 10\n"), "D.toml: trials_per_participant: only used with pairs = \"active\"");
+    EXPECT_EQ(designError("trials_per_participant = 10\n"),
+              "D.toml: trials_per_participant: only used with pairs = \"active\"");
     EXPECT_EQ(designError("pairs = \"activ\"\n"),
               "D.toml: pairs: expected \"all\", \"active\" or an array of [A, B] condition pairs, got \"activ\"");
 }
 
 TEST(ActiveSampling, PlanFillsOpenSlotsBatchByBatchAroundPracticeAndCatchTrials) {
-    const StudyDefinition study =
-        makeStudy("seed = 3\npairs = \"active\"\ntrials_per_participant = 10\n[practice]\ntrials = 2\n[catch]\nblank = 2\n");
+    const StudyDefinition study = makeStudy(
+        "seed = 3\npairs = \"active\"\ntrials_per_participant = 10\n[practice]\ntrials = 2\n[catch]\nblank = 2\n");
     ASSERT_EQ(study.blocks.size(), 2u);
     ASSERT_EQ(study.blocks[0].conditions.size(), 4u); // batches of 3 pairs
     EXPECT_EQ(study.testTrialCount(), 10);

@@ -59,8 +59,9 @@ CommandResult runSkinlab(std::vector<std::string> arguments) {
 }
 
 int startServer(std::unique_ptr<ChildProcess>& child, const fs::path& database, int port) {
-    child = std::make_unique<ChildProcess>(std::vector<std::string>{SKINLAB_CLI, "study", "serve", database.string(), "--port",
-                                                                    std::to_string(port), "--token", "t0ken", "--threads", "16"});
+    child = std::make_unique<ChildProcess>(std::vector<std::string>{SKINLAB_CLI, "study", "serve", database.string(),
+                                                                    "--port", std::to_string(port), "--token", "t0ken",
+                                                                    "--threads", "16"});
     static const std::regex serving(R"(serving .* on http://127\.0\.0\.1:(\d+)/)");
     for (int i = 0; i < 10; ++i) {
         bool ok = false;
@@ -73,8 +74,8 @@ int startServer(std::unique_ptr<ChildProcess>& child, const fs::path& database, 
 }
 
 std::string describe(const TrialRecord& t) {
-    return std::to_string(t.id) + "@" + std::to_string(t.position) + ":" + trialKindName(t.plan.kind) + ":" + t.plan.block +
-           ":" + t.plan.conditionA + "/" + t.plan.conditionB + (t.plan.aOnLeft ? ":L" : ":R");
+    return std::to_string(t.id) + "@" + std::to_string(t.position) + ":" + trialKindName(t.plan.kind) + ":" +
+           t.plan.block + ":" + t.plan.conditionA + "/" + t.plan.conditionB + (t.plan.aOnLeft ? ":L" : ":R");
 }
 
 // Every stored trial of every participant.
@@ -248,9 +249,9 @@ TEST(ActiveStudy, RunsEndToEndOverHttpAndItsPlanSurvivesKillNine) {
     }
 
     // The CLI's own simulate runs further observers through the restarted server.
-    const CommandResult simulated = runSkinlab({"study", "simulate", files.database.string(), "--observers", "2", "--url",
-                                                "http://127.0.0.1:" + std::to_string(port), "--truth-factor", "quality",
-                                                "--label-prefix", "cli"});
+    const CommandResult simulated =
+        runSkinlab({"study", "simulate", files.database.string(), "--observers", "2", "--url",
+                    "http://127.0.0.1:" + std::to_string(port), "--truth-factor", "quality", "--label-prefix", "cli"});
     EXPECT_EQ(simulated.exitCode, 0) << simulated.out << simulated.err;
     EXPECT_NE(simulated.out.find("2/2 observers completed, 30 responses acknowledged, 0 rejected"), std::string::npos)
         << simulated.out;
@@ -259,7 +260,9 @@ TEST(ActiveStudy, RunsEndToEndOverHttpAndItsPlanSurvivesKillNine) {
 
     // The analysis is unchanged: the export scales like any other.
     const fs::path exported = files.folder.path() / "responses.csv";
-    ASSERT_EQ(runSkinlab({"study", "export", files.database.string(), "--format", "csv", "-o", exported.string()}).exitCode, 0);
+    ASSERT_EQ(
+        runSkinlab({"study", "export", files.database.string(), "--format", "csv", "-o", exported.string()}).exitCode,
+        0);
     const fs::path analysis = files.folder.path() / "scale";
     const CommandResult scaled =
         runSkinlab({"analyze", "scale", exported.string(), "-o", analysis.string(), "--bootstrap", "200"});
@@ -272,7 +275,8 @@ TEST(ActiveStudy, RunsEndToEndOverHttpAndItsPlanSurvivesKillNine) {
     EXPECT_EQ(scale.at("settings").at("intervals"), "bootstrap"); // a CSV export does not say how pairs were chosen
     // Scaled from study.db, the design is known: an active design gets likelihood intervals, said in the output.
     const fs::path fromDatabase = files.folder.path() / "scale-db";
-    const CommandResult scaledDb = runSkinlab({"analyze", "scale", files.database.string(), "-o", fromDatabase.string()});
+    const CommandResult scaledDb =
+        runSkinlab({"analyze", "scale", files.database.string(), "-o", fromDatabase.string()});
     ASSERT_EQ(scaledDb.exitCode, 0) << scaledDb.out << scaledDb.err;
     EXPECT_NE(scaledDb.out.find("active design (pairs chosen from earlier answers): profile-likelihood intervals"),
               std::string::npos)
@@ -280,10 +284,11 @@ TEST(ActiveStudy, RunsEndToEndOverHttpAndItsPlanSurvivesKillNine) {
     const nlohmann::json scaleDb = nlohmann::json::parse(skinlab::readFile(fromDatabase / "scale.json"));
     EXPECT_EQ(scaleDb.at("settings").at("intervals"), "profile");
     EXPECT_EQ(scaleDb.at("settings").at("intervals_reason"), "active design");
-    for (const auto& block : scaleDb.at("blocks")) EXPECT_EQ(block.at("interval_method"), "profile-likelihood") << block.dump();
-    const CommandResult forced = runSkinlab(
-        {"analyze", "scale", files.database.string(), "-o", (files.folder.path() / "scale-boot").string(), "--intervals",
-         "bootstrap", "--bootstrap", "200"});
+    for (const auto& block : scaleDb.at("blocks"))
+        EXPECT_EQ(block.at("interval_method"), "profile-likelihood") << block.dump();
+    const CommandResult forced =
+        runSkinlab({"analyze", "scale", files.database.string(), "-o", (files.folder.path() / "scale-boot").string(),
+                    "--intervals", "bootstrap", "--bootstrap", "200"});
     ASSERT_EQ(forced.exitCode, 0) << forced.out << forced.err;
     EXPECT_NE(forced.out.find("studentized-bootstrap"), std::string::npos) << forced.out;
 

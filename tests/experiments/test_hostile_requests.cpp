@@ -83,7 +83,8 @@ public:
                     return response;
                 }
             }
-            const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+            const auto left =
+                std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
             if (left.count() <= 0) return "";
             pollfd p{fd_, POLLIN, 0};
             if (::poll(&p, 1, static_cast<int>(left.count())) <= 0) return "";
@@ -149,9 +150,9 @@ struct Hostile {
         const std::string before = study.fingerprint();
         const std::string response = send();
         if (status == 0) // any client error
-            EXPECT_TRUE(statusOf(response) >= 400 && statusOf(response) < 500) << what << ": " << response.substr(0, 300);
-        else
-            EXPECT_EQ(statusOf(response), status) << what << ": " << response.substr(0, 300);
+            EXPECT_TRUE(statusOf(response) >= 400 && statusOf(response) < 500)
+                << what << ": " << response.substr(0, 300);
+        else EXPECT_EQ(statusOf(response), status) << what << ": " << response.substr(0, 300);
         if (statusOf(response) >= 400) {
             json body;
             try {
@@ -201,15 +202,42 @@ json answerBody(const Participant& p, const json& trial, const std::string& side
 
 TEST(HostileRequests, TraversalInEveryEncodingReachesNothingButTheStudy) {
     Hostile h;
-    for (const std::string target :
-         {"/../study.db", "/%2e%2e/study.db", "/%2E%2E/%2E%2E/etc/passwd", "/%252e%252e/study.db", "/..%2fstudy.db",
-          "/..%5cstudy.db", "/..\\study.db", "/%c0%ae%c0%ae/study.db", "/%e0%80%ae%e0%80%ae/study.db", "//etc/passwd",
-          "/stimuli/../manifest.json", "/stimuli/..%2f..%2fmanifest.json", "/stimuli/%2e%2e%2fmanifest.json",
-          "/stimuli/0.png/../../study.db", "/stimuli/%30.png", "/stimuli/0.png%00", "/stimuli/0.png%00.txt",
-          "/stimuli//0.png", "/stimuli/0x1.png", "/stimuli/1e1.png", "/stimuli/-0.png", "/stimuli/+1.png",
-          "/stimuli/0000001.png", "/stimuli/999999.png", "/stimuli/../../stimuli/png/0-separable.png",
-          "/png/0-separable.png", "/manifest.json", "/design.toml", "/study.db", "/study.db-wal", "/api/../study.db",
-          "/api/%2e%2e/study.db", "/index.html/../study.db", "/app.js/..", "/api/study/..", "/API/study"}) {
+    for (const std::string target : {"/../study.db",
+                                     "/%2e%2e/study.db",
+                                     "/%2E%2E/%2E%2E/etc/passwd",
+                                     "/%252e%252e/study.db",
+                                     "/..%2fstudy.db",
+                                     "/..%5cstudy.db",
+                                     "/..\\study.db",
+                                     "/%c0%ae%c0%ae/study.db",
+                                     "/%e0%80%ae%e0%80%ae/study.db",
+                                     "//etc/passwd",
+                                     "/stimuli/../manifest.json",
+                                     "/stimuli/..%2f..%2fmanifest.json",
+                                     "/stimuli/%2e%2e%2fmanifest.json",
+                                     "/stimuli/0.png/../../study.db",
+                                     "/stimuli/%30.png",
+                                     "/stimuli/0.png%00",
+                                     "/stimuli/0.png%00.txt",
+                                     "/stimuli//0.png",
+                                     "/stimuli/0x1.png",
+                                     "/stimuli/1e1.png",
+                                     "/stimuli/-0.png",
+                                     "/stimuli/+1.png",
+                                     "/stimuli/0000001.png",
+                                     "/stimuli/999999.png",
+                                     "/stimuli/../../stimuli/png/0-separable.png",
+                                     "/png/0-separable.png",
+                                     "/manifest.json",
+                                     "/design.toml",
+                                     "/study.db",
+                                     "/study.db-wal",
+                                     "/api/../study.db",
+                                     "/api/%2e%2e/study.db",
+                                     "/index.html/../study.db",
+                                     "/app.js/..",
+                                     "/api/study/..",
+                                     "/API/study"}) {
         h.expectRejected("GET " + target, 404, [&] { return h.request("GET", target); });
     }
     // Raw non-ASCII bytes in the target: refused as malformed or unknown.
@@ -219,8 +247,10 @@ TEST(HostileRequests, TraversalInEveryEncodingReachesNothingButTheStudy) {
     h.expectRejected("absolute form", 404, [&] { return h.request("GET", "http://127.0.0.1/../study.db"); });
     h.expectRejected("asterisk", 404, [&] { return h.request("OPTIONS", "*"); });
     h.expectRejected("no target", 400, [&] { return h.exchange("GET HTTP/1.1\r\nHost: " + h.host + "\r\n\r\n"); });
-    h.expectRejected("space in target", 400, [&] { return h.exchange("GET /a b HTTP/1.1\r\nHost: " + h.host + "\r\n\r\n"); });
-    h.expectRejected("not HTTP", 400, [&] { return h.exchange("\x16\x03\x01\x02\x10\x01\x10\x01\xfc\x03\x03\r\n\r\n"); });
+    h.expectRejected("space in target", 400,
+                     [&] { return h.exchange("GET /a b HTTP/1.1\r\nHost: " + h.host + "\r\n\r\n"); });
+    h.expectRejected("not HTTP", 400,
+                     [&] { return h.exchange("\x16\x03\x01\x02\x10\x01\x10\x01\xfc\x03\x03\r\n\r\n"); });
     // The page with hostile query strings is just the page.
     for (const std::string target : {"/?p=../../etc/passwd", "/index.html?p=%00%ff", "/?p=<script>"}) {
         const std::string before = h.study.fingerprint();
@@ -236,7 +266,9 @@ TEST(HostileRequests, MalformedOversizedAndOverflowingJsonIs400Or413) {
     HttpClient client = h.study.client();
     Participant p = joinAndStart(client);
     const json good = answerBody(p, p.state["trial"]["id"], "left");
-    auto post = [&](const std::string& body) { return [&h, body] { return h.request("POST", "/api/response", body); }; };
+    auto post = [&](const std::string& body) {
+        return [&h, body] { return h.request("POST", "/api/response", body); };
+    };
     auto with = [&](const std::string& key, const std::string& rawValue) {
         json copy = good;
         copy.erase(key);
@@ -244,8 +276,9 @@ TEST(HostileRequests, MalformedOversizedAndOverflowingJsonIs400Or413) {
         text.insert(1, "\"" + key + "\":" + rawValue + ",");
         return text;
     };
-    for (const std::string body : {"", "{", "{\"token\":", "}", "null", "[]", "\"text\"", "{}x", "{\"a\":NaN}",
-                                   "{\"a\":Infinity}", "{\"a\":01}", "{'a':1}", "{\"a\":\"\xff\xfe\"}", "{\"a\":\"\\ud800\"}"}) {
+    for (const std::string body :
+         {"", "{", "{\"token\":", "}", "null", "[]", "\"text\"", "{}x", "{\"a\":NaN}", "{\"a\":Infinity}", "{\"a\":01}",
+          "{'a':1}", "{\"a\":\"\xff\xfe\"}", "{\"a\":\"\\ud800\"}"}) {
         h.expectRejected("body " + body, 400, post(body));
     }
     h.expectRejected("deep nesting", 400, post(std::string(7000, '[') + std::string(7000, ']')));
@@ -257,13 +290,23 @@ TEST(HostileRequests, MalformedOversizedAndOverflowingJsonIs400Or413) {
     });
     // Numbers no double (or no 64-bit integer) holds, and numbers out of range.
     for (const auto& [key, value] :
-         std::vector<std::pair<std::string, std::string>>{{"trial", "1e400"}, {"trial", "-1e400"}, {"trial", "1e-400"},
-                                                          {"trial", "18446744073709551615"}, {"trial", "99999999999999999999999"},
-                                                          {"trial", "9223372036854775808"}, {"trial", "1.5"}, {"trial", "-0"},
-                                                          {"session", "1e400"}, {"response_ms", "1e400"}, {"response_ms", "1e308"},
-                                                          {"response_ms", "-1"}, {"device_pixel_ratio", "1e-400"},
-                                                          {"device_pixel_ratio", "17"}, {"viewport_width", "1e400"},
-                                                          {"viewport_width", "4294967297"}, {"side", "1e400"}}) {
+         std::vector<std::pair<std::string, std::string>>{{"trial", "1e400"},
+                                                          {"trial", "-1e400"},
+                                                          {"trial", "1e-400"},
+                                                          {"trial", "18446744073709551615"},
+                                                          {"trial", "99999999999999999999999"},
+                                                          {"trial", "9223372036854775808"},
+                                                          {"trial", "1.5"},
+                                                          {"trial", "-0"},
+                                                          {"session", "1e400"},
+                                                          {"response_ms", "1e400"},
+                                                          {"response_ms", "1e308"},
+                                                          {"response_ms", "-1"},
+                                                          {"device_pixel_ratio", "1e-400"},
+                                                          {"device_pixel_ratio", "17"},
+                                                          {"viewport_width", "1e400"},
+                                                          {"viewport_width", "4294967297"},
+                                                          {"side", "1e400"}}) {
         h.expectRejected(key + "=" + value, 400, post(with(key, value)));
     }
     h.expectRejected("join with 1e400", 400, [&] { return h.request("POST", "/api/join", "{\"label\":1e400}"); });
@@ -284,13 +327,15 @@ TEST(HostileRequests, MalformedOversizedAndOverflowingJsonIs400Or413) {
         return h.exchange("POST /api/join HTTP/1.1\r\nHost: " + h.host +
                           "\r\nContent-Type: application/json\r\nContent-Length: 2\r\nContent-Length: 3\r\n\r\n{}");
     });
-    h.expectRejected("9 KiB header", 431, [&] { return h.request("GET", "/api/study", "", "X-Pad: " + std::string(9000, 'a') + "\r\n"); });
+    h.expectRejected("9 KiB header", 431,
+                     [&] { return h.request("GET", "/api/study", "", "X-Pad: " + std::string(9000, 'a') + "\r\n"); });
     h.expectRejected("2,000 small headers", 431, [&] {
         std::string headers;
         for (int i = 0; i < 2000; ++i) headers += "X-" + std::to_string(i) + ": a\r\n";
         return h.request("GET", "/api/study", "", headers);
     });
-    h.expectRejected("text/plain", 415, [&] { return h.request("POST", "/api/response", good.dump(), "", "text/plain"); });
+    h.expectRejected("text/plain", 415,
+                     [&] { return h.request("POST", "/api/response", good.dump(), "", "text/plain"); });
     // The good request still works afterwards.
     EXPECT_EQ(statusOf(h.request("POST", "/api/response", good.dump())), 200);
 }
@@ -355,7 +400,8 @@ TEST(HostileRequests, ChunkedFloodsAreRefusedEarlyWithoutBuffering) {
     // Chunk sizes that overflow, or a single chunk over the limit.
     h.expectRejected("chunk size overflow", 0, [&] {
         return h.exchange("POST /api/join HTTP/1.1\r\nHost: " + h.host +
-                          "\r\nContent-Type: application/json\r\nTransfer-Encoding: chunked\r\n\r\nfffffffffffffffffffff\r\n{}\r\n0\r\n\r\n");
+                          "\r\nContent-Type: application/json\r\nTransfer-Encoding: "
+                          "chunked\r\n\r\nfffffffffffffffffffff\r\n{}\r\n0\r\n\r\n");
     });
     h.expectRejected("one huge chunk", 413, [&] {
         return h.exchange("POST /api/join HTTP/1.1\r\nHost: " + h.host +
@@ -363,8 +409,9 @@ TEST(HostileRequests, ChunkedFloodsAreRefusedEarlyWithoutBuffering) {
     });
     EXPECT_EQ(h.study.fingerprint(), before);
     // A small chunked body is fine.
-    const std::string joined = h.exchange("POST /api/join HTTP/1.1\r\nHost: " + h.host +
-                                          "\r\nContent-Type: application/json\r\nTransfer-Encoding: chunked\r\n\r\n2\r\n{}\r\n0\r\n\r\n");
+    const std::string joined =
+        h.exchange("POST /api/join HTTP/1.1\r\nHost: " + h.host +
+                   "\r\nContent-Type: application/json\r\nTransfer-Encoding: chunked\r\n\r\n2\r\n{}\r\n0\r\n\r\n");
     EXPECT_EQ(statusOf(joined), 201) << joined;
 }
 
@@ -374,7 +421,9 @@ TEST(HostileRequests, TokensReplaysOrderConcurrencyAndLateAnswers) {
     Participant alice = joinAndStart(client);
     Participant bob = joinAndStart(client);
     const json first = alice.state["trial"]["id"];
-    auto post = [&](const json& body) { return [&h, body] { return h.request("POST", "/api/response", body.dump()); }; };
+    auto post = [&](const json& body) {
+        return [&h, body] { return h.request("POST", "/api/response", body.dump()); };
+    };
     auto with = [](json body, const std::string& key, const json& value) {
         if (value.is_null()) body.erase(key);
         else body[key] = value;
@@ -394,13 +443,12 @@ TEST(HostileRequests, TokensReplaysOrderConcurrencyAndLateAnswers) {
         // The last hex digit changed (to one it is not: a random token ends in '0' one time in 16).
         return h.request("GET", "/api/state?token=" + bob.token.substr(0, 31) + (bob.token.back() == '0' ? "1" : "0"));
     });
-    h.expectRejected("session for nobody", 404, [&] {
-        return h.request("POST", "/api/session", with(screen(), "token", "nobody").dump());
-    });
-    h.expectRejected("researcher status without token", 401, [&] { return h.request("GET", "/api/researcher/status"); });
-    h.expectRejected("researcher token in the URL", 401, [&] {
-        return h.request("GET", std::string("/api/researcher/status?token=") + kResearcherToken);
-    });
+    h.expectRejected("session for nobody", 404,
+                     [&] { return h.request("POST", "/api/session", with(screen(), "token", "nobody").dump()); });
+    h.expectRejected("researcher status without token", 401,
+                     [&] { return h.request("GET", "/api/researcher/status"); });
+    h.expectRejected("researcher token in the URL", 401,
+                     [&] { return h.request("GET", std::string("/api/researcher/status?token=") + kResearcherToken); });
     h.expectRejected("participant token as researcher token", 403, [&] {
         return h.request("GET", "/api/researcher/export", "", "Authorization: Bearer " + alice.token + "\r\n");
     });
@@ -414,7 +462,8 @@ TEST(HostileRequests, TokensReplaysOrderConcurrencyAndLateAnswers) {
     std::vector<int> statuses(16);
     for (int i = 0; i < 16; ++i)
         threads.emplace_back([&, i] {
-            const std::string response = h.request("POST", "/api/response", answerBody(alice, first, i % 2 ? "left" : "right").dump());
+            const std::string response =
+                h.request("POST", "/api/response", answerBody(alice, first, i % 2 ? "left" : "right").dump());
             statuses[static_cast<std::size_t>(i)] = statusOf(response);
         });
     for (std::thread& t : threads) t.join();
@@ -427,7 +476,8 @@ TEST(HostileRequests, TokensReplaysOrderConcurrencyAndLateAnswers) {
     // Replays: the stored answer again is harmless, another one is refused.
     {
         const std::string before = h.study.fingerprint();
-        const std::string replay = h.request("POST", "/api/response", answerBody(alice, first, storedLeft ? "left" : "right").dump());
+        const std::string replay =
+            h.request("POST", "/api/response", answerBody(alice, first, storedLeft ? "left" : "right").dump());
         EXPECT_EQ(statusOf(replay), 200);
         EXPECT_TRUE(json::parse(bodyOf(replay))["duplicate"].get<bool>());
         EXPECT_EQ(h.study.fingerprint(), before);
@@ -462,9 +512,9 @@ TEST(HostileRequests, HostHeadersNonUtf8HeadersAndFloodsOfJoinsOrConnections) {
         return h.exchange("GET /api/study HTTP/1.1\r\nHost: " + host + "\r\nConnection: close\r\n\r\n");
     };
     const std::string port = std::to_string(h.study.port());
-    for (const std::string& host : std::vector<std::string>{"evil.example", "evil.example:" + port, "localhost.evil.example",
-                                                           "127.0.0.1", "127.0.0.1:1", "127.0.0.2:" + port, "[::1]",
-                                                           "\xff\xfe", "", "127.0.0.1:" + port + "@evil"}) {
+    for (const std::string& host : std::vector<std::string>{
+             "evil.example", "evil.example:" + port, "localhost.evil.example", "127.0.0.1", "127.0.0.1:1",
+             "127.0.0.2:" + port, "[::1]", "\xff\xfe", "", "127.0.0.1:" + port + "@evil"}) {
         h.expectRejected("Host " + host, 421, [&] { return withHost(host); });
     }
     h.expectRejected("no Host (HTTP/1.0)", 400, [&] { return h.exchange("GET /api/study HTTP/1.0\r\n\r\n"); });
@@ -480,9 +530,10 @@ TEST(HostileRequests, HostHeadersNonUtf8HeadersAndFloodsOfJoinsOrConnections) {
     json start = screen();
     start["token"] = p.token;
     const std::string body = start.dump();
-    const std::string response = h.exchange("POST /api/session HTTP/1.1\r\nHost: " + h.host + "\r\nUser-Agent: Mozilla\xff\xfe\xc3\r\n"
-                                            "Content-Type: application/json\r\nContent-Length: " + std::to_string(body.size()) +
-                                            "\r\nConnection: close\r\n\r\n" + body);
+    const std::string response = h.exchange("POST /api/session HTTP/1.1\r\nHost: " + h.host +
+                                            "\r\nUser-Agent: Mozilla\xff\xfe\xc3\r\n"
+                                            "Content-Type: application/json\r\nContent-Length: " +
+                                            std::to_string(body.size()) + "\r\nConnection: close\r\n\r\n" + body);
     EXPECT_EQ(statusOf(response), 200) << response;
     {
         SqliteDatabase db(h.study.databasePath().string(), false);
@@ -494,9 +545,12 @@ TEST(HostileRequests, HostHeadersNonUtf8HeadersAndFloodsOfJoinsOrConnections) {
         const json exported = json::parse(exportResponses(h.study.store(), "json"));
         EXPECT_TRUE(exported.is_object());
     });
-    h.expectRejected("bad header name", 400, [&] { return h.exchange("GET /api/study HTTP/1.1\r\nHost: " + h.host + "\r\nBad\xff Name: 1\r\n\r\n"); });
+    h.expectRejected("bad header name", 400, [&] {
+        return h.exchange("GET /api/study HTTP/1.1\r\nHost: " + h.host + "\r\nBad\xff Name: 1\r\n\r\n");
+    });
     h.expectRejected("NUL in a header", 400, [&] {
-        return h.exchange(std::string("GET /api/study HTTP/1.1\r\nHost: ") + h.host + "\r\nX: a" + std::string(1, '\0') + "b\r\n\r\n");
+        return h.exchange(std::string("GET /api/study HTTP/1.1\r\nHost: ") + h.host + "\r\nX: a" +
+                          std::string(1, '\0') + "b\r\n\r\n");
     });
 
     // Joins: a burst of 5 per address (one already used above), then 429 with Retry-After; nothing stored by those.
@@ -508,7 +562,8 @@ TEST(HostileRequests, HostHeadersNonUtf8HeadersAndFloodsOfJoinsOrConnections) {
     // Another address has its own allowance.
     {
         RawSocket other(h.study.port(), "127.0.0.9");
-        other.send("POST /api/join HTTP/1.1\r\nHost: " + h.host + "\r\nContent-Type: application/json\r\nContent-Length: 2\r\n\r\n{}");
+        other.send("POST /api/join HTTP/1.1\r\nHost: " + h.host +
+                   "\r\nContent-Type: application/json\r\nContent-Length: 2\r\n\r\n{}");
         EXPECT_EQ(statusOf(other.readResponse()), 201);
     }
 
@@ -530,8 +585,11 @@ TEST(HostileRequests, HostHeadersNonUtf8HeadersAndFloodsOfJoinsOrConnections) {
 TEST(HostileRequests, PublicHostNameIsAcceptedWhenGiven) {
     Hostile h([](ServerOptions& o) { o.publicHost = "study.example.org"; });
     for (const std::string host : {"study.example.org", "Study.Example.org:443", "study.example.org:8080"})
-        EXPECT_EQ(statusOf(h.exchange("GET /api/study HTTP/1.1\r\nHost: " + host + "\r\nConnection: close\r\n\r\n")), 200) << host;
-    EXPECT_EQ(statusOf(h.exchange("GET /api/study HTTP/1.1\r\nHost: evil.example.org\r\nConnection: close\r\n\r\n")), 421);
+        EXPECT_EQ(statusOf(h.exchange("GET /api/study HTTP/1.1\r\nHost: " + host + "\r\nConnection: close\r\n\r\n")),
+                  200)
+            << host;
+    EXPECT_EQ(statusOf(h.exchange("GET /api/study HTTP/1.1\r\nHost: evil.example.org\r\nConnection: close\r\n\r\n")),
+              421);
 }
 
 TEST(HostileRequests, StimuliArePinnedCachedAndNeverFollowLinksOutOfTheSet) {

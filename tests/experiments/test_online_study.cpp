@@ -58,9 +58,9 @@ json prolificIds() { return {{"PROLIFIC_PID", kPid}, {"STUDY_ID", kStudyId}, {"S
 // What the page reports when a session starts.
 json viewing(int screenWidth = 1920, int screenHeight = 1080, double dpr = 1.0, bool fullscreen = true,
              bool pointerFine = true) {
-    return {{"viewport_width", 1600}, {"viewport_height", 900}, {"device_pixel_ratio", dpr},
+    return {{"viewport_width", 1600},      {"viewport_height", 900},        {"device_pixel_ratio", dpr},
             {"screen_width", screenWidth}, {"screen_height", screenHeight}, {"colour_depth", 24},
-            {"fullscreen", fullscreen}, {"pointer_fine", pointerFine}, {"touch_points", 0}};
+            {"fullscreen", fullscreen},    {"pointer_fine", pointerFine},   {"touch_points", 0}};
 }
 
 json withToken(json body, const std::string& token) {
@@ -68,15 +68,17 @@ json withToken(json body, const std::string& token) {
     return body;
 }
 
-json answer(const std::string& token, std::int64_t session, const json& state, bool hidden = false, bool blurred = false) {
-    return {{"token", token}, {"trial", state["trial"]["id"]}, {"side", "left"}, {"session", session},
-            {"response_ms", 640.0}, {"client_time", "2026-12-01T20:00:00.000Z"}, {"viewport_width", 1600},
-            {"viewport_height", 900}, {"device_pixel_ratio", 1.0}, {"page_hidden", hidden}, {"focus_lost", blurred},
-            {"fullscreen", true}};
+json answer(const std::string& token, std::int64_t session, const json& state, bool hidden = false,
+            bool blurred = false) {
+    return {{"token", token},         {"trial", state["trial"]["id"]}, {"side", "left"},
+            {"session", session},     {"response_ms", 640.0},          {"client_time", "2026-12-01T20:00:00.000Z"},
+            {"viewport_width", 1600}, {"viewport_height", 900},        {"device_pixel_ratio", 1.0},
+            {"page_hidden", hidden},  {"focus_lost", blurred},         {"fullscreen", true}};
 }
 
 // A rejected request: the status, an error naming `mentions`, and nothing stored.
-void expectRejected(RunningStudy& study, int status, const std::string& mentions, const std::function<JsonAnswer()>& send) {
+void expectRejected(RunningStudy& study, int status, const std::string& mentions,
+                    const std::function<JsonAnswer()>& send) {
     const std::string before = study.fingerprint();
     const JsonAnswer a = send();
     EXPECT_EQ(a.status, status) << a.raw;
@@ -120,7 +122,8 @@ TEST(OnlineStudy, ProlificIdsRoundTripResumeAndRedirect) {
     EXPECT_EQ(info.body["recruitment"]["platform"], "prolific");
     EXPECT_EQ(info.body["recruitment"]["parameters"], json({"PROLIFIC_PID", "STUDY_ID", "SESSION_ID"}));
 
-    const JsonAnswer joined = postJson(client, "/api/join", {{"join_key", "first-visit"}, {"recruitment", prolificIds()}});
+    const JsonAnswer joined =
+        postJson(client, "/api/join", {{"join_key", "first-visit"}, {"recruitment", prolificIds()}});
     ASSERT_EQ(joined.status, 201) << joined.raw;
     EXPECT_FALSE(joined.body["resumed"].get<bool>());
     const std::string token = joined.body["token"];
@@ -131,7 +134,8 @@ TEST(OnlineStudy, ProlificIdsRoundTripResumeAndRedirect) {
     json state = session.body;
     // Three answers: the second given while the page was hidden, the third after the window lost the focus.
     for (int i = 0; i < 3; ++i) {
-        const JsonAnswer ack = postJson(client, "/api/response", answer(token, session.body["session"], state, i == 1, i == 2));
+        const JsonAnswer ack =
+            postJson(client, "/api/response", answer(token, session.body["session"], state, i == 1, i == 2));
         ASSERT_EQ(ack.status, 200) << ack.raw;
         participantAnswers += ack.raw;
         state = ack.body;
@@ -139,7 +143,8 @@ TEST(OnlineStudy, ProlificIdsRoundTripResumeAndRedirect) {
     const std::int64_t nextTrial = state["trial"]["id"];
 
     // A repeat visit with the same PROLIFIC_PID (a new browser: another join key) is the same participant.
-    const JsonAnswer again = postJson(client, "/api/join", {{"join_key", "second-visit"}, {"recruitment", prolificIds()}});
+    const JsonAnswer again =
+        postJson(client, "/api/join", {{"join_key", "second-visit"}, {"recruitment", prolificIds()}});
     ASSERT_EQ(again.status, 200) << again.raw;
     EXPECT_TRUE(again.body["resumed"].get<bool>());
     EXPECT_EQ(again.body["token"], token);
@@ -165,7 +170,9 @@ TEST(OnlineStudy, ProlificIdsRoundTripResumeAndRedirect) {
     // Every export format carries the ids, the viewing conditions and the flags.
     const std::vector<std::string> csv = csvLines(exportResponses(study.store(), "csv"));
     ASSERT_EQ(csv.size(), 9u);
-    EXPECT_EQ(csv[0].rfind("observer,scene,condition_A,condition_B,is_A_selected,A_on_left,trial_kind,correct,response_ms,", 0), 0u);
+    EXPECT_EQ(csv[0].rfind(
+                  "observer,scene,condition_A,condition_B,is_A_selected,A_on_left,trial_kind,correct,response_ms,", 0),
+              0u);
     int flagged = 0;
     for (std::size_t k = 1; k < csv.size(); ++k) {
         EXPECT_EQ(fieldOf(csv[k], columnOf(csv[0], "external_id")), kPid) << csv[k];
@@ -202,7 +209,9 @@ TEST(OnlineStudy, ProlificIdsRoundTripResumeAndRedirect) {
 TEST(OnlineStudy, MalformedOrMissingPlatformIdsAreOne400NamingTheParameter) {
     RunningStudy study(design(kProlific));
     HttpClient client = study.client();
-    auto join = [&](json ids) { return [&client, ids] { return postJson(client, "/api/join", {{"recruitment", ids}}); }; };
+    auto join = [&](json ids) {
+        return [&client, ids] { return postJson(client, "/api/join", {{"recruitment", ids}}); };
+    };
     json shortPid = prolificIds();
     shortPid["PROLIFIC_PID"] = "5f8a1b2c";
     expectRejected(study, 400, "PROLIFIC_PID", join(shortPid));
@@ -227,7 +236,8 @@ TEST(OnlineStudy, MturkPreviewShowsNoJoinAndTheWorkerIdResumes) {
     HttpClient client = study.client();
     const JsonAnswer info = get(client, "/api/study");
     EXPECT_EQ(info.body["recruitment"]["parameters"], json({"workerId", "hitId", "assignmentId"}));
-    const json preview = {{"workerId", "A1B2C3D4E5F6G7"}, {"assignmentId", "ASSIGNMENT_ID_NOT_AVAILABLE"},
+    const json preview = {{"workerId", "A1B2C3D4E5F6G7"},
+                          {"assignmentId", "ASSIGNMENT_ID_NOT_AVAILABLE"},
                           {"hitId", "3ABCDEFGHIJKLMNOPQRSTUVWXYZ012"}};
     expectRejected(study, 403, "preview", [&] { return postJson(client, "/api/join", {{"recruitment", preview}}); });
     json badWorker = preview;
@@ -278,7 +288,8 @@ TEST(OnlineStudy, GenericPlatformUsesTheNamedParameter) {
     });
     const JsonAnswer joined = postJson(client, "/api/join", {{"recruitment", {{"survey_code", "48213"}}}});
     ASSERT_EQ(joined.status, 201) << joined.raw;
-    EXPECT_EQ(postJson(client, "/api/join", {{"recruitment", {{"survey_code", "48213"}}}}).body["token"], joined.body["token"]);
+    EXPECT_EQ(postJson(client, "/api/join", {{"recruitment", {{"survey_code", "48213"}}}}).body["token"],
+              joined.body["token"]);
     EXPECT_EQ(postJson(client, "/api/join", {{"recruitment", {{"survey_code", "48214"}}}}).status, 201);
     EXPECT_EQ(study.store().status().size(), 2u);
 }
@@ -296,10 +307,12 @@ TEST(OnlineStudy, DesignKeysAreCheckedStrictly) {
     EXPECT_NE(error("[recruitment]\nplatform = \"prolific\"\nid_parameter = \"x\"\n").find("recruitment.id_parameter"),
               std::string::npos);
     EXPECT_NE(error("[recruitment]\nplatform = \"qualtrics\"\n").find("recruitment.platform"), std::string::npos);
-    EXPECT_NE(error("[recruitment]\nplatform = \"generic\"\nid_parameter = \"p\"\n").find("id_parameter"), std::string::npos);
+    EXPECT_NE(error("[recruitment]\nplatform = \"generic\"\nid_parameter = \"p\"\n").find("id_parameter"),
+              std::string::npos);
     EXPECT_NE(error("[recruitment]\ncompletion_url = \"javascript:alert(1)\"\n").find("recruitment.completion_url"),
               std::string::npos);
-    EXPECT_NE(error("[recruitment]\ncompletion_code = \"a b\"\n").find("recruitment.completion_code"), std::string::npos);
+    EXPECT_NE(error("[recruitment]\ncompletion_code = \"a b\"\n").find("recruitment.completion_code"),
+              std::string::npos);
     EXPECT_NE(error("[display]\ncalibrate = true\n").find("display.viewing_distance_mm"), std::string::npos);
     EXPECT_NE(error("[requirements]\nfull_screen = true\n").find("requirements.full_screen"), std::string::npos);
     EXPECT_EQ(error("[recruitment]\nplatform = \"sona\"\nid_parameter = \"id\"\n[display]\ncalibrate = true\n"
@@ -328,7 +341,8 @@ TEST(OnlineStudy, RequirementsRefuseTheSessionBeforeTheFirstTrial) {
     expectRejected(study, 403, "full screen", start(viewing(1920, 1080, 1.0, false)));
     expectRejected(study, 403, "mouse or trackpad", start(viewing(1920, 1080, 1.0, true, false)));
     json bare = viewing();
-    for (const char* key : {"screen_width", "screen_height", "colour_depth", "fullscreen", "pointer_fine", "touch_points"})
+    for (const char* key :
+         {"screen_width", "screen_height", "colour_depth", "fullscreen", "pointer_fine", "touch_points"})
         bare.erase(key);
     expectRejected(study, 403, "did not report the screen", start(bare));
     const JsonAnswer refused = postJson(client, "/api/session", withToken(viewing(800, 600, 1.5, false, false), token));
@@ -348,7 +362,8 @@ TEST(OnlineStudy, CardCalibrationGivesPixelsPerDegree) {
     HttpClient client = study.client();
     const JsonAnswer joined = postJson(client, "/api/join", json::object());
     const std::string token = joined.body["token"];
-    expectRejected(study, 400, "card_width", [&] { return postJson(client, "/api/session", withToken(viewing(), token)); });
+    expectRejected(study, 400, "card_width",
+                   [&] { return postJson(client, "/api/session", withToken(viewing(), token)); });
     json calibrated = viewing(1440, 900, 2.0);
     calibrated["card_width"] = 323.5;
     const JsonAnswer session = postJson(client, "/api/session", withToken(calibrated, token));
@@ -376,12 +391,14 @@ TEST(OnlineStudy, AnalyzeScaleDropsFlaggedTrialsFromEveryFormat) {
         json state = session.body;
         // The participant API hides which trials are tests (catch trials look alike): the store knows.
         std::map<std::int64_t, TrialKind> kinds;
-        for (const TrialRecord& t : study.store().trials(study.store().participant(token).id)) kinds[t.id] = t.plan.kind;
+        for (const TrialRecord& t : study.store().trials(study.store().participant(token).id))
+            kinds[t.id] = t.plan.kind;
         int tests = 0;
         while (!state["completed"].get<bool>()) {
             const TrialKind kind = kinds.at(state["trial"]["id"].get<std::int64_t>() & 0xFFFFFFFFll);
             const int n = kind == TrialKind::test ? ++tests : 0;
-            state = postJson(client, "/api/response", answer(token, session.body["session"], state, n == 1, n == 3)).body;
+            state =
+                postJson(client, "/api/response", answer(token, session.body["session"], state, n == 1, n == 3)).body;
         }
     }
     ASSERT_EQ(study.store().flaggedTrials().size(), 4u);

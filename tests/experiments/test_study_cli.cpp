@@ -50,8 +50,9 @@ CommandResult runSkinlab(std::vector<std::string> arguments) {
 
 // Starts `skinlab study serve` and returns the port it printed.
 int startServer(std::unique_ptr<ChildProcess>& child, const fs::path& database, int port) {
-    child = std::make_unique<ChildProcess>(std::vector<std::string>{
-        SKINLAB_CLI, "study", "serve", database.string(), "--port", std::to_string(port), "--token", "t0ken", "--threads", "16"});
+    child = std::make_unique<ChildProcess>(std::vector<std::string>{SKINLAB_CLI, "study", "serve", database.string(),
+                                                                    "--port", std::to_string(port), "--token", "t0ken",
+                                                                    "--threads", "16"});
     static const std::regex serving(R"(serving .* on http://127\.0\.0\.1:(\d+)/)");
     for (int i = 0; i < 10; ++i) {
         bool ok = false;
@@ -68,37 +69,39 @@ int startServer(std::unique_ptr<ChildProcess>& child, const fs::path& database, 
 TEST(StudyCli, CreateStatusExportAndTheirErrors) {
     StudyFiles files;
     CommandResult created = runSkinlab({"study", "create", "--stimuli", files.stimuli.string(), "--design",
-                                     files.design.string(), "-o", files.database.string()});
+                                        files.design.string(), "-o", files.database.string()});
     ASSERT_EQ(created.exitCode, 0) << created.err;
-    EXPECT_NE(created.out.find("per participant 27 trials (1 practice, 12 test, 12 repeat, 2 catch)"), std::string::npos)
+    EXPECT_NE(created.out.find("per participant 27 trials (1 practice, 12 test, 12 repeat, 2 catch)"),
+              std::string::npos)
         << created.out;
 
     // Never overwrites a study; the existing file is untouched.
     const std::string before = skinlab::sha256File(files.database);
     CommandResult again = runSkinlab({"study", "create", "--stimuli", files.stimuli.string(), "--design",
-                                   files.design.string(), "-o", files.database.string()});
+                                      files.design.string(), "-o", files.database.string()});
     EXPECT_EQ(again.exitCode, 2);
-    EXPECT_EQ(again.err, "skinlab: error: " + files.database.string() +
-                             ": already exists; a study file is never overwritten (it may hold responses) — choose another "
-                             "-o or remove it first\n");
+    EXPECT_EQ(again.err,
+              "skinlab: error: " + files.database.string() +
+                  ": already exists; a study file is never overwritten (it may hold responses) — choose another "
+                  "-o or remove it first\n");
     EXPECT_EQ(skinlab::sha256File(files.database), before);
 
     // Design errors name the file and key, and leave no output behind.
     const fs::path other = files.folder.path() / "other.db";
     CommandResult badKey = runSkinlab({"study", "create", "--stimuli", files.stimuli.string(), "--design",
-                                    files.design.string(), "-o", other.string(), "--set", "repetitions=0"});
+                                       files.design.string(), "-o", other.string(), "--set", "repetitions=0"});
     EXPECT_EQ(badKey.exitCode, 2);
     EXPECT_EQ(badKey.err, "skinlab: error: " + files.design.string() + ": repetitions: 0 is out of range [1, 100]\n");
     EXPECT_FALSE(fs::exists(other));
     CommandResult noManifest = runSkinlab({"study", "create", "--stimuli", files.folder.path().string(), "--design",
-                                        files.design.string(), "-o", other.string()});
+                                           files.design.string(), "-o", other.string()});
     EXPECT_EQ(noManifest.exitCode, 2);
     EXPECT_EQ(noManifest.err, "skinlab: error: " + (files.folder.path() / "manifest.json").string() +
                                   ": no manifest.json in the stimulus folder\n");
     // A stimulus changed after the set was built: its hash no longer matches.
     skinlab::writeFileAtomic(files.stimuli / "png" / "1-artistic.png", "not a png");
     CommandResult changed = runSkinlab({"study", "create", "--stimuli", files.stimuli.string(), "--design",
-                                     files.design.string(), "-o", other.string()});
+                                        files.design.string(), "-o", other.string()});
     EXPECT_EQ(changed.exitCode, 2);
     EXPECT_NE(changed.err.find("1-artistic.png: sha256 differs from the manifest"), std::string::npos) << changed.err;
     EXPECT_FALSE(fs::exists(other));
@@ -108,8 +111,12 @@ TEST(StudyCli, CreateStatusExportAndTheirErrors) {
     EXPECT_NE(status.out.find("0 participants, 0 completed, 0 responses"), std::string::npos) << status.out;
     CommandResult csv = runSkinlab({"study", "export", files.database.string(), "--format", "csv"});
     // Contract 3's columns, then the online columns (docs/experiments.md), and no rows.
-    EXPECT_EQ(csv.out.rfind("observer,scene,condition_A,condition_B,is_A_selected,A_on_left,trial_kind,correct,response_ms,"
-                            "flagged,", 0), 0u) << csv.out;
+    EXPECT_EQ(
+        csv.out.rfind("observer,scene,condition_A,condition_B,is_A_selected,A_on_left,trial_kind,correct,response_ms,"
+                      "flagged,",
+                      0),
+        0u)
+        << csv.out;
     EXPECT_EQ(std::count(csv.out.begin(), csv.out.end(), '\n'), 1) << csv.out;
     CommandResult badFormat = runSkinlab({"study", "export", files.database.string(), "--format", "xls"});
     EXPECT_NE(badFormat.exitCode, 0);
@@ -120,8 +127,8 @@ TEST(StudyCli, CreateStatusExportAndTheirErrors) {
 
 TEST(StudyCli, KillNineDuringASessionLosesAndDuplicatesNothing) {
     StudyFiles files;
-    ASSERT_EQ(runSkinlab({"study", "create", "--stimuli", files.stimuli.string(), "--design", files.design.string(), "-o",
-                       files.database.string()})
+    ASSERT_EQ(runSkinlab({"study", "create", "--stimuli", files.stimuli.string(), "--design", files.design.string(),
+                          "-o", files.database.string()})
                   .exitCode,
               0);
     std::unique_ptr<ChildProcess> server;
@@ -162,7 +169,8 @@ TEST(StudyCli, KillNineDuringASessionLosesAndDuplicatesNothing) {
     // Exactly one stored response per planned trial, and every acknowledged answer stored as acknowledged.
     EXPECT_EQ(store.responseCount(), total);
     std::map<std::int64_t, bool> storedLeft;
-    for (const ResponseRow& r : store.responses()) EXPECT_TRUE(storedLeft.emplace(r.trialId, r.aSelected == r.aOnLeft).second);
+    for (const ResponseRow& r : store.responses())
+        EXPECT_TRUE(storedLeft.emplace(r.trialId, r.aSelected == r.aOnLeft).second);
     std::size_t acknowledged = 0;
     for (const ObserverResult& o : report.observers)
         for (const auto& [trial, side] : o.acknowledged) {
@@ -178,15 +186,17 @@ TEST(StudyCli, KillNineDuringASessionLosesAndDuplicatesNothing) {
 
     // The CLI's own simulate, status and export work against the restarted server.
     CommandResult simulated = runSkinlab({"study", "simulate", files.database.string(), "--observers", "2", "--url",
-                                       "http://127.0.0.1:" + std::to_string(port), "--truth-factor", "quality",
-                                       "--lapse", "0.1", "--label-prefix", "cli"});
+                                          "http://127.0.0.1:" + std::to_string(port), "--truth-factor", "quality",
+                                          "--lapse", "0.1", "--label-prefix", "cli"});
     EXPECT_EQ(simulated.exitCode, 0) << simulated.out << simulated.err;
     EXPECT_NE(simulated.out.find("2/2 observers completed, 54 responses acknowledged, 0 rejected"), std::string::npos)
         << simulated.out;
     CommandResult status = runSkinlab({"study", "status", files.database.string()});
     EXPECT_NE(status.out.find("14 participants, 14 completed, 378 responses"), std::string::npos) << status.out;
     const fs::path exported = files.folder.path() / "responses.csv";
-    ASSERT_EQ(runSkinlab({"study", "export", files.database.string(), "--format", "pwcmp", "-o", exported.string()}).exitCode, 0);
+    ASSERT_EQ(
+        runSkinlab({"study", "export", files.database.string(), "--format", "pwcmp", "-o", exported.string()}).exitCode,
+        0);
     const std::string pwcmp = skinlab::readFile(exported);
     EXPECT_EQ(std::count(pwcmp.begin(), pwcmp.end(), '\n'), 1 + 14 * 24);
 

@@ -91,7 +91,9 @@ TEST(StudyDashboard, TokenOnlyInTheAuthorizationHeader) {
     EXPECT_EQ(inUrl.status, 401);
     EXPECT_NE(inUrl.raw.find("never in the URL"), std::string::npos) << inUrl.raw;
     EXPECT_EQ(dashboard(client, "wrong-token").status, 403);
-    EXPECT_EQ(get(client, "/api/researcher/dashboard", {{"Authorization", std::string("Basic ") + kResearcherToken}}).status, 401);
+    EXPECT_EQ(
+        get(client, "/api/researcher/dashboard", {{"Authorization", std::string("Basic ") + kResearcherToken}}).status,
+        401);
     const JsonAnswer ok = dashboard(client);
     ASSERT_EQ(ok.status, 200) << ok.raw;
     EXPECT_EQ(ok.contentType, "application/json");
@@ -195,7 +197,8 @@ TEST(StudyServerProxy, ForwardedAddressIsBelievedOnlyFromATrustedProxy) {
     ASSERT_EQ(board.status, 200);
     std::map<std::string, std::string> addresses;
     for (const json& p : board.body["participants"])
-        addresses[p["observer"]] = p["client_address"].get<std::string>() + "/" + p["address_source"].get<std::string>();
+        addresses[p["observer"]] =
+            p["client_address"].get<std::string>() + "/" + p["address_source"].get<std::string>();
     EXPECT_EQ(addresses["P001"], "198.51.100.7/forwarded");
     EXPECT_EQ(addresses["P002"], "198.51.100.8/forwarded");
     EXPECT_EQ(addresses["P003"], "127.0.0.3/peer");
@@ -251,13 +254,14 @@ TEST(StudyBackup, CopyWhileAnswersAreWrittenHoldsAConsistentPrefix) {
         // A consistent prefix: participants answered in order, each one's trials in order, so the copy holds
         // every answer of the participants before some point, a leading run of positions of the one at that
         // point, and nothing after it.
-        SqliteStatement rows = copy.prepare(
-            "SELECT t.participant_id, t.position FROM responses r JOIN trials t ON t.id = r.trial_id"
-            " ORDER BY t.participant_id, t.position");
+        SqliteStatement rows =
+            copy.prepare("SELECT t.participant_id, t.position FROM responses r JOIN trials t ON t.id = r.trial_id"
+                         " ORDER BY t.participant_id, t.position");
         std::vector<std::pair<std::int64_t, int>> stored;
         while (rows.step()) stored.emplace_back(rows.integer(0), static_cast<int>(rows.integer(1)));
         EXPECT_EQ(static_cast<std::int64_t>(stored.size()), summary.responses);
-        SqliteStatement planned = copy.prepare("SELECT participant_id, COUNT(*) FROM trials GROUP BY participant_id ORDER BY participant_id");
+        SqliteStatement planned =
+            copy.prepare("SELECT participant_id, COUNT(*) FROM trials GROUP BY participant_id ORDER BY participant_id");
         std::map<std::int64_t, int> perParticipant;
         while (planned.step()) perParticipant[planned.integer(0)] = static_cast<int>(planned.integer(1));
         std::size_t k = 0;
@@ -292,8 +296,10 @@ TEST(StudyBackup, CopyWhileAnswersAreWrittenHoldsAConsistentPrefix) {
 
 TEST(NginxSiteConfig, FillsTheTemplateAndRefusesValuesNginxWouldMisread) {
     TemporaryFolder folder("nginx-config");
-    const auto cert = writeText(folder.path(), "cert.pem", "-----BEGIN CERTIFICATE-----\nMIIB\n-----END CERTIFICATE-----\n");
-    const auto key = writeText(folder.path(), "key.pem", "-----BEGIN PRIVATE KEY-----\nMIIB\n-----END PRIVATE KEY-----\n");
+    const auto cert =
+        writeText(folder.path(), "cert.pem", "-----BEGIN CERTIFICATE-----\nMIIB\n-----END CERTIFICATE-----\n");
+    const auto key =
+        writeText(folder.path(), "key.pem", "-----BEGIN PRIVATE KEY-----\nMIIB\n-----END PRIVATE KEY-----\n");
     NginxSiteOptions o;
     o.serverName = "study.example.org";
     o.upstream = "127.0.0.1:8080";
@@ -328,6 +334,7 @@ TEST(NginxSiteConfig, FillsTheTemplateAndRefusesValuesNginxWouldMisread) {
     refused([](NginxSiteOptions& b) { b.certificate = "cert.pem"; }, "--cert");
     refused([](NginxSiteOptions& b) { b.certificate = b.certificate + " ssl_verify"; }, "--cert");
     refused([&](NginxSiteOptions& b) { b.key = (folder.path() / "missing.pem").string(); }, "--key");
-    refused([&](NginxSiteOptions& b) { b.key = writeText(folder.path(), "plain.txt", "not a key\n").string(); }, "--key");
+    refused([&](NginxSiteOptions& b) { b.key = writeText(folder.path(), "plain.txt", "not a key\n").string(); },
+            "--key");
     refused([](NginxSiteOptions& b) { b.listen = "443x"; }, "--listen");
 }

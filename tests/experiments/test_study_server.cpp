@@ -103,7 +103,8 @@ TEST(StudyServer, ParticipantCompletesASessionAndExportsFollowContract3) {
             EXPECT_EQ(image.contentType, "image/png");
             EXPECT_EQ(image.raw.substr(1, 3), "PNG");
         }
-        JsonAnswer ack = postJson(client, "/api/response", responseBody(p, trial["id"], answered % 3 ? "left" : "right"));
+        JsonAnswer ack =
+            postJson(client, "/api/response", responseBody(p, trial["id"], answered % 3 ? "left" : "right"));
         ASSERT_EQ(ack.status, 200) << ack.raw;
         EXPECT_TRUE(ack.body["stored"].get<bool>());
         p.state = ack.body;
@@ -117,7 +118,11 @@ TEST(StudyServer, ParticipantCompletesASessionAndExportsFollowContract3) {
     std::string line;
     std::getline(csv, line);
     // Contract 3's columns first; the online columns (empty here: a client that reports none) after them.
-    EXPECT_EQ(line.rfind("observer,scene,condition_A,condition_B,is_A_selected,A_on_left,trial_kind,correct,response_ms,flagged,", 0), 0u)
+    EXPECT_EQ(
+        line.rfind(
+            "observer,scene,condition_A,condition_B,is_A_selected,A_on_left,trial_kind,correct,response_ms,flagged,",
+            0),
+        0u)
         << line;
     int rows = 0, practice = 0, catches = 0;
     while (std::getline(csv, line)) {
@@ -147,7 +152,8 @@ TEST(StudyServer, ParticipantCompletesASessionAndExportsFollowContract3) {
     EXPECT_EQ(exported["responses"][0]["user_agent"].get<std::string>().rfind("skinlab-client", 0), 0u);
 
     // Researcher endpoints with the token.
-    JsonAnswer status = get(client, "/api/researcher/status", {{"Authorization", std::string("Bearer ") + kResearcherToken}});
+    JsonAnswer status =
+        get(client, "/api/researcher/status", {{"Authorization", std::string("Bearer ") + kResearcherToken}});
     ASSERT_EQ(status.status, 200);
     EXPECT_EQ(status.body["participants"][0]["answered"], 16);
     EXPECT_EQ(status.body["participants"][0]["catch_answered"], 2);
@@ -203,9 +209,12 @@ TEST(StudyServer, HostileAndMalformedRequestsAreRejectedWithoutChangingData) {
     };
     const json good = responseBody(alice, second, "right");
 
-    expectRejected(study, "bad JSON", 400, [&] { return postRaw(client, "/api/response", "{\"token\": ", "application/json"); });
-    expectRejected(study, "JSON array", 400, [&] { return postRaw(client, "/api/response", "[1,2]", "application/json"); });
-    expectRejected(study, "not JSON content type", 415, [&] { return postRaw(client, "/api/response", good.dump(), "text/plain"); });
+    expectRejected(study, "bad JSON", 400,
+                   [&] { return postRaw(client, "/api/response", "{\"token\": ", "application/json"); });
+    expectRejected(study, "JSON array", 400,
+                   [&] { return postRaw(client, "/api/response", "[1,2]", "application/json"); });
+    expectRejected(study, "not JSON content type", 415,
+                   [&] { return postRaw(client, "/api/response", good.dump(), "text/plain"); });
     expectRejected(study, "form post", 415, [&] {
         return postRaw(client, "/api/response", "token=x&trial=1", "application/x-www-form-urlencoded");
     });
@@ -253,11 +262,11 @@ TEST(StudyServer, HostileAndMalformedRequestsAreRejectedWithoutChangingData) {
     expectRejected(study, "export with wrong token", 403, [&] {
         return get(client, "/api/researcher/export", {{"Authorization", "Bearer abc"}});
     });
-    expectRejected(study, "export with the token in the URL", 401, [&] {
-        return get(client, std::string("/api/researcher/export?token=") + kResearcherToken);
-    });
+    expectRejected(study, "export with the token in the URL", 401,
+                   [&] { return get(client, std::string("/api/researcher/export?token=") + kResearcherToken); });
     expectRejected(study, "export with bad format", 400, [&] {
-        return get(client, "/api/researcher/export?format=xml", {{"Authorization", std::string("Bearer ") + kResearcherToken}});
+        return get(client, "/api/researcher/export?format=xml",
+                   {{"Authorization", std::string("Bearer ") + kResearcherToken}});
     });
 
     // Path traversal and files outside the study: nothing but the numbered stimuli is reachable.
@@ -339,7 +348,8 @@ TEST(StudyServer, SimulateRunAgainWithTheSamePrefixContinuesItsObservers) {
     RunningStudy study(kDesign);
     // An interrupted run: observer "resume-001" joined (with the simulator's join key) and answered 3 trials.
     HttpClient client = study.client();
-    JsonAnswer joined = postJson(client, "/api/join", {{"label", "resume-001"}, {"join_key", simulatedJoinKey("resume-001")}});
+    JsonAnswer joined =
+        postJson(client, "/api/join", {{"label", "resume-001"}, {"join_key", simulatedJoinKey("resume-001")}});
     ASSERT_EQ(joined.status, 201) << joined.raw;
     Participant p;
     p.token = joined.body["token"];

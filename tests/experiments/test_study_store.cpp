@@ -127,7 +127,11 @@ TEST(StudyStore, ClientTextIsStoredAsWellFormedUtf8AndExportsNeverFail) {
 
 TEST(StudyStore, ValidUtf8KeepsWellFormedTextAndBoundsIt) {
     EXPECT_EQ(validUtf8("plain ascii", 512), "plain ascii");
-    EXPECT_EQ(validUtf8("Gr\xC3\xBC\xC3\x9F" "e \xF0\x9F\x98\x80", 512), "Gr\xC3\xBC\xC3\x9F" "e \xF0\x9F\x98\x80");
+    EXPECT_EQ(validUtf8("Gr\xC3\xBC\xC3\x9F"
+                        "e \xF0\x9F\x98\x80",
+                        512),
+              "Gr\xC3\xBC\xC3\x9F"
+              "e \xF0\x9F\x98\x80");
     EXPECT_EQ(validUtf8("\xC0\xAF", 512), "\xEF\xBF\xBD") << "overlong '/'";
     EXPECT_EQ(validUtf8("\xED\xA0\x80", 512), "\xEF\xBF\xBD") << "surrogate";
     EXPECT_EQ(validUtf8("\xF4\x90\x80\x80", 512), "\xEF\xBF\xBD") << "above U+10FFFF";
@@ -168,13 +172,15 @@ TEST(StudyStore, TrialReferencesAreTaggedAndScopedToTheirParticipant) {
     // References fit in a JavaScript number and differ between participants.
     EXPECT_LT(trialReference(alice.token, aliceTrials[0].id), std::int64_t(1) << 53);
     EXPECT_NE(trialReference(alice.token, 7), trialReference(bob.token, 7));
-    EXPECT_EQ(study.store->recordResponse(answer(alice, aliceSession, aliceTrials[0], "left")), ResponseOutcome::stored);
+    EXPECT_EQ(study.store->recordResponse(answer(alice, aliceSession, aliceTrials[0], "left")),
+              ResponseOutcome::stored);
 }
 
 // Property: whatever `study export` writes, in any format, `analyze scale`'s reader reads back the same responses,
 // whatever the block, condition and observer names hold (commas, quotes, line breaks, spaces, non-ASCII).
 TEST(StudyStore, EveryExportFormatReadsBackToTheSameCounts) {
-    const std::vector<std::string> alphabet = {"a", "B", "7", ",", "\"", "\n", "\r\n", " ", "\t", "\xC3\xA9", "'", ";", "-", "\xE2\x82\xAC"};
+    const std::vector<std::string> alphabet = {"a", "B",  "7",        ",", "\"", "\n", "\r\n",
+                                               " ", "\t", "\xC3\xA9", "'", ";",  "-",  "\xE2\x82\xAC"};
     for (std::uint64_t seed = 1; seed <= 12; ++seed) {
         SCOPED_TRACE("seed " + std::to_string(seed));
         StudyFile study;
@@ -182,7 +188,8 @@ TEST(StudyStore, EveryExportFormatReadsBackToTheSameCounts) {
         auto randomName = [&](const std::string& base) {
             std::string name;
             const int n = 1 + static_cast<int>(random.unit() * 8);
-            for (int k = 0; k < n; ++k) name += alphabet[static_cast<std::size_t>(random.unit() * alphabet.size()) % alphabet.size()];
+            for (int k = 0; k < n; ++k)
+                name += alphabet[static_cast<std::size_t>(random.unit() * alphabet.size()) % alphabet.size()];
             // Keep names distinct and not only blanks: the reader trims unquoted blanks, as CSV readers do.
             return (random.coin() ? name + base : base + name);
         };
@@ -203,7 +210,8 @@ TEST(StudyStore, EveryExportFormatReadsBackToTheSameCounts) {
             }
             for (const auto& [from, to] : names)
                 for (const char* column : {"block", "condition_a", "condition_b"}) {
-                    SqliteStatement u = db.prepare(std::string("UPDATE trials SET ") + column + " = ? WHERE " + column + " = ?");
+                    SqliteStatement u =
+                        db.prepare(std::string("UPDATE trials SET ") + column + " = ? WHERE " + column + " = ?");
                     u.bind(1, to).bind(2, from);
                     u.run();
                 }

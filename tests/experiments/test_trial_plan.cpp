@@ -47,7 +47,8 @@ TEST(TrialPlan, ResolvesBlocksConditionsAndPairs) {
     EXPECT_EQ(withReference.blocks[0].conditions.size(), 3u);
     EXPECT_EQ(withReference.blocks[0].pairs.size(), 3u);
     ASSERT_GE(withReference.blocks[0].referenceStimulus, 0);
-    EXPECT_EQ(withReference.stimuli[static_cast<std::size_t>(withReference.blocks[0].referenceStimulus)].id, "0-reference");
+    EXPECT_EQ(withReference.stimuli[static_cast<std::size_t>(withReference.blocks[0].referenceStimulus)].id,
+              "0-reference");
 
     const StudyDefinition listed = makeStudy("pairs = [[\"separable\", \"artistic\"]]\nblocks = [\"scene:b/close\"]\n");
     ASSERT_EQ(listed.blocks.size(), 1u);
@@ -71,7 +72,8 @@ TEST(TrialPlan, SameSeedSamePlanOtherParticipantOtherOrder) {
     }
     const auto c = planTrials(study, 4, participantSeed(study.design.seed, 4));
     int differences = 0;
-    for (std::size_t i = 0; i < std::min(a.size(), c.size()); ++i) differences += pairKey(a[i]) != pairKey(c[i]) ? 1 : 0;
+    for (std::size_t i = 0; i < std::min(a.size(), c.size()); ++i)
+        differences += pairKey(a[i]) != pairKey(c[i]) ? 1 : 0;
     EXPECT_GT(differences, static_cast<int>(a.size()) / 2) << "orders of two participants should differ";
 }
 
@@ -172,7 +174,8 @@ TEST(TrialPlan, PracticeFirstCatchSpreadAndNoPairTwiceInARow) {
 }
 
 TEST(TrialPlan, GroupedBlocksStayTogether) {
-    const StudyDefinition study = makeStudy("seed = 2\nblock_order = \"grouped\"\n[catch]\nblank = 0\n[practice]\ntrials = 0\n");
+    const StudyDefinition study =
+        makeStudy("seed = 2\nblock_order = \"grouped\"\n[catch]\nblank = 0\n[practice]\ntrials = 0\n");
     const auto plan = planTrials(study, 0, participantSeed(2, 0));
     int switches = 0;
     for (std::size_t i = 1; i < plan.size(); ++i) switches += plan[i].block != plan[i - 1].block ? 1 : 0;
@@ -182,21 +185,25 @@ TEST(TrialPlan, GroupedBlocksStayTogether) {
 TEST(TrialPlan, DesignErrorsNameFileKeyAndValue) {
     EXPECT_EQ(expectInputError("repetitions = 0\n"), "D.toml: repetitions: 0 is out of range [1, 100]");
     EXPECT_EQ(expectInputError("repetitons = 2\n"), "D.toml: repetitons: unknown key");
-    EXPECT_EQ(expectInputError("block_order = \"random\"\n"), "D.toml: block_order: 'random' is not one of: interleaved, grouped");
-    EXPECT_EQ(expectInputError("conditions = [\"separabel\", \"artistic\"]\n"),
-              "D.toml: conditions: \"separabel\" is not a level of factor \"method\" (levels: reference-like, separable, "
-              "artistic, reference)");
+    EXPECT_EQ(expectInputError("block_order = \"random\"\n"),
+              "D.toml: block_order: 'random' is not one of: interleaved, grouped");
+    EXPECT_EQ(
+        expectInputError("conditions = [\"separabel\", \"artistic\"]\n"),
+        "D.toml: conditions: \"separabel\" is not a level of factor \"method\" (levels: reference-like, separable, "
+        "artistic, reference)");
     EXPECT_EQ(expectInputError("pairs = [[\"separable\", \"separable\"]]\n"),
               "D.toml: pairs[0]: a condition cannot be compared with itself (\"separable\")");
     EXPECT_EQ(expectInputError("pairs = \"some\"\n"),
               "D.toml: pairs: expected \"all\", \"active\" or an array of [A, B] condition pairs, got \"some\"");
     EXPECT_EQ(expectInputError("blocks = [\"scene:c\"]\n"),
               "D.toml: blocks: \"scene:c\" is not a block of the stimulus set (blocks: scene:a/mid, scene:b/close)");
-    EXPECT_EQ(expectInputError("condition_factor = \"scene\"\n"),
-              "D.toml: condition_factor: block \"scene:a/mid\" has two stimuli with scene=scene:a/mid (\"0-reference-like\", "
-              "\"0-separable\"); choose a factor that tells them apart, or split blocks");
-    EXPECT_EQ(expectInputError("[[catch.pairs]]\nfirst = \"0-separable\"\nsecond = \"0-nope\"\nexpected = \"0-separable\"\n"),
-              "D.toml: catch.pairs[0].second: no stimulus with id \"0-nope\"");
+    EXPECT_EQ(
+        expectInputError("condition_factor = \"scene\"\n"),
+        "D.toml: condition_factor: block \"scene:a/mid\" has two stimuli with scene=scene:a/mid (\"0-reference-like\", "
+        "\"0-separable\"); choose a factor that tells them apart, or split blocks");
+    EXPECT_EQ(
+        expectInputError("[[catch.pairs]]\nfirst = \"0-separable\"\nsecond = \"0-nope\"\nexpected = \"0-separable\"\n"),
+        "D.toml: catch.pairs[0].second: no stimulus with id \"0-nope\"");
     EXPECT_EQ(expectInputError("[[catch.pairs]]\nfirst = \"0-separable\"\nsecond = \"0-artistic\"\nexpected = \"x\"\n"),
               "D.toml: catch.pairs[0].expected: must be the first or the second stimulus id, got \"x\"");
 }

@@ -21,7 +21,7 @@ TEST(ReportPlots, HugeAndUndefinedIntervalsAreClippedAndMarked) {
     std::vector<IntervalPoint> points = {{"a", 1.0, -1e9, 1e9}, {"b", 0.0, -0.5, 0.5}, {"c", -1.0, NAN, inf}};
     std::string svg = scaleSvg(points);
     EXPECT_LT(svg.size(), 20000u) << "the plot's size must not depend on the bounds";
-    EXPECT_EQ(count(svg, "class=\"clip\""), 4);  // a: both ends; c: both ends (undefined and infinite)
+    EXPECT_EQ(count(svg, "class=\"clip\""), 4); // a: both ends; c: both ends (undefined and infinite)
     EXPECT_EQ(count(svg, "<circle"), 3);
     EXPECT_EQ(count(svg, "class=\"grid\""), count(svg, "class=\"tick\""));
     EXPECT_LE(count(svg, "class=\"grid\""), 12);
@@ -30,7 +30,8 @@ TEST(ReportPlots, HugeAndUndefinedIntervalsAreClippedAndMarked) {
 }
 
 TEST(ReportPlots, ScatterSkipsUndefinedPoints) {
-    std::vector<ScatterPoint> points = {{"a", 0.1, 1.0, 0.5, 1.5}, {"b", NAN, 0.0, -0.5, 0.5}, {"c", 0.3, -1.0, -1e9, 1e9}};
+    std::vector<ScatterPoint> points = {
+        {"a", 0.1, 1.0, 0.5, 1.5}, {"b", NAN, 0.0, -0.5, 0.5}, {"c", 0.3, -1.0, -1e9, 1e9}};
     std::string svg = scatterSvg(points, "mean FLIP");
     EXPECT_EQ(count(svg, "<circle"), 2);
     EXPECT_LT(svg.size(), 20000u);

@@ -20,7 +20,7 @@ using namespace skinlab::stimuli;
 
 namespace {
 
-const fs::path kSpecFile = "set.toml";  // a name for messages; relative scene paths resolve next to it
+const fs::path kSpecFile = "set.toml"; // a name for messages; relative scene paths resolve next to it
 
 SetSpec spec(const std::string& text, const std::vector<std::string>& overrides = {}) {
     return readSetSpecString(text, kSpecFile, overrides);
@@ -33,7 +33,8 @@ std::vector<std::string> ids(const std::vector<Stimulus>& stimuli) {
 }
 
 // The message of the InputError thrown by f, or "" when nothing is thrown.
-template <class F> std::string errorOf(F&& f) {
+template <class F>
+std::string errorOf(F&& f) {
     try {
         f();
     } catch (const skinlab::InputError& e) {
@@ -105,7 +106,7 @@ levels = [0.5]
                                                   "head-samples-25-no-follow_surface-width_mm-0.5"}));
     EXPECT_EQ(all[1].overrides,
               (std::vector<std::string>{"sss.samples=5", "sss.follow_surface=false", "sss.width_mm=0.5"}));
-    EXPECT_EQ(all[1].block, "builtin:head");  // no view factor and no fixed view: the block is the scene
+    EXPECT_EQ(all[1].block, "builtin:head"); // no view factor and no fixed view: the block is the scene
 }
 
 TEST(StimulusExpansion, NamingTemplateAndLabels) {
@@ -157,8 +158,8 @@ method = "reference"
     EXPECT_TRUE(all[8].reference);
     EXPECT_EQ(all[8].block, "builtin:head/mid");
     // A reference leaves non-block factors (samples) at the scene's default.
-    EXPECT_EQ(all[8].overrides, (std::vector<std::string>{"render.height=64", "render.width=96",
-                                                          "camera.view=\"mid\"", "sss.method=\"reference\""}));
+    EXPECT_EQ(all[8].overrides, (std::vector<std::string>{"render.height=64", "render.width=96", "camera.view=\"mid\"",
+                                                          "sss.method=\"reference\""}));
 }
 
 // An [sss] key the stimulus' method does not read is refused in a factor, an include and a reference alike, naming
@@ -172,17 +173,21 @@ scene = "builtin:head"
 name = "method"
 levels = ["separable", "artistic"]
 )";
-    EXPECT_EQ(errorOf([&] { expand(spec(base + "[[include]]\nmethod = \"artistic\"\nsss.profile = \"burley\"\n")); })
-                  .rfind("set.toml: include[0]: sss.profile: not a parameter of method 'artistic' (its keys: ", 0),
+    EXPECT_EQ(errorOf([&] {
+                  expand(spec(base + "[[include]]\nmethod = \"artistic\"\nsss.profile = \"burley\"\n"));
+              }).rfind("set.toml: include[0]: sss.profile: not a parameter of method 'artistic' (its keys: ", 0),
               0u);
-    EXPECT_NE(errorOf([&] { expand(spec(base + "[[factor]]\nname = \"sss.pscbf_sigma\"\nlevels = [\"std-dev\"]\n")); })
-                  .find("sss.pscbf_sigma: not a parameter of method 'separable'"),
+    EXPECT_NE(errorOf([&] {
+                  expand(spec(base + "[[factor]]\nname = \"sss.pscbf_sigma\"\nlevels = [\"std-dev\"]\n"));
+              }).find("sss.pscbf_sigma: not a parameter of method 'separable'"),
               std::string::npos);
-    EXPECT_NE(errorOf([&] { expand(spec(base + "[[reference]]\nmethod = \"reference\"\nsss.samples = 11\n")); })
-                  .find("sss.samples: not a parameter of method 'reference'"),
+    EXPECT_NE(errorOf([&] {
+                  expand(spec(base + "[[reference]]\nmethod = \"reference\"\nsss.samples = 11\n"));
+              }).find("sss.samples: not a parameter of method 'reference'"),
               std::string::npos);
     // The same key where it belongs: fine.
-    EXPECT_EQ(errorOf([&] { expand(spec(base + "[[include]]\nmethod = \"separable\"\nsss.profile = \"burley\"\n")); }), "");
+    EXPECT_EQ(errorOf([&] { expand(spec(base + "[[include]]\nmethod = \"separable\"\nsss.profile = \"burley\"\n")); }),
+              "");
     // [fixed]: sss.samples and sss.sampling go where they are read; width_mm (read by every method) everywhere.
     const std::vector<Stimulus> all = expand(spec(base + R"(
 [fixed]
@@ -193,7 +198,8 @@ method = "reference"
     ASSERT_EQ(all.size(), 3u);
     EXPECT_EQ(all[0].overrides, (std::vector<std::string>{"sss.samples=11", "sss.sampling=\"importance\"",
                                                           "sss.width_mm=2.0", "sss.method=\"separable\""}));
-    EXPECT_EQ(all[1].overrides, (std::vector<std::string>{"sss.samples=11", "sss.width_mm=2.0", "sss.method=\"artistic\""}));
+    EXPECT_EQ(all[1].overrides,
+              (std::vector<std::string>{"sss.samples=11", "sss.width_mm=2.0", "sss.method=\"artistic\""}));
     EXPECT_EQ(all[2].overrides, (std::vector<std::string>{"sss.width_mm=2.0", "sss.method=\"reference\""}));
 }
 
@@ -307,8 +313,7 @@ INSTANTIATE_TEST_SUITE_P(
                 "set.toml: set.scene: scene file 'no-such-scene.toml' not found"},
         BadSpec{"BadSetName", "[set]\nname = \"My Set\"\nscene = \"builtin:head\"\n",
                 "set.toml: set.name: 'My Set' is not a valid set name (use a-z 0-9 . _ -)"},
-        BadSpec{"UnknownSetKey", kBase + "[set.x]\n",
-                "set.toml: set.x: unknown key"},
+        BadSpec{"UnknownSetKey", kBase + "[set.x]\n", "set.toml: set.x: unknown key"},
         BadSpec{"IdCollision",
                 "[set]\nname = \"x\"\nscene = \"builtin:head\"\nid = \"{scene}\"\n[[factor]]\nname = \"method\"\n"
                 "levels = [\"none\", \"separable\"]\n",
@@ -355,7 +360,9 @@ TEST(StimulusManifest, JsonRoundTripAndCsv) {
               "id,block,reference,scene,view,method,exr,png,sha256_exr,sha256_png,width,height,wall_ms\n"
               "head-mid-none,builtin:head/mid,0,builtin:head,mid,none,exr/head-mid-none.exr,png/head-mid-none.png,"
               "aa,bb,96,64,12.5\n");
-    EXPECT_EQ(errorOf([] { manifestFromJson({{"format", "x"}}, "m.json"); }),
+    EXPECT_EQ(errorOf([] {
+                  manifestFromJson({{"format", "x"}}, "m.json");
+              }),
               "m.json: format: not a skinlab stimulus manifest");
 }
 
@@ -363,19 +370,22 @@ TEST(StimulusOutputFolder, RefusesForeignFolders) {
     fs::path dir = fs::path(SKINLAB_BINARY_DIR) / "tests-tmp" / "stimuli-folder";
     fs::remove_all(dir);
     fs::create_directories(dir);
-    EXPECT_FALSE(claimOutputFolder(dir, "demo", std::nullopt).has_value());  // empty: fine
+    EXPECT_FALSE(claimOutputFolder(dir, "demo", std::nullopt).has_value()); // empty: fine
     std::ofstream(dir / "notes.txt") << "mine";
     EXPECT_EQ(errorOf([&] { claimOutputFolder(dir, "demo", std::nullopt); }),
-              dir.string() + ": is not empty and holds no stimulus set (no manifest.json); choose a new or empty folder");
+              dir.string() +
+                  ": is not empty and holds no stimulus set (no manifest.json); choose a new or empty folder");
     fs::remove(dir / "notes.txt");
     SetSpec s = spec(kBase);
     writeManifest(dir, manifestHeader(s, expand(s), std::nullopt));
     EXPECT_TRUE(claimOutputFolder(dir, "demo", std::nullopt).has_value());
     EXPECT_EQ(errorOf([&] { claimOutputFolder(dir, "other", std::nullopt); }),
               dir.string() + ": holds stimulus set 'demo', not 'other'; choose another folder");
-    EXPECT_EQ(errorOf([&] { claimOutputFolder(dir, "demo", Shard{1, 2}); }),
+    EXPECT_EQ(errorOf([&] {
+                  claimOutputFolder(dir, "demo", Shard{1, 2});
+              }),
               dir.string() + ": holds the whole set of set 'demo', not shard 1/2; choose another folder");
-    EXPECT_TRUE(fs::exists(dir / "manifest.json"));  // nothing stored is lost
+    EXPECT_TRUE(fs::exists(dir / "manifest.json")); // nothing stored is lost
 }
 
 namespace {
@@ -389,18 +399,17 @@ bool needsHead(const std::string& file) {
 // swapped for builtin:head with a --set override so this runs without the scanned head.
 TEST(ShippedSpecs, ExpandToTheDocumentedCounts) {
     const fs::path dir = fs::path(SKINLAB_SOURCE_DIR) / "stimuli" / "specs";
-    const std::vector<std::pair<std::string, size_t>> expected = {
-        {"demo.toml", 19},
-        {"demo-scan.toml", 19},
-        {"thesis-fig5.2-methods.toml", 18},
-        {"thesis-fig3.16-halos.toml", 7},
-        {"thesis-fig3.17-bleeding.toml", 7},
-        {"thesis-fig3.19-curvature.toml", 6},
-        {"thesis-fig5.3-materials.toml", 7},
-        {"thesis-fig5.1-samples.toml", 34},
-        {"extensions-halo.toml", 50},
-        {"extensions-bleed.toml", 25},
-        {"extensions-head.toml", 25}};
+    const std::vector<std::pair<std::string, size_t>> expected = {{"demo.toml", 19},
+                                                                  {"demo-scan.toml", 19},
+                                                                  {"thesis-fig5.2-methods.toml", 18},
+                                                                  {"thesis-fig3.16-halos.toml", 7},
+                                                                  {"thesis-fig3.17-bleeding.toml", 7},
+                                                                  {"thesis-fig3.19-curvature.toml", 6},
+                                                                  {"thesis-fig5.3-materials.toml", 7},
+                                                                  {"thesis-fig5.1-samples.toml", 34},
+                                                                  {"extensions-halo.toml", 50},
+                                                                  {"extensions-bleed.toml", 25},
+                                                                  {"extensions-head.toml", 25}};
     size_t specs = 0;
     for (const auto& entry : fs::directory_iterator(dir))
         if (entry.path().extension() == ".toml") ++specs;
@@ -423,7 +432,7 @@ TEST(ShippedSpecs, ExpandToTheDocumentedCounts) {
     }
     std::vector<Stimulus> demo = expand(readSetSpec(dir / "demo.toml"));
     EXPECT_EQ(demo.front().id, "head-close-none");
-    EXPECT_EQ(demo.back().id, "head-mid-reference-reference_edge_mm-2.0");  // the references come last
+    EXPECT_EQ(demo.back().id, "head-mid-reference-reference_edge_mm-2.0"); // the references come last
 }
 
 // Every stimulus of every shipped spec resolves against the renderer's scene reader (methods, extension switches
@@ -440,7 +449,8 @@ TEST(ShippedSpecs, EveryStimulusResolves) {
         std::vector<std::string> overrides;
         if (!haveHead && needsHead(entry.path().filename().string())) overrides.push_back("set.scene=builtin:head");
         BuildPlan plan;
-        ASSERT_NO_THROW(plan = planBuild(entry.path(), overrides, std::nullopt, haveHead ? fs::path(assets) : fs::path()))
+        ASSERT_NO_THROW(plan =
+                            planBuild(entry.path(), overrides, std::nullopt, haveHead ? fs::path(assets) : fs::path()))
             << entry.path().filename();
         EXPECT_EQ(plan.resolved.size(), plan.all.size()) << entry.path().filename();
         resolved += plan.resolved.size();

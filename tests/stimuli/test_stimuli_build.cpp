@@ -58,12 +58,12 @@ fs::path writeSpec(const std::string& fileName, const std::string& text) {
 
 struct CliRun {
     int exitCode = -1;
-    std::string output;  // stdout + stderr
+    std::string output; // stdout + stderr
 };
 
 // Runs the skinlab CLI with `args`; output to a file so that large outputs cannot block the child.
 CliRun runCli(const std::vector<std::string>& args, const fs::path& log = gRoot / "cli.log",
-           std::function<void(pid_t)> whileRunning = {}) {
+              std::function<void(pid_t)> whileRunning = {}) {
     fs::create_directories(gRoot);
     pid_t pid = ::fork();
     if (pid == 0) {
@@ -99,7 +99,7 @@ nlohmann::json manifestOf(const fs::path& dir) {
 // id → (exr sha256, png sha256), from the manifest, after checking every file against its hash.
 std::map<std::string, std::pair<std::string, std::string>> verifiedHashes(const fs::path& dir) {
     std::map<std::string, std::pair<std::string, std::string>> out;
-    const nlohmann::json manifest = manifestOf(dir);  // kept alive: a range-for over a temporary's member dangles
+    const nlohmann::json manifest = manifestOf(dir); // kept alive: a range-for over a temporary's member dangles
     for (const auto& s : manifest["stimuli"]) {
         std::string exr = s["sha256"]["exr"], png = s["sha256"]["png"];
         EXPECT_EQ(skinlab::sha256File(dir / s["files"]["exr"].get<std::string>()), exr) << s["id"];
@@ -138,7 +138,8 @@ protected:
     const fs::path& fullBuild() {
         if (full_.empty()) {
             fs::path d = gRoot / "full";
-            CliRun run = runCli({"stimuli", "build", writeSpec("small.toml", smallSpec("small")).string(), "-o", d.string()});
+            CliRun run =
+                runCli({"stimuli", "build", writeSpec("small.toml", smallSpec("small")).string(), "-o", d.string()});
             EXPECT_EQ(run.exitCode, 0) << run.output;
             full_ = d;
         }
@@ -180,7 +181,8 @@ TEST_F(StimuliBuild, FullBuildDescribesEveryImage) {
     std::ifstream csv(dir / "manifest.csv");
     std::string header;
     std::getline(csv, header);
-    EXPECT_EQ(header, "id,block,reference,scene,view,camera.yaw_deg,exr,png,sha256_exr,sha256_png,width,height,wall_ms");
+    EXPECT_EQ(header,
+              "id,block,reference,scene,view,camera.yaw_deg,exr,png,sha256_exr,sha256_png,width,height,wall_ms");
     EXPECT_TRUE(fs::exists(dir / "contact.html"));
     auto sheet = OIIO::ImageInput::open((dir / "contact.png").string());
     ASSERT_TRUE(sheet);
@@ -215,22 +217,22 @@ TEST_F(StimuliBuild, KilledBuildResumesToTheSameHashes) {
     fs::path dir = gRoot / "killed";
     fs::remove_all(dir);
     size_t doneAtKill = 0;
-    CliRun killed = runCli({"stimuli", "build", (gRoot / "small.toml").string(), "-o", dir.string()}, gRoot / "killed.log",
-                        [&](pid_t pid) {
-                            // Kill as soon as the manifest records the first stimulus.
-                            auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-                            while (std::chrono::steady_clock::now() < deadline) {
-                                if (fs::exists(dir / "manifest.json")) {
-                                    try {
-                                        doneAtKill = manifestOf(dir)["stimuli"].size();
-                                    } catch (const std::exception&) {
-                                    }
-                                    if (doneAtKill >= 1) break;
-                                }
-                                std::this_thread::sleep_for(std::chrono::milliseconds(2));
-                            }
-                            ::kill(pid, SIGKILL);
-                        });
+    CliRun killed = runCli({"stimuli", "build", (gRoot / "small.toml").string(), "-o", dir.string()},
+                           gRoot / "killed.log", [&](pid_t pid) {
+                               // Kill as soon as the manifest records the first stimulus.
+                               auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+                               while (std::chrono::steady_clock::now() < deadline) {
+                                   if (fs::exists(dir / "manifest.json")) {
+                                       try {
+                                           doneAtKill = manifestOf(dir)["stimuli"].size();
+                                       } catch (const std::exception&) {
+                                       }
+                                       if (doneAtKill >= 1) break;
+                                   }
+                                   std::this_thread::sleep_for(std::chrono::milliseconds(2));
+                               }
+                               ::kill(pid, SIGKILL);
+                           });
     ASSERT_EQ(killed.exitCode, 128 + SIGKILL) << killed.output;
     nlohmann::json partial = manifestOf(dir);
     ASSERT_LT(partial["stimuli"].size(), 6u) << "the build finished before it could be killed";
@@ -240,7 +242,7 @@ TEST_F(StimuliBuild, KilledBuildResumesToTheSameHashes) {
     for (const char* sub : {"exr", "png"})
         for (const auto& entry : fs::directory_iterator(dir / sub)) {
             std::string name = entry.path().filename().string();
-            if (name.front() == '.') continue;  // a temporary name; the rerun removes it
+            if (name.front() == '.') continue; // a temporary name; the rerun removes it
             auto input = OIIO::ImageInput::open(entry.path().string());
             EXPECT_TRUE(input) << name << " is corrupt";
         }
@@ -260,7 +262,7 @@ TEST_F(StimuliBuild, MergedShardsEqualTheFullBuild) {
         fs::path dir = gRoot / ("shard" + std::to_string(i));
         fs::remove_all(dir);
         CliRun run = runCli({"stimuli", "build", (gRoot / "small.toml").string(), "-o", dir.string(), "--shard",
-                          std::to_string(i) + "/2", "--no-contact-sheet"});
+                             std::to_string(i) + "/2", "--no-contact-sheet"});
         ASSERT_EQ(run.exitCode, 0) << run.output;
         EXPECT_EQ(manifestOf(dir)["stimuli"].size(), 3u);
         shards.push_back(dir.string());
@@ -313,21 +315,21 @@ TEST_F(StimuliBuild, SecondBuildOfABusyFolderIsRefused) {
     const fs::path& full = fullBuild();
     fs::path dir = gRoot / "busy";
     CliRun second;
-    CliRun first = runCli({"stimuli", "build", (gRoot / "small.toml").string(), "-o", dir.string()}, gRoot / "first.log",
-                          [&](pid_t pid) {
-                              // Freeze the first build once it has marked the folder, run the second, thaw the first.
-                              auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-                              while (!fs::exists(dir / "manifest.json") && std::chrono::steady_clock::now() < deadline)
-                                  std::this_thread::sleep_for(std::chrono::milliseconds(2));
-                              ::kill(pid, SIGSTOP);
-                              second = runCli({"stimuli", "build", (gRoot / "small.toml").string(), "-o", dir.string()},
-                                              gRoot / "second.log");
-                              ::kill(pid, SIGCONT);
-                          });
+    CliRun first = runCli(
+        {"stimuli", "build", (gRoot / "small.toml").string(), "-o", dir.string()}, gRoot / "first.log", [&](pid_t pid) {
+            // Freeze the first build once it has marked the folder, run the second, thaw the first.
+            auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+            while (!fs::exists(dir / "manifest.json") && std::chrono::steady_clock::now() < deadline)
+                std::this_thread::sleep_for(std::chrono::milliseconds(2));
+            ::kill(pid, SIGSTOP);
+            second =
+                runCli({"stimuli", "build", (gRoot / "small.toml").string(), "-o", dir.string()}, gRoot / "second.log");
+            ::kill(pid, SIGCONT);
+        });
     ASSERT_EQ(first.exitCode, 0) << first.output;
     EXPECT_EQ(second.exitCode, 2) << second.output;
-    EXPECT_EQ(second.output.rfind("skinlab: error: " + dir.string() + ": another skinlab build is writing this folder (pid ",
-                                  0),
+    EXPECT_EQ(second.output.rfind(
+                  "skinlab: error: " + dir.string() + ": another skinlab build is writing this folder (pid ", 0),
               0u)
         << second.output;
     EXPECT_NE(second.output.find("); wait for it or stop it, then rebuild\n"), std::string::npos) << second.output;
@@ -358,29 +360,33 @@ TEST_F(StimuliBuild, BadInputFailsBeforeRendering) {
     // Unknown factor key: the scene spec does not know it.
     CliRun r = build(smallSpec("bad") + "[[factor]]\nname = \"sss.no_such_key\"\nlevels = [1]\n", out);
     EXPECT_EQ(r.exitCode, 2);
-    EXPECT_EQ(r.output, "skinlab: error: " + spec + ": factor 'sss.no_such_key': level '1': builtin:head: "
-                        "sss.no_such_key: unknown key\n");
+    EXPECT_EQ(r.output, "skinlab: error: " + spec +
+                            ": factor 'sss.no_such_key': level '1': builtin:head: "
+                            "sss.no_such_key: unknown key\n");
     EXPECT_FALSE(fs::exists(out));
 
     // Unknown level of a known factor.
     r = build(smallSpec("bad") + "[[factor]]\nname = \"sss.curvature_measure\"\nlevels = [\"gauss\"]\n", out);
     EXPECT_EQ(r.exitCode, 2);
-    EXPECT_EQ(r.output, "skinlab: error: " + spec + ": factor 'sss.curvature_measure': level 'gauss': builtin:head: "
-                        "sss.curvature_measure: 'gauss' is not one of: normal, screen\n");
+    EXPECT_EQ(r.output, "skinlab: error: " + spec +
+                            ": factor 'sss.curvature_measure': level 'gauss': builtin:head: "
+                            "sss.curvature_measure: 'gauss' is not one of: normal, screen\n");
     EXPECT_FALSE(fs::exists(out));
 
     // A key the stimulus' method does not read (the fixed method is none): refused, naming key and method.
     r = build(smallSpec("bad") + "[[factor]]\nname = \"sss.profile\"\nlevels = [\"burley\"]\n", out);
     EXPECT_EQ(r.exitCode, 2);
-    EXPECT_EQ(r.output.rfind("skinlab: error: " + spec + ": factor: sss.profile: not a parameter of method 'none'", 0), 0u)
+    EXPECT_EQ(r.output.rfind("skinlab: error: " + spec + ": factor: sss.profile: not a parameter of method 'none'", 0),
+              0u)
         << r.output;
     EXPECT_FALSE(fs::exists(out));
 
     // Unknown level of the view (its allowed values are fixed by the scene spec).
     r = build(smallSpec("bad") + "[[include]]\nview = \"overhead\"\n", out);
     EXPECT_EQ(r.exitCode, 2);
-    EXPECT_EQ(r.output, "skinlab: error: " + spec + ": stimulus 'head-overhead': builtin:head: camera.view: "
-                        "'overhead' is not one of: close, mid, far, explicit\n");
+    EXPECT_EQ(r.output, "skinlab: error: " + spec +
+                            ": stimulus 'head-overhead': builtin:head: camera.view: "
+                            "'overhead' is not one of: close, mid, far, explicit\n");
     EXPECT_FALSE(fs::exists(out));
 
     // Missing asset: a scene spec whose model file is absent, named in the message.
@@ -427,19 +433,19 @@ TEST_F(StimuliBuild, SlurmDryRunPrintsTheScripts) {
     CliRun run = runCli({"stimuli", "slurm", spec.string(), "-o", out.string(), "--shards", "3", "--partition", "gpu",
                          "--time", "0:30:00", "--gpus-per-task", "1", "--account", "lab", "--dry-run"});
     ASSERT_EQ(run.exitCode, 0) << run.output;
-    for (const std::string& line : std::vector<std::string>
-         {"#SBATCH --array=0-2\n", "#SBATCH --requeue\n", "#SBATCH --partition=gpu\n", "#SBATCH --time=0:30:00\n",
-          "#SBATCH --gpus-per-task=1\n", "#SBATCH --account=lab\n", "n=3\n", "i=$((SLURM_ARRAY_TASK_ID + 1))\n",
-          "#SBATCH --output=" + (out / "slurm" / "logs" / "build-%A_%a.log").string() + "\n",
-          " -o \"$dir\" --shard \"$i/$n\" --progress lines --no-contact-sheet || status=$?\n",
-          "--dependency=afterok:ARRAY_JOB_ID", "'" + (out / "set").string() + "'"})
+    for (const std::string& line : std::vector<std::string>{
+             "#SBATCH --array=0-2\n", "#SBATCH --requeue\n", "#SBATCH --partition=gpu\n", "#SBATCH --time=0:30:00\n",
+             "#SBATCH --gpus-per-task=1\n", "#SBATCH --account=lab\n", "n=3\n", "i=$((SLURM_ARRAY_TASK_ID + 1))\n",
+             "#SBATCH --output=" + (out / "slurm" / "logs" / "build-%A_%a.log").string() + "\n",
+             " -o \"$dir\" --shard \"$i/$n\" --progress lines --no-contact-sheet || status=$?\n",
+             "--dependency=afterok:ARRAY_JOB_ID", "'" + (out / "set").string() + "'"})
         EXPECT_NE(run.output.find(line), std::string::npos) << line << "\n" << run.output;
     EXPECT_EQ(run.output.find("#SBATCH --gpus-per-task=1", run.output.find("merge.sbatch")), std::string::npos)
         << "the merge job asks for no GPU";
     EXPECT_FALSE(fs::exists(out));
 
-    CliRun one = runCli({"stimuli", "slurm", spec.string(), "-o", out.string(), "--shards", "3", "--only-shard", "2",
-                         "--dry-run"});
+    CliRun one = runCli(
+        {"stimuli", "slurm", spec.string(), "-o", out.string(), "--shards", "3", "--only-shard", "2", "--dry-run"});
     ASSERT_EQ(one.exitCode, 0) << one.output;
     EXPECT_NE(one.output.find("#SBATCH --array=1\n"), std::string::npos) << one.output;
 
@@ -447,8 +453,8 @@ TEST_F(StimuliBuild, SlurmDryRunPrintsTheScripts) {
     EXPECT_EQ(tooMany.exitCode, 2);
     EXPECT_EQ(tooMany.output, "skinlab: error: --shards: 7 is more than the 6 stimuli of set 'small'\n");
 
-    CliRun badShard = runCli({"stimuli", "slurm", spec.string(), "-o", out.string(), "--shards", "3", "--only-shard",
-                              "4", "--dry-run"});
+    CliRun badShard = runCli(
+        {"stimuli", "slurm", spec.string(), "-o", out.string(), "--shards", "3", "--only-shard", "4", "--dry-run"});
     EXPECT_EQ(badShard.exitCode, 2);
     EXPECT_EQ(badShard.output, "skinlab: error: --only-shard: '4' is not a shard of 1..3\n");
 
@@ -460,12 +466,14 @@ TEST_F(StimuliBuild, SlurmDryRunPrintsTheScripts) {
     CliRun noSbatch = runCli({"stimuli", "slurm", spec.string(), "-o", out.string(), "--shards", "3"});
     ::setenv("PATH", saved.c_str(), 1);
     EXPECT_EQ(noSbatch.exitCode, 1);
-    EXPECT_EQ(noSbatch.output.rfind("skinlab: failure: sbatch not found: install slurm-client", 0), 0u) << noSbatch.output;
+    EXPECT_EQ(noSbatch.output.rfind("skinlab: failure: sbatch not found: install slurm-client", 0), 0u)
+        << noSbatch.output;
     EXPECT_EQ(std::count(noSbatch.output.begin(), noSbatch.output.end(), '\n'), 1) << noSbatch.output;
     EXPECT_FALSE(fs::exists(out));
 
     CliRun noBuild = runCli({"stimuli", "status", gRoot.string()});
     EXPECT_EQ(noBuild.exitCode, 2);
-    EXPECT_EQ(noBuild.output, "skinlab: error: " + gRoot.string() +
-                                  ": holds no Slurm build (no slurm/jobs.json); submit one with `skinlab stimuli slurm`\n");
+    EXPECT_EQ(noBuild.output,
+              "skinlab: error: " + gRoot.string() +
+                  ": holds no Slurm build (no slurm/jobs.json); submit one with `skinlab stimuli slurm`\n");
 }

@@ -76,8 +76,8 @@ TEST(MetricAgreement, IdenticalObserversGiveIntervalsAtTheEstimate) {
     scaling::Analysis analysis = scaling::analyzeDataset(data, options);
     AgreementOptions agreementOptions;
     agreementOptions.samples = 50;
-    AgreementResult result = computeAgreement(data, analysis, metricRows({0.4, 0.3, 0.2, 0.1}), options.fit,
-                                              agreementOptions);
+    AgreementResult result =
+        computeAgreement(data, analysis, metricRows({0.4, 0.3, 0.2, 0.1}), options.fit, agreementOptions);
     const MetricAgreement& flip = rowOf(result, "image.flip_mean");
     EXPECT_EQ(flip.conditions, 4);
     EXPECT_DOUBLE_EQ(flip.spearman, -1.0);
@@ -106,8 +106,8 @@ TEST(MetricAgreement, VaryingObserversGiveAnIntervalAroundTheEstimate) {
     scaling::Analysis analysis = scaling::analyzeDataset(data, options);
     AgreementOptions agreementOptions;
     agreementOptions.samples = 200;
-    AgreementResult result = computeAgreement(data, analysis, metricRows({0.4, 0.32, 0.25, 0.1}), options.fit,
-                                              agreementOptions);
+    AgreementResult result =
+        computeAgreement(data, analysis, metricRows({0.4, 0.32, 0.25, 0.1}), options.fit, agreementOptions);
     const MetricAgreement& flip = rowOf(result, "image.flip_mean");
     EXPECT_LE(flip.pearsonLow, flip.pearson);
     EXPECT_GE(flip.pearsonHigh, flip.pearson);

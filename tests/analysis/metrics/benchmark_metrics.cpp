@@ -33,7 +33,7 @@ struct Fixture {
         scene.stripeHalfWidth = 0.02;
         testing::SyntheticRender reference = testing::renderDiscScene(scene);
         testing::SyntheticRender test = reference;
-        test.beauty = cv::Mat(reference.beauty * 1.05);  // every pixel differs: the full ΔE00 cost
+        test.beauty = cv::Mat(reference.beauty * 1.05); // every pixel differs: the full ΔE00 cost
         testing::writeSyntheticExr(referencePath, reference);
         testing::writeSyntheticExr(testPath, test);
     }
@@ -57,7 +57,8 @@ void loadPair(benchmark::State& state) {
 // Edges, three exact distance transforms and the four bands.
 void buildBands(benchmark::State& state) {
     MetricRender reference = loadMetricRender(fixture().referencePath, RenderRole::reference);
-    BandGeometry geometry{*reference.sssRadiusMillimetres / *reference.millimetresPerUnit, *reference.focalLengthPixels};
+    BandGeometry geometry{*reference.sssRadiusMillimetres / *reference.millimetresPerUnit,
+                          *reference.focalLengthPixels};
     for (auto _ : state) {
         ErrorBands bands = buildErrorBands(reference.depth, reference.mask, geometry);
         benchmark::DoNotOptimize(bands.masks[0].data);

@@ -19,7 +19,7 @@ namespace fs = std::filesystem;
 
 struct CommandResult {
     int exitCode = -1;
-    std::string output;  // stdout and stderr together
+    std::string output; // stdout and stderr together
 };
 
 CommandResult runSkinlab(const std::string& arguments) {
@@ -38,8 +38,9 @@ CommandResult runSkinlab(const std::string& arguments) {
 class AnalyzeMetricsCommand : public ::testing::Test {
 protected:
     void SetUp() override {
-        folder = fs::temp_directory_path() /
-                 ("skinlab-metrics-cli-" + std::to_string(::getpid()) + "-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+        folder =
+            fs::temp_directory_path() / ("skinlab-metrics-cli-" + std::to_string(::getpid()) + "-" +
+                                         std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
         fs::remove_all(folder);
         fs::create_directories(folder / "exr");
         scene.size = 128;
@@ -84,10 +85,10 @@ TEST_F(AnalyzeMetricsCommand, ComparesFilesAndWritesAllOutputs) {
 }
 
 TEST_F(AnalyzeMetricsCommand, ComparesAStimulusSet) {
-    nlohmann::json manifest = {{"format", "skinlab-stimuli"}, {"version", 1}, {"set", "cli"},
-                               {"stimuli", nlohmann::json::array()}};
-    for (auto [id, render, isReference] : {std::tuple{"disc-reference", &reference, true},
-                                           std::tuple{"disc-separable", &blurred, false}}) {
+    nlohmann::json manifest = {
+        {"format", "skinlab-stimuli"}, {"version", 1}, {"set", "cli"}, {"stimuli", nlohmann::json::array()}};
+    for (auto [id, render, isReference] :
+         {std::tuple{"disc-reference", &reference, true}, std::tuple{"disc-separable", &blurred, false}}) {
         std::string exr = std::string("exr/") + id + ".exr";
         testing::writeSyntheticExr(path(exr), *render);
         manifest["stimuli"].push_back({{"id", id},
@@ -98,7 +99,8 @@ TEST_F(AnalyzeMetricsCommand, ComparesAStimulusSet) {
                                        {"reference", isReference}});
     }
     writeFileAtomic(path("manifest.json"), manifest.dump(2));
-    CommandResult run = runSkinlab("analyze metrics --stimuli " + folder.string() + " -o " + path("out") + " --no-heatmaps");
+    CommandResult run =
+        runSkinlab("analyze metrics --stimuli " + folder.string() + " -o " + path("out") + " --no-heatmaps");
     ASSERT_EQ(run.exitCode, 0) << run.output;
     nlohmann::json json = nlohmann::json::parse(readFile(path("out/metrics.json")));
     ASSERT_EQ(json["comparisons"].size(), 1u);
@@ -134,7 +136,8 @@ TEST_F(AnalyzeMetricsCommand, BadInputsFailWithOneLineNamingFileAndChannel) {
         {"--reference " + path("exr/reference.exr") + " " + path("exr/small.exr"),
          path("exr/small.exr") + ": size 100x100 differs from the reference " + path("exr/reference.exr") +
              " (128x128)"},
-        {"--reference " + path("exr/reference.exr"), "TEST.exr: required: at least one render to compare with the reference"},
+        {"--reference " + path("exr/reference.exr"),
+         "TEST.exr: required: at least one render to compare with the reference"},
         {path("exr/reference.exr"), "--reference: required: the reference EXR (or use --stimuli DIR)"},
         {"--stimuli " + folder.string() + " " + path("exr/reference.exr"),
          path("exr/reference.exr") + ": test files cannot be combined with --stimuli (the set lists its renders)"},

@@ -39,7 +39,7 @@ TEST(ColourSpace, SrgbEncodingFollowsIec61966) {
     EXPECT_NEAR(encodeSrgb(1.0), 1.0, 1e-12);
     EXPECT_NEAR(encodeSrgb(0.002), 12.92 * 0.002, 1e-12);
     EXPECT_NEAR(encodeSrgb(0.18), 1.055 * std::pow(0.18, 1 / 2.4) - 0.055, 1e-12);
-    EXPECT_EQ(encodeSrgb(2.0), encodeSrgb(1.0));  // clipped
+    EXPECT_EQ(encodeSrgb(2.0), encodeSrgb(1.0)); // clipped
 }
 
 } // namespace

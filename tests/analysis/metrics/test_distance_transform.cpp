@@ -18,7 +18,7 @@ TEST(DistanceTransform, MatchesBruteForceOnRandomFeatures) {
         for (int y = 0; y < features.rows; ++y)
             for (int x = 0; x < features.cols; ++x)
                 if (pick(random)) features.at<uint8_t>(y, x) = 1;
-        features.at<uint8_t>(5, 5) = 1;  // at least one
+        features.at<uint8_t>(5, 5) = 1; // at least one
         DistanceField field = euclideanDistanceTransform(features);
         for (int y = 0; y < features.rows; ++y)
             for (int x = 0; x < features.cols; ++x) {
@@ -26,7 +26,8 @@ TEST(DistanceTransform, MatchesBruteForceOnRandomFeatures) {
                 for (int fy = 0; fy < features.rows; ++fy)
                     for (int fx = 0; fx < features.cols; ++fx)
                         if (features.at<uint8_t>(fy, fx)) best = std::min(best, std::hypot(fx - x, fy - y));
-                ASSERT_NEAR(field.distance.at<float>(y, x), best, 1e-4) << "density " << density << " at " << x << "," << y;
+                ASSERT_NEAR(field.distance.at<float>(y, x), best, 1e-4)
+                    << "density " << density << " at " << x << "," << y;
                 int nearest = field.nearest.at<int>(y, x);
                 int nx = nearest % features.cols;
                 int ny = nearest / features.cols;

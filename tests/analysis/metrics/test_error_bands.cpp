@@ -10,8 +10,8 @@
 namespace skinlab::metrics {
 namespace {
 
-using testing::DiscScene;
 using testing::discPixel;
+using testing::DiscScene;
 using testing::renderDiscScene;
 
 // Pixels this close (in pixels) to an analytic band boundary may fall either way: point sampling puts the
@@ -28,7 +28,7 @@ TEST(ErrorBands, DiscInFrontOfFarPlaneHasAHaloRingOfWidthRho) {
     DiscScene scene;
     scene.size = 256;
     testing::SyntheticRender render = renderDiscScene(scene);
-    BandGeometry geometry{0.008, render.focalLengthPixels};  // r_w = 8 mm in metres
+    BandGeometry geometry{0.008, render.focalLengthPixels}; // r_w = 8 mm in metres
     ErrorBands bands = buildErrorBands(render.depth, render.mask, geometry);
 
     const double rho = geometry.supportRadiusWorld * geometry.focalLengthPixels / scene.nearDepth;
@@ -73,7 +73,8 @@ TEST(ErrorBands, DiscInFrontOfFarPlaneHasAHaloRingOfWidthRho) {
     EXPECT_GT(checkedSpill, 500);
     EXPECT_GT(checkedInterior, 1000);
     // Area of the ring, within the boundary uncertainty of one perimeter's worth of pixels.
-    double ringArea = M_PI * (discRadiusPixels * discRadiusPixels - (discRadiusPixels - rho) * (discRadiusPixels - rho));
+    double ringArea =
+        M_PI * (discRadiusPixels * discRadiusPixels - (discRadiusPixels - rho) * (discRadiusPixels - rho));
     EXPECT_NEAR(cv::countNonZero(bands.mask(Band::halo)), ringArea, 2 * M_PI * discRadiusPixels);
 }
 
@@ -99,8 +100,8 @@ TEST(ErrorBands, SkinOnBothSidesOfADepthEdgeGivesHaloOnBothSides) {
                 ++checked;
             }
             if (fromEdge > rhoFar + boundaryTolerance) {
-                    ASSERT_FALSE(inBand(bands, Band::halo, x, y)) << x << "," << y;
-                }
+                ASSERT_FALSE(inBand(bands, Band::halo, x, y)) << x << "," << y;
+            }
             ASSERT_FALSE(inBand(bands, Band::spill, x, y)) << "skin is never spill";
         }
     EXPECT_GT(checked, 300);
@@ -115,7 +116,7 @@ TEST(ErrorBands, MaterialEdgeAtContinuousDepthGivesABleedBand) {
     cv::Mat depth(size, size, CV_32FC1, cv::Scalar(depthValue));
     cv::Mat mask = cv::Mat::zeros(size, size, CV_32FC1);
     mask(cv::Rect(0, 0, size / 2, size)).setTo(1.0f);
-    BandGeometry geometry{0.01, 1000.0};  // ρ = 0.01·1000/2 = 5 px
+    BandGeometry geometry{0.01, 1000.0}; // ρ = 0.01·1000/2 = 5 px
     ErrorBands bands = buildErrorBands(depth, mask, geometry);
     const double rho = 5.0;
     EXPECT_EQ(cv::countNonZero(bands.mask(Band::halo)), 0);

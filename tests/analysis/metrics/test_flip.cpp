@@ -74,10 +74,10 @@ TEST(Flip, IdenticalImagesScoreZero) {
 // filters' rounding, ~1e-16 on the zero-sum feature kernels, enters the exponent through a square root: FLIP =
 // ΔE_c^(1 − ~1e-8), off by ~1e-8 · |ln ΔE_c| · ΔE_c.
 TEST(Flip, ConstantImagesEqualTheRemappedColourDifference) {
-    const Colour pairs[][2] = {{{0.5, 0.5, 0.5}, {0.52, 0.5, 0.48}},   // small: below the knee
-                               {{0.6, 0.4, 0.3}, {0.55, 0.42, 0.33}},  // skin-like
-                               {{0.1, 0.8, 0.2}, {0.9, 0.1, 0.6}},     // large: above the knee
-                               {{0, 1, 0}, {0, 0, 1}}};                // c_max: FLIP 1
+    const Colour pairs[][2] = {{{0.5, 0.5, 0.5}, {0.52, 0.5, 0.48}},  // small: below the knee
+                               {{0.6, 0.4, 0.3}, {0.55, 0.42, 0.33}}, // skin-like
+                               {{0.1, 0.8, 0.2}, {0.9, 0.1, 0.6}},    // large: above the knee
+                               {{0, 1, 0}, {0, 0, 1}}};               // c_max: FLIP 1
     for (double ppd : {flipDefaultPixelsPerDegree, 30.0}) {
         for (const auto& pair : pairs) {
             double expected = expectedConstantFlip(pair[0], pair[1]);
@@ -111,7 +111,7 @@ TEST(Flip, FeaturesRaiseTheErrorAtAMissingLine) {
     cv::Mat swapped = flipErrorMap(test, reference, flipDefaultPixelsPerDegree);
     EXPECT_EQ(cv::norm(map, swapped, cv::NORM_INF), 0.0);
     EXPECT_GT(map.at<double>(32, 48), 0.3);
-    EXPECT_EQ(map.at<double>(32, 2), 0.0);  // farther than the CSF and feature radii (10 and 9 pixels)
+    EXPECT_EQ(map.at<double>(32, 2), 0.0); // farther than the CSF and feature radii (10 and 9 pixels)
     double mask = flipMean(map, cv::Mat::zeros(64, 96, CV_8UC1));
     EXPECT_TRUE(std::isnan(mask));
 }

@@ -23,9 +23,9 @@ using testing::SyntheticRender;
 class MetricsRun : public ::testing::Test {
 protected:
     void SetUp() override {
-        folder = fs::temp_directory_path() /
-                 ("skinlab-metrics-run-" + std::to_string(::getpid()) + "-" +
-                  std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+        folder =
+            fs::temp_directory_path() / ("skinlab-metrics-run-" + std::to_string(::getpid()) + "-" +
+                                         std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
         fs::remove_all(folder);
         fs::create_directories(folder);
         testing::DiscScene scene;
@@ -40,7 +40,8 @@ protected:
         return path;
     }
     // Runs and returns the InputError message ("" if none was thrown).
-    std::string failureOf(const fs::path& reference, const std::vector<fs::path>& tests, MetricsRunOptions options = {}) {
+    std::string failureOf(const fs::path& reference, const std::vector<fs::path>& tests,
+                          MetricsRunOptions options = {}) {
         try {
             runMetrics(planFileComparisons(reference, tests), options, output);
         } catch (const InputError& e) {
@@ -56,7 +57,7 @@ protected:
 TEST_F(MetricsRun, WritesCsvJsonAndHeatmaps) {
     fs::path reference = write("ref.exr", render);
     SyntheticRender brighter = render;
-    brighter.beauty = cv::Mat(render.beauty * 1.1);  // a new buffer: `render` must stay unchanged
+    brighter.beauty = cv::Mat(render.beauty * 1.1); // a new buffer: `render` must stay unchanged
     fs::path same = write("same.exr", render);
     fs::path changed = write("brighter.exr", brighter);
     auto records = runMetrics(planFileComparisons(reference, {same, changed}), {}, output);
@@ -74,7 +75,7 @@ TEST_F(MetricsRun, WritesCsvJsonAndHeatmaps) {
     const auto& second = json["comparisons"][1];
     EXPECT_GT(second["skin"]["delta_e00_mean"].get<double>(), 0.5);
     EXPECT_GT(second["bands"]["halo"]["pixels"].get<int>(), 0);
-    EXPECT_NEAR(second["support_radius_world"].get<double>(), 0.008, 1e-9);  // 8 mm / 1000 mm per unit
+    EXPECT_NEAR(second["support_radius_world"].get<double>(), 0.008, 1e-9); // 8 mm / 1000 mm per unit
     EXPECT_EQ(second["heatmap"], "heatmaps/brighter.png");
 
     std::string csv = readFile(output / "metrics.csv");
@@ -85,8 +86,8 @@ TEST_F(MetricsRun, WritesCsvJsonAndHeatmaps) {
 
     cv::Mat heatmap = cv::imread((output / "heatmaps/brighter.png").string(), cv::IMREAD_COLOR);
     ASSERT_FALSE(heatmap.empty());
-    EXPECT_EQ(heatmap.cols, 96 + 170);  // image + legend panel
-    EXPECT_EQ(heatmap.rows, 260);       // the legend's minimum height
+    EXPECT_EQ(heatmap.cols, 96 + 170); // image + legend panel
+    EXPECT_EQ(heatmap.rows, 260);      // the legend's minimum height
     // No temporary files left behind.
     for (const auto& entry : fs::recursive_directory_iterator(output))
         EXPECT_EQ(entry.path().filename().string().find(".tmp-"), std::string::npos) << entry.path();
@@ -146,8 +147,8 @@ TEST_F(MetricsRun, DifferentCameraIsNamed) {
         return text.str();
     };
     EXPECT_EQ(failureOf(reference, {other}), other.string() + ": skinlab:f_px: " + printed(zoomed.focalLengthPixels) +
-                                                  " differs from the reference's " + printed(render.focalLengthPixels) +
-                                                  " (not the same camera)");
+                                                 " differs from the reference's " + printed(render.focalLengthPixels) +
+                                                 " (not the same camera)");
     EXPECT_FALSE(fs::exists(output)) << "checked before anything is written";
 }
 
@@ -183,7 +184,7 @@ TEST_F(MetricsRun, RepeatedTestNamesAreRejected) {
     fs::path a = write("a/x.exr", render);
     fs::path b = write("b/x.exr", render);
     EXPECT_EQ(failureOf(reference, {a, b}), b.string() + ": test name 'x' repeats (" + a.string() +
-                                                  "); heat maps are named after the file stem, so rename one");
+                                                "); heat maps are named after the file stem, so rename one");
 }
 
 } // namespace

@@ -28,9 +28,9 @@ namespace fs = std::filesystem;
 class PlainImages : public ::testing::Test {
 protected:
     void SetUp() override {
-        folder = fs::temp_directory_path() /
-                 ("skinlab-plain-images-" + std::to_string(::getpid()) + "-" +
-                  std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+        folder =
+            fs::temp_directory_path() / ("skinlab-plain-images-" + std::to_string(::getpid()) + "-" +
+                                         std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
         fs::remove_all(folder);
         fs::create_directories(folder);
         output = folder / "out";
@@ -51,7 +51,8 @@ protected:
                 cv::Vec3b v = bgr8.at<cv::Vec3b>(y, x);
                 for (int c = 0; c < 3; ++c) {
                     double e = v[2 - c] / 255.0;
-                    out.at<cv::Vec3d>(y, x)[c] = srgb ? (e <= 0.04045 ? e / 12.92 : std::pow((e + 0.055) / 1.055, 2.4)) : e;
+                    out.at<cv::Vec3d>(y, x)[c] =
+                        srgb ? (e <= 0.04045 ? e / 12.92 : std::pow((e + 0.055) / 1.055, 2.4)) : e;
                 }
             }
         return out;

@@ -38,8 +38,8 @@ ComparisonResult compareFiles(const fs::path& folder, const SyntheticRender& ref
 DiscScene sceneWithEveryBand(int size) {
     DiscScene scene;
     scene.size = size;
-    scene.farPlaneIsSkin = true;   // halo on both sides of the silhouette
-    scene.stripeHalfWidth = 0.02;  // a non-skin stripe across the disc: bleed and spill
+    scene.farPlaneIsSkin = true;  // halo on both sides of the silhouette
+    scene.stripeHalfWidth = 0.02; // a non-skin stripe across the disc: bleed and spill
     return scene;
 }
 
@@ -74,11 +74,12 @@ TEST(RenderComparison, UniformSkinChangeGivesKnownScores) {
     test.beauty = reference.beauty.clone();
     for (int y = 0; y < test.height; ++y)
         for (int x = 0; x < test.width; ++x)
-            if (reference.mask.at<float>(y, x) >= 0.5f) test.beauty.at<cv::Vec3f>(y, x) += cv::Vec3f(0.05f, 0.05f, 0.05f);
+            if (reference.mask.at<float>(y, x) >= 0.5f)
+                test.beauty.at<cv::Vec3f>(y, x) += cv::Vec3f(0.05f, 0.05f, 0.05f);
     ComparisonResult result = compareFiles(folder, reference, test);
 
-    const cv::Vec3f skinColour(0.6f, 0.4f, 0.3f);  // renderDiscScene's skin
-    const cv::Vec3f farColour(0.3f, 0.3f, 0.35f);  // the far plane, skin here too
+    const cv::Vec3f skinColour(0.6f, 0.4f, 0.3f); // renderDiscScene's skin
+    const cv::Vec3f farColour(0.3f, 0.3f, 0.35f); // the far plane, skin here too
     auto changeOf = [](cv::Vec3f c) {
         return ciede2000(displayLab(c[0], c[1], c[2], 1.0), displayLab(c[0] + 0.05f, c[1] + 0.05f, c[2] + 0.05f, 1.0));
     };
@@ -103,7 +104,7 @@ TEST(RenderComparison, UniformSkinChangeGivesKnownScores) {
     EXPECT_EQ(result.band(Band::spill).deltaE00Mean, 0.0);
     EXPECT_EQ(result.band(Band::spill).leakEnergy, 0.0);
     EXPECT_GT(result.skin.deltaE00Mean, 0.5);
-    EXPECT_LT(result.image.deltaE00Mean, result.skin.deltaE00Mean);  // the stripe is unchanged
+    EXPECT_LT(result.image.deltaE00Mean, result.skin.deltaE00Mean); // the stripe is unchanged
 }
 
 // Adds a synthetic screen-space error of *physical* width w (world units, on the surface it lands on) next to every
@@ -135,15 +136,14 @@ SyntheticRender withEdgeErrors(const DiscScene& scene, const SyntheticRender& re
 // docs/metrics.md: energy scores agree within 5% between 512² and 1024² renders of the same scene.
 TEST(RenderComparison, LeakEnergiesAreResolutionIndependent) {
     fs::path folder = freshFolder("resolution");
-    const double errorWidth = 0.8 * 0.008;  // 80% of r_w = 8 mm, so the error lies inside the bands
+    const double errorWidth = 0.8 * 0.008; // 80% of r_w = 8 mm, so the error lies inside the bands
     BandScores scores[2][4];
     double haloFraction[2] = {};
     int index = 0;
     for (int size : {512, 1024}) {
         DiscScene scene = sceneWithEveryBand(size);
         SyntheticRender reference = testing::renderDiscScene(scene);
-        ComparisonResult result =
-            compareFiles(folder, reference, withEdgeErrors(scene, reference, errorWidth));
+        ComparisonResult result = compareFiles(folder, reference, withEdgeErrors(scene, reference, errorWidth));
         for (Band band : allBands) scores[index][static_cast<size_t>(band)] = result.band(band);
         haloFraction[index] = result.band(Band::halo).fractionOfImage;
         ++index;
@@ -153,8 +153,8 @@ TEST(RenderComparison, LeakEnergiesAreResolutionIndependent) {
         double high = scores[1][static_cast<size_t>(band)].leakEnergy;
         EXPECT_GT(low, 1e-4) << bandName(band) << ": the synthetic error must reach this band";
         EXPECT_NEAR(low / high, 1.0, 0.05) << bandName(band) << " leak energy 512²: " << low << ", 1024²: " << high;
-        std::printf("%s leak energy 512^2 %.6g 1024^2 %.6g (ratio %.4f)\n", std::string(bandName(band)).c_str(), low, high,
-                    low / high);
+        std::printf("%s leak energy 512^2 %.6g 1024^2 %.6g (ratio %.4f)\n", std::string(bandName(band)).c_str(), low,
+                    high, low / high);
         // The band covers the same fraction of the picture at both sizes, up to pixel quantisation: a straight
         // band of width ρ counts round(ρ) pixels across, so its area is off by up to 0.5/ρ (6.5% at ρ = 7.6 px, the
         // 512² render). The leak energy does not inherit this because the error fades out inside the band.
@@ -171,7 +171,7 @@ TEST(RenderComparison, LeakEnergiesAreResolutionIndependent) {
 
 TEST(RenderComparison, Percentile95InterpolatesBetweenOrderStatistics) {
     std::vector<double> values;
-    for (int i = 0; i <= 100; ++i) values.push_back(100 - i);  // 0..100 shuffled order
+    for (int i = 0; i <= 100; ++i) values.push_back(100 - i); // 0..100 shuffled order
     EXPECT_DOUBLE_EQ(percentile95(values), 95.0);
     EXPECT_DOUBLE_EQ(percentile95({1.0, 2.0}), 1.95);
     EXPECT_DOUBLE_EQ(percentile95({7.0}), 7.0);

@@ -18,8 +18,9 @@ namespace fs = std::filesystem;
 class StimulusSetPairs : public ::testing::Test {
 protected:
     void SetUp() override {
-        folder = fs::temp_directory_path() / ("skinlab-metrics-set-" + std::to_string(::getpid()) + "-" +
-                                              std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+        folder =
+            fs::temp_directory_path() / ("skinlab-metrics-set-" + std::to_string(::getpid()) + "-" +
+                                         std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
         fs::remove_all(folder);
         fs::create_directories(folder / "exr");
         testing::DiscScene scene;
@@ -27,7 +28,8 @@ protected:
         testing::SyntheticRender render = testing::renderDiscScene(scene);
         for (const char* id : {"disc-reference", "disc-separable", "disc-gaussian", "head-separable"})
             testing::writeSyntheticExr(folder / "exr" / (std::string(id) + ".exr"), render);
-        manifest = {{"format", "skinlab-stimuli"}, {"version", 1}, {"set", "test"}, {"stimuli", nlohmann::json::array()}};
+        manifest = {
+            {"format", "skinlab-stimuli"}, {"version", 1}, {"set", "test"}, {"stimuli", nlohmann::json::array()}};
         addStimulus("disc-reference", "builtin:disc/mid", "reference", true);
         addStimulus("disc-separable", "builtin:disc/mid", "separable", false);
         addStimulus("disc-gaussian", "builtin:disc/mid", "gaussian-sum", false);

@@ -22,7 +22,7 @@ fs::path scratch() {
 
 struct CliRun {
     int exitCode = -1;
-    std::string output;  // stdout and stderr
+    std::string output; // stdout and stderr
 };
 
 CliRun run(const std::string& arguments) {
@@ -55,9 +55,11 @@ std::string simulatedCsv() {
                 const auto [i, j] = simulated.block.pairs[p];
                 const auto pi = static_cast<Eigen::Index>(p);
                 for (int w = 0; w < simulated.block.winsFirst(k, pi); ++w)
-                    csv << "p" << k << "," << scene << "," << names[i] << "," << names[j] << ",1," << (w % 2) << ",test,,900\n";
+                    csv << "p" << k << "," << scene << "," << names[i] << "," << names[j] << ",1," << (w % 2)
+                        << ",test,,900\n";
                 for (int w = 0; w < simulated.block.winsSecond(k, pi); ++w)
-                    csv << "p" << k << "," << scene << "," << names[j] << "," << names[i] << ",1," << (w % 2) << ",test,,900\n";
+                    csv << "p" << k << "," << scene << "," << names[j] << "," << names[i] << ",1," << (w % 2)
+                        << ",test,,900\n";
             }
             csv << "p" << k << "," << scene << ",none,artistic,0,1,catch," << (k == 3 ? 0 : 1) << ",400\n";
         }
@@ -84,7 +86,8 @@ TEST(CliScale, WritesEveryOutput) {
     // True order none < gaussian-sum < separable < artistic; the extremes are 1.6 JOD apart.
     EXPECT_LT(mid["scores"][0]["jod"].get<double>(), mid["scores"][3]["jod"].get<double>());
     EXPECT_TRUE(mid["side_bias"]["available"].get<bool>());
-    for (const char* plot : {"scores", "matrix"}) EXPECT_TRUE(fs::exists(output / mid["plots"][plot].get<std::string>()));
+    for (const char* plot : {"scores", "matrix"})
+        EXPECT_TRUE(fs::exists(output / mid["plots"][plot].get<std::string>()));
     // Observer p3 failed its catch trials; p11 answered at random in block 1.
     bool sawCatch = false;
     for (const auto& observer : json["observers"])
@@ -123,8 +126,8 @@ TEST(CliScale, CountMatrixOracle) {
 
 TEST(CliValidate, SmallRunMeetsTheScreeningTargets) {
     const fs::path output = scratch() / "validate";
-    const CliRun result = run("analyze validate --experiments 20 --observers 20 --bootstrap 200 --scenarios screening -o " +
-                           output.string());
+    const CliRun result = run(
+        "analyze validate --experiments 20 --observers 20 --bootstrap 200 --scenarios screening -o " + output.string());
     ASSERT_EQ(result.exitCode, 0) << result.output;
     std::ifstream stream(output / "validation.json");
     const nlohmann::json json = nlohmann::json::parse(stream);
@@ -137,7 +140,8 @@ TEST(CliValidate, SmallRunMeetsTheScreeningTargets) {
 TEST(CliValidate, DegenerateScenariosGiveFiniteIntervals) {
     const fs::path output = scratch() / "validate-degenerate";
     const CliRun result = run("analyze validate --experiments 6 --observers 10 --bootstrap 200 --trials-per-pair 2 "
-                              "--scenarios sparse,disconnected,near-unanimous -o " + output.string());
+                              "--scenarios sparse,disconnected,near-unanimous -o " +
+                              output.string());
     ASSERT_EQ(result.exitCode, 0) << result.output;
     std::ifstream stream(output / "validation.json");
     const nlohmann::json json = nlohmann::json::parse(stream);
@@ -158,7 +162,8 @@ TEST(CliValidate, ActiveScenarioRunsWithProfileIntervals) {
     // likelihood intervals next to the bootstrap's coverage; the figures themselves are in docs/analysis.md.
     const fs::path output = scratch() / "validate-active";
     const CliRun result = run("analyze validate --experiments 4 --observers 6 --bootstrap 100 --scores 0,0.5,1,2,3 "
-                              "--active-trials 8 --scenarios active -o " + output.string());
+                              "--active-trials 8 --scenarios active -o " +
+                              output.string());
     ASSERT_EQ(result.exitCode, 0) << result.output;
     std::ifstream stream(output / "validation.json");
     const nlohmann::json json = nlohmann::json::parse(stream);

@@ -102,7 +102,7 @@ TEST(DegenerateDesigns, IdenticalUnanimousObserversFinishAndWriteScaleJson) {
     const Dataset data = dataset(4, identicalObservers());
     const Analysis analysis = analyzeDataset(data, quickOptions());
     const fs::path folder = scratch("identical");
-    writeScaleOutputs(analysis, folder);  // hung in the score plot (one grid line per JOD up to ±1e9)
+    writeScaleOutputs(analysis, folder); // hung in the score plot (one grid line per JOD up to ±1e9)
     ASSERT_TRUE(fs::exists(folder / "scale.json"));
     const BlockAnalysis& block = analysis.blocks.at(0);
     expectHonestIntervals(block, 60.0);
@@ -121,10 +121,8 @@ TEST(DegenerateDesigns, NineUnanimousPairsOfTwelveObserversFinish) {
     for (int k = 0; k < 12; ++k)
         for (int i = 0; i < 5; ++i)
             for (int j = i + 1; j < 5; ++j) {
-                if (i == 1 && j == 2)
-                    answers[k].push_back({i, j, k < 5 ? 1 : 0, k < 5 ? 0 : 1});
-                else
-                    answers[k].push_back({i, j, 0, 1});
+                if (i == 1 && j == 2) answers[k].push_back({i, j, k < 5 ? 1 : 0, k < 5 ? 0 : 1});
+                else answers[k].push_back({i, j, 0, 1});
             }
     const Dataset data = dataset(5, answers);
     const Analysis analysis = analyzeDataset(data, quickOptions());
@@ -168,7 +166,8 @@ TEST(DegenerateDesigns, ResamplesWithoutSpreadKeepIntervalsFinite) {
 double exactBinomialP(int k, int n) {
     const int extreme = std::max(k, n - k);
     double tail = 0.0;
-    for (int x = extreme; x <= n; ++x) tail += std::exp(std::lgamma(n + 1.0) - std::lgamma(x + 1.0) - std::lgamma(n - x + 1.0) - n * std::log(2.0));
+    for (int x = extreme; x <= n; ++x)
+        tail += std::exp(std::lgamma(n + 1.0) - std::lgamma(x + 1.0) - std::lgamma(n - x + 1.0) - n * std::log(2.0));
     return std::min(1.0, 2.0 * tail);
 }
 
@@ -207,11 +206,10 @@ std::vector<std::vector<Answers>> disconnectedDesign(const std::vector<std::stri
 TEST(DegenerateDesigns, DisconnectedDesignsGetPercentileSizedIntervals) {
     // The first never finished (the score plot); the second gave c5 [-10.7, 14.0] where the percentile interval
     // is [1.03, 3.69].
-    for (const auto& design :
-         {disconnectedDesign({"101000", "010100", "000100", "011010", "001101", "101000", "001000", "101101", "001101",
-                              "000000"}),
-          disconnectedDesign({"001100", "000000", "111100", "101100", "100111", "000000", "100000", "012000", "101100",
-                              "200000"})}) {
+    for (const auto& design : {disconnectedDesign({"101000", "010100", "000100", "011010", "001101", "101000", "001000",
+                                                   "101101", "001101", "000000"}),
+                               disconnectedDesign({"001100", "000000", "111100", "101100", "100111", "000000", "100000",
+                                                   "012000", "101100", "200000"})}) {
         const Analysis analysis = analyzeDataset(dataset(6, design), quickOptions());
         writeScaleOutputs(analysis, scratch("disconnected"));
         const BlockAnalysis& block = analysis.blocks.at(0);
@@ -222,7 +220,8 @@ TEST(DegenerateDesigns, DisconnectedDesignsGetPercentileSizedIntervals) {
             // Never narrower than pwcmp's percentile interval, and at most ~2.5 times as wide.
             EXPECT_LE(block.low[i], block.percentileLow[i] + 1e-9) << i;
             EXPECT_GE(block.high[i], block.percentileHigh[i] - 1e-9) << i;
-            EXPECT_LE(block.high[i] - block.low[i], 2.5 * (block.percentileHigh[i] - block.percentileLow[i]) + 0.5) << i;
+            EXPECT_LE(block.high[i] - block.low[i], 2.5 * (block.percentileHigh[i] - block.percentileLow[i]) + 0.5)
+                << i;
             EXPECT_TRUE(block.intervalFlags[i].fallback) << i;
         }
     }

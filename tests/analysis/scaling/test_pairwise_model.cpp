@@ -81,8 +81,8 @@ TEST(PairwiseModel, UnanimousAnswersGiveFiniteFlaggedScores) {
     }
     EXPECT_FALSE(result.mleExists);
     EXPECT_EQ(result.unanimousPairs.size(), 2u);
-    EXPECT_GT(result.thurstone.scores[0], result.thurstone.scores[1] + 1.0);  // c0 won everything
-    EXPECT_LT(result.thurstone.scores[0] - result.thurstone.scores[1], 8.0);   // bounded by the prior
+    EXPECT_GT(result.thurstone.scores[0], result.thurstone.scores[1] + 1.0); // c0 won everything
+    EXPECT_LT(result.thurstone.scores[0] - result.thurstone.scores[1], 8.0); // bounded by the prior
     ASSERT_FALSE(result.warnings.empty());
     EXPECT_NE(result.warnings.front().find("unanimous"), std::string::npos);
 }
@@ -137,7 +137,7 @@ TEST(Consistency, KendallUOfAnEvenSplitIsMinimal) {
 TEST(Consistency, KendallZetaCountsCircularTriads) {
     BlockData block = unanimousObservers(2, 3);
     // Observer 1: c0 ≻ c1, c1 ≻ c2, c2 ≻ c0 — one circular triad, the maximum for m = 3 ((27 − 3)/24 = 1).
-    block.winsFirst.row(1) << 1, 0, 1;  // pairs (0,1), (0,2), (1,2)
+    block.winsFirst.row(1) << 1, 0, 1; // pairs (0,1), (0,2), (1,2)
     block.winsSecond.row(1) << 0, 1, 0;
     const TriadConsistency consistent = kendallZeta(block, 0);
     const TriadConsistency circular = kendallZeta(block, 1);

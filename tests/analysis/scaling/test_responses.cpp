@@ -84,9 +84,9 @@ TEST(Responses, WrongColumns) {
     EXPECT_EQ(errorOf(path), path + ": line 1: column 5: unexpected column 'chosen'; expected the columns "
                                     "observer,scene,condition_A,condition_B,is_A_selected or a count matrix header "
                                     "'condition,<names>'");
-    const std::string missing = writeText("missing.csv",
-                                          "observer,scene,condition_A,condition_B,is_A_selected,A_on_left,trial_kind,"
-                                          "correct\no1,s,a,b,1,1,test,\n");
+    const std::string missing =
+        writeText("missing.csv", "observer,scene,condition_A,condition_B,is_A_selected,A_on_left,trial_kind,"
+                                 "correct\no1,s,a,b,1,1,test,\n");
     EXPECT_EQ(errorOf(missing), missing + ": line 1: column response_ms: missing column; expected the columns "
                                           "observer,scene,condition_A,condition_B,is_A_selected,A_on_left,trial_kind,"
                                           "correct,response_ms");
@@ -100,19 +100,19 @@ TEST(Responses, BadValues) {
     const std::string kind = writeText(
         "kind.csv", "observer,scene,condition_A,condition_B,is_A_selected,A_on_left,trial_kind,correct,response_ms\n"
                     "o1,s,a,b,1,1,warmup,,812\n");
-    EXPECT_EQ(errorOf(kind), kind + ": line 2: column trial_kind: 'warmup' is not one of test, repeat, catch, practice");
+    EXPECT_EQ(errorOf(kind),
+              kind + ": line 2: column trial_kind: 'warmup' is not one of test, repeat, catch, practice");
 }
 
 TEST(Responses, SkinlabCsvGroupsBlocksObserversAndTrialKinds) {
     const std::string path = writeText(
-        "good.csv",
-        "scene,observer,condition_A,condition_B,is_A_selected,A_on_left,trial_kind,correct,response_ms\n"
-        "\"builtin:head/mid\",o1,separable,none,1,1,test,,900\n"
-        "\"builtin:head/mid\",o1,none,separable,0,0,repeat,,700\n"
-        "\"builtin:head/mid\",o1,separable,none,1,1,catch,0,500\n"
-        "\"builtin:head/mid\",o2,separable,none,0,1,test,,800\n"
-        "\"builtin:head/mid\",o2,separable,none,1,1,practice,,800\n"
-        "\"builtin:head/far\",o2,separable,none,1,0,test,,650\n");
+        "good.csv", "scene,observer,condition_A,condition_B,is_A_selected,A_on_left,trial_kind,correct,response_ms\n"
+                    "\"builtin:head/mid\",o1,separable,none,1,1,test,,900\n"
+                    "\"builtin:head/mid\",o1,none,separable,0,0,repeat,,700\n"
+                    "\"builtin:head/mid\",o1,separable,none,1,1,catch,0,500\n"
+                    "\"builtin:head/mid\",o2,separable,none,0,1,test,,800\n"
+                    "\"builtin:head/mid\",o2,separable,none,1,1,practice,,800\n"
+                    "\"builtin:head/far\",o2,separable,none,1,0,test,,650\n");
     const Dataset dataset = buildDataset(readResponses(path), {});
     ASSERT_EQ(dataset.blocks.size(), 2u);
     const BlockData& mid = dataset.blocks[0];
@@ -122,7 +122,7 @@ TEST(Responses, SkinlabCsvGroupsBlocksObserversAndTrialKinds) {
     // separable (index 0) beat none twice (o1, test and repeat) and lost once (o2).
     EXPECT_EQ(mid.countMatrix()(0, 1), 2.0);
     EXPECT_EQ(mid.countMatrix()(1, 0), 1.0);
-    EXPECT_EQ(mid.leftChosen[0], 2.0);  // o1 chose the left stimulus both times
+    EXPECT_EQ(mid.leftChosen[0], 2.0); // o1 chose the left stimulus both times
     EXPECT_EQ(mid.leftChosen[1], 0.0);
     ASSERT_EQ(dataset.attention.size(), 2u);
     EXPECT_EQ(dataset.attention[0].catchTrials, 1);
@@ -155,7 +155,7 @@ TEST(Responses, StudyDatabaseView) {
     EXPECT_EQ(table.responses[1].aOnLeft, std::optional<bool>(false));
     EXPECT_EQ(table.responses[3].kind, TrialKind::Catch);
     const Dataset dataset = buildDataset(table, {});
-    EXPECT_EQ(dataset.blocks.front().countMatrix()(1, 0), 2.0);  // y beat x twice
+    EXPECT_EQ(dataset.blocks.front().countMatrix()(1, 0), 2.0); // y beat x twice
 
     const auto bare = scratch() / "bare.db";
     std::filesystem::remove(bare);

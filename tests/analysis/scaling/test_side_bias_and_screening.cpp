@@ -32,7 +32,7 @@ TEST(SideBias, DetectsAConstantBias) {
     block.pairs = {{0, 1}};
     block.winsFirst = Eigen::MatrixXd::Constant(1, 1, 200);
     block.winsSecond = Eigen::MatrixXd::Constant(1, 1, 200);
-    block.sideCounts = {{140, 60, 60, 140}};  // a left: a 140, b 60; b left: a 60, b 140
+    block.sideCounts = {{140, 60, 60, 140}}; // a left: a 140, b 60; b left: a 60, b 140
     block.leftChosen = Eigen::VectorXd::Constant(1, 280);
     block.sideTrials = Eigen::VectorXd::Constant(1, 400);
     const SideBias bias = estimateSideBias(block, Eigen::Vector2d(0.0, 0.0), Model::Thurstone);

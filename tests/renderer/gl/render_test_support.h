@@ -37,20 +37,21 @@ inline Renderer* sharedRenderer() {
     return renderer.get();
 }
 
-#define SKINLAB_REQUIRE_RENDERER(name)                                                              \
-    ::skinlab::renderer::Renderer* name = ::skinlab::renderer::test::sharedRenderer();              \
+#define SKINLAB_REQUIRE_RENDERER(name)                                                                                 \
+    ::skinlab::renderer::Renderer* name = ::skinlab::renderer::test::sharedRenderer();                                 \
     if (!name) GTEST_SKIP() << "no EGL/OpenGL 4.5 context: " << ::skinlab::renderer::test::rendererFailure()
 
 struct ExrImage {
     int width = 0;
     int height = 0;
-    std::map<std::string, std::vector<float>> channels;  // planar, top row first
+    std::map<std::string, std::vector<float>> channels; // planar, top row first
     std::map<std::string, std::string> strings;
     std::map<std::string, float> floats;
     std::vector<std::string> channelOrder;
 
     float at(const std::string& channel, int x, int y) const {
-        return channels.at(channel)[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)];
+        return channels.at(
+            channel)[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)];
     }
 };
 
@@ -68,13 +69,16 @@ inline ExrImage readExr(const std::filesystem::path& path) {
     const std::size_t pixels = static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height);
     for (int c = 0; c < spec.nchannels; ++c) {
         std::vector<float> plane(pixels);
-        for (std::size_t p = 0; p < pixels; ++p) plane[p] = interleaved[p * static_cast<std::size_t>(spec.nchannels) + static_cast<std::size_t>(c)];
+        for (std::size_t p = 0; p < pixels; ++p)
+            plane[p] = interleaved[p * static_cast<std::size_t>(spec.nchannels) + static_cast<std::size_t>(c)];
         image.channels[spec.channelnames[static_cast<std::size_t>(c)]] = std::move(plane);
         image.channelOrder.push_back(spec.channelnames[static_cast<std::size_t>(c)]);
     }
     for (const auto& attribute : spec.extra_attribs) {
-        if (attribute.type() == OIIO::TypeDesc::STRING) image.strings[attribute.name().string()] = attribute.get_string();
-        else if (attribute.type() == OIIO::TypeDesc::FLOAT) image.floats[attribute.name().string()] = attribute.get_float();
+        if (attribute.type() == OIIO::TypeDesc::STRING)
+            image.strings[attribute.name().string()] = attribute.get_string();
+        else if (attribute.type() == OIIO::TypeDesc::FLOAT)
+            image.floats[attribute.name().string()] = attribute.get_float();
     }
     return image;
 }

@@ -32,7 +32,7 @@ void writeRgb(const std::filesystem::path& path, int width, int height, const st
     std::filesystem::create_directories(path.parent_path());
     OIIO::ImageSpec spec(width, height, 3, half ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
     spec.attribute("compression", "zip");
-    spec.attribute("DateTime", "");  // no timestamp: regenerating an unchanged golden gives the same bytes
+    spec.attribute("DateTime", ""); // no timestamp: regenerating an unchanged golden gives the same bytes
     auto out = OIIO::ImageOutput::create(path.string());
     ASSERT_TRUE(out && out->open(path.string(), spec)) << path;
     ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, rgb.data()));
@@ -66,7 +66,8 @@ TEST_P(GoldenImages, BuiltinSceneMatchesItsGolden) {
     for (std::size_t p = 0; p < image.channels.at("R").size(); ++p)
         for (const char* c : {"R", "G", "B"}) actual.push_back(image.channels.at(c)[p]);
     // Goldens are stored as half floats; compare against the actual values rounded the same way.
-    const std::filesystem::path golden = std::filesystem::path(SKINLAB_SOURCE_DIR) / "tests/data/golden" / (name + ".exr");
+    const std::filesystem::path golden =
+        std::filesystem::path(SKINLAB_SOURCE_DIR) / "tests/data/golden" / (name + ".exr");
     if (const char* update = std::getenv("SKINLAB_UPDATE_GOLDENS"); update && std::string(update) == "1") {
         writeRgb(golden, kSize, kSize, actual, true);
         GTEST_SKIP() << "SKINLAB_UPDATE_GOLDENS=1: wrote " << golden;

@@ -23,7 +23,8 @@ std::string quote(const std::string& s) {
     return q + "'";
 }
 
-CliRun runCli(const std::vector<std::string>& arguments, const test::TempFolder& folder, const std::string& environment = "") {
+CliRun runCli(const std::vector<std::string>& arguments, const test::TempFolder& folder,
+              const std::string& environment = "") {
     std::string command = environment + " " + quote(SKINLAB_CLI);
     for (const auto& a : arguments) command += " " + quote(a);
     const auto outPath = folder.path().parent_path() / (folder.path().filename().string() + ".stdout");
@@ -70,10 +71,10 @@ protected:
 
 TEST_F(RenderCli, RendersExrPngAndTimings) {
     if (!eglAvailable()) GTEST_SKIP() << "no EGL: " << test::rendererFailure();
-    const CliRun run = runCli({"render", "--scene", "builtin:ear", "--width", "64", "--height", "40", "-o",
-                            (out / "ear.exr").string(), "--png", (out / "ear.png").string(), "--timings",
-                            (out / "t.json").string()},
-                           folder);
+    const CliRun run =
+        runCli({"render", "--scene", "builtin:ear", "--width", "64", "--height", "40", "-o", (out / "ear.exr").string(),
+                "--png", (out / "ear.png").string(), "--timings", (out / "t.json").string()},
+               folder);
     ASSERT_EQ(run.exitCode, 0) << run.err;
     const test::ExrImage image = test::readExr(out / "ear.exr");
     EXPECT_EQ(image.width, 64);
@@ -90,13 +91,15 @@ TEST_F(RenderCli, RendersExrPngAndTimings) {
 TEST_F(RenderCli, UnknownBuiltinScene) {
     const CliRun run = runCli({"render", "--scene", "builtin:torso", "-o", (out / "x.exr").string()}, folder);
     EXPECT_EQ(run.exitCode, 2);
-    EXPECT_EQ(errorLine(run), "skinlab: error: unknown built-in scene 'builtin:torso' (known: builtin:halo, "
-                              "builtin:bleed, builtin:ear, builtin:head, builtin:halo-grey-backdrop, builtin:bleed-true-mask)");
+    EXPECT_EQ(errorLine(run),
+              "skinlab: error: unknown built-in scene 'builtin:torso' (known: builtin:halo, "
+              "builtin:bleed, builtin:ear, builtin:head, builtin:halo-grey-backdrop, builtin:bleed-true-mask)");
     EXPECT_TRUE(folderIsEmpty(out.path()));
 }
 
 TEST_F(RenderCli, BadSpecValueThroughSet) {
-    const CliRun run = runCli({"render", "--scene", "builtin:head", "--set", "camera.fov_deg=500", "-o", (out / "x.exr").string()}, folder);
+    const CliRun run = runCli(
+        {"render", "--scene", "builtin:head", "--set", "camera.fov_deg=500", "-o", (out / "x.exr").string()}, folder);
     EXPECT_EQ(run.exitCode, 2);
     EXPECT_EQ(errorLine(run), "skinlab: error: builtin:head: camera.fov_deg: 500 is out of range [1, 179]");
     EXPECT_TRUE(folderIsEmpty(out.path()));
@@ -114,8 +117,8 @@ TEST_F(RenderCli, MissingModelFile) {
     const auto spec = sceneWith("[model]\nsource = \"missing.glb\"\n");
     const CliRun run = runCli({"render", "--scene", spec.string(), "-o", (out / "x.exr").string()}, folder);
     EXPECT_EQ(run.exitCode, 2);
-    EXPECT_EQ(errorLine(run), "skinlab: error: " + spec.string() + ": model.source: file not found: " +
-                                  (folder / "missing.glb").string());
+    EXPECT_EQ(errorLine(run), "skinlab: error: " + spec.string() +
+                                  ": model.source: file not found: " + (folder / "missing.glb").string());
     EXPECT_TRUE(folderIsEmpty(out.path()));
 }
 
@@ -137,9 +140,9 @@ TEST_F(RenderCli, CorruptModelTextureAndEnvironment) {
     };
     for (const Case& c : cases) {
         const auto spec = sceneWith(c.body);
-        const CliRun run = runCli({"render", "--scene", spec.string(), "-o", (out / "x.exr").string(), "--png",
-                                (out / "x.png").string()},
-                               folder);
+        const CliRun run = runCli(
+            {"render", "--scene", spec.string(), "-o", (out / "x.exr").string(), "--png", (out / "x.png").string()},
+            folder);
         EXPECT_EQ(run.exitCode, 2) << c.body << run.err;
         const std::string line = errorLine(run);
         EXPECT_EQ(line.rfind("skinlab: error: " + c.expectedStart, 0), 0u) << line;
@@ -160,18 +163,19 @@ TEST_F(RenderCli, UnwritableOutputDetectedWhileWritingLeavesNoFile) {
     if (!eglAvailable()) GTEST_SKIP() << "no EGL: " << test::rendererFailure();
     // The EXR's folder exists but the final name is a folder: rename fails after rendering; nothing remains.
     std::filesystem::create_directories(out / "taken.exr");
-    const CliRun run = runCli({"render", "--scene", "builtin:halo", "--width", "32", "--height", "32", "-o",
-                            (out / "taken.exr").string()},
-                           folder);
+    const CliRun run = runCli(
+        {"render", "--scene", "builtin:halo", "--width", "32", "--height", "32", "-o", (out / "taken.exr").string()},
+        folder);
     EXPECT_NE(run.exitCode, 0);
     EXPECT_EQ(errorLine(run).rfind("skinlab: ", 0), 0u) << run.err;
     std::vector<std::string> names;
     for (const auto& entry : std::filesystem::directory_iterator(out.path())) names.push_back(entry.path().filename());
-    EXPECT_EQ(names, std::vector<std::string>{"taken.exr"});  // no temporary left behind
+    EXPECT_EQ(names, std::vector<std::string>{"taken.exr"}); // no temporary left behind
 }
 
 TEST_F(RenderCli, UnknownMethod) {
-    const CliRun run = runCli({"render", "--scene", "builtin:halo", "--method", "magic", "-o", (out / "x.exr").string()}, folder);
+    const CliRun run =
+        runCli({"render", "--scene", "builtin:halo", "--method", "magic", "-o", (out / "x.exr").string()}, folder);
     EXPECT_EQ(run.exitCode, 2);
     EXPECT_EQ(errorLine(run).rfind("skinlab: error: builtin:halo: sss.method: 'magic' is not one of:", 0), 0u)
         << errorLine(run);
@@ -183,7 +187,8 @@ TEST_F(RenderCli, ShaderFolderOverrideAndShaderErrorsNameTheFile) {
     // A copy of the shaders renders the same image as the embedded ones ...
     const auto shaders = folder / "shaders";
     std::filesystem::copy(std::filesystem::path(SKINLAB_SOURCE_DIR) / "renderer/shaders", shaders);
-    const std::vector<std::string> arguments = {"render", "--scene", "builtin:bleed", "--width", "32", "--height", "32", "-o"};
+    const std::vector<std::string> arguments = {"render", "--scene", "builtin:bleed", "--width", "32", "--height",
+                                                "32",     "-o"};
     auto withOutput = [&](const std::string& name) {
         auto a = arguments;
         a.push_back((out / name).string());
@@ -196,7 +201,10 @@ TEST_F(RenderCli, ShaderFolderOverrideAndShaderErrorsNameTheFile) {
     std::ofstream(shaders / "add_specular.frag", std::ios::app) << "\nthis is not GLSL\n";
     const CliRun run = runCli(withOutput("broken.exr"), folder, "SKINLAB_SHADER_DIR=" + quote(shaders.string()));
     EXPECT_EQ(run.exitCode, 1);
-    EXPECT_NE(run.err.find("skinlab: failure: shader add_specular.frag: compile failed (sources: 0 = add_specular.frag): 0:"), std::string::npos) << run.err;
+    EXPECT_NE(
+        run.err.find("skinlab: failure: shader add_specular.frag: compile failed (sources: 0 = add_specular.frag): 0:"),
+        std::string::npos)
+        << run.err;
     EXPECT_FALSE(std::filesystem::exists(out / "broken.exr"));
 }
 

@@ -25,10 +25,10 @@ using test::TempFolder;
 RenderRequest lambertPlane(const std::filesystem::path& exr, std::vector<std::string> extra = {}) {
     RenderRequest request;
     request.scene = "builtin:bleed-true-mask";
-    request.overrides = {"materials=[{name = \"skin\", albedo = [0.5, 0.5, 0.5], glossiness = 0.5, specular_intensity = 1.0}]",
-                         "lights=[{type = \"directional\", direction = [0.0, 0.0, -1.0], intensity = 2.0, shadow = false}]",
-                         "environment.radiance=[0.0, 0.0, 0.0]",
-                         "tone_map.operator=linear"};
+    request.overrides = {
+        "materials=[{name = \"skin\", albedo = [0.5, 0.5, 0.5], glossiness = 0.5, specular_intensity = 1.0}]",
+        "lights=[{type = \"directional\", direction = [0.0, 0.0, -1.0], intensity = 2.0, shadow = false}]",
+        "environment.radiance=[0.0, 0.0, 0.0]", "tone_map.operator=linear"};
     for (auto& e : extra) request.overrides.push_back(e);
     request.width = 64;
     request.height = 48;
@@ -83,7 +83,7 @@ TEST(RenderPipeline, SpecularMatchesEquation45PerPixel) {
             const float depth = image.at("depth.Z", x, y);
             const glm::vec3 viewPoint{ndcX * tanHalf * aspect * depth, ndcY * tanHalf * depth, -depth};
             const glm::vec3 world = glm::vec3(worldFromView * glm::vec4(viewPoint, 1.0f));
-            ASSERT_NEAR(world.z, 0.0f, 1e-3f);  // the patch lies in z = 0
+            ASSERT_NEAR(world.z, 0.0f, 1e-3f); // the patch lies in z = 0
             const glm::vec3 toViewer = glm::normalize(cameraPosition - world);
             const float expected = 2.0f * specularEq45({0, 0, 1}, {0, 0, 1}, toViewer, 0.5f);
             ASSERT_NEAR(image.at("specular.G", x, y), expected, 1e-3f * expected + 1e-6f) << x << "," << y;
@@ -97,7 +97,7 @@ TEST(RenderPipeline, SpecularBrdfMirrorAgainstHandComputedValues) {
     EXPECT_NEAR(specularEq45({0, 0, 1}, {0, 0, 1}, {0, 0, 1}, 0.5f), 258.0f / 8.0f * 0.028f, 1e-5f);
     // Glossiness 0 → alpha = 0: a constant lobe 2/8 * F * (n.l).
     const glm::vec3 l = glm::normalize(glm::vec3(0, 1, 1));
-    const glm::vec3 v = glm::normalize(glm::vec3(0, -1, 1));  // mirror direction: h = n, l.h = cos 45°
+    const glm::vec3 v = glm::normalize(glm::vec3(0, -1, 1)); // mirror direction: h = n, l.h = cos 45°
     const float f = 0.028f + 0.972f * std::pow(1.0f - std::sqrt(0.5f), 5.0f);
     EXPECT_NEAR(specularEq45({0, 0, 1}, l, v, 0.0f), 0.25f * f * std::sqrt(0.5f), 1e-6f);
     // Same geometry, alpha = 256: (n.h)^alpha = 1 at the mirror direction.
@@ -122,7 +122,7 @@ TEST(RenderPipeline, ConstantEnvironmentGivesAlbedoTimesRadiance) {
             ASSERT_NEAR(image.at("diffuse.R", x, y), 0.15f, 1e-3f * 0.15f);
             ASSERT_NEAR(image.at("diffuse.G", x, y), 0.30f, 1e-3f * 0.30f);
             ASSERT_NEAR(image.at("diffuse.B", x, y), 0.45f, 1e-3f * 0.45f);
-            ASSERT_EQ(image.at("specular.G", x, y), 0.0f);  // specular comes from lights only
+            ASSERT_EQ(image.at("specular.G", x, y), 0.0f); // specular comes from lights only
         }
 }
 
@@ -148,7 +148,8 @@ TEST(RenderPipeline, ShadowsDarkenTheBackdropBehindTheSphere) {
     request.height = 96;
     request.exrPath = folder / "lit.exr";
     // The key light of halo.toml, without and with its shadow (--set replaces the whole array of lights).
-    const std::string light = "lights=[{type = \"directional\", direction = [0.45, -0.45, -0.77], intensity = 1.2, shadow = ";
+    const std::string light =
+        "lights=[{type = \"directional\", direction = [0.45, -0.45, -0.77], intensity = 1.2, shadow = ";
     request.overrides = {light + "false}]"};
     renderer->render(request);
     request.exrPath = folder / "shadowed.exr";
@@ -162,7 +163,7 @@ TEST(RenderPipeline, ShadowsDarkenTheBackdropBehindTheSphere) {
         ++backdrop;
         const float before = lit.channels.at("diffuse.G")[p];
         const float after = shadowed.channels.at("diffuse.G")[p];
-        ASSERT_LE(after, before * (1.0f + 1e-5f) + 1e-7f);  // a shadow never brightens
+        ASSERT_LE(after, before * (1.0f + 1e-5f) + 1e-7f); // a shadow never brightens
         darkened += after < 0.5f * before;
     }
     EXPECT_GT(backdrop, 1000);
@@ -179,10 +180,31 @@ TEST(RenderPipeline, ExrLayoutChannelsAndMetadata) {
     request.exrPath = folder / "halo.exr";
     const RenderResult result = renderer->render(request);
     const ExrImage image = readExr(request.exrPath);
-    for (const char* channel : {"R", "G", "B", "diffuse.R", "diffuse.G", "diffuse.B", "specular.R", "specular.G",
-                                "specular.B", "albedo.R", "albedo.G", "albedo.B", "depth.Z", "normal.X", "normal.Y",
-                                "normal.Z", "geonormal.X", "geonormal.Y", "geonormal.Z", "mask.Y", "transmittance.R",
-                                "transmittance.G", "transmittance.B", "aux.Y", "curvature.Y"})
+    for (const char* channel : {"R",
+                                "G",
+                                "B",
+                                "diffuse.R",
+                                "diffuse.G",
+                                "diffuse.B",
+                                "specular.R",
+                                "specular.G",
+                                "specular.B",
+                                "albedo.R",
+                                "albedo.G",
+                                "albedo.B",
+                                "depth.Z",
+                                "normal.X",
+                                "normal.Y",
+                                "normal.Z",
+                                "geonormal.X",
+                                "geonormal.Y",
+                                "geonormal.Z",
+                                "mask.Y",
+                                "transmittance.R",
+                                "transmittance.G",
+                                "transmittance.B",
+                                "aux.Y",
+                                "curvature.Y"})
         EXPECT_TRUE(image.channels.count(channel)) << channel;
     EXPECT_EQ(image.channels.size(), 25u);
     EXPECT_EQ(nlohmann::json::parse(image.strings.at("skinlab:resolved")), result.resolved);
@@ -192,7 +214,7 @@ TEST(RenderPipeline, ExrLayoutChannelsAndMetadata) {
     EXPECT_NEAR(image.floats.at("skinlab:f_px"), 32.0f / std::tan(glm::radians(15.0f)), 1e-3f);
     EXPECT_EQ(image.floats.at("skinlab:mm_per_unit"), 1.0f);
     EXPECT_TRUE(image.floats.count("skinlab:sss_radius_mm"));
-    EXPECT_FALSE(image.strings.count("DateTime"));  // determinism: no timestamps
+    EXPECT_FALSE(image.strings.count("DateTime")); // determinism: no timestamps
     int skin = 0;
     for (std::size_t p = 0; p < image.channels.at("R").size(); ++p) {
         const float mask = image.channels.at("mask.Y")[p];
@@ -306,13 +328,13 @@ TEST(ToneMappers, KnownValues) {
     toneMapReinhard(skin, 0.5f, y);
     EXPECT_NEAR(y[0] / y[1], 2.0f, 1e-5f);
     EXPECT_NEAR(y[2] / y[1], 0.6f, 1e-5f);
-    EXPECT_LT(toneMap(2.0f, "reinhard-rgb") / toneMap(1.0f, "reinhard-rgb"), 1.34f);  // (2/3) / (1/2)
+    EXPECT_LT(toneMap(2.0f, "reinhard-rgb") / toneMap(1.0f, "reinhard-rgb"), 1.34f); // (2/3) / (1/2)
     // The key a scales the image before the curve: a = 0.36 on L̄ = 0.18 doubles the scaled luminance.
     toneMapReinhard(grey, 0.36f / 0.18f, y);
     EXPECT_NEAR(y[0], 2.0f / 3.0f, 1e-6f);
     EXPECT_NEAR(toneMap(1.0f, "exponential", 2.0f), 1.0f - std::exp(-2.0f), 1e-7f);
-    EXPECT_NEAR(toneMap(5.6f, "filmic"), 1.0f, 1e-6f);  // hable(2 * W / 2) / hable(W): white maps to 1
-    EXPECT_NEAR(toneMap(0.0f, "filmic"), 0.0f, 1e-7f);  // hable(0) = DE/DF - E/F = 0 up to float rounding
+    EXPECT_NEAR(toneMap(5.6f, "filmic"), 1.0f, 1e-6f); // hable(2 * W / 2) / hable(W): white maps to 1
+    EXPECT_NEAR(toneMap(0.0f, "filmic"), 0.0f, 1e-7f); // hable(0) = DE/DF - E/F = 0 up to float rounding
 }
 
 TEST(RenderPipeline, ScannedHeadRendersWithItsMapsAndEnvironment) {
@@ -345,15 +367,16 @@ TEST(RenderPipeline, ScannedHeadRendersWithItsMapsAndEnvironment) {
         albedoSum += a;
         albedoSquares += a * a;
         specularMax = std::max(specularMax, static_cast<double>(image.channels.at("specular.G")[p]));
-        const glm::vec3 n{image.channels.at("normal.X")[p], image.channels.at("normal.Y")[p], image.channels.at("normal.Z")[p]};
+        const glm::vec3 n{image.channels.at("normal.X")[p], image.channels.at("normal.Y")[p],
+                          image.channels.at("normal.Z")[p]};
         const glm::vec3 g{image.channels.at("geonormal.X")[p], image.channels.at("geonormal.Y")[p],
                           image.channels.at("geonormal.Z")[p]};
-        mapped += glm::dot(n, g) < 0.9999f;  // the map is smooth ("SmoothUV"): small deviations
+        mapped += glm::dot(n, g) < 0.9999f; // the map is smooth ("SmoothUV"): small deviations
     }
     ASSERT_GT(skin, 128 * 128 / 10);
     const double mean = albedoSum / skin;
     EXPECT_GT(std::sqrt(albedoSquares / skin - mean * mean), 0.02) << "albedo map not applied";
-    EXPECT_GT(mapped, skin / 4) << "normal map not applied";  // measured: about half the skin pixels
+    EXPECT_GT(mapped, skin / 4) << "normal map not applied"; // measured: about half the skin pixels
     EXPECT_GT(specularMax, 0.0);
     EXPECT_GT(background, 100);
 }

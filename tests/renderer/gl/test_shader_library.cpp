@@ -39,7 +39,7 @@ private:
 
 std::string compileError(const ShaderFolder& folder) {
     ::setenv("SKINLAB_SHADER_DIR", folder.path().c_str(), 1);
-    gl::ShaderLibrary library;  // reads SKINLAB_SHADER_DIR
+    gl::ShaderLibrary library; // reads SKINLAB_SHADER_DIR
     try {
         library.program("fullscreen.vert", "copy.frag");
     } catch (const RuntimeError& e) {
@@ -51,19 +51,19 @@ std::string compileError(const ShaderFolder& folder) {
 } // namespace
 
 TEST(ShaderLibrary, CompileErrorsKeepTheLinesOfTheFilesAfterAnInclude) {
-    SKINLAB_REQUIRE_RENDERER(renderer);  // its context is current on this thread
+    SKINLAB_REQUIRE_RENDERER(renderer); // its context is current on this thread
     (void)renderer;
     ShaderFolder folder;
     std::string include;
     for (int i = 0; i < 40; ++i) include += "// line " + std::to_string(i + 1) + " of the include\n";
-    include += "float helper(float x) { return 2.0 * x; }\n";  // line 41
+    include += "float helper(float x) { return 2.0 * x; }\n"; // line 41
     folder.write("lines.glsl", include);
     folder.write("copy.frag", "#version 450 core\n"
                               "#extension GL_GOOGLE_include_directive : require\n"
                               "#include \"lines.glsl\"\n"
                               "out vec4 colour;\n"
                               "void main() {\n"
-                              "    colour = vec4(helper(undeclaredName));\n"  // line 6 of copy.frag
+                              "    colour = vec4(helper(undeclaredName));\n" // line 6 of copy.frag
                               "}\n");
     const std::string error = compileError(folder);
     // Mesa writes SOURCE:LINE(COLUMN); the file itself is source 0, the include source 1.
@@ -72,7 +72,7 @@ TEST(ShaderLibrary, CompileErrorsKeepTheLinesOfTheFilesAfterAnInclude) {
     EXPECT_NE(error.find("sources: 0 = copy.frag, 1 = lines.glsl"), std::string::npos) << error;
 
     // An error inside the include names the include's own line.
-    folder.write("lines.glsl", include + "float broken() { return undeclaredInInclude; }\n");  // line 42
+    folder.write("lines.glsl", include + "float broken() { return undeclaredInInclude; }\n"); // line 42
     folder.write("copy.frag", "#version 450 core\n"
                               "#extension GL_GOOGLE_include_directive : require\n"
                               "#include \"lines.glsl\"\n"

@@ -23,11 +23,12 @@ ExrImage renderScene(Renderer& renderer, const TempFolder& folder, const std::st
                      std::vector<std::string> overrides = {}) {
     RenderRequest request;
     request.scene = scene;
-    request.overrides = {"shadow.resolution=256"};  // shadows play no part here
+    request.overrides = {"shadow.resolution=256"}; // shadows play no part here
     for (auto& o : overrides) request.overrides.push_back(std::move(o));
     request.width = size;
     request.height = size;
-    request.exrPath = folder / (scene.substr(8) + std::to_string(size) + std::to_string(request.overrides.size()) + ".exr");
+    request.exrPath =
+        folder / (scene.substr(8) + std::to_string(size) + std::to_string(request.overrides.size()) + ".exr");
     renderer.render(request);
     return readExr(request.exrPath);
 }
@@ -41,15 +42,15 @@ double median(std::vector<double> values) {
 TEST(SurfaceAovs, SphereCurvatureIsOneOverItsRadius) {
     SKINLAB_REQUIRE_RENDERER(renderer);
     TempFolder folder("curvature-sphere");
-    const double expected = 1.0 / kHaloSphereRadiusMm;  // 1/world unit (1 unit = 1 mm)
+    const double expected = 1.0 / kHaloSphereRadiusMm; // 1/world unit (1 unit = 1 mm)
     struct Variant {
         int size;
         const char* view;
     };
     // Two resolutions and two distances: the measure is in 1/world unit, independent of the pixel scale.
     for (const Variant variant : {Variant{128, "mid"}, Variant{64, "mid"}, Variant{96, "far"}}) {
-        const ExrImage image =
-            renderScene(*renderer, folder, "builtin:halo-grey-backdrop", variant.size, {std::string("camera.view=") + variant.view});
+        const ExrImage image = renderScene(*renderer, folder, "builtin:halo-grey-backdrop", variant.size,
+                                           {std::string("camera.view=") + variant.view});
         std::vector<double> interior;
         for (const auto& [x, y] : test::interiorSkinPixels(image, 4)) interior.push_back(image.at("curvature.Y", x, y));
         const double measured = median(interior);
@@ -79,7 +80,8 @@ TEST(SurfaceAovs, FlatPatchCurvatureIsNearZero) {
     float largest = 0.0f;
     for (const auto& [x, y] : interior) largest = std::max(largest, std::abs(image.at("curvature.Y", x, y)));
     std::printf("builtin:bleed flat patch, 128 px: largest |curvature| %.3g /mm over %zu interior pixels "
-                "(bound 0.1/40 = %.3g)\n", largest, interior.size(), 0.1 / kHaloSphereRadiusMm);
+                "(bound 0.1/40 = %.3g)\n",
+                largest, interior.size(), 0.1 / kHaloSphereRadiusMm);
     EXPECT_LT(largest, 0.1f / kHaloSphereRadiusMm);
 }
 
@@ -97,9 +99,11 @@ TEST(SurfaceAovs, AuxiliaryImageMatchesTheCppMirrorAndGrowsTowardsTheSilhouette)
                 continue;
             }
             const glm::vec3 position = test::viewPositionAt(image, camera, x, y);
-            const glm::vec3 normal = glm::normalize(
-                viewFromWorld * glm::vec3(image.at("geonormal.X", x, y), image.at("geonormal.Y", x, y), image.at("geonormal.Z", x, y)));
-            const float grey = (image.at("albedo.R", x, y) + image.at("albedo.G", x, y) + image.at("albedo.B", x, y)) / 3.0f;
+            const glm::vec3 normal =
+                glm::normalize(viewFromWorld * glm::vec3(image.at("geonormal.X", x, y), image.at("geonormal.Y", x, y),
+                                                         image.at("geonormal.Z", x, y)));
+            const float grey =
+                (image.at("albedo.R", x, y) + image.at("albedo.G", x, y) + image.at("albedo.B", x, y)) / 3.0f;
             const float expected = sss::auxiliaryValue(position, normal, grey);
             ASSERT_NEAR(image.at("aux.Y", x, y), expected, 1e-3f * expected + 1e-5f) << x << "," << y;
             ++checked;
@@ -110,9 +114,11 @@ TEST(SurfaceAovs, AuxiliaryImageMatchesTheCppMirrorAndGrowsTowardsTheSilhouette)
     // row through the centre F = cos φ_i / cos φ_j grows as the surface turns away from the viewer.
     const glm::vec4 clip = camera.projection * camera.view * glm::vec4(0, 0, 0, 1);
     const int centreX = static_cast<int>(std::floor((clip.x / clip.w * 0.5f + 0.5f) * static_cast<float>(image.width)));
-    const int centreY = static_cast<int>(std::floor((0.5f - clip.y / clip.w * 0.5f) * static_cast<float>(image.height)));
+    const int centreY =
+        static_cast<int>(std::floor((0.5f - clip.y / clip.w * 0.5f) * static_cast<float>(image.height)));
     const float grey = (image.at("albedo.R", centreX, centreY) + image.at("albedo.G", centreX, centreY) +
-                        image.at("albedo.B", centreX, centreY)) / 3.0f;
+                        image.at("albedo.B", centreX, centreY)) /
+                       3.0f;
     const float centre = image.at("aux.Y", centreX, centreY);
     std::printf("aux.Y at the sphere centre pixel (%d, %d): %.5f, albedo grey %.5f (ratio %.4f)\n", centreX, centreY,
                 centre, grey, centre / grey);
@@ -138,11 +144,14 @@ TEST(SurfaceAovs, ScreenSpaceCurvatureGrowsTowardsTheSilhouette) {
     SKINLAB_REQUIRE_RENDERER(renderer);
     TempFolder folder("curvature-screen");
     const ExrImage normal = renderScene(*renderer, folder, "builtin:halo-grey-backdrop", 160);
-    const ExrImage screen = renderScene(*renderer, folder, "builtin:halo-grey-backdrop", 160, {"sss.curvature_measure=screen"});
+    const ExrImage screen =
+        renderScene(*renderer, folder, "builtin:halo-grey-backdrop", 160, {"sss.curvature_measure=screen"});
     const test::ExrCamera camera = test::exrCamera(screen);
     const glm::vec4 clip = camera.projection * camera.view * glm::vec4(0, 0, 0, 1);
-    const int centreX = static_cast<int>(std::floor((clip.x / clip.w * 0.5f + 0.5f) * static_cast<float>(screen.width)));
-    const int centreY = static_cast<int>(std::floor((0.5f - clip.y / clip.w * 0.5f) * static_cast<float>(screen.height)));
+    const int centreX =
+        static_cast<int>(std::floor((clip.x / clip.w * 0.5f + 0.5f) * static_cast<float>(screen.width)));
+    const int centreY =
+        static_cast<int>(std::floor((0.5f - clip.y / clip.w * 0.5f) * static_cast<float>(screen.height)));
     int edge = centreX;
     while (edge + 1 < screen.width && screen.at("mask.Y", edge + 1, centreY) > 0.0f) ++edge;
     const int radiusPixels = edge - centreX;
@@ -154,7 +163,8 @@ TEST(SurfaceAovs, ScreenSpaceCurvatureGrowsTowardsTheSilhouette) {
     const double screenOuter = screen.at("curvature.Y", outer, centreY) / inverseRadius;
     const double normalOuter = normal.at("curvature.Y", outer, centreY) / inverseRadius;
     std::printf("builtin:halo sphere, 160 px, curvature × r: centre screen %.3f / normal %.3f; at 90 %% of the radius "
-                "screen %.3f / normal %.3f\n", screenCentre, normalCentre, screenOuter, normalOuter);
+                "screen %.3f / normal %.3f\n",
+                screenCentre, normalCentre, screenOuter, normalOuter);
     EXPECT_NEAR(screenCentre, 1.0, 0.1);
     EXPECT_NEAR(normalOuter, 1.0, 0.1);
     EXPECT_GT(screenOuter, 1.2 * screenCentre);

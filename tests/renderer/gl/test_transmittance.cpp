@@ -70,7 +70,7 @@ TEST(Transmittance, BackLitFinIsBrighterWithItOnAndTheDiffuseGainsExactlyTheAov)
     std::printf("builtin:ear (2.5 mm, translucency 0.75): skin diffuse.R mean %.5f off, %.5f on (+%.1f %%); "
                 "transmittance.R mean %.5f\n",
                 offMean, onMean, 100.0 * (onMean / offMean - 1.0), transmittedMean);
-    EXPECT_GT(onMean, offMean * 1.05);  // the back light reaches the front of the thin fin
+    EXPECT_GT(onMean, offMean * 1.05); // the back light reaches the front of the thin fin
     EXPECT_GT(transmittedMean, 0.0);
     // Red travels farthest through skin (d'Eon's widest lobes are red).
     EXPECT_GT(skinMean(on, "transmittance.R"), skinMean(on, "transmittance.G"));
@@ -94,7 +94,8 @@ TEST(Transmittance, DisabledLeavesTheDiffuseUnchangedWhateverTheTranslucency) {
     SKINLAB_REQUIRE_RENDERER(renderer);
     TempFolder folder("transmittance-disabled");
     const ExrImage a = renderEar(*renderer, folder, "a", {"transmittance.translucency=0.5"});
-    const ExrImage b = renderEar(*renderer, folder, "b", {"transmittance.translucency=1.0", "transmittance.curvature=true"});
+    const ExrImage b =
+        renderEar(*renderer, folder, "b", {"transmittance.translucency=1.0", "transmittance.curvature=true"});
     for (const char* c : kRgb) {
         EXPECT_EQ(a.channels.at(std::string("diffuse.") + c), b.channels.at(std::string("diffuse.") + c)) << c;
         EXPECT_EQ(maxAbs(b, std::string("transmittance.") + c), 0.0f) << c;
@@ -111,7 +112,8 @@ TEST(Transmittance, ThickerFinsTransmitLess) {
                                          {"model.thickness_mm=" + std::to_string(thicknessMm),
                                           "transmittance.enabled=true", "transmittance.translucency=0.8"});
         const double mean = skinMean(image, "transmittance.R");
-        std::printf("builtin:ear thickness %.1f mm, translucency 0.8: skin transmittance.R mean %.5f\n", thicknessMm, mean);
+        std::printf("builtin:ear thickness %.1f mm, translucency 0.8: skin transmittance.R mean %.5f\n", thicknessMm,
+                    mean);
         EXPECT_GT(mean, 0.0);
         if (!first) {
             EXPECT_LT(mean, previous * 0.8) << thicknessMm << " mm";
@@ -125,8 +127,9 @@ TEST(Transmittance, FullTranslucencyGivesUnitTransmittancePerPixel) {
     SKINLAB_REQUIRE_RENDERER(renderer);
     TempFolder folder("transmittance-unit");
     // Exposure +1 EV: the AOV carries exposure like every radiance AOV.
-    const ExrImage image = renderEar(*renderer, folder, "unit",
-                                     {"transmittance.enabled=true", "transmittance.translucency=1.0", "render.exposure_ev=1"});
+    const ExrImage image =
+        renderEar(*renderer, folder, "unit",
+                  {"transmittance.enabled=true", "transmittance.translucency=1.0", "render.exposure_ev=1"});
     // The back light of builtin:ear (renderer/scenes/builtin/ear.toml); the front fill casts no shadow and so
     // transmits nothing.
     const glm::vec3 toLight = -glm::normalize(glm::vec3(0.15f, -0.2f, 0.97f));
@@ -150,7 +153,8 @@ TEST(Transmittance, FullTranslucencyGivesUnitTransmittancePerPixel) {
             }
             if (mask > 0.0f && facing > 0.0f) ++checked;
         }
-    std::printf("translucency 1: %d back-lit skin pixels, largest |transmittance - formula| %.2g\n", checked, largestError);
+    std::printf("translucency 1: %d back-lit skin pixels, largest |transmittance - formula| %.2g\n", checked,
+                largestError);
     EXPECT_GT(checked, 500);
 }
 
@@ -170,8 +174,8 @@ TEST(Transmittance, CurvatureOptionScalesTheAddedLightByOnePlusNormalisedCurvatu
     SKINLAB_REQUIRE_RENDERER(renderer);
     TempFolder folder("transmittance-curvature");
     const ExrImage off = renderEar(*renderer, folder, "off", {});
-    const ExrImage on = renderEar(*renderer, folder, "curvature",
-                                  {"transmittance.enabled=true", "transmittance.curvature=true"});
+    const ExrImage on =
+        renderEar(*renderer, folder, "curvature", {"transmittance.enabled=true", "transmittance.curvature=true"});
     const float mmPerUnit = on.floats.at("skinlab:mm_per_unit");
     int curved = 0;
     for (int y = 0; y < on.height; ++y)
@@ -179,14 +183,17 @@ TEST(Transmittance, CurvatureOptionScalesTheAddedLightByOnePlusNormalisedCurvatu
             const float c = sss::normalisedCurvature(on.at("curvature.Y", x, y), mmPerUnit);
             if (c > 0.1f && on.at("transmittance.R", x, y) > 0.0f) ++curved;
             for (const char* channel : kRgb) {
-                const float added = on.at(std::string("diffuse.") + channel, x, y) - off.at(std::string("diffuse.") + channel, x, y);
-                const float expected = on.at(std::string("transmittance.") + channel, x, y) * sss::transmittanceCurvatureScale(c);
+                const float added =
+                    on.at(std::string("diffuse.") + channel, x, y) - off.at(std::string("diffuse.") + channel, x, y);
+                const float expected =
+                    on.at(std::string("transmittance.") + channel, x, y) * sss::transmittanceCurvatureScale(c);
                 ASSERT_NEAR(added, expected, 1e-6f + 1e-5f * on.at(std::string("diffuse.") + channel, x, y))
                     << channel << " at " << x << "," << y;
             }
         }
-    std::printf("transmittance.curvature: %d transmitting pixels with normalised curvature > 0.1 (the fin's rim)\n", curved);
-    EXPECT_GT(curved, 20);  // the rounded rim of the fin is tightly curved
+    std::printf("transmittance.curvature: %d transmitting pixels with normalised curvature > 0.1 (the fin's rim)\n",
+                curved);
+    EXPECT_GT(curved, 20); // the rounded rim of the fin is tightly curved
 }
 
 // transmittance.curvature_form = "thesis": the profile widened inside the exponent, s / (1 + 2c), in the main pass
@@ -210,7 +217,8 @@ TEST(Transmittance, ThesisCurvatureFormWidensTheProfileInsideTheExponent) {
                 ASSERT_GE(thesis.at(t, x, y), plain.at(t, x, y) * (1.0f - 1e-5f)) << channel << " at " << x << "," << y;
                 if (std::string(channel) == "R" && thesis.at(t, x, y) > plain.at(t, x, y) * 1.01f) ++brighter;
                 const std::string d = std::string("diffuse.") + channel;
-                ASSERT_NEAR(thesis.at(d, x, y) - off.at(d, x, y), thesis.at(t, x, y), 1e-6f + 1e-5f * thesis.at(d, x, y));
+                ASSERT_NEAR(thesis.at(d, x, y) - off.at(d, x, y), thesis.at(t, x, y),
+                            1e-6f + 1e-5f * thesis.at(d, x, y));
             }
     std::printf("transmittance.curvature_form = thesis: %d pixels transmit > 1 %% more red than without curvature\n",
                 brighter);

@@ -41,9 +41,10 @@ std::string readFile(const std::string& path) {
 } // namespace
 
 TEST(TransmittanceGlsl, MatchesDeonTransmittance) {
-    SKINLAB_REQUIRE_RENDERER(renderer);  // its context is current on this thread
+    SKINLAB_REQUIRE_RENDERER(renderer); // its context is current on this thread
     (void)renderer;
-    const std::string include = readFile(std::string(SKINLAB_SOURCE_DIR) + "/renderer/shaders/transmittance_profile.glsl");
+    const std::string include =
+        readFile(std::string(SKINLAB_SOURCE_DIR) + "/renderer/shaders/transmittance_profile.glsl");
     ASSERT_FALSE(include.empty());
     const std::string source = "#version 450 core\n" + include + kMain;
     const GLuint shader = glCreateShader(GL_COMPUTE_SHADER);
@@ -63,7 +64,7 @@ TEST(TransmittanceGlsl, MatchesDeonTransmittance) {
     ASSERT_EQ(ok, GL_TRUE);
 
     std::vector<float> thicknesses;
-    for (int i = 0; i <= 64; ++i) thicknesses.push_back(0.125f * static_cast<float>(i));  // 0…8 mm
+    for (int i = 0; i <= 64; ++i) thicknesses.push_back(0.125f * static_cast<float>(i)); // 0…8 mm
     GLuint buffers[2];
     glCreateBuffers(2, buffers);
     glNamedBufferStorage(buffers[0], GLsizeiptr(thicknesses.size() * sizeof(float)), thicknesses.data(), 0);
@@ -83,11 +84,13 @@ TEST(TransmittanceGlsl, MatchesDeonTransmittance) {
             // float32 exp on the device against double: 1e-6 absolute on values ≤ 1.
             EXPECT_NEAR(out[i * 4 + static_cast<std::size_t>(c)], expected[static_cast<std::size_t>(c)], 1e-6)
                 << "s = " << thicknesses[i] << " mm, channel " << c;
-            largest = std::max(largest, std::abs(out[i * 4 + static_cast<std::size_t>(c)] - expected[static_cast<std::size_t>(c)]));
+            largest = std::max(
+                largest, std::abs(out[i * 4 + static_cast<std::size_t>(c)] - expected[static_cast<std::size_t>(c)]));
         }
     }
-    for (int c = 0; c < 3; ++c) EXPECT_NEAR(out[static_cast<std::size_t>(c)], 1.0f, 1e-6f);  // T(0) = 1 per channel
-    std::printf("transmittance_profile.glsl vs deonTransmittance(), 65 thicknesses 0-8 mm: largest difference %.2g\n", largest);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(out[static_cast<std::size_t>(c)], 1.0f, 1e-6f); // T(0) = 1 per channel
+    std::printf("transmittance_profile.glsl vs deonTransmittance(), 65 thicknesses 0-8 mm: largest difference %.2g\n",
+                largest);
     glDeleteBuffers(2, buffers);
     glDeleteProgram(program);
 }

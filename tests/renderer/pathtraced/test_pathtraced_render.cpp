@@ -18,8 +18,8 @@ using namespace skinlab::renderer::test;
 
 namespace {
 
-#define SKINLAB_REQUIRE_BLENDER()                                                                  \
-    if (pathtraced::findProgram("blender").empty())                                                \
+#define SKINLAB_REQUIRE_BLENDER()                                                                                      \
+    if (pathtraced::findProgram("blender").empty())                                                                    \
     GTEST_SKIP() << "the program blender is not installed (Debian package blender)"
 
 const std::vector<std::string> kTiny = {"pathtraced.samples=16"};
@@ -31,7 +31,8 @@ struct CliRun {
 
 CliRun runCli(const std::string& arguments, const TempFolder& folder) {
     const auto errPath = folder / "stderr.txt";
-    const std::string command = std::string(SKINLAB_CLI) + " " + arguments + " > /dev/null 2> '" + errPath.string() + "'";
+    const std::string command =
+        std::string(SKINLAB_CLI) + " " + arguments + " > /dev/null 2> '" + errPath.string() + "'";
     const int status = std::system(command.c_str());
     CliRun run;
     run.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -108,7 +109,7 @@ TEST(PathtracedRender, LayoutMaskAndDepthAgreeWithTheRasterizer) {
         renderToExr(*renderer, "builtin:" + scene, "none", {}, 64, 64, folder / (scene + "-raster.exr"));
         const ExrImage cycles = readExr(folder / (scene + "-cycles.exr"));
         const ExrImage raster = readExr(folder / (scene + "-raster.exr"));
-        EXPECT_EQ(cycles.channelOrder, raster.channelOrder);  // the same layout as every other method
+        EXPECT_EQ(cycles.channelOrder, raster.channelOrder); // the same layout as every other method
         ASSERT_TRUE(cycles.strings.count("skinlab:pathtraced"));
         const nlohmann::json record = nlohmann::json::parse(cycles.strings.at("skinlab:pathtraced"));
         EXPECT_EQ(record.at("samples"), 16);
@@ -124,9 +125,9 @@ TEST(PathtracedRender, LayoutMaskAndDepthAgreeWithTheRasterizer) {
                     a.depthChecked);
         EXPECT_GT(a.skin, 200) << scene;
         if (scene == "ear") EXPECT_GT(a.background, 200) << scene;
-        else EXPECT_EQ(a.background, 0) << scene;  // the backdrop fills the view
+        else EXPECT_EQ(a.background, 0) << scene; // the backdrop fills the view
         EXPECT_EQ(a.maskMismatchInside, 0) << scene;
-        EXPECT_LT(a.worstDepth, 1e-3) << scene;  // the same camera and triangles: float precision
+        EXPECT_LT(a.worstDepth, 1e-3) << scene; // the same camera and triangles: float precision
         EXPECT_GT(a.depthChecked, 1000) << scene;
     }
 }
@@ -147,11 +148,12 @@ TEST(PathtracedRender, UniformlyLitSlabHasTheExpectedEnergy) {
                "f 2//3 6//3 7//3\nf 2//3 7//3 3//3\nf 1//4 4//4 8//4\nf 1//4 8//4 5//4\n"
                "f 4//5 3//5 7//5\nf 4//5 7//5 8//5\nf 1//6 5//6 6//6\nf 1//6 6//6 2//6\n";
         std::ofstream toml(folder / "slab.toml");
-        toml << "mm_per_unit = 1.0\n[model]\nsource = \"slab.obj\"\n"
-                "[[materials]]\nname = \"*\"\nalbedo = [0.6, 0.42, 0.34]\nskin = true\n"
-                "[camera]\nview = \"explicit\"\nposition = [0.0, 0.0, 400.0]\ntarget = [0.0, 0.0, 0.0]\nfov_deg = 10.0\n"
-                "[[lights]]\ntype = \"directional\"\ndirection = [0.0, 0.0, -1.0]\nintensity = 1.0\nshadow = true\n"
-                "[environment]\nradiance = [0.0, 0.0, 0.0]\nbackground = \"color\"\n";
+        toml
+            << "mm_per_unit = 1.0\n[model]\nsource = \"slab.obj\"\n"
+               "[[materials]]\nname = \"*\"\nalbedo = [0.6, 0.42, 0.34]\nskin = true\n"
+               "[camera]\nview = \"explicit\"\nposition = [0.0, 0.0, 400.0]\ntarget = [0.0, 0.0, 0.0]\nfov_deg = 10.0\n"
+               "[[lights]]\ntype = \"directional\"\ndirection = [0.0, 0.0, -1.0]\nintensity = 1.0\nshadow = true\n"
+               "[environment]\nradiance = [0.0, 0.0, 0.0]\nbackground = \"color\"\n";
     }
     const std::string scene = (folder / "slab.toml").string();
     struct Case {
@@ -184,7 +186,7 @@ TEST(PathtracedRender, UniformlyLitSlabHasTheExpectedEnergy) {
             std::printf("slab %s channel %d: diffuse %.4f (beauty %.4f), expected %.4f, ratio %.4f\n", c.name, ch, mean,
                         beauty / n, albedo[ch], mean / albedo[ch]);
             EXPECT_NEAR(mean / albedo[ch], 1.0, c.tolerance) << c.name << " channel " << ch;
-            EXPECT_NEAR(beauty / n, mean, 1e-3 * mean) << c.name;  // no specular: beauty is the diffuse light
+            EXPECT_NEAR(beauty / n, mean, 1e-3 * mean) << c.name; // no specular: beauty is the diffuse light
         }
     }
 }
@@ -213,8 +215,8 @@ TEST(PathtracedRender, RasterizerSpecularSourceAddsTheRasterizersSpecularLayer) 
     SKINLAB_REQUIRE_BLENDER();
     SKINLAB_REQUIRE_RENDERER(renderer);
     TempFolder folder("pathtraced-specular-source");
-    renderToExr(*renderer, "builtin:halo", "pathtraced", {"pathtraced.samples=4", "pathtraced.specular_source=\"rasterizer\""},
-                32, 32, folder / "cycles.exr");
+    renderToExr(*renderer, "builtin:halo", "pathtraced",
+                {"pathtraced.samples=4", "pathtraced.specular_source=\"rasterizer\""}, 32, 32, folder / "cycles.exr");
     renderToExr(*renderer, "builtin:halo", "none", {}, 32, 32, folder / "raster.exr");
     const ExrImage cycles = readExr(folder / "cycles.exr");
     const ExrImage raster = readExr(folder / "raster.exr");
@@ -231,7 +233,7 @@ TEST(PathtracedRender, RasterizerSpecularSourceAddsTheRasterizersSpecularLayer) 
                     << c << " at " << x << ", " << y;
             }
     }
-    EXPECT_GT(specular, 0.1);  // the sphere has a highlight: the check above is not on zeros
+    EXPECT_GT(specular, 0.1); // the sphere has a highlight: the check above is not on zeros
 }
 
 TEST(PathtracedCli, MissingBlenderIsAOneLineErrorAndWritesNothing) {
@@ -251,8 +253,8 @@ TEST(PathtracedCli, MissingBlenderIsAOneLineErrorAndWritesNothing) {
 TEST(PathtracedCli, ProfileFitAtATinySize) {
     SKINLAB_REQUIRE_BLENDER();
     TempFolder folder("pathtraced-fit");
-    const CliRun run = runCli("pathtraced fit-profile --samples 16 --pixels 512 --rows 4 -o '" + (folder / "fit").string() + "'",
-                              folder);
+    const CliRun run = runCli(
+        "pathtraced fit-profile --samples 16 --pixels 512 --rows 4 -o '" + (folder / "fit").string() + "'", folder);
     ASSERT_EQ(run.exitCode, 0) << run.err;
     const nlohmann::json fit = nlohmann::json::parse(readText(folder / "fit" / "profile_fit.json"));
     std::printf("fit at 512 px, 16 samples: radius_mm %s, rms %s\n", fit.at("radius_mm").dump().c_str(),

@@ -43,7 +43,8 @@ Exported exportScene(const std::string& scene, std::vector<std::string> override
     Exported e;
     overrides.push_back("sss.method=\"pathtraced\"");
     e.spec = loadSceneSpec(scene, overrides, {});
-    e.model = e.spec.modelSource == "builtin:halo" ? makeHaloScene(static_cast<float>(e.spec.depthGapMm)) : makeBleedScene();
+    e.model =
+        e.spec.modelSource == "builtin:halo" ? makeHaloScene(static_cast<float>(e.spec.depthGapMm)) : makeBleedScene();
     BlenderSceneInputs inputs;
     inputs.spec = &e.spec;
     inputs.model = &e.model;
@@ -51,8 +52,8 @@ Exported exportScene(const std::string& scene, std::vector<std::string> override
         const MeshMaterial& m = e.model.materials[part.material];
         inputs.partMaterials.push_back({m.albedo, m.skin ? 1.0f : 0.0f, m.glossiness, m.specularIntensity});
     }
-    inputs.camera = frameCamera(e.spec.camera, e.model.boundsMin, e.model.boundsMax, e.model.boundsMin, e.model.boundsMax,
-                                e.spec.width, e.spec.height);
+    inputs.camera = frameCamera(e.spec.camera, e.model.boundsMin, e.model.boundsMax, e.model.boundsMin,
+                                e.model.boundsMax, e.spec.width, e.spec.height);
     inputs.params = pathtracedParamsFromJson(e.spec.pathtraced);
     inputs.sssWidthMm = e.spec.sss.widthMm;
     e.json = blenderSceneJson(inputs, "mesh.bin", "cycles.exr", "cycles.json");
@@ -70,7 +71,8 @@ TEST(PathtracedParams, DefaultsAndStrictKeys) {
     EXPECT_NE(zero.find("pathtraced.samples"), std::string::npos) << zero;
     const std::string unknown = errorOf([] { loadSceneSpec("builtin:halo", {"pathtraced.sample=4"}, {}); });
     EXPECT_NE(unknown.find("pathtraced.sample"), std::string::npos) << unknown;
-    const std::string radius = errorOf([] { loadSceneSpec("builtin:halo", {"pathtraced.radius_mm=[1.0, -1.0, 1.0]"}, {}); });
+    const std::string radius =
+        errorOf([] { loadSceneSpec("builtin:halo", {"pathtraced.radius_mm=[1.0, -1.0, 1.0]"}, {}); });
     EXPECT_NE(radius.find("pathtraced.radius_mm"), std::string::npos) << radius;
     // The JSON form round-trips.
     PathtracedParams p;
@@ -87,7 +89,8 @@ TEST(PathtracedParams, SpecularSourceRasterizerRendersNoCyclesSpecular) {
     EXPECT_GT(own.json.at("materials").at(0).at("specular").get<double>(), 0.0);
     const Exported borrowed = exportScene("builtin:halo", {"pathtraced.specular_source=\"rasterizer\""});
     for (const auto& material : borrowed.json.at("materials")) EXPECT_EQ(material.at("specular").get<double>(), 0.0);
-    const std::string bad = errorOf([] { loadSceneSpec("builtin:halo", {"pathtraced.specular_source=\"glossy\""}, {}); });
+    const std::string bad =
+        errorOf([] { loadSceneSpec("builtin:halo", {"pathtraced.specular_source=\"glossy\""}, {}); });
     EXPECT_NE(bad.find("pathtraced.specular_source"), std::string::npos) << bad;
     EXPECT_NE(bad.find("glossy"), std::string::npos) << bad;
 }
@@ -95,7 +98,7 @@ TEST(PathtracedParams, SpecularSourceRasterizerRendersNoCyclesSpecular) {
 TEST(BlenderScene, LightsInBlenderUnits) {
     // builtin:head: a spot (intensity 1.6, colour [1, 0.95, 0.88]) and a directional light (0.25, [0.85, 0.9, 1]).
     const SceneSpec spec = loadSceneSpec("builtin:head", {"sss.method=\"pathtraced\""}, {});
-    Model model = makeBleedScene();  // any model: only the lights are checked here
+    Model model = makeBleedScene(); // any model: only the lights are checked here
     BlenderSceneInputs inputs;
     inputs.spec = &spec;
     inputs.model = &model;
@@ -111,7 +114,7 @@ TEST(BlenderScene, LightsInBlenderUnits) {
     const double cosInner = std::cos(15.0 * kPi / 180.0), cosOuter = std::cos(25.0 * kPi / 180.0);
     EXPECT_NEAR(spot.at("spot_blend").get<double>(), (cosInner - cosOuter) / (1.0 - cosOuter), 1e-9);
     EXPECT_EQ(sun.at("type"), "sun");
-    EXPECT_NEAR(sun.at("strength").get<double>(), kPi * 0.25, 1e-6);  // colour max 1: strength π L_c
+    EXPECT_NEAR(sun.at("strength").get<double>(), kPi * 0.25, 1e-6); // colour max 1: strength π L_c
     EXPECT_NEAR(sun.at("color").at(0).get<double>(), 0.85, 1e-6);
     EXPECT_FALSE(sun.at("shadow").get<bool>());
     EXPECT_NEAR(principledRoughness(0.5), std::pow(2.0 / (8192.0 * std::pow(0.5, 5.0) + 2.0), 0.25), 1e-12);
@@ -124,7 +127,7 @@ TEST(BlenderScene, EnvironmentLookupMatchesSkinlabConvention) {
     const glm::mat3 environmentFromWorld(
         glm::rotate(glm::mat4(1.0f), static_cast<float>(-rotation * kPi / 180.0), glm::vec3(0, 1, 0)));
     SceneSpec spec = loadSceneSpec("builtin:halo", {"sss.method=\"pathtraced\""}, {});
-    spec.environment.file = "/nonexistent/sky.hdr";  // only its presence matters to the JSON
+    spec.environment.file = "/nonexistent/sky.hdr"; // only its presence matters to the JSON
     spec.environment.rotationDeg = rotation;
     Model model = makeBleedScene();
     BlenderSceneInputs inputs;
@@ -145,7 +148,7 @@ TEST(BlenderScene, EnvironmentLookupMatchesSkinlabConvention) {
         const double vTop = 1.0 - (std::atan2(D.z, std::hypot(D.x, D.y)) / kPi + 0.5);
         const glm::vec2 expected = equirectCoordinates(environmentFromWorld * d);
         double du = std::abs(u - expected.x);
-        du = std::min(du, 1.0 - du);  // the seam
+        du = std::min(du, 1.0 - du); // the seam
         EXPECT_LT(du, 1e-5) << i;
         EXPECT_NEAR(vTop, expected.y, 1e-5) << i;
     }
@@ -153,27 +156,28 @@ TEST(BlenderScene, EnvironmentLookupMatchesSkinlabConvention) {
 
 TEST(BlenderScene, PartsAndRadii) {
     const Model halo = makeHaloScene(200.0f);
-    EXPECT_TRUE(isClosedSurface(halo, halo.parts[0]));   // the skin sphere
-    EXPECT_FALSE(isClosedSurface(halo, halo.parts[1]));  // the backdrop plane
+    EXPECT_TRUE(isClosedSurface(halo, halo.parts[0]));  // the skin sphere
+    EXPECT_FALSE(isClosedSurface(halo, halo.parts[1])); // the backdrop plane
     const Exported bleed = exportScene("builtin:bleed", {});
     EXPECT_EQ(bleed.json.at("mesh").at("parts").size(), bleed.model.parts.size());
     for (const auto& part : bleed.json.at("mesh").at("parts")) EXPECT_FALSE(part.at("closed").get<bool>());
     // Radii: mm at width 3 mm, scaled by width_mm / 3 and divided by mm_per_unit.
-    const Exported wide = exportScene("builtin:halo", {"sss.width_mm=6.0", "mm_per_unit=2.0", "pathtraced.radius_mm=[3.0, 2.0, 1.0]"});
+    const Exported wide =
+        exportScene("builtin:halo", {"sss.width_mm=6.0", "mm_per_unit=2.0", "pathtraced.radius_mm=[3.0, 2.0, 1.0]"});
     EXPECT_NEAR(wide.json.at("materials").at(0).at("radius").at(0).get<double>(), 3.0 * 2.0 / 2.0, 1e-9);
     EXPECT_NEAR(wide.json.at("materials").at(0).at("radius").at(2).get<double>(), 1.0 * 2.0 / 2.0, 1e-9);
 }
 
 TEST(BlenderProcess, MissingAndFailingProgramsAreOneLineErrors) {
     const std::filesystem::path folder = makeWorkFolder("skinlab-test-process");
-    const std::string missing = errorOf([&] {
-        runBlender("skinlab-no-such-blender", folder / "x.py", {}, folder, folder / "blender.log");
-    });
+    const std::string missing =
+        errorOf([&] { runBlender("skinlab-no-such-blender", folder / "x.py", {}, folder, folder / "blender.log"); });
     EXPECT_NE(missing.find("skinlab-no-such-blender"), std::string::npos) << missing;
     EXPECT_NE(missing.find("not found"), std::string::npos) << missing;
     EXPECT_EQ(missing.find('\n'), std::string::npos) << missing;
     // A program that runs and fails: the error names it, its exit status and the log.
-    const std::string failing = errorOf([&] { runBlender("false", folder / "x.py", {}, folder, folder / "blender.log"); });
+    const std::string failing =
+        errorOf([&] { runBlender("false", folder / "x.py", {}, folder, folder / "blender.log"); });
     EXPECT_NE(failing.find("exit status 1"), std::string::npos) << failing;
     EXPECT_NE(failing.find((folder / "blender.log").string()), std::string::npos) << failing;
     EXPECT_EQ(failing.find('\n'), std::string::npos) << failing;
@@ -182,7 +186,7 @@ TEST(BlenderProcess, MissingAndFailingProgramsAreOneLineErrors) {
 
 TEST(ProfileFit, DeonEdgeResponseKnownValues) {
     for (int c = 0; c < 3; ++c) {
-        EXPECT_NEAR(deonEdgeResponse(c, 0.0), 0.5, 1e-9);  // each channel's weights sum to 1
+        EXPECT_NEAR(deonEdgeResponse(c, 0.0), 0.5, 1e-9); // each channel's weights sum to 1
         EXPECT_LT(deonEdgeResponse(c, 20.0), 1e-9);
     }
     // Red has the widest tail (d'Eon's 7.41 mm² lobe): at 2 mm red keeps more than green and blue.
@@ -197,10 +201,14 @@ TEST(ProfileFit, RecoversTheScaleOfASyntheticResponse) {
     const double pixel = 0.005;
     for (int i = 0; i < 8000; ++i) response.xMm.push_back((i + 0.5) * pixel);
     for (int c = 0; c < 3; ++c)
-        for (double x : response.xMm) response.value[static_cast<std::size_t>(c)].push_back(deonEdgeResponse(c, x * k[static_cast<std::size_t>(c)]));
+        for (double x : response.xMm)
+            response.value[static_cast<std::size_t>(c)].push_back(
+                deonEdgeResponse(c, x * k[static_cast<std::size_t>(c)]));
     const ProfileFit fit = fitRadii(response, {1.0, 1.0, 1.0});
     for (int c = 0; c < 3; ++c) {
-        EXPECT_NEAR(fit.radiusMm[static_cast<std::size_t>(c)], k[static_cast<std::size_t>(c)], 1e-3 * k[static_cast<std::size_t>(c)]) << c;
+        EXPECT_NEAR(fit.radiusMm[static_cast<std::size_t>(c)], k[static_cast<std::size_t>(c)],
+                    1e-3 * k[static_cast<std::size_t>(c)])
+            << c;
         EXPECT_LT(fit.rmsError[static_cast<std::size_t>(c)], 1e-4) << c;
         EXPECT_GT(fit.initialRmsError[static_cast<std::size_t>(c)], fit.rmsError[static_cast<std::size_t>(c)]) << c;
     }

@@ -31,13 +31,14 @@ TEST(ExtensionWeights, LabOfTheSrgbPrimariesAndWhite) {
 }
 
 TEST(ExtensionWeights, LabWeightIsExponentialInDeltaE) {
-    const glm::vec3 a{50, 0, 0}, b{50, 3, 4};  // ΔE*ab = 5
+    const glm::vec3 a{50, 0, 0}, b{50, 3, 4}; // ΔE*ab = 5
     EXPECT_FLOAT_EQ(labWeight(a, a, 0.09f), 1.0f);
-    EXPECT_FLOAT_EQ(labWeight(a, b, 0.0f), 1.0f);  // β = 0: off
+    EXPECT_FLOAT_EQ(labWeight(a, b, 0.0f), 1.0f); // β = 0: off
     EXPECT_NEAR(labWeight(a, b, 0.09f), std::exp(-0.45f), 1e-6f);
     EXPECT_NEAR(labWeight(a, b, 0.5f), std::exp(-2.5f), 1e-6f);
     // Skin against the bleed scene's green-blue paint: the weight nearly vanishes at the thesis's β = 0.09.
-    const float skinToPaint = labWeight(linearRec709ToLab({0.6f, 0.4f, 0.3f}), linearRec709ToLab({0.05f, 0.6f, 0.8f}), 0.09f);
+    const float skinToPaint =
+        labWeight(linearRec709ToLab({0.6f, 0.4f, 0.3f}), linearRec709ToLab({0.05f, 0.6f, 0.8f}), 0.09f);
     EXPECT_LT(skinToPaint, 0.01f);
 }
 
@@ -80,7 +81,7 @@ TEST(ExtensionWeights, CurvatureStrategies) {
     EXPECT_FLOAT_EQ(normalisedCurvature(1.0f / 20.0f, 1.0f), 1.0f);
     EXPECT_FLOAT_EQ(normalisedCurvature(1.0f / 80.0f, 1.0f), 0.25f);
     EXPECT_FLOAT_EQ(normalisedCurvature(0.0f, 1.0f), 0.0f);
-    EXPECT_FLOAT_EQ(normalisedCurvature(-1.0f, 1.0f), 0.0f);  // concave (negative) is clamped
+    EXPECT_FLOAT_EQ(normalisedCurvature(-1.0f, 1.0f), 0.0f); // concave (negative) is clamped
     // Units: 1 unit = 10 mm, curvature 1/8 per unit = 1/80 per mm.
     EXPECT_FLOAT_EQ(normalisedCurvature(1.0f / 8.0f, 10.0f), 0.25f);
 

@@ -100,10 +100,24 @@ TEST(ExtensionsGlsl, MatchesTheCppFunctions) {
     const float mmPerUnit = 2.0f;
     const std::vector<Case> cases{
         {{1, 1, 1}, {0, 0, -5}, {0, 0, 1}, {0.6f, 0.4f, 0.3f}, 0.09f, 10.0f, 0.0f, 0.5f},
-        {{1, 0, 0}, {1, 2, -50}, glm::normalize(glm::vec3(0.3f, 0.2f, 1.0f)), {0.05f, 0.6f, 0.8f}, 0.5f, 10.0f, 0.01f, 0.3f},
+        {{1, 0, 0},
+         {1, 2, -50},
+         glm::normalize(glm::vec3(0.3f, 0.2f, 1.0f)),
+         {0.05f, 0.6f, 0.8f},
+         0.5f,
+         10.0f,
+         0.01f,
+         0.3f},
         {{0.18f, 0.18f, 0.18f}, {-3, 1, -7}, {1, 0, 0}, {0.02f, 0.02f, 0.02f}, 0.09f, 1.0f, 0.05f, 0.0f},
         {{0.005f, 0.004f, 0.003f}, {0, 0, -5}, {0, 0, -1}, {0.5f, 0.5f, 0.5f}, 0.0f, 0.0f, 1.0f, 1.0f},
-        {{0.6f, 0.4f, 0.3f}, {10, -10, -40}, glm::normalize(glm::vec3(-0.5f, 0.5f, 0.7f)), {0.6f, 0.45f, 0.3f}, 0.09f, 10.0f, -0.2f, 0.5f},
+        {{0.6f, 0.4f, 0.3f},
+         {10, -10, -40},
+         glm::normalize(glm::vec3(-0.5f, 0.5f, 0.7f)),
+         {0.6f, 0.45f, 0.3f},
+         0.09f,
+         10.0f,
+         -0.2f,
+         0.5f},
         {{0.02f, 0.6f, 0.8f}, {0, 0, 0}, {0, 0, 1}, {1, 1, 1}, 2.0f, 10.0f, 0.03f, 0.25f},
     };
     std::vector<glm::vec4> inputs;
@@ -133,7 +147,9 @@ TEST(ExtensionsGlsl, MatchesTheCppFunctions) {
 
     // Tolerances: GLSL pow(t, 1/3) against std::cbrt and exp/length in the driver's float precision differ in the
     // last bits; Lab components (0…100) within 2e-3, weights and scales (0…20) within 1e-4 relative.
-    const auto near = [](float a, float b, float relative) { return std::abs(a - b) <= relative * std::max(1.0f, std::abs(b)); };
+    const auto near = [](float a, float b, float relative) {
+        return std::abs(a - b) <= relative * std::max(1.0f, std::abs(b));
+    };
     for (std::size_t i = 0; i < cases.size(); ++i) {
         const Case& c = cases[i];
         const glm::vec3 lab = linearRec709ToLab(c.rgb);
@@ -141,7 +157,9 @@ TEST(ExtensionsGlsl, MatchesTheCppFunctions) {
         EXPECT_TRUE(near(out[4 * i].w, labWeight(lab, linearRec709ToLab(c.otherRgb), c.beta), 1e-4f)) << "case " << i;
         const float aux = auxiliaryValue(c.viewPosition, c.viewNormal);
         EXPECT_TRUE(near(out[4 * i + 1].x, aux, 1e-5f)) << "case " << i << ": " << out[4 * i + 1].x << " vs " << aux;
-        EXPECT_TRUE(near(out[4 * i + 1].y, auxiliaryWeight(aux, auxiliaryValue(c.viewPosition, c.viewNormal, c.otherRgb.g), c.lambda), 1e-4f))
+        EXPECT_TRUE(near(out[4 * i + 1].y,
+                         auxiliaryWeight(aux, auxiliaryValue(c.viewPosition, c.viewNormal, c.otherRgb.g), c.lambda),
+                         1e-4f))
             << "case " << i;
         const float curvature = normalisedCurvature(c.curvaturePerUnit, mmPerUnit);
         EXPECT_TRUE(near(out[4 * i + 1].z, curvature, 1e-6f)) << "case " << i;
@@ -152,6 +170,7 @@ TEST(ExtensionsGlsl, MatchesTheCppFunctions) {
             EXPECT_TRUE(near(out[4 * i + 2][k], curvatureWidthScale(strategies[k], curvature, c.floor), 1e-6f))
                 << "case " << i << " strategy " << k;
         const glm::vec3 resolved = resolveWeightedSum(c.rgb, c.beta * 0.01f, c.otherRgb);
-        for (int k = 0; k < 3; ++k) EXPECT_TRUE(near(out[4 * i + 3][k], resolved[k], 1e-5f)) << "case " << i << " resolve " << k;
+        for (int k = 0; k < 3; ++k)
+            EXPECT_TRUE(near(out[4 * i + 3][k], resolved[k], 1e-5f)) << "case " << i << " resolve " << k;
     }
 }

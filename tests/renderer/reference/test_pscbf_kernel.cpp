@@ -96,7 +96,7 @@ TEST(PscbfKernel, TwoPassesWithTheSpikeKeepEnergyAndFlatFields) {
     surface.width = surface.height = 41;
     surface.depth.assign(41 * 41, 100.0f);
     surface.mask.assign(41 * 41, 1.0f);
-    surface.focalLengthPixels = 100.0f;  // 1 mm = 1 pixel at depth 100 mm
+    surface.focalLengthPixels = 100.0f; // 1 mm = 1 pixel at depth 100 mm
     surface.mmPerUnit = 1.0f;
     std::vector<Rgb> flat(41 * 41, Rgb{0.3f, 0.5f, 0.7f});
     const auto flatOut = applyKernel(surface, flat, kernel, {});
@@ -109,7 +109,7 @@ TEST(PscbfKernel, TwoPassesWithTheSpikeKeepEnergyAndFlatFields) {
     for (int c = 0; c < 3; ++c) {
         double sum = 0.0;
         for (const auto& pixel : out) sum += pixel[c];
-        EXPECT_NEAR(sum, 1.0, 1e-4) << c;  // the footprint (±4.5 px) stays inside the 41 px image
+        EXPECT_NEAR(sum, 1.0, 1e-4) << c; // the footprint (±4.5 px) stays inside the 41 px image
         // The centre keeps at least the spike.
         EXPECT_GT(out[20 * 41 + 20][c], pscbf.profile.spike[c]);
     }
@@ -148,7 +148,8 @@ TEST(PscbfKernel, StandardDeviationReading) {
     EXPECT_EQ(sd.spike, mikkelsenSkinProfile().spike);
     EXPECT_DOUBLE_EQ(sd.maxRadiusMm, 4.5);
 
-    const toml::table root = skinlab::parseTomlString("[sss]\nmethod = \"pscbf\"\npscbf_sigma = \"std-dev\"\n", "s.toml");
+    const toml::table root =
+        skinlab::parseTomlString("[sss]\nmethod = \"pscbf\"\npscbf_sigma = \"std-dev\"\n", "s.toml");
     const SssParams params = readSssParams(skinlab::SpecReader(root, "s.toml"));
     EXPECT_EQ(params.pscbfSigma, PscbfSigma::StdDev);
     EXPECT_EQ(sssParamsFromJson(params.toJson()).pscbfSigma, PscbfSigma::StdDev);
@@ -169,6 +170,7 @@ TEST(PscbfKernel, StandardDeviationReading) {
 // were `assert`s, compiled out there), and the message names the expression and both values.
 TEST(PscbfKernelDeathTest, PreconditionsAreCheckedInEveryBuild) {
     GTEST_FLAG_SET(death_test_style, "threadsafe");
-    EXPECT_DEATH(makePscbfKernel(mikkelsenSkinProfile(), 4), R"(check failed at .*pscbf_kernel\.cpp:[0-9]+: samples % 2 == 1 \(0 vs 1\))");
+    EXPECT_DEATH(makePscbfKernel(mikkelsenSkinProfile(), 4),
+                 R"(check failed at .*pscbf_kernel\.cpp:[0-9]+: samples % 2 == 1 \(0 vs 1\))");
     EXPECT_DEATH(makePscbfKernel(mikkelsenSkinProfile(), 103), R"(samples <= 101 \(103 vs 101\))");
 }

@@ -47,8 +47,8 @@ TEST(ReferenceRender, RendersEveryBuiltinScene) {
     TempFolder folder("reference-builtin");
     for (const std::string scene : {"halo-grey-backdrop", "bleed-true-mask", "ear", "head"}) {
         const std::string edge = scene == "head" ? "4" : "3";
-        const Rendered reference = renderScene(*renderer, folder, scene, "builtin:" + scene, "reference",
-                                               {"sss.reference_edge_mm=" + edge});
+        const Rendered reference =
+            renderScene(*renderer, folder, scene, "builtin:" + scene, "reference", {"sss.reference_edge_mm=" + edge});
         const Rendered none = renderScene(*renderer, folder, scene + "-none", "builtin:" + scene, "none", {});
         const ExrImage& image = reference.image;
         int skin = 0, changed = 0;
@@ -77,7 +77,7 @@ TEST(ReferenceRender, RendersEveryBuiltinScene) {
         // it is (the renormalised convolution keeps uniform light unchanged, at the paint borders too).
         if (scene == "bleed-true-mask") EXPECT_EQ(changed, 0) << scene;
         else EXPECT_GT(changed, skin / 4) << scene;
-        EXPECT_EQ(nonSkinDifference, 0.0) << scene;  // non-skin and background: the main pass's diffuse
+        EXPECT_EQ(nonSkinDifference, 0.0) << scene; // non-skin and background: the main pass's diffuse
         EXPECT_LE(run.at("longest_edge_mm").get<double>(), std::stod(edge)) << scene;
         // Band width of the metrics: the profile's 0.1 % cutoff, 8.04 mm for d'Eon's skin at width 3 mm.
         EXPECT_NEAR(image.floats.at("skinlab:sss_radius_mm"), 8.04f, 0.01f) << scene;
@@ -122,9 +122,11 @@ TEST(ReferenceRender, UniformlyLitFlatSkinKeepsItsDiffuse) {
     TempFolder folder("reference-flat");
     std::vector<std::string> overrides = kHeadOnLight;
     overrides.push_back("materials=[{name = \"*\", albedo = [0.6, 0.45, 0.4], skin = true}]");
-    const Rendered none = renderScene(*renderer, folder, "flat-none", "builtin:bleed-true-mask", "none", overrides, 128);
-    overrides.push_back("sss.reference_edge_mm=3");  // the reference method's key
-    const Rendered reference = renderScene(*renderer, folder, "flat", "builtin:bleed-true-mask", "reference", overrides, 128);
+    const Rendered none =
+        renderScene(*renderer, folder, "flat-none", "builtin:bleed-true-mask", "none", overrides, 128);
+    overrides.push_back("sss.reference_edge_mm=3"); // the reference method's key
+    const Rendered reference =
+        renderScene(*renderer, folder, "flat", "builtin:bleed-true-mask", "reference", overrides, 128);
     const ExrImage& image = reference.image;
     // Pixels whose 9 × 9 neighbourhood is all skin: away from the patch border (interpolation of the last
     // triangle row against the background is not what this test is about).
@@ -155,8 +157,9 @@ TEST(ReferenceRender, ConvergesAsTheEdgeShrinks) {
     std::vector<ExrImage> images;
     const char* edges[] = {"2", "1", "0.5"};
     for (const char* edge : edges)
-        images.push_back(renderScene(*renderer, folder, std::string("halo-") + edge, "builtin:halo-grey-backdrop", "reference",
-                                     {std::string("sss.reference_edge_mm=") + edge, "sss.width_mm=0.75"}, 128)
+        images.push_back(renderScene(*renderer, folder, std::string("halo-") + edge, "builtin:halo-grey-backdrop",
+                                     "reference", {std::string("sss.reference_edge_mm=") + edge, "sss.width_mm=0.75"},
+                                     128)
                              .image);
     std::vector<double> differences;
     for (std::size_t k = 0; k + 1 < images.size(); ++k) {
@@ -183,13 +186,14 @@ TEST(ReferenceRender, PaintNeverReachesTheSkin) {
     // unchanged, its non-skin pixels equal the main pass's output (method none).
     SKINLAB_REQUIRE_RENDERER(renderer);
     TempFolder folder("reference-skin-only");
-    const std::string paint =
-        "materials=[{name = \"paint-dark\", albedo = [0.9, 0.1, 0.05]}, {name = \"paint-bright\", albedo = [1.0, 1.0, 1.0]}]";
+    const std::string paint = "materials=[{name = \"paint-dark\", albedo = [0.9, 0.1, 0.05]}, {name = "
+                              "\"paint-bright\", albedo = [1.0, 1.0, 1.0]}]";
     const std::vector<std::string> edge = {"sss.reference_edge_mm=3"};
     const Rendered plain = renderScene(*renderer, folder, "plain", "builtin:bleed-true-mask", "reference", edge, 128);
-    const Rendered painted = renderScene(*renderer, folder, "painted", "builtin:bleed-true-mask", "reference",
-                                         {edge[0], paint}, 128);
-    const Rendered none = renderScene(*renderer, folder, "painted-none", "builtin:bleed-true-mask", "none", {paint}, 128);
+    const Rendered painted =
+        renderScene(*renderer, folder, "painted", "builtin:bleed-true-mask", "reference", {edge[0], paint}, 128);
+    const Rendered none =
+        renderScene(*renderer, folder, "painted-none", "builtin:bleed-true-mask", "none", {paint}, 128);
     int skin = 0, paintPixels = 0, paintChanged = 0;
     double skinDifference = 0.0, paintDifference = 0.0;
     for (int y = 0; y < plain.image.height; ++y)
@@ -205,8 +209,9 @@ TEST(ReferenceRender, PaintNeverReachesTheSkin) {
             }
         }
     std::printf("skin only: %d skin pixels, max change %.3g; %d of %d paint pixels recoloured; max difference to "
-                "method none off skin %.3g\n", skin, skinDifference, paintChanged, paintPixels, paintDifference);
-    EXPECT_GT(paintChanged, paintPixels / 2);  // the paint really changed
+                "method none off skin %.3g\n",
+                skin, skinDifference, paintChanged, paintPixels, paintDifference);
+    EXPECT_GT(paintChanged, paintPixels / 2); // the paint really changed
     EXPECT_EQ(skinDifference, 0.0);
     EXPECT_EQ(paintDifference, 0.0);
 }
@@ -219,12 +224,12 @@ TEST(ReferenceRender, DiffuseDoesNotDependOnTheCameraDistance) {
     TempFolder folder("reference-view");
     std::vector<ExrImage> images;
     for (const char* distance : {"200", "400"})
-        images.push_back(renderScene(*renderer, folder, std::string("view-") + distance, "builtin:halo-grey-backdrop", "reference",
-                                     {"sss.reference_edge_mm=3", "camera.view=explicit", "camera.fov_deg=30",
-                                      std::string("camera.position=[0.0, 0.0, ") + distance + "]",
-                                      "camera.target=[0.0, 0.0, 0.0]"},
-                                     128)
-                             .image);
+        images.push_back(
+            renderScene(*renderer, folder, std::string("view-") + distance, "builtin:halo-grey-backdrop", "reference",
+                        {"sss.reference_edge_mm=3", "camera.view=explicit", "camera.fov_deg=30",
+                         std::string("camera.position=[0.0, 0.0, ") + distance + "]", "camera.target=[0.0, 0.0, 0.0]"},
+                        128)
+                .image);
     double worst = 0.0;
     for (const float angleDeg : {0.0f, 20.0f, -20.0f, 35.0f}) {
         // A point of the sphere in the horizontal plane, `angleDeg` from the view axis, and the pixel showing it.
@@ -244,13 +249,14 @@ TEST(ReferenceRender, DiffuseDoesNotDependOnTheCameraDistance) {
             const float py = (0.5f - clip.y / clip.w * 0.5f) * float(images[k].height) - 0.5f;
             const int x0 = int(std::floor(px)), y0 = int(std::floor(py));
             const float fx = px - float(x0), fy = py - float(y0);
-            values[k] = glm::mix(glm::mix(diffuseAt(images[k], x0, y0), diffuseAt(images[k], x0 + 1, y0), fx),
-                                 glm::mix(diffuseAt(images[k], x0, y0 + 1), diffuseAt(images[k], x0 + 1, y0 + 1), fx), fy);
+            values[k] =
+                glm::mix(glm::mix(diffuseAt(images[k], x0, y0), diffuseAt(images[k], x0 + 1, y0), fx),
+                         glm::mix(diffuseAt(images[k], x0, y0 + 1), diffuseAt(images[k], x0 + 1, y0 + 1), fx), fy);
         }
         const double relative = glm::length(values[0] - values[1]) / glm::length(values[1]);
         std::printf("view independence at %+.0f deg: diffuse %.4f %.4f %.4f (200 mm) vs %.4f %.4f %.4f (400 mm), "
-                    "relative difference %.2e\n", angleDeg, values[0].r, values[0].g, values[0].b, values[1].r,
-                    values[1].g, values[1].b, relative);
+                    "relative difference %.2e\n",
+                    angleDeg, values[0].r, values[0].g, values[0].b, values[1].r, values[1].g, values[1].b, relative);
         worst = std::max(worst, relative);
     }
     EXPECT_LT(worst, 0.003);
@@ -272,14 +278,14 @@ TEST(ReferenceRender, RefusesTabulatedProfilesAndTooFineEdges) {
     // A tabulated kernel (.bn: float32 count, then rows r, g, b, offset mm) is a 1-D marginal: no radial form.
     const auto kernel = folder / "five-taps.bn";
     {
-        const float values[] = {20.0f, 0.1f, 0.1f, 0.1f, -2.0f, 0.2f, 0.2f, 0.2f, -1.0f, 0.4f, 0.4f, 0.4f, 0.0f,
-                                0.2f,  0.2f, 0.2f, 1.0f, 0.1f, 0.1f, 0.1f, 2.0f};
+        const float values[] = {20.0f, 0.1f, 0.1f, 0.1f, -2.0f, 0.2f, 0.2f, 0.2f, -1.0f, 0.4f, 0.4f,
+                                0.4f,  0.0f, 0.2f, 0.2f, 0.2f,  1.0f, 0.1f, 0.1f, 0.1f,  2.0f};
         std::ofstream out(kernel, std::ios::binary);
         out.write(reinterpret_cast<const char*>(values), sizeof(values));
     }
     try {
-        renderScene(*renderer, folder, "tabulated", "builtin:halo-grey-backdrop", "reference", {"sss.profile=file:" + kernel.string()},
-                    48);
+        renderScene(*renderer, folder, "tabulated", "builtin:halo-grey-backdrop", "reference",
+                    {"sss.profile=file:" + kernel.string()}, 48);
         FAIL() << "no exception";
     } catch (const skinlab::InputError& e) {
         const std::string message = e.what();
@@ -298,19 +304,20 @@ TEST(ReferenceRender, IgnoresTransmittance) {
     TempFolder folder("reference-transmittance");
     const std::vector<std::string> edge = {"sss.reference_edge_mm=3"};
     const Rendered without = renderScene(*renderer, folder, "without", "builtin:ear", "reference", edge, 96);
-    const Rendered with = renderScene(*renderer, folder, "with", "builtin:ear", "reference",
-                                      {edge[0], "transmittance.enabled=true"}, 96);
-    const Rendered screen = renderScene(*renderer, folder, "screen", "builtin:ear", "none",
-                                        {"transmittance.enabled=true"}, 96);
+    const Rendered with =
+        renderScene(*renderer, folder, "with", "builtin:ear", "reference", {edge[0], "transmittance.enabled=true"}, 96);
+    const Rendered screen =
+        renderScene(*renderer, folder, "screen", "builtin:ear", "none", {"transmittance.enabled=true"}, 96);
     double transmitted = 0.0, difference = 0.0;
     for (int y = 0; y < with.image.height; ++y)
         for (int x = 0; x < with.image.width; ++x) {
             transmitted += screen.image.at("transmittance.R", x, y);
-            difference = std::max<double>(difference, glm::length(diffuseAt(with.image, x, y) - diffuseAt(without.image, x, y)));
+            difference =
+                std::max<double>(difference, glm::length(diffuseAt(with.image, x, y) - diffuseAt(without.image, x, y)));
         }
     std::printf("transmittance: screen-space sum of transmittance.R %.4g; reference max change %.3g\n", transmitted,
                 difference);
-    EXPECT_GT(transmitted, 0.0);  // transmittance is really on in this scene
+    EXPECT_GT(transmitted, 0.0); // transmittance is really on in this scene
     // Not bit-identical: the draw blends mix(main-pass diffuse, convolved, mask), and the main-pass diffuse does
     // include transmittance; at mask 1 the blend leaves float rounding (≈ 3e-8) of that.
     EXPECT_LT(difference, 1e-6);

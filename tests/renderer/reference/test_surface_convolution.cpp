@@ -41,7 +41,8 @@ double integrateRadial(const RadialProfile& profile, int channel, double rMm) {
 // Step irradiance E = 1 for x > stepX, 0 for x < stepX (stepX between two columns of samples); albedo 1.
 std::vector<glm::vec3> stepIrradiance(const SurfaceSamples& samples, float stepX) {
     std::vector<glm::vec3> irradiance(samples.size());
-    for (std::size_t i = 0; i < samples.size(); ++i) irradiance[i] = glm::vec3(samples.positionMm[i].x > stepX ? 1.0f : 0.0f);
+    for (std::size_t i = 0; i < samples.size(); ++i)
+        irradiance[i] = glm::vec3(samples.positionMm[i].x > stepX ? 1.0f : 0.0f);
     return irradiance;
 }
 
@@ -66,7 +67,8 @@ TEST(RadialProfile, CumulativeIsTheIntegralOfTheRadialDensity) {
     for (const double width : {3.0, 1.5}) {
         const auto deon = makeRadialProfile(profileParams("deon", width));
         for (int c = 0; c < 3; ++c)
-            for (const double r : {0.5, 2.0, 6.0}) EXPECT_NEAR(deon->cumulative(c, r), integrateRadial(*deon, c, r), 1e-6) << c << " " << r;
+            for (const double r : {0.5, 2.0, 6.0})
+                EXPECT_NEAR(deon->cumulative(c, r), integrateRadial(*deon, c, r), 1e-6) << c << " " << r;
         for (int c = 0; c < 3; ++c) EXPECT_NEAR(deon->cumulative(c, 1e3), 1.0, 1e-12);
     }
     // Burley: the 1/r centre is integrable; compare away from 0 (difference of the cumulative between 0.5 and 4 mm).
@@ -120,7 +122,7 @@ TEST_P(StepResponse, EqualsTheMarginalCdf) {
         const float spacing = 40.0f / float(1 << statistics.rounds);
         const float stepX = 0.5f * spacing;
         const SurfaceSamples samples = gatherSurfaceSamples(plane, 1.0f);
-        std::vector<std::uint32_t> receivers;  // the samples on the line y = 0 with |x| ≤ 5 mm
+        std::vector<std::uint32_t> receivers; // the samples on the line y = 0 with |x| ≤ 5 mm
         for (std::uint32_t i = 0; i < samples.size(); ++i)
             if (std::abs(samples.positionMm[i].y) < 1e-4f && std::abs(samples.positionMm[i].x) <= 5.0f)
                 receivers.push_back(i);
@@ -162,7 +164,7 @@ TEST(SurfaceConvolution, ConvergesAsSampleDensityGrows) {
     const auto profile = makeRadialProfile(profileParams("deon"));
     std::vector<std::uint32_t> receivers;
     for (std::uint32_t i = 0; i < halo.vertices.size(); i += 7)
-        if (glm::length(halo.vertices[i].position) < kHaloSphereRadiusMm + 1.0f) receivers.push_back(i);  // sphere only
+        if (glm::length(halo.vertices[i].position) < kHaloSphereRadiusMm + 1.0f) receivers.push_back(i); // sphere only
     std::vector<std::vector<glm::vec3>> results;
     for (const float edge : {4.0f, 2.0f, 1.0f, 0.5f}) {
         const Model fine = tessellateSkin(halo, edge, 1.0f);
@@ -179,11 +181,12 @@ TEST(SurfaceConvolution, ConvergesAsSampleDensityGrows) {
     for (std::size_t k = 0; k + 1 < results.size(); ++k) {
         rms.push_back(rmsDifference(results[k], results.back(), receivers));
         worst.push_back(maxDifference(results[k], results.back(), receivers));
-        std::printf("convergence: edge %.2g mm vs 0.5 mm: RMS difference %.6f, max %.6f; vs the next density: RMS %.6f\n",
-                    4.0 / (1 << k), rms.back(), worst.back(), rmsDifference(results[k], results[k + 1], receivers));
+        std::printf(
+            "convergence: edge %.2g mm vs 0.5 mm: RMS difference %.6f, max %.6f; vs the next density: RMS %.6f\n",
+            4.0 / (1 << k), rms.back(), worst.back(), rmsDifference(results[k], results[k + 1], receivers));
     }
     for (std::size_t k = 1; k < rms.size(); ++k) EXPECT_LT(rms[k], rms[k - 1]) << k;
-    EXPECT_LT(worst.back(), 0.01);  // radiance ≤ albedo < 1: 1 mm is within 1 % of white of 0.5 mm
+    EXPECT_LT(worst.back(), 0.01); // radiance ≤ albedo < 1: 1 mm is within 1 % of white of 0.5 mm
 }
 
 TEST(SurfaceConvolution, OnlySkinScattersAndReceives) {
@@ -201,7 +204,7 @@ TEST(SurfaceConvolution, OnlySkinScattersAndReceives) {
     const auto b = convolveSurface(samples, bright, *profile);
     for (std::size_t i = 0; i < samples.size(); ++i) {
         if (samples.skin[i]) {
-            ASSERT_EQ(a[i], b[i]) << i;  // bit-identical: no non-skin source enters the sums
+            ASSERT_EQ(a[i], b[i]) << i; // bit-identical: no non-skin source enters the sums
             // Uniform irradiance on uniformly coloured skin stays E·α after renormalisation, at edges too.
             for (int c = 0; c < 3; ++c) ASSERT_NEAR(a[i][c], samples.albedo[i][c], 1e-5f) << i;
         } else {
@@ -218,7 +221,8 @@ TEST(SurfaceConvolution, DeterministicForAnyThreadCount) {
     ConvolutionSettings one, three;
     one.threads = 1;
     three.threads = 3;
-    EXPECT_EQ(convolveSurface(samples, irradiance, *profile, one), convolveSurface(samples, irradiance, *profile, three));
+    EXPECT_EQ(convolveSurface(samples, irradiance, *profile, one),
+              convolveSurface(samples, irradiance, *profile, three));
 }
 
 namespace {
@@ -292,6 +296,6 @@ TEST(SurfaceConvolution, ThroughTissueStopsLightAcrossAnAirGap) {
     for (int c = 0; c < 3; ++c) {
         EXPECT_EQ(stopped[upper][c], 0.0f) << c;
         EXPECT_NEAR(stopped[lower][c], 1.0, 1e-5) << c;
-        EXPECT_LT(across[lower][c], 1.0f) << c;  // the dark upper face dilutes the lit one in the old normaliser
+        EXPECT_LT(across[lower][c], 1.0f) << c; // the dark upper face dilutes the lit one in the old normaliser
     }
 }

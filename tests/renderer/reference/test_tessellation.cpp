@@ -88,15 +88,16 @@ TEST(Tessellation, SplitsUntilTheTargetEdgeAndStaysConforming) {
     EXPECT_LE(longestSkinEdgeMm(fine, 1.0f), 1.0f);
     EXPECT_NEAR(statistics.longestSkinEdgeMm, 10.0f * std::sqrt(2.0f) / 16.0f, 1e-4f);
     EXPECT_EQ(statistics.skinTriangles, 2u * 256u);
-    EXPECT_EQ(fine.vertices.size(), 17u * 17u);  // a 16 × 16 grid of cells
+    EXPECT_EQ(fine.vertices.size(), 17u * 17u); // a 16 × 16 grid of cells
     // Original vertices keep their indices and positions.
-    for (std::size_t i = 0; i < square.vertices.size(); ++i) EXPECT_EQ(fine.vertices[i].position, square.vertices[i].position);
+    for (std::size_t i = 0; i < square.vertices.size(); ++i)
+        EXPECT_EQ(fine.vertices[i].position, square.vertices[i].position);
     int boundary = 0;
     for (const auto& [edge, count] : edgeUses(fine, fine.parts[0])) {
         EXPECT_LE(count, 2);
         if (count == 1) ++boundary;
     }
-    EXPECT_EQ(boundary, 4 * 16);  // only the square's outline is open
+    EXPECT_EQ(boundary, 4 * 16); // only the square's outline is open
 }
 
 TEST(Tessellation, SplitsOnlyLongTrianglesOfAMixedMesh) {
@@ -109,8 +110,10 @@ TEST(Tessellation, SplitsOnlyLongTrianglesOfAMixedMesh) {
     for (std::size_t i = 0; i + 2 < fine.indices.size(); i += 3)
         triangles.insert({fine.indices[i], fine.indices[i + 1], fine.indices[i + 2]});
     for (std::size_t i = 0; i < 600; i += 3)
-        EXPECT_TRUE(triangles.count({mixed.indices[i], mixed.indices[i + 1], mixed.indices[i + 2]})) << "triangle " << i / 3;
-    for (std::size_t i = 0; i < mixed.vertices.size(); ++i) EXPECT_EQ(fine.vertices[i].position, mixed.vertices[i].position);
+        EXPECT_TRUE(triangles.count({mixed.indices[i], mixed.indices[i + 1], mixed.indices[i + 2]}))
+            << "triangle " << i / 3;
+    for (std::size_t i = 0; i < mixed.vertices.size(); ++i)
+        EXPECT_EQ(fine.vertices[i].position, mixed.vertices[i].position);
     // Conforming: every edge used at most twice; the open edges are the two outlines (40 small + 4 × 2^k large).
     int boundary = 0;
     for (const auto& [edge, count] : edgeUses(fine, fine.parts[0])) {
@@ -120,8 +123,8 @@ TEST(Tessellation, SplitsOnlyLongTrianglesOfAMixedMesh) {
     const std::size_t uniform = uniformSchemeVertices(mixed, 2.0f, 1.0f);
     std::printf("mixed mesh at 2 mm: %zu vertices (%d rounds, %zu boundary edges); uniform scheme: %zu\n",
                 fine.vertices.size(), statistics.rounds, std::size_t(boundary), uniform);
-    EXPECT_EQ(boundary, 40 + 4 * 16);  // the 20 mm square's sides end at 1.25 mm, like the uniform scheme's
-    EXPECT_LT(fine.vertices.size() * 20, uniform);  // far below: only the large square is refined
+    EXPECT_EQ(boundary, 40 + 4 * 16);              // the 20 mm square's sides end at 1.25 mm, like the uniform scheme's
+    EXPECT_LT(fine.vertices.size() * 20, uniform); // far below: only the large square is refined
     // The 20 mm square is refined like the uniform scheme does it (17 × 17 grid), the small grid not at all.
     EXPECT_EQ(fine.vertices.size(), 121u + 17u * 17u);
 }
@@ -132,8 +135,8 @@ TEST(Tessellation, BuiltinHeadNeedsFarFewerVerticesThanUniformRounds) {
     const Model fine = tessellateSkin(head, 2.0f, 1.0f, &statistics);
     const std::size_t uniform = uniformSchemeVertices(head, 2.0f, 1.0f);
     std::printf("builtin:head at 2 mm: %zu -> %zu vertices in %d rounds (longest skin edge %.3f mm); uniform "
-                "scheme: %zu\n", head.vertices.size(), fine.vertices.size(), statistics.rounds,
-                statistics.longestSkinEdgeMm, uniform);
+                "scheme: %zu\n",
+                head.vertices.size(), fine.vertices.size(), statistics.rounds, statistics.longestSkinEdgeMm, uniform);
     EXPECT_LE(statistics.longestSkinEdgeMm, 2.0f);
     EXPECT_LT(fine.vertices.size() * 5, uniform);
     for (const auto& part : fine.parts) {
@@ -187,7 +190,7 @@ TEST(SurfaceSamples, AreasSumToTheSkinSurface) {
     for (std::size_t i = 0; i < bleedSamples.size(); ++i)
         if (!bleedSamples.skin[i]) {
             ++paint;
-            EXPECT_LT(bleedSamples.albedo[i].r, 0.1f);  // both paints have red albedo 0.02 / 0.05
+            EXPECT_LT(bleedSamples.albedo[i].r, 0.1f); // both paints have red albedo 0.02 / 0.05
         }
     EXPECT_GT(paint, 0);
 }

@@ -21,7 +21,8 @@ namespace fs = std::filesystem;
 constexpr float kPi = std::numbers::pi_v<float>;
 
 void expectDirection(const glm::vec3& actual, const glm::vec3& expected) {
-    EXPECT_NEAR(glm::length(actual - expected), 0.0f, 1e-6f) << "(" << actual.x << ", " << actual.y << ", " << actual.z << ")";
+    EXPECT_NEAR(glm::length(actual - expected), 0.0f, 1e-6f)
+        << "(" << actual.x << ", " << actual.y << ", " << actual.z << ")";
 }
 
 TEST(EquirectConvention, CentreIsMinusZTopIsUpRightIsPlusX) {
@@ -38,7 +39,7 @@ TEST(EquirectConvention, CoordinatesInvertDirections) {
         for (int j = 1; j < 18; ++j) {
             const float u = (static_cast<float>(i) + 0.25f) / 37.0f;
             const float v = static_cast<float>(j) / 18.0f;
-            const glm::vec2 back = equirectCoordinates(equirectDirection(u, v) * 3.0f);  // any length
+            const glm::vec2 back = equirectCoordinates(equirectDirection(u, v) * 3.0f); // any length
             EXPECT_NEAR(back.x, u, 1e-5f);
             EXPECT_NEAR(back.y, v, 1e-5f);
         }
@@ -49,12 +50,14 @@ TEST(EnvironmentLookup, ReturnsTexelValuesAtTexelCentresAndWrapsInU) {
     Environment environment = makeConstantEnvironment(glm::vec3(0.0f), 8, 4);
     for (int y = 0; y < 4; ++y) {
         for (int x = 0; x < 8; ++x) {
-            environment.pixels[static_cast<std::size_t>(y * 8 + x)] = glm::vec3(static_cast<float>(x), static_cast<float>(y), 1.0f);
+            environment.pixels[static_cast<std::size_t>(y * 8 + x)] =
+                glm::vec3(static_cast<float>(x), static_cast<float>(y), 1.0f);
         }
     }
     for (int y = 0; y < 4; ++y) {
         for (int x = 0; x < 8; ++x) {
-            const glm::vec3 d = equirectDirection((static_cast<float>(x) + 0.5f) / 8.0f, (static_cast<float>(y) + 0.5f) / 4.0f);
+            const glm::vec3 d =
+                equirectDirection((static_cast<float>(x) + 0.5f) / 8.0f, (static_cast<float>(y) + 0.5f) / 4.0f);
             const glm::vec3 value = environment.radiance(d);
             EXPECT_NEAR(value.x, static_cast<float>(x), 1e-4f);
             EXPECT_NEAR(value.y, static_cast<float>(y), 1e-4f);
@@ -66,8 +69,14 @@ TEST(EnvironmentLookup, ReturnsTexelValuesAtTexelCentresAndWrapsInU) {
 
 // --- SH9 irradiance -----------------------------------------------------------------------------------------
 
-const glm::vec3 kNormals[] = {{0, 1, 0}, {0, -1, 0}, {1, 0, 0}, {-1, 0, 0}, {0, 0, 1}, {0, 0, -1},
-                              glm::normalize(glm::vec3(1, 1, 1)), glm::normalize(glm::vec3(-0.3f, -0.5f, 0.8f))};
+const glm::vec3 kNormals[] = {{0, 1, 0},
+                              {0, -1, 0},
+                              {1, 0, 0},
+                              {-1, 0, 0},
+                              {0, 0, 1},
+                              {0, 0, -1},
+                              glm::normalize(glm::vec3(1, 1, 1)),
+                              glm::normalize(glm::vec3(-0.3f, -0.5f, 0.8f))};
 
 TEST(IrradianceSH9, ConstantEnvironmentGivesPiTimesRadiance) {
     const glm::vec3 radiance(1.0f, 2.0f, 0.25f);
@@ -93,7 +102,8 @@ TEST(IrradianceSH9, ShaderCoefficientsReproduceTheIrradiance) {
     for (const glm::vec3& n : kNormals) {
         const auto basis = shBasis9(n);
         glm::vec3 sum(0.0f);
-        for (int i = 0; i < 9; ++i) sum += shaderCoefficients[static_cast<std::size_t>(i)] * basis[static_cast<std::size_t>(i)];
+        for (int i = 0; i < 9; ++i)
+            sum += shaderCoefficients[static_cast<std::size_t>(i)] * basis[static_cast<std::size_t>(i)];
         const glm::vec3 direct = irradianceSH9(radianceCoefficients, n);
         EXPECT_NEAR(glm::length(sum - direct), 0.0f, 1e-5f * glm::length(direct));
     }
@@ -113,7 +123,7 @@ TEST(IrradianceSH9, SkyAboveBlackBelowMatchesTheAnalyticValue) {
     }
     const auto coefficients = projectSH9(environment);
     for (const glm::vec3& n : kNormals) {
-        const float expected = 0.5f * (1.0f + n.y);  // in units of π L
+        const float expected = 0.5f * (1.0f + n.y); // in units of π L
         const glm::vec3 irradiance = irradianceSH9(coefficients, n);
         for (int c = 0; c < 3; ++c) EXPECT_NEAR(irradiance[c] / (kPi * sky[c]), expected, 2e-3f) << n.x << n.y << n.z;
     }
@@ -127,8 +137,9 @@ glm::vec3 bruteForceIrradiance(const Environment& environment, const glm::vec3& 
                                   (std::cos(std::numbers::pi * y / environment.height) -
                                    std::cos(std::numbers::pi * (y + 1) / environment.height));
         for (int x = 0; x < environment.width; ++x) {
-            const glm::vec3 d = equirectDirection((static_cast<float>(x) + 0.5f) / static_cast<float>(environment.width),
-                                                  (static_cast<float>(y) + 0.5f) / static_cast<float>(environment.height));
+            const glm::vec3 d =
+                equirectDirection((static_cast<float>(x) + 0.5f) / static_cast<float>(environment.width),
+                                  (static_cast<float>(y) + 0.5f) / static_cast<float>(environment.height));
             const double cosine = std::max(0.0f, glm::dot(d, normal));
             sum += glm::dvec3(environment.texel(x, y)) * cosine * solidAngle;
         }
@@ -210,7 +221,8 @@ TEST_F(EnvironmentFiles, FloatExrLoadsUntouchedAndIntegratesToPiL) {
 
 TEST_F(EnvironmentFiles, BadFilesNameThePath) {
     const fs::path missing = folder_ / "absent.hdr";
-    EXPECT_EQ(inputErrorOf([&] { loadEnvironment(missing); }), missing.string() + ": cannot read environment (no such file)");
+    EXPECT_EQ(inputErrorOf([&] { loadEnvironment(missing); }),
+              missing.string() + ": cannot read environment (no such file)");
     const fs::path garbage = folder_ / "garbage.hdr";
     std::ofstream(garbage) << "#?RADIANCE but then nothing sensible\x01\x02";
     const std::string message = inputErrorOf([&] { loadEnvironment(garbage); });

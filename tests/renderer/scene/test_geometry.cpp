@@ -105,7 +105,7 @@ void expectValidModel(const Model& model) {
 // closed surface uses every edge exactly twice.
 int countOpenEdges(const Model& model, std::uint32_t material) {
     const auto key = [](const glm::vec3& p) {
-        const glm::vec3 canonical = p + glm::vec3(0.0f);  // -0 → +0
+        const glm::vec3 canonical = p + glm::vec3(0.0f); // -0 → +0
         std::array<std::uint32_t, 3> bits{};
         std::memcpy(bits.data(), &canonical, sizeof(canonical));
         return bits;
@@ -254,8 +254,8 @@ TEST(BleedScene, PaintSquaresHaveTheirAlbedoAndExactExtents) {
         EXPECT_NEAR(lowest.y, -halfSquare, 1e-4f) << square.name;
         EXPECT_NEAR(highest.y, halfSquare, 1e-4f) << square.name;
         // Area within float rounding (1e-3 relative): the square is fully tiled, nothing else is in the part.
-        EXPECT_NEAR(partArea(model, materialIndex(model, square.name)) / (kBleedSquareSizeMm * kBleedSquareSizeMm),
-                    1.0, 1e-3);
+        EXPECT_NEAR(partArea(model, materialIndex(model, square.name)) / (kBleedSquareSizeMm * kBleedSquareSizeMm), 1.0,
+                    1e-3);
     }
     const double patch = kBleedPatchSizeMm * kBleedPatchSizeMm;
     EXPECT_NEAR(partArea(model, materialIndex(model, "skin")) / (patch - 2.0 * kBleedSquareSizeMm * kBleedSquareSizeMm),
@@ -280,7 +280,8 @@ TEST(BleedScene, BoundariesAreSharpAndAtOneDepth) {
     // ... yet the parts meet: a paint corner has a skin vertex at the very same position (no gap, no overlap).
     int skinAtCorner = 0;
     forEachVertexOf(model, materialIndex(model, "skin"), [&](const Vertex& v) {
-        if (v.position == glm::vec3(-kBleedSquareOffsetMm - 0.5f * kBleedSquareSizeMm, 0.5f * kBleedSquareSizeMm, 0.0f)) {
+        if (v.position ==
+            glm::vec3(-kBleedSquareOffsetMm - 0.5f * kBleedSquareSizeMm, 0.5f * kBleedSquareSizeMm, 0.0f)) {
             ++skinAtCorner;
         }
     });
@@ -394,7 +395,8 @@ TEST(HeadScene, LipsAreRedderAndBrowsDarker) {
         const Vertex& v = model.vertices[model.indices[i]];
         const glm::vec3& p = v.position;
         const bool nearMouth = p.z > 40.0f && std::abs(p.x) < 25.0f && std::abs(p.y + 66.0f) < 13.0f;
-        const bool nearBrows = p.z > 40.0f && std::abs(p.x) > 10.0f && std::abs(p.x) < 55.0f && std::abs(p.y - 21.0f) < 7.0f;
+        const bool nearBrows =
+            p.z > 40.0f && std::abs(p.x) > 10.0f && std::abs(p.x) < 55.0f && std::abs(p.y - 21.0f) < 7.0f;
         if (nearMouth && v.color.r > 1.0f && v.color.g < 0.7f) ++lips;
         if (nearBrows && v.color.r < 0.4f && v.color.g < 0.4f) ++brows;
         if (!nearMouth && !nearBrows && v.color != glm::vec3(1.0f)) ++elsewhereTinted;
@@ -419,9 +421,10 @@ TEST(HeadScene, EarsProtrudeAtTheSidesAtEarHeight) {
         const float outer = std::max(std::abs(lowest.x), std::abs(highest.x));
         EXPECT_NEAR(outer, kHeadEarOuterX, 1.0f);
         EXPECT_GT(highest.y - lowest.y, 55.0f) << "an adult ear is about 60 mm long";
-        EXPECT_LT(lowest.y, -30.0f);  // from about the nose base ...
-        EXPECT_GT(highest.y, 10.0f);  // ... to about the brows
-        EXPECT_EQ(countOpenEdges(Model{model.vertices, model.indices, {part}, model.materials, {}, {}}, part.material), 0);
+        EXPECT_LT(lowest.y, -30.0f); // from about the nose base ...
+        EXPECT_GT(highest.y, 10.0f); // ... to about the brows
+        EXPECT_EQ(countOpenEdges(Model{model.vertices, model.indices, {part}, model.materials, {}, {}}, part.material),
+                  0);
         EXPECT_GT(signedVolume(model, part), 0.0) << "mirrored ear must still face outwards";
     }
 }
@@ -470,9 +473,11 @@ TEST(HeadSkinDetail, MapsAreDeterministicUnitNormalsWithDetailAndNoSeam) {
         }
     const double albedoMean = albedoSum / count;
     const double tiltMean = tiltSum / count;
-    std::printf("head skin detail 1024×512: albedo multiplier mean %.4f; normal tilt mean %.4f, %.1f %% of texels tilted > "
-                "0.1\n", albedoMean, tiltMean, 100.0 * tilted / count);
-    EXPECT_NEAR(albedoMean, 1.0, 0.05);  // the map varies the skin albedo, it does not change its tone
+    std::printf(
+        "head skin detail 1024×512: albedo multiplier mean %.4f; normal tilt mean %.4f, %.1f %% of texels tilted > "
+        "0.1\n",
+        albedoMean, tiltMean, 100.0 * tilted / count);
+    EXPECT_NEAR(albedoMean, 1.0, 0.05); // the map varies the skin albedo, it does not change its tone
     // Pores and lines: the normal map is not flat (a flat map gives 0 and 0; measured at this size: 0.023 and 1.1 %).
     EXPECT_GT(tiltMean, 0.01);
     EXPECT_GT(tilted, count / 200);
@@ -495,7 +500,8 @@ TEST(HeadSkinDetail, TheHeadBringsTheMapsUnlessAskedForTheSmoothHead) {
     EXPECT_FALSE(smooth.albedoMap || smooth.normalMap);
     // The same mesh either way.
     ASSERT_EQ(detailed.vertices.size(), smooth.vertices.size());
-    EXPECT_EQ(0, std::memcmp(detailed.vertices.data(), smooth.vertices.data(), smooth.vertices.size() * sizeof(Vertex)));
+    EXPECT_EQ(0,
+              std::memcmp(detailed.vertices.data(), smooth.vertices.data(), smooth.vertices.size() * sizeof(Vertex)));
     // The eyes sample the flat row 0 of the maps.
     const SubMesh& eye = detailed.parts[3];
     ASSERT_EQ(detailed.materials[eye.material].name, "eye");

@@ -180,7 +180,7 @@ std::string base64(const std::string& bytes) {
 std::string triangleGltf() {
     const float positions[] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
     const float normals[] = {0, 0, 1, 0, 0, 1, 0, 0, 1};
-    const float uvs[] = {0, 0, 1, 0, 0, 1};  // glTF: v = 0 at the image top
+    const float uvs[] = {0, 0, 1, 0, 0, 1}; // glTF: v = 0 at the image top
     std::string buffer(reinterpret_cast<const char*>(positions), sizeof positions);
     buffer.append(reinterpret_cast<const char*>(normals), sizeof normals);
     buffer.append(reinterpret_cast<const char*>(uvs), sizeof uvs);
@@ -190,11 +190,13 @@ std::string triangleGltf() {
  "scene": 0,
  "scenes": [{"nodes": [0]}],
  "nodes": [{"translation": [10, 5, 0], "children": [1]},
-           {"mesh": 0, "scale": [2, 2, 2], "rotation": [0, )" + std::to_string(s) + ", 0, " + std::to_string(s) + R"(]}],
+           {"mesh": 0, "scale": [2, 2, 2], "rotation": [0, )" +
+           std::to_string(s) + ", 0, " + std::to_string(s) + R"(]}],
  "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}, "material": 0}]}],
  "materials": [{"name": "skin-material", "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.25, 0.125, 1]}}],
- "buffers": [{"byteLength": )" + std::to_string(buffer.size()) + R"(, "uri": "data:application/octet-stream;base64,)" +
-           base64(buffer) + R"("}],
+ "buffers": [{"byteLength": )" +
+           std::to_string(buffer.size()) + R"(, "uri": "data:application/octet-stream;base64,)" + base64(buffer) +
+           R"("}],
  "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36},
                  {"buffer": 0, "byteOffset": 36, "byteLength": 36},
                  {"buffer": 0, "byteOffset": 72, "byteLength": 24}],
@@ -430,8 +432,9 @@ protected:
 
 TEST_F(TextureLoader, DecodesSrgbColourAndLeavesDataAndAlphaAlone) {
     // 2 × 2 RGBA, top row first: (128, 64, 255, 128) (0, 10, 200, 255) / (255, 255, 255, 0) (1, 2, 3, 4)
-    const fs::path path = writeImage("rgba.png", 2, 2, 4, {128, 64, 255, 128, 0, 10, 200, 255,  //
-                                                           255, 255, 255, 0, 1, 2, 3, 4});
+    const fs::path path = writeImage("rgba.png", 2, 2, 4,
+                                     {128, 64, 255, 128, 0, 10, 200, 255, //
+                                      255, 255, 255, 0, 1, 2, 3, 4});
     const Image colour = loadTexture(path, ColorEncoding::sRGB);
     const Image data = loadTexture(path, ColorEncoding::Data);
     ASSERT_EQ(colour.width, 2);
@@ -448,7 +451,7 @@ TEST_F(TextureLoader, DecodesSrgbColourAndLeavesDataAndAlphaAlone) {
             EXPECT_EQ(colour.texel(x, y).a, data.texel(x, y).a) << "alpha is never colour-decoded";
         }
     }
-    EXPECT_NEAR(colour.texel(0, 0).r, 0.2158605f, 2e-6f);  // sRGB 128/255
+    EXPECT_NEAR(colour.texel(0, 0).r, 0.2158605f, 2e-6f); // sRGB 128/255
 }
 
 TEST_F(TextureLoader, GreyAndRgbFilesBecomeRgba) {
@@ -457,7 +460,7 @@ TEST_F(TextureLoader, GreyAndRgbFilesBecomeRgba) {
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(grey.texel(0, 0)[c], 0.2f, 1e-7f);
     EXPECT_EQ(grey.texel(0, 0).a, 1.0f);
     const Image rgb = loadTexture(writeImage("rgb.jpg", 1, 1, 3, {255, 255, 255}), ColorEncoding::sRGB);
-    EXPECT_NEAR(rgb.texel(0, 0).g, 1.0f, 1e-2f);  // JPEG is lossy; white stays near white
+    EXPECT_NEAR(rgb.texel(0, 0).g, 1.0f, 1e-2f); // JPEG is lossy; white stays near white
     EXPECT_EQ(rgb.texel(0, 0).a, 1.0f);
 }
 
@@ -475,7 +478,8 @@ TEST_F(TextureLoader, BadFilesNameThePath) {
 
 TEST(ScannedHeadTextures, LoadAsLinearFloatRgba) {
     const char* assets = std::getenv("SKINLAB_ASSETS");
-    if (assets == nullptr || *assets == '\0') GTEST_SKIP() << "SKINLAB_ASSETS is not set; needs the scanned head's maps";
+    if (assets == nullptr || *assets == '\0')
+        GTEST_SKIP() << "SKINLAB_ASSETS is not set; needs the scanned head's maps";
     const fs::path folder = fs::path(assets) / "LeePerrySmith";
     const Image albedo = loadTexture(folder / "Map-COL.jpg", ColorEncoding::sRGB);
     const Image normals = loadTexture(folder / "Infinite-Level_02_Tangent_SmoothUV.jpg", ColorEncoding::Data);

@@ -25,8 +25,8 @@ std::string errorOf(const std::string& scene, const std::vector<std::string>& ov
 class TempFolder {
 public:
     TempFolder() {
-        path_ = std::filesystem::temp_directory_path() / ("skinlab-scene-spec-" + std::to_string(::getpid()) + "-" +
-                                                          std::to_string(counter_++));
+        path_ = std::filesystem::temp_directory_path() /
+                ("skinlab-scene-spec-" + std::to_string(::getpid()) + "-" + std::to_string(counter_++));
         std::filesystem::create_directories(path_);
     }
     ~TempFolder() { std::filesystem::remove_all(path_); }
@@ -46,7 +46,7 @@ TEST(SceneSpec, EveryBuiltinSceneLoadsWithItsDefaults) {
         const SceneSpec spec = loadSceneSpec("builtin:" + name, {}, {});
         // The named variants (halo-grey-backdrop, bleed-true-mask) render the model their name starts with.
         EXPECT_EQ(spec.modelSource, "builtin:" + name.substr(0, name.find('-')));
-        EXPECT_EQ(spec.mmPerUnit, 1.0) << name;  // built-in models are in millimetres (builtin_geometry.h)
+        EXPECT_EQ(spec.mmPerUnit, 1.0) << name; // built-in models are in millimetres (builtin_geometry.h)
         EXPECT_FALSE(spec.lights.empty()) << name;
         EXPECT_EQ(spec.resolved["scene"], "builtin:" + name);
         EXPECT_EQ(spec.resolved["sss"]["method"], "none");
@@ -56,8 +56,8 @@ TEST(SceneSpec, EveryBuiltinSceneLoadsWithItsDefaults) {
 
 TEST(SceneSpec, OverridesChangeValuesAndAreRecordedInTheResolvedParameters) {
     const SceneSpec spec = loadSceneSpec(
-        "builtin:head", {"camera.view=close", "render.width=320", "tone_map.operator=reinhard", "render.exposure_ev=-1.5"},
-        {});
+        "builtin:head",
+        {"camera.view=close", "render.width=320", "tone_map.operator=reinhard", "render.exposure_ev=-1.5"}, {});
     EXPECT_EQ(spec.camera.view, "close");
     EXPECT_EQ(spec.width, 320);
     EXPECT_EQ(spec.toneMapper, "reinhard");
@@ -73,13 +73,16 @@ TEST(SceneSpec, ErrorMessagesNameFileKeyAndValue) {
     EXPECT_EQ(errorOf("builtin:head", {"camera.fvo=3"}), "builtin:head: camera.fvo: unknown key");
     EXPECT_EQ(errorOf("builtin:head", {"camera.fov_deg=\"wide\""}),
               "builtin:head: camera.fov_deg: expected a number, got string \"wide\"");
-    EXPECT_EQ(errorOf("builtin:head", {"camera.fov_deg=200"}), "builtin:head: camera.fov_deg: 200 is out of range [1, 179]");
+    EXPECT_EQ(errorOf("builtin:head", {"camera.fov_deg=200"}),
+              "builtin:head: camera.fov_deg: 200 is out of range [1, 179]");
     EXPECT_EQ(errorOf("builtin:head", {"camera.view=sideways"}),
               "builtin:head: camera.view: 'sideways' is not one of: close, mid, far, explicit");
     EXPECT_EQ(errorOf("builtin:head", {"render.width=8"}), "builtin:head: render.width: 8 is out of range [16, 8192]");
-    EXPECT_EQ(errorOf("builtin:head", {"tone_map.operator=aces"}),
-              "builtin:head: tone_map.operator: 'aces' is not one of: linear, exponential, reinhard, reinhard-rgb, filmic");
-    EXPECT_EQ(errorOf("builtin:head", {"lights=3"}), "builtin:head: lights: expected an array of tables, got integer 3");
+    EXPECT_EQ(
+        errorOf("builtin:head", {"tone_map.operator=aces"}),
+        "builtin:head: tone_map.operator: 'aces' is not one of: linear, exponential, reinhard, reinhard-rgb, filmic");
+    EXPECT_EQ(errorOf("builtin:head", {"lights=3"}),
+              "builtin:head: lights: expected an array of tables, got integer 3");
     EXPECT_EQ(errorOf("builtin:ear", {"model.depth_gap_mm=10"}),
               "builtin:ear: model.depth_gap_mm: only applies to builtin:halo");
     EXPECT_EQ(errorOf("builtin:head", {"camera.position=[0, 0, 1]"}),
@@ -90,7 +93,7 @@ TEST(SceneSpec, ErrorMessagesNameFileKeyAndValue) {
               "builtin:head: model.source: unknown built-in model 'builtin:torso' (known: builtin:halo, builtin:bleed, "
               "builtin:ear, builtin:head)");
     EXPECT_EQ(errorOf("builtin:head", {"environment.file=assets:envmaps/x.hdr"}, ""),
-              errorOf("builtin:head", {"environment.file=assets:envmaps/x.hdr"}, ""));  // stable
+              errorOf("builtin:head", {"environment.file=assets:envmaps/x.hdr"}, "")); // stable
     EXPECT_EQ(errorOf("builtin:nope", {}),
               "unknown built-in scene 'builtin:nope' (known: builtin:halo, builtin:bleed, builtin:ear, builtin:head, "
               "builtin:halo-grey-backdrop, builtin:bleed-true-mask)");
@@ -105,19 +108,22 @@ TEST(SceneSpec, SssKeyOfAnotherMethodIsAnError) {
     EXPECT_EQ(errorOf("builtin:head", {separable, "sss.artistic_falloff=[1.0, 0.5, 0.5]"})
                   .rfind("builtin:head: sss.artistic_falloff: not a parameter of method 'separable' (its keys: ", 0),
               0u);
-    EXPECT_EQ(errorOf("builtin:head", {"sss.samples=31"}).rfind("builtin:head: sss.samples: not a parameter of method 'none'", 0),
+    EXPECT_EQ(errorOf("builtin:head", {"sss.samples=31"})
+                  .rfind("builtin:head: sss.samples: not a parameter of method 'none'", 0),
               0u);
     TempFolder folder;
     const auto file = folder.write(
-        "scene.toml", "[model]\nsource = \"builtin:head\"\n[sss]\nmethod = \"separable\"\nartistic_strength = [1, 1, 1]\n");
+        "scene.toml",
+        "[model]\nsource = \"builtin:head\"\n[sss]\nmethod = \"separable\"\nartistic_strength = [1, 1, 1]\n");
     const std::string fromFile = errorOf(file.string(), {});
     EXPECT_EQ(fromFile.rfind(file.string() + ": sss.artistic_strength: not a parameter of method 'separable'", 0), 0u)
         << fromFile;
-    const SceneSpec spec = loadSceneSpec("builtin:head", {"sss.method=artistic", "sss.artistic_falloff=[1.0, 0.5, 0.5]"}, {});
+    const SceneSpec spec =
+        loadSceneSpec("builtin:head", {"sss.method=artistic", "sss.artistic_falloff=[1.0, 0.5, 0.5]"}, {});
     EXPECT_EQ(spec.sss.method, sss::SssMethod::Artistic);
     EXPECT_EQ(spec.sss.artisticFalloff[1], 0.5);
     EXPECT_EQ(spec.resolved["sss"]["artistic_falloff"][1], 0.5);
-    EXPECT_FALSE(spec.resolved["sss"].contains("profile"));  // separable's key, not artistic's
+    EXPECT_FALSE(spec.resolved["sss"].contains("profile")); // separable's key, not artistic's
 }
 
 TEST(SceneSpec, LightsAreValidatedPerType) {
@@ -131,8 +137,10 @@ TEST(SceneSpec, LightsAreValidatedPerType) {
               "builtin:bleed: lights[1].intensity: -1 is out of range [0, 1e+06]");
     EXPECT_EQ(errorOf("builtin:bleed", {"lights=[{direction = [0, 0, 0]}]"}),
               "builtin:bleed: lights[0].direction: must not be the zero vector");
-    EXPECT_EQ(errorOf("builtin:bleed", {"lights=[{colour = [1, 1, 1]}]"}), "builtin:bleed: lights[0].colour: unknown key");
-    EXPECT_EQ(errorOf("builtin:bleed", {"lights=[{}, {}, {}, {}, {}]"}), "builtin:bleed: lights: at most 4 lights, got 5");
+    EXPECT_EQ(errorOf("builtin:bleed", {"lights=[{colour = [1, 1, 1]}]"}),
+              "builtin:bleed: lights[0].colour: unknown key");
+    EXPECT_EQ(errorOf("builtin:bleed", {"lights=[{}, {}, {}, {}, {}]"}),
+              "builtin:bleed: lights: at most 4 lights, got 5");
     EXPECT_EQ(loadSceneSpec("builtin:bleed", {"lights=[]"}, {}).lights.size(), 0u);
 }
 
@@ -147,8 +155,9 @@ TEST(SceneSpec, FilePathsResolveAgainstTheSpecFolderAndTheAssetsFolder) {
 
     // "assets:" paths need --assets / $SKINLAB_ASSETS.
     ::unsetenv("SKINLAB_ASSETS");
-    EXPECT_EQ(errorOf(path, {"textures.albedo=assets:skin.jpg"}),
-              path + ": textures.albedo: 'assets:skin.jpg' needs the assets folder: pass --assets DIR or set SKINLAB_ASSETS");
+    EXPECT_EQ(
+        errorOf(path, {"textures.albedo=assets:skin.jpg"}),
+        path + ": textures.albedo: 'assets:skin.jpg' needs the assets folder: pass --assets DIR or set SKINLAB_ASSETS");
     EXPECT_EQ(errorOf(path, {"textures.albedo=assets:skin.jpg"}, folder.path()),
               path + ": textures.albedo: file not found: " + (folder.path() / "skin.jpg").string());
     folder.write("skin.jpg", "not really a jpeg: checked when rendering");
@@ -186,7 +195,7 @@ TEST(CameraFraming, FocalLengthAndNamedViewDistances) {
         EXPECT_NEAR(fill, expected, 1e-4f) << view;
     }
     camera.view = "mid";
-    camera.yawDeg = 90.0;  // orbit to +X
+    camera.yawDeg = 90.0; // orbit to +X
     const CameraPose side = frameCamera(camera, lo, hi, lo, hi, 100, 100);
     EXPECT_NEAR(side.position.z, 0.0f, 1e-4f);
     EXPECT_GT(side.position.x, radius);

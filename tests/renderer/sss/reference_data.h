@@ -8,8 +8,9 @@ namespace skinlab::test {
 
 inline std::filesystem::path referenceKernelDir() {
     const char* env = std::getenv("SKINLAB_REFERENCE");
-    const std::filesystem::path root = env && *env ? std::filesystem::path(env)
-                                                   : std::filesystem::path(SKINLAB_SOURCE_DIR) / ".." / "shared" / "reference";
+    const std::filesystem::path root = env && *env
+                                           ? std::filesystem::path(env)
+                                           : std::filesystem::path(SKINLAB_SOURCE_DIR) / ".." / "shared" / "reference";
     return root / "separable-sss-kernels";
 }
 
@@ -19,7 +20,7 @@ inline std::filesystem::path referenceKernel(const char* material) {
 
 } // namespace skinlab::test
 
-#define SKINLAB_REQUIRE_REFERENCE(path)                                                                           \
-    if (!std::filesystem::exists(path))                                                                           \
-    GTEST_SKIP() << "reference kernel " << (path) << " absent (set SKINLAB_REFERENCE to the folder holding "     \
+#define SKINLAB_REQUIRE_REFERENCE(path)                                                                                \
+    if (!std::filesystem::exists(path))                                                                                \
+    GTEST_SKIP() << "reference kernel " << (path) << " absent (set SKINLAB_REFERENCE to the folder holding "           \
                  << "separable-sss-kernels/)"

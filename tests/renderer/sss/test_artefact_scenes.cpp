@@ -21,10 +21,11 @@ namespace {
 
 using test::TempFolder;
 
-constexpr int kSize = 128;  // pixels, square
+constexpr int kSize = 128; // pixels, square
 
 std::filesystem::path renderExr(Renderer& renderer, const TempFolder& folder, const std::string& name,
-                                const std::string& scene, const std::string& method, std::vector<std::string> overrides) {
+                                const std::string& scene, const std::string& method,
+                                std::vector<std::string> overrides) {
     test::renderToExr(renderer, scene, method, std::move(overrides), kSize, kSize, folder / (name + ".exr"));
     return folder / (name + ".exr");
 }
@@ -51,7 +52,8 @@ TEST(ArtefactScenes, HaloDefaultShowsAVisibleHalo) {
             renderExr(*renderer, folder, name + "-separable", scene, "separable", {"sss.follow_surface=false"});
         const metrics::BandScores halo = bandScores(reference, separable, metrics::Band::halo);
         std::printf("%s, %d², separable without follow-surface against the reference: halo band %zu px, ΔE00 mean "
-                    "%.2f, p95 %.2f\n", scene.c_str(), kSize, halo.pixels, halo.deltaE00Mean, halo.deltaE00P95);
+                    "%.2f, p95 %.2f\n",
+                    scene.c_str(), kSize, halo.pixels, halo.deltaE00Mean, halo.deltaE00P95);
         if (scene == "builtin:halo") {
             EXPECT_GT(halo.pixels, 500u);
             EXPECT_GE(halo.deltaE00P95, 3.0) << "the default halo scene must show its halo";
@@ -63,14 +65,15 @@ TEST(ArtefactScenes, BleedDefaultShowsVisibleBleeding) {
     SKINLAB_REQUIRE_RENDERER(renderer);
     TempFolder folder("artefact-bleed");
     // Ground truth: the true materials (the paint non-skin), i.e. builtin:bleed-true-mask.
-    const auto reference = renderExr(*renderer, folder, "reference", "builtin:bleed", "reference", {kEdge, "materials=[]"});
+    const auto reference =
+        renderExr(*renderer, folder, "reference", "builtin:bleed", "reference", {kEdge, "materials=[]"});
     for (const std::string scene : {"builtin:bleed", "builtin:bleed-true-mask"}) {
-        const auto separable =
-            renderExr(*renderer, folder, scene.substr(8) + "-separable", scene, "separable", {"sss.follow_surface=false"});
+        const auto separable = renderExr(*renderer, folder, scene.substr(8) + "-separable", scene, "separable",
+                                         {"sss.follow_surface=false"});
         const metrics::BandScores bleed = bandScores(reference, separable, metrics::Band::bleed);
         std::printf("%s, %d², separable without follow-surface against the true-mask reference: bleed band %zu px, "
-                    "ΔE00 mean %.2f, p95 %.2f\n", scene.c_str(), kSize, bleed.pixels, bleed.deltaE00Mean,
-                    bleed.deltaE00P95);
+                    "ΔE00 mean %.2f, p95 %.2f\n",
+                    scene.c_str(), kSize, bleed.pixels, bleed.deltaE00Mean, bleed.deltaE00P95);
         if (scene == "builtin:bleed") {
             EXPECT_GT(bleed.pixels, 500u);
             EXPECT_GE(bleed.deltaE00P95, 3.0) << "the default bleed scene must show its bleeding";

@@ -179,7 +179,8 @@ TEST(CpuBlur, LabWeightKeepsPaintLightOutOfTheSkin) {
             p.labWeight = beta;
             const auto out = applyKernel(surface, image, makeKernel(p), blurSettingsFromParams(p));
             float worst = 0.0f;
-            for (int x = 0; x < width / 2; ++x) worst = std::max(worst, std::abs(out[8 * width + x][0] - image[8 * width + x][0]));
+            for (int x = 0; x < width / 2; ++x)
+                worst = std::max(worst, std::abs(out[8 * width + x][0] - image[8 * width + x][0]));
             return worst;
         };
         const float off = worstSkinChange(0.0);
@@ -197,7 +198,7 @@ TEST(CpuBlur, CbfStopsLightAtAStepOfTheAuxiliaryImage) {
     std::vector<Rgb> image(surface.aux.size());
     for (int y = 0; y < height; ++y)
         for (int x = 0; x < width; ++x) {
-            surface.aux[size_t(y) * width + x] = x < width / 2 ? 1.0f : 3.0f;  // F differs by 2 across x = 32
+            surface.aux[size_t(y) * width + x] = x < width / 2 ? 1.0f : 3.0f; // F differs by 2 across x = 32
             image[size_t(y) * width + x] = x < width / 2 ? Rgb{0.2f, 0.2f, 0.2f} : Rgb{1.0f, 1.0f, 1.0f};
         }
     for (SssMethod m : kMethods) {
@@ -206,7 +207,7 @@ TEST(CpuBlur, CbfStopsLightAtAStepOfTheAuxiliaryImage) {
         auto crossed = [&](bool cbf) {
             p.cbf = cbf;
             const auto out = applyKernel(surface, image, makeKernel(p), blurSettingsFromParams(p));
-            double light = 0.0;  // light that reached the dark side
+            double light = 0.0; // light that reached the dark side
             for (int x = 0; x < width / 2; ++x) light += out[8 * width + x][1] - 0.2;
             return light;
         };

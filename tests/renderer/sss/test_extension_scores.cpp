@@ -29,7 +29,7 @@ namespace {
 
 using test::TempFolder;
 
-constexpr int kSize = 128;  // pixels, square
+constexpr int kSize = 128; // pixels, square
 
 const std::vector<std::string> kScreenSpaceMethods = renderer::sss::screenSpaceMethodNames();
 
@@ -65,20 +65,22 @@ TEST(ExtensionScores, FollowSurfaceAndCbfAgainstTheHaloOfEveryScreenSpaceMethod)
     for (const double gapMm : {5.0, 200.0}) {
         const std::vector<std::string> scene{
             "materials=[{name = \"*\", skin = true}]",
-            "camera.view=explicit", "camera.position=[0.0, 0.0, 300.0]", "camera.target=[0.0, 0.0, 0.0]",
+            "camera.view=explicit",
+            "camera.position=[0.0, 0.0, 300.0]",
+            "camera.target=[0.0, 0.0, 0.0]",
             "lights=[{type = \"directional\", direction = [0.45, -0.45, -0.77], intensity = 1.2, shadow = false}]",
             "model.depth_gap_mm=" + std::to_string(gapMm)};
         const std::string gap = std::to_string(static_cast<int>(gapMm));
         // 2 mm reference edges: the skin backdrop is 600 × 600 mm, and 1 mm edges take 3–4× as long (11 s per
         // reference); 4 mm edges moved the halo scores by < 10 % and changed none of the comparisons below.
-        const auto referenceExr = renderExr(*renderer, folder, "reference-" + gap, "builtin:halo-grey-backdrop", "reference",
-                                            with(scene, {"sss.reference_edge_mm=2"}));
+        const auto referenceExr = renderExr(*renderer, folder, "reference-" + gap, "builtin:halo-grey-backdrop",
+                                            "reference", with(scene, {"sss.reference_edge_mm=2"}));
         const metrics::PreparedReference reference = prepare(referenceExr);
         for (const auto& method : kScreenSpaceMethods) {
             auto halo = [&](const std::string& name, std::initializer_list<std::string> overrides) {
                 return leakEnergy(reference,
-                                  renderExr(*renderer, folder, method + "-" + gap + "-" + name, "builtin:halo-grey-backdrop", method,
-                                            with(scene, overrides)),
+                                  renderExr(*renderer, folder, method + "-" + gap + "-" + name,
+                                            "builtin:halo-grey-backdrop", method, with(scene, overrides)),
                                   metrics::Band::halo);
             };
             const double off = halo("off", {"sss.follow_surface=false"});
@@ -117,18 +119,18 @@ TEST(ExtensionScores, LabWeightCutsTheBleedOfTheSeparableMethods) {
     const std::vector<std::string> coarseMask{"materials=[{name = \"*\", skin = true}]"};
     struct Case {
         std::string method;
-        double beta;  // the thesis's β: 0.09 for the separable methods, 0.5 for the sum of Gaussians
+        double beta; // the thesis's β: 0.09 for the separable methods, 0.5 for the sum of Gaussians
     };
-    for (const Case& c : std::vector<Case>{{"separable", 0.09}, {"artistic", 0.09}, {"pscbf", 0.09},
-                                           {"gaussian-sum", 0.5}}) {
+    for (const Case& c :
+         std::vector<Case>{{"separable", 0.09}, {"artistic", 0.09}, {"pscbf", 0.09}, {"gaussian-sum", 0.5}}) {
         const double off = leakEnergy(
             reference, renderExr(*renderer, folder, c.method + "-off", "builtin:bleed-true-mask", c.method, coarseMask),
             metrics::Band::bleed);
-        const double lab = leakEnergy(
-            reference,
-            renderExr(*renderer, folder, c.method + "-lab", "builtin:bleed-true-mask", c.method,
-                      with(coarseMask, {"sss.lab_weight=" + std::to_string(c.beta)})),
-            metrics::Band::bleed);
+        const double lab =
+            leakEnergy(reference,
+                       renderExr(*renderer, folder, c.method + "-lab", "builtin:bleed-true-mask", c.method,
+                                 with(coarseMask, {"sss.lab_weight=" + std::to_string(c.beta)})),
+                       metrics::Band::bleed);
         std::printf("  %-13s bleed leak energy: %.3e without, %.3e with sss.lab_weight = %.2f (x %.4f)\n",
                     c.method.c_str(), off, lab, c.beta, lab / off);
         EXPECT_GT(off, 1e-4) << c.method << ": no bleeding to remove";
@@ -152,9 +154,9 @@ TEST(ExtensionScores, CurvatureStrategiesOnAFlatPlane) {
         test::readExr(renderExr(*renderer, folder, "none", "builtin:bleed-true-mask", "none", coarseMask));
     for (const std::string method : {"separable", "gaussian-sum"}) {
         auto blur = [&](const std::string& strategy) {
-            const test::ExrImage image = test::readExr(
-                renderExr(*renderer, folder, method + "-" + strategy, "builtin:bleed-true-mask", method,
-                          with(coarseMask, {"sss.curvature=" + strategy, "sss.curvature_floor=0.5"})));
+            const test::ExrImage image =
+                test::readExr(renderExr(*renderer, folder, method + "-" + strategy, "builtin:bleed-true-mask", method,
+                                        with(coarseMask, {"sss.curvature=" + strategy, "sss.curvature_floor=0.5"})));
             double change = 0.0, curvature = 0.0;
             for (int y = 0; y < image.height; ++y)
                 for (int x = 0; x < image.width; ++x) {
@@ -192,22 +194,24 @@ TEST(ExtensionScores, CurvatureStrategiesOnTheHaloSphere) {
         return 0.2126 * image.at("diffuse.R", x, y) + 0.7152 * image.at("diffuse.G", x, y) +
                0.0722 * image.at("diffuse.B", x, y);
     };
-    const test::ExrImage none = test::readExr(renderExr(*renderer, folder, "none", "builtin:halo-grey-backdrop", "none", scene));
+    const test::ExrImage none =
+        test::readExr(renderExr(*renderer, folder, "none", "builtin:halo-grey-backdrop", "none", scene));
     auto blur = [&](const std::string& strategy) {
-        const test::ExrImage image = test::readExr(
-            renderExr(*renderer, folder, strategy, "builtin:halo-grey-backdrop", "separable",
-                      with(scene, {"sss.curvature=" + strategy, "sss.curvature_floor=0.5"})));
+        const test::ExrImage image =
+            test::readExr(renderExr(*renderer, folder, strategy, "builtin:halo-grey-backdrop", "separable",
+                                    with(scene, {"sss.curvature=" + strategy, "sss.curvature_floor=0.5"})));
         double change = 0.0, curvature = 0.0;
         int sphere = 0;
         for (int y = 0; y < image.height; ++y)
             for (int x = 0; x < image.width; ++x) {
-                if (image.at("mask.Y", x, y) < 1.0f) continue;  // the sphere (the backdrop is not skin)
+                if (image.at("mask.Y", x, y) < 1.0f) continue; // the sphere (the backdrop is not skin)
                 change += std::abs(diffuseLuminance(image, x, y) - diffuseLuminance(none, x, y));
                 curvature += image.at("curvature.Y", x, y);
                 ++sphere;
             }
         std::printf("  separable curvature %-12s: sphere luminance change %.4g (mean curvature.Y %.4f /mm, "
-                    "%d px)\n", strategy.c_str(), change, curvature / sphere, sphere);
+                    "%d px)\n",
+                    strategy.c_str(), change, curvature / sphere, sphere);
         return change;
     };
     const double increase = blur("increase");

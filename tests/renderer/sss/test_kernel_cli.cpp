@@ -55,7 +55,7 @@ TEST(KernelCli, PrintsNormalisedTapsAsJson) {
             for (int c = 0; c < 3; ++c) {
                 double sum = 0.0;
                 for (const auto& tap : stage["taps"]) sum += tap["weight"][c].get<double>();
-                EXPECT_NEAR(sum, 1.0, 1e-9) << method;  // JSON keeps 17 significant digits
+                EXPECT_NEAR(sum, 1.0, 1e-9) << method; // JSON keeps 17 significant digits
             }
         }
         EXPECT_EQ(json["statistics"]["stages"].size(), json["kernel"]["stages"].size());
@@ -72,7 +72,7 @@ TEST(KernelCli, PrintsCsv) {
     int rows = 0;
     while (std::getline(lines, line)) ++rows;
     EXPECT_EQ(rows, 7);
-    EXPECT_NE(run.out.find("\n0,-2,"), std::string::npos) << run.out;  // RANGE = 2 for N ≤ 20
+    EXPECT_NE(run.out.find("\n0,-2,"), std::string::npos) << run.out; // RANGE = 2 for N ≤ 20
 }
 
 TEST(KernelCli, BadInputIsOneLineWithExitCode2) {
@@ -105,7 +105,8 @@ TEST(KernelCli, MethodsTableAndKeysOfAnotherMethod) {
     EXPECT_NE(screen.out.find("pscbf\n"), std::string::npos);
     const CliRun bad = runCli("kernel --method separable --set 'sss.artistic_falloff=[1.0,0.5,0.5]'");
     EXPECT_EQ(bad.exitCode, 2);
-    EXPECT_NE(bad.out.find("command line: sss.artistic_falloff: not a parameter of method 'separable'"), std::string::npos)
+    EXPECT_NE(bad.out.find("command line: sss.artistic_falloff: not a parameter of method 'separable'"),
+              std::string::npos)
         << bad.out;
     const CliRun profile = runCli("kernel --method artistic --profile burley");
     EXPECT_EQ(profile.exitCode, 2);

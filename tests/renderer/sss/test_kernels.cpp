@@ -37,8 +37,7 @@ void expectNormalisedSymmetric(const std::vector<KernelTap>& taps, const std::st
     for (size_t i = 0; i < half; ++i) {
         EXPECT_NEAR(taps[i].offsetMm, -taps[taps.size() - 1 - i].offsetMm, 1e-12) << what;
         EXPECT_LT(taps[i].offsetMm, taps[i + 1].offsetMm) << what;
-        for (int c = 0; c < 3; ++c)
-            EXPECT_NEAR(taps[i].weight[c], taps[taps.size() - 1 - i].weight[c], 1e-9) << what;
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(taps[i].weight[c], taps[taps.size() - 1 - i].weight[c], 1e-9) << what;
     }
 }
 
@@ -61,16 +60,18 @@ TEST(Kernels, EveryStageOfEveryMethodIsNormalisedAndSymmetric) {
         std::string profile;
         std::string material;
     };
-    const std::vector<Case> cases{{SssMethod::Separable, "deon", "skin"},   {SssMethod::Separable, "burley", "skin"},
-                                  {SssMethod::Separable, "burley", "marble"}, {SssMethod::Separable, "burley", "ketchup"},
-                                  {SssMethod::Artistic, "deon", "skin"},    {SssMethod::GaussianSum, "deon", "skin"}};
+    const std::vector<Case> cases{
+        {SssMethod::Separable, "deon", "skin"},     {SssMethod::Separable, "burley", "skin"},
+        {SssMethod::Separable, "burley", "marble"}, {SssMethod::Separable, "burley", "ketchup"},
+        {SssMethod::Artistic, "deon", "skin"},      {SssMethod::GaussianSum, "deon", "skin"}};
     for (const auto& kase : cases)
         for (TapPlacement placement : {TapPlacement::Quadratic, TapPlacement::Importance})
             for (int samples : {3, 5, 7, 21, 25, 101}) {
-                const Kernel kernel = makeKernel(paramsFor(kase.method, samples, placement, kase.profile, kase.material));
+                const Kernel kernel =
+                    makeKernel(paramsFor(kase.method, samples, placement, kase.profile, kase.material));
                 const std::string what = std::string(methodName(kase.method)) + "/" + kase.profile + "/" +
-                                         kase.material + "/" + std::string(placementName(placement)) + "/N=" +
-                                         std::to_string(samples);
+                                         kase.material + "/" + std::string(placementName(placement)) +
+                                         "/N=" + std::to_string(samples);
                 ASSERT_FALSE(kernel.stages.empty()) << what;
                 double accumulated[3] = {0, 0, 0};
                 for (const auto& stage : kernel.stages) {
@@ -80,7 +81,7 @@ TEST(Kernels, EveryStageOfEveryMethodIsNormalisedAndSymmetric) {
                 }
                 for (int c = 0; c < 3; ++c) EXPECT_NEAR(accumulated[c], 1.0, 1e-12) << what;
             }
-    EXPECT_TRUE(makeKernel(SssParams{}).stages.empty());  // method none
+    EXPECT_TRUE(makeKernel(SssParams{}).stages.empty()); // method none
 }
 
 TEST(Kernels, ArtisticBaselineMatchesHandComputedTapsForSevenSamples) {
@@ -119,7 +120,7 @@ TEST(Kernels, ArtisticRangeIsThreeAboveTwentySamplesAndWidthScalesOffsets) {
     EXPECT_NEAR(artisticTaps(21, {1, 1, 1}, {1, 1, 1}).back().offsetMm, 3.0, 1e-12);
     EXPECT_NEAR(artisticTaps(19, {1, 1, 1}, {1, 1, 1}).back().offsetMm, 2.0, 1e-12);
     SssParams p = paramsFor(SssMethod::Artistic, 25, TapPlacement::Quadratic);
-    p.widthMm = 6.0;  // twice the profile scale
+    p.widthMm = 6.0; // twice the profile scale
     EXPECT_NEAR(makeKernel(p).stages[0].taps.back().offsetMm, 6.0, 1e-12);
 }
 
@@ -200,7 +201,8 @@ TEST(Kernels, InconsistentParametersAreInputErrors) {
         makeKernel(paramsFor(SssMethod::Separable, 21, TapPlacement::Quadratic, "deon", "marble"));
         FAIL() << "no exception";
     } catch (const skinlab::InputError& e) {
-        EXPECT_STREQ(e.what(), "sss.material: 'marble' has no d'Eon profile (only 'skin'); use sss.profile = \"burley\"");
+        EXPECT_STREQ(e.what(),
+                     "sss.material: 'marble' has no d'Eon profile (only 'skin'); use sss.profile = \"burley\"");
     }
 }
 
@@ -246,17 +248,22 @@ TEST(TabulatedKernel, BadFilesAreNamedInTheError) {
     const fs::path dir = scratchDir();
     EXPECT_EQ(errorOf(dir / "missing.bn"), (dir / "missing.bn").string() + ": kernel file not found");
     skinlab::writeFileAtomic(dir / "short.bn", floats({12, 0.25f, 0.2f, 0.1f, -1, 0.5f}));
-    EXPECT_EQ(errorOf(dir / "short.bn"), (dir / "short.bn").string() + ": truncated: header says 12 floats, file holds 5");
+    EXPECT_EQ(errorOf(dir / "short.bn"),
+              (dir / "short.bn").string() + ": truncated: header says 12 floats, file holds 5");
     skinlab::writeFileAtomic(dir / "empty.bn", "");
     EXPECT_EQ(errorOf(dir / "empty.bn"), (dir / "empty.bn").string() + ": truncated: 0 bytes, no header");
     skinlab::writeFileAtomic(dir / "text.bn", "hello world, not a kernel\n");
-    EXPECT_NE(errorOf(dir / "text.bn").find("text.bn: not a .bn kernel"), std::string::npos) << errorOf(dir / "text.bn");
+    EXPECT_NE(errorOf(dir / "text.bn").find("text.bn: not a .bn kernel"), std::string::npos)
+        << errorOf(dir / "text.bn");
     skinlab::writeFileAtomic(dir / "odd.bn", floats({6, 1, 1, 1, 0, 1, 1}));
-    EXPECT_EQ(errorOf(dir / "odd.bn"), (dir / "odd.bn").string() + ": not a .bn kernel: 6 floats is not a multiple of 4");
-    skinlab::writeFileAtomic(dir / "negative.bn", floats({12, 0.25f, 0.2f, 0.1f, -1, -0.5f, 0.6f, 0.8f, 0, 0.25f, 0.2f, 0.1f, 1}));
+    EXPECT_EQ(errorOf(dir / "odd.bn"),
+              (dir / "odd.bn").string() + ": not a .bn kernel: 6 floats is not a multiple of 4");
+    skinlab::writeFileAtomic(dir / "negative.bn",
+                             floats({12, 0.25f, 0.2f, 0.1f, -1, -0.5f, 0.6f, 0.8f, 0, 0.25f, 0.2f, 0.1f, 1}));
     EXPECT_EQ(errorOf(dir / "negative.bn"),
               (dir / "negative.bn").string() + ": row 1: weight -0.500000 is not a finite non-negative number");
-    skinlab::writeFileAtomic(dir / "uneven.bn", floats({12, 0.25f, 0.2f, 0.1f, -1, 0.5f, 0.6f, 0.8f, 0, 0.25f, 0.2f, 0.1f, 3}));
+    skinlab::writeFileAtomic(dir / "uneven.bn",
+                             floats({12, 0.25f, 0.2f, 0.1f, -1, 0.5f, 0.6f, 0.8f, 0, 0.25f, 0.2f, 0.1f, 3}));
     EXPECT_EQ(errorOf(dir / "uneven.bn"), (dir / "uneven.bn").string() + ": row 1: offsets are not uniformly spaced");
 }
 
@@ -264,7 +271,7 @@ TEST(TabulatedKernel, PublishedSkin1KernelLoads) {
     const fs::path skin1 = skinlab::test::referenceKernel("Skin1");
     SKINLAB_REQUIRE_REFERENCE(skin1);
     const auto rows = readTabulatedKernel(skin1);
-    ASSERT_EQ(rows.size(), 618u);  // README: 618 rows, x in [−10.35, 10.35]
+    ASSERT_EQ(rows.size(), 618u); // README: 618 rows, x in [−10.35, 10.35]
     EXPECT_NEAR(rows.front().offsetMm, -10.35, 0.01);
     EXPECT_NEAR(rows.back().offsetMm, 10.35, 0.01);
     for (int c = 0; c < 3; ++c) {

@@ -16,7 +16,7 @@ TEST(Profiles, DeonWeightsSumToOnePerChannelWithPublishedBlue) {
     for (const auto& lobe : deonSkinLobes())
         for (int c = 0; c < 3; ++c) sum[c] += lobe.weight[c];
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(sum[c], 1.0, 1e-12) << "channel " << c;
-    EXPECT_DOUBLE_EQ(deonSkinLobes()[0].weight[2], 0.649);  // not the thesis text's 0.69
+    EXPECT_DOUBLE_EQ(deonSkinLobes()[0].weight[2], 0.649); // not the thesis text's 0.69
 }
 
 TEST(Profiles, MarginalOfGaussianIsTheOneDimensionalGaussian) {
@@ -76,16 +76,15 @@ TEST(Profiles, BurleyMarginalCumulativeAndMomentMatchTheDensity) {
         EXPECT_NEAR(burley.cumulative(c, 200.0 * d), 1.0, 1e-9);
         for (double x : {0.3 * d, d, 4.0 * d}) {
             // ∫_0^x a(t) dt with the log singularity at 0 handled by t = x·s² (dt = 2xs ds).
-            const double integral =
-                integrate([&](double s) { return s == 0.0 ? 0.0 : burley.density(c, x * s * s) * 2.0 * x * s; }, 0.0,
-                          1.0, 1e-13);
+            const double integral = integrate(
+                [&](double s) { return s == 0.0 ? 0.0 : burley.density(c, x * s * s) * 2.0 * x * s; }, 0.0, 1.0, 1e-13);
             EXPECT_NEAR(burley.cumulative(c, x) - 0.5, integral, 1e-8) << "channel " << c << " x=" << x;
             // Two independent routes: ∫K0 (closed form, tabulated) and the strip energy of the radial profile.
             EXPECT_NEAR(burley.cumulative(c, x), burley.cumulativeByStrip(c, x), 1e-8) << "channel " << c;
         }
-        const double moment = 2.0 * integrateToInfinity(
-                                        [&](double t) { return t == 0.0 ? 0.0 : t * t * burley.density(c, t); }, 0.0,
-                                        3.0 * d, 1e-13);
+        const double moment =
+            2.0 * integrateToInfinity([&](double t) { return t == 0.0 ? 0.0 : t * t * burley.density(c, t); }, 0.0,
+                                      3.0 * d, 1e-13);
         EXPECT_NEAR(moment / burley.secondMoment(c), 1.0, 1e-6);
     }
 }
@@ -94,7 +93,7 @@ TEST(Profiles, TransmittanceIsOneAtZeroThicknessAndDecreases) {
     const auto t0 = deonTransmittance(0.0);
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(t0[c], 1.0, 1e-12);
     const auto t1 = deonTransmittance(1.0);
-    EXPECT_GT(t1[0], t1[1]);  // red travels farther than green and blue
+    EXPECT_GT(t1[0], t1[1]); // red travels farther than green and blue
     EXPECT_GT(t1[1], t1[2]);
     EXPECT_DOUBLE_EQ(burleyTransmittance(0.5, 0.0), 1.0);
 }

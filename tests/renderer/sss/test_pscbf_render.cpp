@@ -71,12 +71,12 @@ void renderScene(Renderer& renderer, const std::string& scene) {
 // One frame of SSS stage inputs, CPU side; rows bottom first (GL order), view = identity (world = view space).
 struct SyntheticFrame {
     int width = 160;
-    int height = 90;  // 16:9
+    int height = 90; // 16:9
     float focalLengthPixels = 300.0f;
     float mmPerUnit = 1.0f;
-    std::vector<std::array<float, 4>> diffuse;  // rgb, a = skin mask
-    std::vector<float> depth;                   // world units
-    std::vector<std::array<float, 4>> normal;   // world = view space, xyz unit
+    std::vector<std::array<float, 4>> diffuse; // rgb, a = skin mask
+    std::vector<float> depth;                  // world units
+    std::vector<std::array<float, 4>> normal;  // world = view space, xyz unit
     std::vector<std::array<float, 4>> albedo;
     std::vector<float> aux;
     std::vector<float> curvature;
@@ -125,7 +125,7 @@ StageFixture& stageFixture() {
 sss::SssParams pscbfParams() {
     sss::SssParams params;
     params.method = sss::SssMethod::Pscbf;
-    params.samples = sss::kPscbfSamples;  // Mikkelsen's 13 taps per axis
+    params.samples = sss::kPscbfSamples; // Mikkelsen's 13 taps per axis
     return params;
 }
 
@@ -164,7 +164,8 @@ std::vector<std::array<float, 4>> runStage(const SyntheticFrame& frame, const ss
     settings.sss = params;
     stageFixture().stage->run(inputs, settings, output.get());
     std::vector<std::array<float, 4>> out(frame.diffuse.size());
-    glGetTextureImage(output.get(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(out.size() * sizeof(out[0])), out.data());
+    glGetTextureImage(output.get(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(out.size() * sizeof(out[0])),
+                      out.data());
     gl::checkGl("pscbf test readback");
     return out;
 }
@@ -174,7 +175,7 @@ std::vector<std::array<float, 4>> runStage(const SyntheticFrame& frame, const ss
 struct Spread {
     double x = 0.0;
     double y = 0.0;
-    double energy = 0.0;  // Σ output (the impulse has energy 1)
+    double energy = 0.0; // Σ output (the impulse has energy 1)
 };
 
 Spread impulseSpread(const SyntheticFrame& frame, const std::vector<std::array<float, 4>>& out, std::array<int, 2> at,
@@ -193,7 +194,7 @@ Spread impulseSpread(const SyntheticFrame& frame, const std::vector<std::array<f
 }
 
 // A plane facing the camera at 4 pixels per mm (the red taps then reach 18 pixels), an impulse at the centre.
-constexpr double kFacingDepth = 75.0;  // f_px / (mm_per_unit · 4 px/mm)
+constexpr double kFacingDepth = 75.0; // f_px / (mm_per_unit · 4 px/mm)
 const std::array<int, 2> kCentre{80, 45};
 
 SyntheticFrame impulseOnPlane(std::array<double, 3> normal) {
@@ -214,7 +215,8 @@ TEST(PscbfRender, RendersTheScannedHead) {
     SKINLAB_REQUIRE_RENDERER(renderer);
     const char* assets = std::getenv("SKINLAB_ASSETS");
     if (!assets || !*assets) GTEST_SKIP() << "$SKINLAB_ASSETS unset: the scanned head is not available";
-    renderScene(*renderer, (std::filesystem::path(SKINLAB_SOURCE_DIR) / "renderer/scenes/lee-perry-smith.toml").string());
+    renderScene(*renderer,
+                (std::filesystem::path(SKINLAB_SOURCE_DIR) / "renderer/scenes/lee-perry-smith.toml").string());
 }
 
 TEST(PscbfRender, UniformlyLitSkinPlaneKeepsItsMean) {
@@ -256,14 +258,14 @@ TEST(PscbfRender, DepthWeightStopsLightCrossingTheDepthGapOfHalo) {
             "lights=[{type = \"directional\", direction = [0.45, -0.45, -0.77], intensity = 1.2, shadow = false}]",
             "sss.width_mm=12"};
         const ExrImage none = render(*renderer, folder, "builtin:halo-grey-backdrop", "none", overrides, 96, 96);
-        overrides.push_back(std::string("sss.follow_surface=") + (follow ? "true" : "false"));  // not read by none
+        overrides.push_back(std::string("sss.follow_surface=") + (follow ? "true" : "false")); // not read by none
         const ExrImage image = render(*renderer, folder, "builtin:halo-grey-backdrop", method, overrides, 96, 96);
         float nearest = 1e30f;
         for (float z : image.channels.at("depth.Z")) nearest = std::min(nearest, z);
         double leak = 0.0;
         for (int y = 0; y < image.height; ++y)
             for (int x = 0; x < image.width; ++x)
-                if (image.at("depth.Z", x, y) > nearest + 150.0f)  // the backdrop (≥ 200 mm behind the sphere's back)
+                if (image.at("depth.Z", x, y) > nearest + 150.0f) // the backdrop (≥ 200 mm behind the sphere's back)
                     leak += std::abs(luminance(image, x, y) - luminance(none, x, y));
         return leak;
     };
@@ -463,10 +465,10 @@ TEST(PscbfStage, ExtensionsReachThePasses) {
     for (int y = 0; y < frame.height; ++y)
         for (int x = 0; x < frame.width; ++x) {
             const bool left = x < kCentre[0];
-            frame.diffuse[frame.index(x, y)] = left ? std::array<float, 4>{1.0f, 1.0f, 1.0f, 1.0f}
-                                                    : std::array<float, 4>{0.0f, 0.0f, 0.0f, 1.0f};
-            frame.albedo[frame.index(x, y)] = left ? std::array<float, 4>{0.8f, 0.5f, 0.4f, 1.0f}
-                                                   : std::array<float, 4>{0.1f, 0.5f, 0.2f, 1.0f};
+            frame.diffuse[frame.index(x, y)] =
+                left ? std::array<float, 4>{1.0f, 1.0f, 1.0f, 1.0f} : std::array<float, 4>{0.0f, 0.0f, 0.0f, 1.0f};
+            frame.albedo[frame.index(x, y)] =
+                left ? std::array<float, 4>{0.8f, 0.5f, 0.4f, 1.0f} : std::array<float, 4>{0.1f, 0.5f, 0.2f, 1.0f};
             frame.aux[frame.index(x, y)] = left ? 1.0f : 2.0f;
         }
     auto crossed = [&](const sss::SssParams& params) {
@@ -478,7 +480,7 @@ TEST(PscbfStage, ExtensionsReachThePasses) {
     };
     const double off = crossed(pscbfParams());
     sss::SssParams lab = pscbfParams();
-    lab.labWeight = 0.09;  // the thesis's β for the separable methods
+    lab.labWeight = 0.09; // the thesis's β for the separable methods
     sss::SssParams cbf = pscbfParams();
     cbf.cbf = true;
     sss::SssParams reduce = pscbfParams();
@@ -488,8 +490,9 @@ TEST(PscbfStage, ExtensionsReachThePasses) {
     EXPECT_LT(withLab, 0.5 * off);
     EXPECT_LT(withCbf, 0.5 * off);
     EXPECT_LT(withReduce, 1e-6);
-    std::printf("  red light crossing the border: off %.4g, lab_weight 0.09 %.4g, cbf %.4g, curvature reduce (flat) %.4g\n",
-                off, withLab, withCbf, withReduce);
+    std::printf(
+        "  red light crossing the border: off %.4g, lab_weight 0.09 %.4g, cbf %.4g, curvature reduce (flat) %.4g\n",
+        off, withLab, withCbf, withReduce);
 }
 
 } // namespace skinlab::renderer

@@ -43,7 +43,7 @@ GlFixture& fixture() {
     return f;
 }
 
-#define SKINLAB_REQUIRE_GL()                                                                                        \
+#define SKINLAB_REQUIRE_GL()                                                                                           \
     if (!fixture().context) GTEST_SKIP() << "no EGL/OpenGL 4.5 context: " << fixture().failure
 
 // Runs the GL SSS stage on CPU-side buffers and returns the output colour (rgb).
@@ -187,8 +187,8 @@ TEST(SssGlPasses, KeepTheMeanOfALitSkinPlaneAwayFromBorders) {
     std::vector<Rgb> diffuse(size_t(w) * h);
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x)
-            diffuse[size_t(y) * w + x] = Rgb{0.8f + 0.2f * std::sin(0.9f * x + 0.3f * y), 0.5f + 0.1f * std::cos(1.3f * y),
-                                             0.3f + 0.1f * std::sin(0.5f * x * 0.7f)};
+            diffuse[size_t(y) * w + x] = Rgb{0.8f + 0.2f * std::sin(0.9f * x + 0.3f * y),
+                                             0.5f + 0.1f * std::cos(1.3f * y), 0.3f + 0.1f * std::sin(0.5f * x * 0.7f)};
     for (sss::SssMethod m : kMethods) {
         const sss::SssParams p = params(m);
         const int margin = static_cast<int>(std::ceil(sss::makeKernel(p).supportRadiusMm() * 3.0)) + 1;
@@ -225,7 +225,7 @@ TEST(SssGlPasses, ImpulseSpreadsEquallyOnBothAxesOfA16By9Image) {
                     yy += v * (y - cy) * (y - cy);
                 }
             EXPECT_NEAR(std::sqrt(xx / yy), 1.0, 0.02) << sss::methodName(m) << " channel " << c;
-            EXPECT_NEAR(sum, 1.0, 1e-4) << sss::methodName(m) << " channel " << c;  // energy of the impulse
+            EXPECT_NEAR(sum, 1.0, 1e-4) << sss::methodName(m) << " channel " << c; // energy of the impulse
             EXPECT_GT(std::sqrt(xx / sum), 0.5) << sss::methodName(m) << ": no spread";
         }
     }
@@ -255,8 +255,9 @@ ExtensionTestImage extensionTestImage() {
         for (int x = 0; x < w; ++x) {
             const size_t i = size_t(y) * w + x;
             const bool paint = x >= 20 && x < 34 && y >= 12 && y < 30;
-            surface.albedo[i] = paint ? Rgb{0.05f, 0.08f, 0.4f}
-                                      : Rgb{0.55f + 0.1f * std::sin(0.2f * x), 0.35f, 0.25f + 0.05f * std::cos(0.3f * y)};
+            surface.albedo[i] = paint
+                                    ? Rgb{0.05f, 0.08f, 0.4f}
+                                    : Rgb{0.55f + 0.1f * std::sin(0.2f * x), 0.35f, 0.25f + 0.05f * std::cos(0.3f * y)};
             if (x >= 40) surface.depth[i] += 30.0f;
             surface.aux[i] = (x >= 40 ? 1.6f : 1.0f) + 0.05f * std::sin(0.13f * x + 0.21f * y);
             // κ in 1/world unit (mm_per_unit = 1): 0 … 0.075/mm, normalised c = 0 … 1 (clamped from 0.05/mm on).
@@ -297,7 +298,7 @@ TEST(SssGlPasses, ExtensionsMatchTheCpuReference) {
     };
     const std::vector<Extensions> extensions{
         {"cbf", true, 10.0, 0.0, "off"},
-        {"cbf lambda 1000", true, 1000.0, 0.0, "off"},  // rejects nearly every tap off the centre texel
+        {"cbf lambda 1000", true, 1000.0, 0.0, "off"}, // rejects nearly every tap off the centre texel
         {"lab_weight 0.09", false, 10.0, 0.09, "off"},
         {"lab_weight 0.5", false, 10.0, 0.5, "off"},
         {"curvature increase", false, 10.0, 0.0, "increase"},
@@ -321,8 +322,8 @@ TEST(SssGlPasses, ExtensionsMatchTheCpuReference) {
             p.curvature = e.curvature;
             p.extensionInput = e.input;
             p.curvatureReferenceMm = e.referenceMm;
-            const auto cpu = sss::applyKernel(image.surface, image.diffuse, sss::makeKernel(p),
-                                              sss::blurSettingsFromParams(p));
+            const auto cpu =
+                sss::applyKernel(image.surface, image.diffuse, sss::makeKernel(p), sss::blurSettingsFromParams(p));
             const auto gpu = runOnGpu(image.surface, image.diffuse, p);
             const float difference = maxAbsDifference(cpu, gpu);
             // 1e-3 as in MatchTheCpuReferenceOnATestImage: float32 on both sides in the same order; the extension
@@ -364,7 +365,7 @@ TEST(SssGlPasses, LitExtensionInputCutsAtAShadowTerminator) {
     const auto gpuAlbedo = runOnGpu(surface, diffuse, albedo);
     const auto gpuLit = runOnGpu(surface, diffuse, lit);
     EXPECT_LE(maxAbsDifference(gpuAlbedo, gpuOff), 1e-5f) << "one albedo: the albedo input must not weigh any tap";
-    const size_t shadowed = size_t(h / 2) * w + 50;  // 2 pixels into the shadow
+    const size_t shadowed = size_t(h / 2) * w + 50; // 2 pixels into the shadow
     EXPECT_GT(gpuOff[shadowed][0], 0.05f * 0.6f + 0.02f) << "the unweighted blur carries light across the terminator";
     EXPECT_LT(gpuLit[shadowed][0], 0.5f * (gpuOff[shadowed][0] + 0.05f * 0.6f))
         << "the lit input should keep most of the light on its side";
@@ -424,16 +425,16 @@ TEST(SssGlPasses, CurvatureScalesTheSpreadOfAnImpulse) {
     sss::SurfaceBuffers plane = flatPlane(w, h, 8.0f);
     std::vector<Rgb> impulse(size_t(w) * h, Rgb{0, 0, 0});
     impulse[size_t(cy) * w + cx] = Rgb{1, 1, 1};
-    const float fullyCurved = 1.0f / sss::kCurvatureReferenceRadiusMm;  // κ (1/mm = 1/unit here) with c = 1
+    const float fullyCurved = 1.0f / sss::kCurvatureReferenceRadiusMm; // κ (1/mm = 1/unit here) with c = 1
     struct Case {
         const char* strategy;
-        float curvature;  // κ, 1/world unit
+        float curvature; // κ, 1/world unit
         double floor;
         double expectedScale;
     };
-    const std::vector<Case> cases{{"reduce-floor", 0.0f, 0.5, 0.5},    {"reduce-floor", 0.0f, 0.3, 0.3},
+    const std::vector<Case> cases{{"reduce-floor", 0.0f, 0.5, 0.5},        {"reduce-floor", 0.0f, 0.3, 0.3},
                                   {"reduce-floor", fullyCurved, 0.5, 1.0}, {"reduce", 0.6f * fullyCurved, 0.5, 0.6},
-                                  {"increase", fullyCurved, 0.5, 2.0},    {"increase", 0.0f, 0.5, 1.0}};
+                                  {"increase", fullyCurved, 0.5, 2.0},     {"increase", 0.0f, 0.5, 1.0}};
     for (sss::SssMethod method : {sss::SssMethod::Separable, sss::SssMethod::Artistic, sss::SssMethod::GaussianSum}) {
         const Spread off = spreadOf(runOnGpu(plane, impulse, params(method)), w, h, cx, cy, 0);
         for (const auto& k : cases) {

@@ -65,11 +65,12 @@ material = "marble"
 }
 
 TEST(SssParams, ErrorsNameFileKeyAndValue) {
-    EXPECT_EQ(sssError("[sss]\nmethod = \"blur\""),
-              "scene.toml: sss.method: 'blur' is not one of: none, gaussian-sum, separable, artistic, pscbf, reference, pathtraced");
+    EXPECT_EQ(sssError("[sss]\nmethod = \"blur\""), "scene.toml: sss.method: 'blur' is not one of: none, gaussian-sum, "
+                                                    "separable, artistic, pscbf, reference, pathtraced");
     EXPECT_EQ(sssError("[sss]\nmethod = \"separable\"\nsamples = 20"),
               "scene.toml: sss.samples: 20 is even; a symmetric kernel needs an odd number of taps (3…101)");
-    EXPECT_EQ(sssError("[sss]\nmethod = \"separable\"\nsamples = 103"), "scene.toml: sss.samples: 103 is out of range [3, 101]");
+    EXPECT_EQ(sssError("[sss]\nmethod = \"separable\"\nsamples = 103"),
+              "scene.toml: sss.samples: 103 is out of range [3, 101]");
     EXPECT_EQ(sssError("[sss]\nwidth_mm = 0"), "scene.toml: sss.width_mm: 0 is out of range [0.01, 100]");
     EXPECT_EQ(sssError("[sss]\nmethod = \"separable\"\nmaterial = \"marble\""),
               "scene.toml: sss.material: 'marble' has no d'Eon profile (only 'skin'); use sss.profile = \"burley\"");
@@ -129,8 +130,8 @@ TEST(SssParams, DemoSssWidthConversion) {
     for (const View v : {View{0.012, 47.9, 20.0, 2.5, 720.0}, View{1.5, 1.0, 30.0, 300.0, 512.0},
                          View{0.05, 10.0, 45.0, 7.0, 1080.0}}) {
         const double t = std::tan(0.5 * v.fovDeg * kPi / 180.0);
-        const double demoStepUv = v.sssWidth * (1.0 / t) / v.z / 3.0;  // per kernel unit
-        const double demoEdgePixels = 3.0 * demoStepUv * v.height;     // vertical pass, offset 3
+        const double demoStepUv = v.sssWidth * (1.0 / t) / v.z / 3.0; // per kernel unit
+        const double demoEdgePixels = 3.0 * demoStepUv * v.height;    // vertical pass, offset 3
 
         SssParams params;
         params.method = SssMethod::Artistic;
@@ -168,8 +169,9 @@ TEST(SssParams, ThesisVariantKeys) {
     EXPECT_EQ(defaults.extensionInput, "albedo");
     EXPECT_EQ(defaults.curvatureMeasure, "normal");
     EXPECT_DOUBLE_EQ(defaults.curvatureReferenceMm, 20.0);
-    const SssParams p = readSss("[sss]\nmethod = \"separable\"\nextension_input = \"lit\"\ncurvature_measure = \"screen\"\n"
-                                "curvature_reference_mm = 40.0\n");
+    const SssParams p =
+        readSss("[sss]\nmethod = \"separable\"\nextension_input = \"lit\"\ncurvature_measure = \"screen\"\n"
+                "curvature_reference_mm = 40.0\n");
     EXPECT_EQ(p.extensionInput, "lit");
     EXPECT_EQ(p.curvatureMeasure, "screen");
     EXPECT_DOUBLE_EQ(p.curvatureReferenceMm, 40.0);

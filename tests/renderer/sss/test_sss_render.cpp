@@ -89,12 +89,12 @@ TEST(SssRender, EveryMethodWithEveryExtensionRendersEveryScene) {
     const std::vector<std::string> all{"sss.cbf=true", "sss.lab_weight=0.09", "sss.curvature=reduce-floor",
                                        "transmittance.enabled=true", "transmittance.curvature=true"};
     const std::vector<std::string> methods = renderer::sss::screenSpaceMethodNames();
-    std::vector<std::string> scenes{"builtin:halo-grey-backdrop", "builtin:bleed-true-mask", "builtin:ear", "builtin:head"};
+    std::vector<std::string> scenes{"builtin:halo-grey-backdrop", "builtin:bleed-true-mask", "builtin:ear",
+                                    "builtin:head"};
     const char* assets = std::getenv("SKINLAB_ASSETS");
     if (assets && *assets)
         scenes.push_back((std::filesystem::path(SKINLAB_SOURCE_DIR) / "renderer/scenes/lee-perry-smith.toml").string());
-    else
-        std::printf("  $SKINLAB_ASSETS unset: the scanned head is skipped\n");
+    else std::printf("  $SKINLAB_ASSETS unset: the scanned head is skipped\n");
     for (const auto& scene : scenes) renderEveryMethod(*renderer, scene, all, methods);
 }
 
@@ -139,14 +139,14 @@ TEST(SssRender, FollowSurfaceStopsLightCrossingTheDepthGapOfHalo) {
         // Wide kernel so that it reaches across the silhouette at this small size.
         overrides.push_back("sss.width_mm=12");
         const ExrImage none = render(*renderer, folder, "builtin:halo-grey-backdrop", "none", overrides, 96, 96);
-        overrides.push_back(std::string("sss.follow_surface=") + (follow ? "true" : "false"));  // not read by none
+        overrides.push_back(std::string("sss.follow_surface=") + (follow ? "true" : "false")); // not read by none
         const ExrImage image = render(*renderer, folder, "builtin:halo-grey-backdrop", method, overrides, 96, 96);
         float nearest = 1e30f;
         for (float z : image.channels.at("depth.Z")) nearest = std::min(nearest, z);
         double leak = 0.0;
         for (int y = 0; y < image.height; ++y)
             for (int x = 0; x < image.width; ++x)
-                if (image.at("depth.Z", x, y) > nearest + 150.0f)  // the backdrop (≥ 200 mm behind the sphere's back)
+                if (image.at("depth.Z", x, y) > nearest + 150.0f) // the backdrop (≥ 200 mm behind the sphere's back)
                     leak += std::abs(luminance(image, x, y) - luminance(none, x, y));
         return leak;
     };
@@ -155,7 +155,8 @@ TEST(SssRender, FollowSurfaceStopsLightCrossingTheDepthGapOfHalo) {
         const double on = crossing(method, true);
         EXPECT_GT(off, 0.01) << method << ": no light crossed even without follow-surface";
         EXPECT_LE(on, 0.25 * off) << method;
-        std::printf("  %-13s light crossing the gap: %.4g without follow-surface, %.4g with\n", method.c_str(), off, on);
+        std::printf("  %-13s light crossing the gap: %.4g without follow-surface, %.4g with\n", method.c_str(), off,
+                    on);
     }
 }
 
