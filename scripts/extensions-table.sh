@@ -66,7 +66,8 @@ for s in m["stimuli"]:
     if not s["reference"]: continue
     scene = s["scene"]
     if not scene.startswith("builtin:") and not os.path.isabs(scene): scene = os.path.join(sys.argv[2], scene)
-    print(s["id"], scene, "\x1f".join(o for o in s["overrides"] if not o.startswith("sss.method=")), sep="\t")' \
+    keep = [o for o in s["overrides"] if not o.startswith(("sss.method=", "sss.reference_edge_mm="))]  # reference-only keys
+    print(s["id"], scene, "\x1f".join(keep), sep="\t")' \
     "$dir/manifest.json" "$root/stimuli/specs")
 }
 
