@@ -562,7 +562,12 @@ std::optional<TrialRecord> StudyStore::nextTrial(std::int64_t participantId) {
         }
         // Active design: every stored trial answered, so the next batch is planned and stored now (before it is
         // shown). When another request of the same participant stored one meanwhile, look again.
-        if (extendActivePlan(participantId) == ActiveExtension::complete) return std::nullopt;
+        if (extendActivePlan(participantId) == ActiveExtension::complete) {
+            // The plan is complete — possibly because a concurrent request stored its last batch after the look
+            // above, so its trials may still be unanswered: look once more.
+            std::lock_guard lock(mutex_);
+            return firstUnanswered(participantId);
+        }
     }
 }
 
