@@ -35,7 +35,8 @@ else
 fi
 
 # The second reference: for every reference stimulus, the same scene and overrides rendered by `pathtraced`
-# (PATHTRACED_SAMPLES samples, default 64; no interreflection and the rasterizer's specular layer, so that it
+# (PATHTRACED_SAMPLES samples, default 64; no interreflection, the rasterizer's specular layer and the environment
+# unshadowed like the rasterizer's ambient term, so that it
 # differs from the screen-space renders in the subsurface transport only: docs/pathtraced.md), and the block's
 # stimuli scored against it in OUT_DIR/SET/metrics-pathtraced/REFERENCE_ID/. PATHTRACED=0 skips it (no Blender).
 pathtraced_references() {  # pathtraced_references SET_NAME
@@ -45,7 +46,8 @@ pathtraced_references() {  # pathtraced_references SET_NAME
     local exr="$dir/pathtraced/$id.exr" args=()
     while IFS= read -r o; do [ -n "$o" ] && args+=(--set "$o"); done <<< "${overrides//$'\x1f'/$'\n'}"
     args+=(--set 'sss.method="pathtraced"' --set "pathtraced.samples=${PATHTRACED_SAMPLES:-64}"
-           --set 'pathtraced.max_bounces=0' --set 'pathtraced.specular_source="rasterizer"')
+           --set 'pathtraced.max_bounces=0' --set 'pathtraced.specular_source="rasterizer"'
+           --set 'pathtraced.environment_shadow=false')
     local stamp; stamp="$scene ${args[*]}"
     if [ ! -e "$exr" ] || [ "$(cat "$exr.inputs" 2> /dev/null)" != "$stamp" ]; then
       "$skinlab" render --scene "$scene" "${args[@]}" -o "$exr" > /dev/null

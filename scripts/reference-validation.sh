@@ -64,6 +64,7 @@ max_bounces = 0
 sun_angle_deg = 0.0
 filter_width_px = 0.01
 specular_source = "rasterizer"
+environment_shadow = false
 EOF
 }
 

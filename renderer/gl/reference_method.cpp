@@ -261,6 +261,7 @@ void ReferenceMethod::run(const ReferenceInputs& inputs, const sss::SssParams& p
     }
     reference::ConvolutionSettings convolution;
     convolution.cutoffTail = kCutoffTail;
+    for (int c = 0; c < 3; ++c) convolution.throughGain[c] = params.referenceThroughGain[c];
     reference::ConvolutionReport report;
     const std::vector<glm::vec3> convolved =
         reference::convolveSurface(samples, radiance, *profile, convolution, nullptr, &report);

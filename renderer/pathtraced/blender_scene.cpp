@@ -73,6 +73,10 @@ std::string_view cyclesScript() {
     return *script;
 }
 
+bool rendersEnvironmentSeparately(const BlenderSceneInputs& inputs) {
+    return !inputs.params.environmentShadow && !inputs.spec->lights.empty();
+}
+
 nlohmann::json blenderSceneJson(const BlenderSceneInputs& inputs, std::string_view meshFile, std::string_view output,
                                 std::string_view record) {
     const SceneSpec& spec = *inputs.spec;
@@ -157,7 +161,7 @@ nlohmann::json blenderSceneJson(const BlenderSceneInputs& inputs, std::string_vi
     // Environment: rows of the map from a world direction d to Blender's equirectangular lookup direction D
     // (cycles_scene.py): D = M · R_y(−rotation) · d with M = [[0,0,−1],[−1,0,0],[0,1,0]].
     const EnvironmentSpec& e = spec.environment;
-    nlohmann::json world = {{"intensity", e.intensity}};
+    nlohmann::json world = {{"intensity", e.intensity}, {"shadow", p.environmentShadow}};
     if (!e.file.empty()) {
         const glm::mat3 environmentFromWorld(
             glm::rotate(glm::mat4(1.0f), static_cast<float>(-e.rotationDeg * kPi / 180.0), glm::vec3(0, 1, 0)));
@@ -173,6 +177,7 @@ nlohmann::json blenderSceneJson(const BlenderSceneInputs& inputs, std::string_vi
     if (e.background == "color") world["camera_background"] = vec3Json(e.backgroundColor);
     else if (e.file.empty()) world["camera_background"] = nullptr;
     scene["world"] = world;
+    if (rendersEnvironmentSeparately(inputs)) scene["environment_output"] = std::string(kEnvironmentOutput);
 
     const glm::mat4 viewToWorld = glm::inverse(inputs.camera.view);
     nlohmann::json matrix = nlohmann::json::array();

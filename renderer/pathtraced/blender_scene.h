@@ -42,6 +42,11 @@ double principledSpecular(double f0);
 // such as builtin:bleed's scatters like a semi-infinite slab, except for light that walks past its rim.
 bool isClosedSurface(const Model& model, const SubMesh& part);
 
+// pathtraced.environment_shadow = false with lights in the scene: Cycles renders the lights (with their shadows)
+// into the output and the unshadowed environment into `folder`/kEnvironmentOutput, and the two are summed.
+inline constexpr std::string_view kEnvironmentOutput = "cycles-environment.exr";
+bool rendersEnvironmentSeparately(const BlenderSceneInputs& inputs);
+
 // The JSON description (the geometry itself goes to `meshFile`, named relative to the JSON's folder).
 nlohmann::json blenderSceneJson(const BlenderSceneInputs& inputs, std::string_view meshFile, std::string_view output,
                                 std::string_view record);

@@ -73,7 +73,26 @@ CyclesImage renderWithCycles(const BlenderSceneInputs& inputs, float exposure) {
 
     CyclesImage image;
     const std::filesystem::path exr = folder / "cycles.exr";
-    const auto channels = readExrChannels(exr, image.width, image.height);
+    auto channels = readExrChannels(exr, image.width, image.height);
+    if (rendersEnvironmentSeparately(inputs)) {
+        // The unshadowed environment's pass: light adds (Combined and the direct / indirect passes); colours,
+        // depth and indices are the same in both passes.
+        const std::filesystem::path second = folder / kEnvironmentOutput;
+        int width = 0, height = 0;
+        const auto environment = readExrChannels(second, width, height);
+        if (width != image.width || height != image.height)
+            throw InputError(second.string() + ": " + std::to_string(width) + "x" + std::to_string(height) +
+                             ", the first pass is " + std::to_string(image.width) + "x" + std::to_string(image.height));
+        for (auto& [name, values] : channels) {
+            const bool light = name.find("Combined.") != std::string::npos || name.find("Dir.") != std::string::npos ||
+                               name.find("Ind.") != std::string::npos;
+            if (!light || name.ends_with(".A")) continue;
+            const auto found = environment.find(name);
+            if (found == environment.end())
+                throw InputError(second.string() + ": no channel '" + name + "' in the environment pass");
+            for (std::size_t p = 0; p < values.size(); ++p) values[p] += found->second[p];
+        }
+    }
     if (image.width != inputs.spec->width || image.height != inputs.spec->height)
         throw InputError(exr.string() + ": Cycles wrote " + std::to_string(image.width) + "x" +
                          std::to_string(image.height) + ", expected " + std::to_string(inputs.spec->width) + "x" +

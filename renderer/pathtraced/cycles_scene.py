@@ -357,7 +357,7 @@ def build_camera(scene, description):
     scene.camera = obj
 
 
-def render(scene, folder, output_name, record_name):
+def render_to(scene, folder, output_name):
     output = os.path.join(folder, output_name)
     scene.render.filepath = output
     start = time.time()
@@ -365,9 +365,40 @@ def render(scene, folder, output_name, record_name):
     seconds = time.time() - start
     if not os.path.isfile(output):
         fail("Cycles wrote no image to " + output)
-    record = {"blender_version": bpy.app.version_string, "render_seconds": seconds}
+    return seconds
+
+
+def write_record(folder, record_name, seconds, passes=1):
+    record = {"blender_version": bpy.app.version_string, "render_seconds": seconds, "passes": passes}
     with open(os.path.join(folder, record_name), "w") as handle:
         json.dump(record, handle)
+
+
+def render(scene, folder, output_name, record_name):
+    write_record(folder, record_name, render_to(scene, folder, output_name))
+
+
+def world_strengths(scene, factor):
+    # Scales the Strength of every Background node of the world (lighting and what the camera sees).
+    for node in scene.world.node_tree.nodes:
+        if node.bl_idname == "ShaderNodeBackground":
+            node.inputs["Strength"].default_value *= factor
+
+
+def unshadowed_environment(scene):
+    # The environment's light reaches every point as if nothing occluded it, and no light but the environment is
+    # left (their shadows are rendered in the other pass). Objects are seen by camera rays only: neither shadow
+    # rays nor the BSDF-sampled rays that multiple importance sampling combines with them stop at an object.
+    # (The random walk inside an object intersects only that object and ignores ray visibility.)
+    for obj in scene.collection.objects:
+        if obj.type == "LIGHT":
+            obj.hide_render = True
+        elif obj.type == "MESH":
+            obj.visible_shadow = False
+            obj.visible_diffuse = False
+            obj.visible_glossy = False
+            obj.visible_transmission = False
+            obj.visible_volume_scatter = False
 
 
 def render_scene(path):
@@ -388,7 +419,24 @@ def render_scene(path):
     build_lights(scene, description["lights"])
     build_world(scene, description["world"])
     build_camera(scene, description["camera"])
-    render(scene, folder, description["output"], description["record"])
+    if description["world"].get("shadow", True):
+        render(scene, folder, description["output"], description["record"])
+    elif description.get("environment_output"):
+        # Two passes, summed by skinlab: the lights with their shadows (the world dark), then the environment
+        # unshadowed without the lights.
+        strengths = [n.inputs["Strength"].default_value for n in scene.world.node_tree.nodes
+                     if n.bl_idname == "ShaderNodeBackground"]
+        world_strengths(scene, 0.0)
+        seconds = render_to(scene, folder, description["output"])
+        backgrounds = [n for n in scene.world.node_tree.nodes if n.bl_idname == "ShaderNodeBackground"]
+        for node, strength in zip(backgrounds, strengths):
+            node.inputs["Strength"].default_value = strength
+        unshadowed_environment(scene)
+        seconds += render_to(scene, folder, description["environment_output"])
+        write_record(folder, description["record"], seconds, passes=2)
+    else:
+        unshadowed_environment(scene)
+        render(scene, folder, description["output"], description["record"])
 
 
 def box(name, low, high):

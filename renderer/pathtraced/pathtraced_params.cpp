@@ -24,6 +24,7 @@ PathtracedParams readTable(const SpecReader& t) {
     if (p.specularSource != "cycles" && p.specularSource != "rasterizer")
         t.fail("specular_source", "'" + p.specularSource + "' is not one of \"cycles\", \"rasterizer\"");
     p.radiusMm = t.vec3("radius_mm", p.radiusMm, 1e-4, 1000.0);
+    p.environmentShadow = t.boolean("environment_shadow", p.environmentShadow);
     p.sunAngleDeg = t.number("sun_angle_deg", p.sunAngleDeg, 0.0, 90.0);
     p.filterWidthPx = t.number("filter_width_px", p.filterWidthPx, 0.01, 10.0);
     p.threads = static_cast<int>(t.integer("threads", p.threads, 0, 1024));
@@ -34,17 +35,12 @@ PathtracedParams readTable(const SpecReader& t) {
 } // namespace
 
 nlohmann::json PathtracedParams::toJson() const {
-    return {{"samples", samples},
-            {"seed", seed},
-            {"max_bounces", maxBounces},
-            {"sss", sss},
-            {"specular", specular},
-            {"specular_source", specularSource},
-            {"radius_mm", radiusMm},
-            {"sun_angle_deg", sunAngleDeg},
-            {"filter_width_px", filterWidthPx},
-            {"threads", threads},
-            {"blender", blender}};
+    return {{"samples", samples},           {"seed", seed},
+            {"max_bounces", maxBounces},    {"sss", sss},
+            {"specular", specular},         {"specular_source", specularSource},
+            {"radius_mm", radiusMm},        {"environment_shadow", environmentShadow},
+            {"sun_angle_deg", sunAngleDeg}, {"filter_width_px", filterWidthPx},
+            {"threads", threads},           {"blender", blender}};
 }
 
 PathtracedParams readPathtracedParams(const SpecReader& scene) {

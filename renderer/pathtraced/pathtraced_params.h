@@ -31,6 +31,10 @@ struct PathtracedParams {
     // Random-walk radii per channel (mm) at the profile's own scale; scaled by sss.width_mm / 3 like every
     // screen-space kernel, then divided by mm_per_unit (Cycles takes them in scene units).
     std::array<double, 3> radiusMm = fittedRadiusMm();
+    // false: the environment lights every point as if nothing occluded it (objects cast no shadow on its light;
+    // lights keep theirs), as the rasterizer's SH ambient term does: Cycles then renders the lights and the
+    // environment in two passes and sums them. true: the environment is shadowed like any light.
+    bool environmentShadow = true;
     double sunAngleDeg = 0.0;        // angular diameter of directional lights (0: a hard sun, as the shadow map)
     double filterWidthPx = 0.01;     // pixel filter width; 0.01 point-samples the pixel centre like the rasterizer
     int threads = 0;                 // Cycles threads (0: all cores); pixels do not depend on it

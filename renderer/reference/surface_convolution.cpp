@@ -82,7 +82,7 @@ std::vector<glm::vec3> convolveSurface(const SurfaceSamples& samples, const std:
             }
             const glm::vec3 value = irradiance[q] * samples.albedo[q];
             for (int c = 0; c < 3; ++c) {
-                weighted[c] += k[c] * value[c];
+                weighted[c] += (facing ? k[c] : k[c] * settings.throughGain[c]) * value[c];
                 if (facing) weightSum[c] += k[c];
             }
             ++sources;

@@ -42,7 +42,11 @@ inline constexpr float kAirGapSine = 0.17364818f; // sin 10°
 struct ConvolutionSettings {
     Transport transport = Transport::ThroughTissue;
     double cutoffTail = 1e-3; // share of each channel's energy allowed outside the cutoff radius
-    unsigned threads = 0;     // worker threads; 0: std::thread::hardware_concurrency()
+    // ThroughTissue: per-channel gain on the sources facing away from the receiver (a thin part's far side), whose
+    // light the reflectance profile at the 3-D distance under-estimates against a path tracer (calibration:
+    // docs/extensions.md). Does not enter the normaliser. 1: the profile as it is.
+    std::array<double, 3> throughGain{1.0, 1.0, 1.0};
+    unsigned threads = 0; // worker threads; 0: std::thread::hardware_concurrency()
 };
 
 struct ConvolutionReport {

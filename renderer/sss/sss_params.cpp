@@ -45,7 +45,7 @@ const std::vector<MethodInfo> kMethods{
      false,
      false,
      "object-space SSS on the tessellated surface (the ground truth of the metrics)",
-     {"profile", "material", "reference_edge_mm"}},
+     {"profile", "material", "reference_edge_mm", "reference_through_gain"}},
     {SssMethod::Pathtraced, "pathtraced", false, false, "Blender Cycles' random-walk SSS ([pathtraced] table)", {}},
 };
 #undef SKINLAB_BLUR_KEYS
@@ -129,6 +129,7 @@ SssParams readSssTable(const SpecReader& sss) {
     p.pscbfSigma = sss.choice("pscbf_sigma", "variance", kPscbfSigmaNames) == "std-dev" ? PscbfSigma::StdDev
                                                                                         : PscbfSigma::Variance;
     p.referenceEdgeMm = sss.number("reference_edge_mm", p.referenceEdgeMm, 0.05, 50.0);
+    p.referenceThroughGain = sss.vec3("reference_through_gain", p.referenceThroughGain, 0.0, 100.0);
     return p;
 }
 
@@ -226,7 +227,8 @@ nlohmann::json SssParams::toJson() const {
                                 {"curvature_measure", curvatureMeasure},
                                 {"curvature_reference_mm", curvatureReferenceMm},
                                 {"pscbf_sigma", std::string(pscbfSigmaName(pscbfSigma))},
-                                {"reference_edge_mm", referenceEdgeMm}};
+                                {"reference_edge_mm", referenceEdgeMm},
+                                {"reference_through_gain", referenceThroughGain}};
     nlohmann::json own = nlohmann::json::object();
     for (const auto& [key, value] : all.items())
         if (methodUsesKey(method, key)) own[key] = value;

@@ -133,6 +133,11 @@ struct SssParams {
     PscbfSigma pscbfSigma = PscbfSigma::Variance;
     // reference method: longest skin edge (mm) after tessellation; irradiance is sampled at the vertices.
     double referenceEdgeMm = 1.0;
+    // reference method: per-channel gain on the light that reaches a receiver from the far side of a thin part
+    // (sources whose normal faces away from the receiver's). 1: the reflectance profile at the 3-D distance
+    // through the part, as it is. Default: fitted to Blender Cycles' random walk on 1 and 2 mm skin fins
+    // (scripts/transmittance-calibration.sh; docs/pathtraced.md, "Through-light: calibration").
+    std::array<double, 3> referenceThroughGain{1.72, 5.31, 9.44};
 
     // The resolved record: the method and the keys it reads (its row of the method table), nothing else.
     nlohmann::json toJson() const;

@@ -191,6 +191,76 @@ TEST(PathtracedRender, UniformlyLitSlabHasTheExpectedEnergy) {
     }
 }
 
+TEST(PathtracedRender, EnvironmentShadowOffLightsLikeTheRasterizersAmbient) {
+    // A floor with a 60 mm wall standing on it, a grey constant environment and a weak light straight down (the
+    // wall casts no shadow of it on the floor seen). The rasterizer's ambient term has no occlusion: the floor next
+    // to the wall is as bright as far from it. Cycles with the environment shadowed darkens the floor next to the
+    // wall (the wall hides up to half its sky); with pathtraced.environment_shadow = false (two passes, summed)
+    // it does not, like the rasterizer.
+    SKINLAB_REQUIRE_BLENDER();
+    SKINLAB_REQUIRE_RENDERER(renderer);
+    TempFolder folder("pathtraced-environment-shadow");
+    {
+        std::ofstream obj(folder / "wall.obj");
+        const auto box = [&obj](int base, double x0, double x1, double y0, double y1, double z0, double z1) {
+            for (double z : {z0, z1})
+                for (auto [x, y] : {std::pair{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}})
+                    obj << "v " << x << " " << y << " " << z << "\n";
+            const int f[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+            for (const auto& q : f) {
+                obj << "f " << base + q[0] << " " << base + q[1] << " " << base + q[2] << "\n";
+                obj << "f " << base + q[0] << " " << base + q[2] << " " << base + q[3] << "\n";
+            }
+        };
+        box(1, -300.0, 100.0, -150.0, 150.0, -20.0, 0.0); // the floor, top face z = 0
+        box(9, 0.0, 10.0, -150.0, 150.0, 0.0, 60.0);      // the wall
+        std::ofstream toml(folder / "wall.toml");
+        toml << "mm_per_unit = 1.0\n[model]\nsource = \"wall.obj\"\n"
+                "[[materials]]\nname = \"*\"\nalbedo = [0.5, 0.5, 0.5]\nskin = true\n"
+                "[camera]\nview = \"explicit\"\nposition = [-45.0, 0.0, 400.0]\ntarget = [-45.0, 0.0, 0.0]\n"
+                "fov_deg = 20.0\n"
+                "[[lights]]\ntype = \"directional\"\ndirection = [0.0, 0.0, -1.0]\nintensity = 0.1\nshadow = true\n"
+                "[environment]\nradiance = [0.5, 0.5, 0.5]\nbackground = \"color\"\n";
+    }
+    const std::string scene = (folder / "wall.toml").string();
+    const std::vector<std::string> cycles = {"pathtraced.samples=16", "pathtraced.sss=false",
+                                             "pathtraced.specular=false", "pathtraced.max_bounces=0"};
+    auto open = cycles;
+    open.push_back("pathtraced.environment_shadow=false");
+    renderToExr(*renderer, scene, "pathtraced", cycles, 64, 64, folder / "shadowed.exr");
+    renderToExr(*renderer, scene, "pathtraced", open, 64, 64, folder / "open.exr");
+    renderToExr(*renderer, scene, "none", {}, 64, 64, folder / "raster.exr");
+    // Floor columns by x (mm): the camera sees x in [-115.5, 25.5] over 64 columns (2.2 mm each).
+    const auto columnOf = [](double x) { return static_cast<int>((x + 45.0 + 70.53) / 141.06 * 64.0); };
+    const auto regionMean = [&](const ExrImage& image, double x0, double x1) {
+        double sum = 0.0;
+        int n = 0;
+        for (int y = 16; y < 48; ++y)
+            for (int x = columnOf(x0); x <= columnOf(x1); ++x) sum += image.at("diffuse.G", x, y), ++n;
+        return sum / n;
+    };
+    struct Figures {
+        double near, far;
+    };
+    const auto figures = [&](const char* file) {
+        const ExrImage image = readExr(folder / file);
+        return Figures{regionMean(image, -9.0, -3.0), regionMean(image, -110.0, -80.0)};
+    };
+    const Figures shadowed = figures("shadowed.exr"), unshadowed = figures("open.exr"), raster = figures("raster.exr");
+    std::printf("floor near the wall / far from it: rasterizer %.4f / %.4f, Cycles shadowed %.4f / %.4f, Cycles "
+                "environment_shadow=false %.4f / %.4f\n",
+                raster.near, raster.far, shadowed.near, shadowed.far, unshadowed.near, unshadowed.far);
+    // Expected far from the wall: albedo × (light 0.1 + environment 0.5) = 0.30 (the rasterizer exactly; Cycles'
+    // Principled diffuse is Burley's, within a few per cent of Lambert's under a uniform sky).
+    EXPECT_NEAR(raster.far, 0.30, 0.01);
+    EXPECT_NEAR(raster.near / raster.far, 1.0, 0.02);
+    EXPECT_NEAR(unshadowed.far / raster.far, 1.0, 0.08);
+    EXPECT_NEAR(unshadowed.near / unshadowed.far, 1.0, 0.06); // the unshadowed environment: no darkening
+    EXPECT_LT(shadowed.near / shadowed.far, 0.85);            // shadowed: the wall hides sky
+    // The light's pass is in the sum: without it the floor would be albedo × 0.5 = 0.25.
+    EXPECT_GT(unshadowed.far, 0.27);
+}
+
 TEST(PathtracedRender, SameInputsGiveTheSameImage) {
     SKINLAB_REQUIRE_BLENDER();
     SKINLAB_REQUIRE_RENDERER(renderer);

@@ -95,6 +95,24 @@ TEST(PathtracedParams, SpecularSourceRasterizerRendersNoCyclesSpecular) {
     EXPECT_NE(bad.find("glossy"), std::string::npos) << bad;
 }
 
+TEST(PathtracedParams, EnvironmentShadowOffRendersTheEnvironmentInItsOwnPass) {
+    // Default: the environment is shadowed like any light, one pass. false: with lights, a second output for the
+    // unshadowed environment; without lights, one pass (cycles_scene.py turns the shadows off in it).
+    const Exported shadowed = exportScene("builtin:halo", {});
+    EXPECT_TRUE(shadowed.json.at("world").at("shadow").get<bool>());
+    EXPECT_FALSE(shadowed.json.contains("environment_output"));
+    const Exported open = exportScene("builtin:halo", {"pathtraced.environment_shadow=false"});
+    EXPECT_EQ(open.spec.resolved.at("pathtraced").at("environment_shadow"), false);
+    EXPECT_FALSE(open.json.at("world").at("shadow").get<bool>());
+    ASSERT_FALSE(open.spec.lights.empty());
+    EXPECT_EQ(open.json.at("environment_output"), std::string(kEnvironmentOutput));
+    const Exported dark = exportScene("builtin:halo", {"pathtraced.environment_shadow=false", "lights=[]"});
+    EXPECT_TRUE(dark.spec.lights.empty());
+    EXPECT_FALSE(dark.json.contains("environment_output"));
+    const std::string bad = errorOf([] { loadSceneSpec("builtin:halo", {"pathtraced.environment_shadow=2"}, {}); });
+    EXPECT_NE(bad.find("pathtraced.environment_shadow"), std::string::npos) << bad;
+}
+
 TEST(BlenderScene, LightsInBlenderUnits) {
     // builtin:head: a spot (intensity 1.6, colour [1, 0.95, 0.88]) and a directional light (0.25, [0.85, 0.9, 1]).
     const SceneSpec spec = loadSceneSpec("builtin:head", {"sss.method=\"pathtraced\""}, {});

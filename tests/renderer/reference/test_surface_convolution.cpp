@@ -278,6 +278,16 @@ TEST(SurfaceConvolution, ThroughTissueKeepsThinPartsBrightAndCarriesTheirThrough
     // Red, the widest lobe, carries the most light through 2 mm; the difference is large enough to matter.
     EXPECT_GT(newBack[front][0], 0.05);
     EXPECT_GT(newBack[front][0], newBack[front][2]);
+    // The through-light gain scales exactly the light from the far side: back-lit, the front receives g·T;
+    // front-lit, nothing changes (the far side is dark and the normaliser holds only the near side).
+    ConvolutionSettings gained;
+    gained.throughGain = {1.8, 3.0, 0.5};
+    const auto gainedBack = convolveSurface(slab, backLit, *profile, gained);
+    const auto gainedFront = convolveSurface(slab, frontLit, *profile, gained);
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(gainedBack[front][c], gained.throughGain[c] * newBack[front][c], 1e-5) << c;
+        EXPECT_NEAR(gainedFront[front][c], 1.0, 1e-5) << c;
+    }
 }
 
 TEST(SurfaceConvolution, ThroughTissueStopsLightAcrossAnAirGap) {
