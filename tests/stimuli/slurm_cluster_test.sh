@@ -8,8 +8,8 @@
 #     another one's renderer is killed midway (SIGKILL, as on a crash): the requeued task resumes its shard, the killed one
 #     is reported failed with its log, is resubmitted alone (`--only-shard`), and the merged set again equals the
 #     local build, with no temporary file left anywhere.
-# Usage: slurm_cluster_test.sh SKINLAB_CLI SOURCE_DIR. Exits 77 (skipped) when Slurm, munge or jq is missing, or no
-# EGL renderer works; it needs to run as root (CI) or as a user allowed to start the daemons.
+# Usage: slurm_cluster_test.sh SKINLAB_CLI SOURCE_DIR. Exits 77 (skipped) when Slurm, munge or jq is missing, no
+# cgroup filesystem is mounted, or no EGL renderer works; it needs to run as root (CI) or as a user allowed to start the daemons.
 set -euo pipefail
 
 SKINLAB="$1"
@@ -25,6 +25,10 @@ for tool in munged slurmctld slurmd sbatch squeue scontrol sinfo scancel; do
 done
 command -v jq >/dev/null || skip "jq not found: install jq (scripts/install-deps.sh)"
 [ "$(id -u)" = 0 ] || skip "slurmd must run as root to start jobs (CI runs this test as root)"
+# Slurm 22.05's slurmd initialises its cgroup plugin even with proctrack/linuxproc and task/none, and fails to start
+# without a cgroup filesystem (e.g. a chroot whose /sys was bind-mounted without its submounts).
+awk '$2 == "/sys/fs/cgroup" { found = 1 } END { exit !found }' /proc/mounts ||
+  skip "no cgroup filesystem at /sys/fs/cgroup, which slurmd needs (in a chroot: mount --rbind /sys)"
 
 source "$SOURCE_DIR/tests/stimuli/slurm_cluster.sh"
 
