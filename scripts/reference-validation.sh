@@ -6,7 +6,9 @@
 #   - the 24 screen-space conditions of the evaluation table (gaussian-sum, separable, artistic, pscbf × none,
 #     follow-surface, +cbf, +lab_weight, +curvature reduce-floor, all) and the `reference` render (2 mm edges) as a
 #     stimulus set;
-#   - `pathtraced` twice, with seeds 0 and 1 (the second measures the path tracer's own noise on every score);
+#   - `pathtraced` twice, with seeds 0 and 1 (the second measures the path tracer's own noise on every score), with
+#     no interreflection, the rasterizer's specular layer and the environment unshadowed (as the rasterizer's
+#     ambient term), so that the two references differ in the subsurface transport only;
 # and scores, with `skinlab analyze metrics` (the bands of docs/metrics.md, from each reference's depth and mask):
 #   - every condition against `reference` and against `pathtraced`;
 #   - `reference` against `pathtraced` (the per-band disagreement), and `pathtraced` seed 1 against seed 0 (noise).
