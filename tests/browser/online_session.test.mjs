@@ -13,53 +13,24 @@ import http from 'node:http';
 import os from 'node:os';
 import path from 'node:path';
 import readline from 'node:readline';
-import zlib from 'node:zlib';
 import { fileURLToPath } from 'node:url';
+import { encodePng, CHROMIUM, FLAGS, loadPlaywright } from './study_fixture.mjs';
 
-const SKIP = 77;
 const here = path.dirname(fileURLToPath(import.meta.url));
 const cli = process.argv[2];
-const CHROMIUM = '/usr/bin/chromium';
 if (!cli || !fs.existsSync(cli)) { console.error('usage: node online_session.test.mjs SKINLAB_CLI'); process.exit(1); }
-if (!fs.existsSync(CHROMIUM)) { console.log('SKIP: /usr/bin/chromium not installed'); process.exit(SKIP); }
-let chromium;
-try {
-  ({ chromium } = await import(path.join(here, 'node_modules/playwright-core/index.mjs')));
-} catch (e) {
-  console.log('SKIP: playwright-core not installed (run npm install in tests/browser)');
-  process.exit(SKIP);
-}
+const chromium = await loadPlaywright(here);
 
-const FLAGS = ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
-  '--disable-component-update', '--disable-sync'];
 let failures = 0;
 function check(condition, message) {
   if (!condition) { failures++; console.error('FAIL: ' + message); }
 }
 
 // --- a tiny stimulus set: one block, three methods, flat colours ---
-function crc32(buffer) {
-  let c = 0xffffffff;
-  for (const b of buffer) {
-    c ^= b;
-    for (let k = 0; k < 8; k++) c = c & 1 ? 0xedb88320 ^ (c >>> 1) : c >>> 1;
-  }
-  return (c ^ 0xffffffff) >>> 0;
-}
-function chunk(type, data) {
-  const length = Buffer.alloc(4); length.writeUInt32BE(data.length);
-  const body = Buffer.concat([Buffer.from(type, 'ascii'), data]);
-  const crc = Buffer.alloc(4); crc.writeUInt32BE(crc32(body));
-  return Buffer.concat([length, body, crc]);
-}
 function solidPng(width, height, rgb) {
-  const header = Buffer.alloc(13);
-  header.writeUInt32BE(width, 0); header.writeUInt32BE(height, 4);
-  header[8] = 8; header[9] = 2;
-  const raw = Buffer.alloc((width * 3 + 1) * height);
-  for (let y = 0; y < height; y++) for (let x = 0; x < width; x++) rgb.forEach((v, k) => { raw[y * (width * 3 + 1) + 1 + x * 3 + k] = v; });
-  return Buffer.concat([Buffer.from([137, 80, 78, 71, 13, 10, 26, 10]), chunk('IHDR', header),
-    chunk('IDAT', zlib.deflateSync(raw)), chunk('IEND', Buffer.alloc(0))]);
+  const pixels = Buffer.alloc(width * height * 3);
+  for (let i = 0; i < width * height; i++) rgb.forEach((v, k) => { pixels[i * 3 + k] = v; });
+  return encodePng(width, height, pixels);
 }
 
 const work = fs.mkdtempSync(path.join(os.tmpdir(), 'skinlab-online-'));

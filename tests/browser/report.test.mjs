@@ -9,23 +9,13 @@ import os from 'node:os';
 import path from 'node:path';
 import readline from 'node:readline';
 import { fileURLToPath } from 'node:url';
+import { CHROMIUM, FLAGS, loadPlaywright } from './study_fixture.mjs';
 
-const SKIP = 77;
 const here = path.dirname(fileURLToPath(import.meta.url));
 const cli = process.argv[2];
 const screenshotCopy = process.argv[3];
-const CHROMIUM = '/usr/bin/chromium';
 if (!cli || !fs.existsSync(cli)) { console.error('usage: node report.test.mjs SKINLAB_CLI'); process.exit(1); }
-if (!fs.existsSync(CHROMIUM)) { console.log('SKIP: /usr/bin/chromium not installed'); process.exit(SKIP); }
-let chromium;
-try {
-  ({ chromium } = await import(path.join(here, 'node_modules/playwright-core/index.mjs')));
-} catch (e) {
-  console.log('SKIP: playwright-core not installed (run npm install in tests/browser)');
-  process.exit(SKIP);
-}
-const FLAGS = ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
-  '--disable-component-update', '--disable-sync'];
+const chromium = await loadPlaywright(here);
 let failures = 0;
 function check(condition, message) {
   if (!condition) { failures++; console.error('FAIL: ' + message); }

@@ -41,7 +41,8 @@ function chunk(type, data) {
   const crc = Buffer.alloc(4); crc.writeUInt32BE(crc32(body));
   return Buffer.concat([length, body, crc]);
 }
-function encodePng(width, height, rgb) {
+// 8-bit RGB PNG of `rgb` (width × height × 3 bytes, rows top first).
+export function encodePng(width, height, rgb) {
   const header = Buffer.alloc(13);
   header.writeUInt32BE(width, 0); header.writeUInt32BE(height, 4);
   header[8] = 8; header[9] = 2;

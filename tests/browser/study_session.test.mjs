@@ -13,55 +13,20 @@ import path from 'node:path';
 import readline from 'node:readline';
 import zlib from 'node:zlib';
 import { fileURLToPath } from 'node:url';
+import { encodePng, CHROMIUM, FLAGS, loadPlaywright } from './study_fixture.mjs';
 
-const SKIP = 77;
 const here = path.dirname(fileURLToPath(import.meta.url));
 const cli = process.argv[2];
 const active = process.argv[3] === 'active';
-const CHROMIUM = '/usr/bin/chromium';
 if (!cli || !fs.existsSync(cli)) { console.error('usage: node study_session.test.mjs SKINLAB_CLI'); process.exit(1); }
-if (!fs.existsSync(CHROMIUM)) { console.log('SKIP: /usr/bin/chromium not installed'); process.exit(SKIP); }
-let chromium;
-try {
-  ({ chromium } = await import(path.join(here, 'node_modules/playwright-core/index.mjs')));
-} catch (e) {
-  console.log('SKIP: playwright-core not installed (run npm install in tests/browser)');
-  process.exit(SKIP);
-}
+const chromium = await loadPlaywright(here);
 
-const FLAGS = ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
-  '--disable-component-update', '--disable-sync'];
 let failures = 0;
 function check(condition, message) {
   if (!condition) { failures++; console.error('FAIL: ' + message); }
 }
 
-// --- PNG writing and reading (8-bit RGB/RGBA, no interlace) ---
-const crcTable = Array.from({ length: 256 }, (_, n) => {
-  let c = n;
-  for (let k = 0; k < 8; k++) c = c & 1 ? 0xedb88320 ^ (c >>> 1) : c >>> 1;
-  return c >>> 0;
-});
-function crc32(buffer) {
-  let c = 0xffffffff;
-  for (const b of buffer) c = crcTable[(c ^ b) & 0xff] ^ (c >>> 8);
-  return (c ^ 0xffffffff) >>> 0;
-}
-function chunk(type, data) {
-  const length = Buffer.alloc(4); length.writeUInt32BE(data.length);
-  const body = Buffer.concat([Buffer.from(type, 'ascii'), data]);
-  const crc = Buffer.alloc(4); crc.writeUInt32BE(crc32(body));
-  return Buffer.concat([length, body, crc]);
-}
-function encodePng(width, height, rgb) {
-  const header = Buffer.alloc(13);
-  header.writeUInt32BE(width, 0); header.writeUInt32BE(height, 4);
-  header[8] = 8; header[9] = 2; // 8-bit RGB
-  const raw = Buffer.alloc((width * 3 + 1) * height);
-  for (let y = 0; y < height; y++) rgb.copy(raw, y * (width * 3 + 1) + 1, y * width * 3, (y + 1) * width * 3);
-  return Buffer.concat([Buffer.from([137, 80, 78, 71, 13, 10, 26, 10]), chunk('IHDR', header),
-    chunk('IDAT', zlib.deflateSync(raw)), chunk('IEND', Buffer.alloc(0))]);
-}
+// --- PNG reading (8-bit RGB/RGBA, no interlace; writing: study_fixture.mjs) ---
 function decodePng(buffer) {
   let offset = 8, width = 0, height = 0, colourType = 0;
   const idat = [];
