@@ -43,32 +43,7 @@ if [[ " $cases " == *" scan "* ]] && { [ -z "${SKINLAB_ASSETS:-}" ] || [ ! -e "$
   cases="${cases/scan/}"
 fi
 
-# Settings shared by every scene: the SSS width, and the path tracer set to agree with the rasterizer everywhere
-# but in the subsurface transport: no interreflection, a hard sun, pixel-centre sampling, and the rasterizer's
-# specular layer (docs/pathtraced.md, "Rasterizer and Cycles").
-common_tail() {
-  cat <<EOF
-
-[render]
-width = $size
-height = $size
-exposure_ev = 0.0
-
-[tone_map]
-operator = "filmic"
-
-[sss]
-width_mm = 3.0
-
-[pathtraced]
-samples = $samples
-max_bounces = 0
-sun_angle_deg = 0.0
-filter_width_px = 0.01
-specular_source = "rasterizer"
-environment_shadow = false
-EOF
-}
+source "$root/scripts/lib/validation-scenes.sh"  # common_tail, ear_scene
 
 # halo_scene GAP: builtin:halo with the backdrop made skin (as renderer/scenes/evaluation/halo-skin-backdrop.toml).
 halo_scene() {
@@ -164,50 +139,6 @@ radiance = [0.1, 0.1, 0.1]
 intensity = 1.0
 background = "color"
 background_color = [0.02, 0.02, 0.02]
-EOF
-  common_tail
-}
-
-ear_scene() {
-  cat <<EOF
-mm_per_unit = 1.0
-
-[model]
-source = "builtin:ear"
-thickness_mm = 2.5
-
-[[materials]]
-name = "skin"
-albedo = [0.60, 0.42, 0.34]
-skin = true
-glossiness = 0.6
-specular_intensity = 1.0
-
-[camera]
-view = "mid"
-fov_deg = 30.0
-yaw_deg = 0.0
-pitch_deg = 0.0
-
-[[lights]]
-type = "directional"
-direction = [0.15, -0.2, 0.97]
-color = [1.0, 0.95, 0.88]
-intensity = 3.0
-shadow = true
-
-[[lights]]
-type = "directional"
-direction = [-0.3, -0.3, -0.9]
-color = [1.0, 1.0, 1.0]
-intensity = 0.15
-shadow = false
-
-[environment]
-radiance = [0.03, 0.03, 0.035]
-intensity = 1.0
-background = "color"
-background_color = [0.01, 0.01, 0.01]
 EOF
   common_tail
 }
@@ -370,7 +301,7 @@ for name in $cases; do
     halo-5) halo_scene 5.0 > "$dir/test.toml"; cp "$dir/test.toml" "$dir/ref.toml" ;;
     halo-200) halo_scene 200.0 > "$dir/test.toml"; cp "$dir/test.toml" "$dir/ref.toml" ;;
     bleed) bleed_scene true > "$dir/test.toml"; bleed_scene false > "$dir/ref.toml" ;;
-    ear) ear_scene > "$dir/test.toml"; cp "$dir/test.toml" "$dir/ref.toml" ;;
+    ear) ear_scene 2.5 > "$dir/test.toml"; cp "$dir/test.toml" "$dir/ref.toml" ;;
     head) head_scene > "$dir/test.toml"; cp "$dir/test.toml" "$dir/ref.toml" ;;
     scan) scan_scene > "$dir/test.toml"; cp "$dir/test.toml" "$dir/ref.toml" ;;
     *) echo "reference-validation: unknown case '$name' in CASES (halo-5 halo-200 bleed ear head scan)" >&2; exit 2 ;;

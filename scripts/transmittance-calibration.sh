@@ -23,67 +23,7 @@ for program in oiiotool python3 blender; do
 done
 mkdir -p "$out"
 
-ear_scene() {  # ear_scene THICKNESS_MM
-  cat <<EOF
-mm_per_unit = 1.0
-
-[model]
-source = "builtin:ear"
-thickness_mm = $1
-
-[[materials]]
-name = "skin"
-albedo = [0.60, 0.42, 0.34]
-skin = true
-glossiness = 0.6
-specular_intensity = 1.0
-
-[camera]
-view = "mid"
-fov_deg = 30.0
-yaw_deg = 0.0
-pitch_deg = 0.0
-
-[[lights]]
-type = "directional"
-direction = [0.15, -0.2, 0.97]
-color = [1.0, 0.95, 0.88]
-intensity = 3.0
-shadow = true
-
-[[lights]]
-type = "directional"
-direction = [-0.3, -0.3, -0.9]
-color = [1.0, 1.0, 1.0]
-intensity = 0.15
-shadow = false
-
-[environment]
-radiance = [0.03, 0.03, 0.035]
-intensity = 1.0
-background = "color"
-background_color = [0.01, 0.01, 0.01]
-
-[render]
-width = $size
-height = $size
-exposure_ev = 0.0
-
-[tone_map]
-operator = "filmic"
-
-[sss]
-width_mm = 3.0
-
-[pathtraced]
-samples = $samples
-max_bounces = 0
-sun_angle_deg = 0.0
-filter_width_px = 0.01
-specular_source = "rasterizer"
-environment_shadow = false
-EOF
-}
+source "$root/scripts/lib/validation-scenes.sh"  # ear_scene (with common_tail)
 
 # Mask-weighted mean skin diffuse: Σ diffuse · mask.Y / Σ mask.Y, by oiiotool.
 skin_mean() {
