@@ -378,13 +378,6 @@ def render(scene, folder, output_name, record_name):
     write_record(folder, record_name, render_to(scene, folder, output_name))
 
 
-def world_strengths(scene, factor):
-    # Scales the Strength of every Background node of the world (lighting and what the camera sees).
-    for node in scene.world.node_tree.nodes:
-        if node.bl_idname == "ShaderNodeBackground":
-            node.inputs["Strength"].default_value *= factor
-
-
 def unshadowed_environment(scene):
     # The environment's light reaches every point as if nothing occluded it, and no light but the environment is
     # left (their shadows are rendered in the other pass). Objects are seen by camera rays only: neither shadow
@@ -424,13 +417,15 @@ def render_scene(path):
     elif description.get("environment_output"):
         # Two passes, summed by skinlab: the lights with their shadows (the world dark), then the environment
         # unshadowed without the lights.
-        strengths = [n.inputs["Strength"].default_value for n in scene.world.node_tree.nodes
-                     if n.bl_idname == "ShaderNodeBackground"]
-        world_strengths(scene, 0.0)
+        # Every Background node of the world (what lights the scene and what the camera sees) dark, then restored.
+        backgrounds = [node.inputs["Strength"] for node in scene.world.node_tree.nodes
+                       if node.bl_idname == "ShaderNodeBackground"]
+        strengths = [strength.default_value for strength in backgrounds]
+        for strength in backgrounds:
+            strength.default_value = 0.0
         seconds = render_to(scene, folder, description["output"])
-        backgrounds = [n for n in scene.world.node_tree.nodes if n.bl_idname == "ShaderNodeBackground"]
-        for node, strength in zip(backgrounds, strengths):
-            node.inputs["Strength"].default_value = strength
+        for strength, value in zip(backgrounds, strengths):
+            strength.default_value = value
         unshadowed_environment(scene)
         seconds += render_to(scene, folder, description["environment_output"])
         write_record(folder, description["record"], seconds, passes=2)
