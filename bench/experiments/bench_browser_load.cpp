@@ -14,7 +14,7 @@
 //          [--chunked-floods N] [--kill-at F1,F2] [--image-kib K] [--folder DIR] [--server PATH]
 // Prints a summary (Markdown rows for docs/benchmarks.md).
 #include "common/files.h"
-#include "common/hash.h"
+#include "bench_stimulus_set.h"
 #include "experiments/study_creation.h"
 #include "experiments/study_store.h"
 
@@ -70,24 +70,12 @@ struct Options {
 // Five conditions in one block: 10 pairs × 2 repetitions + 2 catch = 22 answers per participant; images are random
 // bytes of the given size (the server does not decode them; a 1280×720 PNG is about 1 MiB).
 void writeSet(const fs::path& folder, int imageKiB) {
-    fs::create_directories(folder / "png");
-    json manifest{{"format", "skinlab-stimuli"}, {"version", 1}, {"set", "bench"}, {"stimuli", json::array()}};
     std::mt19937 random(1);
-    for (int m = 0; m < 5; ++m) {
-        const std::string id = "c" + std::to_string(m);
+    skinlab::bench::writeBenchStimulusSet(folder, 5, 1280, 720, [&](const std::string&) {
         std::string bytes(static_cast<std::size_t>(imageKiB) * 1024, '\0');
         for (char& c : bytes) c = static_cast<char>(random());
-        skinlab::writeFileAtomic(folder / "png" / (id + ".png"), bytes);
-        manifest["stimuli"].push_back({{"id", id},
-                                       {"files", {{"png", "png/" + id + ".png"}}},
-                                       {"sha256", {{"png", skinlab::sha256Hex(bytes)}}},
-                                       {"factors", {{"method", id}}},
-                                       {"block", "bench"},
-                                       {"reference", false},
-                                       {"width", 1280},
-                                       {"height", 720}});
-    }
-    skinlab::writeFileAtomic(folder / "manifest.json", manifest.dump());
+        return bytes;
+    });
 }
 
 // The server process.

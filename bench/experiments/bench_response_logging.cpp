@@ -9,7 +9,7 @@
 // Usage: bench_experiments_response_logging [--observers 50,200] [--think-ms MIN:MAX] [--folder DIR] [--active M]
 // Prints one Markdown table row per run for docs/benchmarks.md.
 #include "common/files.h"
-#include "common/hash.h"
+#include "bench_stimulus_set.h"
 #include "experiments/simulated_observers.h"
 #include "experiments/study_creation.h"
 #include "experiments/study_server.h"
@@ -18,7 +18,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
-#include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 #include <sstream>
 #include <string>
@@ -36,23 +35,8 @@ namespace {
 int activeConditions = 0; // --active M (0: the fixed five-condition design)
 
 void writeSet(const fs::path& folder) {
-    fs::create_directories(folder / "png");
-    nlohmann::json manifest{
-        {"format", "skinlab-stimuli"}, {"version", 1}, {"set", "bench"}, {"stimuli", nlohmann::json::array()}};
-    for (int m = 0; m < (activeConditions > 0 ? activeConditions : 5); ++m) {
-        const std::string id = "c" + std::to_string(m);
-        const std::string bytes = "placeholder image " + id;
-        skinlab::writeFileAtomic(folder / "png" / (id + ".png"), bytes);
-        manifest["stimuli"].push_back({{"id", id},
-                                       {"files", {{"png", "png/" + id + ".png"}}},
-                                       {"sha256", {{"png", skinlab::sha256Hex(bytes)}}},
-                                       {"factors", {{"method", id}}},
-                                       {"block", "bench"},
-                                       {"reference", false},
-                                       {"width", 256},
-                                       {"height", 256}});
-    }
-    skinlab::writeFileAtomic(folder / "manifest.json", manifest.dump());
+    skinlab::bench::writeBenchStimulusSet(folder, activeConditions > 0 ? activeConditions : 5, 256, 256,
+                                          [](const std::string& id) { return "placeholder image " + id; });
 }
 
 struct Run {
