@@ -11,7 +11,6 @@
 #include <array>
 #include <charconv>
 #include <cmath>
-#include <fstream>
 #include <map>
 #include <set>
 
@@ -258,6 +257,20 @@ ResponseTable readJson(const std::filesystem::path& path) {
     return table;
 }
 
+// True when SQLite opens `path` as a database (read-only, through its own descriptor, which it keeps or closes
+// without dropping other connections' locks). An empty file is not taken for one (SQLite would).
+bool isSqliteDatabase(const std::filesystem::path& path) {
+    std::error_code ec;
+    const auto size = std::filesystem::file_size(path, ec);
+    if (ec || size == 0) return false;
+    sqlite3* database = nullptr;
+    bool isDatabase = sqlite3_open_v2(path.c_str(), &database, SQLITE_OPEN_READONLY, nullptr) == SQLITE_OK;
+    isDatabase = isDatabase &&
+                 sqlite3_exec(database, "SELECT count(*) FROM sqlite_master", nullptr, nullptr, nullptr) == SQLITE_OK;
+    sqlite3_close(database);
+    return isDatabase;
+}
+
 ResponseTable readDatabase(const std::filesystem::path& path) {
     ResponseTable table;
     table.file = path.string();
@@ -294,6 +307,21 @@ ResponseTable readDatabase(const std::filesystem::path& path) {
         sqlite3_step(closer.statement) == SQLITE_ROW) {
         const unsigned char* pairs = sqlite3_column_text(closer.statement, 0);
         table.adaptiveDesign = pairs != nullptr && std::string(reinterpret_cast<const char*>(pairs)) == "active";
+    }
+    sqlite3_finalize(closer.statement);
+    closer.statement = nullptr;
+    // Each block's conditions in design order, so that every output lists them as the design does.
+    if (sqlite3_prepare_v2(database, "SELECT json_extract(value, '$.blocks') FROM meta WHERE key = 'definition'", -1,
+                           &closer.statement, nullptr) == SQLITE_OK &&
+        sqlite3_step(closer.statement) == SQLITE_ROW) {
+        const unsigned char* blocks = sqlite3_column_text(closer.statement, 0);
+        const nlohmann::json parsed =
+            blocks ? nlohmann::json::parse(reinterpret_cast<const char*>(blocks), nullptr, false) : nlohmann::json();
+        if (parsed.is_array())
+            for (const nlohmann::json& block : parsed)
+                if (block.is_object() && block.contains("name") && block.contains("conditions"))
+                    table.designConditionOrder[block["name"].get<std::string>()] =
+                        block["conditions"].get<std::vector<std::string>>();
     }
     sqlite3_finalize(closer.statement);
     closer.statement = nullptr;
@@ -370,15 +398,17 @@ DroppedFlagged dropFlagged(ResponseTable& table) {
 }
 
 ResponseTable readResponses(const std::filesystem::path& path) {
-    std::ifstream stream(path, std::ios::binary);
-    if (!stream) throwInput(path.string(), "", "cannot open the responses file");
-    std::string head(16, '\0');
-    stream.read(head.data(), 16);
-    head.resize(static_cast<size_t>(stream.gcount()));
-    // Every SQLite 3 database starts with this 16-byte magic string (sqlite.org/fileformat.html §1.3).
-    if (head == std::string("SQLite format 3\0", 16)) return readDatabase(path);
-    const size_t first = head.find_first_not_of(" \t\r\n");
-    if (first != std::string::npos && head[first] == '{') return readJson(path);
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) throwInput(path.string(), "", "cannot open the responses file");
+    // A study database may be live: served by this very process (the researcher dashboard scales through here) or
+    // by another. Only SQLite may open it. Any other descriptor of the file, once closed, drops every POSIX lock
+    // this process holds on it; another process then believes it holds the last connection and removes the
+    // write-ahead log under the server (sqlite.org/howtocorrupt.html, section 2.2). So SQLite itself is asked
+    // whether the file is a database, before anything else reads it.
+    if (isSqliteDatabase(path)) return readDatabase(path);
+    const std::string text = readFile(path);
+    const size_t first = text.find_first_not_of(" \t\r\n");
+    if (first != std::string::npos && text[first] == '{') return readJson(path);
     return readCsv(path);
 }
 

@@ -4,6 +4,7 @@
 #include "child_process.h"
 #include "common/files.h"
 #include "common/hash.h"
+#include "experiments/http_client.h"
 #include "experiments/simulated_observers.h"
 #include "experiments/sqlite_database.h"
 #include "experiments/study_store.h"
@@ -13,6 +14,8 @@
 #include <atomic>
 #include <csignal>
 #include <gtest/gtest.h>
+#include <map>
+#include <random>
 #include <regex>
 #include <thread>
 
@@ -202,4 +205,140 @@ TEST(StudyCli, KillNineDuringASessionLosesAndDuplicatesNothing) {
 
     server->kill(SIGTERM);
     EXPECT_EQ(server->wait(), 0) << "SIGTERM stops the server cleanly";
+}
+
+namespace {
+
+// Descriptors the process holds on files that were removed meanwhile ("/path (deleted)" in /proc/PID/fd): a study
+// file's -wal or -shm among them means another process believed it held the last connection and removed them.
+std::vector<std::string> deletedDescriptors(pid_t pid, const fs::path& database) {
+    std::vector<std::string> found;
+    std::error_code ec;
+    const fs::path fds = fs::path("/proc") / std::to_string(pid) / "fd";
+    for (const fs::directory_entry& entry : fs::directory_iterator(fds, ec)) {
+        const fs::path target = fs::read_symlink(entry.path(), ec);
+        if (ec) continue;
+        const std::string text = target.string();
+        if (text.rfind(database.string(), 0) == 0 && text.find("(deleted)") != std::string::npos) found.push_back(text);
+    }
+    return found;
+}
+
+// Everything a researcher may run on a study while it is served (docs/experiments.md): the dashboard (which scales
+// the answers inside the server), `study status`, `study export`, `study backup` and `analyze scale`.
+void readWhileServing(const StudyFiles& files, int port, int round) {
+    HttpClient client("127.0.0.1", port);
+    for (int attempt = 0; attempt < 100; ++attempt) {
+        const HttpAnswer answer = client.get("/api/researcher/dashboard", {{"Authorization", "Bearer t0ken"}});
+        ASSERT_EQ(answer.status, 200) << answer.body;
+        // The first request may find the scale still being computed; the reading is what matters.
+        if (answer.body.find("\"computing\"") == std::string::npos) break;
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    const std::string tag = std::to_string(round);
+    for (const std::vector<std::string>& command : std::vector<std::vector<std::string>>{
+             {"study", "status", files.database.string()},
+             {"study", "export", files.database.string(), "--format", "csv", "-o",
+              (files.folder.path() / ("export-" + tag + ".csv")).string()},
+             {"study", "backup", files.database.string(), (files.folder.path() / ("backup-" + tag + ".db")).string()},
+             {"analyze", "scale", files.database.string(), "-o", (files.folder.path() / ("scale-" + tag)).string(),
+              "--bootstrap", "100"}}) {
+        const CommandResult result = runSkinlab(command);
+        // analyze scale may find too few answers in an early round; it must fail cleanly, never crash.
+        EXPECT_TRUE(result.exitCode == 0 || (command[0] == "analyze" && result.exitCode == 2))
+            << command[0] << " " << command[1] << ": " << result.err;
+    }
+}
+
+} // namespace
+
+// Reading a served study from other processes and from the dashboard never costs an answer: the readers run while
+// observers answer and between waves of observers (when no other connection is open, which is when a lost lock
+// lets a reader remove the server's write-ahead log), the server is killed with SIGKILL at seeded random points,
+// and every acknowledged answer must be stored exactly once, every observer must finish, and the server must never
+// hold a descriptor of a removed study file.
+TEST(StudyCli, ReadersWhileServingNeitherLoseNorDuplicateAnswers) {
+    StudyFiles files;
+    ASSERT_EQ(runSkinlab({"study", "create", "--stimuli", files.stimuli.string(), "--design", files.design.string(),
+                          "-o", files.database.string()})
+                  .exitCode,
+              0);
+    std::unique_ptr<ChildProcess> server;
+    const int port = startServer(server, files.database, 0);
+    ASSERT_GT(port, 0);
+    std::mt19937 random(20261202);
+    constexpr int kRounds = 3;
+    constexpr int kObservers = 4;
+    constexpr std::int64_t kTrials = 27;
+    std::map<std::int64_t, bool> acknowledgedLeft;
+    int kills = 0;
+    for (int round = 0; round < kRounds; ++round) {
+        std::int64_t before = 0;
+        {
+            // The simulation reads the plan through its own connection; it is closed before the idle readers run.
+            StudyStore store(files.database);
+            before = store.responseCount();
+            SimulationOptions options;
+            options.port = port;
+            options.observers = kObservers;
+            options.seed = static_cast<std::uint64_t>(round + 1);
+            options.labelPrefix = "wave" + std::to_string(round);
+            options.thinkMinMs = 2;
+            options.thinkMaxMs = 8;
+            options.truth.byCondition = {{"reference-like", 1}, {"separable", 0.5}, {"artistic", 0}, {"reference", 2}};
+            SimulationReport report;
+            std::thread simulation([&] { report = simulateObservers(store, options); });
+            // Readers while observers answer, then a kill at a random point of the wave.
+            const std::int64_t wave = kObservers * kTrials;
+            const std::int64_t killAt =
+                before + std::uniform_int_distribution<std::int64_t>(wave / 5, wave / 2)(random);
+            readWhileServing(files, port, round * 2);
+            for (int i = 0; i < 4000 && store.responseCount() < killAt; ++i)
+                std::this_thread::sleep_for(std::chrono::milliseconds(5));
+            EXPECT_TRUE(deletedDescriptors(server->pid(), files.database).empty());
+            server->kill(SIGKILL);
+            EXPECT_EQ(server->wait(), 128 + SIGKILL);
+            ++kills;
+            std::this_thread::sleep_for(std::chrono::milliseconds(200));
+            ASSERT_EQ(startServer(server, files.database, port), port);
+            simulation.join();
+            for (const ObserverResult& o : report.observers) {
+                EXPECT_TRUE(o.completed) << o.label << ": " << o.failure;
+                for (const auto& [trial, side] : o.acknowledged)
+                    EXPECT_TRUE(acknowledgedLeft.emplace(trial, side == "left").second)
+                        << "trial " << trial << " acknowledged twice";
+            }
+        }
+        // No connection of this process is open now: the readers alone, then the server's descriptors.
+        readWhileServing(files, port, round * 2 + 1);
+        const std::vector<std::string> deleted = deletedDescriptors(server->pid(), files.database);
+        EXPECT_TRUE(deleted.empty()) << "round " << round << ": the server holds " << deleted.size()
+                                     << " descriptors of removed files, e.g. " << deleted.front();
+        // Sometimes a kill right after the readers, before the next wave joins.
+        if (std::uniform_int_distribution<int>(0, 1)(random) == 1) {
+            server->kill(SIGKILL);
+            EXPECT_EQ(server->wait(), 128 + SIGKILL);
+            ++kills;
+            ASSERT_EQ(startServer(server, files.database, port), port);
+        }
+    }
+    server->kill(SIGTERM);
+    EXPECT_EQ(server->wait(), 0);
+
+    // Every acknowledged answer is stored exactly once, with the side it was acknowledged with.
+    StudyStore store(files.database);
+    EXPECT_EQ(acknowledgedLeft.size(), static_cast<std::size_t>(kRounds * kObservers * kTrials));
+    EXPECT_EQ(store.responseCount(), kRounds * kObservers * kTrials);
+    std::map<std::int64_t, bool> storedLeft;
+    for (const ResponseRow& r : store.responses())
+        EXPECT_TRUE(storedLeft.emplace(r.trialId, r.aSelected == r.aOnLeft).second) << "trial " << r.trialId;
+    for (const auto& [trial, left] : acknowledgedLeft) {
+        ASSERT_TRUE(storedLeft.count(trial)) << "acknowledged answer to trial " << trial << " lost";
+        EXPECT_EQ(storedLeft.at(trial), left);
+    }
+    SqliteDatabase db(files.database.string(), false);
+    SqliteStatement check = db.prepare("PRAGMA integrity_check");
+    ASSERT_TRUE(check.step());
+    EXPECT_EQ(check.text(0), "ok");
+    EXPECT_GE(kills, kRounds);
 }
