@@ -65,9 +65,9 @@ void registerAnalyzeMetrics(CLI::App& analyze) {
         "Compare renders with a reference: PSNR, SSIM, CIEDE2000 and LDR-FLIP on the image and on skin, and halo/bleed/"
         "spill/interior band scores; plain images (PNG, JPEG, RGB-only EXR) get the image-wide scores "
         "(docs/metrics.md)");
-    command->add_option(
-        "tests", arguments->tests,
-        "Test renders (EXR, contract 1) or plain images (PNG, JPEG, EXR, ...) to compare with --reference");
+    command->add_option("tests", arguments->tests,
+                        "Test renders (skinlab EXRs with their layers) or plain images (PNG, JPEG, EXR, ...) to "
+                        "compare with --reference");
     command->add_option("--reference", arguments->reference,
                         "Reference EXR (with depth.Z, mask.Y and skinlab:f_px/mm_per_unit/sss_radius_mm); with "
                         "--stimuli: the id of the reference stimulus (default: each block's \"reference\": true)");

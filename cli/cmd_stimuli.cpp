@@ -200,12 +200,14 @@ void runStatus(const StimuliOptions& o) {
 
 void registerStimuli(CLI::App& app) {
     auto options = std::make_shared<StimuliOptions>();
-    CLI::App* stimuli = app.add_subcommand("stimuli", "Build, list and merge stimulus sets (docs/stimuli.md)");
+    CLI::App* stimuli = app.add_subcommand(
+        "stimuli", "Build, list, merge and inspect stimulus sets, locally or on a Slurm cluster (docs/stimuli.md)");
     stimuli->require_subcommand(1);
 
-    auto specOptions = [&](CLI::App* cmd) {
+    // `stimuli slurm` shards by --shards itself, so it has no --shard.
+    auto specOptions = [&](CLI::App* cmd, bool shard = true) {
         cmd->add_option("spec", options->spec, "Stimulus-set spec (TOML), e.g. stimuli/specs/demo.toml")->required();
-        cmd->add_option("--shard", options->shard, "Only slice i of n (1-based), e.g. 2/8");
+        if (shard) cmd->add_option("--shard", options->shard, "Only slice i of n (1-based), e.g. 2/8");
         cmd->add_option("--assets", options->assets, "Folder of shared assets (default: $SKINLAB_ASSETS)");
         cmd->add_option("--set", options->overrides, "Override a spec value: key=value (repeatable)");
     };
@@ -237,7 +239,7 @@ void registerStimuli(CLI::App& app) {
 
     CLI::App* slurm = stimuli->add_subcommand(
         "slurm", "Build a set on a Slurm cluster: a job array (one task per shard) and a merge job (afterok)");
-    specOptions(slurm);
+    specOptions(slurm, false);
     slurm
         ->add_option("-o,--output", options->output,
                      "Folder on the shared file system: shards/I, set (the merged set), slurm (scripts, logs, job ids)")

@@ -4,6 +4,7 @@
 #include "common/files.h"
 #include "experiments/nginx_config.h"
 #include "experiments/simulated_observers.h"
+#include "experiments/study_plan.h"
 #include "experiments/study_backup.h"
 #include "experiments/study_creation.h"
 #include "experiments/study_export.h"
@@ -13,6 +14,7 @@
 #include <csignal>
 #include <cstdio>
 #include <pthread.h>
+#include <algorithm>
 #include <regex>
 #include <thread>
 
@@ -39,6 +41,8 @@ struct StudyOptions {
     int observers = 0;
     std::string truth;
     std::string truthFactor;
+    std::vector<int> planObservers;
+    int planSimulations = 200;
     double lapse = 0;
     double sideBias = 0;
     int randomObservers = 0;
@@ -104,6 +108,27 @@ void runServe(const StudyOptions& o) {
     std::printf("stopped\n");
 }
 
+// --truth FILE.json, --truth predicted (the manifest's predicted JODs) or --truth-factor NAME.
+ex::SimulationTruth truthOf(ex::StudyStore& store, const StudyOptions& o, bool predictedByDefault = false) {
+    if (!o.truth.empty() && !o.truthFactor.empty()) throw InputError("--truth and --truth-factor: give one of them");
+    if (o.truth == "predicted" || (o.truth.empty() && o.truthFactor.empty() && predictedByDefault))
+        return ex::truthFromPredictions(store);
+    if (!o.truth.empty()) return ex::readTruthJson(o.truth);
+    if (!o.truthFactor.empty()) return ex::truthFromFactor(store, o.truthFactor);
+    return {};
+}
+
+void runPlan(const StudyOptions& o) {
+    ex::StudyStore store(o.study);
+    const ex::SimulationTruth truth = truthOf(store, o, true);
+    ex::PlanOptions options;
+    options.simulations = o.planSimulations;
+    options.seed = o.seed;
+    if (!o.planObservers.empty()) options.observerCounts = o.planObservers;
+    std::sort(options.observerCounts.begin(), options.observerCounts.end());
+    std::fputs(ex::planText(ex::planStudy(store.definition(), truth, options)).c_str(), stdout);
+}
+
 void runSimulate(const StudyOptions& o) {
     ex::StudyStore store(o.study);
     ex::SimulationOptions options;
@@ -114,8 +139,7 @@ void runSimulate(const StudyOptions& o) {
     options.port = std::stoi(m[2].str());
     options.observers = o.observers;
     if (!o.truth.empty() && !o.truthFactor.empty()) throw InputError("--truth and --truth-factor: give one of them");
-    if (!o.truth.empty()) options.truth = ex::readTruthJson(o.truth);
-    if (!o.truthFactor.empty()) options.truth = ex::truthFromFactor(store, o.truthFactor);
+    options.truth = truthOf(store, o);
     options.lapseRate = o.lapse;
     options.sideBias = o.sideBias;
     options.randomObservers = o.randomObservers;
@@ -137,8 +161,10 @@ void runSimulate(const StudyOptions& o) {
     std::printf("%d/%d observers completed, %zu responses acknowledged, %d rejected, %d re-sends, %.1f s\n",
                 report.completed(), o.observers, report.acknowledged(), report.rejected(), report.transportRetries(),
                 report.wallSeconds);
-    std::printf("response latency: p50 %.2f ms, p99 %.2f ms\n", report.latencyPercentile(50),
-                report.latencyPercentile(99));
+    if (report.latenciesMs.empty()) std::printf("response latency: no response was acknowledged\n");
+    else
+        std::printf("response latency: p50 %.2f ms, p99 %.2f ms\n", report.latencyPercentile(50),
+                    report.latencyPercentile(99));
     if (report.completed() != o.observers) throw RuntimeError("not every simulated observer completed the study");
 }
 
@@ -216,7 +242,8 @@ void registerStudy(CLI::App& app) {
         ->required()
         ->check(CLI::Range(1, 5000));
     simulate->add_option("--truth", options->truth,
-                         "JSON of true scores in JOD: {\"cond\": q} or {\"block\": {\"cond\": q}}");
+                         "True scores in JOD: \"predicted\" (each stimulus's predicted JOD in the manifest), or a JSON "
+                         "file {\"cond\": q} or {\"block\": {\"cond\": q}}");
     simulate->add_option("--truth-factor", options->truthFactor, "Numeric manifest factor holding the true score");
     simulate->add_option("--url", options->url, "Server URL")->capture_default_str();
     simulate->add_option("--lapse", options->lapse, "Probability of a random answer")->check(CLI::Range(0.0, 1.0));
@@ -234,6 +261,21 @@ void registerStudy(CLI::App& app) {
                        "Only the API calls, each on a new connection (default: like a browser — one kept-alive "
                        "connection, the page, the study and each image once)");
     simulate->callback([options] { runSimulate(*options); });
+
+    CLI::App* plan = study->add_subcommand(
+        "plan", "Observers needed for the predicted differences to come out significant (power by simulation)");
+    plan->add_option("study", options->study, "study.db")->required();
+    plan->add_option("--truth", options->truth,
+                     "True scores: \"predicted\" (default: the manifest's predicted JODs) or a JSON file");
+    plan->add_option("--truth-factor", options->truthFactor, "Numeric manifest factor holding the true score");
+    plan->add_option("--observers", options->planObservers, "Observer counts to simulate, e.g. 10,20,40")
+        ->delimiter(',')
+        ->check(CLI::Range(2, 10000));
+    plan->add_option("--simulations", options->planSimulations, "Simulated studies per observer count")
+        ->capture_default_str()
+        ->check(CLI::Range(20, 100000));
+    plan->add_option("--seed", options->seed, "Seed of the simulations")->capture_default_str();
+    plan->callback([options] { runPlan(*options); });
 
     CLI::App* status = study->add_subcommand("status", "Per-participant progress and catch-trial accuracy");
     status->add_option("study", options->study, "study.db")->required();
@@ -264,7 +306,8 @@ void registerStudy(CLI::App& app) {
     deploy->add_option("-o,--output", options->output, "Site file to write (default: standard output)");
     deploy->callback([options] { runDeployConfig(*options); });
 
-    CLI::App* exportCommand = study->add_subcommand("export", "Export responses (contract 3)");
+    CLI::App* exportCommand =
+        study->add_subcommand("export", "Export responses (skinlab CSV, pwcmp CSV or JSON; docs/experiments.md)");
     exportCommand->add_option("study", options->study, "study.db")->required();
     exportCommand->add_option("--format", options->format, "csv, json or pwcmp")
         ->check(CLI::IsMember({"csv", "json", "pwcmp"}))

@@ -9,7 +9,6 @@ void registerKernel(CLI::App& app);
 void registerStimuli(CLI::App& app);
 void registerStudy(CLI::App& app);
 void registerAnalyze(CLI::App& app);
-void registerBench(CLI::App& app);
 void registerReport(CLI::App& app);
 void registerPathtraced(CLI::App& app);
 void registerMethods(CLI::App& app);

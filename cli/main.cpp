@@ -27,7 +27,6 @@ int main(int argc, char** argv) {
     skinlab::cli::registerStimuli(app);
     skinlab::cli::registerStudy(app);
     skinlab::cli::registerAnalyze(app);
-    skinlab::cli::registerBench(app);
     skinlab::cli::registerReport(app);
     skinlab::cli::registerPathtraced(app);
     skinlab::cli::registerMethods(app);

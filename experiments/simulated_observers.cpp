@@ -272,6 +272,26 @@ SimulationTruth readTruthJson(const std::filesystem::path& path) {
     return truth;
 }
 
+SimulationTruth truthFromPredictions(StudyStore& store) {
+    SimulationTruth truth;
+    truth.source = "--truth predicted";
+    const json manifest = json::parse(store.meta("manifest_json"));
+    std::map<std::string, const json*> byId;
+    for (const json& s : manifest["stimuli"]) byId[s["id"].get<std::string>()] = &s;
+    for (const StudyStimulus& s : store.definition().stimuli) {
+        if (s.condition.empty()) continue;
+        const json& entry = *byId.at(s.id);
+        const auto predicted = entry.find("predicted");
+        if (predicted == entry.end() || !predicted->is_object() || !predicted->contains("jod") ||
+            !(*predicted)["jod"].is_number())
+            throw InputError("--truth predicted: stimulus \"" + s.id +
+                             "\" has no predicted JOD in the manifest (build the set with a [[reference]] so that "
+                             "`stimuli build` predicts each stimulus against it)");
+        truth.byBlock[s.block][s.condition] = (*predicted)["jod"].get<double>();
+    }
+    return truth;
+}
+
 SimulationTruth truthFromFactor(StudyStore& store, const std::string& factor) {
     SimulationTruth truth;
     truth.source = "--truth-factor " + factor;

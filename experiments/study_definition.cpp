@@ -3,6 +3,7 @@
 #include "common/error.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <set>
 
@@ -148,7 +149,63 @@ StudyDefinition resolveStudy(const StudyDesign& design, const StimulusManifest& 
         pair.repeat = c.repeat;
         def.catchPairs.push_back(pair);
     }
+
+    // Every trial must fit the declared viewport at one image pixel per device pixel (devicePixelRatio 1).
+    const StageNeeds needs = def.stageNeeds();
+    const int width = needs.cssWidth(), height = needs.cssHeight();
+    if (width > design.display.viewportWidth || height > design.display.viewportHeight) {
+        const std::string key =
+            width > design.display.viewportWidth ? "display.viewport_width" : "display.viewport_height";
+        throwInput(file, key,
+                   "the trials need " + std::to_string(width) + " × " + std::to_string(height) +
+                       " CSS pixels at one image pixel per device pixel (block \"" + needs.widestBlock +
+                       "\": " + std::to_string(needs.pairWidth) + " px of images side by side" +
+                       (needs.referenceHeight > 0 ? ", a reference above them" : "") + "), more than the declared " +
+                       std::to_string(design.display.viewportWidth) + " × " +
+                       std::to_string(design.display.viewportHeight) +
+                       " viewport; render smaller stimuli, crop them, or declare a larger viewport");
+    }
     return def;
+}
+
+int StageNeeds::cssWidth(double dpr) const { return static_cast<int>(std::ceil(pairWidth / dpr + 3 * kMargin)); }
+
+int StageNeeds::cssHeight(double dpr) const {
+    return static_cast<int>(
+        std::ceil((pairHeight + referenceHeight) / dpr + kTop + kBottom + (referenceHeight > 0 ? kMargin : 0)));
+}
+
+nlohmann::json StageNeeds::toJson() const {
+    return {{"pair_width", pairWidth},
+            {"pair_height", pairHeight},
+            {"reference_height", referenceHeight},
+            {"margin", kMargin},
+            {"top", kTop},
+            {"bottom", kBottom}};
+}
+
+StageNeeds StudyDefinition::stageNeeds() const {
+    StageNeeds needs;
+    auto pair = [&](const std::string& block, int first, int second) {
+        const StudyStimulus& a = stimuli.at(static_cast<std::size_t>(first));
+        const StudyStimulus& b = stimuli.at(static_cast<std::size_t>(second));
+        if (a.width + b.width > needs.pairWidth) needs.widestBlock = block;
+        needs.pairWidth = std::max(needs.pairWidth, a.width + b.width);
+        needs.pairHeight = std::max({needs.pairHeight, a.height, b.height});
+    };
+    for (const StudyBlock& block : blocks) {
+        for (const auto& [i, j] : block.pairs)
+            pair(block.name, block.conditionStimulus[static_cast<std::size_t>(i)],
+                 block.conditionStimulus[static_cast<std::size_t>(j)]);
+        // A blank catch trial shows a stimulus beside a blank panel of its size.
+        if (design.blankCatchTrials > 0)
+            for (int s : block.conditionStimulus) pair(block.name, s, s);
+        if (design.showReference && block.referenceStimulus >= 0)
+            needs.referenceHeight =
+                std::max(needs.referenceHeight, stimuli.at(static_cast<std::size_t>(block.referenceStimulus)).height);
+    }
+    for (const StudyCatchPair& c : catchPairs) pair(c.block, c.first, c.second);
+    return needs;
 }
 
 int StudyDefinition::testTrialCount() const {

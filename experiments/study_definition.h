@@ -39,6 +39,24 @@ struct StudyCatchPair {
     int repeat = 1;
 };
 
+// What the participant page needs to show every trial at one image pixel per device pixel: the widest pair (the
+// two images side by side) and the tallest stimulus row, in device pixels, plus the page's fixed margins in CSS
+// pixels. The page lays trials out with exactly these figures (GET /api/study "stage"), so the check at
+// `study create`, the check before joining and the layout of a trial agree.
+struct StageNeeds {
+    static constexpr int kMargin = 16; // CSS px between and around the images
+    static constexpr int kTop = 64;    // CSS px reserved above the images for the question (and practice label)
+    static constexpr int kBottom = 36; // CSS px reserved below the images for the key hint
+    int pairWidth = 0;                 // device px: the widest left + right pair
+    int pairHeight = 0;                // device px: the tallest pair
+    int referenceHeight = 0;           // device px: the tallest reference shown above a pair (0: none shown)
+    std::string widestBlock;           // the block of the widest pair, for messages
+    // CSS pixels needed at devicePixelRatio `dpr`.
+    int cssWidth(double dpr = 1.0) const;
+    int cssHeight(double dpr = 1.0) const;
+    nlohmann::json toJson() const;
+};
+
 struct StudyDefinition {
     StudyDesign design;
     std::vector<StudyStimulus> stimuli;
@@ -51,6 +69,7 @@ struct StudyDefinition {
     int testTrialCount() const;   // first showings (kind "test")
     int repeatTrialCount() const; // further repetitions (kind "repeat")
     int catchTrialCount() const;
+    StageNeeds stageNeeds() const;
 };
 
 // Resolves `design` against `manifest`. Errors name the design file and key (e.g.

@@ -126,6 +126,8 @@ StudyDesign designFromToml(toml::table& root, const std::string& file, const std
     if (d.display.calibrate && !display.has("viewing_distance_mm"))
         display.fail("viewing_distance_mm", "required with calibrate = true (pixels per degree need the distance)");
     d.display.viewingDistanceMm = display.number("viewing_distance_mm", 0, 100, 5000);
+    d.display.viewportWidth = static_cast<int>(display.integer("viewport_width", 1920, 320, 16384));
+    d.display.viewportHeight = static_cast<int>(display.integer("viewport_height", 1080, 240, 16384));
 
     SpecReader requirements = spec.table("requirements");
     d.requirements.minScreenWidth = static_cast<int>(requirements.integer("min_screen_width", 0, 0, 100000));
@@ -179,7 +181,11 @@ nlohmann::json StudyDesign::toJson() const {
               {"id_parameter", recruitment.idParameter},
               {"completion_url", recruitment.completionUrl},
               {"completion_code", recruitment.completionCode}}},
-            {"display", {{"calibrate", display.calibrate}, {"viewing_distance_mm", display.viewingDistanceMm}}},
+            {"display",
+             {{"calibrate", display.calibrate},
+              {"viewing_distance_mm", display.viewingDistanceMm},
+              {"viewport_width", display.viewportWidth},
+              {"viewport_height", display.viewportHeight}}},
             {"requirements",
              {{"min_screen_width", requirements.minScreenWidth},
               {"min_screen_height", requirements.minScreenHeight},
@@ -227,6 +233,9 @@ StudyDesign StudyDesign::fromJson(const nlohmann::json& j) {
     if (const auto display = j.find("display"); display != j.end()) {
         d.display.calibrate = display->at("calibrate").get<bool>();
         d.display.viewingDistanceMm = display->at("viewing_distance_mm").get<double>();
+        // Study files created before the declared viewport existed: the default.
+        d.display.viewportWidth = display->value("viewport_width", d.display.viewportWidth);
+        d.display.viewportHeight = display->value("viewport_height", d.display.viewportHeight);
     }
     if (const auto r = j.find("requirements"); r != j.end()) {
         d.requirements.minScreenWidth = r->at("min_screen_width").get<int>();

@@ -32,6 +32,11 @@ struct RecruitmentDesign {
 struct DisplayDesign {
     bool calibrate = false;
     double viewingDistanceMm = 0; // 0 = not stated
+    // The browser viewport the study is designed for, in CSS pixels at devicePixelRatio 1 (a full-screen window
+    // of a 1920×1080 display by default). `study create` refuses a design whose trials need more at one image
+    // pixel per device pixel.
+    int viewportWidth = 1920;
+    int viewportHeight = 1080;
 };
 
 // [requirements]: a session that does not meet them is refused before the first trial.

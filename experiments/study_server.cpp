@@ -456,6 +456,9 @@ HttpResponse StudyServer::route(const HttpRequest& req) {
                     {"viewing_distance_mm", d.display.viewingDistanceMm},
                     {"card_width_mm", kIdCardWidthMm},
                     {"card_height_mm", kIdCardHeightMm}}},
+                  // What every trial needs at one image pixel per device pixel: the page refuses a smaller window
+                  // before the participant joins, and lays trials out with the same margins.
+                  {"stage", definition.stageNeeds().toJson()},
                   {"requirements",
                    {{"min_screen_width", d.requirements.minScreenWidth},
                     {"min_screen_height", d.requirements.minScreenHeight},

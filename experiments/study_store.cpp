@@ -400,6 +400,15 @@ std::string StudyStore::meta(const std::string& key) const {
     return s.text(0);
 }
 
+std::vector<std::string> StudyStore::simulatedLabels() const {
+    // simulatedJoinKey(): "sim-" and 40 hexadecimal digits.
+    SqliteStatement s = db_->prepare("SELECT label FROM participants WHERE join_key LIKE 'sim-%' AND "
+                                     "length(join_key) = 44 ORDER BY participant_index");
+    std::vector<std::string> labels;
+    while (s.step()) labels.push_back(s.text(0));
+    return labels;
+}
+
 ParticipantRecord StudyStore::join(const std::string& requestedLabel, const std::string& joinKey,
                                    const std::optional<ExternalIds>& external) {
     bool created = false;

@@ -142,6 +142,8 @@ public:
     const StudyDefinition& definition() const { return definition_; }
     const std::filesystem::path& path() const { return path_; }
     std::string meta(const std::string& key) const;
+    // Labels of the participants `study simulate` sent (their join keys say so), in joining order.
+    std::vector<std::string> simulatedLabels() const;
 
     // A new participant with a fresh token, seed and planned trials (one transaction). `label` empty = "P001"...
     // `joinKey` (chosen by the client, may be empty) makes joining idempotent: a retried join whose first answer

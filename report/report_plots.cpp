@@ -118,7 +118,8 @@ std::string scaleSvg(const std::vector<IntervalPoint>& points) {
     return svg + "</svg>";
 }
 
-std::string scatterSvg(const std::vector<ScatterPoint>& points, const std::string& xLabel) {
+std::string scatterSvg(const std::vector<ScatterPoint>& points, const std::string& xLabel,
+                       const ScatterOptions& options) {
     const double left = 52.0, right = 330.0, top = 14.0, bottom = 212.0;
     std::vector<double> xs, ys;
     for (const auto& p : points) {
@@ -126,7 +127,17 @@ std::string scatterSvg(const std::vector<ScatterPoint>& points, const std::strin
         ys.push_back(p.y);
     }
     Range rx = rangeOf(xs, 0.08, 1e-6);
-    Range ry = rangeOf(ys, 0.15, 1.0);
+    // The axis holds the estimates and their intervals where those stay within 1.5 JOD of them; longer bars are
+    // clipped and end in a red arrow (with the value in its tooltip).
+    for (const auto& p : points) {
+        if (std::isfinite(p.low)) ys.push_back(std::max(p.low, p.y - 1.5));
+        if (std::isfinite(p.high)) ys.push_back(std::min(p.high, p.y + 1.5));
+    }
+    Range ry = rangeOf(ys, 0.05, 1.0);
+    if (options.identity) { // one range for both axes, so y = x is the diagonal
+        rx.low = ry.low = std::min(rx.low, ry.low);
+        rx.high = ry.high = std::max(rx.high, ry.high);
+    }
     std::string svg = "<svg class=\"plot scatter\" xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"0 0 350 256\" "
                       "width=\"350\" height=\"256\" role=\"img\">";
     for (double t : ticks(rx)) {
@@ -143,18 +154,35 @@ std::string scatterSvg(const std::vector<ScatterPoint>& points, const std::strin
     }
     svg += "<text x=\"" + px(0.5 * (left + right)) + "\" y=\"250\" class=\"axis\">" + escapeHtml(xLabel) + "</text>";
     svg += "<text x=\"12\" y=\"" + px(0.5 * (top + bottom)) + "\" class=\"axis\" transform=\"rotate(-90 12 " +
-           px(0.5 * (top + bottom)) + ")\">JOD</text>";
+           px(0.5 * (top + bottom)) + ")\">" + escapeHtml(options.yLabel) + "</text>";
+    if (options.identity)
+        svg += "<line x1=\"" + px(left) + "\" y1=\"" + px(bottom) + "\" x2=\"" + px(right) + "\" y2=\"" + px(top) +
+               "\" class=\"identity\"><title>measured = predicted</title></line>";
     for (const auto& p : points) {
         if (!std::isfinite(p.x) || !std::isfinite(p.y)) continue;
         double x = rx.map(p.x, left, right);
-        double lowValue = std::isfinite(p.low) ? std::max(p.low, ry.low) : ry.low;
-        double highValue = std::isfinite(p.high) ? std::min(p.high, ry.high) : ry.high;
+        const bool clippedLow = !std::isfinite(p.low) || p.low < ry.low;
+        const bool clippedHigh = !std::isfinite(p.high) || p.high > ry.high;
+        double lowValue = clippedLow ? ry.low : p.low;
+        double highValue = clippedHigh ? ry.high : p.high;
         svg += "<line x1=\"" + px(x) + "\" y1=\"" + px(ry.map(lowValue, bottom, top)) + "\" x2=\"" + px(x) +
                "\" y2=\"" + px(ry.map(highValue, bottom, top)) + "\" class=\"bar\"/>";
+        if (clippedLow)
+            svg += "<path d=\"M" + px(x) + " " + px(bottom + 2) +
+                   " l-5 -8 h10 z\" class=\"clip\"><title>interval "
+                   "continues to " +
+                   formatNumber(p.low, 2) + " JOD</title></path>";
+        if (clippedHigh)
+            svg += "<path d=\"M" + px(x) + " " + px(top - 2) +
+                   " l-5 8 h10 z\" class=\"clip\"><title>interval "
+                   "continues to " +
+                   formatNumber(p.high, 2) + " JOD</title></path>";
         double y = ry.map(p.y, bottom, top);
+        // Labels on the side with room: left of points in the right part of the plot, so none runs off the figure.
+        const bool leftSide = x > left + 0.6 * (right - left);
         svg += "<circle cx=\"" + px(x) + "\" cy=\"" + px(y) + "\" r=\"4\" class=\"dot\"><title>" + escapeHtml(p.label) +
-               "</title></circle><text x=\"" + px(x + 6) + "\" y=\"" + px(y - 6) + "\" class=\"point\">" +
-               escapeHtml(p.label) + "</text>";
+               "</title></circle><text x=\"" + px(leftSide ? x - 6 : x + 6) + "\" y=\"" + px(std::max(y - 6, top + 8)) +
+               "\" class=\"point\"" + (leftSide ? " text-anchor=\"end\"" : "") + ">" + escapeHtml(p.label) + "</text>";
     }
     return svg + "</svg>";
 }

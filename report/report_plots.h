@@ -21,7 +21,14 @@ struct ScatterPoint {
     double y = 0.0, low = 0.0, high = 0.0; // JOD and its interval
 };
 
-std::string scatterSvg(const std::vector<ScatterPoint>& points, const std::string& xLabel);
+struct ScatterOptions {
+    std::string yLabel = "JOD";
+    // Both axes share one range and the line y = x is drawn (measured against predicted JOD).
+    bool identity = false;
+};
+
+std::string scatterSvg(const std::vector<ScatterPoint>& points, const std::string& xLabel,
+                       const ScatterOptions& options = {});
 
 // A number for the page: `digits` after the point, "−" for minus, "—" for a non-finite value.
 std::string formatNumber(double value, int digits);

@@ -9,6 +9,7 @@
 #include "common/html.h"
 #include "common/version.h"
 #include "experiments/study_store.h"
+#include "report/prediction_section.h"
 #include "report/report_plots.h"
 
 #include <algorithm>
@@ -133,12 +134,20 @@ td.sig { background: var(--sig); font-weight: 600; } td.ns { background: var(--n
 figcaption { font-size: 12.5px; color: var(--muted); margin-top: 3px; }
 .heat img { width: 330px; }
 .scatters { display: flex; flex-wrap: wrap; gap: 16px; } .scatters figure { margin: 0; width: 350px; }
-svg.plot { font-size: 11px; } svg .grid { stroke: #e3e6ec; } svg .bar { stroke: var(--accent); stroke-width: 2.5; }
+svg.plot { font-size: 11px; } svg .grid { stroke: #e3e6ec; } svg .identity { stroke: #888; stroke-dasharray: 4 3; } svg .bar { stroke: var(--accent); stroke-width: 2.5; }
 svg .dot { fill: var(--accent); } svg .clip { fill: #c0392b; } svg .tick { text-anchor: middle; fill: var(--muted); }
 svg .ytick { text-anchor: end; } svg .label { text-anchor: end; fill: var(--ink); font-size: 12px; }
 svg .axis { text-anchor: middle; fill: var(--ink); font-size: 12px; } svg .point { fill: var(--muted); font-size: 10px; }
 .note { color: var(--muted); font-size: 13px; }
-@media print { main { padding: 0; max-width: none; } h2 { break-after: avoid; } figure, table, svg { break-inside: avoid; } }
+.banner { background: #fff4e0; border: 1px solid #e0b060; border-left: 5px solid #d08a00; padding: 10px 14px; margin: 14px 0; }
+@media print {
+  main { padding: 0; max-width: none; }
+  h1, h2, h3 { break-after: avoid; page-break-after: avoid; }
+  h2 + p, h2 + ul, h3 + p, h3 + table, h3 + div, p.note + table, p.note + div { break-before: avoid; page-break-before: avoid; }
+  figure, svg, tr, li, .banner, .question { break-inside: avoid; page-break-inside: avoid; }
+  table { break-inside: auto; }
+  tbody tr:nth-last-child(-n+2), tbody tr:nth-child(-n+2) { break-before: avoid; page-break-before: avoid; }
+}
 )CSS";
 
 } // namespace
@@ -149,6 +158,7 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
     if (options.output.empty()) throwInput("-o", "", "required: the report folder");
     experiments::StudyStore store(options.study);
     const experiments::StudyDefinition& definition = store.definition();
+    const std::vector<std::string> simulated = store.simulatedLabels();
     const experiments::StudyDesign& design = definition.design;
     const fs::path stimuliFolder = options.stimuli.empty() ? fs::path(store.meta("stimuli_dir")) : options.stimuli;
     if (!fs::is_regular_file(stimuliFolder / "manifest.json"))
@@ -192,6 +202,9 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
     scaling::ResponseTable table;
     table.file = options.study.string();
     table.format = scaling::ResponseFormat::StudyDatabase;
+    // Conditions in design order, as `analyze scale` and the dashboard list them.
+    for (const experiments::StudyBlock& block : store.definition().blocks)
+        table.designConditionOrder[block.name] = block.conditions;
     int line = 0;
     for (const experiments::ResponseRow& row : rows) {
         ++line;
@@ -335,12 +348,30 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
          << " — study report</title><style>" << styleSheet << "</style></head><body><main>\n";
     html << "<h1>" << h(design.title) << "</h1><p class=\"sub\">Study report · " << h(options.study.filename().string())
          << " · stimulus set " << h(store.meta("stimulus_set")) << " · skinlab " << h(version()) << "</p>\n";
+    // Predicted JOD (ColorVideoVDP, recorded by `stimuli build`) against the measured scale.
+    const nlohmann::json storedManifest = nlohmann::json::parse(store.meta("manifest_json"));
+    const std::vector<PredictionAgreement> predictions = predictionAgreement(definition, storedManifest, analysis);
+    std::string predictionDisplay;
+    for (const nlohmann::json& s : storedManifest.value("stimuli", nlohmann::json::array()))
+        if (s.contains("predicted") && s["predicted"].contains("display"))
+            predictionDisplay = s["predicted"]["display"].get<std::string>();
     html << "<p class=\"question\">Question put to observers: <strong>" << h(design.question) << "</strong></p>\n";
     html << "<nav class=\"note\">Contents: <a href=\"#findings\">Findings</a> · <a href=\"#design\">Design</a> · "
             "<a href=\"#participants\">Participants</a> · <a href=\"#stimuli\">Stimuli</a> · <a "
             "href=\"#scale\">Scale</a>"
-            " · <a href=\"#metrics\">Objective errors</a> · <a href=\"#agreement\">Metrics vs. perception</a></nav>\n";
+            " · <a href=\"#metrics\">Objective errors</a> · <a href=\"#agreement\">Metrics vs. perception</a>"
+         << (predictions.empty() ? "" : " · <a href=\"#prediction\">Predicted and measured</a>") << "</nav>\n";
 
+    // Observers sent by `study simulate` answer from a model, not from what they saw: said first, in a banner.
+    if (!simulated.empty()) {
+        html << "<div class=\"banner\"><strong>Simulated observers.</strong> " << simulated.size() << " of "
+             << store.status().size()
+             << " participants were simulated by <code>skinlab study simulate</code> (their answers come from a "
+                "model of the observer, not from people looking at the stimuli): ";
+        for (std::size_t i = 0; i < simulated.size() && i < 8; ++i) html << (i ? ", " : "") << h(simulated[i]);
+        if (simulated.size() > 8) html << ", …";
+        html << ". The findings below describe the simulation.</div>\n";
+    }
     // --- Findings (generated). ---
     html << "<h2 id=\"findings\">Findings</h2><ul class=\"findings\">\n";
     html << "<li>" << linked("participants", std::to_string(included)) << " observers analysed";
@@ -355,30 +386,44 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
                   [&](int a, int b) { return block.thurstone.scores[a] > block.thurstone.scores[b]; });
         int best = order.front(), worst = order.back();
         int significant = 0;
-        std::vector<std::string> beaten;
+        std::vector<std::string> beaten, tied; // below the best significantly / not separated from it
+        const scaling::PairTest* runnerUp = nullptr;
         for (const scaling::PairTest& pair : block.pairs) {
-            if (!pair.significant) continue;
-            ++significant;
+            if (pair.significant) ++significant;
             int other = pair.test.first == best ? pair.test.second : pair.test.second == best ? pair.test.first : -1;
-            if (other >= 0 && block.thurstone.scores[best] > block.thurstone.scores[other])
-                beaten.push_back(block.conditions[static_cast<std::size_t>(other)]);
+            if (other < 0) continue;
+            (pair.significant ? beaten : tied).push_back(block.conditions[static_cast<std::size_t>(other)]);
+            if (order.size() > 1 && other == order[1]) runnerUp = &pair;
         }
         const std::size_t pairCount = block.pairs.size();
+        // Differences, not scores against the block mean: the best against the next, and which conditions it is
+        // tied with (their difference is not significant).
         html << "<li><strong>" << h(block.name) << "</strong>: <em>"
-             << h(block.conditions[static_cast<std::size_t>(best)]) << "</em> scored highest, "
-             << linked(anchor, num(block.thurstone.scores[best]) + " JOD") << " ["
-             << linked(anchor, num(block.low[best])) << ", " << linked(anchor, num(block.high[best])) << "]; <em>"
-             << h(block.conditions[static_cast<std::size_t>(worst)]) << "</em> lowest, "
-             << linked(anchor, num(block.thurstone.scores[worst]) + " JOD") << ". "
-             << linked("pairs-" + slug(block.name), std::to_string(significant)) << " of " << pairCount
-             << " pairs are separated significantly (" << h(scaling::correctionName(analysis.options.correction))
+             << h(block.conditions[static_cast<std::size_t>(best)]) << "</em> scored highest";
+        if (runnerUp) {
+            const double sign = runnerUp->test.first == best ? 1.0 : -1.0;
+            const double low = sign > 0 ? runnerUp->test.low : -runnerUp->test.high;
+            const double high = sign > 0 ? runnerUp->test.high : -runnerUp->test.low;
+            html << ", " << linked(anchor, num(sign * runnerUp->test.difference) + " JOD") << " ["
+                 << linked(anchor, num(low)) << ", " << linked(anchor, num(high)) << "] above the next, <em>"
+                 << h(block.conditions[static_cast<std::size_t>(order[1])]) << "</em> ("
+                 << (runnerUp->significant ? "significant" : "not significant")
+                 << ", adjusted p = " << num(runnerUp->adjustedPValue, 3) << ")";
+        }
+        html << "; <em>" << h(block.conditions[static_cast<std::size_t>(worst)]) << "</em> lowest, "
+             << linked(anchor, num(block.thurstone.scores[best] - block.thurstone.scores[worst]) + " JOD")
+             << " below the best. " << linked("pairs-" + slug(block.name), std::to_string(significant)) << " of "
+             << pairCount << " pairs are separated significantly ("
+             << h(scaling::correctionName(analysis.options.correction))
              << "-corrected, α = " << num(analysis.options.alpha, 2) << ")";
+        if (!tied.empty()) {
+            html << "; the best is <strong>tied</strong> (not separated) with ";
+            for (std::size_t i = 0; i < tied.size(); ++i) html << (i ? ", " : "") << "<em>" << h(tied[i]) << "</em>";
+        }
         if (!beaten.empty()) {
-            html << "; the best is significantly above ";
+            html << "; it is significantly above ";
             for (std::size_t i = 0; i < beaten.size(); ++i)
                 html << (i ? ", " : "") << "<em>" << h(beaten[i]) << "</em>";
-        } else if (block.conditions.size() > 1) {
-            html << "; the best is not significantly above any other condition";
         }
         html << ".</li>\n";
         // The metric that predicts this block's scale best: highest Spearman oriented so that + means agreement.
@@ -399,12 +444,24 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
         }
         if (bestMetric) {
             const std::string a = "agreement-" + slug(block.name);
-            html << "<li>In <strong>" << h(block.name) << "</strong> the metric that predicts the scale best is <em>"
+            const int compared = static_cast<int>(
+                std::count_if(agreementResult.rows.begin(), agreementResult.rows.end(), [&](const auto& row) {
+                    return row.block == block.name && std::isfinite(row.spearmanP);
+                }));
+            html << "<li>In <strong>" << h(block.name) << "</strong> the metric that agrees best with the scale is <em>"
                  << h(bestMetric->metric.label) << "</em> (" << (bestMetric->metric.higherIsBetter ? "higher" : "lower")
                  << " is better): Spearman ρ = " << linked(a, num(bestMetric->spearman)) << " ["
                  << linked(a, num(bestMetric->spearmanLow)) << ", " << linked(a, num(bestMetric->spearmanHigh))
-                 << "], Pearson r = " << linked(a, num(bestMetric->pearson)) << " over " << bestMetric->conditions
-                 << " conditions";
+                 << "], p = " << num(bestMetric->spearmanP) << " (" << num(bestMetric->spearmanPHolm)
+                 << " after Holm's correction for choosing the best of " << compared
+                 << " metrics), Pearson r = " << linked(a, num(bestMetric->pearson)) << " over "
+                 << bestMetric->conditions << " conditions";
+            if (bestMetric->conditions < agreement::kFewConditions)
+                html << " — with so few conditions the intervals are wide and the choice of the best metric is "
+                        "weakly determined";
+            if (!(bestMetric->spearmanPHolm < 0.05))
+                html << "; no metric agrees significantly once the choice is "
+                        "accounted for";
             if (bestMetric->significantPairs > 0)
                 html << "; it orders " << linked(a, std::to_string(bestMetric->predictedPairs)) << " of "
                      << linked(a, std::to_string(bestMetric->significantPairs))
@@ -460,7 +517,11 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
                                    : "ok")
              << "</td><td class=\"l\">" << (o.excluded ? "excluded: " + h(o.reason) : std::string("included"))
              << "</td></tr>\n";
-    html << "</tbody></table>\n<p><strong>Viewing conditions.</strong> Recorded per answer by the browser: viewports ";
+    html << "</tbody></table>\n<p><strong>Viewing conditions.</strong> Recorded per answer by the browser"
+         << (simulated.empty() ? std::string()
+                               : std::string(" (the simulated observers report a fixed 1920×1080 viewport; nobody "
+                                             "looked at a screen)"))
+         << ": viewports ";
     {
         int shown = 0;
         for (const auto& [w, hgt] : viewports) {
@@ -510,8 +571,8 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
     // --- Scale. ---
     html << "<h2 id=\"scale\">Perceptual scale (JOD)</h2><p class=\"note\">Higher = chosen more often. Bars: "
          << num(100.0 * analysisOptions.bootstrap.level, 0) << " % confidence intervals; bars running off the axis end "
-         << "in a red arrow. Matrix: row − column in JOD; green = significant after correction, grey = not; n/c = "
-            "never compared directly.</p>\n";
+         << "in a red arrow. Conditions sorted by score here (design order elsewhere). Matrix: row − column in JOD; "
+            "green = significant after correction, grey = not; n/c = never compared directly.</p>\n";
     for (const scaling::BlockAnalysis& block : analysis.blocks) {
         std::vector<int> order(block.conditions.size());
         std::iota(order.begin(), order.end(), 0);
@@ -525,10 +586,25 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
              << " observers)</h3>" << scaleSvg(points);
         html << "<table><thead><tr><th class=\"l\">condition</th><th>JOD</th><th>low</th><th>high</th><th>SE</th></tr>"
                 "</thead><tbody>";
-        for (int i : order)
-            html << "<tr><td class=\"l\">" << h(block.conditions[static_cast<std::size_t>(i)]) << "</td><td>"
-                 << num(block.thurstone.scores[i]) << "</td><td>" << num(block.low[i]) << "</td><td>"
-                 << num(block.high[i]) << "</td><td>" << num(block.standardError[i]) << "</td></tr>";
+        for (int i : order) {
+            // A condition no pair of which was compared has no score: the prior alone put it at the mean.
+            const bool measured = std::any_of(block.pairs.begin(), block.pairs.end(), [&](const auto& pair) {
+                return (pair.test.first == i || pair.test.second == i) && pair.comparisons > 0;
+            });
+            // Where the interval fell back (percentile ∪ profile), the bootstrap SE means nothing: not shown.
+            const bool fallback = static_cast<std::size_t>(i) < block.intervalFlags.size() &&
+                                  block.intervalFlags[static_cast<std::size_t>(i)].fallback;
+            html << "<tr><td class=\"l\">" << h(block.conditions[static_cast<std::size_t>(i)]) << "</td>";
+            if (!measured) html << "<td colspan=\"4\" class=\"l\">not measured (never compared)</td></tr>";
+            else
+                html << "<td>" << num(block.thurstone.scores[i]) << "</td><td>" << num(block.low[i]) << "</td><td>"
+                     << num(block.high[i]) << (fallback ? " †" : "") << "</td><td>"
+                     << (fallback ? std::string("—") : num(block.standardError[i])) << "</td></tr>";
+        }
+        if (std::any_of(block.intervalFlags.begin(), block.intervalFlags.end(),
+                        [](const auto& f) { return f.fallback; }))
+            html << "<p class=\"note\">† interval from the hull of the percentile and profile-likelihood intervals "
+                    "(the studentized bootstrap is degenerate there); no standard error is given for it.</p>";
         html << "</tbody></table>";
         for (const std::string& warning : block.warnings) html << "<p class=\"note\">Note: " << h(warning) << "</p>";
         // Pairwise significance matrix.
@@ -560,6 +636,9 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
         }
         html << "</tbody></table>\n";
     }
+
+    // --- Predicted and measured (when the stimulus set recorded predictions). ---
+    html << predictionSectionHtml(predictions, predictionDisplay);
 
     // --- Objective errors. ---
     html << "<h2 id=\"metrics\">Objective errors against the reference</h2>\n";
@@ -619,10 +698,14 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
     } else {
         html
             << "<p class=\"note\">Correlation of each metric with the JOD scale over the block's conditions (raw sign: "
-               "an error metric that agrees with the observers correlates negatively). Intervals: "
-            << num(100.0 * agreementOptions.level, 0) << " % percentile bootstrap over observers ("
+               "an error metric that agrees with the observers correlates negatively). The conditions are the sample "
+               "(n per row). Intervals: "
+            << num(100.0 * agreementOptions.level, 0)
+            << " % Fisher z over the conditions (Spearman: Bonett–Wright), widened by the variance of a bootstrap "
+               "over observers ("
             << agreementOptions.samples
-            << " resamples, the scale re-fitted each time). Pairs: of the pairs the "
+            << " resamples, the scale re-fitted each time). p: no association, exact over every ordering of up to 8 "
+               "conditions; Holm: corrected over the block's metrics. Pairs: of the pairs the "
                "observers separated significantly, how many the metric orders the same way (ties count as not). "
                "Also in agreement.csv and agreement.json.</p>\n";
         static const std::vector<std::string> plotted = {"image.psnr_db",        "image.ssim",
@@ -631,7 +714,8 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
         for (const scaling::BlockAnalysis& block : analysis.blocks) {
             html << "<h3 id=\"agreement-" << slug(block.name) << "\">" << h(block.name) << "</h3><table><thead><tr>"
                  << "<th class=\"l\">metric</th><th>better</th><th>n</th><th>Pearson r</th><th>95 % interval</th>"
-                    "<th>Spearman ρ</th><th>95 % interval</th><th>pairs ordered</th></tr></thead><tbody>";
+                    "<th>Spearman ρ</th><th>95 % interval</th><th>p</th><th>p (Holm)</th><th>pairs ordered</th></tr>"
+                    "</thead><tbody>";
             std::vector<const agreement::MetricAgreement*> shown;
             for (const agreement::MetricAgreement& row : agreementResult.rows) {
                 if (row.block != block.name || row.conditions == 0) continue;
@@ -640,7 +724,8 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
                      << (row.metric.higherIsBetter ? "higher" : "lower") << "</td><td>" << row.conditions << "</td><td>"
                      << num(row.pearson) << "</td><td>[" << num(row.pearsonLow) << ", " << num(row.pearsonHigh)
                      << "]</td><td>" << num(row.spearman) << "</td><td>[" << num(row.spearmanLow) << ", "
-                     << num(row.spearmanHigh) << "]</td><td>"
+                     << num(row.spearmanHigh) << "]</td><td>" << num(row.spearmanP) << "</td><td>"
+                     << num(row.spearmanPHolm) << "</td><td>"
                      << (row.significantPairs
                              ? std::to_string(row.predictedPairs) + " / " + std::to_string(row.significantPairs)
                              : std::string("—"))

@@ -1,11 +1,17 @@
 #!/usr/bin/env bash
-# Installs missing Debian packages, configures (CMake preset "release") and builds everything.
+# Installs missing Debian packages, configures (CMake preset "release") and builds:
+#   scripts/build.sh              everything (libraries, the CLI, tests, benchmarks)
+#   scripts/build.sh TARGET ...   only those targets (the main job builds `skinlab`)
+# SKINLAB_DEPS picks the package profile (scripts/install-deps.sh: demo or all, default all).
+# Both README commands configure with the same flags, so the second one reuses what the first one built.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/install-deps.sh
+bash scripts/install-deps.sh "${SKINLAB_DEPS:-all}"
 # ccache (when present) may reuse objects across clones of the repository in other folders.
 export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=true
-# SKINLAB_WERROR=ON (scripts/test.sh, hence CI) treats every warning as an error, so e.g. a `switch` over SssMethod
-# that misses a method fails the build (-Wall includes -Wswitch).
-cmake --preset release -DSKINLAB_WERROR="${SKINLAB_WERROR:-OFF}" >/dev/null
-cmake --build --preset release -j "$(nproc)"
+# Warnings are errors (set SKINLAB_WERROR=OFF to build past them while developing), so e.g. a `switch` over
+# SssMethod that misses a method fails the build (-Wall includes -Wswitch).
+cmake --preset release -DSKINLAB_WERROR="${SKINLAB_WERROR:-ON}" >/dev/null
+targets=()
+for t in "$@"; do targets+=(--target "$t"); done
+cmake --build --preset release -j "$(nproc)" "${targets[@]}"

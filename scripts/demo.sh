@@ -12,7 +12,8 @@
 # and prints where everything is, and the command for a session with a real participant.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/build.sh
+# Only what the main job uses: the packages of the "demo" profile and the `skinlab` executable.
+SKINLAB_DEPS=demo bash scripts/build.sh skinlab
 export SKINLAB_ASSETS="${SKINLAB_ASSETS:-$(cd .. && pwd)/shared/assets}"
 skinlab=./build/release/cli/skinlab
 out=out/demo

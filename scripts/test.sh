@@ -4,8 +4,8 @@
 # $SKINLAB_ASSETS (default ../shared/assets) and skip with a message when it is absent.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-# Warnings are errors in the test build (set SKINLAB_WERROR=OFF to build past them while developing).
-SKINLAB_WERROR="${SKINLAB_WERROR:-ON}" bash scripts/build.sh
+# Everything, with every package the tests use (warnings are errors, as in the main job's build).
+SKINLAB_DEPS=all bash scripts/build.sh
 if [ -f tests/browser/package.json ]; then
   (cd tests/browser && npm install --no-audit --no-fund --loglevel=error >/dev/null)
 fi

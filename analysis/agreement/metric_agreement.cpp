@@ -2,6 +2,7 @@
 #include "common/csv.h"
 
 #include "analysis/scaling/bootstrap.h"
+#include "analysis/scaling/profile_likelihood.h"
 #include "common/error.h"
 #include "common/version.h"
 
@@ -11,6 +12,7 @@
 #include <limits>
 #include <numeric>
 #include <random>
+#include <tuple>
 
 namespace skinlab::analysis::agreement {
 namespace {
@@ -122,6 +124,40 @@ double spearmanCorrelation(const std::vector<double>& x, const std::vector<doubl
     return pearsonCorrelation(ranks(x), ranks(y));
 }
 
+std::pair<double, double> correlationInterval(double r, int n, bool spearman, double extraVariance, double level) {
+    if (n < 4 || !std::isfinite(r)) return {notANumber, notANumber};
+    const double clamped = std::clamp(r, -0.999999, 0.999999);
+    const double variance = (spearman ? 1.0 + 0.5 * r * r : 1.0) / double(n - 3) + std::max(0.0, extraVariance);
+    const double z = std::atanh(clamped);
+    const double half = scaling::normalQuantile(0.5 + 0.5 * level) * std::sqrt(variance);
+    return {std::tanh(z - half), std::tanh(z + half)};
+}
+
+double correlationPValue(const std::vector<double>& x, const std::vector<double>& y, bool spearman) {
+    auto correlation = [&](const std::vector<double>& a, const std::vector<double>& b) {
+        return spearman ? spearmanCorrelation(a, b) : pearsonCorrelation(a, b);
+    };
+    const double observed = correlation(x, y);
+    const std::size_t n = x.size();
+    if (!std::isfinite(observed)) return notANumber;
+    if (n <= 8) {
+        std::vector<std::size_t> order(n);
+        std::iota(order.begin(), order.end(), 0);
+        std::vector<double> permuted(n);
+        long long extreme = 0, total = 0;
+        do {
+            for (std::size_t i = 0; i < n; ++i) permuted[i] = y[order[i]];
+            const double r = correlation(x, permuted);
+            if (std::isfinite(r) && std::abs(r) >= std::abs(observed) - 1e-12) ++extreme;
+            ++total;
+        } while (std::next_permutation(order.begin(), order.end()));
+        return double(extreme) / double(total);
+    }
+    const double variance = (spearman ? 1.0 + 0.5 * observed * observed : 1.0) / double(n - 3);
+    const double z = std::atanh(std::clamp(observed, -0.999999, 0.999999)) / std::sqrt(variance);
+    return std::erfc(std::abs(z) / std::sqrt(2.0));
+}
+
 AgreementResult computeAgreement(const scaling::Dataset& dataset, const scaling::Analysis& analysis,
                                  const std::vector<ConditionMetrics>& metrics, const scaling::FitOptions& fit,
                                  const AgreementOptions& options) {
@@ -204,19 +240,24 @@ AgreementResult computeAgreement(const scaling::Dataset& dataset, const scaling:
                 if (std::isfinite(s)) spearmans.push_back(s);
             }
             row.bootstrapSamples = static_cast<int>(pearsons.size());
-            const double tail = 0.5 * (1.0 - options.level);
-            auto interval = [&](std::vector<double>& samples, double& low, double& high) {
-                if (samples.size() < 2 || !std::isfinite(row.pearson)) {
-                    low = high = notANumber;
-                    return;
+            // The observers' share of the uncertainty: the variance of atanh(r) over the resamples.
+            auto zVariance = [](const std::vector<double>& samples) {
+                if (samples.size() < 2) return 0.0;
+                double mean = 0.0, squares = 0.0;
+                for (double r : samples) mean += std::atanh(std::clamp(r, -0.999999, 0.999999));
+                mean /= double(samples.size());
+                for (double r : samples) {
+                    const double d = std::atanh(std::clamp(r, -0.999999, 0.999999)) - mean;
+                    squares += d * d;
                 }
-                std::sort(samples.begin(), samples.end());
-                low = scaling::sortedQuantile(samples, tail);
-                high = scaling::sortedQuantile(samples, 1.0 - tail);
+                return squares / double(samples.size() - 1);
             };
-            interval(pearsons, row.pearsonLow, row.pearsonHigh);
-            interval(spearmans, row.spearmanLow, row.spearmanHigh);
-            if (!std::isfinite(row.spearman)) row.spearmanLow = row.spearmanHigh = notANumber;
+            std::tie(row.pearsonLow, row.pearsonHigh) =
+                correlationInterval(row.pearson, row.conditions, false, zVariance(pearsons), options.level);
+            std::tie(row.spearmanLow, row.spearmanHigh) =
+                correlationInterval(row.spearman, row.conditions, true, zVariance(spearmans), options.level);
+            row.pearsonP = correlationPValue(x, y, false);
+            row.spearmanP = correlationPValue(x, y, true);
 
             // Pairs the observers separated significantly: does the metric order them the same way?
             for (const scaling::PairTest& pair : block.pairs) {
@@ -233,6 +274,25 @@ AgreementResult computeAgreement(const scaling::Dataset& dataset, const scaling:
                 row.significantPairs ? double(row.predictedPairs) / double(row.significantPairs) : notANumber;
             result.rows.push_back(row);
         }
+        // Holm over the block's metrics: naming the metric with the smallest p picks one of many.
+        std::vector<MetricAgreement*> tested;
+        for (MetricAgreement& row : result.rows)
+            if (row.block == block.name && std::isfinite(row.spearmanP)) tested.push_back(&row);
+            else if (row.block == block.name) row.spearmanPHolm = notANumber;
+        std::sort(tested.begin(), tested.end(),
+                  [](const MetricAgreement* a, const MetricAgreement* b) { return a->spearmanP < b->spearmanP; });
+        double running = 0.0;
+        for (std::size_t k = 0; k < tested.size(); ++k) {
+            running = std::max(running, std::min(1.0, double(tested.size() - k) * tested[k]->spearmanP));
+            tested[k]->spearmanPHolm = running;
+        }
+        const int used = static_cast<int>(std::count_if(byCondition.begin(), byCondition.end(),
+                                                        [](const ConditionMetrics* row) { return row != nullptr; }));
+        if (used < kFewConditions)
+            result.warnings.push_back(block.name + ": correlations over " + std::to_string(used) +
+                                      " conditions: their intervals are wide and the metric with the largest one "
+                                      "is weakly determined (" +
+                                      std::to_string(kFewConditions) + " or more conditions recommended)");
     }
     return result;
 }
@@ -257,6 +317,9 @@ nlohmann::json agreementJson(const AgreementResult& result) {
                         {"spearman", jsonNumber(row.spearman)},
                         {"spearman_low", jsonNumber(row.spearmanLow)},
                         {"spearman_high", jsonNumber(row.spearmanHigh)},
+                        {"pearson_p", jsonNumber(row.pearsonP)},
+                        {"spearman_p", jsonNumber(row.spearmanP)},
+                        {"spearman_p_holm", jsonNumber(row.spearmanPHolm)},
                         {"significant_pairs", row.significantPairs},
                         {"predicted_pairs", row.predictedPairs},
                         {"predicted_share", jsonNumber(row.predictedShare)},
@@ -268,7 +331,10 @@ nlohmann::json agreementJson(const AgreementResult& result) {
              {{"bootstrap_samples", result.options.samples},
               {"seed", result.options.seed},
               {"level", result.options.level},
-              {"interval", "percentile, observers resampled with replacement, Thurstone scale re-fitted per resample"},
+              {"interval", "Fisher z over the conditions (Spearman: Bonett-Wright variance), widened by the variance "
+                           "of atanh(r) over a bootstrap of the observers (Thurstone scale re-fitted per resample)"},
+              {"p_value", "two-sided, no association: exact over all orderings of the conditions up to 8, else Fisher "
+                          "z; spearman_p_holm: Holm over the block's metrics"},
               {"correlation_sign", "raw: metric against JOD (an error metric that agrees with observers correlates "
                                    "negatively)"},
               {"pairs", "pairs significant in the scale analysis; a tie in the metric counts as not predicted"}}},
@@ -278,12 +344,14 @@ nlohmann::json agreementJson(const AgreementResult& result) {
 }
 
 std::string agreementCsv(const AgreementResult& result) {
-    std::string out = "block,metric,higher_is_better,conditions,pearson,pearson_low,pearson_high,spearman,spearman_low,"
-                      "spearman_high,significant_pairs,predicted_pairs,predicted_share\n";
+    std::string out =
+        "block,metric,higher_is_better,conditions,pearson,pearson_low,pearson_high,spearman,spearman_low,"
+        "spearman_high,pearson_p,spearman_p,spearman_p_holm,significant_pairs,predicted_pairs,predicted_share\n";
     for (const MetricAgreement& row : result.rows) {
         out += csvText(row.block) + "," + row.metric.key + "," + (row.metric.higherIsBetter ? "1" : "0") + "," +
                std::to_string(row.conditions);
-        for (double v : {row.pearson, row.pearsonLow, row.pearsonHigh, row.spearman, row.spearmanLow, row.spearmanHigh})
+        for (double v : {row.pearson, row.pearsonLow, row.pearsonHigh, row.spearman, row.spearmanLow, row.spearmanHigh,
+                         row.pearsonP, row.spearmanP, row.spearmanPHolm})
             out += "," + csvNumber(v);
         out += "," + std::to_string(row.significantPairs) + "," + std::to_string(row.predictedPairs) + "," +
                csvNumber(row.predictedShare) + "\n";

@@ -1,9 +1,11 @@
 #pragma once
 // Image metrics against perception (docs/metrics.md, "Metrics against perception"): for each block of a study
 // whose stimuli were scored against a reference, the Pearson and Spearman correlations between every metric and
-// the JOD scale across the block's conditions, with percentile intervals from a bootstrap over observers (each
-// resample re-fits the scale), and the share of the pairs that observers separated significantly whose order the
-// metric predicts.
+// the JOD scale across the block's conditions, and the share of the pairs that observers separated significantly
+// whose order the metric predicts. The conditions are the sample a correlation is computed over (a handful, as a
+// rule), so its interval is Fisher's z interval over the conditions (Bonett & Wright 2000 for Spearman), widened by
+// the variance a bootstrap over observers (each resample re-fits the scale) adds; its p value is exact (all
+// permutations of the conditions) for up to 8 conditions.
 #include "analysis/scaling/scale_analysis.h"
 
 #include <cstdint>
@@ -42,8 +44,11 @@ conditionMetricsFromJson(const nlohmann::json& metrics, const std::string& file,
 struct AgreementOptions {
     int samples = 1000; // bootstrap resamples of the observers
     std::uint64_t seed = 1;
-    double level = 0.95; // two-sided percentile interval
+    double level = 0.95; // two-sided interval
 };
+
+// Fewer conditions than this in a block: a warning that its correlations are weakly determined.
+inline constexpr int kFewConditions = 8;
 
 struct MetricAgreement {
     std::string block;
@@ -51,7 +56,9 @@ struct MetricAgreement {
     int conditions = 0; // conditions with a finite value of the metric (and a JOD score)
     double pearson = 0.0, pearsonLow = 0.0, pearsonHigh = 0.0; // metric vs JOD; NaN when undefined
     double spearman = 0.0, spearmanLow = 0.0, spearmanHigh = 0.0;
-    int significantPairs = 0;    // pairs of these conditions separated significantly (scale analysis)
+    double pearsonP = 0.0, spearmanP = 0.0; // two-sided p of no correlation (exact permutation for ≤ 8 conditions)
+    double spearmanPHolm = 0.0;             // spearmanP after Holm's correction over the block's metrics
+    int significantPairs = 0;               // pairs of these conditions separated significantly (scale analysis)
     int predictedPairs = 0;      // of them, pairs the metric orders as the observers did (ties: not predicted)
     double predictedShare = 0.0; // predicted / significant; NaN without a significant pair
     int bootstrapSamples = 0;    // resamples with a defined correlation
@@ -80,6 +87,14 @@ AgreementResult computeAgreement(const scaling::Dataset& dataset, const scaling:
 double pearsonCorrelation(const std::vector<double>& x, const std::vector<double>& y);
 // Spearman's ρ: Pearson of the ranks, ties sharing their mean rank.
 double spearmanCorrelation(const std::vector<double>& x, const std::vector<double>& y);
+
+// Interval of a correlation `r` over `n` conditions at `level`: tanh(atanh r ± z·se) with se² = c/(n − 3) +
+// `extraVariance` (of atanh r; the observers' share), c = 1 for Pearson, 1 + r²/2 for Spearman (Bonett & Wright
+// 2000). NaN for n < 4.
+std::pair<double, double> correlationInterval(double r, int n, bool spearman, double extraVariance, double level);
+// Two-sided p of |correlation| ≥ |observed| under no association: exact over all n! orderings for n ≤ 8, else
+// from Fisher's z (variance 1/(n − 3), Spearman (1 + r²/2)/(n − 3)).
+double correlationPValue(const std::vector<double>& x, const std::vector<double>& y, bool spearman);
 
 nlohmann::json agreementJson(const AgreementResult& result); // format "skinlab-agreement", version 1
 std::string agreementCsv(const AgreementResult& result);     // one row per block and metric

@@ -151,6 +151,22 @@ Dataset buildDataset(const ResponseTable& table, const DatasetOptions& options) 
         }
         observers[b].add(r.observer);
     }
+    // A study database lists each block's conditions in the design's order (conditions it does not name follow
+    // in first-appearance order), so the CLI, the dashboard and the report show them alike.
+    if (options.conditionOrder.empty())
+        for (size_t b = 0; b < conditions.size(); ++b) {
+            const auto design = table.designConditionOrder.find(blocks.names[b]);
+            if (design == table.designConditionOrder.end()) continue;
+            auto rank = [&](const std::string& name) {
+                const auto it = std::find(design->second.begin(), design->second.end(), name);
+                return it - design->second.begin();
+            };
+            std::vector<std::string> names = conditions[b].names;
+            std::stable_sort(names.begin(), names.end(),
+                             [&](const std::string& x, const std::string& y) { return rank(x) < rank(y); });
+            conditions[b] = NameIndex();
+            for (const std::string& name : names) conditions[b].add(name);
+        }
     if (!options.onlyBlock.empty() && blocks.find(options.onlyBlock) < 0)
         throwInput(table.file, "--block",
                    "no block '" + options.onlyBlock + "' (blocks: " + joined(blocks.names) + ")");

@@ -10,6 +10,7 @@
 //  - a count matrix CSV: header `condition,<name 1>,...,<name m>`, then one row per condition
 //    `<name i>,D_i1,...,D_im` with D_ij = times i was chosen over j (one block, no observers).
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -45,6 +46,8 @@ struct ResponseTable {
     std::vector<double> matrixCounts;
     // Study databases only: the pairs were chosen from earlier answers (a study with pairs = "active").
     bool adaptiveDesign = false;
+    // Study databases only: each block's conditions in the design's order (the order every output lists them in).
+    std::map<std::string, std::vector<std::string>> designConditionOrder;
 };
 
 // Reads any accepted format; throws InputError "FILE: line N: column C: message" on bad input.

@@ -213,7 +213,19 @@ nlohmann::json analysisJson(const Analysis& analysis) {
 std::string reportSectionHtml(const Analysis& analysis) {
     const AnalysisOptions& o = analysis.options;
     std::ostringstream html;
-    html << "<section class=\"skinlab-scaling\">\n<h2>Perceptual scaling (Thurstone Case V, JOD)</h2>\n"
+    // Styled on its own (the rules apply inside the section only), so the file reads well opened alone and embedded.
+    html << "<section class=\"skinlab-scaling\">\n<meta charset=\"utf-8\">\n<style>\n"
+            ".skinlab-scaling { font-family: system-ui, sans-serif; max-width: 60em; margin: 1em auto; color: #222; "
+            "line-height: 1.4; }\n"
+            ".skinlab-scaling table { border-collapse: collapse; margin: 0.5em 0 1.5em; }\n"
+            ".skinlab-scaling th, .skinlab-scaling td { border: 1px solid #ccc; padding: 0.2em 0.6em; "
+            "text-align: left; }\n"
+            ".skinlab-scaling th { background: #f2f2f2; }\n"
+            ".skinlab-scaling img { max-width: 100%; margin: 0.3em 0.5em 0.3em 0; vertical-align: top; }\n"
+            ".skinlab-scaling .warning { color: #8a4b00; }\n"
+            ".skinlab-scaling code { background: #f4f4f4; padding: 0 0.2em; }\n"
+            "</style>\n";
+    html << "<h2>Perceptual scaling (Thurstone Case V, JOD)</h2>\n"
          << "<p>Input <code>" << escapeHtml(analysis.file) << "</code> (" << responseFormatName(analysis.format)
          << "). Scores in JOD (1 JOD = 75 % preference, each block's mean = 0); " << fixed(100 * o.bootstrap.level, 0)
          << (o.intervals == IntervalMethod::profile

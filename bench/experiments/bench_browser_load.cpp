@@ -68,10 +68,10 @@ struct Options {
 };
 
 // Five conditions in one block: 10 pairs × 2 repetitions + 2 catch = 22 answers per participant; images are random
-// bytes of the given size (the server does not decode them; a 1280×720 PNG is about 1 MiB).
+// bytes of the given size (the server does not decode them; the dimensions declared are the demo's 896×504, which a 1920×1080 window shows side by side).
 void writeSet(const fs::path& folder, int imageKiB) {
     std::mt19937 random(1);
-    skinlab::bench::writeBenchStimulusSet(folder, 5, 1280, 720, [&](const std::string&) {
+    skinlab::bench::writeBenchStimulusSet(folder, 5, 896, 504, [&](const std::string&) {
         std::string bytes(static_cast<std::size_t>(imageKiB) * 1024, '\0');
         for (char& c : bytes) c = static_cast<char>(random());
         return bytes;

@@ -21,9 +21,11 @@ let trialHidden = false; // the page was hidden while the current trial was show
 let trialBlurred = false; // the window lost the focus while the current trial was shown
 
 const $ = (id) => document.getElementById(id);
-const MARGIN = 16;      // CSS px between and around the images
-const TOP = 64;         // CSS px reserved for the question (and practice label)
-const BOTTOM = 36;      // CSS px reserved for the key hint
+// CSS px between and around the images, above them (the question and practice label) and below them (the key
+// hint): the server's figures (GET /api/study "stage"), the same ones `study create` checked the design with.
+let MARGIN = 16;
+let TOP = 64;
+let BOTTOM = 36;
 
 function showScreen(html) {
   $('stage').hidden = true;
@@ -188,6 +190,7 @@ async function start() {
       escapeHtml(platform) + ' (the link carries your participant id).</p>');
     return;
   }
+  await ensureStudyFits();
   if (!token) {
     showScreen('<h1>' + escapeHtml(study.title) + '</h1><p class="message">' +
       escapeHtml(study.consent || 'This study shows you pairs of images and asks which one matches a question. ' +
@@ -237,17 +240,21 @@ function updateProgress() {
   $('bar-fill').style.width = (total ? (100 * done / total) : 100) + '%';
 }
 
+// CSS pixels needed to show images of w × h device pixels side by side (and a reference refH tall above them) at
+// one image pixel per device pixel.
+function needed(w, h, refH) {
+  const dpr = window.devicePixelRatio || 1;
+  return {needW: Math.ceil(w / dpr + 3 * MARGIN), needH: Math.ceil((h + refH) / dpr + TOP + BOTTOM + (refH ? MARGIN : 0))};
+}
+
 // Layout in device pixels, snapped so every image's top-left corner is on a whole device pixel.
 function layout(trial) {
   const dpr = window.devicePixelRatio || 1;
   const w = trial.left.width + trial.right.width;
   const h = Math.max(trial.left.height, trial.right.height);
   const refH = trial.reference ? trial.reference.height : 0;
-  const needW = w / dpr + 3 * MARGIN;
-  const needH = (h + refH) / dpr + TOP + BOTTOM + (trial.reference ? MARGIN : 0);
-  if (window.innerWidth < needW || window.innerHeight < needH) {
-    return {tooSmall: true, needW: Math.ceil(needW), needH: Math.ceil(needH)};
-  }
+  const {needW, needH} = needed(w, h, refH);
+  if (window.innerWidth < needW || window.innerHeight < needH) return {tooSmall: true, needW, needH};
   const snap = (cssPx) => Math.round(cssPx * dpr) / dpr;
   const top = snap(TOP + (trial.reference ? refH / dpr + MARGIN : 0) +
                    (window.innerHeight - needH) / 2);
@@ -285,13 +292,33 @@ function imagesLoaded() {
     new Promise((resolve) => { img.onload = resolve; img.onerror = resolve; })));
 }
 
+function showTooSmall(l) {
+  document.body.dataset.tooSmall = l.needW + 'x' + l.needH;
+  showScreen('<h1>The window is too small</h1><p class="message">The images are shown at their exact pixel size. ' +
+    'Please enlarge the window (or use full screen, or reset the browser zoom to 100%) to at least ' +
+    l.needW + ' × ' + l.needH + ' CSS pixels (now ' + window.innerWidth + ' × ' + window.innerHeight + '). ' +
+    'The study continues by itself once the window is large enough.</p>');
+}
+
 async function ensureWindowLargeEnough(trial) {
   for (;;) {
     const l = layout(trial);
-    if (!l.tooSmall) return l;
-    showScreen('<h1>The window is too small</h1><p class="message">The images are shown at their exact pixel size. ' +
-      'Please enlarge the window (or use full screen, or reset the browser zoom to 100%) to at least ' +
-      l.needW + ' × ' + l.needH + ' CSS pixels (now ' + window.innerWidth + ' × ' + window.innerHeight + ').</p>');
+    if (!l.tooSmall) { delete document.body.dataset.tooSmall; return l; }
+    showTooSmall(l);
+    await new Promise((resolve) => window.addEventListener('resize', resolve, {once: true}));
+  }
+}
+
+// Before consent (and before joining): the largest trial of the study must fit, so nobody joins, or does any
+// work, in a window too small to take part.
+async function ensureStudyFits() {
+  const stage = study.stage;
+  if (!stage) return;
+  MARGIN = stage.margin; TOP = stage.top; BOTTOM = stage.bottom;
+  for (;;) {
+    const l = needed(stage.pair_width, stage.pair_height, stage.reference_height);
+    if (window.innerWidth >= l.needW && window.innerHeight >= l.needH) { delete document.body.dataset.tooSmall; return; }
+    showTooSmall(l);
     await new Promise((resolve) => window.addEventListener('resize', resolve, {once: true}));
   }
 }

@@ -206,16 +206,35 @@ function renderScale(scale) {
   }));
 }
 
-// Each condition's score (dot) and interval (line) on a common JOD axis.
+// A tick step of 1, 2 or 5 × 10^k giving about five ticks over `span`.
+function tickStep(span) {
+  const raw = span / 5;
+  const power = Math.pow(10, Math.floor(Math.log10(raw)));
+  return [1, 2, 5, 10].map((m) => m * power).find((step) => step >= raw);
+}
+
+// Each condition's score (dot) and interval (line) on a common JOD axis whose ends are ticks beyond every value.
 function scalePlot(conditions) {
-  const width = 640, rowHeight = 22, left = 160, right = 20;
-  const height = conditions.length * rowHeight + 28;
-  const values = conditions.flatMap((c) => [c.low, c.high, c.jod]).filter((v) => typeof v === 'number');
-  const lo = Math.min(...values, 0), hi = Math.max(...values, 0);
-  const span = hi - lo || 1;
-  const x = (v) => left + (width - left - right) * (v - lo) / span;
+  const width = 640, rowHeight = 22, left = 160, right = 20, axisHeight = 34;
+  const height = conditions.length * rowHeight + axisHeight;
+  const values = conditions.flatMap((c) => [c.low, c.high, c.jod]).filter((v) => typeof v === 'number' && isFinite(v));
+  let lo = Math.min(...values, 0), hi = Math.max(...values, 0);
+  if (hi - lo < 1e-9) { lo -= 0.5; hi += 0.5; }
+  const step = tickStep(hi - lo);
+  lo = Math.floor(lo / step - 1e-9) * step;
+  hi = Math.ceil(hi / step + 1e-9) * step;
+  const x = (v) => left + (width - left - right) * (v - lo) / (hi - lo);
   const svg = svgElement('svg', { width, height, role: 'img', 'aria-label': 'JOD scale with intervals' });
-  svg.append(svgElement('line', { class: 'axis', x1: x(0), y1: 4, x2: x(0), y2: height - 20 }));
+  const axisY = height - axisHeight + 8;
+  svg.append(svgElement('line', { class: 'axis', x1: x(lo), y1: axisY, x2: x(hi), y2: axisY }));
+  const digits = step < 0.1 ? 2 : step < 1 ? 1 : 0;
+  for (let k = 0, v = lo; v <= hi + step / 2; v = lo + (++k) * step) {
+    svg.append(svgElement('line', { class: v === 0 || Math.abs(v) < step / 1e6 ? 'axis zero' : 'tick', x1: x(v), y1: 4,
+      x2: x(v), y2: axisY + 4 }));
+    svg.append(svgElement('text', { class: 'tick-label', x: x(v), y: axisY + 16, 'text-anchor': 'middle' },
+      fixed(v, digits)));
+  }
+  svg.append(svgElement('text', { class: 'tick-label', x: width - right, y: height - 2, 'text-anchor': 'end' }, 'JOD'));
   conditions.forEach((c, i) => {
     const y = 14 + i * rowHeight;
     svg.append(svgElement('text', { x: 4, y: y + 4 }, c.condition));
@@ -223,8 +242,6 @@ function scalePlot(conditions) {
       svg.append(svgElement('line', { class: 'interval', x1: x(c.low), y1: y, x2: x(c.high), y2: y }));
     if (typeof c.jod === 'number') svg.append(svgElement('circle', { class: 'point', cx: x(c.jod), cy: y, r: 4 }));
   });
-  svg.append(svgElement('text', { x: x(lo), y: height - 4 }, fixed(lo, 1) + ' JOD'),
-    svgElement('text', { x: x(hi) - 40, y: height - 4 }, fixed(hi, 1) + ' JOD'));
   return svg;
 }
 

@@ -84,7 +84,7 @@ SceneSpec loadSceneSpec(const std::string& scene, const std::vector<std::string>
             assetsDirectory = environment;
 
     // Errors name the spec file (or builtin:NAME) the way the user wrote it.
-    SpecReader root(table, scene.rfind("builtin:", 0) == 0 ? scene : scene, "");
+    SpecReader root(table, scene, "");
     PathResolver paths{&root, specDirectory, assetsDirectory};
     nlohmann::json resolved;
     resolved["scene"] = scene;

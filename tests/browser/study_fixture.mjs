@@ -52,9 +52,10 @@ export function encodePng(width, height, rgb) {
     chunk('IDAT', zlib.deflateSync(raw)), chunk('IEND', Buffer.alloc(0))]);
 }
 
-// One block, `methods` conditions; design with one practice and one blank catch trial. Returns the study path.
-export function createStudy(cli, work, { methods = ['reference-like', 'separable', 'artistic'], title = 'Online test' } = {}) {
-  const W = 96, H = 64;
+// One block, `methods` conditions of W × H pixels; design with one practice and one blank catch trial (and
+// `designExtra`, TOML tables appended). Returns the study path.
+export function createStudy(cli, work, { methods = ['reference-like', 'separable', 'artistic'], title = 'Online test',
+  width: W = 96, height: H = 64, designExtra = '' } = {}) {
   fs.mkdirSync(path.join(work, 'stimuli/png'), { recursive: true });
   const manifest = { format: 'skinlab-stimuli', version: 1, set: 'online-test', spec_sha256: '0'.repeat(64),
     renderer: { gl_renderer: 'none', gl_version: '', skinlab_version: '' }, stimuli: [] };
@@ -72,7 +73,7 @@ export function createStudy(cli, work, { methods = ['reference-like', 'separable
   fs.writeFileSync(path.join(work, 'stimuli/manifest.json'), JSON.stringify(manifest, null, 2));
   fs.writeFileSync(path.join(work, 'design.toml'),
     `title = "${title}"\nquestion = "Which looks more like real skin?"\nseed = 5\nbreak_every = 0\nrepetitions = 1\n` +
-    '[practice]\ntrials = 1\n[catch]\nblank = 1\n');
+    '[practice]\ntrials = 1\n[catch]\nblank = 1\n' + designExtra);
   const database = path.join(work, 'study.db');
   const created = spawnSync(cli, ['study', 'create', '--stimuli', path.join(work, 'stimuli'), '--design',
     path.join(work, 'design.toml'), '-o', database], { encoding: 'utf8' });

@@ -38,6 +38,17 @@ TEST(ReportPlots, ScatterSkipsUndefinedPoints) {
     EXPECT_EQ(svg.find("nan"), std::string::npos);
 }
 
+// An interval far beyond the points is clipped with a red arrow at each end it leaves (the value in the tooltip),
+// and a label of a point in the right part of the plot is anchored at its end, so it is not cut at the figure's edge.
+TEST(ReportPlots, ScatterMarksClippedBarsAndKeepsLabelsInside) {
+    std::vector<ScatterPoint> points = {{"gaussian-sum", 0.9, 0.5, -200, 200}, {"none", 0.1, -0.5, -0.8, -0.2}};
+    std::string svg = scatterSvg(points, "mean FLIP");
+    EXPECT_EQ(count(svg, "class=\"clip\""), 2);
+    EXPECT_NE(svg.find("interval continues to 200.00 JOD"), std::string::npos);
+    EXPECT_NE(svg.find("text-anchor=\"end\">gaussian-sum</text>"), std::string::npos) << svg;
+    EXPECT_NE(svg.find("class=\"point\">none</text>"), std::string::npos);
+}
+
 TEST(ReportPlots, NumbersNeverShowNan) {
     EXPECT_EQ(formatNumber(NAN, 2), "\u2014");
     EXPECT_EQ(formatNumber(std::numeric_limits<double>::infinity(), 2), "\u2014");

@@ -1,6 +1,0 @@
-#include "cli/commands.h"
-
-namespace skinlab::cli {
-// Placeholder: the owning module fills this in.
-void registerBench(CLI::App& app) { (void)app; }
-} // namespace skinlab::cli

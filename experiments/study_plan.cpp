@@ -1,0 +1,147 @@
+#include "experiments/study_plan.h"
+
+#include "analysis/scaling/pairwise_model.h"
+#include "analysis/scaling/simulation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+
+namespace skinlab::experiments {
+namespace scaling = skinlab::analysis::scaling;
+
+namespace {
+
+// Two-sided p of a standard normal statistic.
+double twoSidedP(double z) { return std::erfc(std::abs(z) / std::sqrt(2.0)); }
+
+// Which pairs (i < j, indices into the conditions) one simulated study resolves: Wald tests from the fit's Fisher
+// information, Holm over every pair of the block, significant at α with the sign of the predicted difference.
+std::vector<std::vector<bool>> resolvedPairs(const scaling::BlockData& block, const std::vector<double>& truth,
+                                             double alpha) {
+    const int m = block.conditionCount();
+    const scaling::FitResult fit = scaling::fitScores(block.totalCounts(), scaling::FitOptions());
+    struct Test {
+        int i, j;
+        double p;
+        bool rightWay;
+    };
+    std::vector<Test> tests;
+    for (int i = 0; i < m; ++i)
+        for (int j = i + 1; j < m; ++j) {
+            const double difference = fit.scores[i] - fit.scores[j];
+            const double variance =
+                fit.inverseInformation(i, i) + fit.inverseInformation(j, j) - 2.0 * fit.inverseInformation(i, j);
+            const double p = variance > 0 ? twoSidedP(difference / std::sqrt(variance)) : 1.0;
+            tests.push_back({i, j, p, (difference > 0) == (truth[i] > truth[j])});
+        }
+    std::vector<std::size_t> order(tests.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return tests[a].p < tests[b].p; });
+    std::vector<std::vector<bool>> resolved(static_cast<std::size_t>(m), std::vector<bool>(m, false));
+    double running = 0.0;
+    for (std::size_t k = 0; k < order.size(); ++k) {
+        const Test& t = tests[order[k]];
+        running = std::max(running, std::min(1.0, double(order.size() - k) * t.p));
+        const bool significant = running < alpha && t.rightWay;
+        resolved[t.i][t.j] = resolved[t.j][t.i] = significant;
+    }
+    return resolved;
+}
+
+} // namespace
+
+StudyPlan planStudy(const StudyDefinition& definition, const SimulationTruth& truth, const PlanOptions& options) {
+    StudyPlan plan;
+    plan.options = options;
+    plan.repetitions = definition.design.repetitions;
+    plan.trialsPerObserver = definition.design.practiceTrials + definition.testTrialCount() +
+                             definition.repeatTrialCount() + definition.catchTrialCount();
+    for (const StudyBlock& block : definition.blocks) {
+        PlannedBlock planned;
+        planned.name = block.name;
+        planned.conditions = block.conditions;
+        for (const std::string& condition : block.conditions)
+            planned.predicted.push_back(truth.quality(block.name, condition));
+        const int m = static_cast<int>(block.conditions.size());
+        std::vector<int> byQuality(static_cast<std::size_t>(m));
+        std::iota(byQuality.begin(), byQuality.end(), 0);
+        std::stable_sort(byQuality.begin(), byQuality.end(),
+                         [&](int a, int b) { return planned.predicted[a] > planned.predicted[b]; });
+        for (int k = 0; k + 1 < m; ++k)
+            planned.neighbours.push_back({block.conditions[byQuality[k]],
+                                          block.conditions[byQuality[k + 1]],
+                                          planned.predicted[byQuality[k]] - planned.predicted[byQuality[k + 1]],
+                                          {}});
+        for (std::size_t c = 0; c < options.observerCounts.size(); ++c) {
+            std::vector<int> resolvedCount(planned.neighbours.size(), 0);
+            for (int s = 0; s < options.simulations; ++s) {
+                scaling::SimulationDesign design;
+                design.trueScores = planned.predicted;
+                design.observers = options.observerCounts[c];
+                design.trialsPerPair = definition.design.repetitions;
+                const std::uint64_t seed = options.seed * 1000003ull + c * 7919ull + static_cast<std::uint64_t>(s);
+                const scaling::SimulatedBlock simulated = scaling::simulateBlock(design, seed);
+                const auto resolved = resolvedPairs(simulated.block, planned.predicted, options.alpha);
+                for (std::size_t k = 0; k < planned.neighbours.size(); ++k)
+                    if (resolved[byQuality[k]][byQuality[k + 1]]) ++resolvedCount[k];
+            }
+            for (std::size_t k = 0; k < planned.neighbours.size(); ++k)
+                planned.neighbours[k].power.push_back(double(resolvedCount[k]) / options.simulations);
+            const bool all = std::all_of(planned.neighbours.begin(), planned.neighbours.end(),
+                                         [&](const PlannedPair& p) { return p.power.back() >= options.power; });
+            if (all && planned.observersNeeded < 0) planned.observersNeeded = options.observerCounts[c];
+        }
+        plan.blocks.push_back(std::move(planned));
+    }
+    return plan;
+}
+
+std::string planText(const StudyPlan& plan) {
+    std::string out;
+    char line[512];
+    std::snprintf(line, sizeof line,
+                  "power by simulation: %d simulated studies per observer count, each pair shown %d time(s) to every "
+                  "observer, Holm over each block's pairs, alpha %.3g, target power %.2g; %d trials per observer\n",
+                  plan.options.simulations, plan.repetitions, plan.options.alpha, plan.options.power,
+                  plan.trialsPerObserver);
+    out += line;
+    for (const PlannedBlock& block : plan.blocks) {
+        out += "block " + block.name + ": predicted JOD";
+        for (std::size_t i = 0; i < block.conditions.size(); ++i) {
+            std::snprintf(line, sizeof line, "%s %s %.3f", i ? "," : "", block.conditions[i].c_str(),
+                          block.predicted[i]);
+            out += line;
+        }
+        out += "\n  neighbours (predicted order) and their power at";
+        for (int n : plan.options.observerCounts) out += " " + std::to_string(n);
+        out += " observers:\n";
+        for (const PlannedPair& pair : block.neighbours) {
+            std::snprintf(line, sizeof line, "  %s > %s (%.3f JOD):", pair.better.c_str(), pair.worse.c_str(),
+                          pair.difference);
+            out += line;
+            for (double p : pair.power) {
+                std::snprintf(line, sizeof line, " %.2f", p);
+                out += line;
+            }
+            out += "\n";
+        }
+        if (block.observersNeeded > 0) {
+            std::snprintf(line, sizeof line,
+                          "  needs %d observers (%d trials in all) for every neighbouring pair to be resolved with "
+                          "power >= %.2g\n",
+                          block.observersNeeded, block.observersNeeded * plan.trialsPerObserver, plan.options.power);
+            out += line;
+        } else {
+            std::snprintf(line, sizeof line,
+                          "  not resolved with power >= %.2g by %d observers: the predicted differences are too small "
+                          "for this design\n",
+                          plan.options.power, plan.options.observerCounts.back());
+            out += line;
+        }
+    }
+    return out;
+}
+
+} // namespace skinlab::experiments
