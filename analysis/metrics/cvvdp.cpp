@@ -26,6 +26,14 @@ namespace {
 using Clock = std::chrono::steady_clock;
 constexpr double pi = 3.14159265358979323846;
 
+// Runs body(y) for every row, the rows split across OpenCV's worker threads.
+template <typename Body>
+void forRows(int rows, const Body& body) {
+    cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
+        for (int y = range.start; y < range.end; ++y) body(y);
+    });
+}
+
 double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 nlohmann::json embeddedJson(const char* name) {
@@ -156,7 +164,7 @@ cv::Mat reduce(const cv::Mat& x) {
     const int h = x.rows, w = x.cols;
     const int h2 = (h + 1) / 2, w2 = (w + 1) / 2;
     cv::Mat rowsPass(h2, w, CV_32FC1);
-    for (int i = 0; i < h2; ++i) {
+    forRows(h2, [&](int i) {
         float* out = rowsPass.ptr<float>(i);
         std::fill(out, out + w, 0.0f);
         for (int k = 0; k < 5; ++k) {
@@ -165,7 +173,7 @@ cv::Mat reduce(const cv::Mat& x) {
             const float* in = x.ptr<float>(source);
             for (int j = 0; j < w; ++j) out[j] += kernel[k] * in[j];
         }
-    }
+    });
     auto addRow = [&](int target, int source, float weight) {
         float* out = rowsPass.ptr<float>(target);
         const float* in = x.ptr<float>(source);
@@ -182,7 +190,7 @@ cv::Mat reduce(const cv::Mat& x) {
 
     cv::Mat y(h2, w2, CV_32FC1);
     const bool oddRows = h % 2 == 1;
-    for (int i = 0; i < h2; ++i) {
+    forRows(h2, [&](int i) {
         const float* in = rowsPass.ptr<float>(i);
         float* out = y.ptr<float>(i);
         for (int j = 0; j < w2; ++j) {
@@ -202,7 +210,7 @@ cv::Mat reduce(const cv::Mat& x) {
         out[0] += in[0] * kernel[1] + (w > 1 ? in[1] * kernel[0] : 0.0f);
         if (oddRows) out[w2 - 1] += in[w - 1] * kernel[3] + (w > 1 ? in[w - 2] * kernel[4] : 0.0f);
         else out[w2 - 1] += in[w - 1] * kernel[4];
-    }
+    });
     return y;
 }
 
@@ -213,7 +221,7 @@ cv::Mat expand(const cv::Mat& x, int h, int w) {
     const int hx = x.rows, wx = x.cols;
     auto clampIndex = [](int i, int n) { return std::clamp(i, 0, n - 1); };
     cv::Mat columns(hx, w, CV_32FC1);
-    for (int i = 0; i < hx; ++i) {
+    forRows(hx, [&](int i) {
         const float* in = x.ptr<float>(i);
         float* out = columns.ptr<float>(i);
         for (int n = 0; n < w; ++n) {
@@ -223,9 +231,9 @@ cv::Mat expand(const cv::Mat& x, int h, int w) {
                                  kernel[4] * in[clampIndex(m + 1, wx)]);
             else out[n] = 2.0f * (kernel[1] * in[clampIndex(m, wx)] + kernel[3] * in[clampIndex(m + 1, wx)]);
         }
-    }
+    });
     cv::Mat y(h, w, CV_32FC1);
-    for (int n = 0; n < h; ++n) {
+    forRows(h, [&](int n) {
         const int m = n / 2;
         float* out = y.ptr<float>(n);
         if (n % 2 == 0) {
@@ -238,7 +246,7 @@ cv::Mat expand(const cv::Mat& x, int h, int w) {
             const float* b = columns.ptr<float>(clampIndex(m + 1, hx));
             for (int j = 0; j < w; ++j) out[j] = 2.0f * (kernel[1] * a[j] + kernel[3] * b[j]);
         }
-    }
+    });
     return y;
 }
 
@@ -528,7 +536,7 @@ CvvdpResult cvvdp(const cv::Mat& referenceLinear, const cv::Mat& testLinear, con
     for (int img = 0; img < 2; ++img) {
         const cv::Mat& source = img == 0 ? testLinear : referenceLinear;
         for (int c = 0; c < 3; ++c) planes[c][img].create(height, width, CV_32FC1);
-        for (int y = 0; y < height; ++y) {
+        forRows(height, [&](int y) {
             const auto* in = source.ptr<cv::Vec3f>(y);
             float* out[3] = {planes[0][img].ptr<float>(y), planes[1][img].ptr<float>(y), planes[2][img].ptr<float>(y)};
             for (int x = 0; x < width; ++x) {
@@ -536,7 +544,7 @@ CvvdpResult cvvdp(const cv::Mat& referenceLinear, const cv::Mat& testLinear, con
                 for (int c = 0; c < 3; ++c)
                     out[c][x] = static_cast<float>(toDkl[3 * c] * r + toDkl[3 * c + 1] * g + toDkl[3 * c + 2] * b);
             }
-        }
+        });
     }
     t.colour += secondsSince(start);
 
@@ -558,15 +566,26 @@ CvvdpResult cvvdp(const cv::Mat& referenceLinear, const cv::Mat& testLinear, con
     for (auto& q : result.bandQuality) q.assign(bandCount, 0.0);
 
     const float channelGain[3] = {1.0f, 1.45f, 1.0f};
-    const double maskGain = std::pow(10.0, p.maskC);
-    const double maxDifference = std::pow(10.0, p.dMax);
-    const double epsilonPowerP = std::pow(safeEpsilon, p.maskP);
-    std::array<double, 3> epsilonPowerQ;
-    for (int c = 0; c < 3; ++c) epsilonPowerQ[c] = std::pow(safeEpsilon, p.maskQ[c]);
+    const float maskGain = static_cast<float>(std::pow(10.0, p.maskC));
+    const float maxDifference = static_cast<float>(std::pow(10.0, p.dMax));
+    const float epsilon = static_cast<float>(safeEpsilon);
+    const float maskP = static_cast<float>(p.maskP);
+    const float epsilonPowerP = std::pow(epsilon, maskP);
+    float maskQ[3], epsilonPowerQ[3], crossMasking[3][3];
+    for (int c = 0; c < 3; ++c) {
+        maskQ[c] = static_cast<float>(p.maskQ[c]);
+        epsilonPowerQ[c] = std::pow(epsilon, maskQ[c]);
+        for (int to = 0; to < 3; ++to) crossMasking[c][to] = static_cast<float>(p.crossMasking[c][to]);
+    }
     const cv::Mat blurKernel = gaussianKernel(p.puDilate);
     const int blurPad = static_cast<int>(p.puDilate * 2);
     std::vector<cv::Mat> heatBands(computeMap ? bandCount : 0);
+    // The pooling exponents of the released parameters are β = 2 and β_tch = 4: those powers are products.
+    const bool squarePooling = p.beta == 2.0;
+    const bool fourthPowerChannels = p.betaTch == 4.0;
     const double betaTchRoot = std::pow(safeEpsilon, 1.0 / p.betaTch);
+    const double epsilonPowerBeta = std::pow(safeEpsilon, p.beta);
+    const double epsilonPowerTch = std::pow(safeEpsilon, p.betaTch);
 
     for (int band = 0; band < bandCount; ++band) {
         const bool baseband = band == bandCount - 1;
@@ -612,106 +631,110 @@ CvvdpResult cvvdp(const cv::Mat& referenceLinear, const cv::Mat& testLinear, con
             // Laplacian band = level − expanded next level; Weber contrast against the expanded next level's
             // achromatic value of the same image.
             start = Clock::now();
-            std::array<std::array<cv::Mat, 2>, 3> contrast;
-            cv::Mat logBackground(h, w, CV_32FC1);
-            std::array<cv::Mat, 2> background;
-            for (int img = 0; img < 2; ++img) {
-                const cv::Mat expanded = expand(gaussian[band + 1][0][img], h, w);
-                background[img].create(h, w, CV_32FC1);
-                contrast[0][img].create(h, w, CV_32FC1);
-                for (int y = 0; y < h; ++y) {
-                    const float* e = expanded.ptr<float>(y);
-                    const float* g = gaussian[band][0][img].ptr<float>(y);
-                    float* bg = background[img].ptr<float>(y);
-                    float* out = contrast[0][img].ptr<float>(y);
-                    for (int x = 0; x < w; ++x) {
-                        bg[x] = std::max(e[x], 0.01f);
-                        out[x] = std::min((g[x] - e[x]) / bg[x], 1000.0f) * bandMultiplier;
-                    }
-                }
-            }
-            for (int c = 1; c < 3; ++c)
-                for (int img = 0; img < 2; ++img) {
-                    const cv::Mat expanded = expand(gaussian[band + 1][c][img], h, w);
-                    contrast[c][img].create(h, w, CV_32FC1);
-                    for (int y = 0; y < h; ++y) {
-                        const float* e = expanded.ptr<float>(y);
-                        const float* g = gaussian[band][c][img].ptr<float>(y);
-                        const float* bg = background[img].ptr<float>(y);
-                        float* out = contrast[c][img].ptr<float>(y);
-                        for (int x = 0; x < w; ++x) out[x] = std::min((g[x] - e[x]) / bg[x], 1000.0f) * bandMultiplier;
-                    }
-                }
-            for (int y = 0; y < h; ++y) {
-                const float* bg = background[1].ptr<float>(y);
-                float* out = logBackground.ptr<float>(y);
-                for (int x = 0; x < w; ++x) out[x] = std::log10(bg[x]);
-            }
+            std::array<std::array<cv::Mat, 2>, 3> expanded;
+            for (int c = 0; c < 3; ++c)
+                for (int img = 0; img < 2; ++img) expanded[c][img] = expand(gaussian[band + 1][c][img], h, w);
             t.pyramid += secondsSince(start);
 
-            // CSF-weighted contrast: test and reference per channel, sensitivity from the reference's background.
+            // Per row: contrast, CSF-weighted contrast (sensitivity from the reference's background), the masker
+            // min(|T|, |R|) per channel. Then the phase-uncertainty blur of the masker.
             start = Clock::now();
+            const std::array<CsfRow, 3> rows = {csfRow(0, layout.frequencies[band]),
+                                                csfRow(1, layout.frequencies[band]),
+                                                csfRow(2, layout.frequencies[band])};
+            std::array<std::array<cv::Mat, 2>, 3> contrast;
             std::array<cv::Mat, 3> minimum;
             for (int c = 0; c < 3; ++c) {
-                const CsfRow row = csfRow(c, layout.frequencies[band]);
                 minimum[c].create(h, w, CV_32FC1);
-                for (int y = 0; y < h; ++y) {
-                    const float* lb = logBackground.ptr<float>(y);
-                    float* tc = contrast[c][0].ptr<float>(y);
-                    float* rc = contrast[c][1].ptr<float>(y);
-                    float* mn = minimum[c].ptr<float>(y);
-                    for (int x = 0; x < w; ++x) {
-                        const float s = row(lb[x]) * channelGain[c];
-                        tc[x] *= s;
-                        rc[x] *= s;
-                        mn[x] = std::min(std::fabs(tc[x]), std::fabs(rc[x]));
+                for (int img = 0; img < 2; ++img) contrast[c][img].create(h, w, CV_32FC1);
+            }
+            forRows(h, [&](int y) {
+                const float* backgroundTest = expanded[0][0].ptr<float>(y);
+                const float* backgroundReference = expanded[0][1].ptr<float>(y);
+                const float *level[3][2], *coarse[3][2];
+                float *weighted[3][2], *masker[3];
+                for (int c = 0; c < 3; ++c) {
+                    masker[c] = minimum[c].ptr<float>(y);
+                    for (int img = 0; img < 2; ++img) {
+                        level[c][img] = gaussian[band][c][img].ptr<float>(y);
+                        coarse[c][img] = expanded[c][img].ptr<float>(y);
+                        weighted[c][img] = contrast[c][img].ptr<float>(y);
                     }
                 }
-            }
+                for (int x = 0; x < w; ++x) {
+                    const float bgTest = std::max(backgroundTest[x], 0.01f);
+                    const float bgReference = std::max(backgroundReference[x], 0.01f);
+                    const float logBackground = std::log10(bgReference);
+                    for (int c = 0; c < 3; ++c) {
+                        const float test =
+                            std::min((level[c][0][x] - coarse[c][0][x]) / bgTest, 1000.0f) * bandMultiplier;
+                        const float reference =
+                            std::min((level[c][1][x] - coarse[c][1][x]) / bgReference, 1000.0f) * bandMultiplier;
+                        const float s = rows[c](logBackground) * channelGain[c];
+                        weighted[c][0][x] = test * s;
+                        weighted[c][1][x] = reference * s;
+                        masker[c][x] = std::min(std::fabs(test * s), std::fabs(reference * s));
+                    }
+                }
+            });
             t.csf += secondsSince(start);
 
             // Mutual masking: the smaller of the two contrasts, blurred (phase uncertainty), raised to q, pooled
-            // across channels with the cross-masking weights.
+            // across channels with the cross-masking weights; the difference raised to p, divided by 1 + mask,
+            // softly clamped at 10^d_max.
             start = Clock::now();
-            const bool blur = h > blurPad && w > blurPad;
-            for (int c = 0; c < 3; ++c)
-                if (blur)
+            if (h > blurPad && w > blurPad)
+                for (int c = 0; c < 3; ++c)
                     cv::sepFilter2D(minimum[c], minimum[c], CV_32F, blurKernel, blurKernel, {-1, -1}, 0.0,
                                     cv::BORDER_REFLECT_101);
-            for (int y = 0; y < h; ++y) {
+            forRows(h, [&](int y) {
                 const float* mn[3] = {minimum[0].ptr<float>(y), minimum[1].ptr<float>(y), minimum[2].ptr<float>(y)};
-                const float* tc[3] = {contrast[0][0].ptr<float>(y), contrast[1][0].ptr<float>(y),
-                                      contrast[2][0].ptr<float>(y)};
-                const float* rc[3] = {contrast[0][1].ptr<float>(y), contrast[1][1].ptr<float>(y),
-                                      contrast[2][1].ptr<float>(y)};
-                float* d[3] = {difference[0].ptr<float>(y), difference[1].ptr<float>(y), difference[2].ptr<float>(y)};
+                const float *test[3], *reference[3];
+                float* d[3];
+                for (int c = 0; c < 3; ++c) {
+                    test[c] = contrast[c][0].ptr<float>(y);
+                    reference[c] = contrast[c][1].ptr<float>(y);
+                    d[c] = difference[c].ptr<float>(y);
+                }
                 for (int x = 0; x < w; ++x) {
-                    double masker[3];
+                    float masker[3];
                     for (int k = 0; k < 3; ++k)
-                        masker[k] = std::pow(double(mn[k][x]) * maskGain + safeEpsilon, p.maskQ[k]) - epsilonPowerQ[k];
+                        masker[k] = std::pow(mn[k][x] * maskGain + epsilon, maskQ[k]) - epsilonPowerQ[k];
                     for (int c = 0; c < 3; ++c) {
-                        const double m = p.crossMasking[0][c] * masker[0] + p.crossMasking[1][c] * masker[1] +
-                                         p.crossMasking[2][c] * masker[2];
-                        const double u =
-                            (std::pow(std::fabs(double(tc[c][x]) - double(rc[c][x])) + safeEpsilon, p.maskP) -
-                             epsilonPowerP) /
-                            (1.0 + m);
-                        d[c][x] = static_cast<float>(maxDifference * u / (maxDifference + u));
+                        const float m = crossMasking[0][c] * masker[0] + crossMasking[1][c] * masker[1] +
+                                        crossMasking[2][c] * masker[2];
+                        const float delta = std::fabs(test[c][x] - reference[c][x]);
+                        const float u = (std::pow(delta + epsilon, maskP) - epsilonPowerP) / (1.0f + m);
+                        d[c][x] = maxDifference * u / (maxDifference + u);
                     }
                 }
-            }
+            });
             t.masking += secondsSince(start);
         }
 
-        // Spatial pooling (p-norm, β = 2, normalised by the pixel count) and the heat-map band.
+        // Spatial pooling (p-norm, β = 2, normalised by the pixel count; row sums added in order) and the
+        // heat-map band (the channels' β_tch-norm, weighted as in the pooling).
         start = Clock::now();
+        std::array<std::vector<double>, 3> rowSums;
+        for (auto& r : rowSums) r.assign(h, 0.0);
+        forRows(h, [&](int y) {
+            for (int c = 0; c < 3; ++c) {
+                const float* d = difference[c].ptr<float>(y);
+                double sum = 0.0;
+                if (squarePooling)
+                    for (int x = 0; x < w; ++x) {
+                        const double v = double(d[x]) + safeEpsilon;
+                        sum += v * v;
+                    }
+                else
+                    for (int x = 0; x < w; ++x) sum += std::pow(double(d[x]) + safeEpsilon, p.beta);
+                rowSums[c][y] = sum;
+            }
+        });
         for (int c = 0; c < 3; ++c) {
             double sum = 0.0;
-            for (int y = 0; y < h; ++y) {
-                const float* d = difference[c].ptr<float>(y);
-                for (int x = 0; x < w; ++x) sum += std::pow(double(d[x]) + safeEpsilon, p.beta);
-            }
-            sum -= static_cast<double>(pixels) * std::pow(safeEpsilon, p.beta);
+            for (double r : rowSums[c]) sum += r;
+            sum -= static_cast<double>(pixels) * epsilonPowerBeta;
             result.bandQuality[c][band] = safePow(sum / static_cast<double>(pixels), 1.0 / p.beta);
         }
         t.pooling += secondsSince(start);
@@ -720,21 +743,23 @@ CvvdpResult cvvdp(const cv::Mat& referenceLinear, const cv::Mat& testLinear, con
             double weight[3];
             for (int c = 0; c < 3; ++c)
                 weight[c] = p.channelWeight[c] * p.imageIntegration * (baseband ? p.basebandWeight[c] : 1.0);
-            const double epsilonPower = std::pow(safeEpsilon, p.betaTch);
             cv::Mat& heat = heatBands[band];
             heat.create(h, w, CV_32FC1);
-            for (int y = 0; y < h; ++y) {
+            forRows(h, [&](int y) {
                 const float* d[3] = {difference[0].ptr<float>(y), difference[1].ptr<float>(y),
                                      difference[2].ptr<float>(y)};
                 float* out = heat.ptr<float>(y);
                 for (int x = 0; x < w; ++x) {
                     double sum = 0.0;
-                    for (int c = 0; c < 3; ++c)
-                        sum += std::pow(d[c][x] * weight[c] + safeEpsilon, p.betaTch) - epsilonPower;
-                    out[x] = static_cast<float>((std::pow(sum + safeEpsilon, 1.0 / p.betaTch) - betaTchRoot) /
-                                                bandMultiplier);
+                    for (int c = 0; c < 3; ++c) {
+                        const double v = d[c][x] * weight[c] + safeEpsilon;
+                        sum += (fourthPowerChannels ? (v * v) * (v * v) : std::pow(v, p.betaTch)) - epsilonPowerTch;
+                    }
+                    const double norm = fourthPowerChannels ? std::sqrt(std::sqrt(sum + safeEpsilon))
+                                                            : std::pow(sum + safeEpsilon, 1.0 / p.betaTch);
+                    out[x] = static_cast<float>((norm - betaTchRoot) / bandMultiplier);
                 }
-            }
+            });
             t.heatmap += secondsSince(start);
         }
     }
