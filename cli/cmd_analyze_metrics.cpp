@@ -96,12 +96,11 @@ void runAnalyzeMetrics(const AnalyzeMetricsArguments& arguments) {
     options.metric.pixelsPerDegree = arguments.pixelsPerDegree;
     options.metric.encoding = metrics::parseImageEncoding(arguments.encoding);
     options.metric.display = display;
-    spdlog::info("metrics: ColorVideoVDP display {}", metrics::describeCvvdpDisplay(display));
     options.heatmapMax = arguments.heatmapMax;
     options.heatmaps = !arguments.noHeatmaps;
     auto records = metrics::runMetrics(plan, options, arguments.outputFolder);
-    spdlog::info("metrics: {} comparison(s) written to {}/metrics.csv and metrics.json", records.size(),
-                 arguments.outputFolder);
+    spdlog::info("metrics: {} comparison(s) written to {}/metrics.csv and metrics.json (ColorVideoVDP on {})",
+                 records.size(), arguments.outputFolder, metrics::describeCvvdpDisplay(display));
 }
 
 std::string displayNameList() {
