@@ -102,7 +102,8 @@ struct CvvdpResult {
 CvvdpResult cvvdp(const cv::Mat& referenceLinear, const cv::Mat& testLinear, const CvvdpDisplay& display,
                   bool computeMap = true, CvvdpStageTimes* times = nullptr);
 
-// The JOD mapping of the reference: 10 − a·Q^e, linear below Q = 0.1 (same value and slope there).
+// The JOD mapping of the reference: 10 − a·Q^e, and below Q = 0.1 the straight line from 10 at Q = 0 to that
+// curve's value at 0.1.
 double cvvdpQualityToJod(double quality);
 
 // Mean of a visibility map over `mask` (CV_8UC1, non-zero selects; everywhere when empty); NaN when the mask
