@@ -1,7 +1,8 @@
 // Wall-clock time of ColorVideoVDP (analysis/metrics/cvvdp.h) on one image pair per resolution, with and without
-// the per-pixel map, and the time of each stage (colour, pyramid, CSF, masking, pooling, map) as counters in
-// seconds per call, and the CPU time of the whole process (all threads) per call. The pair: a textured image and its Gaussian blur (σ = 2 px), so every band has differences;
-// the time does not depend on the content. Display: standard_fhd (ppd 37.8, 8 bands at 720p).
+// the per-pixel map, the time of each stage (colour, pyramid, CSF, masking, pooling, map) as counters in seconds
+// per call, and the CPU time of the whole process (all threads) per call. The pair: a textured image and its
+// Gaussian blur (σ = 2 px), so every band has differences; the time does not depend on the content. Display:
+// standard_fhd (ppd 37.8: 7 Laplacian bands and the baseband).
 // Run: build/release/bench/metrics/bench_cvvdp --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
 #include "analysis/metrics/cvvdp.h"
 

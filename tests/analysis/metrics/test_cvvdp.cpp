@@ -242,7 +242,7 @@ TEST(Cvvdp, SmallAndLargeImages) {
     EXPECT_TRUE(std::isfinite(result.jod));
     EXPECT_LT(result.jod, 10.0);
     EXPECT_EQ(result.map.size(), large.size());
-    EXPECT_EQ(result.bandFrequencies.size(), 9u); // 75.4 ppd: 8 Laplacian bands (to 0.15 cpd) and the baseband
+    EXPECT_EQ(result.bandFrequencies.size(), 9u); // 75.4 ppd: 8 Laplacian bands (to 0.19 cpd) and the baseband
 }
 
 // More pixels per degree (a farther or denser display) makes the same blur harder to see.
