@@ -3,6 +3,7 @@
 #include "cli/commands.h"
 #include "common/error.h"
 
+#include <array>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -25,9 +26,54 @@ struct AnalyzeMetricsArguments {
     bool noHeatmaps = false;
     double pixelsPerDegree = metrics::flipDefaultPixelsPerDegree;
     std::string encoding = "auto";
+    std::string display = "standard_fhd";
+    std::optional<double> displayPpd;
+    std::optional<std::string> displayResolution;
+    std::optional<double> displayDiagonal;
+    std::optional<double> displayDistance;
+    std::optional<double> displayPeak;
+    std::optional<double> displayContrast;
+    std::optional<double> displayAmbient;
+    std::optional<double> displayReflectivity;
 };
 
+// "WIDTHxHEIGHT" → {width, height}; InputError naming --display-resolution otherwise.
+std::array<int, 2> parseResolution(const std::string& text) {
+    const auto separator = text.find('x');
+    std::array<int, 2> size{0, 0};
+    bool ok = separator != std::string::npos && separator > 0 && separator + 1 < text.size();
+    if (ok) {
+        try {
+            std::size_t used = 0;
+            size[0] = std::stoi(text.substr(0, separator), &used);
+            ok = used == separator;
+            const std::string rest = text.substr(separator + 1);
+            size[1] = std::stoi(rest, &used);
+            ok = ok && used == rest.size();
+        } catch (const std::exception&) {
+            ok = false;
+        }
+    }
+    if (!ok || size[0] <= 0 || size[1] <= 0)
+        throwInput("--display-resolution", "", "\"" + text + "\" must be WIDTHxHEIGHT in pixels, e.g. 1920x1080");
+    return size;
+}
+
+metrics::CvvdpDisplay displayOf(const AnalyzeMetricsArguments& arguments) {
+    metrics::CvvdpDisplayOverrides overrides;
+    overrides.pixelsPerDegree = arguments.displayPpd;
+    if (arguments.displayResolution) overrides.resolution = parseResolution(*arguments.displayResolution);
+    overrides.diagonalInches = arguments.displayDiagonal;
+    overrides.viewingDistanceMetres = arguments.displayDistance;
+    overrides.peakLuminance = arguments.displayPeak;
+    overrides.contrast = arguments.displayContrast;
+    overrides.ambientIlluminance = arguments.displayAmbient;
+    overrides.reflectivity = arguments.displayReflectivity;
+    return metrics::applyCvvdpOverrides(metrics::cvvdpDisplay(arguments.display), overrides);
+}
+
 void runAnalyzeMetrics(const AnalyzeMetricsArguments& arguments) {
+    const metrics::CvvdpDisplay display = displayOf(arguments); // option errors before any file is read
     metrics::ComparisonPlan plan;
     if (!arguments.stimulusFolder.empty()) {
         if (!arguments.tests.empty())
@@ -49,11 +95,18 @@ void runAnalyzeMetrics(const AnalyzeMetricsArguments& arguments) {
     options.metric.sssRadiusMillimetres = arguments.sssRadiusMillimetres;
     options.metric.pixelsPerDegree = arguments.pixelsPerDegree;
     options.metric.encoding = metrics::parseImageEncoding(arguments.encoding);
+    options.metric.display = display;
     options.heatmapMax = arguments.heatmapMax;
     options.heatmaps = !arguments.noHeatmaps;
     auto records = metrics::runMetrics(plan, options, arguments.outputFolder);
-    spdlog::info("metrics: {} comparison(s) written to {}/metrics.csv and metrics.json", records.size(),
-                 arguments.outputFolder);
+    spdlog::info("metrics: {} comparison(s) written to {}/metrics.csv and metrics.json (ColorVideoVDP on {})",
+                 records.size(), arguments.outputFolder, metrics::describeCvvdpDisplay(display));
+}
+
+std::string displayNameList() {
+    std::string list;
+    for (const std::string& name : metrics::cvvdpDisplayNames()) list += (list.empty() ? "" : ", ") + name;
+    return list;
 }
 
 } // namespace
@@ -62,7 +115,8 @@ void registerAnalyzeMetrics(CLI::App& analyze) {
     auto arguments = std::make_shared<AnalyzeMetricsArguments>();
     CLI::App* command = analyze.add_subcommand(
         "metrics",
-        "Compare renders with a reference: PSNR, SSIM, CIEDE2000 and LDR-FLIP on the image and on skin, and halo/bleed/"
+        "Compare renders with a reference: PSNR, SSIM, CIEDE2000, LDR-FLIP and ColorVideoVDP on the image and on skin, "
+        "and halo/bleed/"
         "spill/interior band scores; plain images (PNG, JPEG, RGB-only EXR) get the image-wide scores "
         "(docs/metrics.md)");
     command->add_option("tests", arguments->tests,
@@ -91,6 +145,21 @@ void registerAnalyzeMetrics(CLI::App& analyze) {
     command->add_option("--encoding", arguments->encoding,
                         "How pixel values map to linear light: auto (default: float files linear, 8/16-bit sRGB unless "
                         "the file says linear), srgb, linear");
+    command->add_option("--display", arguments->display,
+                        "ColorVideoVDP display model (default standard_fhd): " + displayNameList());
+    command->add_option("--display-ppd", arguments->displayPpd,
+                        "Custom display: pixels per degree (overrides the geometry)");
+    command->add_option("--display-resolution", arguments->displayResolution,
+                        "Custom display: resolution WIDTHxHEIGHT in pixels (with the diagonal and distance: ppd)");
+    command->add_option("--display-diagonal-in", arguments->displayDiagonal, "Custom display: diagonal in inches");
+    command->add_option("--display-distance-m", arguments->displayDistance,
+                        "Custom display: viewing distance in metres");
+    command->add_option("--display-peak", arguments->displayPeak, "Custom display: peak luminance in cd/m2");
+    command->add_option("--display-contrast", arguments->displayContrast,
+                        "Custom display: contrast ratio (peak / black level)");
+    command->add_option("--display-ambient", arguments->displayAmbient, "Custom display: ambient light in lux");
+    command->add_option("--display-reflectivity", arguments->displayReflectivity,
+                        "Custom display: reflectivity of the screen (0-1, default 0.005)");
     command->callback([arguments] { runAnalyzeMetrics(*arguments); });
 }
 

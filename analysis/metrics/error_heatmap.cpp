@@ -150,4 +150,36 @@ void writeFlipHeatmap(const std::filesystem::path& path, const cv::Mat& flip) {
     writePng(path, renderFlipHeatmap(flip));
 }
 
+cv::Mat renderCvvdpHeatmap(const cv::Mat& visibility) {
+    CV_Assert(visibility.type() == CV_32FC1);
+    constexpr double scaleMax = 1.0; // JOD
+    cv::Mat heat = colourise(visibility, scaleMax, cv::COLORMAP_VIRIDIS);
+    const int height = std::max(heat.rows, legendMinimumHeight);
+    cv::Mat canvas(height, heat.cols + legendWidth, CV_8UC3, legendBackground);
+    heat.copyTo(canvas(cv::Rect(0, 0, heat.cols, heat.rows)));
+    const int left = heat.cols + 12;
+    cv::putText(canvas, "ColorVideoVDP", {left, 18}, cv::FONT_HERSHEY_SIMPLEX, fontScale, textColour, 1, cv::LINE_AA);
+    cv::putText(canvas, "JOD loss", {left, 36}, cv::FONT_HERSHEY_SIMPLEX, fontScale, textColour, 1, cv::LINE_AA);
+    const int barTop = 48, barHeight = 120, barWidth = 18;
+    cv::Mat ramp(barHeight, 1, CV_32FC1);
+    for (int i = 0; i < barHeight; ++i)
+        ramp.at<float>(i) = static_cast<float>(scaleMax * (1.0 - double(i) / double(barHeight - 1)));
+    cv::Mat rampColour;
+    cv::resize(colourise(ramp, scaleMax, cv::COLORMAP_VIRIDIS), rampColour, {barWidth, barHeight}, 0, 0,
+               cv::INTER_NEAREST);
+    rampColour.copyTo(canvas(cv::Rect(left, barTop, barWidth, barHeight)));
+    const double ticks[3] = {scaleMax, 0.5 * scaleMax, 0.0};
+    for (int i = 0; i < 3; ++i) {
+        int y = barTop + static_cast<int>(std::lround(i * (barHeight - 1) / 2.0));
+        cv::line(canvas, {left + barWidth, y}, {left + barWidth + 4, y}, textColour, 1);
+        cv::putText(canvas, formatScale(ticks[i]) + (i == 0 ? "+" : ""), {left + barWidth + 8, y + 5},
+                    cv::FONT_HERSHEY_SIMPLEX, fontScale, textColour, 1, cv::LINE_AA);
+    }
+    return canvas;
+}
+
+void writeCvvdpHeatmap(const std::filesystem::path& path, const cv::Mat& visibility) {
+    writePng(path, renderCvvdpHeatmap(visibility));
+}
+
 } // namespace skinlab::metrics

@@ -21,4 +21,9 @@ void writeErrorHeatmap(const std::filesystem::path& path, const cv::Mat& deltaE0
 cv::Mat renderFlipHeatmap(const cv::Mat& flip);
 void writeFlipHeatmap(const std::filesystem::path& path, const cv::Mat& flip);
 
+// The per-pixel ColorVideoVDP visibility (JOD loss, CV_32FC1) through the viridis colour map on [0, 1] JOD
+// (one JOD and more saturate, as the reference's "threshold" map) with a legend panel.
+cv::Mat renderCvvdpHeatmap(const cv::Mat& visibility);
+void writeCvvdpHeatmap(const std::filesystem::path& path, const cv::Mat& visibility);
+
 } // namespace skinlab::metrics

@@ -32,7 +32,8 @@ nlohmann::json regionJson(const RegionScores& scores) {
             {"ssim", jsonNumber(scores.ssim)},
             {"delta_e00_mean", jsonNumber(scores.deltaE00Mean)},
             {"delta_e00_p95", jsonNumber(scores.deltaE00P95)},
-            {"flip_mean", jsonNumber(scores.flipMean)}};
+            {"flip_mean", jsonNumber(scores.flipMean)},
+            {"cvvdp_map_mean", jsonNumber(scores.cvvdpMapMean)}};
 }
 
 nlohmann::json bandJson(const BandScores& scores) {
@@ -42,6 +43,7 @@ nlohmann::json bandJson(const BandScores& scores) {
             {"delta_e00_mean", jsonNumber(scores.deltaE00Mean)},
             {"delta_e00_p95", jsonNumber(scores.deltaE00P95)},
             {"flip_mean", jsonNumber(scores.flipMean)},
+            {"cvvdp_map_mean", jsonNumber(scores.cvvdpMapMean)},
             {"excess", jsonNumber(scores.excess)},
             {"leak_energy", jsonNumber(scores.leakEnergy)}};
 }
@@ -49,35 +51,36 @@ nlohmann::json bandJson(const BandScores& scores) {
 } // namespace
 
 std::string metricsCsv(const std::vector<ComparisonRecord>& records) {
-    std::string out = "reference,test,block,width,height,sss_radius_mm,mm_per_unit,support_radius_world,f_px";
+    std::string out = "reference,test,block,width,height,sss_radius_mm,mm_per_unit,support_radius_world,f_px,cvvdp_jod";
     for (const char* region : {"image", "skin"})
-        for (const char* field : {"pixels", "psnr_db", "ssim", "delta_e00_mean", "delta_e00_p95", "flip_mean"})
+        for (const char* field :
+             {"pixels", "psnr_db", "ssim", "delta_e00_mean", "delta_e00_p95", "flip_mean", "cvvdp_map_mean"})
             out += std::string(",") + region + "_" + field;
     for (Band band : allBands)
         for (const char* field : {"pixels", "fraction_of_image", "fraction_of_skin", "delta_e00_mean", "delta_e00_p95",
-                                  "flip_mean", "excess", "leak_energy"})
+                                  "flip_mean", "cvvdp_map_mean", "excess", "leak_energy"})
             out += "," + std::string(bandName(band)) + "_" + field;
-    out += ",heatmap,flip_heatmap,bands_measured\n";
+    out += ",heatmap,flip_heatmap,cvvdp_heatmap,bands_measured\n";
     for (const ComparisonRecord& record : records) {
         out += csvText(record.job.referenceName) + "," + csvText(record.job.testName) + "," + csvText(record.job.block);
         out += "," + std::to_string(record.width) + "," + std::to_string(record.height);
         for (double v : {record.sssRadiusMillimetres, record.millimetresPerUnit, record.geometry.supportRadiusWorld,
-                         record.geometry.focalLengthPixels})
+                         record.geometry.focalLengthPixels, record.cvvdpJod})
             out += "," + csvNumber(v);
         for (const RegionScores* region : {&record.image, &record.skin}) {
             out += "," + std::to_string(region->pixels);
-            for (double v :
-                 {region->psnrDecibels, region->ssim, region->deltaE00Mean, region->deltaE00P95, region->flipMean})
+            for (double v : {region->psnrDecibels, region->ssim, region->deltaE00Mean, region->deltaE00P95,
+                             region->flipMean, region->cvvdpMapMean})
                 out += "," + csvNumber(v);
         }
         for (const BandScores& band : record.bands) {
             out += "," + std::to_string(band.pixels);
             for (double v : {band.fractionOfImage, band.fractionOfSkin, band.deltaE00Mean, band.deltaE00P95,
-                             band.flipMean, band.excess, band.leakEnergy})
+                             band.flipMean, band.cvvdpMapMean, band.excess, band.leakEnergy})
                 out += "," + csvNumber(v);
         }
-        out += "," + csvText(record.heatmap) + "," + csvText(record.flipHeatmap) + "," +
-               (record.bandsMeasured ? "1" : "0") + "\n";
+        out += "," + csvText(record.heatmap) + "," + csvText(record.flipHeatmap) + "," + csvText(record.cvvdpHeatmap) +
+               "," + (record.bandsMeasured ? "1" : "0") + "\n";
     }
     return out;
 }
@@ -99,12 +102,14 @@ nlohmann::json metricsJson(const std::vector<ComparisonRecord>& records, const R
             {"mm_per_unit", record.millimetresPerUnit},
             {"support_radius_world", record.geometry.supportRadiusWorld},
             {"f_px", record.geometry.focalLengthPixels},
+            {"cvvdp_jod", jsonNumber(record.cvvdpJod)},
             {"image", regionJson(record.image)},
             {"bands_measured", record.bandsMeasured},
             {"skin", record.bandsMeasured ? regionJson(record.skin) : nlohmann::json()},
             {"bands", record.bandsMeasured ? bands : nlohmann::json()},
             {"heatmap", record.heatmap.empty() ? nlohmann::json() : nlohmann::json(record.heatmap)},
             {"flip_heatmap", record.flipHeatmap.empty() ? nlohmann::json() : nlohmann::json(record.flipHeatmap)},
+            {"cvvdp_heatmap", record.cvvdpHeatmap.empty() ? nlohmann::json() : nlohmann::json(record.cvvdpHeatmap)},
         });
     }
     return {{"format", "skinlab-metrics"},
@@ -120,6 +125,17 @@ nlohmann::json metricsJson(const std::vector<ComparisonRecord>& records, const R
                {{"variant", "LDR-FLIP (Andersson et al. 2020)"},
                 {"pixels_per_degree", settings.pixelsPerDegree},
                 {"input", "linear RGB x exposure, clamped to [0,1]"}}},
+              {"cvvdp",
+               {{"variant", "ColorVideoVDP v0.5.6 parameters (Mantiuk et al. 2024), still image"},
+                {"display", settings.display.name},
+                {"display_description", settings.display.description},
+                {"pixels_per_degree", settings.display.pixelsPerDegree},
+                {"peak_luminance", settings.display.peakLuminance},
+                {"black_level", settings.display.blackLevel()},
+                {"reflected_level", settings.display.reflectedLevel()},
+                {"eotf", settings.display.eotf},
+                {"input", "linear Rec.709 RGB x exposure as the display's relative value (1 = peak)"},
+                {"map", "per-pixel JOD loss, 10 - JOD"}}},
               {"encoding", imageEncodingName(settings.encoding)}}},
             {"blocks_without_reference", blocksWithoutReference},
             {"comparisons", comparisons}};

@@ -24,6 +24,8 @@ struct ComparisonRecord {
     std::array<BandScores, 4> bands;
     std::string heatmap;       // path relative to the output folder; "" when heat maps are off
     std::string flipHeatmap;   // the FLIP map, likewise
+    std::string cvvdpHeatmap;  // the ColorVideoVDP visibility map, likewise
+    double cvvdpJod = 10.0;    // ColorVideoVDP (JOD, 10 = no visible difference)
     bool bandsMeasured = true; // false: plain reference, skin and band scores undefined (null / empty cells)
 };
 
@@ -32,6 +34,7 @@ struct ReportSettings {
     double heatmapMax = 10.0;
     double pixelsPerDegree = flipDefaultPixelsPerDegree;
     ImageEncoding encoding = ImageEncoding::automatic;
+    CvvdpDisplay display = cvvdpDisplay("standard_fhd");
 };
 
 // CSV with a header row; NaN (undefined: empty band, no skin) is an empty cell, +inf (PSNR of identical

@@ -73,11 +73,14 @@ std::vector<ComparisonRecord> runMetrics(const ComparisonPlan& plan, const Metri
         record.image = result.image;
         record.skin = result.skin;
         record.bands = result.bands;
+        record.cvvdpJod = result.cvvdpJod;
         if (options.heatmaps) {
             record.heatmap = "heatmaps/" + job.testName + ".png";
             writeErrorHeatmap(outputFolder / record.heatmap, result.deltaE00, reference.bands, options.heatmapMax);
             record.flipHeatmap = "heatmaps/" + job.testName + ".flip.png";
             writeFlipHeatmap(outputFolder / record.flipHeatmap, result.flip);
+            record.cvvdpHeatmap = "heatmaps/" + job.testName + ".cvvdp.png";
+            writeCvvdpHeatmap(outputFolder / record.cvvdpHeatmap, result.cvvdpMap);
         }
         records.push_back(std::move(record));
     }
@@ -85,7 +88,7 @@ std::vector<ComparisonRecord> runMetrics(const ComparisonPlan& plan, const Metri
     // 3. Tables last.
     writeFileAtomic(outputFolder / "metrics.csv", metricsCsv(records));
     ReportSettings settings{options.metric.exposure, options.heatmapMax, options.metric.pixelsPerDegree,
-                            options.metric.encoding};
+                            options.metric.encoding, options.metric.display};
     writeFileAtomic(outputFolder / "metrics.json",
                     metricsJson(records, settings, plan.blocksWithoutReference).dump(2) + "\n");
     return records;

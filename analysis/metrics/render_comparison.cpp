@@ -188,6 +188,14 @@ ComparisonResult compareWithReference(const PreparedReference& reference, const 
 
     cv::Mat ssimMap = structuralSimilarityMap(reference.display, encoded.display);
     result.flip = flipErrorMap(ref.beauty, test.beauty, options.pixelsPerDegree, options.exposure);
+    {
+        const bool scaled = options.exposure != 1.0;
+        const CvvdpResult visibility =
+            cvvdp(scaled ? cv::Mat(ref.beauty * options.exposure) : ref.beauty,
+                  scaled ? cv::Mat(test.beauty * options.exposure) : test.beauty, options.display, true);
+        result.cvvdpJod = visibility.jod;
+        result.cvvdpMap = visibility.map;
+    }
     const cv::Mat& skin = reference.bands.skin;
     const auto totalPixels = static_cast<std::size_t>(ref.width) * static_cast<std::size_t>(ref.height);
     const auto skinPixels = static_cast<std::size_t>(cv::countNonZero(skin));
@@ -201,15 +209,17 @@ ComparisonResult compareWithReference(const PreparedReference& reference, const 
         scores.deltaE00Mean = mean(values);
         scores.deltaE00P95 = percentile95(std::move(values));
         scores.flipMean = flipMean(result.flip, mask);
+        scores.cvvdpMapMean = cvvdpMapMean(result.cvvdpMap, mask);
         return scores;
     };
     result.image = regionScores(cv::Mat());
     if (ref.plain) {
         // No skin mask and no depth: the skin region and the bands are undefined.
         result.bandsMeasured = false;
-        result.skin = {0, notANumber, notANumber, notANumber, notANumber, notANumber};
+        result.skin = {0, notANumber, notANumber, notANumber, notANumber, notANumber, notANumber};
         for (auto& scores : result.bands)
-            scores = {0, notANumber, notANumber, notANumber, notANumber, notANumber, notANumber, notANumber};
+            scores = {0,          notANumber, notANumber, notANumber, notANumber,
+                      notANumber, notANumber, notANumber, notANumber};
         return result;
     }
     result.skin = regionScores(skin);
@@ -225,6 +235,7 @@ ComparisonResult compareWithReference(const PreparedReference& reference, const 
         scores.deltaE00Mean = mean(values);
         scores.deltaE00P95 = percentile95(std::move(values));
         scores.flipMean = flipMean(result.flip, mask);
+        scores.cvvdpMapMean = cvvdpMapMean(result.cvvdpMap, mask);
         double leakSum = maskedSum(absoluteLuminance, mask);
         scores.leakEnergy = reference.skinLuminanceSum > 0.0 ? leakSum / reference.skinLuminanceSum : notANumber;
     }

@@ -1,6 +1,7 @@
 #pragma once
 // One comparison of a test render with a reference: per-pixel ΔE00, global and skin PSNR/SSIM/ΔE00, and the
 // band scores (docs/metrics.md lists every field).
+#include "analysis/metrics/cvvdp.h"
 #include "analysis/metrics/error_bands.h"
 #include "analysis/metrics/flip.h"
 #include "analysis/metrics/metric_render.h"
@@ -23,6 +24,8 @@ struct MetricOptions {
     double pixelsPerDegree = flipDefaultPixelsPerDegree;
     // How 8/16-bit and EXR inputs are decoded to linear RGB (plain images; skinlab renders are linear EXRs).
     ImageEncoding encoding = ImageEncoding::automatic;
+    // ColorVideoVDP's display (default standard_fhd); the linear input × exposure is the display's relative value.
+    CvvdpDisplay display = cvvdpDisplay("standard_fhd");
 };
 
 // The reference with everything that does not depend on the test render computed once. For a plain reference
@@ -49,8 +52,9 @@ struct RegionScores {
     double psnrDecibels = 0.0; // +inf when identical on the region
     double ssim = 0.0;         // mean SSIM over the region
     double deltaE00Mean = 0.0;
-    double deltaE00P95 = 0.0; // 95th percentile, linear interpolation between order statistics
-    double flipMean = 0.0;    // mean LDR-FLIP over the region (pooled in double)
+    double deltaE00P95 = 0.0;  // 95th percentile, linear interpolation between order statistics
+    double flipMean = 0.0;     // mean LDR-FLIP over the region (pooled in double)
+    double cvvdpMapMean = 0.0; // mean ColorVideoVDP visibility (JOD loss per pixel) over the region
 };
 
 struct BandScores {
@@ -60,6 +64,7 @@ struct BandScores {
     double deltaE00Mean = 0.0;   // NaN for an empty band
     double deltaE00P95 = 0.0;    // NaN for an empty band
     double flipMean = 0.0;       // mean LDR-FLIP over the band; NaN for an empty band
+    double cvvdpMapMean = 0.0;   // mean ColorVideoVDP visibility over the band; NaN for an empty band
     double excess = 0.0;         // band mean − interior mean; NaN if either is empty
     double leakEnergy = 0.0;     // Σ_band |Y_T − Y_R| / Σ_skin Y_R; NaN without skin luminance
 };
@@ -71,6 +76,8 @@ struct ComparisonResult {
     std::array<BandScores, 4> bands; // indexed by Band
     cv::Mat deltaE00;                // CV_32FC1 per-pixel ΔE00
     cv::Mat flip;                    // CV_64FC1 per-pixel LDR-FLIP
+    double cvvdpJod = 10.0;          // ColorVideoVDP of the whole image on MetricOptions::display
+    cv::Mat cvvdpMap;                // CV_32FC1 per-pixel ColorVideoVDP visibility (JOD loss)
     const BandScores& band(Band b) const { return bands[static_cast<std::size_t>(b)]; }
 };
 

@@ -1,4 +1,5 @@
 // `skinlab analyze metrics` as a user runs it: the real executable on EXR files and on a stimulus set.
+#include "analysis/metrics/cvvdp.h"
 #include "common/files.h"
 #include "common/hash.h"
 #include "synthetic_render.h"
@@ -82,6 +83,35 @@ TEST_F(AnalyzeMetricsCommand, ComparesFilesAndWritesAllOutputs) {
     EXPECT_TRUE(fs::exists(path("out/metrics.csv")));
     EXPECT_TRUE(fs::exists(path("out/heatmaps/halo.png")));
     EXPECT_TRUE(fs::exists(path("out/heatmaps/same.png")));
+    // ColorVideoVDP: 10 JOD for the identical render, less for the blurred one, its map written.
+    EXPECT_EQ(json["comparisons"][0]["cvvdp_jod"], 10.0);
+    EXPECT_LT(json["comparisons"][1]["cvvdp_jod"].get<double>(), 10.0);
+    EXPECT_EQ(json["comparisons"][0]["image"]["cvvdp_map_mean"], 0.0);
+    EXPECT_GT(halo["halo"]["cvvdp_map_mean"].get<double>(), halo["interior"]["cvvdp_map_mean"].get<double>());
+    EXPECT_EQ(json["settings"]["cvvdp"]["display"], "standard_fhd");
+    EXPECT_TRUE(fs::exists(path("out/heatmaps/halo.cvvdp.png")));
+}
+
+// --display picks a model; the custom options change it (same photometry, the 4K model's ppd: same JOD).
+TEST_F(AnalyzeMetricsCommand, DisplayModelAndCustomDisplay) {
+    testing::writeSyntheticExr(path("exr/reference.exr"), reference);
+    testing::writeSyntheticExr(path("exr/halo.exr"), blurred);
+    const std::string files = " --reference " + path("exr/reference.exr") + " " + path("exr/halo.exr");
+    auto jodOf = [&](const std::string& options, const std::string& out) {
+        CommandResult run = runSkinlab("analyze metrics" + files + " --no-heatmaps -o " + path(out) + options);
+        EXPECT_EQ(run.exitCode, 0) << run.output;
+        return nlohmann::json::parse(readFile(path(out + "/metrics.json")));
+    };
+    const auto fhd = jodOf("", "fhd");
+    const auto uhd = jodOf(" --display standard_4k", "4k");
+    const auto custom = jodOf(" --display-ppd 75.40244934516305", "custom");
+    const double jodFhd = fhd["comparisons"][0]["cvvdp_jod"], jod4k = uhd["comparisons"][0]["cvvdp_jod"];
+    EXPECT_GT(jod4k, jodFhd); // twice the pixels per degree: the blur is harder to see
+    EXPECT_NEAR(custom["comparisons"][0]["cvvdp_jod"].get<double>(), jod4k, 1e-9);
+    EXPECT_EQ(custom["settings"]["cvvdp"]["display"], "custom");
+    const auto dim = jodOf(" --display-peak 20 --display-ambient 0", "dim");
+    EXPECT_NE(dim["comparisons"][0]["cvvdp_jod"].get<double>(), jodFhd);
+    EXPECT_EQ(dim["settings"]["cvvdp"]["peak_luminance"], 20.0);
 }
 
 TEST_F(AnalyzeMetricsCommand, ComparesAStimulusSet) {
@@ -107,7 +137,15 @@ TEST_F(AnalyzeMetricsCommand, ComparesAStimulusSet) {
     EXPECT_EQ(json["comparisons"][0]["test"]["name"], "disc-separable");
     EXPECT_EQ(json["comparisons"][0]["block"], "builtin:disc/mid");
     EXPECT_TRUE(json["comparisons"][0]["heatmap"].is_null());
+    EXPECT_LT(json["comparisons"][0]["cvvdp_jod"].get<double>(), 10.0);
+    EXPECT_TRUE(json["comparisons"][0]["cvvdp_heatmap"].is_null());
     EXPECT_FALSE(fs::exists(path("out/heatmaps")));
+}
+
+std::string displayList() {
+    std::string list;
+    for (const std::string& name : cvvdpDisplayNames()) list += (list.empty() ? "" : ", ") + name;
+    return list;
 }
 
 // Bad input: exit code 2 and exactly one line naming the file and the channel, attribute or size at fault.
@@ -143,6 +181,14 @@ TEST_F(AnalyzeMetricsCommand, BadInputsFailWithOneLineNamingFileAndChannel) {
          path("exr/reference.exr") + ": test files cannot be combined with --stimuli (the set lists its renders)"},
         {"--reference " + path("exr/reference.exr") + " " + path("exr/reference.exr") + " --exposure -1",
          "--exposure: -1 must be a positive number"},
+        {"--reference " + path("exr/reference.exr") + " " + path("exr/reference.exr") + " --display-ppd 0",
+         "--display-ppd: 0 must be a positive number"},
+        {"--reference " + path("exr/reference.exr") + " " + path("exr/reference.exr") + " --display-resolution 12x",
+         "--display-resolution: \"12x\" must be WIDTHxHEIGHT in pixels, e.g. 1920x1080"},
+        {"--reference " + path("exr/reference.exr") + " " + path("exr/reference.exr") + " --display-contrast 0.5",
+         "--display-contrast: 0.5 must be a number >= 1"},
+        {"--reference " + path("exr/reference.exr") + " " + path("exr/reference.exr") + " --display nope",
+         "--display: \"nope\" is not one of " + displayList()},
     };
     for (const Case& c : cases) {
         CommandResult run = runSkinlab("analyze metrics " + c.arguments + out);

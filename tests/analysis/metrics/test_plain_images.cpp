@@ -106,8 +106,20 @@ TEST_F(PlainImages, PngPairGetsTheImageWideScoresAndNoBands) {
     EXPECT_EQ(json["settings"]["encoding"], "auto");
     EXPECT_TRUE(fs::exists(output / "heatmaps/edited.png"));
     EXPECT_TRUE(fs::exists(output / "heatmaps/edited.flip.png"));
+    EXPECT_TRUE(fs::exists(output / "heatmaps/edited.cvvdp.png"));
+    // ColorVideoVDP on the default display (standard_fhd), as the library computes it.
+    cv::Mat referenceFloat, testFloat;
+    referenceLinear.convertTo(referenceFloat, CV_32FC3);
+    testLinear.convertTo(testFloat, CV_32FC3);
+    const CvvdpResult visibility = cvvdp(referenceFloat, testFloat, cvvdpDisplay("standard_fhd"));
+    EXPECT_NEAR(comparison["cvvdp_jod"].get<double>(), visibility.jod, 1e-4);
+    EXPECT_LT(comparison["cvvdp_jod"].get<double>(), 10.0);
+    EXPECT_NEAR(comparison["image"]["cvvdp_map_mean"].get<double>(), cvvdpMapMean(visibility.map), 1e-4);
+    EXPECT_EQ(json["settings"]["cvvdp"]["display"], "standard_fhd");
     std::string csv = readFile(output / "metrics.csv");
-    EXPECT_NE(csv.find(",heatmaps/edited.png,heatmaps/edited.flip.png,0\n"), std::string::npos) << csv;
+    EXPECT_NE(csv.find(",heatmaps/edited.png,heatmaps/edited.flip.png,heatmaps/edited.cvvdp.png,0\n"),
+              std::string::npos)
+        << csv;
 }
 
 TEST_F(PlainImages, JpegIsReadAsSrgb) {
