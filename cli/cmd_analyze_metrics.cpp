@@ -22,7 +22,7 @@ struct AnalyzeMetricsArguments {
     std::string outputFolder;
     double exposure = 1.0;
     std::optional<double> sssRadiusMillimetres;
-    double heatmapMax = 10.0;
+    double heatmapMax = 0.0;
     bool noHeatmaps = false;
     double pixelsPerDegree = metrics::flipDefaultPixelsPerDegree;
     std::string encoding = "auto";
@@ -137,7 +137,8 @@ void registerAnalyzeMetrics(CLI::App& analyze) {
     command->add_option("--sss-radius-mm", arguments->sssRadiusMillimetres,
                         "SSS support radius in mm for the bands (default: the reference's skinlab:sss_radius_mm)");
     command->add_option("--heatmap-max", arguments->heatmapMax,
-                        "dE00 at the top of the heat map's colour scale (default 10)");
+                        "dE00 at the top of the heat map's colour scale (default 0: each map's scale from its own "
+                        "data, the 99th percentile rounded up; FLIP and ColorVideoVDP maps always so)");
     command->add_flag("--no-heatmaps", arguments->noHeatmaps, "Write only metrics.csv and metrics.json");
     command->add_option("--ppd", arguments->pixelsPerDegree,
                         "FLIP's pixels per degree of visual angle (default 67.0206: 0.7 m from a 0.7 m wide 3840-pixel "

@@ -1,4 +1,5 @@
 // `skinlab stimuli build|list|merge|contact|slurm|status`: stimulus sets (docs/stimuli.md).
+#include "analysis/metrics/cvvdp.h"
 #include "cli/commands.h"
 #include "common/error.h"
 #include "stimuli/build.h"
@@ -16,6 +17,8 @@ namespace skinlab::cli {
 namespace {
 
 struct StimuliOptions {
+    bool noPredict = false;
+    std::string display = "standard_fhd";
     std::string spec;
     std::string output;
     std::string shard;
@@ -73,6 +76,9 @@ void runBuild(const StimuliOptions& o) {
     options.jobs = o.jobs;
     options.assetsDir = o.assets;
     options.contactSheet = !o.noContactSheet;
+    options.predict = !o.noPredict;
+    options.display = o.display;
+    if (options.predict) (void)metrics::cvvdpDisplay(o.display); // an unknown name fails before anything renders
     options.progress = o.progress == "bar"     ? stimuli::BuildOptions::ProgressStyle::bar
                        : o.progress == "lines" ? stimuli::BuildOptions::ProgressStyle::lines
                                                : stimuli::BuildOptions::ProgressStyle::automatic;
@@ -80,6 +86,10 @@ void runBuild(const StimuliOptions& o) {
     std::printf("stimuli: %zu stimuli (%zu rendered, %zu unchanged) in %.1f s; manifest: %s\n", summary.stimuli,
                 summary.rendered, summary.kept, summary.wallSeconds, summary.manifest.string().c_str());
     if (!summary.contactHtml.empty()) std::printf("contact sheet: %s\n", summary.contactHtml.string().c_str());
+    for (const std::string& line : summary.predictions) std::printf("stimuli: predicted: %s\n", line.c_str());
+    if (summary.invisibleBlock)
+        std::printf("stimuli: warning: some blocks' conditions are predicted to look alike (see above); a study of "
+                    "them would measure (almost) nothing\n");
 }
 
 void runList(const StimuliOptions& o) {
@@ -218,6 +228,12 @@ void registerStimuli(CLI::App& app) {
     build->add_option("--jobs", options->jobs, "Parallel renderers, one EGL context each (default 1)")
         ->check(CLI::Range(1, 64));
     build->add_flag("--no-contact-sheet", options->noContactSheet, "Do not write contact.html / contact.png");
+    build->add_flag("--no-predict", options->noPredict,
+                    "Do not predict each stimulus's visibility against its block's reference (ColorVideoVDP)");
+    build
+        ->add_option("--display", options->display,
+                     "Display model of the predictions (analysis/metrics/cvvdp/display_models.json)")
+        ->capture_default_str();
     build->add_option("--progress", options->progress, "Progress display: auto (bar on a terminal), bar, lines")
         ->check(CLI::IsMember({"auto", "bar", "lines"}));
     build->callback([options] { runBuild(*options); });

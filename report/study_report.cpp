@@ -311,7 +311,8 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
         }
     }
     std::vector<agreement::ConditionMetrics> conditionMetrics;
-    std::map<std::string, std::string> heatmapOf, flipHeatmapOf; // stimulus → copied heat map
+    std::map<std::string, std::string> heatmapOf, flipHeatmapOf, cvvdpHeatmapOf; // stimulus → copied heat map
+    std::map<std::string, std::string> scaleOf; // copied heat map → its colour scale ("0–0.05")
     if (!metricsFolder.empty()) {
         const fs::path file = metricsFolder / "metrics.json";
         try {
@@ -323,11 +324,22 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
         for (const nlohmann::json& comparison : metricsJson["comparisons"]) {
             std::string name = comparison["test"].value("name", "");
             if (!conditionOfStimulus.count(name)) continue;
-            for (const char* key : {"heatmap", "flip_heatmap"}) {
-                if (!comparison.contains(key) || !comparison[key].is_string()) continue;
-                std::string copied = "heatmaps/" + slug(name) + (std::string(key) == "heatmap" ? ".png" : ".flip.png");
-                copyFileAtomic(metricsFolder / comparison[key].get<std::string>(), out / copied);
-                (std::string(key) == "heatmap" ? heatmapOf : flipHeatmapOf)[name] = copied;
+            const struct {
+                const char* key;
+                const char* suffix;
+                const char* scale;
+                std::map<std::string, std::string>* of;
+            } maps[] = {{"heatmap", ".png", "delta_e00", &heatmapOf},
+                        {"flip_heatmap", ".flip.png", "flip", &flipHeatmapOf},
+                        {"cvvdp_heatmap", ".cvvdp.png", "cvvdp", &cvvdpHeatmapOf}};
+            for (const auto& map : maps) {
+                if (!comparison.contains(map.key) || !comparison[map.key].is_string()) continue;
+                std::string copied = "heatmaps/" + slug(name) + map.suffix;
+                copyFileAtomic(metricsFolder / comparison[map.key].get<std::string>(), out / copied);
+                (*map.of)[name] = copied;
+                if (comparison.contains("heatmap_scale") && comparison["heatmap_scale"].is_object() &&
+                    comparison["heatmap_scale"].contains(map.scale))
+                    scaleOf[copied] = "0–" + num(comparison["heatmap_scale"][map.scale].get<double>(), 3);
             }
         }
     }
@@ -653,7 +665,8 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
                 html << (k++ ? ", " : "") << h(block) << ": " << h(reference);
             html << ")";
         }
-        html << ". ΔE00 and FLIP: lower is better; PSNR and SSIM: higher is better. Bands: mean ΔE00 in the halo, "
+        html << ". ΔE00 and FLIP: lower is better; PSNR, SSIM and ColorVideoVDP (10 = indistinguishable): higher is "
+                "better. Heat maps: each on its own colour scale (printed under it). Bands: mean ΔE00 in the halo, "
                 "bleed, spill and interior bands (docs/metrics.md). FLIP at "
              << num(metricsJson.contains("settings") && metricsJson["settings"].contains("flip")
                         ? metricsJson["settings"]["flip"].value("pixels_per_degree", NAN)
@@ -664,7 +677,7 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
             html << "<h3 id=\"metrics-" << slug(block.name) << "\">" << h(block.name) << "</h3><table><thead><tr>"
                  << "<th class=\"l\">condition</th><th>PSNR (dB)</th><th>SSIM</th><th>mean ΔE00</th><th>p95 ΔE00</th>"
                     "<th>mean FLIP</th><th>skin FLIP</th><th>halo ΔE00</th><th>bleed ΔE00</th><th>spill ΔE00</th>"
-                    "<th>interior ΔE00</th></tr></thead><tbody>";
+                    "<th>interior ΔE00</th><th>ColorVideoVDP (JOD)</th></tr></thead><tbody>";
             for (const agreement::ConditionMetrics& row : conditionMetrics) {
                 if (row.block != block.name) continue;
                 auto v = [&](const char* key) { return row.values.at(key); };
@@ -674,18 +687,22 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
                      << "</td><td>" << num(v("skin.flip_mean"), 4) << "</td><td>"
                      << num(v("bands.halo.delta_e00_mean"), 3) << "</td><td>" << num(v("bands.bleed.delta_e00_mean"), 3)
                      << "</td><td>" << num(v("bands.spill.delta_e00_mean"), 3) << "</td><td>"
-                     << num(v("bands.interior.delta_e00_mean"), 3) << "</td></tr>";
+                     << num(v("bands.interior.delta_e00_mean"), 3) << "</td><td>" << num(v("cvvdp_jod"), 2)
+                     << "</td></tr>";
             }
             html << "</tbody></table><div class=\"thumbs heat\">";
             for (const ConditionImages& image : imagesOfBlock[block.name]) {
-                if (heatmapOf.count(image.stimulus))
-                    html << "<figure><a href=\"" << h(heatmapOf[image.stimulus]) << "\"><img src=\""
-                         << h(heatmapOf[image.stimulus]) << "\" alt=\"ΔE00 of " << h(image.condition)
-                         << "\"></a><figcaption>ΔE00, " << h(image.condition) << "</figcaption></figure>";
-                if (flipHeatmapOf.count(image.stimulus))
-                    html << "<figure><a href=\"" << h(flipHeatmapOf[image.stimulus]) << "\"><img src=\""
-                         << h(flipHeatmapOf[image.stimulus]) << "\" alt=\"FLIP of " << h(image.condition)
-                         << "\"></a><figcaption>FLIP, " << h(image.condition) << "</figcaption></figure>";
+                // Each map on its own colour scale (from its data), printed under it.
+                for (const auto& [of, what] : {std::pair{&heatmapOf, "ΔE00"}, std::pair{&flipHeatmapOf, "FLIP"},
+                                               std::pair{&cvvdpHeatmapOf, "ColorVideoVDP (JOD loss)"}}) {
+                    const auto found = of->find(image.stimulus);
+                    if (found == of->end()) continue;
+                    const auto scale = scaleOf.find(found->second);
+                    html << "<figure><a href=\"" << h(found->second) << "\"><img src=\"" << h(found->second)
+                         << "\" alt=\"" << what << " of " << h(image.condition) << "\"></a><figcaption>" << what << ", "
+                         << h(image.condition) << (scale == scaleOf.end() ? std::string() : ", scale " + scale->second)
+                         << "</figcaption></figure>";
+                }
             }
             html << "</div>\n";
         }

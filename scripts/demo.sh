@@ -4,8 +4,9 @@
 #   2. builds the demo stimulus set (every SSS method and the main extensions) with a contact sheet: on the scanned
 #      head when its assets are found ($SKINLAB_ASSETS, default ../shared/assets: stimuli/specs/demo-scan.toml),
 #      otherwise on the built-in head (stimuli/specs/demo.toml), with a message saying so;
-#   3. creates a 2AFC study from it, serves it on loopback and runs 20 simulated observers through the real
-#      HTTP API (true scores in experiments/designs/demo-truth.json);
+#   3. creates a 2AFC study from it, estimates how many observers it needs for the differences ColorVideoVDP
+#      predicts (study plan), serves it on loopback and runs 20 simulated observers through the real HTTP API, who
+#      answer from those predictions (study simulate --truth predicted);
 #   4. scales the answers to JOD with confidence intervals;
 #   5. writes the study report (HTML + PDF): stimuli, scale, objective errors against the object-space reference,
 #      metrics against the scale, findings;
@@ -38,6 +39,8 @@ fi
 # A demo study is recreated on every run (a real study is never overwritten by `study create`).
 rm -f "$out/study.db" "$out/study.db-wal" "$out/study.db-shm"
 "$skinlab" study create --stimuli "$out/stimuli" --design "$design" -o "$out/study.db"
+# Before recruiting: which predicted differences would a study of this design resolve, with how many observers?
+"$skinlab" study plan "$out/study.db" --simulations 100 --observers 10,20,40,80,160
 
 "$skinlab" study serve "$out/study.db" --port 0 > "$out/serve.log" 2>&1 &
 server=$!
@@ -49,7 +52,7 @@ for _ in $(seq 1 100); do
   sleep 0.1
 done
 [ -n "$url" ] || { echo "demo: the study server did not start:" >&2; cat "$out/serve.log" >&2; exit 1; }
-"$skinlab" study simulate "$out/study.db" --observers 20 --truth experiments/designs/demo-truth.json \
+"$skinlab" study simulate "$out/study.db" --observers 20 --truth predicted \
   --seed 7 --label-prefix demo --url "$url"
 kill $server; wait $server 2>/dev/null || true
 trap - EXIT

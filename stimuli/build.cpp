@@ -7,6 +7,7 @@
 #include "renderer/renderer.h"
 #include "renderer/sss/sss_params.h"
 #include "stimuli/contact_sheet.h"
+#include "stimuli/prediction.h"
 #include "stimuli/output_folder.h"
 #include "stimuli/progress.h"
 
@@ -299,6 +300,16 @@ BuildSummary buildSet(const BuildOptions& options) {
     }
     summary.kept = summary.stimuli - summary.rendered;
     summary.manifest = dir / kManifestFile;
+    // Predicted visibility against each block's reference, once every stimulus is there (kept when up to date).
+    if (options.predict && manifest.complete) {
+        PredictionOptions prediction;
+        prediction.display = options.display;
+        const PredictionSummary predicted = predictStimuli(dir, manifest, prediction);
+        if (predicted.predicted > 0) writeManifest(dir, manifest);
+        summary.predictions = predictionLines(predicted, prediction);
+        summary.invisibleBlock = std::any_of(predicted.blocks.begin(), predicted.blocks.end(),
+                                             [](const BlockPrediction& b) { return b.invisible; });
+    }
     if (options.contactSheet && manifest.complete) summary.contactHtml = writeContactSheet(dir, manifest).html;
     summary.wallSeconds = secondsSince(start);
     return summary;

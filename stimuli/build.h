@@ -22,6 +22,9 @@ struct BuildOptions {
     std::filesystem::path assetsDir; // empty: $SKINLAB_ASSETS
     bool contactSheet = true;
     enum class ProgressStyle { automatic, bar, lines } progress = ProgressStyle::automatic;
+    // Predicted visibility (stimuli/prediction.h): each stimulus against its block's reference, on this display.
+    bool predict = true;
+    std::string display = "standard_fhd";
 };
 
 // The checked plan of a build: what would be rendered, and each stimulus's resolved scene parameters.
@@ -43,7 +46,9 @@ struct BuildSummary {
     size_t kept = 0;     // unchanged from an earlier run
     double wallSeconds = 0.0;
     std::filesystem::path manifest;
-    std::filesystem::path contactHtml; // empty when no contact sheet was written
+    std::filesystem::path contactHtml;    // empty when no contact sheet was written
+    std::vector<std::string> predictions; // one line per block with a reference, and warnings (prediction.h)
+    bool invisibleBlock = false;          // some block's conditions all lie within 0.25 JOD of each other
 };
 
 BuildSummary buildSet(const BuildOptions& options);

@@ -84,7 +84,14 @@ std::string caption(const nlohmann::json& stimulus, const std::vector<std::strin
     for (const auto& name : varying)
         if (f.contains(name)) text += (text.empty() ? "" : " ") + levelText(name, f[name]);
     if (stimulus.at("reference").get<bool>()) text += text.empty() ? "reference" : " (ref)";
-    return text.empty() ? stimulus.at("id").get<std::string>() : text;
+    if (text.empty()) text = stimulus.at("id").get<std::string>();
+    // The predicted visibility against the block's reference (ColorVideoVDP), when the build recorded it.
+    if (stimulus.contains("predicted") && stimulus["predicted"].contains("jod")) {
+        char jod[48];
+        std::snprintf(jod, sizeof jod, " · %.2f JOD", stimulus["predicted"]["jod"].get<double>());
+        text += jod;
+    }
+    return text;
 }
 
 // Splits a caption into lines no wider than `width` pixels at 13 px (OpenImageIO's text_size with `font`), at

@@ -65,6 +65,8 @@ double lookUp(const nlohmann::json& object, const std::string& key) {
 const std::vector<MetricDefinition>& metricDefinitions() {
     static const std::vector<MetricDefinition> definitions = [] {
         std::vector<MetricDefinition> list;
+        // ColorVideoVDP's JOD against the reference (10 = indistinguishable): higher is closer.
+        list.push_back({"cvvdp_jod", "ColorVideoVDP (JOD)", true});
         for (const char* region : {"image", "skin"}) {
             std::string r = region;
             list.push_back({r + ".psnr_db", "PSNR (" + r + ")", true});

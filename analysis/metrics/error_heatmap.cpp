@@ -120,11 +120,31 @@ void writeErrorHeatmap(const std::filesystem::path& path, const cv::Mat& deltaE0
     writePng(path, renderErrorHeatmap(deltaE00, bands, scaleMax));
 }
 
-cv::Mat renderFlipHeatmap(const cv::Mat& flip) {
+double automaticScaleMax(const cv::Mat& values, double minimum) {
+    cv::Mat asFloat;
+    values.convertTo(asFloat, CV_32FC1);
+    std::vector<float> finite;
+    finite.reserve(asFloat.total());
+    for (int y = 0; y < asFloat.rows; ++y) {
+        const float* row = asFloat.ptr<float>(y);
+        for (int x = 0; x < asFloat.cols; ++x)
+            if (std::isfinite(row[x])) finite.push_back(row[x]);
+    }
+    if (finite.empty()) return std::max(minimum, 1e-12);
+    const std::size_t k = std::min(finite.size() - 1, static_cast<std::size_t>(0.99 * double(finite.size())));
+    std::nth_element(finite.begin(), finite.begin() + static_cast<std::ptrdiff_t>(k), finite.end());
+    const double p99 = std::max(double(finite[k]), minimum);
+    const double power = std::pow(10.0, std::floor(std::log10(p99)));
+    for (double m : {1.0, 2.0, 5.0, 10.0})
+        if (m * power >= p99 * (1.0 - 1e-9)) return m * power;
+    return 10.0 * power;
+}
+
+cv::Mat renderFlipHeatmap(const cv::Mat& flip, double scaleMax) {
     CV_Assert(flip.type() == CV_64FC1 || flip.type() == CV_32FC1);
     cv::Mat values;
     flip.convertTo(values, CV_32FC1);
-    cv::Mat heat = colourise(values, 1.0, cv::COLORMAP_MAGMA);
+    cv::Mat heat = colourise(values, scaleMax, cv::COLORMAP_MAGMA);
     const int height = std::max(heat.rows, legendMinimumHeight);
     cv::Mat canvas(height, heat.cols + legendWidth, CV_8UC3, legendBackground);
     heat.copyTo(canvas(cv::Rect(0, 0, heat.cols, heat.rows)));
@@ -132,27 +152,28 @@ cv::Mat renderFlipHeatmap(const cv::Mat& flip) {
     cv::putText(canvas, "LDR-FLIP", {left, 18}, cv::FONT_HERSHEY_SIMPLEX, fontScale, textColour, 1, cv::LINE_AA);
     const int barTop = 30, barHeight = 120, barWidth = 18;
     cv::Mat ramp(barHeight, 1, CV_32FC1);
-    for (int i = 0; i < barHeight; ++i) ramp.at<float>(i) = static_cast<float>(1.0 - double(i) / double(barHeight - 1));
+    for (int i = 0; i < barHeight; ++i)
+        ramp.at<float>(i) = static_cast<float>(scaleMax * (1.0 - double(i) / double(barHeight - 1)));
     cv::Mat rampColour;
-    cv::resize(colourise(ramp, 1.0, cv::COLORMAP_MAGMA), rampColour, {barWidth, barHeight}, 0, 0, cv::INTER_NEAREST);
+    cv::resize(colourise(ramp, scaleMax, cv::COLORMAP_MAGMA), rampColour, {barWidth, barHeight}, 0, 0,
+               cv::INTER_NEAREST);
     rampColour.copyTo(canvas(cv::Rect(left, barTop, barWidth, barHeight)));
-    const double ticks[3] = {1.0, 0.5, 0.0};
+    const double ticks[3] = {scaleMax, 0.5 * scaleMax, 0.0};
     for (int i = 0; i < 3; ++i) {
         int y = barTop + static_cast<int>(std::lround(i * (barHeight - 1) / 2.0));
         cv::line(canvas, {left + barWidth, y}, {left + barWidth + 4, y}, textColour, 1);
-        cv::putText(canvas, formatScale(ticks[i]), {left + barWidth + 8, y + 5}, cv::FONT_HERSHEY_SIMPLEX, fontScale,
-                    textColour, 1, cv::LINE_AA);
+        cv::putText(canvas, formatScale(ticks[i]) + (i == 0 && scaleMax < 1.0 ? "+" : ""), {left + barWidth + 8, y + 5},
+                    cv::FONT_HERSHEY_SIMPLEX, fontScale, textColour, 1, cv::LINE_AA);
     }
     return canvas;
 }
 
-void writeFlipHeatmap(const std::filesystem::path& path, const cv::Mat& flip) {
-    writePng(path, renderFlipHeatmap(flip));
+void writeFlipHeatmap(const std::filesystem::path& path, const cv::Mat& flip, double scaleMax) {
+    writePng(path, renderFlipHeatmap(flip, scaleMax));
 }
 
-cv::Mat renderCvvdpHeatmap(const cv::Mat& visibility) {
-    CV_Assert(visibility.type() == CV_32FC1);
-    constexpr double scaleMax = 1.0; // JOD
+cv::Mat renderCvvdpHeatmap(const cv::Mat& visibility, double scaleMax) {
+    CV_Assert(visibility.type() == CV_32FC1 && scaleMax > 0.0);
     cv::Mat heat = colourise(visibility, scaleMax, cv::COLORMAP_VIRIDIS);
     const int height = std::max(heat.rows, legendMinimumHeight);
     cv::Mat canvas(height, heat.cols + legendWidth, CV_8UC3, legendBackground);
@@ -178,8 +199,8 @@ cv::Mat renderCvvdpHeatmap(const cv::Mat& visibility) {
     return canvas;
 }
 
-void writeCvvdpHeatmap(const std::filesystem::path& path, const cv::Mat& visibility) {
-    writePng(path, renderCvvdpHeatmap(visibility));
+void writeCvvdpHeatmap(const std::filesystem::path& path, const cv::Mat& visibility, double scaleMax) {
+    writePng(path, renderCvvdpHeatmap(visibility, scaleMax));
 }
 
 } // namespace skinlab::metrics

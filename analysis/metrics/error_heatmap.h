@@ -18,12 +18,17 @@ void writeErrorHeatmap(const std::filesystem::path& path, const cv::Mat& deltaE0
                        double scaleMax);
 
 // The per-pixel LDR-FLIP map (0..1) through the magma colour map (the paper's choice) with a legend panel.
-cv::Mat renderFlipHeatmap(const cv::Mat& flip);
-void writeFlipHeatmap(const std::filesystem::path& path, const cv::Mat& flip);
+cv::Mat renderFlipHeatmap(const cv::Mat& flip, double scaleMax = 1.0);
+void writeFlipHeatmap(const std::filesystem::path& path, const cv::Mat& flip, double scaleMax = 1.0);
 
 // The per-pixel ColorVideoVDP visibility (JOD loss, CV_32FC1) through the viridis colour map on [0, 1] JOD
 // (one JOD and more saturate, as the reference's "threshold" map) with a legend panel.
-cv::Mat renderCvvdpHeatmap(const cv::Mat& visibility);
-void writeCvvdpHeatmap(const std::filesystem::path& path, const cv::Mat& visibility);
+cv::Mat renderCvvdpHeatmap(const cv::Mat& visibility, double scaleMax = 1.0);
+void writeCvvdpHeatmap(const std::filesystem::path& path, const cv::Mat& visibility, double scaleMax = 1.0);
+
+// A colour scale chosen from the data of one figure: the 99th percentile of the finite values rounded up to 1, 2
+// or 5 × 10^k (so the map shows its own structure instead of saturating or staying black), and at least
+// `minimum`. Heat maps drawn with it say their scale in the legend.
+double automaticScaleMax(const cv::Mat& values, double minimum);
 
 } // namespace skinlab::metrics

@@ -110,6 +110,10 @@ nlohmann::json metricsJson(const std::vector<ComparisonRecord>& records, const R
             {"heatmap", record.heatmap.empty() ? nlohmann::json() : nlohmann::json(record.heatmap)},
             {"flip_heatmap", record.flipHeatmap.empty() ? nlohmann::json() : nlohmann::json(record.flipHeatmap)},
             {"cvvdp_heatmap", record.cvvdpHeatmap.empty() ? nlohmann::json() : nlohmann::json(record.cvvdpHeatmap)},
+            {"heatmap_scale", record.heatmap.empty() ? nlohmann::json()
+                                                     : nlohmann::json{{"delta_e00", record.heatmapMax},
+                                                                      {"flip", record.flipHeatmapMax},
+                                                                      {"cvvdp", record.cvvdpHeatmapMax}}},
         });
     }
     return {{"format", "skinlab-metrics"},
@@ -120,7 +124,8 @@ nlohmann::json metricsJson(const std::vector<ComparisonRecord>& records, const R
               {"display_encoding", displayEncodingDescription},
               {"skin_mask_threshold", 0.5},
               {"percentile", "p95 with linear interpolation between order statistics"},
-              {"heatmap_max_delta_e00", settings.heatmapMax},
+              {"heatmap_max_delta_e00", settings.heatmapMax > 0.0 ? nlohmann::json(settings.heatmapMax)
+                                                                  : nlohmann::json("per map (heatmap_scale)")},
               {"flip",
                {{"variant", "LDR-FLIP (Andersson et al. 2020)"},
                 {"pixels_per_degree", settings.pixelsPerDegree},

@@ -22,10 +22,12 @@ struct ComparisonRecord {
     RegionScores image;
     RegionScores skin;
     std::array<BandScores, 4> bands;
-    std::string heatmap;       // path relative to the output folder; "" when heat maps are off
-    std::string flipHeatmap;   // the FLIP map, likewise
-    std::string cvvdpHeatmap;  // the ColorVideoVDP visibility map, likewise
-    double cvvdpJod = 10.0;    // ColorVideoVDP (JOD, 10 = no visible difference)
+    std::string heatmap;      // path relative to the output folder; "" when heat maps are off
+    std::string flipHeatmap;  // the FLIP map, likewise
+    std::string cvvdpHeatmap; // the ColorVideoVDP visibility map, likewise
+    double cvvdpJod = 10.0;   // ColorVideoVDP (JOD, 10 = no visible difference)
+    // The top of each heat map's colour scale (its legend says it): ΔE00, FLIP, JOD loss.
+    double heatmapMax = 0.0, flipHeatmapMax = 0.0, cvvdpHeatmapMax = 0.0;
     bool bandsMeasured = true; // false: plain reference, skin and band scores undefined (null / empty cells)
 };
 

@@ -21,8 +21,9 @@ std::vector<ComparisonRecord> runMetrics(const ComparisonPlan& plan, const Metri
                                          const fs::path& outputFolder) {
     if (plan.jobs.empty()) throwInput("", "", "nothing to compare: no test render besides the reference");
     validateMetricOptions(options.metric);
-    if (!(options.heatmapMax > 0.0) || !std::isfinite(options.heatmapMax))
-        throwInput("--heatmap-max", "", std::to_string(options.heatmapMax) + " must be a positive number");
+    if (options.heatmapMax < 0.0 || !std::isfinite(options.heatmapMax))
+        throwInput("--heatmap-max", "",
+                   std::to_string(options.heatmapMax) + " must be a positive number (0: from the data)");
 
     // 1. Check every input from its header before any output exists.
     std::map<fs::path, MetricRender> referenceHeaders;
@@ -75,12 +76,17 @@ std::vector<ComparisonRecord> runMetrics(const ComparisonPlan& plan, const Metri
         record.bands = result.bands;
         record.cvvdpJod = result.cvvdpJod;
         if (options.heatmaps) {
+            // Each map's colour scale from its own data (--heatmap-max fixes the ΔE00 one instead).
+            record.heatmapMax =
+                options.heatmapMax > 0.0 ? options.heatmapMax : automaticScaleMax(result.deltaE00, 0.01);
+            record.flipHeatmapMax = std::min(1.0, automaticScaleMax(result.flip, 0.001));
+            record.cvvdpHeatmapMax = automaticScaleMax(result.cvvdpMap, 0.001);
             record.heatmap = "heatmaps/" + job.testName + ".png";
-            writeErrorHeatmap(outputFolder / record.heatmap, result.deltaE00, reference.bands, options.heatmapMax);
+            writeErrorHeatmap(outputFolder / record.heatmap, result.deltaE00, reference.bands, record.heatmapMax);
             record.flipHeatmap = "heatmaps/" + job.testName + ".flip.png";
-            writeFlipHeatmap(outputFolder / record.flipHeatmap, result.flip);
+            writeFlipHeatmap(outputFolder / record.flipHeatmap, result.flip, record.flipHeatmapMax);
             record.cvvdpHeatmap = "heatmaps/" + job.testName + ".cvvdp.png";
-            writeCvvdpHeatmap(outputFolder / record.cvvdpHeatmap, result.cvvdpMap);
+            writeCvvdpHeatmap(outputFolder / record.cvvdpHeatmap, result.cvvdpMap, record.cvvdpHeatmapMax);
         }
         records.push_back(std::move(record));
     }

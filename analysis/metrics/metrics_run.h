@@ -13,7 +13,7 @@ namespace skinlab::metrics {
 
 struct MetricsRunOptions {
     MetricOptions metric;
-    double heatmapMax = 10.0; // ΔE00 at the top of the heat map's colour scale
+    double heatmapMax = 0.0; // ΔE00 at the top of the heat map's colour scale; 0 = from each map's data
     bool heatmaps = true;
 };
 
