@@ -140,9 +140,11 @@ Tally runActiveExperiment(const ValidationOptions& options, int observers, std::
     analysisOptions.correction = options.correction;
     analysisOptions.alpha = options.alpha;
     analysisOptions.bootstrap.level = 0.95;
+    analysisOptions.fit.prior = options.prior;
     const BlockAnalysis analysis = analyzeBlock(block, analysisOptions);
     // The observer bootstrap on the same data, for comparison.
     FitOptions fitOptions;
+    fitOptions.prior = options.prior;
     BootstrapOptions bootstrapOptions;
     bootstrapOptions.samples = options.bootstrapSamples;
     bootstrapOptions.seed = mixSeed(seed, 1);
@@ -221,6 +223,7 @@ Tally runExperiment(const ValidationOptions& options, const std::string& scenari
     tally.experiments = 1;
 
     FitOptions fitOptions;
+    fitOptions.prior = options.prior;
     BlockData block = simulated.block;
     if (screening) {
         const FitResult full = fitScores(block.totalCounts(), fitOptions);
@@ -365,6 +368,7 @@ std::string validationMarkdown(const ValidationReport& report) {
                            : o.trialsPerPair * static_cast<int>(o.trueScores.size() * (o.trueScores.size() - 1) / 2),
         bootstrapCoverages.c_str());
     out += line;
+    out += std::string("Prior: ") + priorName(o.prior) + ".\n\n";
     out += "| scenario | observers | coverage | mean width | fallback share | largest half-width | "
            "coverage (percentile, pwcmp) | "
            "mean width | RMSE (JOD) | Spearman | significant & correct | significant & reversed | random caught | "
@@ -407,6 +411,7 @@ nlohmann::json validationJson(const ValidationReport& report) {
                        {"correction", correctionName(o.correction)},
                        {"alpha", o.alpha},
                        {"screening_whisker", o.screeningWhisker},
+                       {"prior", priorName(o.prior)},
                        {"scenarios", o.scenarios},
                        {"sparse_pair_fraction", o.sparsePairFraction},
                        {"disconnected_groups", o.disconnectedGroups},
