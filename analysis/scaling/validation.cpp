@@ -159,9 +159,14 @@ Tally runActiveExperiment(const ValidationOptions& options, int observers, std::
     for (int i = 0; i < m; ++i) {
         tally.intervals += 1;
         tally.covered += analysis.low[i] <= truth[i] && truth[i] <= analysis.high[i];
-        tally.width += analysis.high[i] - analysis.low[i];
-        tally.maximumHalfWidth =
-            std::max({tally.maximumHalfWidth, fit[i] - analysis.low[i], analysis.high[i] - fit[i]});
+        // An end the data do not set is open (unanimous answers: docs/analysis.md, "Intervals the data
+        // support"); widths and half-widths are those of the ends that are set.
+        if (std::isfinite(analysis.low[i]) && std::isfinite(analysis.high[i]))
+            tally.width += analysis.high[i] - analysis.low[i];
+        if (std::isfinite(analysis.low[i]))
+            tally.maximumHalfWidth = std::max(tally.maximumHalfWidth, fit[i] - analysis.low[i]);
+        if (std::isfinite(analysis.high[i]))
+            tally.maximumHalfWidth = std::max(tally.maximumHalfWidth, analysis.high[i] - fit[i]);
         tally.bootstrapCovered += bootstrap.low[i] <= truth[i] && truth[i] <= bootstrap.high[i];
         tally.percentileCovered += bootstrap.percentileLow[i] <= truth[i] && truth[i] <= bootstrap.percentileHigh[i];
         tally.percentileWidth += bootstrap.percentileHigh[i] - bootstrap.percentileLow[i];
