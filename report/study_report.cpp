@@ -366,9 +366,13 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
         const std::size_t pairCount = block.pairs.size();
         html << "<li><strong>" << h(block.name) << "</strong>: <em>"
              << h(block.conditions[static_cast<std::size_t>(best)]) << "</em> scored highest, "
-             << linked(anchor, num(block.thurstone.scores[best]) + " JOD") << " ["
-             << linked(anchor, num(block.low[best])) << ", " << linked(anchor, num(block.high[best])) << "]; <em>"
-             << h(block.conditions[static_cast<std::size_t>(worst)]) << "</em> lowest, "
+             << linked(anchor, num(block.thurstone.scores[best]) + " JOD") << " "
+             << (std::isfinite(block.high[best])
+                     ? "[" + linked(anchor, num(block.low[best])) + ", " + linked(anchor, num(block.high[best])) + "]"
+                 : std::isfinite(block.low[best])
+                     ? "(at least " + linked(anchor, num(block.low[best])) + "; the answers set no upper end)"
+                     : std::string("(no interval: the answers do not bound it)"))
+             << "; <em>" << h(block.conditions[static_cast<std::size_t>(worst)]) << "</em> lowest, "
              << linked(anchor, num(block.thurstone.scores[worst]) + " JOD") << ". "
              << linked("pairs-" + slug(block.name), std::to_string(significant)) << " of " << pairCount
              << " pairs are separated significantly (" << h(scaling::correctionName(analysis.options.correction))
@@ -438,6 +442,7 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
          << h(store.meta("design_sha256").substr(0, 16)) << "…</code> / <code>"
          << h(store.meta("manifest_sha256").substr(0, 16)) << "…</code></td></tr>"
          << "<tr><th class=\"l\">Analysis</th><td class=\"l\">Thurstone Case V in JOD (1 JOD = 75 % preference), "
+         << h(scaling::priorName(analysis.options.fit.prior)) << " prior, "
          << h(analysis.blocks.empty() ? std::string("—") : analysis.blocks.front().intervalMethod) << " intervals ("
          << options.bootstrapSamples << " resamples, " << num(100.0 * analysisOptions.bootstrap.level, 0)
          << " %), pairwise tests " << h(scaling::correctionName(analysis.options.correction)) << "-corrected</td></tr>"

@@ -8,7 +8,7 @@
 // The CSV was read into per-observer count matrices exactly as pw_scale_table does (conditions in the order of
 // unique(), i.e. sorted), then per scene `pw_scale(M)` (defaults: 'gaussian' prior, 'mean0' regularisation),
 // `pw_scale(M, {'prior', 'none'})` with fminunc's TolFun and TolX at 1e-14, and
-// `[L, dist_L] = pw_outlier_analysis({MM_corridor, ..., MM_window})`.
+// `[L, dist_L] = pw_outlier_analysis({MM_corridor, ..., MM_window})`; and examples/ex1_simple_scaling.m as it is.
 #include "analysis/scaling/comparison_data.h"
 #include "analysis/scaling/pairwise_model.h"
 #include "analysis/scaling/responses.h"
@@ -95,6 +95,21 @@ TEST(PwcmpReference, PwcmpPriorReproducesPwScale) {
         }
     }
     EXPECT_GT(largestGaussianDifference, 0.3) << "the two priors should differ on this data";
+}
+
+TEST(PwcmpReference, PwcmpPriorReproducesExampleOne) {
+    // examples/ex1_simple_scaling.m: D = [0 25 0; 75 0 25; 0 75 0]; pw_scale(D) gave -0.999998, 0, 0.999998.
+    PairCounts counts;
+    counts.conditions = 3;
+    counts.pairs = {{0, 1}, {1, 2}};
+    counts.first = Eigen::Vector2d(25, 25);
+    counts.second = Eigen::Vector2d(75, 75);
+    FitOptions options;
+    options.prior = Prior::Pwcmp;
+    const FitResult fit = fitScores(counts, options);
+    EXPECT_NEAR(fit.scores[0], -0.999998, 1e-4);
+    EXPECT_NEAR(fit.scores[1], 0.0, 1e-4);
+    EXPECT_NEAR(fit.scores[2], 0.999998, 1e-4);
 }
 
 TEST(PwcmpReference, NegligibleGaussianPriorReproducesPwScaleWithoutPrior) {
