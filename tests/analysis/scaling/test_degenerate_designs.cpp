@@ -132,7 +132,7 @@ TEST(DegenerateDesigns, IdenticalUnanimousObserversFinishAndWriteScaleJson) {
 
 TEST(DegenerateDesigns, UnanimousStudiesGetOneSidedBoundsInsteadOfPriorSetEnds) {
     // 5 observers, 4 conditions, every answer unanimous (c3 ≻ c2 ≻ c1 ≻ c0). The interval of c3 used to be
-    // [0.62, 22.99]: its upper end was the prior's. The data say "at least" for the best condition, "at most" for
+    // [3.15, 20.11]: its upper end was the prior's. The data say "at least" for the best condition, "at most" for
     // the worst, and nothing about the middle ones relative to the mean.
     const Analysis analysis = analyzeDataset(dataset(4, identicalObservers()), quickOptions());
     const BlockAnalysis& block = analysis.blocks.at(0);
@@ -160,7 +160,7 @@ TEST(DegenerateDesigns, UnanimousStudiesGetOneSidedBoundsInsteadOfPriorSetEnds) 
 }
 
 TEST(DegenerateDesigns, DisconnectedComponentsAreScaledSeparately) {
-    // A count matrix (profile intervals) with two components of three conditions: each score used to get ±14.6 JOD
+    // A count matrix (profile intervals) with two components of three conditions: each score used to get ±7.3 JOD
     // (the prior's spread between the components). Each component is centred on its own mean, its scores get
     // data-sized intervals, and differences across components are not measured.
     for (const Prior prior : {Prior::Gaussian, Prior::Pwcmp}) {
