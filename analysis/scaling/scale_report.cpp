@@ -114,9 +114,12 @@ nlohmann::json analysisJson(const Analysis& analysis) {
         {"unit", "JOD (1 JOD = 75 % preference), mean of each block's scores = 0"},
         {"prior", priorName(o.fit.prior)},
         {"prior_precision", o.fit.prior == Prior::Gaussian ? nlohmann::json(o.fit.priorPrecision) : nlohmann::json()},
-        {"interval", "symmetric studentized bootstrap over observers, cluster-robust SE; where the "
-                     "studentization is degenerate (flagged per interval) the hull of the percentile "
-                     "and the profile-posterior intervals, with a score test"},
+        {"interval", o.intervals == IntervalMethod::percentile
+                         ? "percentile bootstrap over observers (pwcmp's pw_scale_bootstrp), bootstrap p-values"
+                         : "symmetric studentized bootstrap over observers, cluster-robust SE; where the "
+                           "studentization is degenerate (flagged per interval) the hull of the percentile "
+                           "and the profile-posterior intervals, with a score test; ends the data do not set are "
+                           "open (bound)"},
         {"intervals", o.intervals == IntervalMethod::profile      ? "profile"
                       : o.intervals == IntervalMethod::percentile ? "percentile"
                                                                   : "bootstrap"},

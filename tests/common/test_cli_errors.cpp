@@ -36,6 +36,7 @@ TEST(CliErrors, EverySubcommandExitsTwoWithOneLine) {
         "analyze scale r.csv",                            // missing required option
         "analyze scale -o out",                           // missing positional argument
         "analyze scale r.csv -o out --bootstrap ten",     // not a number
+        "analyze scale r.csv -o out --columns nope=x",    // a --columns role skinlab does not know
         "analyze validate --experiments 0",               // out of range
         "analyze validate --scenarios",                   // option without its value
         "analyze",                                        // missing sub-subcommand
