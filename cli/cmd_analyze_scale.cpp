@@ -10,6 +10,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 
@@ -29,6 +30,9 @@ struct ScaleArguments {
     double alpha = 0.05;
     double whisker = 1.5;
     double priorPrecision = 0.002;
+    std::string prior = "gaussian";
+    bool pwcmpOutliers = false;
+    std::vector<std::string> columns;
     std::string block;
     bool singleBlock = false;
     std::vector<std::string> conditions;
@@ -43,6 +47,8 @@ void runScale(const ScaleArguments& arguments) {
     datasetOptions.singleBlock = arguments.singleBlock;
     scaling::AnalysisOptions options;
     options.fit.priorPrecision = arguments.priorPrecision;
+    options.fit.prior = arguments.prior == "pwcmp" ? scaling::Prior::Pwcmp : scaling::Prior::Gaussian;
+    options.pwcmpOutliers = arguments.pwcmpOutliers;
     options.bootstrap.samples = arguments.bootstrap;
     options.bootstrap.seed = arguments.seed;
     options.bootstrap.threads = arguments.threads;
@@ -51,7 +57,26 @@ void runScale(const ScaleArguments& arguments) {
     options.alpha = arguments.alpha;
     options.screeningWhisker = arguments.whisker;
 
-    scaling::ResponseTable table = scaling::readResponses(arguments.responses);
+    scaling::ReadOptions readOptions;
+    const std::vector<std::string>& roles = scaling::mappableColumns();
+    for (const std::string& entry : arguments.columns) {
+        const size_t equals = entry.find('=');
+        const std::string role = entry.substr(0, equals);
+        if (equals == std::string::npos || equals + 1 == entry.size() ||
+            std::find(roles.begin(), roles.end(), role) == roles.end()) {
+            std::string names;
+            for (const std::string& name : roles) names += (names.empty() ? "" : ", ") + name;
+            throwInput("--columns", "", "'" + entry + "' is not ROLE=COLUMN with ROLE one of " + names);
+        }
+        readOptions.columns.emplace_back(role, entry.substr(equals + 1));
+    }
+    scaling::ResponseTable table = scaling::readResponses(arguments.responses, readOptions);
+    if (!table.ignoredColumns.empty()) {
+        std::string names;
+        for (const std::string& name : table.ignoredColumns) names += (names.empty() ? "" : ", ") + name;
+        std::fprintf(stderr, "note: %s: ignored column(s) %s (--columns selects other ones)\n", table.file.c_str(),
+                     names.c_str());
+    }
     if (arguments.dropFlagged) {
         const scaling::DroppedFlagged dropped = scaling::dropFlagged(table);
         if (dropped.recorded)
@@ -61,7 +86,10 @@ void runScale(const ScaleArguments& arguments) {
     }
     // Likelihood-based intervals stay valid when each observer's pairs depended on earlier answers; the observer
     // bootstrap does not (docs/analysis.md, "Validation of active designs").
-    if (arguments.intervals == "profile" || (arguments.intervals == "auto" && table.adaptiveDesign)) {
+    if (arguments.intervals == "percentile") {
+        options.intervals = scaling::IntervalMethod::percentile;
+        options.intervalReason = "--intervals percentile";
+    } else if (arguments.intervals == "profile" || (arguments.intervals == "auto" && table.adaptiveDesign)) {
         options.intervals = scaling::IntervalMethod::profile;
         options.intervalReason = arguments.intervals == "profile" ? "--intervals profile" : "active design";
     } else {
@@ -85,14 +113,27 @@ void runScale(const ScaleArguments& arguments) {
                     note += (note.empty() ? "" : ", ") + reason;
                 note = "  percentile+profile (" + note + ")";
             }
-            std::printf("  %-24s %+7.3f JOD  [%+.3f, %+.3f]%s\n", block.conditions[i].c_str(),
-                        block.thurstone.scores[k], block.low[k], block.high[k], note.c_str());
+            char interval[96];
+            const double low = block.low[k], high = block.high[k];
+            if (std::isfinite(low) && std::isfinite(high))
+                std::snprintf(interval, sizeof interval, "[%+.3f, %+.3f]", low, high);
+            else if (std::isfinite(low)) std::snprintf(interval, sizeof interval, "at least %+.3f", low);
+            else if (std::isfinite(high)) std::snprintf(interval, sizeof interval, "at most %+.3f", high);
+            else std::snprintf(interval, sizeof interval, "not measured");
+            std::printf("  %-24s %+7.3f JOD  %s%s\n", block.conditions[i].c_str(), block.thurstone.scores[k], interval,
+                        note.c_str());
         }
     }
+    for (const scaling::ObserverSummary& observer : analysis.observers)
+        if (arguments.pwcmpOutliers && !std::isnan(observer.pwcmpDistance))
+            std::printf("pwcmp outlier analysis: %-16s log10 likelihood per pair %.4f  dist_L %.3f%s\n",
+                        observer.observer.c_str(), observer.pwcmpLogLikelihood, observer.pwcmpDistance,
+                        observer.pwcmpOutlier ? "  outlier" : "");
     std::printf("wrote %s\n", (std::filesystem::path(arguments.output) / "scale.json").c_str());
 }
 
 struct ValidateArguments {
+    std::string prior = "gaussian";
     std::string output;
     scaling::ValidationOptions options;
     std::string correction = "holm";
@@ -130,6 +171,7 @@ std::vector<std::string> failedTargets(const scaling::ValidationReport& report) 
 
 void runValidate(ValidateArguments& arguments) {
     arguments.options.correction = scaling::parseCorrection(arguments.correction);
+    arguments.options.prior = arguments.prior == "pwcmp" ? scaling::Prior::Pwcmp : scaling::Prior::Gaussian;
     const std::vector<std::string>& known = scaling::validationScenarios();
     std::string names;
     for (const std::string& name : known) names += (names.empty() ? "" : ", ") + name;
@@ -205,6 +247,19 @@ void registerAnalyzeScale(CLI::App& analyze) {
                      "precision (1/JOD^2) of the Gaussian prior on every pairwise difference")
         ->check(CLI::Range(1e-6, 10.0))
         ->capture_default_str();
+    scale
+        ->add_option("--prior", scaleArguments->prior,
+                     "gaussian (--prior-precision on every pairwise difference) or pwcmp (pwcmp's pw_scale default "
+                     "prior and mean-zero regularisation)")
+        ->check(CLI::IsMember({"gaussian", "pwcmp"}))
+        ->capture_default_str();
+    scale->add_flag("--pwcmp-outliers", scaleArguments->pwcmpOutliers,
+                    "also run pwcmp's outlier analysis (leave-one-observer-out dist_L, flagged above 1.5)");
+    scale
+        ->add_option("--columns", scaleArguments->columns,
+                     "long CSVs: ROLE=COLUMN for the roles observer, scene, condition_A, condition_B, is_A_selected "
+                     "(other columns are ignored with a note)")
+        ->delimiter(',');
     scale->add_option("--block", scaleArguments->block, "analyse only this block (scene)");
     scale->add_flag("--single-block", scaleArguments->singleBlock, "the file must hold one block only");
     scale
@@ -215,9 +270,10 @@ void registerAnalyzeScale(CLI::App& analyze) {
                     "leave out trials during which the page was hidden or lost the focus (online studies)");
     scale
         ->add_option("--intervals", scaleArguments->intervals,
-                     "bootstrap (over observers), profile (profile likelihood, valid for active designs), or auto: "
-                     "profile for a study.db with pairs = \"active\", bootstrap otherwise")
-        ->check(CLI::IsMember({"auto", "bootstrap", "profile"}))
+                     "bootstrap (studentized, over observers), profile (profile likelihood, valid for active "
+                     "designs), percentile (pwcmp's percentile bootstrap over observers), or auto: profile for a "
+                     "study.db with pairs = \"active\", bootstrap otherwise")
+        ->check(CLI::IsMember({"auto", "bootstrap", "profile", "percentile"}))
         ->capture_default_str();
     scale->callback([scaleArguments] { runScale(*scaleArguments); });
 
@@ -253,6 +309,9 @@ void registerAnalyzeScale(CLI::App& analyze) {
         ->capture_default_str();
     validate->add_option("--correction", validateArguments->correction, "multiple-comparison correction")
         ->check(CLI::IsMember({"holm", "bonferroni", "none"}))
+        ->capture_default_str();
+    validate->add_option("--prior", validateArguments->prior, "prior of the fits: gaussian or pwcmp")
+        ->check(CLI::IsMember({"gaussian", "pwcmp"}))
         ->capture_default_str();
     validate->add_option("--whisker", o.screeningWhisker, "inter-quartile rule factor w")
         ->check(CLI::Range(0.0, 10.0))

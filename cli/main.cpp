@@ -3,7 +3,9 @@
 #include "common/error.h"
 #include "common/version.h"
 
+#include <algorithm>
 #include <cstdio>
+#include <string>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
@@ -34,7 +36,14 @@ int main(int argc, char** argv) {
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        return app.exit(e);
+        // --help and --version end the parse with exit code 0: CLI11 prints them. Every other parse error (an
+        // unknown option, a bad or missing value, a missing subcommand) is a command-line error: one line, exit 2,
+        // whatever CLI11's own code for it.
+        if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);
+        std::string message = e.what();
+        std::replace(message.begin(), message.end(), '\n', ' ');
+        std::fprintf(stderr, "skinlab: error: %s (see --help)\n", message.c_str());
+        return 2;
     } catch (const skinlab::InputError& e) {
         std::fprintf(stderr, "skinlab: error: %s\n", e.what());
         return 2;

@@ -507,6 +507,7 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
          << h(store.meta("design_sha256").substr(0, 16)) << "…</code> / <code>"
          << h(store.meta("manifest_sha256").substr(0, 16)) << "…</code></td></tr>"
          << "<tr><th class=\"l\">Analysis</th><td class=\"l\">Thurstone Case V in JOD (1 JOD = 75 % preference), "
+         << h(scaling::priorName(analysis.options.fit.prior)) << " prior, "
          << h(analysis.blocks.empty() ? std::string("—") : analysis.blocks.front().intervalMethod) << " intervals ("
          << options.bootstrapSamples << " resamples, " << num(100.0 * analysisOptions.bootstrap.level, 0)
          << " %), pairwise tests " << h(scaling::correctionName(analysis.options.correction)) << "-corrected</td></tr>"

@@ -255,6 +255,16 @@ BootstrapResult bootstrapObservers(const BlockData& block, const FitResult& fit,
             }
             const std::vector<double> t = studentize(differences, differenceSe, k, test.difference, test.standardError,
                                                      differenceStandardError(model, i, j), diagnosis);
+            {
+                const std::vector<double> d = sortedColumn(differences, k);
+                test.percentileLow = sortedQuantile(d, lowerProbability);
+                test.percentileHigh = sortedQuantile(d, upperProbability);
+                const auto atMostZero = std::upper_bound(d.begin(), d.end(), 0.0) - d.begin();
+                const auto atLeastZero = d.end() - std::lower_bound(d.begin(), d.end(), 0.0);
+                const double share =
+                    static_cast<double>(std::min(atMostZero, atLeastZero)) / static_cast<double>(samples);
+                test.percentilePValue = std::clamp(2.0 * share, 1.0 / samples, 1.0);
+            }
             if (!diagnosis.fallback) {
                 const double half = sortedQuantile(t, options.level) * test.standardError;
                 test.low = test.difference - half;

@@ -23,6 +23,7 @@
 
 #include <Eigen/Dense>
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -46,6 +47,10 @@ struct IntervalDiagnosis {
     bool fallback = false;
     std::vector<std::string> reasons; // "disconnected", "unanimous", "observers-agree", "zero-spread-resamples",
                                       // "extreme-t", "bound-at-search-cap"
+    // Which ends of the interval the data set (docs/analysis.md, "Intervals the data support"): "two-sided";
+    // "lower" (the data bound it from below only: unanimous answers; the upper end is +∞), "upper", or "none"
+    // (neither end: e.g. conditions in different components of a disconnected design, which cannot be compared).
+    std::string bound = "two-sided";
 };
 
 struct DifferenceTest {
@@ -55,6 +60,9 @@ struct DifferenceTest {
     double low = 0.0, high = 0.0; // studentized interval of the difference (or the fallback, see diagnosis)
     double pValue = 1.0;          // two-sided, unadjusted (studentized, or the score test for a fallback)
     IntervalDiagnosis diagnosis;
+    // pwcmp's construction on the same resamples: percentile interval of the resampled differences, and the
+    // two-sided bootstrap p-value 2·min(share of resamples ≤ 0, share ≥ 0) (at least 1/B).
+    double percentileLow = NAN, percentileHigh = NAN, percentilePValue = NAN;
 };
 
 // Structure of a block's comparison graph: connected components (pairs compared at least once) and strongly

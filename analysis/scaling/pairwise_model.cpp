@@ -30,7 +30,40 @@ LinkValues logistic(double difference) {
             -kLogThree * kLogThree * probability * (1.0 - probability)};
 }
 
-// Log posterior = log-likelihood − prior − mean penalty; returns the data log-likelihood through `dataTerm`.
+// Connected components of the compared pairs (a total above 0): a label per condition, 0 … count − 1.
+std::vector<int> componentLabels(const PairCounts& counts, int* count) {
+    std::vector<int> label(counts.conditions);
+    for (int i = 0; i < counts.conditions; ++i) label[i] = i;
+    auto root = [&](int i) {
+        while (label[i] != i) i = label[i] = label[label[i]];
+        return i;
+    };
+    for (size_t p = 0; p < counts.pairs.size(); ++p)
+        if (counts.first[p] + counts.second[p] > 0) label[root(counts.pairs[p].first)] = root(counts.pairs[p].second);
+    std::vector<int> number(counts.conditions, -1);
+    int next = 0;
+    for (int i = 0; i < counts.conditions; ++i) {
+        const int r = root(i);
+        if (number[r] < 0) number[r] = next++;
+    }
+    std::vector<int> result(counts.conditions);
+    for (int i = 0; i < counts.conditions; ++i) result[i] = number[root(i)];
+    if (count) *count = next;
+    return result;
+}
+
+// The mean penalty: −½ (Σ q)² (Gaussian prior, which ties every pair), or −½ Σ_c (Σ_{i∈c} q_i)² over the connected
+// components (pwcmp's prior only involves compared pairs, so each component is centred on its own mean).
+double meanPenalty(const PairCounts& counts, const FitOptions& options, const Eigen::VectorXd& q) {
+    if (options.prior == Prior::Gaussian) return 0.5 * q.sum() * q.sum();
+    int count = 0;
+    const std::vector<int> label = componentLabels(counts, &count);
+    Eigen::VectorXd sums = Eigen::VectorXd::Zero(count);
+    for (int i = 0; i < counts.conditions; ++i) sums[label[i]] += q[i];
+    return 0.5 * sums.squaredNorm();
+}
+
+// Log posterior = log-likelihood + log prior − mean penalty; returns the data log-likelihood through `dataTerm`.
 double objective(const PairCounts& counts, const FitOptions& options, const Eigen::VectorXd& q, double* dataTerm) {
     double data = 0.0;
     for (size_t p = 0; p < counts.pairs.size(); ++p) {
@@ -38,17 +71,90 @@ double objective(const PairCounts& counts, const FitOptions& options, const Eige
         if (counts.first[p] > 0) data += counts.first[p] * linkValues(options.model, d).logProbability;
         if (counts.second[p] > 0) data += counts.second[p] * linkValues(options.model, -d).logProbability;
     }
-    const double m = static_cast<double>(q.size());
-    const double sum = q.sum();
-    // Σ_{i<j} (q_i − q_j)² = m Σ q² − (Σ q)²
-    const double sumSquaredDifferences = m * q.squaredNorm() - sum * sum;
     if (dataTerm) *dataTerm = data;
-    return data - 0.5 * options.priorPrecision * sumSquaredDifferences - 0.5 * sum * sum;
+    double prior = 0.0;
+    if (options.prior == Prior::Gaussian) {
+        const double m = static_cast<double>(q.size());
+        const double sum = q.sum();
+        // Σ_{i<j} (q_i − q_j)² = m Σ q² − (Σ q)²
+        prior = -0.5 * options.priorPrecision * (m * q.squaredNorm() - sum * sum);
+    } else {
+        prior = pwcmpLogPrior(counts, q, nullptr, options.model);
+    }
+    return data + prior - meanPenalty(counts, options, q);
 }
 
 } // namespace
 
 const char* modelName(Model model) { return model == Model::Thurstone ? "thurstone" : "bradley-terry"; }
+
+const char* priorName(Prior prior) { return prior == Prior::Gaussian ? "gaussian" : "pwcmp"; }
+
+double pwcmpLogPrior(const PairCounts& counts, const Eigen::VectorXd& scores, Eigen::VectorXd* gradient, Model model) {
+    // Every compared pair in both orders, as pw_scale's matrices: o = (i, j) with k_o answers for i out of n_o.
+    struct Ordered {
+        int i, j;
+        double k, n;
+    };
+    std::vector<Ordered> ordered;
+    for (size_t p = 0; p < counts.pairs.size(); ++p) {
+        const double n = counts.first[p] + counts.second[p];
+        if (n <= 0) continue;
+        double k = counts.first[p];
+        double kReverse = counts.second[p];
+        // pw_scale's D_wUA: a unanimous pair is moved one answer toward a tie (0 → 1, n → n − 1).
+        if (k == 0 || kReverse == 0) {
+            k = k == 0 ? 1.0 : k - 1.0;
+            kReverse = kReverse == 0 ? 1.0 : kReverse - 1.0;
+        }
+        ordered.push_back({counts.pairs[p].first, counts.pairs[p].second, k, n});
+        ordered.push_back({counts.pairs[p].second, counts.pairs[p].first, kReverse, n});
+    }
+    const auto size = static_cast<Eigen::Index>(ordered.size());
+    if (gradient) gradient->setZero(counts.conditions);
+    if (size == 0) return 0.0;
+    // Per distance o: log P_o, log(1 − P_o) and their derivatives in d_o = q_i − q_j.
+    Eigen::VectorXd logP(size), logQ(size), slopeP(size), slopeQ(size);
+    for (Eigen::Index o = 0; o < size; ++o) {
+        const double d = scores[ordered[o].i] - scores[ordered[o].j];
+        const LinkValues forward = linkValues(model, d), backward = linkValues(model, -d);
+        logP[o] = forward.logProbability;
+        logQ[o] = backward.logProbability;
+        slopeP[o] = forward.slope;
+        slopeQ[o] = -backward.slope;
+    }
+    // R(o, b) = P_o^k_b (1 − P_o)^(n_b − k_b) / Σ_o' (same): the probability of outcome b at distance o, normalised
+    // over the distances (a softmax over o, computed in logs so that large counts do not underflow).
+    Eigen::MatrixXd share(size, size);
+    for (Eigen::Index b = 0; b < size; ++b) {
+        const double k = ordered[b].k, rest = ordered[b].n - ordered[b].k;
+        for (Eigen::Index o = 0; o < size; ++o)
+            share(o, b) = (k > 0 ? k * logP[o] : 0.0) + (rest > 0 ? rest * logQ[o] : 0.0);
+        const double top = share.col(b).maxCoeff();
+        share.col(b) = (share.col(b).array() - top).exp();
+        share.col(b) /= share.col(b).sum();
+    }
+    const Eigen::VectorXd prior = share.rowwise().sum(); // π_o
+    // Each unordered pair appears twice with π equal in both orders; pw_scale's objective also counts the data
+    // twice, so its log posterior is this sum halved.
+    const double value = 0.5 * (prior.array() + 0.1).log().sum();
+    if (gradient) {
+        // ∂π_o/∂d_c = δ_oc Σ_b R(o,b) ℓ'_b(d_o) − Σ_b R(o,b) R(c,b) ℓ'_b(d_c), ℓ_b = k_b log P + (n_b − k_b) log(1 − P),
+        // so ∂/∂d_c ½ Σ_o log(π_o + 0.1) = ½ Σ_b R(c,b) ℓ'_b(d_c) (w_c − u_b), w = 1/(π + 0.1), u_b = Σ_o w_o R(o,b).
+        const Eigen::VectorXd w = (prior.array() + 0.1).inverse();
+        const Eigen::VectorXd u = share.transpose() * w;
+        for (Eigen::Index c = 0; c < size; ++c) {
+            double total = 0.0;
+            for (Eigen::Index b = 0; b < size; ++b) {
+                const double slope = ordered[b].k * slopeP[c] + (ordered[b].n - ordered[b].k) * slopeQ[c];
+                total += share(c, b) * slope * (w[c] - u[b]);
+            }
+            (*gradient)[ordered[c].i] += 0.5 * total;
+            (*gradient)[ordered[c].j] -= 0.5 * total;
+        }
+    }
+    return value;
+}
 
 LinkValues linkValues(Model model, double difference) {
     return model == Model::Thurstone ? probit(difference) : logistic(difference);
@@ -72,18 +178,51 @@ double logLikelihood(Model model, const std::vector<std::pair<int, int>>& pairs,
 
 namespace {
 
-// Gradient and negative Hessian (plus 1 1ᵀ for the mean penalty) of the log posterior at q.
+// Adds the mean penalty's gradient and negative Hessian: 1 1ᵀ (Gaussian prior) or Σ_c 1_c 1_cᵀ (pwcmp's).
+void addMeanPenalty(const PairCounts& counts, const FitOptions& options, const Eigen::VectorXd& q,
+                    Eigen::VectorXd& gradient, Eigen::MatrixXd& information) {
+    const int m = counts.conditions;
+    int count = 1;
+    const std::vector<int> label =
+        options.prior == Prior::Gaussian ? std::vector<int>(m, 0) : componentLabels(counts, &count);
+    Eigen::VectorXd sums = Eigen::VectorXd::Zero(count);
+    for (int i = 0; i < m; ++i) sums[label[i]] += q[i];
+    for (int i = 0; i < m; ++i) {
+        gradient[i] -= sums[label[i]];
+        for (int j = 0; j < m; ++j)
+            if (label[i] == label[j]) information(i, j) += 1.0;
+    }
+}
+
+// Gradient and negative Hessian (plus the mean penalty's) of the log posterior at q.
 void assemble(const PairCounts& counts, const FitOptions& options, const Eigen::VectorXd& q, Eigen::VectorXd& gradient,
               Eigen::MatrixXd& information) {
     const int m = counts.conditions;
     const double md = static_cast<double>(m);
-    const double sum = q.sum();
-    // prior: −τ/2 Σ_{i<j}(q_i − q_j)²  ⇒  gradient −τ(m q − Σq), negative Hessian τ(m I − 1 1ᵀ);
-    // mean penalty −½(Σq)²  ⇒  gradient −Σq, negative Hessian 1 1ᵀ.
-    gradient =
-        -options.priorPrecision * (md * q - Eigen::VectorXd::Constant(m, sum)) - Eigen::VectorXd::Constant(m, sum);
-    information.setConstant(m, m, 1.0 - options.priorPrecision);
-    information.diagonal().array() += options.priorPrecision * md;
+    gradient.setZero(m);
+    information.setZero(m, m);
+    if (options.prior == Prior::Gaussian) {
+        // prior: −τ/2 Σ_{i<j}(q_i − q_j)²  ⇒  gradient −τ(m q − Σq), negative Hessian τ(m I − 1 1ᵀ).
+        gradient = -options.priorPrecision * (md * q - Eigen::VectorXd::Constant(m, q.sum()));
+        information.setConstant(m, m, -options.priorPrecision);
+        information.diagonal().array() += options.priorPrecision * md;
+    } else {
+        // pwcmp's prior: analytic gradient; its Hessian by central differences of the gradient (the prior is a
+        // smooth function of the distances; h = 10⁻⁵ JOD leaves an error near 10⁻¹⁰).
+        pwcmpLogPrior(counts, q, &gradient, options.model);
+        constexpr double h = 1e-5;
+        Eigen::VectorXd up(m), down(m);
+        for (int k = 0; k < m; ++k) {
+            Eigen::VectorXd shifted = q;
+            shifted[k] += h;
+            pwcmpLogPrior(counts, shifted, &up, options.model);
+            shifted[k] -= 2.0 * h;
+            pwcmpLogPrior(counts, shifted, &down, options.model);
+            information.col(k) = -(up - down) / (2.0 * h);
+        }
+        information = 0.5 * (information + information.transpose()).eval();
+    }
+    addMeanPenalty(counts, options, q, gradient, information);
     for (size_t p = 0; p < counts.pairs.size(); ++p) {
         const auto [i, j] = counts.pairs[p];
         const double d = q[i] - q[j];
@@ -107,6 +246,19 @@ void assemble(const PairCounts& counts, const FitOptions& options, const Eigen::
     }
 }
 
+// LDLT of the information for a Newton step. pwcmp's prior is not concave: where the information is not positive
+// definite, a multiple of the identity is added until it is (Levenberg), so the step still ascends.
+Eigen::LDLT<Eigen::MatrixXd> newtonSolver(const Eigen::MatrixXd& information) {
+    Eigen::LDLT<Eigen::MatrixXd> solver(information);
+    double damping = 1e-6 * std::max(1.0, information.diagonal().cwiseAbs().maxCoeff());
+    while (solver.info() != Eigen::Success || solver.vectorD().minCoeff() <= 0.0) {
+        solver.compute(information + damping * Eigen::MatrixXd::Identity(information.rows(), information.cols()));
+        damping *= 10.0;
+        if (damping > 1e12) break;
+    }
+    return solver;
+}
+
 } // namespace
 
 double logPosterior(const PairCounts& counts, const FitOptions& options, const Eigen::VectorXd& scores) {
@@ -120,11 +272,10 @@ FitResult fitScores(const PairCounts& counts, const FitOptions& options, const E
     Eigen::VectorXd gradient(m);
     Eigen::MatrixXd information(m, m); // negative Hessian of the log posterior, plus 1 1ᵀ for the mean
     double current = objective(counts, options, result.scores, nullptr);
-    const double md = static_cast<double>(m);
 
     for (result.iterations = 0; result.iterations < options.maxIterations; ++result.iterations) {
         assemble(counts, options, result.scores, gradient, information);
-        const Eigen::LDLT<Eigen::MatrixXd> solver(information);
+        const Eigen::LDLT<Eigen::MatrixXd> solver = newtonSolver(information);
         Eigen::VectorXd step = solver.solve(gradient);
         // Backtracking: the log posterior is concave, so a full Newton step is accepted except far from the
         // optimum (large unanimous differences), where halving keeps every iteration an ascent.
@@ -145,10 +296,19 @@ FitResult fitScores(const PairCounts& counts, const FitOptions& options, const E
         }
     }
     assemble(counts, options, result.scores, gradient, information);
-    result.inverseInformation = information.ldlt().solve(Eigen::MatrixXd::Identity(m, m));
-    // `information` has eigenvalue m along 1/√m (the mean penalty); remove that direction so the matrix is the
-    // covariance of the mean-zero scores.
-    result.inverseInformation.array() -= 1.0 / (md * md);
+    result.inverseInformation = newtonSolver(information).solve(Eigen::MatrixXd::Identity(m, m));
+    // `information` has eigenvalue |c| along 1_c/√|c| for the mean penalty of each centred group c (all conditions
+    // under the Gaussian prior, each connected component under pwcmp's); remove those directions so the matrix is
+    // the covariance of the centred scores.
+    int groups = 1;
+    const std::vector<int> label =
+        options.prior == Prior::Gaussian ? std::vector<int>(m, 0) : componentLabels(counts, &groups);
+    std::vector<double> groupSize(groups, 0.0);
+    for (int i = 0; i < m; ++i) groupSize[label[i]] += 1.0;
+    for (int i = 0; i < m; ++i)
+        for (int j = 0; j < m; ++j)
+            if (label[i] == label[j])
+                result.inverseInformation(i, j) -= 1.0 / (groupSize[label[i]] * groupSize[label[i]]);
     objective(counts, options, result.scores, &result.logLikelihood);
     return result;
 }
@@ -165,7 +325,7 @@ ConstrainedFit fitConstrained(const PairCounts& counts, const FitOptions& option
         assemble(counts, options, result.scores, gradient, information);
         // Newton step of the Lagrangian: maximise along the directions that keep aᵀq fixed,
         // step = I⁻¹(g − μ a) with μ chosen so that aᵀ step = 0.
-        const Eigen::LDLT<Eigen::MatrixXd> solver(information);
+        const Eigen::LDLT<Eigen::MatrixXd> solver = newtonSolver(information);
         const Eigen::VectorXd towardOptimum = solver.solve(gradient);
         const Eigen::VectorXd alongContrast = solver.solve(contrast);
         const Eigen::VectorXd step =

@@ -40,8 +40,21 @@ struct PairCounts {
     Eigen::VectorXd second;
 };
 
+// The prior on the scores (docs/analysis.md, "Model").
+enum class Prior {
+    // skinlab's: a zero-mean Gaussian of precision FitOptions::priorPrecision on every difference q_i − q_j.
+    Gaussian,
+    // pwcmp's default ("gaussian" in pw_scale.m, Perez-Ortiz & Mantiuk 2017): for every compared pair a, the
+    // probability of observing each compared pair's outcome at a's distance, normalised over the distances of all
+    // compared pairs and summed; log(π_a + 0.1) enters the log posterior once per compared pair. Unanimous counts
+    // are moved one answer toward a tie inside the prior (pw_scale's D_wUA). Data-dependent; Thurstone only.
+    Pwcmp
+};
+const char* priorName(Prior prior);
+
 struct FitOptions {
     Model model = Model::Thurstone;
+    Prior prior = Prior::Gaussian;
     // Precision (1/JOD²) of the zero-mean Gaussian prior put on every difference q_i − q_j, compared or not.
     // 0.002 moves the pwcmp oracle (100 trials per compared pair) by 2.5e-4 JOD (0.01 would move it by 1.2e-3),
     // yet bounds a unanimous 10:0 pair (at 4.96 JOD) and ties the components of a disconnected design together.
@@ -76,6 +89,12 @@ struct ConstrainedFit {
 };
 ConstrainedFit fitConstrained(const PairCounts& counts, const FitOptions& options, const Eigen::VectorXd& contrast,
                               double value, const Eigen::VectorXd& start);
+
+// pwcmp's log prior Σ_a log(π_a + 0.1) over the compared pairs a of `counts` (Prior::Pwcmp), with its gradient in
+// the scores when `gradient` is given.
+// The link is the model's (pwcmp: Thurstone).
+double pwcmpLogPrior(const PairCounts& counts, const Eigen::VectorXd& scores, Eigen::VectorXd* gradient,
+                     Model model = Model::Thurstone);
 
 // Log-likelihood of counts (per pair first/second) under given scores.
 double logLikelihood(Model model, const std::vector<std::pair<int, int>>& pairs, const Eigen::VectorXd& first,

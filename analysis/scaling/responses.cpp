@@ -78,14 +78,12 @@ std::string joined(const auto& names) {
     return out;
 }
 
-void readLongCsv(ResponseTable& table, const std::vector<CsvRecord>& records) {
+// Column index per role (observer, scene, ... and `flagged`); -1 where the file has no such column.
+using ColumnIndex = std::map<std::string, long>;
+
+void readLongCsv(ResponseTable& table, const std::vector<CsvRecord>& records, const ColumnIndex& columns) {
     const std::vector<std::string>& header = records.front().fields;
-    std::map<std::string, size_t> columnIndex;
-    for (size_t k = 0; k < header.size(); ++k) {
-        if (!columnIndex.emplace(header[k], k).second)
-            throwInput(table.file, where(records.front().line, header[k]), "column appears twice in the header");
-    }
-    auto column = [&](const char* name) -> size_t { return columnIndex.at(name); };
+    auto has = [&](const char* role) { return columns.count(role) && columns.at(role) >= 0; };
     const bool full = table.format == ResponseFormat::SkinlabCsv;
     for (size_t r = 1; r < records.size(); ++r) {
         const CsvRecord& record = records[r];
@@ -93,16 +91,20 @@ void readLongCsv(ResponseTable& table, const std::vector<CsvRecord>& records) {
             throwInput(table.file, where(record.line, ""),
                        "has " + std::to_string(record.fields.size()) + " columns, the header has " +
                            std::to_string(header.size()));
-        auto field = [&](const char* name) -> const std::string& { return record.fields[column(name)]; };
+        auto field = [&](const char* role) -> const std::string& {
+            return record.fields[static_cast<size_t>(columns.at(role))];
+        };
+        auto name = [&](const char* role) -> const std::string& {
+            return header[static_cast<size_t>(columns.at(role))];
+        };
         Response response;
         response.line = record.line;
         response.observer = field("observer");
-        response.block = field("scene");
+        if (has("scene")) response.block = field("scene");
         response.conditionA = field("condition_A");
         response.conditionB = field("condition_B");
-        response.aSelected = parseFlag(table.file, record.line, "is_A_selected", field("is_A_selected"));
-        if (columnIndex.count("flagged"))
-            response.flagged = parseOptionalFlag(table.file, record.line, "flagged", field("flagged"));
+        response.aSelected = parseFlag(table.file, record.line, name("is_A_selected"), field("is_A_selected"));
+        if (has("flagged")) response.flagged = parseOptionalFlag(table.file, record.line, "flagged", field("flagged"));
         if (full) {
             response.aOnLeft = parseOptionalFlag(table.file, record.line, "A_on_left", field("A_on_left"));
             response.kind = parseKind(table.file, record.line, field("trial_kind"));
@@ -158,48 +160,74 @@ void readCountMatrix(ResponseTable& table, const std::vector<CsvRecord>& records
         if (!seen[k]) throwInput(table.file, "condition " + names[k], "has no row in the count matrix");
 }
 
-ResponseTable readCsv(const std::filesystem::path& path) {
+ResponseTable readCsv(const std::filesystem::path& path, const ReadOptions& options) {
     ResponseTable table;
     table.file = path.string();
     const std::string text = readFile(path);
     const std::vector<CsvRecord> records = parseCsv(text, table.file);
     if (records.empty()) throwInput(table.file, "", "empty file (expected a header line and responses)");
     const std::vector<std::string>& header = records.front().fields;
-    const std::set<std::string> headerSet(header.begin(), header.end());
-    const std::set<std::string> skinlabSet(kSkinlabColumns.begin(), kSkinlabColumns.end());
-    const std::set<std::string> pwcmpSet(kPwcmpColumns.begin(), kPwcmpColumns.end());
+    const int headerLine = records.front().line;
+    std::map<std::string, size_t> byName;
+    std::string duplicate;
+    for (size_t k = 0; k < header.size(); ++k)
+        if (!byName.emplace(header[k], k).second && duplicate.empty()) duplicate = header[k];
+    // Roles: a mapped column (--columns role=name), else the column named after the role.
+    ColumnIndex columns;
+    std::set<size_t> used;
+    for (const auto& [role, name] : options.columns) {
+        const auto found = byName.find(name);
+        if (found == byName.end())
+            throwInput(table.file, "--columns",
+                       "column '" + name + "' (for " + role + ") is not in the header (" + joined(header) + ")");
+        columns[role] = static_cast<long>(found->second);
+    }
+    for (const char* role : kSkinlabColumns)
+        if (!columns.count(role)) columns[role] = byName.count(role) ? static_cast<long>(byName.at(role)) : -1;
+    columns["flagged"] = byName.count("flagged") ? static_cast<long>(byName.at("flagged")) : -1;
+    auto has = [&](const char* role) { return columns.at(role) >= 0; };
+    const std::array<const char*, 4> skinlabOnly = {"A_on_left", "trial_kind", "correct", "response_ms"};
+    const std::array<const char*, 4> pwcmpRequired = {"observer", "condition_A", "condition_B", "is_A_selected"};
+    const auto skinlabPresent = std::count_if(skinlabOnly.begin(), skinlabOnly.end(), has);
+    const bool pwcmpComplete = std::all_of(pwcmpRequired.begin(), pwcmpRequired.end(), has);
     std::string first = header.front();
     std::transform(first.begin(), first.end(), first.begin(), [](unsigned char c) { return std::tolower(c); });
-    // The online columns are accepted after either set; the rest must match exactly.
-    std::set<std::string> coreSet;
-    for (const std::string& name : headerSet)
-        if (std::find(kOnlineColumns.begin(), kOnlineColumns.end(), name) == kOnlineColumns.end()) coreSet.insert(name);
-    if (coreSet == skinlabSet && headerSet.size() == header.size()) {
+    if (pwcmpComplete && has("scene") && skinlabPresent == 4) {
         table.format = ResponseFormat::SkinlabCsv;
-    } else if (coreSet == pwcmpSet && headerSet.size() == header.size()) {
+    } else if (skinlabPresent >= 2) {
+        // Closer to a skinlab export than to pwcmp's format: name the first missing column.
+        for (const char* role : kSkinlabColumns)
+            if (!has(role))
+                throwInput(table.file, where(headerLine, role),
+                           "missing column; expected the columns " + joined(kSkinlabColumns));
+    } else if (pwcmpComplete) {
         table.format = ResponseFormat::PwcmpCsv;
-    } else if (first.empty() || first == "condition") {
+    } else if (options.columns.empty() && (first.empty() || first == "condition")) {
         table.format = ResponseFormat::CountMatrix;
     } else {
-        // Name the first column that is missing or unexpected, judged against the closer of the two formats.
-        const bool closerToPwcmp = coreSet.size() <= 5;
-        const auto& expected = closerToPwcmp ? pwcmpSet : skinlabSet;
-        for (size_t k = 0; k < header.size(); ++k)
-            if (!expected.count(header[k]) && !(coreSet.size() < headerSet.size() && !coreSet.count(header[k])))
-                throwInput(table.file, where(records.front().line, std::to_string(k + 1)),
-                           "unexpected column '" + header[k] + "'; expected the columns " +
-                               (closerToPwcmp ? joined(kPwcmpColumns) : joined(kSkinlabColumns)) +
-                               " or a count matrix header 'condition,<names>'");
-        for (const auto& name : expected)
-            if (!headerSet.count(name))
-                throwInput(table.file, where(records.front().line, name),
-                           "missing column; expected the columns " +
-                               (closerToPwcmp ? joined(kPwcmpColumns) : joined(kSkinlabColumns)));
-        throwInput(table.file, where(records.front().line, ""), "unrecognised header");
+        for (const char* role : pwcmpRequired)
+            if (!has(role))
+                throwInput(table.file, where(headerLine, role),
+                           "missing column; expected the columns " + joined(kPwcmpColumns) +
+                               " (scene optional; --columns maps other names), a skinlab export or a count matrix "
+                               "header 'condition,<names>'");
     }
     if (records.size() < 2) throwInput(table.file, "", "no responses after the header line");
-    if (table.format == ResponseFormat::CountMatrix) readCountMatrix(table, records);
-    else readLongCsv(table, records);
+    if (table.format == ResponseFormat::CountMatrix) {
+        readCountMatrix(table, records);
+        return table;
+    }
+    if (!duplicate.empty()) throwInput(table.file, where(headerLine, duplicate), "column appears twice in the header");
+    // Every column that is neither read nor one of skinlab's own export columns is listed for a note.
+    for (const auto& [role, index] : columns)
+        if (index >= 0 && (table.format == ResponseFormat::SkinlabCsv ||
+                           std::find(skinlabOnly.begin(), skinlabOnly.end(), role) == skinlabOnly.end()))
+            used.insert(static_cast<size_t>(index));
+    for (size_t k = 0; k < header.size(); ++k)
+        if (!used.count(k) &&
+            std::find(kOnlineColumns.begin(), kOnlineColumns.end(), header[k]) == kOnlineColumns.end())
+            table.ignoredColumns.push_back(header[k]);
+    readLongCsv(table, records, columns);
     return table;
 }
 
@@ -397,7 +425,12 @@ DroppedFlagged dropFlagged(ResponseTable& table) {
     return result;
 }
 
-ResponseTable readResponses(const std::filesystem::path& path) {
+const std::vector<std::string>& mappableColumns() {
+    static const std::vector<std::string> roles(kPwcmpColumns.begin(), kPwcmpColumns.end());
+    return roles;
+}
+
+ResponseTable readResponses(const std::filesystem::path& path, const ReadOptions& options) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path, ec)) throwInput(path.string(), "", "cannot open the responses file");
     // A study database may be live: served by this very process (the researcher dashboard scales through here) or
@@ -409,7 +442,7 @@ ResponseTable readResponses(const std::filesystem::path& path) {
     const std::string text = readFile(path);
     const size_t first = text.find_first_not_of(" \t\r\n");
     if (first != std::string::npos && text[first] == '{') return readJson(path);
-    return readCsv(path);
+    return readCsv(path, options);
 }
 
 } // namespace skinlab::analysis::scaling

@@ -4,8 +4,9 @@
 //  - a CSV export of that view (`skinlab study export --format csv`): columns observer, scene, condition_A,
 //    condition_B, is_A_selected, A_on_left, trial_kind, correct, response_ms (any order, all required), optionally
 //    followed by the online columns of the export (flagged, external_id, ...; only `flagged` is read);
-//  - a pwcmp long-format CSV: observer, scene, condition_A, condition_B, is_A_selected (plus the same optional
-//    online columns);
+//  - a pwcmp long-format CSV: observer, condition_A, condition_B, is_A_selected and usually scene (pwcmp's own
+//    files, e.g. its examples/ex3_tmo_cmp_data.csv, add columns such as session_id and criterion: any other column
+//    is ignored and listed in ResponseTable::ignoredColumns); ReadOptions::columns maps other column names;
 //  - a JSON export (`skinlab study export --format json`, key "responses");
 //  - a count matrix CSV: header `condition,<name 1>,...,<name m>`, then one row per condition
 //    `<name i>,D_i1,...,D_im` with D_ij = times i was chosen over j (one block, no observers).
@@ -48,10 +49,22 @@ struct ResponseTable {
     bool adaptiveDesign = false;
     // Study databases only: each block's conditions in the design's order (the order every output lists them in).
     std::map<std::string, std::vector<std::string>> designConditionOrder;
+    // Long CSVs: header columns that were not read (pwcmp's session_id, criterion, ...), for a note to the user.
+    std::vector<std::string> ignoredColumns;
 };
 
+struct ReadOptions {
+    // Long CSVs: role → column name in the file, for the roles observer, scene, condition_A, condition_B and
+    // is_A_selected (pwcmp's pw_scale_table takes the same column names as arguments; its default selection column
+    // is `selected_A`). Unmapped roles keep their own names.
+    std::vector<std::pair<std::string, std::string>> columns;
+};
+
+// The roles ReadOptions::columns may map.
+const std::vector<std::string>& mappableColumns();
+
 // Reads any accepted format; throws InputError "FILE: line N: column C: message" on bad input.
-ResponseTable readResponses(const std::filesystem::path& path);
+ResponseTable readResponses(const std::filesystem::path& path, const ReadOptions& options = {});
 
 // Removes the responses flagged as given while the page was hidden or without focus (`analyze scale
 // --drop-flagged`). Returns how many were removed; `recorded` tells whether any response carried a flag at all.

@@ -4,8 +4,10 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <map>
 
 namespace skinlab::analysis::scaling {
@@ -73,6 +75,107 @@ bool winGraphStronglyConnected(const BlockData& block, const PairCounts& totals)
     return m < 2 || (reachesAll(true) && reachesAll(false));
 }
 
+// Which ends of each interval the data set. Moving the scores along a direction v that is constant on every
+// strongly connected component of the win graph and never lowers a winner below a condition it beat (v_i ≥ v_j
+// when i beat j and j never beat i) never lowers the likelihood: along such a v only the prior bounds the scores.
+// For a contrast aᵀq the upper end is the prior's iff some such v has aᵀv > 0 — for q_i − q_j iff j did not
+// (transitively) beat i; for a score (relative to its component's mean) iff some condition of the component did
+// not transitively beat it — and symmetrically for the lower end.
+void applyDataBounds(BlockAnalysis& result) {
+    const auto m = static_cast<int>(result.conditions.size());
+    std::vector<int> component(m, 0);
+    for (size_t c = 0; c < result.components.size(); ++c)
+        for (int i : result.components[c]) component[i] = static_cast<int>(c);
+    // beatenBy[i][j]: j transitively beat i (j reaches i along "won at least once" edges), i itself included.
+    std::vector<std::vector<bool>> beatenBy(m, std::vector<bool>(m, false));
+    for (int i = 0; i < m; ++i) {
+        std::vector<int> stack{i};
+        beatenBy[i][i] = true;
+        while (!stack.empty()) {
+            const int node = stack.back();
+            stack.pop_back();
+            for (int winner = 0; winner < m; ++winner)
+                if (result.counts(winner, node) > 0 && !beatenBy[i][winner]) {
+                    beatenBy[i][winner] = true;
+                    stack.push_back(winner);
+                }
+        }
+    }
+    auto label = [](bool lowerFree, bool upperFree) {
+        return lowerFree ? (upperFree ? "none" : "upper") : (upperFree ? "lower" : "two-sided");
+    };
+    const double infinity = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < m; ++i) {
+        bool upperFree = false, lowerFree = false;
+        for (int j = 0; j < m; ++j) {
+            if (component[j] != component[i]) continue;
+            upperFree = upperFree || !beatenBy[i][j]; // j never (transitively) beat i: i can rise above the mean
+            lowerFree = lowerFree || !beatenBy[j][i]; // i never beat j: i can sink below the mean
+        }
+        if (upperFree) result.high[i] = infinity;
+        if (lowerFree) result.low[i] = -infinity;
+        result.intervalFlags[i].bound = label(lowerFree, upperFree);
+    }
+    for (PairTest& pair : result.pairs) {
+        DifferenceTest& test = pair.test;
+        const int i = test.first, j = test.second;
+        const bool connected = component[i] == component[j];
+        const bool upperFree = !connected || !beatenBy[i][j];
+        const bool lowerFree = !connected || !beatenBy[j][i];
+        if (upperFree) test.high = infinity;
+        if (lowerFree) test.low = -infinity;
+        test.diagnosis.bound = label(lowerFree, upperFree);
+        if (!connected) {
+            // Not measured at all: no test either.
+            test.pValue = 1.0;
+            test.standardError = NAN;
+            auto& reasons = test.diagnosis.reasons;
+            if (std::find(reasons.begin(), reasons.end(), "disconnected") == reasons.end())
+                reasons.insert(reasons.begin(), "disconnected");
+        }
+    }
+}
+
+// Quantile as MATLAB's quantile/prctile (and Octave's default, method 5): the sorted values sit at probabilities
+// (k − ½)/n, linear in between, the extremes beyond.
+double quantileMethod5(std::vector<double> values, double probability) {
+    std::sort(values.begin(), values.end());
+    const auto n = static_cast<double>(values.size());
+    const double position = probability * n - 0.5; // 0-based index
+    if (position <= 0.0) return values.front();
+    if (position >= n - 1.0) return values.back();
+    const auto below = static_cast<size_t>(std::floor(position));
+    const double fraction = position - static_cast<double>(below);
+    return values[below] + fraction * (values[below + 1] - values[below]);
+}
+
+// pwcmp's pw_outlier_analysis for one block: per observer, the sum over the pairs it judged of log10 of the
+// binomial probability of its counts under the scale of the other observers (fitted with pwcmp's prior), and the
+// number of those pairs.
+void pwcmpOutlierTerms(const BlockData& block, std::vector<double>& logLikelihood, std::vector<double>& pairs) {
+    const int n = block.observerCount();
+    logLikelihood.assign(n, 0.0);
+    pairs.assign(n, 0.0);
+    FitOptions options;
+    options.prior = Prior::Pwcmp;
+    for (int k = 0; k < n; ++k) {
+        Eigen::VectorXd weights = Eigen::VectorXd::Ones(n);
+        weights[k] = 0.0;
+        const FitResult rest = fitScores(block.weightedCounts(weights), options);
+        for (size_t p = 0; p < block.pairs.size(); ++p) {
+            const auto column = static_cast<Eigen::Index>(p);
+            const double a = block.winsFirst(k, column), b = block.winsSecond(k, column);
+            if (a + b <= 0) continue;
+            const double d = rest.scores[block.pairs[p].first] - rest.scores[block.pairs[p].second];
+            const double logBinomial = std::lgamma(a + b + 1.0) - std::lgamma(a + 1.0) - std::lgamma(b + 1.0);
+            const double logProbability = logBinomial + a * linkValues(Model::Thurstone, d).logProbability +
+                                          b * linkValues(Model::Thurstone, -d).logProbability;
+            logLikelihood[k] += std::max(logProbability / std::log(10.0), -200.0); // max(p, 1e-200)
+            pairs[k] += 1.0;
+        }
+    }
+}
+
 } // namespace
 
 BlockAnalysis analyzeBlock(const BlockData& block, const AnalysisOptions& options) {
@@ -102,18 +205,19 @@ BlockAnalysis analyzeBlock(const BlockData& block, const AnalysisOptions& option
             groups += "}";
         }
         result.warnings.push_back("the comparison graph is disconnected (" + groups +
-                                  "): distances between these groups are set by the prior only, not by the data");
+                                  "): each group is scaled on its own, centred on its own mean; scores in different "
+                                  "groups cannot be compared");
     }
     for (size_t p = 0; p < block.pairs.size(); ++p)
         if ((totals.first[p] > 0) != (totals.second[p] > 0)) result.unanimousPairs.push_back(block.pairs[p]);
     result.mleExists = winGraphStronglyConnected(block, totals);
     if (!result.mleExists && result.components.size() == 1)
         result.warnings.push_back("some conditions won or lost every comparison with the rest (unanimous answers): "
-                                  "their distance is bounded by the prior and is a lower bound");
+                                  "the data bound their distance on one side only (intervals with one end)");
 
     // Intervals and tests.
     std::vector<double> pValues;
-    if (n >= 2 && options.intervals == IntervalMethod::bootstrap) {
+    if (n >= 2 && options.intervals != IntervalMethod::profile) {
         const BootstrapResult bootstrap =
             bootstrapObservers(block, result.thurstone, thurstoneOptions, options.bootstrap);
         result.intervalMethod = "studentized-bootstrap";
@@ -125,6 +229,19 @@ BlockAnalysis analyzeBlock(const BlockData& block, const AnalysisOptions& option
         result.percentileHigh = bootstrap.percentileHigh;
         result.intervalFlags = bootstrap.scoreDiagnoses;
         for (const DifferenceTest& test : bootstrap.differences) result.pairs.push_back({test});
+        if (options.intervals == IntervalMethod::percentile) {
+            // pwcmp's pw_scale_bootstrp: percentiles of the resampled scores and differences.
+            result.intervalMethod = "percentile-bootstrap";
+            result.low = bootstrap.percentileLow;
+            result.high = bootstrap.percentileHigh;
+            result.intervalFlags.assign(m, {});
+            for (PairTest& pair : result.pairs) {
+                pair.test.low = pair.test.percentileLow;
+                pair.test.high = pair.test.percentileHigh;
+                pair.test.pValue = pair.test.percentilePValue;
+                pair.test.diagnosis = {};
+            }
+        }
         result.bradleyTerryStandardError =
             robustCovariance(block, Eigen::VectorXd::Ones(n), result.bradleyTerry, Model::BradleyTerry)
                 .diagonal()
@@ -139,7 +256,7 @@ BlockAnalysis analyzeBlock(const BlockData& block, const AnalysisOptions& option
             fallbacks += diagnosis.fallback;
             for (const std::string& reason : diagnosis.reasons) ++reasons[reason];
         }
-        if (fallbacks > 0) {
+        if (fallbacks > 0 && options.intervals == IntervalMethod::bootstrap) {
             std::string why;
             for (const auto& [reason, count] : reasons) why += (why.empty() ? "" : ", ") + reason;
             result.warnings.push_back(std::to_string(fallbacks) + " of " + std::to_string(m) +
@@ -159,12 +276,18 @@ BlockAnalysis analyzeBlock(const BlockData& block, const AnalysisOptions& option
         result.high.resize(m);
         result.intervalFlags.assign(m, {});
         for (int i = 0; i < m; ++i) {
-            Eigen::VectorXd contrast = Eigen::VectorXd::Constant(m, -1.0 / m);
+            // The score relative to its own component's mean (all conditions when the design is connected).
+            const std::vector<int>* members = &result.components.front();
+            for (const auto& component : result.components)
+                if (std::find(component.begin(), component.end(), i) != component.end()) members = &component;
+            Eigen::VectorXd contrast = Eigen::VectorXd::Zero(m);
+            for (int j : *members) contrast[j] = -1.0 / static_cast<double>(members->size());
             contrast[i] += 1.0;
+            const double shift = result.thurstone.scores[i] - contrast.dot(result.thurstone.scores);
             const ProfileInterval profile =
                 profileInterval(totals, thurstoneOptions, result.thurstone, contrast, options.bootstrap.level);
-            result.low[i] = profile.low;
-            result.high[i] = profile.high;
+            result.low[i] = profile.low + shift;
+            result.high[i] = profile.high + shift;
             if (profile.lowAtCap || profile.highAtCap)
                 result.intervalFlags[i].reasons.emplace_back("bound-at-search-cap");
         }
@@ -193,6 +316,7 @@ BlockAnalysis analyzeBlock(const BlockData& block, const AnalysisOptions& option
         if (block.hasObservers && n < 2)
             result.warnings.push_back("a single observer: intervals are profile-likelihood intervals");
     }
+    applyDataBounds(result);
     for (PairTest& pair : result.pairs) {
         pair.comparisons =
             result.counts(pair.test.first, pair.test.second) + result.counts(pair.test.second, pair.test.first);
@@ -257,6 +381,39 @@ Analysis analyzeDataset(const Dataset& dataset, const AnalysisOptions& options) 
         if (summary.trials > 0 && heldOutSum.count(summary.observer) && analysis.observers.size() >= 2)
             summary.heldOutPerTrial = heldOutSum[summary.observer] / summary.trials;
         perTrial.push_back(summary.heldOutPerTrial);
+    }
+    if (options.pwcmpOutliers && analysis.observers.size() >= 2) {
+        std::map<std::string, double> logLikelihood, pairs;
+        for (const BlockData& block : dataset.blocks) {
+            if (!block.hasObservers || block.observerCount() < 2) continue;
+            std::vector<double> blockLikelihood, blockPairs;
+            pwcmpOutlierTerms(block, blockLikelihood, blockPairs);
+            for (int k = 0; k < block.observerCount(); ++k) {
+                logLikelihood[block.observers[k]] += blockLikelihood[k];
+                pairs[block.observers[k]] += blockPairs[k];
+            }
+        }
+        std::vector<double> values;
+        for (ObserverSummary& summary : analysis.observers)
+            if (pairs.count(summary.observer) && pairs[summary.observer] > 0) {
+                summary.pwcmpLogLikelihood = logLikelihood[summary.observer] / pairs[summary.observer];
+                values.push_back(summary.pwcmpLogLikelihood);
+            }
+        if (values.size() >= 2) {
+            const double firstQuartile = quantileMethod5(values, 0.25);
+            const double range = quantileMethod5(values, 0.75) - firstQuartile;
+            for (ObserverSummary& summary : analysis.observers) {
+                if (std::isnan(summary.pwcmpLogLikelihood)) continue;
+                summary.pwcmpDistance = summary.pwcmpLogLikelihood < firstQuartile
+                                            ? (firstQuartile - summary.pwcmpLogLikelihood) / range
+                                            : 0.0;
+                summary.pwcmpOutlier = summary.pwcmpDistance > kPwcmpOutlierDistance;
+                if (summary.pwcmpOutlier)
+                    analysis.warnings.push_back("observer '" + summary.observer +
+                                                "' is an outlier by pwcmp's rule (dist_L " +
+                                                std::to_string(summary.pwcmpDistance) + " > 1.5)");
+            }
+        }
     }
     const std::vector<bool> flags = lowOutliers(perTrial, options.screeningWhisker, &analysis.screeningRule);
     for (size_t k = 0; k < analysis.observers.size(); ++k) {

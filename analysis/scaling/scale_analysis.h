@@ -19,7 +19,9 @@ namespace skinlab::analysis::scaling {
 // (profile likelihood with fewer than 2 observers). `profile`: profile-likelihood intervals and score tests for
 // every block — valid when the pairs were chosen from earlier answers (an active design), where resampling
 // observers is not (docs/analysis.md, "Validation of active designs").
-enum class IntervalMethod { bootstrap, profile };
+// `percentile`: pwcmp's percentile bootstrap over observers (pw_scale_bootstrp), for comparison with pwcmp; its
+// coverage is below nominal (docs/analysis.md).
+enum class IntervalMethod { bootstrap, profile, percentile };
 
 struct AnalysisOptions {
     FitOptions fit; // fit.model is ignored: both models are always fitted
@@ -29,6 +31,7 @@ struct AnalysisOptions {
     Correction correction = Correction::Holm;
     double alpha = 0.05;           // significance level after correction
     double screeningWhisker = 1.5; // inter-quartile rule factor w
+    bool pwcmpOutliers = false;    // also run pwcmp's outlier analysis (pw_outlier_analysis)
 };
 
 struct PairTest {
@@ -78,7 +81,16 @@ struct ObserverSummary {
     int catchFailures = 0;
     double sideTrials = 0.0;
     double leftChosen = 0.0;
+    // pwcmp's outlier analysis (AnalysisOptions::pwcmpOutliers): mean log10 binomial likelihood of the observer's
+    // counts per compared pair under the leave-one-out scale (pwcmp's prior), and the distance below the first
+    // quartile in inter-quartile ranges, dist_L = max(0, (Q1 − L)/IQR); pwcmp's rule flags dist_L > 1.5.
+    double pwcmpLogLikelihood = NAN;
+    double pwcmpDistance = NAN;
+    bool pwcmpOutlier = false;
 };
+
+// pwcmp's outlier threshold on dist_L (examples/ex3_video_tmo_example.m).
+inline constexpr double kPwcmpOutlierDistance = 1.5;
 
 struct Analysis {
     std::string file;

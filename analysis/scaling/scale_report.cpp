@@ -67,6 +67,21 @@ std::vector<std::string> scoreReasons(const BlockAnalysis& block, size_t i) {
     return i < block.intervalFlags.size() ? block.intervalFlags[i].reasons : std::vector<std::string>{};
 }
 
+std::string scoreBound(const BlockAnalysis& block, size_t i) {
+    return i < block.intervalFlags.size() ? block.intervalFlags[i].bound : std::string("two-sided");
+}
+// An interval as text: "[a, b]", "≥ a" (bound from below only), "≤ b", or "not measured".
+std::string intervalText(double low, double high) {
+    if (std::isfinite(low) && std::isfinite(high)) return "[" + fixed(low, 3) + ", " + fixed(high, 3) + "]";
+    if (std::isfinite(low)) return "at least " + fixed(low, 3);
+    if (std::isfinite(high)) return "at most " + fixed(high, 3);
+    return "not measured";
+}
+std::string priorText(const FitOptions& fit) {
+    if (fit.prior == Prior::Pwcmp) return "pwcmp's prior (pw_scale's default)";
+    return "Gaussian prior of precision " + number(fit.priorPrecision, 6) + " JOD⁻² on every difference";
+}
+
 std::string plotName(size_t index, const std::string& kind, const std::string& block) {
     char prefix[16];
     std::snprintf(prefix, sizeof prefix, "%02zu-", index + 1); // the index keeps names unique after slugging
@@ -93,22 +108,30 @@ nlohmann::json analysisJson(const Analysis& analysis) {
     json["version"] = 1;
     json["skinlab_version"] = skinlab::version();
     json["input"] = {{"file", analysis.file}, {"format", responseFormatName(analysis.format)}};
-    json["settings"] = {{"model", "thurstone-case-v"},
-                        {"sigma", kThurstoneSigma},
-                        {"unit", "JOD (1 JOD = 75 % preference), mean of each block's scores = 0"},
-                        {"prior_precision", o.fit.priorPrecision},
-                        {"interval", "symmetric studentized bootstrap over observers, cluster-robust SE; where the "
-                                     "studentization is degenerate (flagged per interval) the hull of the percentile "
-                                     "and the profile-posterior intervals, with a score test"},
-                        {"intervals", o.intervals == IntervalMethod::profile ? "profile" : "bootstrap"},
-                        {"intervals_reason", o.intervalReason},
-                        {"level", o.bootstrap.level},
-                        {"bootstrap_samples", o.bootstrap.samples},
-                        {"seed", o.bootstrap.seed},
-                        {"correction", correctionName(o.correction)},
-                        {"alpha", o.alpha},
-                        {"screening", "leave-one-out held-out log-likelihood per trial, low outliers by Q1 - w*IQR"},
-                        {"screening_whisker", o.screeningWhisker}};
+    json["settings"] = {
+        {"model", "thurstone-case-v"},
+        {"sigma", kThurstoneSigma},
+        {"unit", "JOD (1 JOD = 75 % preference), mean of each block's scores = 0"},
+        {"prior", priorName(o.fit.prior)},
+        {"prior_precision", o.fit.prior == Prior::Gaussian ? nlohmann::json(o.fit.priorPrecision) : nlohmann::json()},
+        {"interval", o.intervals == IntervalMethod::percentile
+                         ? "percentile bootstrap over observers (pwcmp's pw_scale_bootstrp), bootstrap p-values"
+                         : "symmetric studentized bootstrap over observers, cluster-robust SE; where the "
+                           "studentization is degenerate (flagged per interval) the hull of the percentile "
+                           "and the profile-posterior intervals, with a score test; ends the data do not set are "
+                           "open (bound)"},
+        {"intervals", o.intervals == IntervalMethod::profile      ? "profile"
+                      : o.intervals == IntervalMethod::percentile ? "percentile"
+                                                                  : "bootstrap"},
+        {"intervals_reason", o.intervalReason},
+        {"level", o.bootstrap.level},
+        {"bootstrap_samples", o.bootstrap.samples},
+        {"seed", o.bootstrap.seed},
+        {"correction", correctionName(o.correction)},
+        {"alpha", o.alpha},
+        {"screening", "leave-one-out held-out log-likelihood per trial, low outliers by Q1 - w*IQR"},
+        {"screening_whisker", o.screeningWhisker},
+        {"pwcmp_outliers", o.pwcmpOutliers}};
     for (const BlockAnalysis& block : analysis.blocks) {
         nlohmann::json b;
         b["name"] = block.name;
@@ -134,6 +157,7 @@ nlohmann::json analysisJson(const Analysis& analysis) {
                                    {"standard_error", finite(block.standardError[k])},
                                    {"ci_low", finite(block.low[k])},
                                    {"ci_high", finite(block.high[k])},
+                                   {"bound", scoreBound(block, i)},
                                    {"interval_method", scoreMethod(block, i)},
                                    {"fallback_reasons", scoreReasons(block, i)},
                                    {"percentile_low", finite(block.percentileLow[k])},
@@ -161,6 +185,7 @@ nlohmann::json analysisJson(const Analysis& analysis) {
                                   {"standard_error", finite(pair.test.standardError)},
                                   {"ci_low", finite(pair.test.low)},
                                   {"ci_high", finite(pair.test.high)},
+                                  {"bound", pair.test.diagnosis.bound},
                                   {"comparisons", pair.comparisons},
                                   {"interval_method", pairMethod(block, pair)},
                                   {"fallback_reasons", pair.test.diagnosis.reasons},
@@ -199,6 +224,9 @@ nlohmann::json analysisJson(const Analysis& analysis) {
              {"trials", s.trials},
              {"held_out_loglik_per_trial", finite(s.heldOutPerTrial)},
              {"flagged", s.flagged},
+             {"pwcmp_log10_likelihood_per_pair", finite(s.pwcmpLogLikelihood)},
+             {"pwcmp_dist_l", finite(s.pwcmpDistance)},
+             {"pwcmp_outlier", std::isnan(s.pwcmpDistance) ? nlohmann::json() : nlohmann::json(s.pwcmpOutlier)},
              {"catch_trials", s.catchTrials},
              {"catch_failures", s.catchFailures},
              {"left_rate", s.sideTrials > 0 ? nlohmann::json(s.leftChosen / s.sideTrials) : nlohmann::json()}});
@@ -227,9 +255,13 @@ std::string reportSectionHtml(const Analysis& analysis) {
             "</style>\n";
     html << "<h2>Perceptual scaling (Thurstone Case V, JOD)</h2>\n"
          << "<p>Input <code>" << escapeHtml(analysis.file) << "</code> (" << responseFormatName(analysis.format)
-         << "). Scores in JOD (1 JOD = 75 % preference, each block's mean = 0); " << fixed(100 * o.bootstrap.level, 0)
+         << "). Scores in JOD (1 JOD = 75 % preference, each block's mean = 0), fitted with " << priorText(o.fit)
+         << "; " << fixed(100 * o.bootstrap.level, 0)
          << (o.intervals == IntervalMethod::profile
                  ? " % profile-likelihood intervals (" + o.intervalReason + ") and score tests; "
+             : o.intervals == IntervalMethod::percentile
+                 ? " % percentile bootstrap intervals over observers (pwcmp's construction, " +
+                       std::to_string(o.bootstrap.samples) + " samples) and bootstrap p-values; "
                  : " % intervals by a symmetric studentized bootstrap over observers (" +
                        std::to_string(o.bootstrap.samples) + " samples, seed " + std::to_string(o.bootstrap.seed) +
                        "); where studentization is degenerate (marked †) the hull of the percentile and "
@@ -256,7 +288,7 @@ std::string reportSectionHtml(const Analysis& analysis) {
         for (size_t i = 0; i < block.conditions.size(); ++i) {
             const auto k = static_cast<Eigen::Index>(i);
             html << "<tr><td>" << escapeHtml(block.conditions[i]) << "</td><td>" << fixed(block.thurstone.scores[k], 3)
-                 << "</td><td>[" << fixed(block.low[k], 3) << ", " << fixed(block.high[k], 3) << "]</td><td>"
+                 << "</td><td>" << intervalText(block.low[k], block.high[k]) << "</td><td>"
                  << escapeHtml(scoreMethod(block, i))
                  << (scoreReasons(block, i).empty() ? std::string()
                                                     : " † (" + escapeHtml(joined(scoreReasons(block, i), ", ")) + ")")
@@ -269,7 +301,7 @@ std::string reportSectionHtml(const Analysis& analysis) {
         for (const PairTest& pair : block.pairs)
             html << "<tr><td>" << escapeHtml(block.conditions[pair.test.first]) << "</td><td>"
                  << escapeHtml(block.conditions[pair.test.second]) << "</td><td>" << fixed(pair.test.difference, 3)
-                 << "</td><td>[" << fixed(pair.test.low, 3) << ", " << fixed(pair.test.high, 3) << "]</td><td>"
+                 << "</td><td>" << intervalText(pair.test.low, pair.test.high) << "</td><td>"
                  << escapeHtml(pairMethod(block, pair))
                  << (pair.test.diagnosis.reasons.empty()
                          ? std::string()
@@ -287,17 +319,28 @@ std::string reportSectionHtml(const Analysis& analysis) {
              << (s.sideTrials > 0 ? fixed(100.0 * s.leftChosen / s.sideTrials, 1) + " %" : std::string("–"))
              << "</td></tr>\n";
     html << "</table>\n<p>Outlier rule: held-out log-likelihood per trial below Q1 − " << o.screeningWhisker
-         << "·IQR = " << fixed(analysis.screeningRule.threshold, 3) << ".</p>\n</section>\n";
+         << "·IQR = " << fixed(analysis.screeningRule.threshold, 3) << ".</p>\n";
+    if (o.pwcmpOutliers) {
+        std::string flagged;
+        for (const ObserverSummary& s : analysis.observers)
+            if (s.pwcmpOutlier)
+                flagged +=
+                    (flagged.empty() ? "" : ", ") + escapeHtml(s.observer) + " (" + fixed(s.pwcmpDistance, 2) + ")";
+        html << "<p>pwcmp's outlier analysis (dist_L &gt; 1.5): " << (flagged.empty() ? "no observer" : flagged)
+             << ".</p>\n";
+    }
+    html << "</section>\n";
     return html.str();
 }
 
 void writeScaleOutputs(const Analysis& analysis, const std::filesystem::path& folder) {
     ensureDirectory(folder);
     ensureDirectory(folder / "plots");
-    std::string scores = "block,condition,jod,ci_low,ci_high,standard_error,interval_method,percentile_low,"
-                         "percentile_high,bradley_terry_jod,bradley_terry_standard_error,fallback_reasons\n";
+    std::string scores =
+        "block,condition,jod,ci_low,ci_high,standard_error,interval_method,percentile_low,"
+        "percentile_high,bradley_terry_jod,bradley_terry_standard_error,fallback_reasons,bound,prior\n";
     std::string pairs = "block,condition_A,condition_B,difference_jod,ci_low,ci_high,standard_error,comparisons,"
-                        "p_value,p_adjusted,correction,significant,interval_method,fallback_reasons\n";
+                        "p_value,p_adjusted,correction,significant,interval_method,fallback_reasons,bound\n";
     std::string counts = "block,condition_row,condition_column,count_row_chosen\n";
     std::string consistency = "block,observer,trials,held_out_loglik_per_trial,complete,circular_triads,zeta\n";
     for (size_t b = 0; b < analysis.blocks.size(); ++b) {
@@ -310,7 +353,8 @@ void writeScaleOutputs(const Analysis& analysis, const std::filesystem::path& fo
                       number(block.standardError[k], 8) + "," + scoreMethod(block, i) + "," +
                       number(block.percentileLow[k], 8) + "," + number(block.percentileHigh[k], 8) + "," +
                       number(block.bradleyTerry.scores[k], 8) + "," + number(block.bradleyTerryStandardError[k], 8) +
-                      "," + csvField(joined(scoreReasons(block, i), ";")) + "\n";
+                      "," + csvField(joined(scoreReasons(block, i), ";")) + "," + scoreBound(block, i) + "," +
+                      priorName(analysis.options.fit.prior) + "\n";
             for (size_t j = 0; j < block.conditions.size(); ++j)
                 if (i != j)
                     counts += name + "," + csvField(block.conditions[i]) + "," + csvField(block.conditions[j]) + "," +
@@ -323,7 +367,8 @@ void writeScaleOutputs(const Analysis& analysis, const std::filesystem::path& fo
                      number(pair.test.standardError, 8) + "," + number(pair.comparisons, 10) + "," +
                      number(pair.test.pValue, 6) + "," + number(pair.adjustedPValue, 6) + "," +
                      correctionName(analysis.options.correction) + "," + (pair.significant ? "1" : "0") + "," +
-                     pairMethod(block, pair) + "," + csvField(joined(pair.test.diagnosis.reasons, ";")) + "\n";
+                     pairMethod(block, pair) + "," + csvField(joined(pair.test.diagnosis.reasons, ";")) + "," +
+                     pair.test.diagnosis.bound + "\n";
         for (size_t k = 0; k < block.observerStats.size(); ++k) {
             const ObserverInBlock& s = block.observerStats[k];
             consistency +=
@@ -336,12 +381,14 @@ void writeScaleOutputs(const Analysis& analysis, const std::filesystem::path& fo
         writeFileAtomic(folder / plotName(b, "scores", block.name), encodePng(plotScores(block)));
         writeFileAtomic(folder / plotName(b, "matrix", block.name), encodePng(plotPreferenceMatrix(block)));
     }
-    std::string observers = "observer,trials,held_out_loglik_per_trial,flagged,catch_trials,catch_failures,left_rate\n";
+    std::string observers = "observer,trials,held_out_loglik_per_trial,flagged,catch_trials,catch_failures,left_rate,"
+                            "pwcmp_dist_l,pwcmp_outlier\n";
     for (const ObserverSummary& s : analysis.observers)
-        observers += csvField(s.observer) + "," + number(s.trials, 10) + "," + number(s.heldOutPerTrial, 8) + "," +
-                     (s.flagged ? "1" : "0") + "," + std::to_string(s.catchTrials) + "," +
-                     std::to_string(s.catchFailures) + "," +
-                     (s.sideTrials > 0 ? number(s.leftChosen / s.sideTrials, 6) : "") + "\n";
+        observers +=
+            csvField(s.observer) + "," + number(s.trials, 10) + "," + number(s.heldOutPerTrial, 8) + "," +
+            (s.flagged ? "1" : "0") + "," + std::to_string(s.catchTrials) + "," + std::to_string(s.catchFailures) +
+            "," + (s.sideTrials > 0 ? number(s.leftChosen / s.sideTrials, 6) : "") + "," + number(s.pwcmpDistance, 6) +
+            "," + (std::isnan(s.pwcmpDistance) ? "" : (s.pwcmpOutlier ? "1" : "0")) + "\n";
     writeFileAtomic(folder / "scores.csv", scores);
     writeFileAtomic(folder / "pairs.csv", pairs);
     writeFileAtomic(folder / "counts.csv", counts);

@@ -140,9 +140,11 @@ Tally runActiveExperiment(const ValidationOptions& options, int observers, std::
     analysisOptions.correction = options.correction;
     analysisOptions.alpha = options.alpha;
     analysisOptions.bootstrap.level = 0.95;
+    analysisOptions.fit.prior = options.prior;
     const BlockAnalysis analysis = analyzeBlock(block, analysisOptions);
     // The observer bootstrap on the same data, for comparison.
     FitOptions fitOptions;
+    fitOptions.prior = options.prior;
     BootstrapOptions bootstrapOptions;
     bootstrapOptions.samples = options.bootstrapSamples;
     bootstrapOptions.seed = mixSeed(seed, 1);
@@ -157,9 +159,14 @@ Tally runActiveExperiment(const ValidationOptions& options, int observers, std::
     for (int i = 0; i < m; ++i) {
         tally.intervals += 1;
         tally.covered += analysis.low[i] <= truth[i] && truth[i] <= analysis.high[i];
-        tally.width += analysis.high[i] - analysis.low[i];
-        tally.maximumHalfWidth =
-            std::max({tally.maximumHalfWidth, fit[i] - analysis.low[i], analysis.high[i] - fit[i]});
+        // An end the data do not set is open (unanimous answers: docs/analysis.md, "Intervals the data
+        // support"); widths and half-widths are those of the ends that are set.
+        if (std::isfinite(analysis.low[i]) && std::isfinite(analysis.high[i]))
+            tally.width += analysis.high[i] - analysis.low[i];
+        if (std::isfinite(analysis.low[i]))
+            tally.maximumHalfWidth = std::max(tally.maximumHalfWidth, fit[i] - analysis.low[i]);
+        if (std::isfinite(analysis.high[i]))
+            tally.maximumHalfWidth = std::max(tally.maximumHalfWidth, analysis.high[i] - fit[i]);
         tally.bootstrapCovered += bootstrap.low[i] <= truth[i] && truth[i] <= bootstrap.high[i];
         tally.percentileCovered += bootstrap.percentileLow[i] <= truth[i] && truth[i] <= bootstrap.percentileHigh[i];
         tally.percentileWidth += bootstrap.percentileHigh[i] - bootstrap.percentileLow[i];
@@ -221,6 +228,7 @@ Tally runExperiment(const ValidationOptions& options, const std::string& scenari
     tally.experiments = 1;
 
     FitOptions fitOptions;
+    fitOptions.prior = options.prior;
     BlockData block = simulated.block;
     if (screening) {
         const FitResult full = fitScores(block.totalCounts(), fitOptions);
@@ -365,6 +373,7 @@ std::string validationMarkdown(const ValidationReport& report) {
                            : o.trialsPerPair * static_cast<int>(o.trueScores.size() * (o.trueScores.size() - 1) / 2),
         bootstrapCoverages.c_str());
     out += line;
+    out += std::string("Prior: ") + priorName(o.prior) + ".\n\n";
     out += "| scenario | observers | coverage | mean width | fallback share | largest half-width | "
            "coverage (percentile, pwcmp) | "
            "mean width | RMSE (JOD) | Spearman | significant & correct | significant & reversed | random caught | "
@@ -407,6 +416,7 @@ nlohmann::json validationJson(const ValidationReport& report) {
                        {"correction", correctionName(o.correction)},
                        {"alpha", o.alpha},
                        {"screening_whisker", o.screeningWhisker},
+                       {"prior", priorName(o.prior)},
                        {"scenarios", o.scenarios},
                        {"sparse_pair_fraction", o.sparsePairFraction},
                        {"disconnected_groups", o.disconnectedGroups},

@@ -12,6 +12,7 @@
 //    answer (pairs = "active" in a study), scaled as `analyze scale` scales an active study: profile-likelihood
 //    intervals (the observer bootstrap is not valid there; its coverage is reported alongside).
 #include "analysis/scaling/multiple_comparisons.h"
+#include "analysis/scaling/pairwise_model.h"
 
 #include <functional>
 
@@ -49,6 +50,7 @@ struct ValidationOptions {
     Correction correction = Correction::Holm;
     double alpha = 0.05;
     double screeningWhisker = 1.5;
+    Prior prior = Prior::Gaussian;     // the prior the scores are fitted with (`analyze scale --prior`)
     double sparsePairFraction = 0.3;   // "sparse": share of the pairs each observer judges
     int disconnectedGroups = 2;        // "disconnected": groups of conditions, never compared across
     double nearUnanimousStretch = 3.0; // "near-unanimous": true scores multiplied by this

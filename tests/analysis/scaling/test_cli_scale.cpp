@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <vector>
 
 namespace {
 
@@ -83,6 +85,7 @@ TEST(CliScale, WritesEveryOutput) {
     const auto& mid = json["blocks"][0];
     EXPECT_EQ(mid["name"], "builtin:head/mid");
     EXPECT_EQ(mid["interval_method"], "studentized-bootstrap");
+    EXPECT_EQ(json["settings"]["prior"], "gaussian");
     // True order none < gaussian-sum < separable < artistic; the extremes are 1.6 JOD apart.
     EXPECT_LT(mid["scores"][0]["jod"].get<double>(), mid["scores"][3]["jod"].get<double>());
     EXPECT_TRUE(mid["side_bias"]["available"].get<bool>());
@@ -122,6 +125,34 @@ TEST(CliScale, CountMatrixOracle) {
     EXPECT_NEAR(scores[0]["jod"].get<double>(), -1.0, 1e-3);
     EXPECT_NEAR(scores[2]["jod"].get<double>(), 1.0, 1e-3);
     EXPECT_EQ(json["blocks"][0]["interval_method"], "profile-likelihood");
+}
+
+TEST(CliScale, PwcmpsOwnExampleFileWithItsPriorAndOutlierAnalysis) {
+    // pwcmp's examples/ex3_tmo_cmp_data.csv as it is (extra columns session_id and criterion).
+    const std::string input = std::string(SKINLAB_SOURCE_DIR) + "/tests/data/pwcmp/ex3_tmo_cmp_data.csv";
+    const fs::path output = scratch() / "ex3-out";
+    fs::remove_all(output);
+    const CliRun result = run("analyze scale " + input + " -o " + output.string() +
+                              " --prior pwcmp --pwcmp-outliers --intervals percentile --bootstrap 200");
+    ASSERT_EQ(result.exitCode, 0) << result.output;
+    EXPECT_NE(result.output.find("ignored column(s) session_id, criterion"), std::string::npos) << result.output;
+    std::ifstream stream(output / "scale.json");
+    const nlohmann::json json = nlohmann::json::parse(stream);
+    EXPECT_EQ(json["settings"]["prior"], "pwcmp");
+    EXPECT_TRUE(json["settings"]["prior_precision"].is_null());
+    EXPECT_EQ(json["settings"]["intervals"], "percentile");
+    ASSERT_EQ(json["blocks"].size(), 5u);
+    for (const auto& block : json["blocks"]) EXPECT_EQ(block["interval_method"], "percentile-bootstrap");
+    // pwcmp's example flags M02 and bab (dist_L > 1.5).
+    std::vector<std::string> flagged;
+    for (const auto& observer : json["observers"])
+        if (observer["pwcmp_outlier"] == true) flagged.push_back(observer["observer"]);
+    EXPECT_EQ(flagged, (std::vector<std::string>{"M02", "bab"}));
+    const std::string scores = (std::ostringstream() << std::ifstream(output / "scores.csv").rdbuf()).str();
+    EXPECT_NE(scores.find(",bound,prior\n"), std::string::npos);
+    EXPECT_NE(scores.find(",two-sided,pwcmp\n"), std::string::npos);
+    const std::string html = (std::ostringstream() << std::ifstream(output / "report_section.html").rdbuf()).str();
+    EXPECT_NE(html.find("pwcmp's prior"), std::string::npos);
 }
 
 TEST(CliValidate, SmallRunMeetsTheScreeningTargets) {

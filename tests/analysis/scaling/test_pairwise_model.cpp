@@ -75,9 +75,14 @@ TEST(PairwiseModel, UnanimousAnswersGiveFiniteFlaggedScores) {
     const BlockData block = matrixBlock({{0, 10, 10}, {0, 0, 7}, {0, 3, 0}});
     const BlockAnalysis result = analyzeBlock(block, AnalysisOptions{});
     ASSERT_TRUE(result.thurstone.converged);
-    for (int i = 0; i < 3; ++i) {
-        EXPECT_TRUE(std::isfinite(result.thurstone.scores[i]));
-        EXPECT_TRUE(std::isfinite(result.low[i]) && std::isfinite(result.high[i]));
+    for (int i = 0; i < 3; ++i) EXPECT_TRUE(std::isfinite(result.thurstone.scores[i]));
+    // c0 won every answer: the data bound its score from below only ("at least"); c1 and c2 never beat c0, so
+    // theirs only from above. The other ends would be set by the prior: they are left open.
+    EXPECT_EQ(result.intervalFlags[0].bound, "lower");
+    EXPECT_TRUE(std::isfinite(result.low[0]) && result.low[0] > 0.0 && std::isinf(result.high[0]));
+    for (int i = 1; i < 3; ++i) {
+        EXPECT_EQ(result.intervalFlags[i].bound, "upper") << i;
+        EXPECT_TRUE(std::isinf(result.low[i]) && std::isfinite(result.high[i])) << i;
     }
     EXPECT_FALSE(result.mleExists);
     EXPECT_EQ(result.unanimousPairs.size(), 2u);

@@ -81,8 +81,9 @@ TEST(Responses, MixedBlocksWhereOneIsRequired) {
 
 TEST(Responses, WrongColumns) {
     const std::string path = writeText("columns.csv", "observer,scene,condition_A,condition_B,chosen\no1,s,a,b,1\n");
-    EXPECT_EQ(errorOf(path), path + ": line 1: column 5: unexpected column 'chosen'; expected the columns "
-                                    "observer,scene,condition_A,condition_B,is_A_selected or a count matrix header "
+    EXPECT_EQ(errorOf(path), path + ": line 1: column is_A_selected: missing column; expected the columns "
+                                    "observer,scene,condition_A,condition_B,is_A_selected (scene optional; --columns "
+                                    "maps other names), a skinlab export or a count matrix header "
                                     "'condition,<names>'");
     const std::string missing =
         writeText("missing.csv", "observer,scene,condition_A,condition_B,is_A_selected,A_on_left,trial_kind,"
@@ -164,6 +165,43 @@ TEST(Responses, StudyDatabaseView) {
     sqlite3_close(database);
     EXPECT_EQ(errorOf(bare.string()),
               bare.string() + ": responses_long: cannot read the responses view: no such table: responses_long");
+}
+
+TEST(Responses, PwcmpExtraColumnsAreIgnoredAndColumnsCanBeMapped) {
+    // pwcmp's own files carry more columns (examples/ex3_tmo_cmp_data.csv: session_id, criterion).
+    const std::string path = writeText("pwcmp-extra.csv", "observer,session_id,scene,condition_A,condition_B,"
+                                                          "is_A_selected,criterion\nM01,1,window,a,b,1,perceptual\n"
+                                                          "M01,1,window,b,a,0,perceptual\n");
+    const ResponseTable table = readResponses(path);
+    EXPECT_EQ(table.format, ResponseFormat::PwcmpCsv);
+    EXPECT_EQ(table.ignoredColumns, (std::vector<std::string>{"session_id", "criterion"}));
+    ASSERT_EQ(table.responses.size(), 2u);
+    EXPECT_EQ(table.responses[1].block, "window");
+    EXPECT_TRUE(table.responses[0].aSelected);
+    EXPECT_FALSE(table.responses[1].aSelected);
+    // pw_scale_table's own column names (its default selection column is selected_A), no scene column.
+    const std::string renamed =
+        writeText("pwcmp-renamed.csv", "subject,cond1,cond2,selected_A\ns1,a,b,1\ns1,a,b,0\ns2,b,a,1\n");
+    ReadOptions options;
+    options.columns = {
+        {"observer", "subject"}, {"condition_A", "cond1"}, {"condition_B", "cond2"}, {"is_A_selected", "selected_A"}};
+    const ResponseTable mapped = readResponses(renamed, options);
+    EXPECT_EQ(mapped.format, ResponseFormat::PwcmpCsv);
+    EXPECT_TRUE(mapped.ignoredColumns.empty());
+    ASSERT_EQ(mapped.responses.size(), 3u);
+    EXPECT_EQ(mapped.responses[2].observer, "s2");
+    EXPECT_EQ(mapped.responses[2].conditionA, "b");
+    const Dataset dataset = buildDataset(mapped, {});
+    ASSERT_EQ(dataset.blocks.size(), 1u);
+    EXPECT_EQ(dataset.blocks[0].name, "all");
+    options.columns = {{"observer", "participant"}};
+    try {
+        readResponses(renamed, options);
+        ADD_FAILURE() << "a mapped column that is not in the header must be an error";
+    } catch (const skinlab::InputError& e) {
+        EXPECT_EQ(std::string(e.what()), renamed + ": --columns: column 'participant' (for observer) is not in the "
+                                                   "header (subject,cond1,cond2,selected_A)");
+    }
 }
 
 } // namespace

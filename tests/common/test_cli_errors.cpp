@@ -1,0 +1,75 @@
+// Every command-line error of every `skinlab` subcommand — an unknown option, a value out of range or not in the
+// allowed set, a missing argument, a missing subcommand — exits with status 2 and one line on stderr (README.md),
+// whatever code CLI11 gives the error; --help and --version still exit 0.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <string>
+#include <sys/wait.h>
+#include <vector>
+
+namespace {
+
+struct CliRun {
+    int exitCode = -1;
+    std::string output; // stdout and stderr
+};
+
+CliRun run(const std::string& arguments) {
+    const std::string command = std::string(SKINLAB_CLI) + " " + arguments + " 2>&1";
+    CliRun result;
+    FILE* pipe = popen(command.c_str(), "r");
+    char buffer[4096];
+    while (size_t n = fread(buffer, 1, sizeof buffer, pipe)) result.output.append(buffer, n);
+    const int status = pclose(pipe);
+    result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return result;
+}
+
+TEST(CliErrors, EverySubcommandExitsTwoWithOneLine) {
+    const std::vector<std::string> cases = {
+        "",                                               // no subcommand
+        "--no-such-flag",                                 // unknown option of the app
+        "analyze scale r.csv -o out --prior-precision 0", // value out of range (CLI11: 105)
+        "analyze scale r.csv -o out --no-such-flag",      // unknown option (CLI11: 106)
+        "analyze scale r.csv -o out --prior flat",        // value not in the allowed set
+        "analyze scale r.csv",                            // missing required option
+        "analyze scale -o out",                           // missing positional argument
+        "analyze scale r.csv -o out --bootstrap ten",     // not a number
+        "analyze scale r.csv -o out --columns nope=x",    // a --columns role skinlab does not know
+        "analyze validate --experiments 0",               // out of range
+        "analyze validate --scenarios",                   // option without its value
+        "analyze",                                        // missing sub-subcommand
+        "study --no-such-flag",                           // unknown option of another subcommand
+        "study export",                                   // missing argument
+        "render --no-such-flag",
+        "kernel --no-such-flag",
+        "stimuli --no-such-flag",
+        "bench --no-such-flag",
+        "report --no-such-flag",
+        "pathtraced --no-such-flag",
+        "methods --no-such-flag",
+        "analyze metrics --no-such-flag",
+        "analyze agreement --no-such-flag",
+        "no-such-subcommand",
+    };
+    for (const std::string& arguments : cases) {
+        const CliRun result = run(arguments);
+        EXPECT_EQ(result.exitCode, 2) << "skinlab " << arguments << "\n" << result.output;
+        EXPECT_EQ(result.output.rfind("skinlab: error: ", 0), 0u) << "skinlab " << arguments << "\n" << result.output;
+        ASSERT_FALSE(result.output.empty());
+        EXPECT_EQ(result.output.find('\n'), result.output.size() - 1)
+            << "skinlab " << arguments << ": more than one line\n"
+            << result.output;
+    }
+}
+
+TEST(CliErrors, HelpAndVersionExitZero) {
+    for (const std::string arguments : {"--help", "--version", "analyze scale --help", "study --help"}) {
+        const CliRun result = run(arguments);
+        EXPECT_EQ(result.exitCode, 0) << "skinlab " << arguments << "\n" << result.output;
+        EXPECT_FALSE(result.output.empty());
+    }
+}
+
+} // namespace
