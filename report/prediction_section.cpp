@@ -1,6 +1,8 @@
 #include "report/prediction_section.h"
 
 #include "analysis/agreement/metric_agreement.h"
+#include "analysis/metrics/cvvdp.h"
+#include "analysis/metrics/metric_render.h"
 #include "common/html.h"
 #include "report/report_plots.h"
 
@@ -78,7 +80,71 @@ std::vector<PredictionAgreement> predictionAgreement(const experiments::StudyDef
     return out;
 }
 
-std::string predictionSectionHtml(const std::vector<PredictionAgreement>& agreementRows, const std::string& display) {
+std::vector<ParticipantPrediction> participantPredictions(const nlohmann::json& manifest,
+                                                          const std::filesystem::path& stimuliFolder,
+                                                          const std::vector<std::pair<std::string, double>>& viewing) {
+    std::vector<ParticipantPrediction> out;
+    if (viewing.empty() || !manifest.contains("stimuli")) return out;
+    // The predicted stimuli and their references, by block.
+    struct Predicted {
+        std::string block, png, referencePng, display;
+        double jod = 0.0;
+    };
+    std::map<std::string, std::string> pngOf;
+    for (const nlohmann::json& s : manifest["stimuli"])
+        pngOf[s["id"].get<std::string>()] = s["files"]["png"].get<std::string>();
+    std::vector<Predicted> predicted;
+    for (const nlohmann::json& s : manifest["stimuli"])
+        if (s.contains("predicted") && s["predicted"].contains("jod") &&
+            pngOf.count(s["predicted"].value("reference", "")))
+            predicted.push_back({s["block"].get<std::string>(), s["files"]["png"].get<std::string>(),
+                                 pngOf[s["predicted"]["reference"].get<std::string>()],
+                                 s["predicted"].value("display", std::string("standard_fhd")),
+                                 s["predicted"]["jod"].get<double>()});
+    if (predicted.empty()) return out;
+    std::map<std::string, metrics::MetricRender> images;
+    auto image = [&](const std::string& png) -> const cv::Mat& {
+        auto it = images.find(png);
+        if (it == images.end())
+            it = images
+                     .emplace(png, metrics::loadMetricRender(stimuliFolder / png, metrics::RenderRole::test,
+                                                             metrics::ImageEncoding::srgb))
+                     .first;
+        return it->second.beauty;
+    };
+    std::map<long, std::vector<double>> byPpd; // predictions per ppd (rounded to 0.1), in `predicted` order
+    for (const auto& [observer, ppd] : viewing) {
+        const long key = std::lround(ppd * 10.0);
+        if (!byPpd.count(key)) {
+            std::vector<double> jods;
+            for (const Predicted& p : predicted) {
+                metrics::CvvdpDisplayOverrides overrides;
+                overrides.pixelsPerDegree = double(key) / 10.0;
+                const metrics::CvvdpDisplay display =
+                    metrics::applyCvvdpOverrides(metrics::cvvdpDisplay(p.display), overrides);
+                jods.push_back(metrics::cvvdp(image(p.referencePng), image(p.png), display, false).jod);
+            }
+            byPpd[key] = std::move(jods);
+        }
+        const std::vector<double>& jods = byPpd[key];
+        ParticipantPrediction row{observer, ppd, 0.0, 0.0, false, static_cast<int>(predicted.size())};
+        for (std::size_t i = 0; i < predicted.size(); ++i) {
+            const double change = std::abs(jods[i] - predicted[i].jod);
+            row.meanChange += change / double(predicted.size());
+            row.largestChange = std::max(row.largestChange, change);
+            for (std::size_t j = 0; j < predicted.size(); ++j)
+                if (predicted[j].block == predicted[i].block &&
+                    (predicted[i].jod > predicted[j].jod) != (jods[i] > jods[j]) &&
+                    predicted[i].jod != predicted[j].jod)
+                    row.orderChanged = true;
+        }
+        out.push_back(row);
+    }
+    return out;
+}
+
+std::string predictionSectionHtml(const std::vector<PredictionAgreement>& agreementRows, const std::string& display,
+                                  const std::vector<ParticipantPrediction>& participants) {
     if (agreementRows.empty()) return {};
     std::ostringstream html;
     html << "<h2 id=\"prediction\">Predicted and measured</h2><p class=\"note\">Each condition's JOD predicted by "
@@ -110,6 +176,22 @@ std::string predictionSectionHtml(const std::vector<PredictionAgreement>& agreem
             html << "<tr><td class=\"l\">" << escapeHtml(a.conditions[i]) << "</td><td>"
                  << formatNumber(a.predicted[i], 2) << "</td><td>" << formatNumber(a.measured[i], 2) << "</td><td>["
                  << formatNumber(a.low[i], 2) << ", " << formatNumber(a.high[i], 2) << "]</td></tr>";
+        html << "</tbody></table>\n";
+    }
+    html << "<h3>With each participant's own display</h3>";
+    if (participants.empty()) {
+        html << "<p class=\"note\">No participant calibrated their display (the design's <code>[display] calibrate"
+                "</code>), so every prediction uses the display model above.</p>\n";
+    } else {
+        html << "<p class=\"note\">Where the card calibration recorded a participant's pixels per degree, every "
+                "prediction again with that geometry (the same display model otherwise): how much it moves.</p>"
+                "<table><thead><tr><th class=\"l\">participant</th><th>pixels per degree</th><th>mean |Δ| JOD</th>"
+                "<th>largest |Δ| JOD</th><th>predicted order</th></tr></thead><tbody>";
+        for (const ParticipantPrediction& p : participants)
+            html << "<tr><td class=\"l\">" << escapeHtml(p.observer) << "</td><td>"
+                 << formatNumber(p.pixelsPerDegree, 1) << "</td><td>" << formatNumber(p.meanChange, 3) << "</td><td>"
+                 << formatNumber(p.largestChange, 3) << "</td><td>" << (p.orderChanged ? "changes" : "same")
+                 << "</td></tr>";
         html << "</tbody></table>\n";
     }
     return html.str();

@@ -9,7 +9,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace skinlab::report {
@@ -31,7 +33,25 @@ std::vector<PredictionAgreement> predictionAgreement(const experiments::StudyDef
                                                      const nlohmann::json& manifest,
                                                      const skinlab::analysis::scaling::Analysis& analysis);
 
+// Predictions with a participant's own display geometry: where an online study's card calibration recorded a
+// participant's pixels per degree, each block's conditions predicted again on the set's display model with that
+// ppd, and how much that changes the predictions.
+struct ParticipantPrediction {
+    std::string observer;
+    double pixelsPerDegree = 0.0;
+    double meanChange = 0.0, largestChange = 0.0; // |JOD with the participant's ppd − the set's prediction|
+    bool orderChanged = false;                    // the conditions' predicted order differs in some block
+    int stimuli = 0;
+};
+
+// `viewing`: (observer, pixels per degree) of the participants whose calibration recorded it. Reads the stimuli's
+// PNGs from `stimuliFolder`. Empty when nothing was predicted or nobody calibrated.
+std::vector<ParticipantPrediction> participantPredictions(const nlohmann::json& manifest,
+                                                          const std::filesystem::path& stimuliFolder,
+                                                          const std::vector<std::pair<std::string, double>>& viewing);
+
 // The section's HTML (heading id "prediction"); empty when nothing was predicted.
-std::string predictionSectionHtml(const std::vector<PredictionAgreement>& agreement, const std::string& display);
+std::string predictionSectionHtml(const std::vector<PredictionAgreement>& agreement, const std::string& display,
+                                  const std::vector<ParticipantPrediction>& participants = {});
 
 } // namespace skinlab::report

@@ -651,7 +651,15 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
     }
 
     // --- Predicted and measured (when the stimulus set recorded predictions). ---
-    html << predictionSectionHtml(predictions, predictionDisplay);
+    std::vector<std::pair<std::string, double>> calibrated; // (observer, pixels per degree) from the card calibration
+    if (!predictions.empty())
+        for (const experiments::SessionViewing& session : store.viewingConditions())
+            if (session.viewing && session.viewing->pixelsPerDegree &&
+                std::none_of(calibrated.begin(), calibrated.end(),
+                             [&](const auto& c) { return c.first == session.observer; }))
+                calibrated.emplace_back(session.observer, *session.viewing->pixelsPerDegree);
+    html << predictionSectionHtml(predictions, predictionDisplay,
+                                  participantPredictions(storedManifest, stimuliFolder, calibrated));
 
     // --- Objective errors. ---
     html << "<h2 id=\"metrics\">Objective errors against the reference</h2>\n";
