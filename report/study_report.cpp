@@ -142,7 +142,7 @@ svg .axis { text-anchor: middle; fill: var(--ink); font-size: 12px; } svg .point
 .banner { background: #fff4e0; border: 1px solid #e0b060; border-left: 5px solid #d08a00; padding: 10px 14px; margin: 14px 0; }
 @media print {
   main { padding: 0; max-width: none; }
-  h1, h2, h3 { break-after: avoid; page-break-after: avoid; }
+  h1, h2, h3, p.note { break-after: avoid; page-break-after: avoid; }
   h2 + p, h2 + ul, h3 + p, h3 + table, h3 + div, p.note + table, p.note + div { break-before: avoid; page-break-before: avoid; }
   figure, svg, tr, li, .banner, .question { break-inside: avoid; page-break-inside: avoid; }
   table { break-inside: auto; }
