@@ -37,8 +37,9 @@ LevelSearch checkedSearch(const LevelSearch& search, const std::vector<double>& 
         lo = std::ceil(lo);
         hi = std::floor(hi);
         if (!(lo < hi))
-            throwInput("--range", "", number(search.lo, "%g") + "," + number(search.hi, "%g") +
-                                          ": holds fewer than two whole numbers (the parameter is an integer)");
+            throwInput("--range", "",
+                       number(search.lo, "%g") + "," + number(search.hi, "%g") +
+                           ": holds fewer than two whole numbers (the parameter is an integer)");
     }
     if (!std::isfinite(search.tolerance) || !(search.tolerance > 0.0))
         throwInput("--tolerance", "", number(search.tolerance, "%g") + " must be a positive number of JOD");
@@ -48,6 +49,10 @@ LevelSearch checkedSearch(const LevelSearch& search, const std::vector<double>& 
     for (double t : targets)
         if (!std::isfinite(t) || !(t > 0.0))
             throwInput("--target-jod", "", number(t, "%g") + " must be a positive number of JOD (a difference)");
+        else if (t <= search.tolerance)
+            throwInput("--target-jod", "",
+                       number(t, "%g") + " is within the tolerance " + number(search.tolerance, "%g") +
+                           " of no difference (the reference itself would meet it)");
 
     return checked;
 }
@@ -139,8 +144,7 @@ LevelSearchResult searchLevels(const std::function<double(double)>& predictedJod
             if (search.integral) {
                 if (b - a <= 1.0) {
                     level.note = "the difference jumps from " + number(seen.at(a)) + " JOD at " + number(a, "%g") +
-                                 " to " + number(seen.at(b)) + " JOD at " + number(b, "%g") +
-                                 " (whole numbers only)";
+                                 " to " + number(seen.at(b)) + " JOD at " + number(b, "%g") + " (whole numbers only)";
                     break;
                 }
                 mid = std::floor(mid);
@@ -266,7 +270,8 @@ CalibrationReport calibrateLevels(const CalibrateOptions& options) {
     const nlohmann::json::json_pointer pointer(pointerOf(key));
     if (!resolvedBase.contains(pointer) || !resolvedBase.at(pointer).is_number())
         throwInput("--factor", "",
-                   "'" + key + "' is not a numeric parameter of stimulus '" + base->id + "' (see docs/scenes.md)");
+                   "'" + key + "' is not a parameter holding one number in stimulus '" + base->id +
+                       "' (see docs/scenes.md)");
     report.integral = resolvedBase.at(pointer).is_number_integer();
 
     // The range: as given, else the smallest and largest numeric level of the spec's factor.
@@ -381,16 +386,16 @@ std::string levelsToml(const CalibrationReport& report) {
             std::none_of(reached.begin(), reached.end(), [&](const auto* r) { return r->value == level.value; }))
             reached.push_back(&level);
     std::sort(reached.begin(), reached.end(), [](const auto* a, const auto* b) { return a->value < b->value; });
-    std::string out = "# Levels of " + report.key + " calibrated by `skinlab stimuli calibrate` (ColorVideoVDP): stimulus '" +
-                      report.stimulus + "' of set '" + report.set + "' against '" + report.reference + "'\n";
+    std::string out = "# Levels of " + report.key +
+                      " calibrated by `skinlab stimuli calibrate` (ColorVideoVDP): stimulus '" + report.stimulus +
+                      "' of set '" + report.set + "' against '" + report.reference + "'\n";
     out += "# display " + report.display + "\n";
     out += "# target JOD, achieved JOD (tolerance " + number(report.search.tolerance, "%g") + "):";
     for (const auto& level : report.result.levels)
         out += std::string(&level == &report.result.levels.front() ? " " : ", ") + number(level.targetJod, "%g") +
                " → " + (level.reached ? number(level.achievedJod) : std::string("not reached"));
     out += "\n[[factor]]\nname = \"" + report.factor + "\"\nlevels = [";
-    for (size_t i = 0; i < reached.size(); ++i)
-        out += (i ? ", " : "") + levelText(reached[i]->value, report.integral);
+    for (size_t i = 0; i < reached.size(); ++i) out += (i ? ", " : "") + levelText(reached[i]->value, report.integral);
     out += "]\n";
     return out;
 }

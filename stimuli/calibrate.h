@@ -25,17 +25,17 @@ struct LevelSearch {
 
 // One target: the value found and what was achieved there.
 struct CalibratedLevel {
-    double targetJod = 0.0;                                     // wanted difference, JOD (10 − predicted JOD)
-    bool reached = false;                                       // a value within the tolerance was found
-    double value = std::numeric_limits<double>::quiet_NaN();    // the value whose difference is closest to the target
+    double targetJod = 0.0;                                  // wanted difference, JOD (10 − predicted JOD)
+    bool reached = false;                                    // a value within the tolerance was found
+    double value = std::numeric_limits<double>::quiet_NaN(); // the value whose difference is closest to the target
     double achievedJod = std::numeric_limits<double>::quiet_NaN(); // its difference (10 − predicted JOD)
     int renders = 0;  // predictions made for this target (probes shared with earlier targets are not counted)
     std::string note; // why the target was not reached ("" when reached)
 };
 
 struct LevelSearchResult {
-    double differenceAtLo = 0.0; // 10 − predicted JOD at lo
-    double differenceAtHi = 0.0; // at hi
+    double differenceAtLo = 0.0;         // 10 − predicted JOD at lo
+    double differenceAtHi = 0.0;         // at hi
     std::vector<CalibratedLevel> levels; // in the order of the targets
     int predictions = 0;                 // distinct values predicted (the two ends included)
     std::vector<std::string> warnings;   // probes that break monotonicity, a parameter without effect
@@ -69,15 +69,15 @@ struct CalibrateOptions {
 
 struct CalibrationReport {
     std::string set;
-    std::string factor;        // the factor name as given
-    std::string key;           // its scene key
-    std::string stimulus;      // id of the varied stimulus
-    std::string reference;     // id of the [[reference]] stimulus, or "KEY=V" of the reference level
-    std::string display;       // one-line description of the display
-    bool integral = false;     // the key takes whole numbers
+    std::string factor;    // the factor name as given
+    std::string key;       // its scene key
+    std::string stimulus;  // id of the varied stimulus
+    std::string reference; // id of the [[reference]] stimulus, or "KEY=V" of the reference level
+    std::string display;   // one-line description of the display
+    bool integral = false; // the key takes whole numbers
     LevelSearch search;
     LevelSearchResult result;
-    int renders = 0;           // all renders, the reference included
+    int renders = 0; // all renders, the reference included
     double wallSeconds = 0.0;
 };
 

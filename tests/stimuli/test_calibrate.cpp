@@ -161,6 +161,7 @@ TEST(CalibrateSearch, BadArgumentsNameTheirOption) {
     EXPECT_NE(message({1.0}, LevelSearch{0.0, 1.0, 0.0}).find("--tolerance"), std::string::npos);
     EXPECT_NE(message({0.0}, LevelSearch{0.0, 1.0, 0.05}).find("--target-jod"), std::string::npos);
     EXPECT_NE(message({}, LevelSearch{0.0, 1.0, 0.05}).find("--target-jod"), std::string::npos);
+    EXPECT_NE(message({0.05}, LevelSearch{0.0, 1.0, 0.05}).find("--target-jod"), std::string::npos);
     LevelSearch integral{0.2, 0.8, 0.05};
     integral.integral = true;
     EXPECT_NE(message({1.0}, integral).find("whole numbers"), std::string::npos);

@@ -156,6 +156,7 @@ TEST_F(StimuliCalibrate, BadInputIsOneLineNamingTheOption) {
         {{"--factor", "sss.width_mm", "--target-jod", "1", "--range", "0.5,4", "--reference-level", "1"},
          "--reference-level"},
         {{"--factor", "sss.width_mm", "--target-jod", "1", "--range", "0.5,4", "--tolerance", "0"}, "--tolerance"},
+        {{"--factor", "sss.artistic_strength", "--target-jod", "1", "--range", "0,1"}, "--factor"},
         {{"--factor", "sss.width_mm", "--target-jod", "1", "--range", "0.5,4", "--stimulus", "nope"}, "--stimulus"},
         {{"--factor", "sss.width_mm", "--target-jod", "1", "--range", "0.5,4", "--display", "nope"}, "--display"},
     };
