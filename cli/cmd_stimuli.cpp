@@ -1,14 +1,18 @@
-// `skinlab stimuli build|list|merge|contact|slurm|status`: stimulus sets (docs/stimuli.md).
+// `skinlab stimuli build|list|merge|contact|slurm|status|calibrate`: stimulus sets (docs/stimuli.md).
 #include "analysis/metrics/cvvdp.h"
 #include "cli/commands.h"
 #include "common/error.h"
+#include "common/files.h"
 #include "stimuli/build.h"
+#include "stimuli/calibrate.h"
 #include "stimuli/contact_sheet.h"
 #include "stimuli/merge.h"
 #include "stimuli/output_folder.h"
 #include "stimuli/slurm.h"
 
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 #include <memory>
 
@@ -38,6 +42,11 @@ struct StimuliOptions {
     int onlyShard = 0;
     bool dryRun = false;
     std::string skinlab;
+    // calibrate
+    std::string factor, targetJod, range, display = "standard_fhd", stimulus;
+    std::optional<double> referenceLevel;
+    double tolerance = 0.05;
+    int maxProbes = 24;
 };
 
 // The submission as one command line (absolute paths, without --only-shard and --dry-run), recorded so that
@@ -206,6 +215,70 @@ void runStatus(const StimuliOptions& o) {
                     status.resubmit.empty() ? "skinlab stimuli slurm SPEC -o OUT ..." : status.resubmit.c_str(), i);
 }
 
+// "a,b,c" → numbers; InputError naming `option` for anything else.
+std::vector<double> numberList(const std::string& text, const std::string& option) {
+    std::vector<double> out;
+    size_t begin = 0;
+    while (true) {
+        size_t end = text.find(',', begin);
+        std::string item = text.substr(begin, end == std::string::npos ? std::string::npos : end - begin);
+        char* stop = nullptr;
+        double v = std::strtod(item.c_str(), &stop);
+        if (item.empty() || stop != item.c_str() + item.size() || !std::isfinite(v))
+            throwInput(option, "", "'" + item + "' in '" + text + "' is not a number");
+        out.push_back(v);
+        if (end == std::string::npos) return out;
+        begin = end + 1;
+    }
+}
+
+void runCalibrate(const StimuliOptions& o) {
+    stimuli::CalibrateOptions options;
+    options.spec = o.spec;
+    options.specOverrides = o.overrides;
+    options.assetsDir = o.assets;
+    options.factor = o.factor;
+    options.targets = numberList(o.targetJod, "--target-jod");
+    options.referenceLevel = o.referenceLevel;
+    if (!o.range.empty()) {
+        std::vector<double> range = numberList(o.range, "--range");
+        if (range.size() != 2) throwInput("--range", "", "'" + o.range + "' must be LO,HI");
+        options.range = std::pair{range[0], range[1]};
+    }
+    options.tolerance = o.tolerance;
+    options.maxProbes = o.maxProbes;
+    options.display = o.display;
+    options.stimulus = o.stimulus;
+    if (!o.output.empty() && std::filesystem::is_directory(o.output))
+        throwInput("-o", "", o.output + " is a folder (give the TOML file to write)");
+    stimuli::CalibrationReport report = stimuli::calibrateLevels(options);
+    const auto& r = report.result;
+    std::printf("calibrate %s: stimulus %s against %s\n", report.key.c_str(), report.stimulus.c_str(),
+                report.reference.c_str());
+    std::printf("display %s; tolerance %g JOD\n", report.display.c_str(), report.search.tolerance);
+    std::printf("range %s .. %s: difference %.3f JOD at %s, %.3f JOD at %s\n",
+                stimuli::levelText(report.search.lo, report.integral).c_str(),
+                stimuli::levelText(report.search.hi, report.integral).c_str(), r.differenceAtLo,
+                stimuli::levelText(report.search.lo, report.integral).c_str(), r.differenceAtHi,
+                stimuli::levelText(report.search.hi, report.integral).c_str());
+    std::printf("%-10s %-14s %-12s %s\n", "target", "value", "achieved", "renders");
+    for (const auto& level : r.levels) {
+        std::printf("%-10g %-14s %-12.3f %d%s%s\n", level.targetJod,
+                    stimuli::levelText(level.value, report.integral).c_str(), level.achievedJod, level.renders,
+                    level.reached ? "" : "  NOT REACHED: ", level.note.c_str());
+    }
+    std::printf("renders: %d (the reference, both ends and %d probes) in %.1f s\n", report.renders, r.predictions - 2,
+                report.wallSeconds);
+    for (const auto& w : r.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+    const std::string toml = stimuli::levelsToml(report);
+    if (o.output.empty()) {
+        std::printf("\n%s", toml.c_str());
+    } else {
+        writeFileAtomic(o.output, toml);
+        std::printf("levels: %s\n", o.output.c_str());
+    }
+}
+
 } // namespace
 
 void registerStimuli(CLI::App& app) {
@@ -288,6 +361,29 @@ void registerStimuli(CLI::App& app) {
     status->add_option("dir", options->output, "The folder given to `stimuli slurm -o`")->required();
     status->add_option("--format", options->format, "text or json")->check(CLI::IsMember({"text", "json"}));
     status->callback([options] { runStatus(*options); });
+
+    CLI::App* calibrate = stimuli->add_subcommand(
+        "calibrate", "Levels of a numeric parameter whose predicted difference (ColorVideoVDP) from the reference "
+                     "is a given number of JOD");
+    calibrate->add_option("spec", options->spec, "Stimulus-set spec (TOML)")->required();
+    calibrate->add_option("--assets", options->assets, "Folder of shared assets (default: $SKINLAB_ASSETS)");
+    calibrate->add_option("--set", options->overrides, "Override a spec value: key=value (repeatable)");
+    calibrate->add_option("--factor", options->factor, "Numeric scene key to calibrate, e.g. sss.width_mm")->required();
+    calibrate
+        ->add_option("--target-jod", options->targetJod,
+                     "Wanted differences from the reference in JOD, comma-separated, e.g. 0.5,1,2")
+        ->required();
+    calibrate->add_option("--reference-level", options->referenceLevel,
+                          "Reference = the stimulus at this value of the key (default: the block's [[reference]])");
+    calibrate->add_option("--range", options->range,
+                          "LO,HI searched (default: the smallest and largest level of the spec's factor)");
+    calibrate->add_option("--tolerance", options->tolerance, "JOD within which a target counts as reached (0.05)");
+    calibrate->add_option("--max-probes", options->maxProbes, "Renders per target at most (24)");
+    calibrate->add_option("--display", options->display, "ColorVideoVDP display model (standard_fhd)");
+    calibrate->add_option("--stimulus", options->stimulus,
+                          "Id of the stimulus whose key varies (default: the first that is not a reference)");
+    calibrate->add_option("-o,--output", options->output, "Write the [[factor]] snippet to this file (atomically)");
+    calibrate->callback([options] { runCalibrate(*options); });
 }
 
 } // namespace skinlab::cli
