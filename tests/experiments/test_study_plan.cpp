@@ -2,6 +2,14 @@
 // by few observers, no difference is (almost) never resolved, and power grows with the number of observers.
 #include "experiments/study_plan.h"
 
+#include "common/error.h"
+#include "common/files.h"
+#include "experiments/study_creation.h"
+#include "experiments/study_store.h"
+#include "stimulus_set_fixture.h"
+
+#include <nlohmann/json.hpp>
+
 #include <gtest/gtest.h>
 
 using namespace skinlab::experiments;
@@ -59,4 +67,46 @@ TEST(StudyPlan, PowerGrowsWithObservers) {
     // 0.5 JOD neighbours with 80 observers answering each pair once: resolved with power ≥ 0.8.
     EXPECT_EQ(block.observersNeeded, 80);
     EXPECT_NE(planText(plan).find("needs 80 observers"), std::string::npos) << planText(plan);
+}
+
+// `--truth predicted` reads each stimulus's predicted JOD from the manifest stored in the study, per block; a set
+// built without predictions is refused, naming the stimulus.
+TEST(StudyPlan, TruthFromThePredictionsInTheManifest) {
+    using namespace skinlab::experiments::test_support;
+    TemporaryFolder folder("plan-truth");
+    const std::filesystem::path stimuli = folder.path() / "stimuli";
+    writeStimulusSet(stimuli);
+    const std::filesystem::path design = writeText(folder.path(), "design.toml", "title = \"t\"\nseed = 3\n");
+    // First without predictions.
+    createStudy(stimuli, design, {}, folder.path() / "plain.db");
+    {
+        StudyStore store(folder.path() / "plain.db");
+        try {
+            truthFromPredictions(store);
+            ADD_FAILURE() << "a set without predictions was accepted";
+        } catch (const skinlab::InputError& e) {
+            EXPECT_NE(std::string(e.what()).find("has no predicted JOD in the manifest"), std::string::npos)
+                << e.what();
+        }
+    }
+    // Then with them: JOD 9 + 0.1 × the method's index, different in each block.
+    nlohmann::json manifest = nlohmann::json::parse(skinlab::readFile(stimuli / "manifest.json"));
+    int k = 0;
+    for (nlohmann::json& s : manifest["stimuli"])
+        if (!s.value("reference", false)) s["predicted"] = {{"jod", 9.0 + 0.1 * k++}, {"display", "standard_fhd"}};
+    skinlab::writeFileAtomic(stimuli / "manifest.json", manifest.dump(2));
+    createStudy(stimuli, design, {}, folder.path() / "predicted.db");
+    StudyStore store(folder.path() / "predicted.db");
+    const SimulationTruth truth = truthFromPredictions(store);
+    k = 0;
+    for (const nlohmann::json& s : manifest["stimuli"]) {
+        if (s.value("reference", false)) continue;
+        EXPECT_DOUBLE_EQ(truth.quality(s["block"].get<std::string>(), s["factors"]["method"].get<std::string>()),
+                         9.0 + 0.1 * k++);
+    }
+    // The planner takes it as any truth.
+    PlanOptions options;
+    options.observerCounts = {5};
+    options.simulations = 20;
+    EXPECT_EQ(planStudy(store.definition(), truth, options).blocks.size(), store.definition().blocks.size());
 }
