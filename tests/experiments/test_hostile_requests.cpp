@@ -715,6 +715,12 @@ TEST(HostileRequests, PlatformIdAloneNeverTakesOverAParticipation) {
     EXPECT_EQ(sameAssignment.status, 200) << sameAssignment.raw;
     EXPECT_EQ(sameAssignment.body.value("token", ""), token);
 
+    // The researcher sees them on the dashboard.
+    const JsonAnswer board =
+        get(client, "/api/researcher/dashboard", {{"Authorization", std::string("Bearer ") + kResearcherToken}});
+    ASSERT_EQ(board.status, 200) << board.raw;
+    EXPECT_EQ(board.body["participants"][0]["refused_attempts"], 4);
+    EXPECT_EQ(board.body["participants"][0]["resumes"], 2);
     // Every refused attempt and every resume is recorded with its address.
     const std::vector<Visit> recorded = visits(study);
     ASSERT_EQ(recorded.size(), 6u);
