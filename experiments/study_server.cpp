@@ -531,7 +531,8 @@ HttpResponse StudyServer::route(const HttpRequest& req) {
             }
         }
         const std::int64_t session =
-            store_.startSession(p.id, userAgentOf(req), width, height, dpr, viewing, options_.sessionsPerParticipant);
+            store_.startSession(p.id, userAgentOf(req), width, height, dpr, viewing, options_.sessionsPerParticipant,
+                                ClientOrigin{req.clientAddress, req.forwardedBy.empty() ? "peer" : "forwarded"});
         json state = stateJson(p);
         state["session"] = session;
         return jsonResponse(200, state);

@@ -375,12 +375,13 @@ StudyStore::StudyStore(const fs::path& path) : path_(path) {
                  " client_address TEXT NOT NULL,"
                  " source TEXT NOT NULL CHECK (source IN ('peer','forwarded')),"
                  " recorded_at TEXT NOT NULL)");
-    // Every later visit of a participant through /api/join: resumed (with its secret) or refused (a platform id
-    // without it). Bounded by kMaxVisitsPerParticipant.
+    // Every later visit of a participant: a join that resumed it (with its secret) or was refused (a platform id
+    // without it), bounded by kMaxVisitsPerParticipant; and every session (page load), bounded by the sessions'
+    // limit.
     db_->execute("CREATE TABLE IF NOT EXISTS participant_visits ("
                  " id INTEGER PRIMARY KEY,"
                  " participant_id INTEGER NOT NULL REFERENCES participants(id),"
-                 " outcome TEXT NOT NULL CHECK (outcome IN ('resumed','refused')),"
+                 " outcome TEXT NOT NULL CHECK (outcome IN ('resumed','refused','session')),"
                  " client_address TEXT NOT NULL,"
                  " source TEXT NOT NULL CHECK (source IN ('peer','forwarded')),"
                  " recorded_at TEXT NOT NULL)");
@@ -429,7 +430,8 @@ void StudyStore::insertVisit(std::int64_t participantId, const char* outcome, co
 }
 
 int StudyStore::visitCount(std::int64_t participantId) {
-    SqliteStatement s = db_->prepare("SELECT COUNT(*) FROM participant_visits WHERE participant_id = ?");
+    SqliteStatement s = db_->prepare("SELECT COUNT(*) FROM participant_visits WHERE participant_id = ? AND outcome IN"
+                                     " ('resumed', 'refused')");
     s.bind(1, participantId);
     s.step();
     return static_cast<int>(s.integer(0));
@@ -564,7 +566,8 @@ ParticipantRecord StudyStore::participant(const std::string& token) {
 
 std::int64_t StudyStore::startSession(std::int64_t participantId, const std::string& userAgent, int viewportWidth,
                                       int viewportHeight, double devicePixelRatio,
-                                      const std::optional<ViewingConditions>& viewing, int maxSessions) {
+                                      const std::optional<ViewingConditions>& viewing, int maxSessions,
+                                      const std::optional<ClientOrigin>& origin) {
     std::lock_guard lock(mutex_);
     SqliteTransaction tx(*db_);
     if (maxSessions > 0) {
@@ -605,6 +608,7 @@ std::int64_t StudyStore::startSession(std::int64_t participantId, const std::str
         else c.bindNull(13);
         c.run();
     }
+    if (origin) insertVisit(participantId, "session", *origin);
     tx.commit();
     return session;
 }

@@ -49,8 +49,8 @@ struct ClientOrigin {
 
 // At most this many sessions per participant (each page load starts one); more are refused with 429.
 inline constexpr int kDefaultSessionsPerParticipant = 32;
-// At most this many visits (resumes and refused attempts) are recorded per participant; beyond, a resume is refused
-// with 429 and a refused attempt is refused without a row.
+// At most this many resumes and refused attempts (joins) are recorded per participant; beyond, a resume is refused
+// with 429 and a refused attempt is refused without a row. (Session rows are bounded by the sessions' limit.)
 inline constexpr int kMaxVisitsPerParticipant = 100;
 
 // What the page saw while one trial was shown (sent with the response).
@@ -172,11 +172,13 @@ public:
     // Throws RequestError 404 for an unknown token.
     ParticipantRecord participant(const std::string& token);
     // `viewing` (when the page reported it) is stored with the session. A participant who already has
-    // `maxSessions` sessions (0 = no limit) is refused with RequestError 429 and nothing is stored.
+    // `maxSessions` sessions (0 = no limit) is refused with RequestError 429 and nothing is stored. `origin`: recorded
+    // with the session (participant_visits, outcome "session"): every page load of a participation has its address.
     std::int64_t startSession(std::int64_t participantId, const std::string& userAgent, int viewportWidth,
                               int viewportHeight, double devicePixelRatio,
                               const std::optional<ViewingConditions>& viewing = std::nullopt,
-                              int maxSessions = kDefaultSessionsPerParticipant);
+                              int maxSessions = kDefaultSessionsPerParticipant,
+                              const std::optional<ClientOrigin>& origin = std::nullopt);
     // The first unanswered trial, if any. For an active design whose stored trials are all answered, the next
     // batch is planned from the current answers and stored first (see experiments/active_plan.h).
     std::optional<TrialRecord> nextTrial(std::int64_t participantId);

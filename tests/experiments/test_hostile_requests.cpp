@@ -660,7 +660,8 @@ struct Visit {
 };
 std::vector<Visit> visits(const RunningStudy& study) {
     SqliteDatabase db(study.databasePath().string(), false);
-    SqliteStatement s = db.prepare("SELECT outcome, client_address, source FROM participant_visits ORDER BY id");
+    SqliteStatement s = db.prepare("SELECT outcome, client_address, source FROM participant_visits WHERE outcome <>"
+                                   " 'session' ORDER BY id");
     std::vector<Visit> out;
     while (s.step()) out.push_back({s.text(0), s.text(1), s.text(2)});
     return out;
@@ -793,6 +794,11 @@ TEST(HostileRequests, SessionsPerParticipantAreBounded) {
         SqliteStatement s = db.prepare("SELECT COUNT(*) FROM sessions");
         ASSERT_TRUE(s.step());
         EXPECT_EQ(s.integer(0), limit);
+        // Every page load of the participation is recorded with its address.
+        SqliteStatement v = db.prepare("SELECT COUNT(*) FROM participant_visits WHERE outcome = 'session' AND"
+                                       " client_address = '127.0.0.1' AND source = 'peer'");
+        ASSERT_TRUE(v.step());
+        EXPECT_EQ(v.integer(0), limit);
         // Answers still go on in the sessions it has.
         EXPECT_EQ(postJson(client, "/api/response", answerBody(p, p.state["trial"]["id"], "left")).status, 200);
     }
