@@ -11,12 +11,18 @@
 #include "experiments/study_server.h"
 #include "experiments/study_store.h"
 
+#include <cerrno>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fcntl.h>
 #include <pthread.h>
 #include <algorithm>
 #include <regex>
+#include <sys/stat.h>
 #include <thread>
+#include <unistd.h>
 
 namespace skinlab::cli {
 namespace ex = skinlab::experiments;
@@ -37,6 +43,9 @@ struct StudyOptions {
     std::string publicHost;
     std::vector<std::string> trustedProxies;
     std::string token;
+    std::string tokenFile;
+    int sessionsPerParticipant = ex::kDefaultSessionsPerParticipant;
+    int joinIpv6Prefix = 64;
     std::string url = "http://127.0.0.1:8080";
     int observers = 0;
     std::string truth;
@@ -66,6 +75,47 @@ void runCreate(const StudyOptions& o) {
     std::printf("next: skinlab study serve %s\n", o.output.c_str());
 }
 
+// writeFileAtomic(), the file readable by its owner only (the site file says where the TLS key lies).
+void writePrivateFileAtomic(const std::string& path, const std::string& text) {
+    AtomicOutput out(path);
+    const int fd = ::open(out.tempPath().c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+    if (fd < 0) throw InputError(path + ": cannot write output (" + std::strerror(errno) + ")");
+    bool written = ::fchmod(fd, 0600) == 0;
+    for (std::size_t at = 0; written && at < text.size();) {
+        const ssize_t n = ::write(fd, text.data() + at, text.size() - at);
+        written = n > 0;
+        at += written ? static_cast<std::size_t>(n) : 0;
+    }
+    ::close(fd);
+    if (!written) throw InputError(path + ": write failed (" + std::strerror(errno) + ")");
+    out.commit();
+}
+
+// The researcher token: --token (visible to every user in `ps`), --token-file, or SKINLAB_RESEARCHER_TOKEN; empty = a
+// random one. The bool says whether it came from the researcher (then it is not printed).
+std::pair<std::string, bool> researcherToken(const StudyOptions& o) {
+    if (!o.token.empty() && !o.tokenFile.empty()) throw InputError("--token and --token-file: give one of them");
+    std::string token = o.token, source = "--token";
+    if (!o.tokenFile.empty()) {
+        token = readFile(o.tokenFile);
+        while (!token.empty() && (token.back() == '\n' || token.back() == '\r')) token.pop_back();
+        source = o.tokenFile;
+    } else if (const char* environment = std::getenv("SKINLAB_RESEARCHER_TOKEN"); token.empty() && environment) {
+        token = environment;
+        source = "SKINLAB_RESEARCHER_TOKEN";
+        if (token.empty()) throw InputError("SKINLAB_RESEARCHER_TOKEN: empty");
+    }
+    if (token.empty()) {
+        if (!o.tokenFile.empty()) throw InputError(o.tokenFile + ": the researcher token file is empty");
+        return {"", false};
+    }
+    if (token.size() > 256) throw InputError(source + ": the researcher token is longer than 256 characters");
+    for (char c : token)
+        if (c <= ' ' || c > '~')
+            throw InputError(source + ": the researcher token must be printable ASCII without blanks");
+    return {token, true};
+}
+
 void runServe(const StudyOptions& o) {
     // Block SIGINT/SIGTERM in every thread; one thread waits for them and stops the server cleanly.
     sigset_t signals;
@@ -84,16 +134,22 @@ void runServe(const StudyOptions& o) {
     options.joinBurst = o.joinsPerMinute;
     options.publicHost = o.publicHost;
     options.trustedProxies = o.trustedProxies;
-    options.researcherToken = o.token;
+    const auto [token, given] = researcherToken(o);
+    options.researcherToken = token;
+    options.sessionsPerParticipant = o.sessionsPerParticipant;
+    options.joinIpv6Prefix = o.joinIpv6Prefix;
     options.stimuliDir = o.stimuli;
     ex::StudyServer server(store, options);
     server.bind();
     std::printf("serving %s on %s\n", o.study.c_str(), server.url().c_str());
-    std::printf("participant link: %s  (each visit without ?p= starts a new participant)\n", server.url().c_str());
-    std::printf("researcher token: %s\n", server.researcherToken().c_str());
-    std::printf("status: curl -H 'Authorization: Bearer %s' %sapi/researcher/status\n",
-                server.researcherToken().c_str(), server.url().c_str());
-    std::printf("dashboard: %sresearcher#token=%s\n", server.url().c_str(), server.researcherToken().c_str());
+    std::printf("participant link: %s  (each visit of the bare link starts a new participant)\n", server.url().c_str());
+    // A token the researcher chose stays out of the output (often a log); a random one must be shown once.
+    const std::string shown = given ? "TOKEN" : server.researcherToken();
+    if (given) std::printf("researcher token: as given (not printed)\n");
+    else std::printf("researcher token: %s\n", shown.c_str());
+    std::printf("status: curl -H 'Authorization: Bearer %s' %sapi/researcher/status\n", shown.c_str(),
+                server.url().c_str());
+    std::printf("dashboard: %sresearcher#token=%s\n", server.url().c_str(), shown.c_str());
     std::fflush(stdout);
 
     std::thread waiter([&] {
@@ -183,7 +239,7 @@ void runBackup(const StudyOptions& o) {
 void runDeployConfig(const StudyOptions& o) {
     const std::string text = ex::nginxSiteConfig(o.site);
     if (o.output.empty() || o.output == "-") std::fwrite(text.data(), 1, text.size(), stdout);
-    else writeFileAtomic(o.output, text);
+    else writePrivateFileAtomic(o.output, text);
 }
 
 void runExport(const StudyOptions& o) {
@@ -232,7 +288,20 @@ void registerStudy(CLI::App& app) {
     serve->add_option("--trusted-proxy", options->trustedProxies,
                       "Address of a reverse proxy whose X-Forwarded-For is believed (repeatable; default with "
                       "--public-host: 127.0.0.1 and ::1)");
-    serve->add_option("--token", options->token, "Researcher token (default: random, printed at start)");
+    serve->add_option("--token", options->token,
+                      "Researcher token (visible in `ps`: prefer --token-file or SKINLAB_RESEARCHER_TOKEN; default: "
+                      "random, printed at start)");
+    serve->add_option("--token-file", options->tokenFile, "File holding the researcher token (its first line)");
+    serve
+        ->add_option("--sessions-per-participant", options->sessionsPerParticipant,
+                     "Sessions (page loads) allowed per participant")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 100000));
+    serve
+        ->add_option("--join-ipv6-prefix", options->joinIpv6Prefix,
+                     "IPv6 clients share the join allowance per this prefix length")
+        ->capture_default_str()
+        ->check(CLI::Range(32, 128));
     serve->add_option("--stimuli", options->stimuli, "Stimulus folder, if it moved since `study create`");
     serve->callback([options] { runServe(*options); });
 
@@ -299,7 +368,11 @@ void registerStudy(CLI::App& app) {
         ->required();
     deploy->add_option("--cert", options->site.certificate, "Certificate chain (PEM), absolute path")->required();
     deploy->add_option("--key", options->site.key, "Private key (PEM), absolute path")->required();
-    deploy->add_option("--listen", options->site.listen, "HTTPS port, or IPv4-ADDRESS:PORT")->capture_default_str();
+    deploy->add_option("--listen", options->site.listen,
+                       "HTTPS port (every address), or IPv4-ADDRESS:PORT or [IPv6-ADDRESS]:PORT (repeatable; default "
+                       "443)");
+    deploy->add_option("--access-log", options->site.accessLog, "nginx access log (absolute path, or off)")
+        ->capture_default_str();
     deploy->add_option("--redirect-port", options->site.redirectPort, "Also redirect plain HTTP on this port (0 = no)")
         ->capture_default_str()
         ->check(CLI::Range(0, 65535));

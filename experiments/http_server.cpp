@@ -194,6 +194,19 @@ private:
         if (ec) return fail(400, "malformed HTTP request (" + ec.message() + ")");
 
         http::request<http::string_body> message = parser_->release();
+        // Only "chunked" is a transfer coding this server decodes. A request with any other (identity, gzip,
+        // "chunked, identity": the body's length is then unknown, RFC 9112 §6.3) is refused and the connection
+        // closed, never read as an empty body with the rest taken for the next request (request smuggling).
+        if (message.count(http::field::transfer_encoding) > 0) {
+            std::string codings;
+            for (const auto& field : message)
+                if (field.name() == http::field::transfer_encoding)
+                    codings += (codings.empty() ? "" : ",") + std::string(field.value());
+            std::string bare;
+            for (char c : codings)
+                if (c != ' ' && c != '\t') bare += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+            if (bare != "chunked") return fail(501, "Transfer-Encoding: only chunked is supported");
+        }
         auto request = std::make_shared<HttpRequest>();
         request->method = std::string(message.method_string());
         const bool head = message.method() == http::verb::head;

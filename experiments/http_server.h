@@ -7,7 +7,8 @@
 // docs/architecture.md ("Study server: threading model").
 //
 // Requests that break a limit or are not HTTP are answered here (JSON {"error": ...}) and never reach the handler:
-// 400 malformed, 408 too slow, 413 body too large, 431 header too large, 429 too many connections from one address.
+// 400 malformed, 408 too slow, 413 body too large, 431 header too large, 429 too many connections from one address,
+// 501 a transfer coding other than chunked (the connection is closed).
 #include <chrono>
 #include <cstddef>
 #include <functional>

@@ -9,6 +9,7 @@
 #include <optional>
 #include <regex>
 #include <string_view>
+#include <vector>
 
 namespace skinlab::experiments {
 
@@ -29,6 +30,35 @@ int portOf(const std::string& option, const std::string& text) {
     if (!std::regex_match(text, digits) || std::stoi(text) < 1 || std::stoi(text) > 65535)
         throw InputError(option + ": \"" + text + "\" is not a port (1-65535)");
     return std::stoi(text);
+}
+
+// One --listen value: PORT, IPv4-ADDRESS:PORT or [IPv6-ADDRESS]:PORT → the nginx addresses (normalised) and port.
+struct ListenAddress {
+    std::vector<std::string> hosts; // "" = every IPv4 address, "[::]" every IPv6 one
+    int port = 0;
+};
+
+ListenAddress listenAddress(const std::string& text) {
+    ListenAddress out;
+    if (text.find(':') == std::string::npos) {
+        out.port = portOf("--listen", text);
+        out.hosts = {"", "[::]"};
+        return out;
+    }
+    const std::size_t colon = text.rfind(':');
+    std::string host = text.substr(0, colon);
+    out.port = portOf("--listen", text.substr(colon + 1));
+    boost::system::error_code ec;
+    if (host.size() > 2 && host.front() == '[' && host.back() == ']') {
+        const auto address = boost::asio::ip::make_address_v6(host.substr(1, host.size() - 2), ec);
+        if (ec) throw InputError("--listen: \"" + host + "\" is not an IPv6 address");
+        out.hosts = {"[" + address.to_string() + "]"};
+    } else {
+        const auto address = boost::asio::ip::make_address_v4(host, ec);
+        if (ec) throw InputError("--listen: \"" + host + "\" is not an IPv4 address (IPv6: [ADDRESS]:PORT)");
+        out.hosts = {address.to_string()};
+    }
+    return out;
 }
 
 // ADDRESS:PORT with an IPv4 address; returns the normalised form.
@@ -67,26 +97,37 @@ std::string nginxSiteConfig(const NginxSiteOptions& o) {
     if (o.serverName.size() > 253 || !std::regex_match(o.serverName, hostName))
         throw InputError("--server-name: \"" + o.serverName + "\" is not a host name");
     const std::string upstream = addressAndPort("--upstream", o.upstream);
-    std::string listen;
-    if (o.listen.find(':') == std::string::npos) {
-        const int port = portOf("--listen", o.listen);
-        listen = "    listen " + std::to_string(port) + " ssl http2;\n    listen [::]:" + std::to_string(port) +
-                 " ssl http2;";
-    } else {
-        listen = "    listen " + addressAndPort("--listen", o.listen) + " ssl http2;";
-    }
+    std::vector<ListenAddress> addresses;
+    for (const std::string& value : o.listen.empty() ? std::vector<std::string>{"443"} : o.listen)
+        addresses.push_back(listenAddress(value));
+    // Only the addresses asked for, HTTPS and the redirect alike.
+    auto listenLines = [&](int port, const char* suffix) {
+        std::string lines;
+        for (const ListenAddress& a : addresses)
+            for (const std::string& host : a.hosts)
+                lines += "    listen " + (host.empty() ? "" : host + ":") + std::to_string(port > 0 ? port : a.port) +
+                         suffix + ";\n";
+        lines.pop_back();
+        return lines;
+    };
+    const std::string listen = listenLines(0, " ssl http2");
+    std::string zone = "skinlab_";
+    for (char c : o.serverName) zone += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+    static const std::regex safePath(R"(/[A-Za-z0-9._/+@=,-]+)");
+    if (o.accessLog != "off" && !std::regex_match(o.accessLog, safePath))
+        throw InputError("--access-log: \"" + o.accessLog +
+                         "\" must be \"off\" or an absolute path of letters, digits and ._/+@=,-");
+    const std::string accessLog = o.accessLog == "off" ? "off" : o.accessLog + " " + zone + "_private";
     std::string redirect;
     if (o.redirectPort != 0) {
         const int port = portOf("--redirect-port", std::to_string(o.redirectPort));
-        const std::string httpsPort = o.listen.substr(o.listen.rfind(':') + 1);
-        redirect = "\n# Plain HTTP: only a redirect to https://\nserver {\n    listen " + std::to_string(port) +
-                   ";\n    listen [::]:" + std::to_string(port) + ";\n    server_name " + o.serverName +
-                   ";\n    return 301 https://$host" + (httpsPort == "443" ? "" : ":" + httpsPort) +
-                   "$request_uri;\n}\n";
+        // To the configured name, never the client's Host header (which the client chooses).
+        const int httpsPort = addresses.front().port;
+        redirect = "\n# Plain HTTP: only a redirect to https://" + o.serverName + "\nserver {\n" +
+                   listenLines(port, "") + "\n    server_name " + o.serverName + ";\n    access_log " + accessLog +
+                   ";\n    return 301 https://" + o.serverName +
+                   (httpsPort == 443 ? "" : ":" + std::to_string(httpsPort)) + "$request_uri;\n}\n";
     }
-    std::string zone = "skinlab_";
-    for (char c : o.serverName) zone += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
-
     const auto file = deploy::embeddedFile("nginx-site.conf.in");
     if (!file) throw RuntimeError("the nginx template is not built in");
     std::string text(*file);
@@ -97,6 +138,7 @@ std::string nginxSiteConfig(const NginxSiteOptions& o) {
     replaceAll(text, "@UPSTREAM@", upstream);
     replaceAll(text, "@CERTIFICATE@", readablePemFile("--cert", o.certificate));
     replaceAll(text, "@KEY@", readablePemFile("--key", o.key));
+    replaceAll(text, "@ACCESS_LOG@", accessLog);
     replaceAll(text, "@ZONE@", zone);
     return text;
 }

@@ -33,7 +33,29 @@ void checkValue(const std::string& name, const std::string& value, const std::st
     }
 }
 
+// Each platform's ids in one spelling, so that one person is one id however the link spells it (docs/study-protocol.md,
+// "Participant identity"). Prolific ids are hexadecimal object ids (case carries no meaning): lower case. MTurk ids
+// are upper-case letters and digits: upper case. Other systems (SONA, generic): surrounding blanks and trailing
+// dots dropped, lower case (a code typed or pasted by hand differs in nothing else).
+std::string normalised(std::string value, const std::string& platform) {
+    if (platform == "prolific" || platform == "mturk") {
+        for (char& c : value)
+            c = static_cast<char>(platform == "mturk" ? std::toupper(static_cast<unsigned char>(c))
+                                                      : std::tolower(static_cast<unsigned char>(c)));
+        return value;
+    }
+    const std::size_t first = value.find_first_not_of(" \t");
+    value = first == std::string::npos ? "" : value.substr(first, value.find_last_not_of(" \t") - first + 1);
+    while (!value.empty() && value.back() == '.') value.pop_back();
+    for (char& c : value) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return value;
+}
+
 } // namespace
+
+std::string normalisedExternalId(const std::string& platform, const std::string& value) {
+    return normalised(value, platform);
+}
 
 PlatformParameters platformParameters(const RecruitmentDesign& r) {
     if (r.platform == "prolific") return {"PROLIFIC_PID", "STUDY_ID", "SESSION_ID"};
@@ -59,15 +81,15 @@ std::optional<ExternalIds> validateExternalIds(const RecruitmentDesign& recruitm
                                 "HIT to take part");
     const std::optional<std::string> id = value(names.id);
     if (!id) throw RequestError(400, names.id + ": missing; open the study from its " + recruitment.platform + " link");
-    checkValue(names.id, *id, recruitment.platform);
-    ids.id = *id;
+    ids.id = normalised(*id, recruitment.platform);
+    checkValue(names.id, ids.id, recruitment.platform);
     if (const auto study = value(names.study)) {
-        checkValue(names.study, *study, recruitment.platform);
-        ids.study = *study;
+        ids.study = normalised(*study, recruitment.platform);
+        checkValue(names.study, ids.study, recruitment.platform);
     }
     if (const auto session = value(names.session)) {
-        checkValue(names.session, *session, recruitment.platform);
-        ids.session = *session;
+        ids.session = normalised(*session, recruitment.platform);
+        checkValue(names.session, ids.session, recruitment.platform);
     }
     return ids;
 }

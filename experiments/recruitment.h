@@ -23,7 +23,7 @@ PlatformParameters platformParameters(const RecruitmentDesign& recruitment);
 // MTurk shows the HIT in preview with this assignmentId: instructions only, no participation.
 inline constexpr const char* kMturkPreviewAssignment = "ASSIGNMENT_ID_NOT_AVAILABLE";
 
-// A participant's ids as sent by the platform (validated).
+// A participant's ids as sent by the platform, validated and normalised (normalisedExternalId()).
 struct ExternalIds {
     std::string platform;
     std::string id;
@@ -31,7 +31,11 @@ struct ExternalIds {
     std::string session;
 };
 
-// Validates the parameters the page forwarded (name -> value) against the design's platform. Throws RequestError:
+// The one spelling of a platform id: Prolific lower case; MTurk upper case; SONA and generic without surrounding
+// blanks and trailing dots, lower case. Ids are compared and stored in this form.
+std::string normalisedExternalId(const std::string& platform, const std::string& value);
+
+// Validates (after normalising) the parameters the page forwarded (name -> value) against the design's platform. Throws RequestError:
 // 400 naming the parameter for a missing or malformed value, 403 for MTurk's preview assignment. nullopt for
 // platform "none".
 std::optional<ExternalIds> validateExternalIds(const RecruitmentDesign& recruitment,

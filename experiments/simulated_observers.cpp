@@ -42,10 +42,11 @@ public:
 
     // Sends until an HTTP answer arrives (bounded by maxAttempts); counts the re-sends. A 429 (too many joins or
     // connections from this address) is waited out as its Retry-After says.
-    HttpResult send(const std::string& method, const std::string& path, const json& body, int& retries) {
+    HttpResult send(const std::string& method, const std::string& path, const json& body, int& retries,
+                    const HttpHeaders& headers = {}) {
         for (int attempt = 0; attempt < options_.maxAttempts; ++attempt) {
             const auto start = std::chrono::steady_clock::now();
-            HttpAnswer res = method == "GET" ? client_.get(path) : client_.post(path, body.dump());
+            HttpAnswer res = client_.send(method, path, method == "GET" ? "" : body.dump(), headers);
             const double ms =
                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
             if (res.status == 429) {
@@ -221,7 +222,7 @@ ObserverResult runObserver(StudyStore& store, const SimulationOptions& options, 
             break;
         }
         // Re-synchronise with the server's view of this participant.
-        state = api.send("GET", "/api/state?token=" + token, json(), result.transportRetries);
+        state = api.send("GET", "/api/state", json(), result.transportRetries, {{"X-Skinlab-Token", token}});
         if (state.status != 200) {
             result.failure = "state: HTTP " + std::to_string(state.status);
             break;

@@ -2,11 +2,23 @@
 
 #include "common/error.h"
 
+#include <cerrno>
+#include <cstring>
+#include <fcntl.h>
 #include <sqlite3.h>
+#include <unistd.h>
 
 namespace skinlab::experiments {
 
 SqliteDatabase::SqliteDatabase(const std::string& path, bool create) : path_(path) {
+    if (create) {
+        // A study holds personal data (platform ids, addresses) and participant secrets: a new file is readable by
+        // its owner only, whatever the umask. SQLite gives its -wal, -shm and journal files the database's mode.
+        const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+        if (fd < 0 && errno != EEXIST)
+            throw InputError(path + ": cannot create the study database: " + std::strerror(errno));
+        if (fd >= 0) ::close(fd);
+    }
     const int flags = SQLITE_OPEN_READWRITE | (create ? SQLITE_OPEN_CREATE : 0) | SQLITE_OPEN_FULLMUTEX;
     if (sqlite3_open_v2(path.c_str(), &db_, flags, nullptr) != SQLITE_OK) {
         std::string message = db_ ? sqlite3_errmsg(db_) : "out of memory";

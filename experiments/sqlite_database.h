@@ -15,7 +15,7 @@ class SqliteStatement;
 
 class SqliteDatabase {
 public:
-    // Opens (creating when `create`) the database file.
+    // Opens (creating when `create`) the database file; a file it creates has mode 0600.
     SqliteDatabase(const std::string& path, bool create);
     ~SqliteDatabase();
     SqliteDatabase(const SqliteDatabase&) = delete;

@@ -121,7 +121,9 @@ json StudyDashboard::counts() {
             "t.kind = 'catch'),"
             " (SELECT COUNT(*) FROM responses r JOIN trials t ON t.id = r.trial_id WHERE r.participant_id = p.id AND "
             "t.kind = 'catch' AND r.chosen = t.expected),"
-            " (SELECT COALESCE(MAX(server_time), '') FROM responses r WHERE r.participant_id = p.id)"
+            " (SELECT COALESCE(MAX(server_time), '') FROM responses r WHERE r.participant_id = p.id),"
+            " (SELECT COUNT(*) FROM participant_visits v WHERE v.participant_id = p.id AND v.outcome = 'resumed'),"
+            " (SELECT COUNT(*) FROM participant_visits v WHERE v.participant_id = p.id AND v.outcome = 'refused')"
             " FROM participants p LEFT JOIN participant_addresses a ON a.participant_id = p.id ORDER BY p.id");
         while (s.step()) {
             const int total = design.activePairs ? planned : static_cast<int>(s.integer(4));
@@ -140,7 +142,9 @@ json StudyDashboard::counts() {
                                     {"completed", answered >= total},
                                     {"catch_answered", catchN},
                                     {"catch_correct", catchOk},
-                                    {"last_response_at", s.text(8)}});
+                                    {"last_response_at", s.text(8)},
+                                    {"resumes", s.integer(9)},
+                                    {"refused_attempts", s.integer(10)}});
         }
     }
     std::vector<double> times;

@@ -3,6 +3,7 @@
 #include "common/error.h"
 
 #include <cstdio>
+#include <string_view>
 
 namespace skinlab::experiments {
 
@@ -17,6 +18,15 @@ std::string csvField(const std::string& value) {
         out += c;
     }
     return out + "\"";
+}
+
+std::string csvTextField(const std::string& value) {
+    // A spreadsheet reads a cell starting with = + - @ (or a tab or carriage return before one) as a formula
+    // ("-2-3", "=HYPERLINK(...)"): such text from a client or a platform is kept as text by a leading apostrophe
+    // (OWASP, "CSV Injection"). Numbers never pass through here.
+    if (!value.empty() && std::string_view("=+-@\t\r").find(value.front()) != std::string_view::npos)
+        return csvField("'" + value);
+    return csvField(value);
 }
 
 namespace {
@@ -71,10 +81,10 @@ std::string onlineFields(const ResponseRow& r) {
         for (int k = 0; k < 8; ++k) add("");
     }
     if (r.external) {
-        add(csvField(r.external->platform));
-        add(csvField(r.external->id));
-        add(csvField(r.external->study));
-        add(csvField(r.external->session));
+        add(csvTextField(r.external->platform));
+        add(csvTextField(r.external->id));
+        add(csvTextField(r.external->study));
+        add(csvTextField(r.external->session));
     } else {
         for (int k = 0; k < 4; ++k) add("");
     }
@@ -185,7 +195,7 @@ std::string exportResponses(StudyStore& store, const std::string& format) {
                       "," + kOnlineColumns + "\n";
     for (const ResponseRow& r : rows) {
         if (pwcmp && r.kind != TrialKind::test && r.kind != TrialKind::repeat) continue;
-        out += csvField(r.observer) + ',' + csvField(r.scene) + ',' + csvField(r.conditionA) + ',' +
+        out += csvTextField(r.observer) + ',' + csvField(r.scene) + ',' + csvField(r.conditionA) + ',' +
                csvField(r.conditionB) + ',' + (r.aSelected ? "1" : "0");
         if (!pwcmp) {
             out += std::string(",") + (r.aOnLeft ? "1" : "0") + ',' + trialKindName(r.kind) + ',' +

@@ -26,5 +26,8 @@ std::string statusText(StudyStore& store);
 
 // CSV field quoting (RFC 4180): quoted when it holds a comma, quote or line break.
 std::string csvField(const std::string& value);
+// csvField() of text that came from a client or a platform: a leading = + - @ (a spreadsheet formula) is kept as text
+// by an apostrophe before it.
+std::string csvTextField(const std::string& value);
 
 } // namespace skinlab::experiments

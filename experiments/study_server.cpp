@@ -195,6 +195,8 @@ StudyServer::StudyServer(StudyStore& store, ServerOptions options) : store_(stor
         if (invalid) throw InputError("--trusted-proxy: \"" + proxy + "\" is not an IP address");
         proxy = address.to_string();
     }
+    joinLimiter_ = std::make_unique<JoinLimiter>(options_.joinsPerMinute, options_.joinBurst, options_.joinTableSize,
+                                                 options_.joinIpv6Prefix);
     dashboard_ = std::make_unique<StudyDashboard>(store_, options_.dashboardInterval);
     HttpLimits limits;
     limits.uncappedClients = options_.trustedProxies;
@@ -255,28 +257,6 @@ bool StudyServer::hostAllowed(const std::string& hostHeader) const {
     return bound.is_unspecified() || address == bound;
 }
 
-bool StudyServer::allowJoin(const std::string& clientAddress, double& retryAfterSeconds) {
-    // A token bucket per client address: joinBurst joins at once, then joinsPerMinute.
-    std::lock_guard lock(joinMutex_);
-    const auto now = std::chrono::steady_clock::now();
-    if (joinBuckets_.size() > 100000) joinBuckets_.clear(); // bounded memory under an address-spraying flood
-    auto [it, fresh] = joinBuckets_.try_emplace(clientAddress);
-    JoinBucket& bucket = it->second;
-    const double perSecond = options_.joinsPerMinute / 60.0;
-    if (fresh) bucket.tokens = options_.joinBurst;
-    else
-        bucket.tokens =
-            std::min(options_.joinBurst,
-                     bucket.tokens + perSecond * std::chrono::duration<double>(now - bucket.updated).count());
-    bucket.updated = now;
-    if (bucket.tokens >= 1) {
-        bucket.tokens -= 1;
-        return true;
-    }
-    retryAfterSeconds = perSecond > 0 ? (1 - bucket.tokens) / perSecond : 60;
-    return false;
-}
-
 bool StudyServer::trustedProxy(const std::string& peer) const {
     return std::find(options_.trustedProxies.begin(), options_.trustedProxies.end(), peer) !=
            options_.trustedProxies.end();
@@ -301,6 +281,17 @@ std::string StudyServer::clientAddress(const HttpRequest& req) const {
 }
 
 HttpResponse StudyServer::handle(const HttpRequest& req) {
+    HttpResponse res = answer(req);
+    // No page of the study may be framed by another site (clickjacking): modern browsers read the CSP
+    // directive, older ones X-Frame-Options.
+    res.headers.emplace_back("X-Frame-Options", "DENY");
+    if (std::none_of(res.headers.begin(), res.headers.end(),
+                     [](const auto& h) { return h.first == "Content-Security-Policy"; }))
+        res.headers.emplace_back("Content-Security-Policy", "frame-ancestors 'none'");
+    return res;
+}
+
+HttpResponse StudyServer::answer(const HttpRequest& req) {
     try {
         if (req.headerCount("Host") != 1) throw RequestError(400, "Host: exactly one Host header is required");
         if (!hostAllowed(req.header("Host")))
@@ -358,7 +349,11 @@ HttpResponse StudyServer::route(const HttpRequest& req) {
         res.headers = {
             {"Cache-Control", "no-cache"},
             {"X-Content-Type-Options", "nosniff"},
-            {"Content-Security-Policy", "default-src 'self'; img-src 'self'; style-src 'self'; script-src 'self'"}};
+            {"Content-Security-Policy",
+             "default-src 'self'; img-src 'self'; style-src 'self'; script-src 'self'; frame-ancestors 'none'"},
+            // The first load of the page may carry secrets in its address (?p=, a platform's session id): no
+            // request from the page names it.
+            {"Referrer-Policy", "no-referrer"}};
         res.body = std::string(*file);
         return res;
     };
@@ -366,11 +361,8 @@ HttpResponse StudyServer::route(const HttpRequest& req) {
     if (get && path == "/app.js") return webFile("app.js", "text/javascript; charset=utf-8");
     if (get && path == "/style.css") return webFile("style.css", "text/css; charset=utf-8");
     // The researcher's dashboard: the page holds no data; its script asks /api/researcher/dashboard with the token.
-    if (get && (path == "/researcher" || path == "/researcher.html")) {
-        HttpResponse res = webFile("researcher.html", "text/html; charset=utf-8");
-        res.headers.emplace_back("Referrer-Policy", "no-referrer");
-        return res;
-    }
+    if (get && (path == "/researcher" || path == "/researcher.html"))
+        return webFile("researcher.html", "text/html; charset=utf-8");
     if (get && path == "/researcher.js") return webFile("researcher.js", "text/javascript; charset=utf-8");
     if (get && path == "/researcher.css") return webFile("researcher.css", "text/css; charset=utf-8");
 
@@ -477,25 +469,22 @@ HttpResponse StudyServer::route(const HttpRequest& req) {
         for (char c : joinKey)
             if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_'))
                 throw RequestError(400, "join_key: only letters, digits, '-' and '_' are allowed");
-        // A platform's participant: validated ids (400 naming the parameter), and the same id resumes.
+        // A platform's participant: validated and normalised ids (400 naming the parameter). The same id resumes
+        // only with the secret of its first join (StudyStore::join).
         const std::optional<ExternalIds> external =
             validateExternalIds(definition.design.recruitment, recruitmentField(body));
-        if (external) {
-            if (const std::optional<ParticipantRecord> known = store_.participantByExternalId(*external)) {
-                spdlog::info("participant {} returned", known->label);
-                return jsonResponse(200, {{"token", known->token}, {"observer", known->label}, {"resumed", true}});
-            }
-        }
+        // Every join counts against the client's allowance: new participants, resumes, refused attempts and taken
+        // labels alike, so none of them can be probed faster than participants can join.
         double retryAfter = 0;
-        if (!allowJoin(req.clientAddress, retryAfter)) {
-            HttpResponse res = errorResponse(429, "too many new participants from this address; retry later");
+        if (!joinLimiter_->allow(req.clientAddress, retryAfter)) {
+            HttpResponse res = errorResponse(429, "too many joins from this network; retry later");
             res.headers.emplace_back("Retry-After", std::to_string(static_cast<int>(std::ceil(retryAfter))));
             return res;
         }
-        const ParticipantRecord p = store_.join(label, joinKey, external);
-        store_.recordJoinAddress(p.id, req.clientAddress, req.forwardedBy.empty() ? "peer" : "forwarded");
+        const ClientOrigin origin{req.clientAddress, req.forwardedBy.empty() ? "peer" : "forwarded"};
+        const ParticipantRecord p = store_.join(label, joinKey, external, origin);
         spdlog::info("participant {} {}", p.label, p.resumed ? "returned" : "joined");
-        // A repeated join key answers as its first join did (201); a known platform id answers 200.
+        // A repeated join key answers as its first join did (201); a resumed platform participant answers 200.
         return jsonResponse(p.resumed && external ? 200 : 201,
                             {{"token", p.token}, {"observer", p.label}, {"resumed", p.resumed}});
     }
@@ -544,15 +533,20 @@ HttpResponse StudyServer::route(const HttpRequest& req) {
                 return jsonResponse(403, {{"error", message}, {"unmet", unmet}});
             }
         }
-        const std::int64_t session = store_.startSession(p.id, userAgentOf(req), width, height, dpr, viewing);
+        const std::int64_t session =
+            store_.startSession(p.id, userAgentOf(req), width, height, dpr, viewing, options_.sessionsPerParticipant,
+                                ClientOrigin{req.clientAddress, req.forwardedBy.empty() ? "peer" : "forwarded"});
         json state = stateJson(p);
         state["session"] = session;
         return jsonResponse(200, state);
     }
 
     if (get && path == "/api/state") {
-        const std::string token = req.queryParameter("token").value_or("");
-        if (token.empty() || token.size() > kMaxTokenLength) throw RequestError(400, "token: missing");
+        // The token travels in this header only: a URL ends up in logs and the browser's history.
+        if (req.queryParameter("token"))
+            throw RequestError(400, "token: send it in the X-Skinlab-Token header, never in the URL");
+        const std::string token = req.header("X-Skinlab-Token");
+        if (token.empty() || token.size() > kMaxTokenLength) throw RequestError(400, "X-Skinlab-Token: missing");
         return jsonResponse(200, stateJson(store_.participant(token)));
     }
 

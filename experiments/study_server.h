@@ -7,6 +7,7 @@
 // Only the stimuli listed in the study are served, by number (/stimuli/<n>.png), from the bytes verified against
 // their sha256 when the server started (held in memory); no request path is ever mapped onto the file system.
 #include "experiments/http_server.h"
+#include "experiments/join_limiter.h"
 #include "experiments/study_store.h"
 
 #include <chrono>
@@ -32,6 +33,9 @@ struct ServerOptions {
     std::string publicHost;                // a name the server is reached by (Host header); empty = its address only
     double joinsPerMinute = 60;            // new participants per client address: sustained rate...
     double joinBurst = 60;                 // ...and burst (more: 429 with Retry-After)
+    int joinIpv6Prefix = 64;               // IPv6 clients share a join allowance per /64 (bits kept)
+    std::size_t joinTableSize = 100000;    // client networks tracked by the join limit (the fullest evicted first)
+    int sessionsPerParticipant = kDefaultSessionsPerParticipant; // sessions per participant (more: 429)
     std::chrono::milliseconds requestTimeout{10000}; // a request must arrive within this once started (else 408)
     // Reverse proxies (IP addresses) whose X-Forwarded-For is believed: a request from one of them counts as coming
     // from the address the proxy forwards (join rate limit, per-client request cap, the stored join address); from
@@ -66,10 +70,10 @@ private:
         std::shared_ptr<const std::string> bytes; // verified at start; served from memory
         std::string etag;                         // "\"<sha256>\""
     };
-    HttpResponse handle(const HttpRequest& request);
+    HttpResponse handle(const HttpRequest& request); // answer() with the headers every response carries
+    HttpResponse answer(const HttpRequest& request);
     HttpResponse route(const HttpRequest& request);
     bool hostAllowed(const std::string& host) const;
-    bool allowJoin(const std::string& clientAddress, double& retryAfterSeconds);
     // The client's address: the peer's, or the one a trusted proxy forwards (X-Forwarded-For, rightmost entry).
     std::string clientAddress(const HttpRequest& request) const;
     bool trustedProxy(const std::string& peer) const;
@@ -79,12 +83,7 @@ private:
     std::vector<Stimulus> stimuli_;
     std::unique_ptr<HttpServer> http_;
     int port_ = 0;
-    struct JoinBucket {
-        double tokens = 0;
-        std::chrono::steady_clock::time_point updated;
-    };
-    std::mutex joinMutex_;
-    std::map<std::string, JoinBucket> joinBuckets_;
+    std::unique_ptr<JoinLimiter> joinLimiter_;
     // Requests in progress per forwarded client address (behind a proxy every connection is the proxy's).
     std::mutex inFlightMutex_;
     std::map<std::string, int> inFlight_;

@@ -375,6 +375,16 @@ StudyStore::StudyStore(const fs::path& path) : path_(path) {
                  " client_address TEXT NOT NULL,"
                  " source TEXT NOT NULL CHECK (source IN ('peer','forwarded')),"
                  " recorded_at TEXT NOT NULL)");
+    // Every later visit of a participant: a join that resumed it (with its secret) or was refused (a platform id
+    // without it), bounded by kMaxVisitsPerParticipant; and every session (page load), bounded by the sessions'
+    // limit.
+    db_->execute("CREATE TABLE IF NOT EXISTS participant_visits ("
+                 " id INTEGER PRIMARY KEY,"
+                 " participant_id INTEGER NOT NULL REFERENCES participants(id),"
+                 " outcome TEXT NOT NULL CHECK (outcome IN ('resumed','refused','session')),"
+                 " client_address TEXT NOT NULL,"
+                 " source TEXT NOT NULL CHECK (source IN ('peer','forwarded')),"
+                 " recorded_at TEXT NOT NULL)");
     for (std::size_t b = 0; b < definition_.blocks.size(); ++b)
         posteriorCache_.push_back(std::make_unique<BlockPosteriorCache>());
 }
@@ -410,29 +420,73 @@ std::vector<std::string> StudyStore::simulatedLabels() const {
 }
 
 ParticipantRecord StudyStore::join(const std::string& requestedLabel, const std::string& joinKey,
-                                   const std::optional<ExternalIds>& external) {
+                                   const std::optional<ExternalIds>& external,
+                                   const std::optional<ClientOrigin>& origin) {
     bool created = false;
-    ParticipantRecord p = joinLocked(requestedLabel, joinKey, external, created);
+    ParticipantRecord p = joinLocked(requestedLabel, joinKey, external, origin, created);
     // Active design: the first stretch (practice trials, the first batch) is planned outside the lock and stored
     // before the join is answered. Should the process die in between, the participant's first nextTrial() plans it.
     if (created && definition_.design.activePairs) extendActivePlan(p.id);
     return p;
 }
 
+void StudyStore::insertVisit(std::int64_t participantId, const char* outcome, const ClientOrigin& origin) {
+    SqliteStatement s = db_->prepare("INSERT INTO participant_visits (participant_id, outcome, client_address, source,"
+                                     " recorded_at) VALUES (?,?,?,?,?)");
+    s.bind(1, participantId).bind(2, std::string(outcome)).bind(3, validUtf8(origin.address, 64));
+    s.bind(4, origin.source).bind(5, utcTimestamp());
+    s.run();
+}
+
+int StudyStore::visitCount(std::int64_t participantId) {
+    SqliteStatement s = db_->prepare("SELECT COUNT(*) FROM participant_visits WHERE participant_id = ? AND outcome IN"
+                                     " ('resumed', 'refused')");
+    s.bind(1, participantId);
+    s.step();
+    return static_cast<int>(s.integer(0));
+}
+
 ParticipantRecord StudyStore::joinLocked(const std::string& requestedLabel, const std::string& joinKey,
-                                         const std::optional<ExternalIds>& external, bool& created) {
+                                         const std::optional<ExternalIds>& external,
+                                         const std::optional<ClientOrigin>& origin, bool& created) {
     std::lock_guard lock(mutex_);
     SqliteTransaction tx(*db_);
+    // A returning participant: recorded (address, time) with every resume; bounded per participant.
+    auto resume = [&](ParticipantRecord existing) {
+        if (origin) {
+            if (visitCount(existing.id) >= kMaxVisitsPerParticipant)
+                throw RequestError(429, "this participant has resumed too often; contact the researcher");
+            insertVisit(existing.id, "resumed", *origin);
+            tx.commit();
+        }
+        existing.resumed = true;
+        return existing;
+    };
     if (external) {
-        // One platform id, one participant: a second visit (another link, another browser) resumes the first.
+        // One platform id, one participant. A second visit resumes the first only with the first join's key (the
+        // same browser) or the platform's per-attempt session id it joined with (the same platform link): anyone
+        // may know or guess a platform id, only the participant holds these.
         SqliteStatement s = db_->prepare(std::string("SELECT ") + kParticipantColumns +
-                                         " FROM participants WHERE id = (SELECT participant_id FROM recruitment"
-                                         " WHERE platform = ? AND external_id = ?)");
+                                         ", join_key, rec.external_session_id FROM participants"
+                                         " JOIN recruitment rec ON rec.participant_id = participants.id"
+                                         " WHERE rec.platform = ? AND rec.external_id = ?");
         s.bind(1, external->platform).bind(2, external->id);
         if (s.step()) {
             ParticipantRecord existing = readParticipant(s);
-            existing.resumed = true;
-            return existing;
+            const std::string storedKey = s.isNull(7) ? "" : s.text(7), storedSession = s.text(8);
+            s.reset();
+            const bool sameBrowser = !joinKey.empty() && joinKey == storedKey;
+            const bool sameAttempt = !external->session.empty() && external->session == storedSession;
+            if (sameBrowser || sameAttempt) return resume(existing);
+            if (origin && visitCount(existing.id) < kMaxVisitsPerParticipant) {
+                insertVisit(existing.id, "refused", *origin);
+                tx.commit();
+            }
+            const std::string parameter = platformParameters(definition_.design.recruitment).id;
+            throw RequestError(409, parameter + ": this " + external->platform +
+                                        " id has already started this study in another browser or from another "
+                                        "link; continue where you started (same browser, same link), or contact "
+                                        "the researcher");
         }
     }
     if (!joinKey.empty()) {
@@ -441,10 +495,11 @@ ParticipantRecord StudyStore::joinLocked(const std::string& requestedLabel, cons
         s.bind(1, joinKey);
         if (s.step()) {
             ParticipantRecord existing = readParticipant(s);
-            if (!requestedLabel.empty() && existing.label != requestedLabel)
+            s.reset();
+            // A join key belongs to one participant: not to another label, nor to another platform id.
+            if ((!requestedLabel.empty() && existing.label != requestedLabel) || external)
                 throw RequestError(409, "join_key: already used by another participant");
-            existing.resumed = true;
-            return existing;
+            return resume(existing);
         }
     }
     ParticipantRecord p;
@@ -497,21 +552,15 @@ ParticipantRecord StudyStore::joinLocked(const std::string& requestedLabel, cons
         ids.bind(5, external->session);
         ids.run();
     }
+    if (origin) {
+        SqliteStatement a = db_->prepare("INSERT OR IGNORE INTO participant_addresses (participant_id, client_address,"
+                                         " source, recorded_at) VALUES (?,?,?,?)");
+        a.bind(1, p.id).bind(2, validUtf8(origin->address, 64)).bind(3, origin->source).bind(4, p.createdAt);
+        a.run();
+    }
     if (!definition_.design.activePairs) insertTrials(*db_, p.id, planTrials(definition_, p.index, p.seed));
     tx.commit();
     created = true;
-    return p;
-}
-
-std::optional<ParticipantRecord> StudyStore::participantByExternalId(const ExternalIds& external) {
-    std::lock_guard lock(mutex_);
-    SqliteStatement s = db_->prepare(std::string("SELECT ") + kParticipantColumns +
-                                     " FROM participants WHERE id = (SELECT participant_id FROM recruitment"
-                                     " WHERE platform = ? AND external_id = ?)");
-    s.bind(1, external.platform).bind(2, external.id);
-    if (!s.step()) return std::nullopt;
-    ParticipantRecord p = readParticipant(s);
-    p.resumed = true;
     return p;
 }
 
@@ -526,9 +575,19 @@ ParticipantRecord StudyStore::participant(const std::string& token) {
 
 std::int64_t StudyStore::startSession(std::int64_t participantId, const std::string& userAgent, int viewportWidth,
                                       int viewportHeight, double devicePixelRatio,
-                                      const std::optional<ViewingConditions>& viewing) {
+                                      const std::optional<ViewingConditions>& viewing, int maxSessions,
+                                      const std::optional<ClientOrigin>& origin) {
     std::lock_guard lock(mutex_);
     SqliteTransaction tx(*db_);
+    if (maxSessions > 0) {
+        // Each page load starts a session: a handful per participant is normal, thousands are a flood.
+        SqliteStatement count = db_->prepare("SELECT COUNT(*) FROM sessions WHERE participant_id = ?");
+        count.bind(1, participantId);
+        count.step();
+        if (count.integer(0) >= maxSessions)
+            throw RequestError(429, "too many sessions for this participant (at most " + std::to_string(maxSessions) +
+                                        "); contact the researcher");
+    }
     SqliteStatement s = db_->prepare("INSERT INTO sessions (participant_id, started_at, user_agent, viewport_width, "
                                      "viewport_height, device_pixel_ratio)"
                                      " VALUES (?,?,?,?,?,?)");
@@ -558,6 +617,7 @@ std::int64_t StudyStore::startSession(std::int64_t participantId, const std::str
         else c.bindNull(13);
         c.run();
     }
+    if (origin) insertVisit(participantId, "session", *origin);
     tx.commit();
     return session;
 }

@@ -36,8 +36,22 @@ struct ParticipantRecord {
     std::uint64_t seed = 0;
     std::string completionCode;
     std::string createdAt;
-    bool resumed = false; // join(): an existing participant was returned (same join key or external id)
+    bool resumed = false; // join(): an existing participant was returned (same join key, or platform id with its
+                          // join key or the platform's session id)
 };
+
+// Where a request came from: the client's address and whether the TCP peer ("peer") or a trusted proxy
+// ("forwarded") said so.
+struct ClientOrigin {
+    std::string address;
+    std::string source = "peer";
+};
+
+// At most this many sessions per participant (each page load starts one); more are refused with 429.
+inline constexpr int kDefaultSessionsPerParticipant = 32;
+// At most this many resumes and refused attempts (joins) are recorded per participant; beyond, a resume is refused
+// with 429 and a refused attempt is refused without a row. (Session rows are bounded by the sessions' limit.)
+inline constexpr int kMaxVisitsPerParticipant = 100;
 
 // What the page saw while one trial was shown (sent with the response).
 struct TrialConditions {
@@ -146,20 +160,27 @@ public:
     std::vector<std::string> simulatedLabels() const;
 
     // A new participant with a fresh token, seed and planned trials (one transaction). `label` empty = "P001"...
-    // `joinKey` (chosen by the client, may be empty) makes joining idempotent: a retried join whose first answer
-    // was lost returns the participant it created. Throws RequestError 409 when the label is taken.
-    // `external` (a recruitment platform's ids): the participant with the same platform id is returned (resumed)
-    // instead of a new one, whatever the join key; a new participant stores them.
+    // `joinKey` (a secret chosen by the client, may be empty) makes joining idempotent: a retried join whose first
+    // answer was lost returns the participant it created. Throws RequestError 409 when the label is taken.
+    // `external` (a recruitment platform's ids, normalised): one platform id is one participant. A join with a known
+    // platform id resumes that participant only with something only that participant's browser holds: the join key
+    // of its first join, or the platform's per-attempt session id (Prolific SESSION_ID, MTurk assignmentId) it first
+    // joined with; the platform id alone never does. Otherwise RequestError 409, and the refused attempt is recorded.
+    // `origin`: stored with a new participant (participant_addresses) and with every resume or refused attempt
+    // (participant_visits).
     ParticipantRecord join(const std::string& label, const std::string& joinKey = "",
-                           const std::optional<ExternalIds>& external = std::nullopt);
-    // The participant who joined with these platform ids, if any.
-    std::optional<ParticipantRecord> participantByExternalId(const ExternalIds& external);
+                           const std::optional<ExternalIds>& external = std::nullopt,
+                           const std::optional<ClientOrigin>& origin = std::nullopt);
     // Throws RequestError 404 for an unknown token.
     ParticipantRecord participant(const std::string& token);
-    // `viewing` (when the page reported it) is stored with the session.
+    // `viewing` (when the page reported it) is stored with the session. A participant who already has
+    // `maxSessions` sessions (0 = no limit) is refused with RequestError 429 and nothing is stored. `origin`: recorded
+    // with the session (participant_visits, outcome "session"): every page load of a participation has its address.
     std::int64_t startSession(std::int64_t participantId, const std::string& userAgent, int viewportWidth,
                               int viewportHeight, double devicePixelRatio,
-                              const std::optional<ViewingConditions>& viewing = std::nullopt);
+                              const std::optional<ViewingConditions>& viewing = std::nullopt,
+                              int maxSessions = kDefaultSessionsPerParticipant,
+                              const std::optional<ClientOrigin>& origin = std::nullopt);
     // The first unanswered trial, if any. For an active design whose stored trials are all answered, the next
     // batch is planned from the current answers and stored first (see experiments/active_plan.h).
     std::optional<TrialRecord> nextTrial(std::int64_t participantId);
@@ -202,7 +223,11 @@ private:
     enum class ActiveExtension { stored, complete, raced };
     ActiveExtension extendActivePlan(std::int64_t participantId);
     ParticipantRecord joinLocked(const std::string& label, const std::string& joinKey,
-                                 const std::optional<ExternalIds>& external, bool& created);
+                                 const std::optional<ExternalIds>& external, const std::optional<ClientOrigin>& origin,
+                                 bool& created);
+    // mutex_ held, inside a transaction.
+    void insertVisit(std::int64_t participantId, const char* outcome, const ClientOrigin& origin);
+    int visitCount(std::int64_t participantId);
     std::optional<TrialRecord> firstUnanswered(std::int64_t participantId); // mutex_ held
     int plannedTrialCount() const;                                          // per participant
     // mutex_ held: the in-memory answer counts of every block, read from the database on first use and updated

@@ -1,15 +1,24 @@
 // skinlab participant page: consent → instructions → practice → trials (2AFC) → completion code.
 // Every answer is sent to the server and only counted once the server has committed it; a failed send is
-// retried with the same body (the server treats a re-send as harmless). Reloading the page with the same ?p=
-// link resumes at the first unanswered trial. Online studies: the recruitment platform's URL parameters are
-// forwarded when joining (the same platform id resumes), the optional card calibration and the viewing conditions
+// retried with the same body (the server treats a re-send as harmless). After joining, the participant's token is
+// kept in the address's fragment (#p=…, which a browser never sends to a server) and only ever sent in request
+// bodies or the X-Skinlab-Token header: reloading or reopening that address resumes at the first unanswered trial.
+// Online studies: the recruitment platform's URL parameters are forwarded when joining (the same platform id resumes
+// with the join key this browser keeps, or with the platform's session id), the optional card calibration and the viewing conditions
 // are reported when a session starts (the server refuses one that misses the design's requirements), every
 // answer says whether the page was hidden or lost the focus while the trial was shown, and the end may redirect
 // to the platform's completion URL.
 'use strict';
 
 const params = new URLSearchParams(location.search);
-let token = params.get('p');
+let token = new URLSearchParams(location.hash.slice(1)).get('p');
+if (params.has('p')) {
+  // An older ?p= link: its token moves into the fragment, out of every later request's URL.
+  token = token || params.get('p');
+  params.delete('p');
+  const query = params.toString();
+  history.replaceState(null, '', location.pathname + (query ? '?' + query : '') + '#p=' + encodeURIComponent(token));
+}
 let study = null;       // /api/study
 let session = null;     // session id
 let state = null;       // last participant state from the server
@@ -64,8 +73,8 @@ function viewingConditions() {
 document.addEventListener('visibilitychange', () => { if (document.hidden) trialHidden = true; });
 window.addEventListener('blur', () => { trialBlurred = true; });
 
-async function api(method, path, body) {
-  const init = {method, headers: {}};
+async function api(method, path, body, headers) {
+  const init = {method, headers: Object.assign({}, headers)};
   if (body !== undefined) {
     init.headers['Content-Type'] = 'application/json';
     init.body = JSON.stringify(body);
@@ -83,10 +92,10 @@ async function api(method, path, body) {
 
 // Retries network failures, server errors (5xx) and 429 (too many joins or connections from this address) with
 // back-off; other client errors (4xx) are final.
-async function apiRetrying(method, path, body) {
+async function apiRetrying(method, path, body, headers) {
   for (let attempt = 0; ; attempt++) {
     try {
-      const data = await api(method, path, body);
+      const data = await api(method, path, body, headers);
       notice('');
       return data;
     } catch (e) {
@@ -198,21 +207,35 @@ async function start() {
         'You can stop at any time by closing this page.') +
       '</p><p>Press <b>Enter</b> or the button to agree and continue.</p><button id="agree">I agree</button>');
     await waitForKeyOrClick(['Enter']);
-    // The join key makes a retried join (answer lost in transit) return the same participant.
-    let joinKey = sessionStorage.getItem('skinlab-join-key');
+    // The join key (a secret of this browser) makes a retried join (answer lost in transit) return the same
+    // participant. A platform participant's is kept for good (per platform id): it is what lets this browser
+    // resume later, as the platform id alone does not.
+    const storage = platform !== 'none' ? localStorage : sessionStorage;
+    const keyName = 'skinlab-join-key' + (platform !== 'none' ? ':' + params.get(study.recruitment.id_parameter) : '');
+    let joinKey = storage.getItem(keyName);
     if (!joinKey) {
       const bytes = new Uint8Array(16);
       crypto.getRandomValues(bytes);
       joinKey = Array.from(bytes, (b) => b.toString(16).padStart(2, '0')).join('');
-      sessionStorage.setItem('skinlab-join-key', joinKey);
+      storage.setItem(keyName, joinKey);
     }
     const join = {join_key: joinKey};
     if (platform !== 'none') join.recruitment = recruitmentParameters();
-    const joined = await apiRetrying('POST', '/api/join', join);
+    let joined;
+    try {
+      joined = await apiRetrying('POST', '/api/join', join);
+    } catch (e) {
+      if (e.status !== 409 || platform === 'none') throw e;
+      // This platform id started the study elsewhere (another browser, another link).
+      document.body.dataset.refused = 'true';
+      showScreen('<h1>' + escapeHtml(study.title) + '</h1><p class="message" id="refusal">' + escapeHtml(e.message) +
+        '</p>');
+      return;
+    }
     token = joined.token;
-    sessionStorage.removeItem('skinlab-join-key'); // a later visit to the bare link is a new participant
-    // The link now identifies this participant: reloading or reopening it resumes.
-    history.replaceState(null, '', '?p=' + encodeURIComponent(token));
+    if (platform === 'none') sessionStorage.removeItem(keyName); // a later visit to the bare link is a new participant
+    // This address now identifies the participant (in its fragment): reloading or reopening it resumes.
+    history.replaceState(null, '', location.pathname + location.search + '#p=' + encodeURIComponent(token));
   }
   if (study.display.calibrate) await calibrate();
   state = await startSession();
@@ -397,7 +420,7 @@ async function runTrials() {
     } catch (e) {
       if (e.status === 409) {
         // Answered elsewhere (another tab): continue from the server's state.
-        state = await apiRetrying('GET', '/api/state?token=' + encodeURIComponent(token));
+        state = await apiRetrying('GET', '/api/state', undefined, {'X-Skinlab-Token': token});
       } else {
         throw e;
       }

@@ -142,7 +142,8 @@ function renderParticipants(participants) {
     row.append(element('td', {}, p.observer),
       element('td', { class: 'number' }, p.answered + ' / ' + p.total + (p.completed ? ' ✓' : '')),
       element('td', { class: 'number' }, p.catch_answered ? p.catch_correct + ' / ' + p.catch_answered : '–'),
-      element('td', {}, p.client_address ? p.client_address + (p.address_source === 'forwarded' ? ' (via proxy)' : '') : '–'),
+      element('td', {}, (p.client_address ? p.client_address + (p.address_source === 'forwarded' ? ' (via proxy)' : '') : '–') +
+        (p.refused_attempts ? ` · ${p.refused_attempts} refused attempt${p.refused_attempts > 1 ? 's' : ''} with this platform id` : '')),
       element('td', {}, p.last_response_at || '–'));
     return row;
   }));

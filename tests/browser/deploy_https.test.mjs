@@ -49,8 +49,19 @@ try {
   const httpsPort = await freePort();
   const site = path.join(prefix, 'skinlab-site.conf');
   const generated = spawnSync(cli, ['study', 'deploy-config', '--server-name', 'localhost', '--upstream',
-    `127.0.0.1:${serverPort}`, '--cert', cert, '--key', key, '--listen', `127.0.0.1:${httpsPort}`, '-o', site], { encoding: 'utf8' });
+    `127.0.0.1:${serverPort}`, '--cert', cert, '--key', key, '--listen', `127.0.0.1:${httpsPort}`,
+    '--access-log', `${prefix}/site-access.log`, '-o', site], { encoding: 'utf8' });
   check(generated.status === 0, 'deploy-config failed: ' + generated.stderr);
+  check((fs.statSync(site).mode & 0o777) === 0o600, `the site file has mode ${(fs.statSync(site).mode & 0o777).toString(8)}`);
+  // The site's client-network map, run by this nginx on a test header instead of the peer's address (which is
+  // loopback here), answered on a plain port: every IPv6 spelling nginx writes must give its /64.
+  const siteText = fs.readFileSync(site, 'utf8');
+  const mapBlock = /\nmap \$remote_addr \$(\w+) \{([\s\S]*?)\n\}/.exec(siteText);
+  check(mapBlock !== null, 'no client-network map in the site file');
+  const mapPort = await freePort();
+  const mapTest = mapBlock ? [
+    `  map $http_x_test_address $test_network {${mapBlock[2].replace('$remote_addr;', '$http_x_test_address;')}\n  }`,
+    `  server { listen 127.0.0.1:${mapPort}; access_log off; location / { return 200 "$test_network"; } }`] : [];
   fs.writeFileSync(path.join(prefix, 'nginx.conf'), [
     `pid ${prefix}/nginx.pid;`,
     `error_log ${prefix}/error.log info;`,
@@ -64,6 +75,7 @@ try {
     `  uwsgi_temp_path ${prefix}/uwsgi;`,
     `  scgi_temp_path ${prefix}/scgi;`,
     `  include ${site};`,
+    ...mapTest,
     '}', ''].join('\n'));
   const asUser = process.getuid && process.getuid() === 0 ? { uid: 65534, gid: 65534 } : {};
   if (asUser.uid !== undefined) {
@@ -140,6 +152,25 @@ try {
   const big = await viaNginx('/api/join', { method: 'POST', headers: { 'Content-Type': 'application/json' },
     body: JSON.stringify({ label: 'x'.repeat(20000) }) });
   check(big.status === 413, 'a 20 kB body through nginx: ' + big.status);
+
+  // The client network of each address (as nginx writes addresses: RFC 5952, "::" for two or more zero groups).
+  for (const [address, network] of [['2001:db8:1:2:3:4:5:6', '2001:db8:1:2'], ['2001:db8:1:2::5', '2001:db8:1:2'],
+    ['2001:db8:1:0:a:b:c:d', '2001:db8:1:0'], ['2001:db8:1::b:c:d', '2001:db8:1:0'], ['2001:db8::5', '2001:db8:0:0'],
+    ['2001:db8::1:2:3:4', '2001:db8:0:0'], ['2001::5:1:2:3:4', '2001:0:0:5'], ['2001::1:2', '2001:0:0:0'],
+    ['192.0.2.1', '192.0.2.1']]) {
+    const answer = await request(mapPort, '/', { headers: { 'X-Test-Address': address } });
+    check(answer.status === 200 && answer.text === network,
+      `client network of ${address}: "${answer.text}", expected ${network}`);
+  }
+
+  // The access log holds paths, never query strings (an older ?p= link, a platform's SESSION_ID) nor tokens.
+  await viaNginx('/?p=0123456789abcdef0123456789abcdef&SESSION_ID=60bb1b2c3d4e5f6a7b8c9d22');
+  await new Promise((r) => setTimeout(r, 300));
+  const accessLog = fs.readFileSync(`${prefix}/site-access.log`, 'utf8');
+  check(/"GET \/api\/study HTTP\/1\.1" 200/.test(accessLog), 'the access log lacks the requests: ' + accessLog.slice(0, 300));
+  check(!accessLog.includes('?') && !accessLog.includes('0123456789abcdef0123456789abcdef') &&
+    !accessLog.includes('60bb1b2c3d4e5f6a7b8c9d22'), 'a query string reached the access log');
+  check(!accessLog.includes(session.token), "the participant's token reached the access log");
   exitCode = failures === 0 ? 0 : 1;
 } catch (e) {
   console.error(e);

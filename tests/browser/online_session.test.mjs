@@ -3,7 +3,8 @@
 // hidden during the second: another tab brought to the front, and where headless Chromium keeps every tab visible,
 // as Debian 12's does, document.hidden = true with a visibilitychange event dispatched to the page), leaves, comes back in a fresh browser with the same link and resumes where it stopped,
 // loses the focus during one more trial, finishes, and is redirected to the completion URL (served here by a
-// stand-in for the platform). The export must hold one participant with the platform ids, the session's viewing
+// stand-in for the platform). A third browser with the same PROLIFIC_PID (upper case) and another SESSION_ID is
+// refused with a page saying why. The export must hold one participant with the platform ids, the session's viewing
 // conditions and pixels per degree, and exactly the hidden and unfocused trials flagged.
 // Usage: node online_session.test.mjs /path/to/skinlab     Exit 0 pass, 1 fail, 77 skip.
 import { spawn, spawnSync } from 'node:child_process';
@@ -169,11 +170,32 @@ async function visit({ name, answerCount, disturb, expectWelcomeBack }) {
   return { answered, redirected, code, url, calibrated };
 }
 
+// Someone else with the participant's PROLIFIC_PID (in upper case) but not their browser or their SESSION_ID: refused
+// with a page saying why, never given the participation.
+async function takeover() {
+  const profile = fs.mkdtempSync(path.join(work, 'profile-'));
+  const context = await chromium.launchPersistentContext(profile, { executablePath: CHROMIUM, headless: true, args: FLAGS,
+    viewport: { width: 1000, height: 700 } });
+  const page = context.pages()[0] || await context.newPage();
+  await page.goto(`http://127.0.0.1:${port}/?PROLIFIC_PID=${PID.toUpperCase()}&STUDY_ID=${STUDY_ID}` +
+    '&SESSION_ID=60cc1b2c3d4e5f6a7b8c9d33');
+  await page.waitForSelector('#agree');
+  await page.keyboard.press('Enter');
+  await page.waitForFunction(() => document.body.dataset.refused === 'true', null, { timeout: 20000 });
+  const text = await page.textContent('#refusal');
+  const trialShown = await page.evaluate(() => document.body.dataset.trial !== undefined);
+  await context.close();
+  return { text, trialShown };
+}
+
 let exitCode = 1;
 try {
   const first = await visit({ name: 'first visit', answerCount: 2, disturb: (n) => (n === 2 ? 'hide' : null) });
   const second = await visit({ name: 'repeat visit', answerCount: TRIALS, expectWelcomeBack: true,
     disturb: (n) => (n === 1 ? 'blur' : null) });
+  const stranger = await takeover();
+  check(/already started this study/.test(stranger.text) && !stranger.trialShown,
+    `the same PROLIFIC_PID without the participant's browser or SESSION_ID was not refused: "${stranger.text}"`);
   check(first.answered.length === 2, `first visit answered ${first.answered.length}`);
   check(second.answered.length === TRIALS - 2, `repeat visit answered ${second.answered.length}, expected ${TRIALS - 2}`);
   check(second.code === CODE, `completion code shown "${second.code}", expected ${CODE}`);

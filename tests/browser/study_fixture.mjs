@@ -180,7 +180,10 @@ export async function runSession(page, url, check, name) {
     lastTrial = trial;
   }
   check(/^[A-Z2-9]{8}$/.test(code), `${name}: completion code "${code}"`);
-  return { answers, code };
+  // The participant's token: in the address's fragment (never sent to a server).
+  const token = new URLSearchParams(new URL(page.url()).hash.slice(1)).get('p') || '';
+  check(/^[0-9a-f]{32}$/.test(token), `${name}: no token in the address's fragment: ${page.url()}`);
+  return { answers, code, token };
 }
 
 export function removeFolder(work) {

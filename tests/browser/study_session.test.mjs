@@ -168,6 +168,8 @@ async function runSession({ name, dpr, launch, resize, reloadAfter }) {
   const page = context.pages()[0] || await context.newPage();
   const pageErrors = [];
   page.on('pageerror', (e) => pageErrors.push(e.message));
+  const requested = []; // every URL the browser asked for, with the headers that could carry a secret
+  context.on('request', (r) => requested.push(r.url() + ' ' + (r.headers().referer || '')));
   await page.goto(base);
   const answers = new Map(); // trial id → side
   let lastTrial = '', reloaded = false, expectAfterReload = null, sawTooSmall = false, sawBreak = false, code = '';
@@ -218,9 +220,14 @@ async function runSession({ name, dpr, launch, resize, reloadAfter }) {
   if (resize) check(sawTooSmall, `${name}: the too-small window was not refused`);
   if (reloadAfter) check(reloaded, `${name}: did not reload`);
   check(pageErrors.length === 0, `${name}: page errors: ${pageErrors.join('; ')}`);
+  // The participant's token lives in the address's fragment, never in a URL sent to the server (nor a Referer).
   const url = new URL(page.url());
+  const token = new URLSearchParams(url.hash.slice(1)).get('p');
+  check(/^[0-9a-f]{32}$/.test(token || ''), `${name}: no token in the address's fragment (${page.url()})`);
+  check(!url.search.includes(token), `${name}: the token is in the query: ${page.url()}`);
+  check(!requested.some((u) => u.includes(token)), `${name}: the token appeared in a requested URL or Referer`);
   await context.close();
-  return { token: url.searchParams.get('p'), answers, dpr };
+  return { token, answers, dpr };
 }
 
 let exitCode = 1;

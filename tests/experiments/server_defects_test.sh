@@ -14,6 +14,18 @@
 #   9. unauthenticated joins from one address are rate-limited;
 #  10. trial ids of two participants are not consecutive integers;
 #  11. `study simulate` interrupted and run again resumes instead of failing with "label taken".
+#  12. a platform id alone (no join key, no platform session id) does not hand out that participant's token;
+#  13. one platform id in another letter case is not a second participant;
+#  14. one token cannot start sessions without bound;
+#  15. joins from many addresses of one IPv6 /64 share one allowance;
+#  16. the participant token is not accepted in the URL;
+#  17. study.db, its backup and the nginx site file are readable by their owner only;
+#  18. the researcher token can come from a file (not the command line, not printed);
+#  19. every answer forbids framing;
+#  20. a body in a transfer coding other than chunked is refused, not read as empty (request smuggling);
+#  21. a label that a spreadsheet would run as a formula is exported as text;
+#  22. the nginx redirect goes to the configured name, on the addresses asked for only, and the access log holds
+#      no query strings.
 #
 # Usage: server_defects_test.sh SKINLAB_CLI SOURCE_DIR. Prints one PASS/FAIL line per check and exits 1 if any
 # failed; exits 77 (skipped) when curl, jq or sqlite3 is missing or no EGL renderer works.
@@ -204,6 +216,16 @@ done
 check "a stimulus swapped for a link is not served" $? "the link's target was served (verified sha256 $sha_before)"
 rm "$image" && mv "$image.orig" "$image"
 
+# 21. A label that a spreadsheet runs as a formula.
+formula_token=$(post /api/join '{"label":"-2-3"}' | body_of | jq -r .token)
+reply=$(post /api/session "{\"token\":\"$formula_token\",\"viewport_width\":1280,\"viewport_height\":720,\"device_pixel_ratio\":1}")
+f_session=$(echo "$reply" | body_of | jq -r .session)
+f_trial=$(echo "$reply" | body_of | jq -r .trial.id)
+post /api/response "{\"token\":\"$formula_token\",\"session\":$f_session,\"trial\":$f_trial,\"side\":\"left\",\"response_ms\":900,\"client_time\":\"t\",\"viewport_width\":1280,\"viewport_height\":720,\"device_pixel_ratio\":1}" >/dev/null
+"$SKINLAB" study export "$WORK/study.db" --format csv -o "$WORK/formula.csv" >/dev/null 2>&1
+grep -q "^'-2-3," "$WORK/formula.csv" && ! grep -q '^-2-3,' "$WORK/formula.csv"
+check "a -2-3 label is exported as text" $? "$(grep -m 1 -- '2-3,' "$WORK/formula.csv")"
+
 # 9. Join flood: 150 joins from one address over one kept-alive connection (the limit lets 60 through at once,
 #    then one a second).
 urls=()
@@ -212,6 +234,95 @@ accepted=$(curl -s -w '\n%{http_code}\n' -H 'Content-Type: application/json' --d
   grep -c '^201$')
 [ "$accepted" -lt 150 ]
 check "150 joins in a row from one address are rate-limited" $? "$accepted accepted"
+
+# 16. The participant token in the URL (the participant of check 2).
+code=$(curl -s -o /dev/null -w '%{http_code}' "$URL/api/state?token=$ua_token")
+[ "$code" != 200 ]
+check "the participant token in the URL is refused" $? "status $code"
+
+# 14. One token, many sessions.
+codes=""
+for _ in $(seq 1 40); do codes+=" $(post /api/session "$session_body" | status_of)"; done
+[[ "$codes" == *429* ]]
+check "40 sessions for one token are not all accepted" $? "statuses:$codes"
+
+# 19. Framing.
+headers=$(curl -s -D - -o /dev/null "$URL/")
+grep -qi '^X-Frame-Options: DENY' <<<"$headers" && grep -qi "frame-ancestors 'none'" <<<"$headers"
+check "the page forbids framing" $? "$(tr -d '\r' <<<"$headers" | tr '\n' ' ')"
+
+# 20. Transfer-Encoding: identity with a second request in its body: one answer (a refusal), never two.
+port=${URL##*:}
+smuggled=$'POST /api/join HTTP/1.1\r\nHost: 127.0.0.1:'"$port"$'\r\nContent-Type: application/json\r\nContent-Length: 2\r\n\r\n{}'
+exec 3<>"/dev/tcp/127.0.0.1/$port"
+printf 'POST /api/join HTTP/1.1\r\nHost: 127.0.0.1:%s\r\nContent-Type: application/json\r\nTransfer-Encoding: identity\r\n\r\n%s' \
+  "$port" "$smuggled" >&3
+answers=$(timeout 4 cat <&3 | grep -ao 'HTTP/1\.1 [0-9][0-9][0-9]' | wc -l)
+exec 3<&-
+[ "$answers" = 1 ]
+check "Transfer-Encoding: identity with a request in the body gets one answer" $? "$answers answers"
+
+stop_server
+
+# 17. Private files (created under the usual umask 022).
+(
+  umask 022
+  "$SKINLAB" study create --stimuli "$WORK/stimuli" --design "$WORK/design.toml" -o "$WORK/private.db" >/dev/null 2>&1
+  "$SKINLAB" study backup "$WORK/private.db" "$WORK/private-backup.db" >/dev/null 2>&1
+  echo "-----BEGIN CERTIFICATE-----" >"$WORK/cert.pem"
+  "$SKINLAB" study deploy-config --server-name study.example.org --upstream 127.0.0.1:8080 --cert "$WORK/cert.pem" \
+    --key "$WORK/cert.pem" --redirect-port 80 --listen 192.0.2.10:443 -o "$WORK/site.conf" >/dev/null 2>&1
+)
+modes=$(stat -c '%a' "$WORK/private.db" "$WORK/private-backup.db" "$WORK/site.conf" 2>&1 | tr '\n' ' ')
+[ "$modes" = "600 600 600 " ]
+check "study.db, a backup and the nginx site file are created 0600" $? "modes $modes"
+
+# 22. The nginx site: redirect target, addresses, access log.
+grep -q 'return 301 https://study.example.org$request_uri;' "$WORK/site.conf" &&
+  ! grep -q '\$host\$request_uri' "$WORK/site.conf" && ! grep -Eq 'listen (\[::\]:)?(80|443)( |;)' "$WORK/site.conf" &&
+  grep -q 'access_log .*_private;' "$WORK/site.conf" && grep -q '"$request_method $uri ' "$WORK/site.conf"
+check "the nginx redirect names the server, listens where asked, logs no query strings" $? \
+  "$(grep -E 'return 301|listen|access_log' "$WORK/site.conf" | tr -s ' ' | tr '\n' ';')"
+
+# 18. The researcher token from a file.
+printf 'file-token-%s\n' "$RANDOM$RANDOM$RANDOM" >"$WORK/token"
+file_token=$(head -n 1 "$WORK/token")
+"$SKINLAB" study serve "$WORK/study.db" --port 0 --token-file "$WORK/token" >"$WORK/serve.log" 2>&1 &
+SERVER_PID=$!
+URL=""
+for _ in $(seq 1 100); do
+  URL=$(grep -o 'http://127\.0\.0\.1:[0-9]*' "$WORK/serve.log" | head -n 1)
+  [ -n "$URL" ] && break
+  sleep 0.1
+done
+code=$(curl -s -o /dev/null -w '%{http_code}' -H "Authorization: Bearer $file_token" "$URL/api/researcher/status")
+[ "$code" = 200 ] && ! grep -q "$file_token" "$WORK/serve.log" && ! tr '\0' ' ' <"/proc/$SERVER_PID/cmdline" | grep -q "$file_token"
+check "the researcher token from --token-file works, unprinted and not on the command line" $? "status $code"
+stop_server
+
+# 12, 13, 15. A study recruiting on MTurk, served behind a "proxy" (this script, from 127.0.0.1).
+cp "$WORK/design.toml" "$WORK/mturk.toml"
+printf '\n[recruitment]\nplatform = "mturk"\n' >>"$WORK/mturk.toml"
+"$SKINLAB" study create --stimuli "$WORK/stimuli" --design "$WORK/mturk.toml" -o "$WORK/mturk.db" >/dev/null 2>&1
+start_server "$WORK/mturk.db" --trusted-proxy 127.0.0.1 --joins-per-minute 5
+worker_token=$(post /api/join '{"join_key":"worker-browser-key","recruitment":{"workerId":"A1B2C3D4E5F6","assignmentId":"3ASSIGNMENTAAAAAAAAAAAAAAAAA"}}' \
+  -H 'X-Forwarded-For: 198.51.100.1' | body_of | jq -r .token)
+reply=$(post /api/join '{"recruitment":{"workerId":"A1B2C3D4E5F6"}}' -H 'X-Forwarded-For: 198.51.100.2')
+[ -n "$worker_token" ] && [ "$worker_token" != null ] && ! grep -q "$worker_token" <<<"$reply"
+check "a worker id alone does not hand out the worker's token" $? "$(tr '\n' ' ' <<<"$reply")"
+post /api/join '{"join_key":"other-browser-key","recruitment":{"workerId":"a1b2c3d4e5f6","assignmentId":"3ASSIGNMENTBBBBBBBBBBBBBBBBB"}}' \
+  -H 'X-Forwarded-For: 198.51.100.3' >/dev/null
+count=$(sqlite3 "$WORK/mturk.db" "SELECT COUNT(*) FROM recruitment WHERE upper(external_id) = 'A1B2C3D4E5F6'")
+[ "$count" = 1 ]
+check "a worker id in lower case is the same participant" $? "$count participants"
+accepted=0
+for n in $(seq 1 10); do
+  code=$(post /api/join "{\"recruitment\":{\"workerId\":\"W1000000000$n\"}}" -H "X-Forwarded-For: 2001:db8:1:2::$n" |
+    status_of)
+  [ "$code" = 201 ] && accepted=$((accepted + 1))
+done
+[ "$accepted" -le 5 ]
+check "10 joins from one IPv6 /64 share one allowance (burst 5)" $? "$accepted accepted"
 
 stop_server
 echo "$failures check(s) failed"

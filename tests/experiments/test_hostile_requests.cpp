@@ -1,11 +1,17 @@
 // Hostile requests against the study server, sent byte for byte over raw sockets (no HTTP library in between
 // to tidy them up): path traversal in every encoding, malformed, oversized and deeply nested JSON, numbers no
 // double holds, slow headers, chunked floods, bad and foreign tokens, replays, out-of-order, concurrent and late
-// answers, non-UTF-8 headers, foreign Host names, join floods and connection floods. Each gets a 4xx (or the page
-// it should), and the study file afterwards holds exactly what it held before (every row of every table).
+// answers, non-UTF-8 headers, foreign Host names, join floods and connection floods, platform ids without the
+// participant's secret (in any letter case), session floods, IPv6 and address-spraying join floods, tokens in URLs,
+// framing, transfer codings the server cannot decode and formula cells. Each gets a 4xx (or the page it should), and
+// the study file afterwards holds exactly what it held before (every row of every table), or the one row that
+// records the attempt.
 #include "common/error.h"
 #include "common/files.h"
+#include "experiments/join_limiter.h"
+#include "experiments/recruitment.h"
 #include "experiments/sqlite_database.h"
+#include "experiments/study_backup.h"
 #include "experiments/study_export.h"
 #include "study_server_fixture.h"
 
@@ -16,6 +22,7 @@
 #include <netinet/in.h>
 #include <poll.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <thread>
 #include <unistd.h>
 
@@ -441,7 +448,9 @@ TEST(HostileRequests, TokensReplaysOrderConcurrencyAndLateAnswers) {
     h.expectRejected("bob's trial", 404, post(with(good, "trial", bob.state["trial"]["id"])));
     h.expectRejected("state with bob's token changed", 404, [&] {
         // The last hex digit changed (to one it is not: a random token ends in '0' one time in 16).
-        return h.request("GET", "/api/state?token=" + bob.token.substr(0, 31) + (bob.token.back() == '0' ? "1" : "0"));
+        return h.request("GET", "/api/state", "",
+                         "X-Skinlab-Token: " + bob.token.substr(0, 31) + (bob.token.back() == '0' ? "1" : "0") +
+                             "\r\n");
     });
     h.expectRejected("session for nobody", 404,
                      [&] { return h.request("POST", "/api/session", with(screen(), "token", "nobody").dump()); });
@@ -485,7 +494,7 @@ TEST(HostileRequests, TokensReplaysOrderConcurrencyAndLateAnswers) {
     h.expectRejected("replay, other side", 409, post(answerBody(alice, first, storedLeft ? "right" : "left")));
 
     // Finish alice, then answer after completion.
-    json state = json::parse(bodyOf(h.request("GET", "/api/state?token=" + alice.token)));
+    json state = json::parse(bodyOf(h.request("GET", "/api/state", "", "X-Skinlab-Token: " + alice.token + "\r\n")));
     json last;
     while (!state["completed"].get<bool>()) {
         last = state["trial"]["id"];
@@ -639,4 +648,290 @@ TEST(HostileRequests, StimuliArePinnedCachedAndNeverFollowLinksOutOfTheSet) {
     } catch (const skinlab::InputError& e) {
         EXPECT_NE(std::string(e.what()).find("outside the stimulus folder"), std::string::npos) << e.what();
     }
+}
+
+namespace {
+
+// A study recruiting through `platform` (extra design lines after it), with the join allowance of `configure`.
+std::string recruitingDesign(const std::string& recruitment) { return std::string(kDesign) + recruitment; }
+
+struct Visit {
+    std::string outcome, address, source;
+};
+std::vector<Visit> visits(const RunningStudy& study) {
+    SqliteDatabase db(study.databasePath().string(), false);
+    SqliteStatement s = db.prepare("SELECT outcome, client_address, source FROM participant_visits WHERE outcome <>"
+                                   " 'session' ORDER BY id");
+    std::vector<Visit> out;
+    while (s.step()) out.push_back({s.text(0), s.text(1), s.text(2)});
+    return out;
+}
+
+JsonAnswer joinWith(HttpClient& client, const json& recruitment, const std::string& joinKey = "") {
+    json body{{"recruitment", recruitment}};
+    if (!joinKey.empty()) body["join_key"] = joinKey;
+    return postJson(client, "/api/join", body);
+}
+
+} // namespace
+
+// A platform id is public knowledge (it shows in the platform's messages, screenshots, a participant's other
+// studies): alone, it must never hand out a participation. Resuming needs the join key of the first join (the same
+// browser) or the platform's per-attempt session id of the first join (the same platform link).
+TEST(HostileRequests, PlatformIdAloneNeverTakesOverAParticipation) {
+    RunningStudy study(recruitingDesign("[recruitment]\nplatform = \"mturk\"\n"));
+    HttpClient client = study.client();
+    const json worker{{"workerId", "A1B2C3D4E5F6"},
+                      {"assignmentId", "3ASSIGNMENTAAAAAAAAAAAAAAAAA"},
+                      {"hitId", "3HITAAAAAAAAAAAAAAAAAAAAAAAA"}};
+    const JsonAnswer first = joinWith(client, worker, "browser-secret-of-the-worker-0001");
+    ASSERT_EQ(first.status, 201) << first.raw;
+    const std::string token = first.body["token"];
+
+    // The attack: the worker id alone, then with a wrong key, another assignment, or in lower case.
+    json otherAssignment = worker;
+    otherAssignment["assignmentId"] = "3ASSIGNMENTBBBBBBBBBBBBBBBBB";
+    json lower = otherAssignment;
+    lower["workerId"] = "a1b2c3d4e5f6";
+    const std::vector<std::pair<std::string, JsonAnswer>> attempts{
+        {"the worker id alone", joinWith(client, {{"workerId", "A1B2C3D4E5F6"}})},
+        {"a wrong join key", joinWith(client, {{"workerId", "A1B2C3D4E5F6"}}, "guessed-key")},
+        {"another assignment", joinWith(client, otherAssignment)},
+        {"lower case, another assignment", joinWith(client, lower, "guessed-key")}};
+    for (const auto& [what, answer] : attempts) {
+        EXPECT_EQ(answer.status, 409) << what << ": " << answer.raw;
+        EXPECT_FALSE(answer.body.contains("token")) << what << ": " << answer.raw;
+        EXPECT_EQ(answer.raw.find(token), std::string::npos) << what << ": the token was handed out";
+        EXPECT_NE(answer.body.value("error", "").find("workerId: this mturk id has already started this study"),
+                  std::string::npos)
+            << answer.raw;
+    }
+    EXPECT_EQ(study.store().status().size(), 1u) << "a refused attempt created a participant";
+
+    // The worker's own browser (its join key) and the worker's own assignment (another browser) resume.
+    const JsonAnswer sameBrowser = joinWith(client, otherAssignment, "browser-secret-of-the-worker-0001");
+    EXPECT_EQ(sameBrowser.status, 200) << sameBrowser.raw;
+    EXPECT_EQ(sameBrowser.body.value("token", ""), token);
+    const JsonAnswer sameAssignment = joinWith(client, worker);
+    EXPECT_EQ(sameAssignment.status, 200) << sameAssignment.raw;
+    EXPECT_EQ(sameAssignment.body.value("token", ""), token);
+
+    // The researcher sees them on the dashboard.
+    const JsonAnswer board =
+        get(client, "/api/researcher/dashboard", {{"Authorization", std::string("Bearer ") + kResearcherToken}});
+    ASSERT_EQ(board.status, 200) << board.raw;
+    EXPECT_EQ(board.body["participants"][0]["refused_attempts"], 4);
+    EXPECT_EQ(board.body["participants"][0]["resumes"], 2);
+    // Every refused attempt and every resume is recorded with its address.
+    const std::vector<Visit> recorded = visits(study);
+    ASSERT_EQ(recorded.size(), 6u);
+    for (std::size_t i = 0; i < recorded.size(); ++i) {
+        EXPECT_EQ(recorded[i].outcome, i < 4 ? "refused" : "resumed") << i;
+        EXPECT_EQ(recorded[i].address, "127.0.0.1");
+        EXPECT_EQ(recorded[i].source, "peer");
+    }
+}
+
+// One person, one platform id, whatever the letter case (or, on generic systems, trailing dots and blanks).
+TEST(HostileRequests, PlatformIdsAreOneParticipantWhateverTheirSpelling) {
+    {
+        RunningStudy study(
+            recruitingDesign("[recruitment]\nplatform = \"prolific\"\ncompletion_code = \"C1ABCDEF\"\n"));
+        HttpClient client = study.client();
+        const std::string pid = "5f8a1b2c3d4e5f6a7b8c9d0e";
+        std::string upper = pid, mixed = pid;
+        for (char& c : upper) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+        for (std::size_t i = 0; i < mixed.size(); i += 2)
+            mixed[i] = static_cast<char>(std::toupper(static_cast<unsigned char>(mixed[i])));
+        EXPECT_EQ(joinWith(client, {{"PROLIFIC_PID", pid}}, "key-one-0001").status, 201);
+        EXPECT_EQ(joinWith(client, {{"PROLIFIC_PID", upper}}, "key-two-0002").status, 409);
+        EXPECT_EQ(joinWith(client, {{"PROLIFIC_PID", mixed}}, "key-three-0003").status, 409);
+        const JsonAnswer resumed = joinWith(client, {{"PROLIFIC_PID", upper}}, "key-one-0001");
+        EXPECT_EQ(resumed.status, 200) << resumed.raw;
+        const std::vector<ParticipantStatus> status = study.store().status();
+        ASSERT_EQ(status.size(), 1u);
+        EXPECT_EQ(status[0].external->id, pid);
+    }
+    {
+        RunningStudy study(recruitingDesign("[recruitment]\nplatform = \"mturk\"\n"));
+        HttpClient client = study.client();
+        EXPECT_EQ(joinWith(client, {{"workerId", "a1b2c3d4e5f6"}}, "key-one-0001").status, 201);
+        EXPECT_EQ(joinWith(client, {{"workerId", "A1B2C3D4E5F6"}}, "key-two-0002").status, 409);
+        ASSERT_EQ(study.store().status().size(), 1u);
+        EXPECT_EQ(study.store().status()[0].external->id, "A1B2C3D4E5F6");
+    }
+    {
+        RunningStudy study(recruitingDesign("[recruitment]\nplatform = \"generic\"\nid_parameter = \"code\"\n"));
+        HttpClient client = study.client();
+        EXPECT_EQ(joinWith(client, {{"code", "Abc.Def"}}, "key-one-0001").status, 201);
+        EXPECT_EQ(joinWith(client, {{"code", "abc.def."}}, "key-two-0002").status, 409);
+        EXPECT_EQ(joinWith(client, {{"code", " ABC.DEF.. "}}, "key-three-0003").status, 409);
+        EXPECT_EQ(joinWith(client, {{"code", "abc.deg"}}, "key-four-0004").status, 201);
+        ASSERT_EQ(study.store().status().size(), 2u);
+        EXPECT_EQ(study.store().status()[0].external->id, "abc.def");
+    }
+    EXPECT_EQ(normalisedExternalId("prolific", "5F8A1B2C3D4E5F6A7B8C9D0E"), "5f8a1b2c3d4e5f6a7b8c9d0e");
+    EXPECT_EQ(normalisedExternalId("mturk", "a1b2c3"), "A1B2C3");
+    EXPECT_EQ(normalisedExternalId("sona", "\t48213. "), "48213");
+}
+
+// Every page load starts a session; one token cannot start thousands (the database, the dashboard's JSON and the
+// exports would grow without bound).
+TEST(HostileRequests, SessionsPerParticipantAreBounded) {
+    for (const int limit : {4, kDefaultSessionsPerParticipant}) {
+        Hostile h([limit](ServerOptions& o) {
+            if (limit != kDefaultSessionsPerParticipant) o.sessionsPerParticipant = limit;
+        });
+        HttpClient client = h.study.client();
+        Participant p = joinAndStart(client);
+        json start = screen();
+        start["token"] = p.token;
+        for (int i = 1; i < limit; ++i) ASSERT_EQ(postJson(client, "/api/session", start).status, 200) << i;
+        for (int i = 0; i < 3; ++i)
+            h.expectRejected("session beyond the limit", 429,
+                             [&] { return h.request("POST", "/api/session", start.dump()); });
+        SqliteDatabase db(h.study.databasePath().string(), false);
+        SqliteStatement s = db.prepare("SELECT COUNT(*) FROM sessions");
+        ASSERT_TRUE(s.step());
+        EXPECT_EQ(s.integer(0), limit);
+        // Every page load of the participation is recorded with its address.
+        SqliteStatement v = db.prepare("SELECT COUNT(*) FROM participant_visits WHERE outcome = 'session' AND"
+                                       " client_address = '127.0.0.1' AND source = 'peer'");
+        ASSERT_TRUE(v.step());
+        EXPECT_EQ(v.integer(0), limit);
+        // Answers still go on in the sessions it has.
+        EXPECT_EQ(postJson(client, "/api/response", answerBody(p, p.state["trial"]["id"], "left")).status, 200);
+    }
+}
+
+// The join allowance is per client network: an IPv6 /64 is one client (a subscriber holds all of it), and the
+// table of allowances never forgets a client that is being refused because others flood it with new addresses.
+TEST(HostileRequests, JoinLimitCountsIpv6NetworksAndSurvivesAddressSprays) {
+    Hostile h([](ServerOptions& o) {
+        o.joinBurst = 5;
+        o.joinsPerMinute = 1;
+        o.trustedProxies = {"127.0.0.1"}; // the test's requests come "through a proxy" from chosen addresses
+    });
+    auto joinFrom = [&](const std::string& address, const std::string& body = "{}") {
+        return statusOf(h.request("POST", "/api/join", body, "X-Forwarded-For: " + address + "\r\n"));
+    };
+    for (int i = 1; i <= 5; ++i) EXPECT_EQ(joinFrom("2001:db8:1:2::" + std::to_string(i)), 201) << i;
+    // Another address of the same /64, and a label probe from it, are refused; nothing is stored.
+    h.expectRejected("the same /64, another address", 429, [&] {
+        return h.request("POST", "/api/join", "{}", "X-Forwarded-For: 2001:db8:1:2:ffff:1:2:3\r\n");
+    });
+    h.expectRejected("a label probe from the same /64", 429, [&] {
+        return h.request("POST", "/api/join", R"({"label":"P001"})", "X-Forwarded-For: 2001:db8:1:2:aaaa::9\r\n");
+    });
+    EXPECT_EQ(joinFrom("2001:db8:1:3::1"), 201) << "the next /64 is another client";
+    // Taken labels cost the allowance too: at most the burst of probes per network.
+    int answered = 0;
+    for (int i = 0; i < 10; ++i)
+        answered += joinFrom("2001:db8:9:9::" + std::to_string(i),
+                             R"({"label":"P00)" + std::to_string(i % 3 + 1) + "\"}") != 429;
+    EXPECT_EQ(answered, 5);
+
+    // The table: a spray of new addresses evicts the fullest buckets, not the one of a client being refused.
+    JoinLimiter limiter(1, 5, 1000);
+    const auto now = JoinLimiter::Clock::now();
+    double retry = 0;
+    for (int i = 0; i < 5; ++i) EXPECT_TRUE(limiter.allow("203.0.113.7", retry, now));
+    EXPECT_FALSE(limiter.allow("203.0.113.7", retry, now));
+    for (int i = 0; i <= 100000; ++i) {
+        const std::string address =
+            "10." + std::to_string(i >> 16) + "." + std::to_string((i >> 8) & 255) + "." + std::to_string(i & 255);
+        limiter.allow(address, retry, now + std::chrono::milliseconds(i / 100));
+    }
+    EXPECT_LE(limiter.size(), 1000u);
+    EXPECT_FALSE(limiter.allow("203.0.113.7", retry, now + std::chrono::seconds(2)))
+        << "the spray reset the refused client's allowance";
+    EXPECT_TRUE(limiter.allow("203.0.113.7", retry, now + std::chrono::seconds(62))) << "it refills as configured";
+    EXPECT_EQ(clientNetwork("2001:db8:1:2:3:4:5:6"), "2001:db8:1:2::/64");
+    EXPECT_EQ(clientNetwork("2001:DB8:1:2::"), "2001:db8:1:2::/64");
+    EXPECT_EQ(clientNetwork("2001:db8::1", 48), "2001:db8::/48");
+    EXPECT_EQ(clientNetwork("::ffff:192.0.2.1"), "192.0.2.1");
+    EXPECT_EQ(clientNetwork("192.0.2.1"), "192.0.2.1");
+}
+
+// Participant tokens stay out of URLs (and so out of proxies' logs and the browser's history); study files and
+// their backups are readable by their owner only.
+TEST(HostileRequests, TokensStayOutOfUrlsAndStudyFilesArePrivate) {
+    Hostile h;
+    HttpClient client = h.study.client();
+    Participant p = joinAndStart(client);
+    h.expectRejected("token in the URL", 400, [&] { return h.request("GET", "/api/state?token=" + p.token); });
+    h.expectRejected("no token", 400, [&] { return h.request("GET", "/api/state"); });
+    EXPECT_EQ(statusOf(h.request("GET", "/api/state", "", "X-Skinlab-Token: " + p.token + "\r\n")), 200);
+
+    auto mode = [](const fs::path& file) {
+        struct stat st {};
+        EXPECT_EQ(::stat(file.c_str(), &st), 0) << file;
+        return st.st_mode & 0777;
+    };
+    const mode_t previous = ::umask(022); // the usual umask, which leaves files readable by everyone
+    EXPECT_EQ(mode(h.study.databasePath()), 0600u);
+    EXPECT_EQ(mode(h.study.databasePath().string() + "-wal"), 0600u);
+    EXPECT_EQ(mode(h.study.databasePath().string() + "-shm"), 0600u);
+    const fs::path copy = h.study.folder() / "backup.db";
+    backupStudy(h.study.databasePath(), copy, false);
+    EXPECT_EQ(mode(copy), 0600u);
+    ::umask(previous);
+}
+
+// Smaller defects: framing, transfer codings the server cannot decode, a slow body, spreadsheet formulas in exports.
+TEST(HostileRequests, FramingTransferCodingsSlowBodiesAndFormulaCells) {
+    Hostile h([](ServerOptions& o) { o.requestTimeout = 1500ms; });
+    for (const std::string target : {"/", "/researcher", "/api/study"}) {
+        const std::string response = h.request("GET", target);
+        EXPECT_NE(response.find("X-Frame-Options: DENY"), std::string::npos) << target;
+        EXPECT_NE(response.find("frame-ancestors 'none'"), std::string::npos) << target;
+    }
+    // A body in a coding the server does not decode: 501 and closed, and the bytes after the header (here a whole
+    // second request) are never taken as the next request.
+    const std::string smuggled = "POST /api/join HTTP/1.1\r\nHost: " + h.host +
+                                 "\r\nContent-Type: application/json\r\nContent-Length: 2\r\n\r\n{}";
+    for (const std::string coding : {"identity", "gzip", "chunked, identity", "gzip, chunked, identity"}) {
+        const std::string before = h.study.fingerprint();
+        RawSocket socket(h.study.port());
+        ASSERT_TRUE(socket.send("POST /api/join HTTP/1.1\r\nHost: " + h.host +
+                                "\r\nContent-Type: application/json\r\nTransfer-Encoding: " + coding + "\r\n\r\n" +
+                                smuggled));
+        const std::string response = socket.readResponse(5s);
+        EXPECT_EQ(statusOf(response), 501) << coding << ": " << response;
+        EXPECT_EQ(socket.readResponse(1s), "") << coding << ": the body was read as a second request";
+        EXPECT_TRUE(socket.closedByServer(3s)) << coding;
+        EXPECT_EQ(h.study.fingerprint(), before) << coding;
+    }
+    // A body sent a byte at a time: cut at the request deadline, however steadily it trickles.
+    {
+        const std::string before = h.study.fingerprint();
+        RawSocket socket(h.study.port());
+        ASSERT_TRUE(socket.send("POST /api/join HTTP/1.1\r\nHost: " + h.host +
+                                "\r\nContent-Type: application/json\r\nContent-Length: 100\r\n\r\n"));
+        const auto start = std::chrono::steady_clock::now();
+        std::string response;
+        for (int i = 0; i < 40 && response.empty(); ++i) {
+            socket.send(" ");
+            response = socket.readResponse(200ms);
+        }
+        EXPECT_EQ(statusOf(response), 408) << response;
+        EXPECT_LT(std::chrono::steady_clock::now() - start, 4s);
+        EXPECT_EQ(h.study.fingerprint(), before);
+    }
+    // Client-chosen text that a spreadsheet would run as a formula is exported as text.
+    HttpClient client = h.study.client();
+    ASSERT_EQ(postJson(client, "/api/join", {{"label", "-2-3"}}).status, 201);
+    const std::string token = h.study.store().status().back().participant.token;
+    json start = screen();
+    start["token"] = token;
+    const JsonAnswer session = postJson(client, "/api/session", start);
+    Participant p{token, session.body["session"].get<std::int64_t>(), session.body};
+    ASSERT_EQ(postJson(client, "/api/response", answerBody(p, p.state["trial"]["id"], "left")).status, 200);
+    const std::string csv = exportResponses(h.study.store(), "csv");
+    EXPECT_NE(csv.find("\n'-2-3,"), std::string::npos) << csv.substr(0, 400);
+    EXPECT_EQ(csv.find("\n-2-3,"), std::string::npos);
+    EXPECT_EQ(csvTextField("=HYPERLINK(\"x\")"), "\"'=HYPERLINK(\"\"x\"\")\"");
+    EXPECT_EQ(csvTextField("@SUM(1)"), "'@SUM(1)");
+    EXPECT_EQ(csvTextField("+1"), "'+1");
+    EXPECT_EQ(csvTextField("P001"), "P001");
 }

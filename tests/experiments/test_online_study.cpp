@@ -142,7 +142,14 @@ TEST(OnlineStudy, ProlificIdsRoundTripResumeAndRedirect) {
     }
     const std::int64_t nextTrial = state["trial"]["id"];
 
-    // A repeat visit with the same PROLIFIC_PID (a new browser: another join key) is the same participant.
+    // A repeat visit from the same Prolific link in a new browser (another join key, the same SESSION_ID) is the
+    // same participant; the PROLIFIC_PID without the SESSION_ID or the first browser's join key is refused.
+    json withoutSession = prolificIds();
+    withoutSession.erase("SESSION_ID");
+    const JsonAnswer stranger =
+        postJson(client, "/api/join", {{"join_key", "third-visit"}, {"recruitment", withoutSession}});
+    EXPECT_EQ(stranger.status, 409) << stranger.raw;
+    EXPECT_FALSE(stranger.body.contains("token"));
     const JsonAnswer again =
         postJson(client, "/api/join", {{"join_key", "second-visit"}, {"recruitment", prolificIds()}});
     ASSERT_EQ(again.status, 200) << again.raw;
@@ -249,11 +256,14 @@ TEST(OnlineStudy, MturkPreviewShowsNoJoinAndTheWorkerIdResumes) {
 
     json accepted = preview;
     accepted["assignmentId"] = "3ABCDEFGHIJKLMNOPQRSTUVWXYZ999";
-    const JsonAnswer joined = postJson(client, "/api/join", {{"recruitment", accepted}});
+    const JsonAnswer joined =
+        postJson(client, "/api/join", {{"join_key", "worker-browser"}, {"recruitment", accepted}});
     ASSERT_EQ(joined.status, 201) << joined.raw;
-    // The same worker with another assignment (a second HIT of the same study) is still one participant.
+    // The same worker with another assignment (a second HIT of the same study) is still one participant: refused
+    // from another browser, resumed from the first one (its join key).
     accepted["assignmentId"] = "3ZZZDEFGHIJKLMNOPQRSTUVWXYZ999";
-    const JsonAnswer again = postJson(client, "/api/join", {{"recruitment", accepted}});
+    EXPECT_EQ(postJson(client, "/api/join", {{"recruitment", accepted}}).status, 409);
+    const JsonAnswer again = postJson(client, "/api/join", {{"join_key", "worker-browser"}, {"recruitment", accepted}});
     ASSERT_EQ(again.status, 200) << again.raw;
     EXPECT_EQ(again.body["token"], joined.body["token"]);
     const std::vector<ParticipantStatus> status = study.store().status();
@@ -286,10 +296,13 @@ TEST(OnlineStudy, GenericPlatformUsesTheNamedParameter) {
     expectRejected(study, 400, "survey_code: missing", [&] {
         return postJson(client, "/api/join", {{"recruitment", {{"PROLIFIC_PID", kPid}}}});
     });
-    const JsonAnswer joined = postJson(client, "/api/join", {{"recruitment", {{"survey_code", "48213"}}}});
+    const JsonAnswer joined =
+        postJson(client, "/api/join", {{"join_key", "k1"}, {"recruitment", {{"survey_code", "48213"}}}});
     ASSERT_EQ(joined.status, 201) << joined.raw;
-    EXPECT_EQ(postJson(client, "/api/join", {{"recruitment", {{"survey_code", "48213"}}}}).body["token"],
-              joined.body["token"]);
+    EXPECT_EQ(
+        postJson(client, "/api/join", {{"join_key", "k1"}, {"recruitment", {{"survey_code", "48213"}}}}).body["token"],
+        joined.body["token"]);
+    EXPECT_EQ(postJson(client, "/api/join", {{"recruitment", {{"survey_code", "48213"}}}}).status, 409);
     EXPECT_EQ(postJson(client, "/api/join", {{"recruitment", {{"survey_code", "48214"}}}}).status, 201);
     EXPECT_EQ(study.store().status().size(), 2u);
 }

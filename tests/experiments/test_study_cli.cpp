@@ -17,6 +17,7 @@
 #include <map>
 #include <random>
 #include <regex>
+#include <sys/stat.h>
 #include <thread>
 
 using namespace skinlab::experiments;
@@ -341,4 +342,70 @@ TEST(StudyCli, ReadersWhileServingNeitherLoseNorDuplicateAnswers) {
     ASSERT_TRUE(check.step());
     EXPECT_EQ(check.text(0), "ok");
     EXPECT_GE(kills, kRounds);
+}
+
+// The researcher token from a file or the environment: never on the command line (every user reads it in `ps`) nor
+// in the output (often a log). Study files and the nginx site file are readable by their owner only.
+TEST(StudyCli, ResearcherTokenFromAFileOrTheEnvironmentAndPrivateFiles) {
+    StudyFiles files;
+    const mode_t previous = ::umask(022);
+    ASSERT_EQ(runSkinlab({"study", "create", "--stimuli", files.stimuli.string(), "--design", files.design.string(),
+                          "-o", files.database.string()})
+                  .exitCode,
+              0);
+    auto mode = [](const fs::path& file) { return fs::status(file).permissions() & fs::perms::all; };
+    EXPECT_EQ(mode(files.database), fs::perms::owner_read | fs::perms::owner_write);
+
+    const std::string secret = "file-token-" + randomHex(16);
+    const fs::path tokenFile = writeText(files.folder.path(), "token", secret + "\n");
+    const std::string environmentSecret = "env-token-" + randomHex(16);
+    for (const bool fromFile : {true, false}) {
+        std::vector<std::string> arguments{SKINLAB_CLI, "study", "serve", files.database.string(), "--port", "0"};
+        if (fromFile) {
+            arguments.push_back("--token-file");
+            arguments.push_back(tokenFile.string());
+        } else {
+            ::setenv("SKINLAB_RESEARCHER_TOKEN", environmentSecret.c_str(), 1);
+        }
+        const std::string token = fromFile ? secret : environmentSecret;
+        ChildProcess child(arguments);
+        ::unsetenv("SKINLAB_RESEARCHER_TOKEN");
+        std::string output;
+        int port = -1;
+        static const std::regex serving(R"(serving .* on http://127\.0\.0\.1:(\d+)/)");
+        for (int i = 0; i < 8; ++i) {
+            bool ok = false;
+            const std::string line = child.readLine(std::chrono::seconds(20), ok);
+            if (!ok) break;
+            output += line + "\n";
+            std::smatch m;
+            if (std::regex_search(line, m, serving)) port = std::stoi(m[1].str());
+            if (line.rfind("dashboard:", 0) == 0) break;
+        }
+        ASSERT_GT(port, 0) << output;
+        EXPECT_EQ(output.find(token), std::string::npos) << "the token was printed: " << output;
+        const std::string commandLine = skinlab::readFile("/proc/" + std::to_string(child.pid()) + "/cmdline");
+        EXPECT_EQ(commandLine.find(token), std::string::npos) << "the token is visible in ps";
+        HttpClient client("127.0.0.1", port);
+        EXPECT_EQ(client.get("/api/researcher/status", {{"Authorization", "Bearer " + token}}).status, 200);
+        EXPECT_EQ(client.get("/api/researcher/status", {{"Authorization", "Bearer wrong"}}).status, 403);
+        child.kill(SIGTERM);
+        child.wait();
+    }
+    EXPECT_EQ(mode(files.database), fs::perms::owner_read | fs::perms::owner_write);
+    const fs::path backup = files.folder.path() / "backup.db";
+    EXPECT_EQ(runSkinlab({"study", "backup", files.database.string(), backup.string()}).exitCode, 0);
+    EXPECT_EQ(mode(backup), fs::perms::owner_read | fs::perms::owner_write);
+    const fs::path pem = writeText(files.folder.path(), "cert.pem", "-----BEGIN CERTIFICATE-----\nMIIB\n");
+    const fs::path site = files.folder.path() / "site.conf";
+    const CommandResult deployed =
+        runSkinlab({"study", "deploy-config", "--server-name", "study.example.org", "--upstream", "127.0.0.1:8080",
+                    "--cert", pem.string(), "--key", pem.string(), "-o", site.string()});
+    EXPECT_EQ(deployed.exitCode, 0) << deployed.err;
+    EXPECT_EQ(mode(site), fs::perms::owner_read | fs::perms::owner_write);
+    // Both sources at once is a mistake.
+    const CommandResult both =
+        runSkinlab({"study", "serve", files.database.string(), "--token", "x", "--token-file", tokenFile.string()});
+    EXPECT_EQ(both.exitCode, 2) << both.err;
+    ::umask(previous);
 }

@@ -55,7 +55,7 @@ Participant joinAndStart(HttpClient& client, const HttpHeaders& headers = {}) {
 int answer(HttpClient& client, const Participant& p, int count = -1) {
     int answered = 0;
     while (count < 0 || answered < count) {
-        JsonAnswer state = get(client, "/api/state?token=" + p.token);
+        JsonAnswer state = get(client, "/api/state", {{"X-Skinlab-Token", p.token}});
         if (state.body["trial"].is_null()) break;
         json body = screen();
         body["token"] = p.token;
@@ -313,8 +313,35 @@ TEST(NginxSiteConfig, FillsTheTemplateAndRefusesValuesNginxWouldMisread) {
           "ssl_certificate     " + cert.string() + ";", "ssl_certificate_key " + key.string() + ";",
           std::string("listen 443 ssl http2;"), std::string("listen [::]:443 ssl http2;"),
           std::string("proxy_set_header X-Forwarded-For $remote_addr;"), std::string("client_max_body_size 16k;"),
-          std::string("return 301 https://$host$request_uri;"), std::string("--public-host study.example.org")}) {
+          std::string("return 301 https://study.example.org$request_uri;"),
+          std::string("--public-host study.example.org"),
+          std::string("map $remote_addr $skinlab_study_example_org_client"),
+          std::string("limit_req_zone $skinlab_study_example_org_client zone="),
+          std::string("limit_conn_zone $skinlab_study_example_org_client zone="),
+          std::string(
+              "log_format skinlab_study_example_org_private '$remote_addr [$time_local] \"$request_method $uri "),
+          std::string("access_log /var/log/nginx/access.log skinlab_study_example_org_private;")}) {
         EXPECT_NE(text.find(expected), std::string::npos) << expected;
+    }
+    // The redirect goes to the configured name, never the client's Host; no log line holds a query string.
+    EXPECT_EQ(text.find("$host$request_uri"), std::string::npos);
+    EXPECT_EQ(text.find("$request "), std::string::npos);
+    EXPECT_EQ(text.find("$request_uri\""), std::string::npos);
+    EXPECT_EQ(text.find("$http_referer"), std::string::npos);
+
+    // Only the addresses asked for, for HTTPS and the redirect alike.
+    {
+        NginxSiteOptions only = o;
+        only.listen = {"192.0.2.10:8443", "[2001:DB8::1]:8443"};
+        only.accessLog = "off";
+        const std::string site = nginxSiteConfig(only);
+        std::vector<std::string> listens;
+        for (std::size_t at = site.find("    listen "); at != std::string::npos; at = site.find("    listen ", at + 1))
+            listens.push_back(site.substr(at + 11, site.find(';', at) - at - 11));
+        EXPECT_EQ(listens, (std::vector<std::string>{"192.0.2.10:80", "[2001:db8::1]:80", "192.0.2.10:8443 ssl http2",
+                                                     "[2001:db8::1]:8443 ssl http2"}));
+        EXPECT_NE(site.find("return 301 https://study.example.org:8443$request_uri;"), std::string::npos);
+        EXPECT_NE(site.find("access_log off;"), std::string::npos);
     }
 
     auto refused = [&](const std::function<void(NginxSiteOptions&)>& change, const std::string& option) {
@@ -336,5 +363,9 @@ TEST(NginxSiteConfig, FillsTheTemplateAndRefusesValuesNginxWouldMisread) {
     refused([&](NginxSiteOptions& b) { b.key = (folder.path() / "missing.pem").string(); }, "--key");
     refused([&](NginxSiteOptions& b) { b.key = writeText(folder.path(), "plain.txt", "not a key\n").string(); },
             "--key");
-    refused([](NginxSiteOptions& b) { b.listen = "443x"; }, "--listen");
+    refused([](NginxSiteOptions& b) { b.listen = {"443x"}; }, "--listen");
+    refused([](NginxSiteOptions& b) { b.listen = {"[2001:db8::zz]:443"}; }, "--listen");
+    refused([](NginxSiteOptions& b) { b.listen = {"2001:db8::1:443"}; }, "--listen");
+    refused([](NginxSiteOptions& b) { b.accessLog = "logs/access.log"; }, "--access-log");
+    refused([](NginxSiteOptions& b) { b.accessLog = "/var/log/a.log; include /etc/passwd"; }, "--access-log");
 }
