@@ -22,7 +22,7 @@ namespace {
 
 struct StimuliOptions {
     bool noPredict = false;
-    std::string display = "standard_fhd";
+    std::string display = "standard_fhd"; // build (predictions) and calibrate: the ColorVideoVDP display model
     std::string spec;
     std::string output;
     std::string shard;
@@ -43,7 +43,7 @@ struct StimuliOptions {
     bool dryRun = false;
     std::string skinlab;
     // calibrate
-    std::string factor, targetJod, range, display = "standard_fhd", stimulus;
+    std::string factor, targetJod, range, stimulus; // and `display` (shared with build)
     std::optional<double> referenceLevel;
     double tolerance = 0.05;
     int maxProbes = 24;

@@ -273,15 +273,29 @@ SimulationTruth readTruthJson(const std::filesystem::path& path) {
     return truth;
 }
 
-SimulationTruth truthFromPredictions(StudyStore& store) {
-    SimulationTruth truth;
-    truth.source = "--truth predicted";
+namespace {
+
+// Calls f(stimulus, its manifest entry) for every stimulus of the study that shows a condition (not a reference).
+template <typename F>
+void forEachConditionEntry(StudyStore& store, F f) {
     const json manifest = json::parse(store.meta("manifest_json"));
     std::map<std::string, const json*> byId;
     for (const json& s : manifest["stimuli"]) byId[s["id"].get<std::string>()] = &s;
-    for (const StudyStimulus& s : store.definition().stimuli) {
-        if (s.condition.empty()) continue;
-        const json& entry = *byId.at(s.id);
+    for (const StudyStimulus& s : store.definition().stimuli)
+        if (!s.condition.empty()) f(s, *byId.at(s.id));
+}
+
+} // namespace
+
+SimulationTruth truthFromPredictions(StudyStore& store) {
+    SimulationTruth truth;
+    truth.source = "--truth predicted";
+    forEachConditionEntry(store, [&](const StudyStimulus& s, const json& entry) {
+        // A block's reference shown as a condition is, by definition, indistinguishable from itself.
+        if (entry.value("reference", false)) {
+            truth.byBlock[s.block][s.condition] = 10.0;
+            return;
+        }
         const auto predicted = entry.find("predicted");
         if (predicted == entry.end() || !predicted->is_object() || !predicted->contains("jod") ||
             !(*predicted)["jod"].is_number())
@@ -289,19 +303,14 @@ SimulationTruth truthFromPredictions(StudyStore& store) {
                              "\" has no predicted JOD in the manifest (build the set with a [[reference]] so that "
                              "`stimuli build` predicts each stimulus against it)");
         truth.byBlock[s.block][s.condition] = (*predicted)["jod"].get<double>();
-    }
+    });
     return truth;
 }
 
 SimulationTruth truthFromFactor(StudyStore& store, const std::string& factor) {
     SimulationTruth truth;
     truth.source = "--truth-factor " + factor;
-    const json manifest = json::parse(store.meta("manifest_json"));
-    std::map<std::string, const json*> byId;
-    for (const json& s : manifest["stimuli"]) byId[s["id"].get<std::string>()] = &s;
-    for (const StudyStimulus& s : store.definition().stimuli) {
-        if (s.condition.empty()) continue;
-        const json& entry = *byId.at(s.id);
+    forEachConditionEntry(store, [&](const StudyStimulus& s, const json& entry) {
         if (!entry.contains("factors") || !entry["factors"].contains(factor))
             throw InputError("--truth-factor: stimulus \"" + s.id + "\" has no factor \"" + factor + "\"");
         const json& value = entry["factors"][factor];
@@ -320,7 +329,7 @@ SimulationTruth truthFromFactor(StudyStore& store, const std::string& factor) {
             }
         }
         truth.byBlock[s.block][s.condition] = q;
-    }
+    });
     return truth;
 }
 

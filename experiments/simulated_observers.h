@@ -29,8 +29,9 @@ SimulationTruth readTruthJson(const std::filesystem::path& path);
 // Scores from a numeric factor of the stimulus manifest stored in the study (e.g. "quality").
 SimulationTruth truthFromFactor(StudyStore& store, const std::string& factor);
 // Scores predicted by a model of vision: each stimulus's predicted JOD against its block's reference, as
-// `skinlab stimuli build` records it in the manifest ("predicted": {"jod": …}, ColorVideoVDP). Throws InputError
-// naming the stimulus when the set was built without predictions.
+// `skinlab stimuli build` records it in the manifest ("predicted": {"jod": …}, ColorVideoVDP); a block's reference
+// shown as a condition scores 10 (no visible difference from itself). Throws InputError naming the stimulus when
+// the set was built without predictions.
 SimulationTruth truthFromPredictions(StudyStore& store);
 
 struct SimulationOptions {

@@ -3,7 +3,8 @@
 // predicts (e.g. ColorVideoVDP's JOD of every stimulus against its block's reference) to come out significant.
 // Each block is simulated as the study would run it — every pair shown `repetitions` times to every observer,
 // Thurstone observers (σ = 1.4826 per JOD, analysis/scaling/simulation.h) — and scaled with the project's own
-// fit; a pair counts as resolved in a simulated study when its Wald test (the fit's Fisher information), after
+// fit; a pair counts as resolved in a simulated study when its likelihood-ratio test (against the fit constrained
+// to an equal pair), after
 // Holm's correction over the block's pairs, is significant at α in the predicted direction. Power is the share of
 // simulated studies that resolve it.
 #include "experiments/simulated_observers.h"

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -140,32 +141,45 @@ double automaticScaleMax(const cv::Mat& values, double minimum) {
     return 10.0 * power;
 }
 
-cv::Mat renderFlipHeatmap(const cv::Mat& flip, double scaleMax) {
-    CV_Assert(flip.type() == CV_64FC1 || flip.type() == CV_32FC1);
-    cv::Mat values;
-    flip.convertTo(values, CV_32FC1);
-    cv::Mat heat = colourise(values, scaleMax, cv::COLORMAP_MAGMA);
+namespace {
+
+// A scalar map through `map` on [0, scaleMax] with a legend panel: `title` lines, a colour bar and three ticks (the
+// top one marked "+" when larger values saturate below `naturalMax`).
+cv::Mat renderScalarHeatmap(const cv::Mat& values, double scaleMax, cv::ColormapTypes map,
+                            const std::vector<std::string>& title, double naturalMax) {
+    CV_Assert(values.type() == CV_32FC1 && scaleMax > 0.0);
+    cv::Mat heat = colourise(values, scaleMax, map);
     const int height = std::max(heat.rows, legendMinimumHeight);
     cv::Mat canvas(height, heat.cols + legendWidth, CV_8UC3, legendBackground);
     heat.copyTo(canvas(cv::Rect(0, 0, heat.cols, heat.rows)));
     const int left = heat.cols + 12;
-    cv::putText(canvas, "LDR-FLIP", {left, 18}, cv::FONT_HERSHEY_SIMPLEX, fontScale, textColour, 1, cv::LINE_AA);
-    const int barTop = 30, barHeight = 120, barWidth = 18;
+    for (std::size_t line = 0; line < title.size(); ++line)
+        cv::putText(canvas, title[line], {left, 18 + 18 * static_cast<int>(line)}, cv::FONT_HERSHEY_SIMPLEX, fontScale,
+                    textColour, 1, cv::LINE_AA);
+    const int barTop = 12 + 18 * static_cast<int>(title.size()), barHeight = 120, barWidth = 18;
     cv::Mat ramp(barHeight, 1, CV_32FC1);
     for (int i = 0; i < barHeight; ++i)
         ramp.at<float>(i) = static_cast<float>(scaleMax * (1.0 - double(i) / double(barHeight - 1)));
     cv::Mat rampColour;
-    cv::resize(colourise(ramp, scaleMax, cv::COLORMAP_MAGMA), rampColour, {barWidth, barHeight}, 0, 0,
-               cv::INTER_NEAREST);
+    cv::resize(colourise(ramp, scaleMax, map), rampColour, {barWidth, barHeight}, 0, 0, cv::INTER_NEAREST);
     rampColour.copyTo(canvas(cv::Rect(left, barTop, barWidth, barHeight)));
     const double ticks[3] = {scaleMax, 0.5 * scaleMax, 0.0};
     for (int i = 0; i < 3; ++i) {
         int y = barTop + static_cast<int>(std::lround(i * (barHeight - 1) / 2.0));
         cv::line(canvas, {left + barWidth, y}, {left + barWidth + 4, y}, textColour, 1);
-        cv::putText(canvas, formatScale(ticks[i]) + (i == 0 && scaleMax < 1.0 ? "+" : ""), {left + barWidth + 8, y + 5},
-                    cv::FONT_HERSHEY_SIMPLEX, fontScale, textColour, 1, cv::LINE_AA);
+        cv::putText(canvas, formatScale(ticks[i]) + (i == 0 && scaleMax < naturalMax ? "+" : ""),
+                    {left + barWidth + 8, y + 5}, cv::FONT_HERSHEY_SIMPLEX, fontScale, textColour, 1, cv::LINE_AA);
     }
     return canvas;
+}
+
+} // namespace
+
+cv::Mat renderFlipHeatmap(const cv::Mat& flip, double scaleMax) {
+    CV_Assert(flip.type() == CV_64FC1 || flip.type() == CV_32FC1);
+    cv::Mat values;
+    flip.convertTo(values, CV_32FC1);
+    return renderScalarHeatmap(values, scaleMax, cv::COLORMAP_MAGMA, {"LDR-FLIP"}, 1.0); // FLIP is at most 1
 }
 
 void writeFlipHeatmap(const std::filesystem::path& path, const cv::Mat& flip, double scaleMax) {
@@ -173,30 +187,8 @@ void writeFlipHeatmap(const std::filesystem::path& path, const cv::Mat& flip, do
 }
 
 cv::Mat renderCvvdpHeatmap(const cv::Mat& visibility, double scaleMax) {
-    CV_Assert(visibility.type() == CV_32FC1 && scaleMax > 0.0);
-    cv::Mat heat = colourise(visibility, scaleMax, cv::COLORMAP_VIRIDIS);
-    const int height = std::max(heat.rows, legendMinimumHeight);
-    cv::Mat canvas(height, heat.cols + legendWidth, CV_8UC3, legendBackground);
-    heat.copyTo(canvas(cv::Rect(0, 0, heat.cols, heat.rows)));
-    const int left = heat.cols + 12;
-    cv::putText(canvas, "ColorVideoVDP", {left, 18}, cv::FONT_HERSHEY_SIMPLEX, fontScale, textColour, 1, cv::LINE_AA);
-    cv::putText(canvas, "JOD loss", {left, 36}, cv::FONT_HERSHEY_SIMPLEX, fontScale, textColour, 1, cv::LINE_AA);
-    const int barTop = 48, barHeight = 120, barWidth = 18;
-    cv::Mat ramp(barHeight, 1, CV_32FC1);
-    for (int i = 0; i < barHeight; ++i)
-        ramp.at<float>(i) = static_cast<float>(scaleMax * (1.0 - double(i) / double(barHeight - 1)));
-    cv::Mat rampColour;
-    cv::resize(colourise(ramp, scaleMax, cv::COLORMAP_VIRIDIS), rampColour, {barWidth, barHeight}, 0, 0,
-               cv::INTER_NEAREST);
-    rampColour.copyTo(canvas(cv::Rect(left, barTop, barWidth, barHeight)));
-    const double ticks[3] = {scaleMax, 0.5 * scaleMax, 0.0};
-    for (int i = 0; i < 3; ++i) {
-        int y = barTop + static_cast<int>(std::lround(i * (barHeight - 1) / 2.0));
-        cv::line(canvas, {left + barWidth, y}, {left + barWidth + 4, y}, textColour, 1);
-        cv::putText(canvas, formatScale(ticks[i]) + (i == 0 ? "+" : ""), {left + barWidth + 8, y + 5},
-                    cv::FONT_HERSHEY_SIMPLEX, fontScale, textColour, 1, cv::LINE_AA);
-    }
-    return canvas;
+    return renderScalarHeatmap(visibility, scaleMax, cv::COLORMAP_VIRIDIS, {"ColorVideoVDP", "JOD loss"},
+                               std::numeric_limits<double>::infinity());
 }
 
 void writeCvvdpHeatmap(const std::filesystem::path& path, const cv::Mat& visibility, double scaleMax) {
