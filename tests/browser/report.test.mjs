@@ -142,7 +142,12 @@ try {
   check(facts.missing.length === 0, 'findings links without target: ' + facts.missing.join(', '));
   check(facts.sections.length === 0, 'missing sections: ' + facts.sections.join(', '));
   check(facts.svgs >= 2 && facts.scatters >= 4, `plots: ${facts.svgs} (scatter ${facts.scatters})`);
-  check(/metric that predicts the scale best/.test(facts.text), 'findings name the best metric');
+  check(/metric that agrees best with the scale/.test(facts.text) && /after Holm's correction/.test(facts.text),
+    'findings name the best metric, with its p corrected for the choice');
+  check(/Predicted and measured/.test(facts.text) && /anchor/.test(facts.text),
+    'the predicted-and-measured section (the set records ColorVideoVDP predictions)');
+  check(/scale 0–/.test(facts.text), 'heat maps print their colour scale');
+  check(/Simulated observers\./.test(facts.text), 'the banner says the observers were simulated');
   check(/Which face looks more like real skin\?/.test(facts.text), 'the question is shown');
   check(facts.thumbnailLinks.every((href) => href && !href.startsWith('/') && fs.existsSync(path.join(reportDir, href))),
     'thumbnails link to files in the report folder');
