@@ -1,4 +1,4 @@
-// `skinlab stimuli build|list|merge|contact|slurm|status|calibrate`: stimulus sets (docs/stimuli.md).
+// `skinlab stimuli build|list|merge|contact|slurm|status|calibrate` (and `import`, cmd_stimuli_import.cpp): stimulus sets (docs/stimuli.md).
 #include "analysis/metrics/cvvdp.h"
 #include "cli/commands.h"
 #include "common/error.h"
@@ -43,7 +43,7 @@ struct StimuliOptions {
     bool dryRun = false;
     std::string skinlab;
     // calibrate
-    std::string factor, targetJod, range, display = "standard_fhd", stimulus;
+    std::string factor, targetJod, range, stimulus;
     std::optional<double> referenceLevel;
     double tolerance = 0.05;
     int maxProbes = 24;
@@ -384,6 +384,8 @@ void registerStimuli(CLI::App& app) {
                           "Id of the stimulus whose key varies (default: the first that is not a reference)");
     calibrate->add_option("-o,--output", options->output, "Write the [[factor]] snippet to this file (atomically)");
     calibrate->callback([options] { runCalibrate(*options); });
+
+    registerStimuliImport(*stimuli); // cmd_stimuli_import.cpp
 }
 
 } // namespace skinlab::cli
