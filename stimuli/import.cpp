@@ -37,9 +37,13 @@ float linearToSrgb(float linear) {
 namespace {
 
 // Columns with a meaning of their own; every factor column is declared (CSV: "factor:NAME"; TOML: `factors`).
-constexpr const char* kReservedColumns[] = {"file", "id", "block", "reference", "encoding", "exposure_ev"};
-const char* const kColumnsHint = "the columns are file, id, block, reference, encoding, exposure_ev and factor "
-                                 "columns (CSV: factor:NAME; TOML: listed in `factors`)";
+constexpr const char* kReservedColumns[] = {"file",  "id",   "block", "reference",   "encoding",     "exposure_ev",
+                                            "depth", "mask", "f_px",  "mm_per_unit", "sss_radius_mm"};
+const char* const kColumnsHint = "the columns are file, id, block, reference, encoding, exposure_ev, depth, mask, "
+                                 "f_px, mm_per_unit, sss_radius_mm and factor columns (CSV: factor:NAME; TOML: "
+                                 "listed in `factors`)";
+// The numeric columns that describe the camera of a depth image (EXR metadata skinlab:NAME).
+constexpr const char* kCameraColumns[] = {"f_px", "mm_per_unit", "sss_radius_mm"};
 
 bool isReserved(const std::string& column) {
     return std::any_of(std::begin(kReservedColumns), std::end(kReservedColumns),
@@ -56,6 +60,9 @@ struct Row {
     bool reference = false;
     std::optional<std::string> encoding;
     std::optional<double> exposureEv;
+    std::optional<std::string> depth;           // image of linear view depth (first channel), as written
+    std::optional<std::string> mask;            // image of the skin mask 0..1 (first channel), as written
+    std::map<std::string, double> camera;       // f_px, mm_per_unit, sss_radius_mm
     std::map<std::string, std::string> factors; // factor → level text (absent when empty)
 };
 
@@ -115,9 +122,6 @@ void readCsvTable(Table& table) {
             const std::string name = column.substr(7);
             checkFactorName(table, header.line, column, name, table.factors);
             table.factors.push_back(name);
-        } else if (column == "depth" || column == "mask") {
-            failAt(table, header.line, column,
-                   "depth and mask images are not imported (the metrics of an imported set are image-wide)");
         } else if (!isReserved(column)) {
             failAt(table, header.line, column, std::string("unknown column (") + kColumnsHint + ")");
         }
@@ -147,6 +151,8 @@ void readCsvTable(Table& table) {
             if (column == "id") row.id = value;
             else if (column == "block") row.block = value;
             else if (column == "encoding") row.encoding = value;
+            else if (column == "depth") row.depth = value;
+            else if (column == "mask") row.mask = value;
             else if (column == "reference") {
                 if (!parseBoolText(value, row.reference))
                     failAt(table, record.line, column, "'" + value + "' is not true or false");
@@ -154,6 +160,11 @@ void readCsvTable(Table& table) {
                 double ev = 0;
                 if (!parseNumberText(value, ev)) failAt(table, record.line, column, "'" + value + "' is not a number");
                 row.exposureEv = ev;
+            } else if (column != "file") { // f_px, mm_per_unit, sss_radius_mm
+                double number = 0;
+                if (!parseNumberText(value, number))
+                    failAt(table, record.line, column, "'" + value + "' is not a number");
+                row.camera[column] = number;
             }
         }
         table.rows.push_back(std::move(row));
@@ -225,15 +236,17 @@ void readTomlTable(Table& table) {
             else if (k == "id") row.id = text();
             else if (k == "block") row.block = text();
             else if (k == "encoding") row.encoding = text();
+            else if (k == "depth") row.depth = text();
+            else if (k == "mask") row.mask = text();
             else if (k == "reference") {
                 if (!node.is_boolean()) failAt(table, line, k, "must be true or false");
                 row.reference = node.as_boolean()->get();
             } else if (k == "exposure_ev") {
                 if (!node.is_number()) failAt(table, line, k, "'" + tomlValueText(node) + "' is not a number");
                 row.exposureEv = node.value<double>().value_or(0.0);
-            } else if (k == "depth" || k == "mask") {
-                failAt(table, line, k,
-                       "depth and mask images are not imported (the metrics of an imported set are image-wide)");
+            } else if (std::find(std::begin(kCameraColumns), std::end(kCameraColumns), k) != std::end(kCameraColumns)) {
+                if (!node.is_number()) failAt(table, line, k, "'" + tomlValueText(node) + "' is not a number");
+                row.camera[k] = node.value<double>().value_or(0.0);
             } else {
                 failAt(table, line, k, std::string("unknown column (") + kColumnsHint + ")");
             }
@@ -248,6 +261,7 @@ struct Pixels {
     int height = 0;
     bool floatingPoint = false; // stored as half/float (EXR, HDR): linear by default
     std::vector<float> rgb;     // width × height × 3
+    std::vector<float> first;   // width × height: the first channel (a depth or mask image)
 };
 
 // Reads RGB of an image (R, G, B by name when present, else the first three channels, a grey image replicated;
@@ -285,9 +299,12 @@ std::optional<Pixels> readPixels(const fs::path& path, std::string& reason) {
     }
     input->close();
     p.rgb.resize(count * 3);
+    p.first.resize(count);
     const size_t n = static_cast<size_t>(spec.nchannels);
-    for (size_t i = 0; i < count; ++i)
+    for (size_t i = 0; i < count; ++i) {
         for (size_t c = 0; c < 3; ++c) p.rgb[i * 3 + c] = all[i * n + static_cast<size_t>(source[c])];
+        p.first[i] = all[i * n];
+    }
     return p;
 }
 
@@ -302,18 +319,22 @@ struct Checked {
     int width = 0;
     int height = 0;
     std::string originalSha256;
+    fs::path depth, mask; // empty without AOVs
 };
 
-void writeImage(const fs::path& path, int width, int height, OIIO::TypeDesc type, const std::vector<float>& rgb,
-                const std::vector<std::pair<std::string, std::string>>& attributes) {
+void writeImage(const fs::path& path, int width, int height, OIIO::TypeDesc type, const std::vector<float>& pixels,
+                const std::vector<std::string>& channels,
+                const std::vector<std::pair<std::string, std::string>>& attributes,
+                const std::map<std::string, double>& numbers = {}) {
     auto output = OIIO::ImageOutput::create(path.string());
     if (!output) throw RuntimeError(path.string() + ": cannot create an image writer (" + OIIO::geterror() + ")");
-    OIIO::ImageSpec spec(width, height, 3, type);
-    spec.channelnames = {"R", "G", "B"};
+    OIIO::ImageSpec spec(width, height, static_cast<int>(channels.size()), type);
+    spec.channelnames = channels;
+    for (const auto& [key, value] : numbers) spec.attribute("skinlab:" + key, static_cast<float>(value));
     spec.attribute("DateTime", ""); // OpenImageIO would stamp the current time: the files would differ per import
     if (type == OIIO::TypeDesc::FLOAT) spec.attribute("compression", "zip");
     for (const auto& [key, value] : attributes) spec.attribute(key, value);
-    if (!output->open(path.string(), spec) || !output->write_image(OIIO::TypeDesc::FLOAT, rgb.data()) ||
+    if (!output->open(path.string(), spec) || !output->write_image(OIIO::TypeDesc::FLOAT, pixels.data()) ||
         !output->close())
         throw RuntimeError(path.string() + ": cannot write the image (" + output->geterror() + ")");
 }
@@ -404,6 +425,34 @@ ImportSummary importStimuli(const ImportOptions& options) {
             blockSizes[c.block] = {c.width, c.height, lineOf(row, "file")};
         }
         c.originalSha256 = sha256File(c.path);
+
+        // Depth and mask AOVs (for the metrics' skin and band scores), with the camera they need.
+        if (row.depth.has_value() != row.mask.has_value())
+            fail(table, row, row.depth ? "mask" : "depth", "depth and mask images are given together");
+        if (row.depth) {
+            for (const char* key : kCameraColumns)
+                if (!row.camera.count(key))
+                    fail(table, row, key,
+                         "a depth image needs f_px, mm_per_unit and sss_radius_mm (the camera and kernel of the "
+                         "metrics' bands)");
+            for (const auto& [key, aov] : {std::pair{"depth", &c.depth}, std::pair{"mask", &c.mask}}) {
+                const std::string& name = key == std::string("depth") ? *row.depth : *row.mask;
+                *aov = fs::path(name).is_absolute() ? fs::path(name) : base / name;
+                if (!fs::is_regular_file(*aov, ec))
+                    fail(table, row, key, "'" + name + "' not found (" + aov->string() + ")");
+                std::optional<Pixels> plane = readPixels(*aov, reason);
+                if (!plane) fail(table, row, key, "'" + name + "' is not a readable image (" + reason + ")");
+                if (plane->width != c.width || plane->height != c.height)
+                    fail(table, row, key,
+                         "'" + name + "' is " + std::to_string(plane->width) + "x" + std::to_string(plane->height) +
+                             ", its image '" + row.file + "' " + std::to_string(c.width) + "x" +
+                             std::to_string(c.height));
+            }
+        }
+        for (const auto& [key, value] : row.camera) {
+            if (!row.depth) fail(table, row, key, "applies only with depth and mask images");
+            if (!(value > 0.0)) fail(table, row, key, std::to_string(value) + " is not a positive number");
+        }
         checked.push_back(std::move(c));
     }
 
@@ -451,11 +500,24 @@ ImportSummary importStimuli(const ImportOptions& options) {
                 linear[i] = srgbToLinear(display[i]);
             }
         }
+        std::vector<std::string> channels = {"R", "G", "B"};
+        if (!c.depth.empty()) { // R, G, B, depth.Z, mask.Y (contract 1)
+            std::optional<Pixels> depth = readPixels(c.depth, reason), mask = readPixels(c.mask, reason);
+            if (!depth || !mask)
+                throw RuntimeError(c.path.string() + ": cannot read its AOVs any more (" + reason + ")");
+            std::vector<float> all;
+            all.reserve(linear.size() / 3 * 5);
+            for (size_t i = 0; i < depth->first.size(); ++i)
+                all.insert(all.end(), {linear[i * 3], linear[i * 3 + 1], linear[i * 3 + 2], depth->first[i],
+                                       std::clamp(mask->first[i], 0.0f, 1.0f)});
+            linear = std::move(all);
+            channels.insert(channels.end(), {"depth.Z", "mask.Y"});
+        }
         AtomicOutput exr(dir / exrRelativePath(c.id));
         AtomicOutput png(dir / pngRelativePath(c.id));
-        writeImage(exr.tempPath(), c.width, c.height, OIIO::TypeDesc::FLOAT, linear,
-                   {{"skinlab:version", version()}, {"skinlab:imported_from", c.row->file}});
-        writeImage(png.tempPath(), c.width, c.height, OIIO::TypeDesc::UINT8, display, {});
+        writeImage(exr.tempPath(), c.width, c.height, OIIO::TypeDesc::FLOAT, linear, channels,
+                   {{"skinlab:version", version()}, {"skinlab:imported_from", c.row->file}}, c.row->camera);
+        writeImage(png.tempPath(), c.width, c.height, OIIO::TypeDesc::UINT8, display, {"R", "G", "B"}, {});
         exr.commit();
         png.commit();
 
@@ -466,6 +528,13 @@ ImportSummary importStimuli(const ImportOptions& options) {
             {"kind", "imported"},         {"original", c.row->file}, {"original_sha256", c.originalSha256},
             {"table", manifest.specFile}, {"line", c.row->line},     {"encoding", c.linear ? "linear" : "srgb"}};
         if (c.linear) provenance["exposure_ev"] = c.exposureEv;
+        if (c.row->depth) {
+            provenance["depth"] = *c.row->depth;
+            provenance["depth_sha256"] = sha256File(c.depth);
+            provenance["mask"] = *c.row->mask;
+            provenance["mask_sha256"] = sha256File(c.mask);
+            for (const auto& [key, value] : c.row->camera) provenance[key] = value;
+        }
         manifest.stimuli.push_back(
             {{"id", c.id},
              {"files", {{"exr", exrRelativePath(c.id)}, {"png", pngRelativePath(c.id)}}},

@@ -238,11 +238,11 @@ TEST(StimuliImport, RefusesBadTablesWithOneLineAndWritesNothing) {
         {"missing.csv", "file,factor:method\na.png,x\nnope.png,y\n",
          ":3: file: 'nope.png' not found (" + (root / "nope.png").string() + ")"},
         {"unknown.csv", "file,methd\na.png,x\n",
-         ":1: methd: unknown column (the columns are file, id, block, reference, encoding, exposure_ev and factor "
-         "columns (CSV: factor:NAME; TOML: listed in `factors`))"},
+         ":1: methd: unknown column (the columns are file, id, block, reference, encoding, exposure_ev, depth, "
+         "mask, f_px, mm_per_unit, sss_radius_mm and factor columns (CSV: factor:NAME; TOML: listed in `factors`))"},
         {"unknown.toml", "factors = [\"method\"]\n[[stimulus]]\nfile = \"a.png\"\nmethod = \"x\"\nmethd = \"y\"\n",
-         ":5: methd: unknown column (the columns are file, id, block, reference, encoding, exposure_ev and factor "
-         "columns (CSV: factor:NAME; TOML: listed in `factors`))"},
+         ":5: methd: unknown column (the columns are file, id, block, reference, encoding, exposure_ev, depth, "
+         "mask, f_px, mm_per_unit, sss_radius_mm and factor columns (CSV: factor:NAME; TOML: listed in `factors`))"},
         {"dup.csv", "file,id\na.png,same\nb.png,same\n", ":3: id: the id 'same' is also the id of line 2"},
         {"dupderived.csv", "file\na.png\nsub/a.png\n",
          ":3: file: the id 'a' is also the id of line 2 (give an id column)"},
@@ -260,8 +260,21 @@ TEST(StimuliImport, RefusesBadTablesWithOneLineAndWritesNothing) {
         {"exposuresrgb.csv", "file,exposure_ev\na.png,1\n",
          ":2: exposure_ev: applies to linear images only ('a.png' is sRGB)"},
         {"reference.csv", "file,reference\na.png,maybe\n", ":2: reference: 'maybe' is not true or false"},
-        {"depth.csv", "file,depth\na.png,d.exr\n",
-         ":1: depth: depth and mask images are not imported (the metrics of an imported set are image-wide)"},
+        {"depthalone.csv", "file,depth\na.png,lin.exr\n", ":2: mask: depth and mask images are given together"},
+        {"nocamera.csv", "file,depth,mask,f_px\na.png,lin.exr,b.png,40\n",
+         ":2: mm_per_unit: a depth image needs f_px, mm_per_unit and sss_radius_mm (the camera and kernel of "
+         "the metrics' bands)"},
+        {"cameraalone.csv", "file,f_px\na.png,40\n", ":2: f_px: applies only with depth and mask images"},
+        {"camerabad.toml",
+         "[[stimulus]]\nfile = \"a.png\"\ndepth = \"lin.exr\"\nmask = \"b.png\"\nf_px = 40\nmm_per_unit = "
+         "\"1\"\nsss_radius_mm = 1\n",
+         ":6: mm_per_unit: '\"1\"' is not a number"},
+        {"cameranegative.csv", "file,depth,mask,f_px,mm_per_unit,sss_radius_mm\na.png,lin.exr,b.png,40,-2,1\n",
+         ":2: mm_per_unit: -2.000000 is not a positive number"},
+        {"masksize.csv", "file,depth,mask,f_px,mm_per_unit,sss_radius_mm\na.png,lin.exr,wide.png,40,1,1\n",
+         ":2: mask: 'wide.png' is 9x6, its image 'a.png' 8x6"},
+        {"masknotfound.csv", "file,depth,mask,f_px,mm_per_unit,sss_radius_mm\na.png,lin.exr,m.png,40,1,1\n",
+         ":2: mask: 'm.png' not found (" + (root / "m.png").string() + ")"},
         {"badid.csv", "file,id\na.png,A B\n", ":2: id: 'A B' is not an id (a-z 0-9 . _ -)"},
         {"fields.csv", "file,id\na.png\n", ":2: the row has 1 fields, the header 2"},
         {"nofile.csv", "id,factor:method\nx,y\n", ":1: file: the header has no 'file' column"},
@@ -293,7 +306,16 @@ TEST(StimuliImport, ImportedSetThroughStudyAnalysisAndReport) {
     TemporaryFolder folder("import-e2e");
     const fs::path root = folder.path();
     const int w = 32, h = 24;
-    std::string csv = "file,id,block,reference,factor:method,factor:quality\n";
+    // Block a's reference carries a depth image and a skin mask (the left half), so its metrics have bands; block
+    // b's reference is a plain image (image-wide metrics).
+    writeImage(root / "img" / "depth.exr", w, h, OIIO::TypeDesc::FLOAT, std::vector<float>(w * h * 3, 2.0f));
+    std::vector<float> mask(w * h * 3, 0.0f);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w / 2; ++x)
+            for (int c = 0; c < 3; ++c) mask[static_cast<size_t>((y * w + x) * 3 + c)] = 1.0f;
+    writeImage(root / "img" / "mask.png", w, h, OIIO::TypeDesc::UINT8, mask);
+    std::string csv =
+        "file,id,block,reference,factor:method,factor:quality,depth,mask,f_px,mm_per_unit,sss_radius_mm\n";
     for (const char* block : {"a", "b"}) {
         for (int k = 0; k < 3; ++k) {
             const std::string id = std::string(block) + "-q" + std::to_string(k);
@@ -301,12 +323,13 @@ TEST(StimuliImport, ImportedSetThroughStudyAnalysisAndReport) {
             std::vector<float> rgb = pattern(w, h, block[0] == 'a' ? 0 : 7, 0.6f);
             for (size_t i = 0; i < rgb.size(); ++i) rgb[i] += 0.05f * static_cast<float>((2 - k) * ((i * 7) % 5));
             writeImage(root / "img" / (id + ".exr"), w, h, OIIO::TypeDesc::FLOAT, rgb);
-            csv +=
-                "img/" + id + ".exr," + id + "," + block + ",,m" + std::to_string(k) + "," + std::to_string(k) + "\n";
+            csv += "img/" + id + ".exr," + id + "," + block + ",,m" + std::to_string(k) + "," + std::to_string(k) +
+                   ",,,,,\n";
         }
         writeImage(root / "img" / (std::string(block) + "-ref.exr"), w, h, OIIO::TypeDesc::FLOAT,
                    pattern(w, h, block[0] == 'a' ? 0 : 7, 0.6f));
-        csv += std::string("img/") + block + "-ref.exr," + block + "-ref," + block + ",true,reference,3\n";
+        csv += std::string("img/") + block + "-ref.exr," + block + "-ref," + block + ",true,reference,3," +
+               (block[0] == 'a' ? "img/depth.exr,img/mask.png,40,10,2\n" : ",,,,\n");
     }
     const fs::path table = writeText(root, "engine.csv", csv);
     const fs::path set = root / "set";
@@ -360,4 +383,6 @@ TEST(StimuliImport, ImportedSetThroughStudyAnalysisAndReport) {
         EXPECT_NE(text.find(id), std::string::npos) << id;
     EXPECT_NE(text.find("a-ref"), std::string::npos);
     EXPECT_NE(text.find("b-ref"), std::string::npos);
+    ASSERT_EQ(metrics.at("comparisons").size(), 6u);
+    for (const auto& c : metrics.at("comparisons")) EXPECT_EQ(c.at("bands_measured"), c.at("block") == "a") << c.dump();
 }
