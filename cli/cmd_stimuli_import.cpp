@@ -1,5 +1,6 @@
 // `skinlab stimuli import TABLE -o DIR`: a stimulus set from images made elsewhere (docs/stimuli.md, "Importing
 // images from other renderers").
+#include "analysis/metrics/cvvdp.h"
 #include "cli/commands.h"
 #include "stimuli/import.h"
 
@@ -15,6 +16,8 @@ struct ImportArguments {
     std::string images;
     std::string name;
     bool noContactSheet = false;
+    bool noPredict = false;
+    std::string display = "standard_fhd";
 };
 } // namespace
 
@@ -30,6 +33,12 @@ void registerStimuliImport(CLI::App& stimuli) {
                         "the table's folder)");
     command->add_option("--name", arguments->name, "Set name (default: the table's name, else its file name)");
     command->add_flag("--no-contact-sheet", arguments->noContactSheet, "Do not write contact.html / contact.png");
+    command->add_flag("--no-predict", arguments->noPredict,
+                      "Do not predict each stimulus's visibility against its block's reference (ColorVideoVDP)");
+    command
+        ->add_option("--display", arguments->display,
+                     "Display model of the predictions (analysis/metrics/cvvdp/display_models.json)")
+        ->capture_default_str();
     command->callback([arguments] {
         stimuli::ImportOptions options;
         options.table = arguments->table;
@@ -37,10 +46,14 @@ void registerStimuliImport(CLI::App& stimuli) {
         options.images = arguments->images;
         options.name = arguments->name;
         options.contactSheet = !arguments->noContactSheet;
+        options.predict = !arguments->noPredict;
+        options.display = arguments->display;
+        if (options.predict) (void)metrics::cvvdpDisplay(options.display); // an unknown name fails before writing
         const stimuli::ImportSummary summary = stimuli::importStimuli(options);
         std::printf("stimuli: imported set '%s': %zu stimuli in %zu block(s); manifest: %s\n", summary.set.c_str(),
                     summary.stimuli, summary.blocks, summary.manifest.string().c_str());
         if (!summary.contactHtml.empty()) std::printf("contact sheet: %s\n", summary.contactHtml.string().c_str());
+        for (const std::string& line : summary.predictions) std::printf("stimuli: predicted: %s\n", line.c_str());
     });
 }
 

@@ -9,6 +9,7 @@
 #include "stimuli/manifest.h"
 #include "stimuli/naming.h"
 #include "stimuli/output_folder.h"
+#include "stimuli/prediction.h"
 
 #include <OpenImageIO/imageio.h>
 #include <algorithm>
@@ -555,6 +556,13 @@ ImportSummary importStimuli(const ImportOptions& options) {
     writeManifest(dir, manifest);
 
     ImportSummary summary;
+    if (options.predict) { // predicted visibility against each block's reference, as in a built set
+        PredictionOptions prediction;
+        prediction.display = options.display;
+        const PredictionSummary predicted = predictStimuli(dir, manifest, prediction);
+        if (predicted.predicted > 0) writeManifest(dir, manifest);
+        summary.predictions = predictionLines(predicted, prediction);
+    }
     summary.set = set;
     summary.stimuli = manifest.stimuli.size();
     summary.blocks = blockSizes.size();

@@ -6,6 +6,7 @@
 // its pixels are encoded. Everything is checked before anything is written.
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace skinlab::stimuli {
 
@@ -15,6 +16,8 @@ struct ImportOptions {
     std::filesystem::path images;    // folder the `file` paths are relative to (default: the table's folder)
     std::string name;                // set name (default: the table's `name`, else its file stem)
     bool contactSheet = true;
+    bool predict = true;                  // ColorVideoVDP against each block's reference, as `stimuli build` does
+    std::string display = "standard_fhd"; // display model of the predictions
 };
 
 struct ImportSummary {
@@ -22,7 +25,8 @@ struct ImportSummary {
     size_t stimuli = 0;
     size_t blocks = 0;
     std::filesystem::path manifest;
-    std::filesystem::path contactHtml; // empty without a contact sheet
+    std::filesystem::path contactHtml;    // empty without a contact sheet
+    std::vector<std::string> predictions; // one line per block with a reference (predictionLines)
 };
 
 // Reads and checks the table and every image, then writes DIR/png/ID.png (8-bit sRGB), DIR/exr/ID.exr (linear

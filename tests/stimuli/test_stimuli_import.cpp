@@ -109,9 +109,13 @@ TEST(StimuliImport, CsvTableOfPngJpegAndExrImages) {
     const fs::path out = root / "set";
     CommandResult r = runSkinlab({"stimuli", "import", table.string(), "-o", out.string()});
     ASSERT_EQ(r.exitCode, 0) << r.err;
-    EXPECT_EQ(r.out, "stimuli: imported set 'other-renderers': 4 stimuli in 1 block(s); manifest: " +
-                         (out / "manifest.json").string() + "\ncontact sheet: " + (out / "contact.html").string() +
-                         "\n");
+    EXPECT_EQ(r.out.rfind("stimuli: imported set 'other-renderers': 4 stimuli in 1 block(s); manifest: " +
+                              (out / "manifest.json").string() + "\ncontact sheet: " + (out / "contact.html").string() +
+                              "\nstimuli: predicted: block other-renderers: 3 "
+                              "stimuli predicted ",
+                          0),
+              0u)
+        << r.out;
 
     const nlohmann::json m = readManifest(out);
     EXPECT_EQ(m.at("format"), "skinlab-stimuli");
@@ -145,6 +149,14 @@ TEST(StimuliImport, CsvTableOfPngJpegAndExrImages) {
     EXPECT_EQ(ref.at("reference"), true);
     EXPECT_EQ(ref.at("provenance").at("encoding"), "linear");
     EXPECT_EQ(ref.at("provenance").at("exposure_ev"), 1.0);
+    // Predicted visibility against the block's reference, as in a built set.
+    EXPECT_FALSE(ref.contains("predicted"));
+    for (const char* id : {"unreal-close", "unity", "photo"}) {
+        const auto& predicted = entry(m, id).at("predicted");
+        EXPECT_EQ(predicted.at("reference"), "ref") << id;
+        EXPECT_EQ(predicted.at("display"), "standard_fhd") << id;
+        EXPECT_LT(predicted.at("jod").get<double>(), 10.0) << id;
+    }
 
     // An 8-bit sRGB image keeps its codes in the PNG (alpha ignored); its EXR holds the sRGB-decoded values.
     int pw = 0, ph = 0;
@@ -198,7 +210,7 @@ TEST(StimuliImport, TomlTableWithBlocksIdsAndAnImagesFolder) {
     const fs::path table = writeText(root / "tables", "t.toml", text);
     const fs::path out = root / "set";
     CommandResult r = runSkinlab({"stimuli", "import", table.string(), "-o", out.string(), "--images",
-                                  (root / "renders").string(), "--no-contact-sheet"});
+                                  (root / "renders").string(), "--no-contact-sheet", "--no-predict"});
     ASSERT_EQ(r.exitCode, 0) << r.err;
     const nlohmann::json m = readManifest(out);
     EXPECT_EQ(m.at("set"), "unreal-skin");
@@ -211,6 +223,7 @@ TEST(StimuliImport, TomlTableWithBlocksIdsAndAnImagesFolder) {
     EXPECT_EQ(s.at("width"), 24);
     EXPECT_EQ(s.at("factors"), nlohmann::json({{"method", "m0"}, {"view", "mid"}}));
     EXPECT_EQ(entry(m, "close-m2").at("width"), 16);
+    EXPECT_FALSE(s.contains("predicted"));
     expectHashes(out, m);
 
     // --name wins over the table's name; a folder holding another set is refused.
