@@ -61,9 +61,9 @@ struct Row {
     bool reference = false;
     std::optional<std::string> encoding;
     std::optional<double> exposureEv;
-    std::optional<std::string> depth;           // image of linear view depth (first channel), as written
-    std::optional<std::string> mask;            // image of the skin mask 0..1 (first channel), as written
-    std::map<std::string, double> camera;       // f_px, mm_per_unit, sss_radius_mm
+    std::optional<std::string> depth;     // image of linear view depth (depth.Z, else the first channel), as written
+    std::optional<std::string> mask;      // image of the skin mask 0..1 (mask.Y, else the first channel), as written
+    std::map<std::string, double> camera; // f_px, mm_per_unit, sss_radius_mm
     std::map<std::string, std::string> factors; // factor → level text (absent when empty)
 };
 
@@ -262,12 +262,12 @@ struct Pixels {
     int height = 0;
     bool floatingPoint = false; // stored as half/float (EXR, HDR): linear by default
     std::vector<float> rgb;     // width × height × 3
-    std::vector<float> first;   // width × height: the first channel (a depth or mask image)
+    std::vector<float> plane;   // width × height: the `planeChannel` channel, else the first (a depth or mask image)
 };
 
 // Reads RGB of an image (R, G, B by name when present, else the first three channels, a grey image replicated;
 // alpha is ignored and never multiplied in). std::nullopt with `reason` when it cannot be read.
-std::optional<Pixels> readPixels(const fs::path& path, std::string& reason) {
+std::optional<Pixels> readPixels(const fs::path& path, std::string& reason, const std::string& planeChannel = "") {
     OIIO::ImageSpec config;
     config.attribute("oiio:UnassociatedAlpha", 1);
     auto input = OIIO::ImageInput::open(path.string(), &config);
@@ -300,11 +300,14 @@ std::optional<Pixels> readPixels(const fs::path& path, std::string& reason) {
     }
     input->close();
     p.rgb.resize(count * 3);
-    p.first.resize(count);
+    p.plane.resize(count);
+    int plane = 0; // a skinlab EXR's own depth.Z / mask.Y, so a built set's render can give its AOVs
+    for (int c = 0; c < spec.nchannels; ++c)
+        if (!planeChannel.empty() && spec.channelnames[static_cast<size_t>(c)] == planeChannel) plane = c;
     const size_t n = static_cast<size_t>(spec.nchannels);
     for (size_t i = 0; i < count; ++i) {
         for (size_t c = 0; c < 3; ++c) p.rgb[i * 3 + c] = all[i * n + static_cast<size_t>(source[c])];
-        p.first[i] = all[i * n];
+        p.plane[i] = all[i * n + static_cast<size_t>(plane)];
     }
     return p;
 }
@@ -503,14 +506,15 @@ ImportSummary importStimuli(const ImportOptions& options) {
         }
         std::vector<std::string> channels = {"R", "G", "B"};
         if (!c.depth.empty()) { // R, G, B, depth.Z, mask.Y (contract 1)
-            std::optional<Pixels> depth = readPixels(c.depth, reason), mask = readPixels(c.mask, reason);
+            std::optional<Pixels> depth = readPixels(c.depth, reason, "depth.Z"),
+                                  mask = readPixels(c.mask, reason, "mask.Y");
             if (!depth || !mask)
                 throw RuntimeError(c.path.string() + ": cannot read its AOVs any more (" + reason + ")");
             std::vector<float> all;
             all.reserve(linear.size() / 3 * 5);
-            for (size_t i = 0; i < depth->first.size(); ++i)
-                all.insert(all.end(), {linear[i * 3], linear[i * 3 + 1], linear[i * 3 + 2], depth->first[i],
-                                       std::clamp(mask->first[i], 0.0f, 1.0f)});
+            for (size_t i = 0; i < depth->plane.size(); ++i)
+                all.insert(all.end(), {linear[i * 3], linear[i * 3 + 1], linear[i * 3 + 2], depth->plane[i],
+                                       std::clamp(mask->plane[i], 0.0f, 1.0f)});
             linear = std::move(all);
             channels.insert(channels.end(), {"depth.Z", "mask.Y"});
         }

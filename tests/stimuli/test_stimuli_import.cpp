@@ -207,6 +207,23 @@ TEST(StimuliImport, TomlTableWithBlocksIdsAndAnImagesFolder) {
             text += std::string("\n[[stimulus]]\nfile = \"") + block + "/m" + std::to_string(k) + ".png\"\nid = \"" +
                     block + "-m" + std::to_string(k) + "\"\nmethod = \"m" + std::to_string(k) + "\"\nview = \"" +
                     block + "\"\nblock = \"unreal/" + block + "\"\n" + (k == 0 ? "reference = true\n" : "");
+    // The close reference takes its depth and mask from a skinlab-style EXR (R, G, B, depth.Z, mask.Y): the named
+    // channels are used, not the first one.
+    {
+        auto aov = OIIO::ImageOutput::create((root / "renders" / "aov.exr").string());
+        ASSERT_TRUE(aov);
+        OIIO::ImageSpec spec(16, 10, 5, OIIO::TypeDesc::FLOAT);
+        spec.channelnames = {"R", "G", "B", "depth.Z", "mask.Y"};
+        std::vector<float> pixels;
+        for (int i = 0; i < 16 * 10; ++i)
+            pixels.insert(pixels.end(), {0.3f, 0.2f, 0.1f, 5.0f + i, i % 2 ? 1.0f : 0.0f});
+        ASSERT_TRUE(aov->open((root / "renders" / "aov.exr").string(), spec));
+        ASSERT_TRUE(aov->write_image(OIIO::TypeDesc::FLOAT, pixels.data()));
+        ASSERT_TRUE(aov->close());
+    }
+    text.replace(text.find("reference = true\n"), 17,
+                 "reference = true\ndepth = \"aov.exr\"\nmask = \"aov.exr\"\nf_px = 12.5\nmm_per_unit = 1000\n"
+                 "sss_radius_mm = 2\n");
     const fs::path table = writeText(root / "tables", "t.toml", text);
     const fs::path out = root / "set";
     CommandResult r = runSkinlab({"stimuli", "import", table.string(), "-o", out.string(), "--images",
@@ -223,6 +240,25 @@ TEST(StimuliImport, TomlTableWithBlocksIdsAndAnImagesFolder) {
     EXPECT_EQ(s.at("width"), 24);
     EXPECT_EQ(s.at("factors"), nlohmann::json({{"method", "m0"}, {"view", "mid"}}));
     EXPECT_EQ(entry(m, "close-m2").at("width"), 16);
+    const auto& closeReference = entry(m, "close-m0");
+    EXPECT_EQ(closeReference.at("provenance").at("depth"), "aov.exr");
+    EXPECT_EQ(closeReference.at("provenance").at("f_px"), 12.5);
+    {
+        auto exr = OIIO::ImageInput::open((out / "exr" / "close-m0.exr").string());
+        ASSERT_TRUE(exr);
+        const OIIO::ImageSpec& spec = exr->spec();
+        ASSERT_EQ(spec.channelnames, (std::vector<std::string>{"R", "G", "B", "depth.Z", "mask.Y"}));
+        EXPECT_FLOAT_EQ(spec.get_float_attribute("skinlab:f_px"), 12.5f);
+        EXPECT_FLOAT_EQ(spec.get_float_attribute("skinlab:mm_per_unit"), 1000.0f);
+        EXPECT_FLOAT_EQ(spec.get_float_attribute("skinlab:sss_radius_mm"), 2.0f);
+        std::vector<float> pixels(16 * 10 * 5);
+        ASSERT_TRUE(exr->read_image(0, 0, 0, 5, OIIO::TypeDesc::FLOAT, pixels.data()));
+        for (int i = 0; i < 16 * 10; ++i) {
+            ASSERT_EQ(pixels[static_cast<size_t>(i * 5 + 3)], 5.0f + i) << i;
+            ASSERT_EQ(pixels[static_cast<size_t>(i * 5 + 4)], i % 2 ? 1.0f : 0.0f) << i;
+        }
+    }
+    EXPECT_FALSE(entry(m, "close-m1").at("provenance").contains("depth"));
     EXPECT_FALSE(s.contains("predicted"));
     expectHashes(out, m);
 
