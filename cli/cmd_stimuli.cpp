@@ -1,4 +1,5 @@
-// `skinlab stimuli build|list|merge|contact|slurm|status|calibrate` (and `import`, cmd_stimuli_import.cpp): stimulus sets (docs/stimuli.md).
+// `skinlab stimuli build|list|merge|contact|slurm|status|calibrate`: stimulus sets (docs/stimuli.md). `import`: in
+// cmd_stimuli_import.cpp.
 #include "analysis/metrics/cvvdp.h"
 #include "cli/commands.h"
 #include "common/error.h"
