@@ -1,4 +1,5 @@
-// `skinlab stimuli build|list|merge|contact|slurm|status|calibrate`: stimulus sets (docs/stimuli.md).
+// `skinlab stimuli build|list|merge|contact|slurm|status|calibrate`: stimulus sets (docs/stimuli.md). `import`: in
+// cmd_stimuli_import.cpp.
 #include "analysis/metrics/cvvdp.h"
 #include "cli/commands.h"
 #include "common/error.h"
@@ -384,6 +385,8 @@ void registerStimuli(CLI::App& app) {
                           "Id of the stimulus whose key varies (default: the first that is not a reference)");
     calibrate->add_option("-o,--output", options->output, "Write the [[factor]] snippet to this file (atomically)");
     calibrate->callback([options] { runCalibrate(*options); });
+
+    registerStimuliImport(*stimuli); // cmd_stimuli_import.cpp
 }
 
 } // namespace skinlab::cli

@@ -19,4 +19,6 @@ namespace skinlab::cli {
 void registerAnalyzeScale(CLI::App& analyze);     // scale, validate
 void registerAnalyzeMetrics(CLI::App& analyze);   // metrics
 void registerAnalyzeAgreement(CLI::App& analyze); // agreement
+// `skinlab stimuli import`, registered by cmd_stimuli.cpp on the `stimuli` subcommand.
+void registerStimuliImport(CLI::App& stimuli);
 } // namespace skinlab::cli
