@@ -112,14 +112,14 @@ std::vector<ParticipantPrediction> participantPredictions(const nlohmann::json& 
                      .first;
         return it->second.beauty;
     };
-    std::map<long, std::vector<double>> byPpd; // predictions per ppd (rounded to 0.1), in `predicted` order
+    std::map<double, std::vector<double>> byPpd; // predictions per distinct ppd, in `predicted` order
     for (const auto& [observer, ppd] : viewing) {
-        const long key = std::lround(ppd * 10.0);
+        const double key = ppd;
         if (!byPpd.count(key)) {
             std::vector<double> jods;
             for (const Predicted& p : predicted) {
                 metrics::CvvdpDisplayOverrides overrides;
-                overrides.pixelsPerDegree = double(key) / 10.0;
+                overrides.pixelsPerDegree = key;
                 const metrics::CvvdpDisplay display =
                     metrics::applyCvvdpOverrides(metrics::cvvdpDisplay(p.display), overrides);
                 jods.push_back(metrics::cvvdp(image(p.referencePng), image(p.png), display, false).jod);
