@@ -1,6 +1,8 @@
 // Every command-line error of every `skinlab` subcommand — an unknown option, a value out of range or not in the
 // allowed set, a missing argument, a missing subcommand — exits with status 2 and one line on stderr (README.md),
 // whatever code CLI11 gives the error; --help and --version still exit 0.
+#include "tests/common/cli_run.h"
+
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -10,21 +12,8 @@
 
 namespace {
 
-struct CliRun {
-    int exitCode = -1;
-    std::string output; // stdout and stderr
-};
-
-CliRun run(const std::string& arguments) {
-    const std::string command = std::string(SKINLAB_CLI) + " " + arguments + " 2>&1";
-    CliRun result;
-    FILE* pipe = popen(command.c_str(), "r");
-    char buffer[4096];
-    while (size_t n = fread(buffer, 1, sizeof buffer, pipe)) result.output.append(buffer, n);
-    const int status = pclose(pipe);
-    result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return result;
-}
+using skinlab::test_support::CliRun;
+CliRun run(const std::string& arguments) { return skinlab::test_support::runCli(arguments); }
 
 TEST(CliErrors, EverySubcommandExitsTwoWithOneLine) {
     const std::vector<std::string> cases = {

@@ -45,11 +45,19 @@ struct StudyFiles {
         writeStimulusSet(stimuli);
         design = writeText(folder.path(), "design.toml", kDesign);
     }
+    // `skinlab study create` of this set and design into `database`; the exit code.
+    int create() const;
 };
 
 CommandResult runSkinlab(std::vector<std::string> arguments) {
     arguments.insert(arguments.begin(), SKINLAB_CLI);
     return runCommand(arguments);
+}
+
+int StudyFiles::create() const {
+    return runSkinlab(
+               {"study", "create", "--stimuli", stimuli.string(), "--design", design.string(), "-o", database.string()})
+        .exitCode;
 }
 
 // Starts `skinlab study serve` and returns the port it printed.
@@ -131,10 +139,7 @@ TEST(StudyCli, CreateStatusExportAndTheirErrors) {
 
 TEST(StudyCli, KillNineDuringASessionLosesAndDuplicatesNothing) {
     StudyFiles files;
-    ASSERT_EQ(runSkinlab({"study", "create", "--stimuli", files.stimuli.string(), "--design", files.design.string(),
-                          "-o", files.database.string()})
-                  .exitCode,
-              0);
+    ASSERT_EQ(files.create(), 0);
     std::unique_ptr<ChildProcess> server;
     const int port = startServer(server, files.database, 0);
     ASSERT_GT(port, 0);
@@ -260,10 +265,7 @@ void readWhileServing(const StudyFiles& files, int port, int round) {
 // hold a descriptor of a removed study file.
 TEST(StudyCli, ReadersWhileServingNeitherLoseNorDuplicateAnswers) {
     StudyFiles files;
-    ASSERT_EQ(runSkinlab({"study", "create", "--stimuli", files.stimuli.string(), "--design", files.design.string(),
-                          "-o", files.database.string()})
-                  .exitCode,
-              0);
+    ASSERT_EQ(files.create(), 0);
     std::unique_ptr<ChildProcess> server;
     const int port = startServer(server, files.database, 0);
     ASSERT_GT(port, 0);
@@ -349,10 +351,7 @@ TEST(StudyCli, ReadersWhileServingNeitherLoseNorDuplicateAnswers) {
 TEST(StudyCli, ResearcherTokenFromAFileOrTheEnvironmentAndPrivateFiles) {
     StudyFiles files;
     const mode_t previous = ::umask(022);
-    ASSERT_EQ(runSkinlab({"study", "create", "--stimuli", files.stimuli.string(), "--design", files.design.string(),
-                          "-o", files.database.string()})
-                  .exitCode,
-              0);
+    ASSERT_EQ(files.create(), 0);
     auto mode = [](const fs::path& file) { return fs::status(file).permissions() & fs::perms::all; };
     EXPECT_EQ(mode(files.database), fs::perms::owner_read | fs::perms::owner_write);
 

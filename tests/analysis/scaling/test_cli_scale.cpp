@@ -2,6 +2,8 @@
 // a bad file → exit 2 and one line naming it; an existing output folder is never left half-written.
 #include "analysis/scaling/simulation.h"
 
+#include "tests/common/cli_run.h"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -22,21 +24,8 @@ fs::path scratch() {
     return folder;
 }
 
-struct CliRun {
-    int exitCode = -1;
-    std::string output; // stdout and stderr
-};
-
-CliRun run(const std::string& arguments) {
-    const std::string command = std::string(SKINLAB_CLI) + " " + arguments + " 2>&1";
-    CliRun result;
-    FILE* pipe = popen(command.c_str(), "r");
-    char buffer[4096];
-    while (size_t n = fread(buffer, 1, sizeof buffer, pipe)) result.output.append(buffer, n);
-    const int status = pclose(pipe);
-    result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return result;
-}
+using skinlab::test_support::CliRun;
+CliRun run(const std::string& arguments) { return skinlab::test_support::runCli(arguments); }
 
 // Contract-3 CSV from simulated observers, two blocks, with sides, a catch trial per observer.
 std::string simulatedCsv() {
