@@ -1,4 +1,5 @@
 // `skinlab analyze metrics`: image-difference metrics of renders against a reference (docs/metrics.md).
+#include "analysis/metrics/debiased_error.h"
 #include "analysis/metrics/metrics_run.h"
 #include "cli/commands.h"
 #include "common/error.h"
@@ -17,6 +18,8 @@ namespace {
 
 struct AnalyzeMetricsArguments {
     std::string reference;
+    std::vector<std::string> referenceSeeds;
+    std::string compareReference;
     std::vector<std::string> tests;
     std::string stimulusFolder;
     std::string outputFolder;
@@ -72,7 +75,30 @@ metrics::CvvdpDisplay displayOf(const AnalyzeMetricsArguments& arguments) {
     return metrics::applyCvvdpOverrides(metrics::cvvdpDisplay(arguments.display), overrides);
 }
 
+// --reference-seeds: every test against the path-traced truth without its noise (docs/metrics.md).
+void runDebiased(const AnalyzeMetricsArguments& arguments) {
+    if (!arguments.reference.empty())
+        throwInput("--reference", "", "cannot be combined with --reference-seeds (the seeds are the reference)");
+    if (!arguments.stimulusFolder.empty())
+        throwInput("--stimuli", "", "cannot be combined with --reference-seeds; give the test renders as files");
+    std::vector<std::filesystem::path> seeds(arguments.referenceSeeds.begin(), arguments.referenceSeeds.end());
+    std::vector<std::filesystem::path> tests(arguments.tests.begin(), arguments.tests.end());
+    metrics::DebiasedRunOptions options;
+    options.exposure = arguments.exposure;
+    if (arguments.sssRadiusMillimetres) {
+        if (!(*arguments.sssRadiusMillimetres > 0.0))
+            throwInput("--sss-radius-mm", "", std::to_string(*arguments.sssRadiusMillimetres) + " must be positive");
+        options.sssRadiusMillimetres = *arguments.sssRadiusMillimetres;
+    }
+    options.compareReference = arguments.compareReference;
+    const auto run = metrics::runDebiasedMetrics(seeds, tests, options, arguments.outputFolder);
+    spdlog::info("metrics: {} render(s) scored against {} path-traced seeds; {}/debiased.csv and debiased.json",
+                 run.tests.size(), seeds.size(), arguments.outputFolder);
+}
+
 void runAnalyzeMetrics(const AnalyzeMetricsArguments& arguments) {
+    if (!arguments.referenceSeeds.empty()) return runDebiased(arguments);
+    if (!arguments.compareReference.empty()) throwInput("--compare-reference", "", "only with --reference-seeds");
     const metrics::CvvdpDisplay display = displayOf(arguments); // option errors before any file is read
     metrics::ComparisonPlan plan;
     if (!arguments.stimulusFolder.empty()) {
@@ -125,6 +151,17 @@ void registerAnalyzeMetrics(CLI::App& analyze) {
     command->add_option("--reference", arguments->reference,
                         "Reference EXR (with depth.Z, mask.Y and skinlab:f_px/mm_per_unit/sss_radius_mm); with "
                         "--stimuli: the id of the reference stimulus (default: each block's \"reference\": true)");
+    command
+        ->add_option("--reference-seeds", arguments->referenceSeeds,
+                     "Path-traced renders of one scene with different seeds (two or more; four or more for "
+                     "standard errors): score the tests against the noise-free image without the noise's bias "
+                     "(debiased.csv, debiased.json); comma-separated or repeated")
+        ->delimiter(',')
+        ->allow_extra_args(false);
+    command->add_option("--compare-reference", arguments->compareReference,
+                        "With --reference-seeds: another ground truth of the same scene (e.g. the object-space "
+                        "reference render): each test's paired difference from it, and the agreement of the tests' "
+                        "rankings under the two truths (Kendall's tau with its interval)");
     command->add_option("--stimuli", arguments->stimulusFolder,
                         "Stimulus set folder (manifest.json): compare every stimulus with its block's reference");
     command

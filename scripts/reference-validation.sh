@@ -30,6 +30,8 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 out="${1:-out/reference-validation}"
 size="${2:-256}"
 samples="${3:-64}"
+seeds="${SEEDS:-4}"
+[ "$seeds" -ge 2 ] 2>/dev/null || { echo "reference-validation: SEEDS=$seeds must be at least 2" >&2; exit 2; }
 skinlab="${SKINLAB:-$root/build/release/cli/skinlab}"
 [ -x "$skinlab" ] || { echo "reference-validation: $skinlab not found (build it: scripts/build.sh, or set SKINLAB)" >&2; exit 2; }
 command -v python3 > /dev/null || { echo "reference-validation: python3 is needed to write the table" >&2; exit 2; }
@@ -313,21 +315,28 @@ for name in $cases; do
   echo "reference-validation: $name: stimuli in $((SECONDS - start)) s" >&2
   render_once "$dir/pathtraced.exr" "$dir/ref.toml" 'sss.method="pathtraced"' 'pathtraced.seed=0'
   render_once "$dir/pathtraced-seed1.exr" "$dir/ref.toml" 'sss.method="pathtraced"' 'pathtraced.seed=1'
+  for seed in $(seq 2 $((seeds - 1))); do
+    render_once "$dir/pathtraced-seed$seed.exr" "$dir/ref.toml" 'sss.method="pathtraced"' "pathtraced.seed=$seed"
+  done
   ref_exr="$(python3 -c 'import json,sys; m=json.load(open(sys.argv[1])); print(next(s["files"]["exr"] for s in m["stimuli"] if s["reference"]))' "$dir/set/manifest.json")"
   tests=()
   while IFS= read -r f; do tests+=("$dir/set/$f"); done < <(python3 -c 'import json,sys; m=json.load(open(sys.argv[1])); [print(s["files"]["exr"]) for s in m["stimuli"] if not s["reference"]]' "$dir/set/manifest.json")
   "$skinlab" analyze metrics --reference "$dir/set/$ref_exr" "${tests[@]}" -o "$dir/metrics-reference" > /dev/null
   "$skinlab" analyze metrics --reference "$dir/pathtraced.exr" "${tests[@]}" "$dir/set/$ref_exr" "$dir/pathtraced-seed1.exr" \
     -o "$dir/metrics-pathtraced" > /dev/null
+  seed_files="$dir/pathtraced.exr"
+  for seed in $(seq 1 $((seeds - 1))); do seed_files+=",$dir/pathtraced-seed$seed.exr"; done
+  "$skinlab" analyze metrics --reference-seeds "$seed_files" --compare-reference "$dir/set/$ref_exr" "${tests[@]}" \
+    -o "$dir/metrics-debiased" > /dev/null
   ran+=("$name")
 done
 
-python3 - "$out" "$size" "$samples" "${ran[@]}" <<'PYTHON'
+python3 - "$out" "$size" "$samples" "$seeds" "${ran[@]}" <<'PYTHON'
 # The table: per-band disagreement of `reference` with `pathtraced` (next to the path tracer's own noise), and
 # Kendall's τ_b between the rankings of the 24 conditions under the two references, per score.
 import json, os, sys
 
-out, size, samples, cases = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4:]
+out, size, samples, seeds, cases = sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4]), sys.argv[5:]
 bands = ["halo", "bleed", "spill", "interior"]
 
 def load(path):
@@ -424,6 +433,34 @@ for name in cases:
         per_condition.append(f"| {name} | {k} | {number(band(a, 'halo', 'leak_energy'))} / {number(band(p, 'halo', 'leak_energy'))} | "
                              f"{number(band(a, 'bleed', 'leak_energy'))} / {number(band(p, 'bleed', 'leak_energy'))} | "
                              f"{number(a['skin']['delta_e00_mean'])} / {number(p['skin']['delta_e00_mean'])} |")
+# Debiased: every condition's squared luminance error against the noise-free path-traced image (pairs of seeds,
+# `analyze metrics --reference-seeds`), the reference's own, and the rankings' agreement with the jackknife interval.
+debiased = ["", f"## Debiased rankings against `pathtraced` ({seeds} seeds): Kendall's τ_b with its 95 % jackknife interval", "",
+            "MSE of Y over the band against the noise-free path-traced image (mean over pairs of seeds of "
+            "(a − r_i)(a − r_j)); `reference`'s own MSE ± its standard error; τ_b between the 24 conditions' MSE against "
+            "`reference` and their debiased MSE against `pathtraced`; pairs Cycles separates (|D| > 1.96 SE) and "
+            "the share of them ranked the same way by `reference`; conditions scoring better than `reference` itself.", "",
+            "| case | band | `reference` MSE ± SE | conditions' MSE min / median / max | τ_b [95 % interval] | separated pairs: same order | better than `reference` |",
+            "|---|---|---|---|---|---|---|"]
+for name in cases:
+    path_json = os.path.join(out, name, "metrics-debiased", "debiased.json")
+    if not os.path.exists(path_json): continue
+    d = json.load(open(path_json))
+    for b in bands + ["skin"]:
+        ref = d["compared_reference"]["regions"][b]
+        if not ref["pixels"]: continue
+        values = sorted(t["regions"][b]["mse"]["value"] for t in d["tests"])
+        agree = d["ranking_agreement"][b]
+        tau = agree["tau_b"]["value"]
+        interval = agree["tau_b_interval_95"]
+        better = sum(1 for t in d["tests"] if t["regions"][b]["difference_from_compared"]["value"] is not None
+                     and t["regions"][b]["difference_from_compared"]["value"] + 1.96 * (t["regions"][b]["difference_from_compared"]["standard_error"] or 0) < 0)
+        sep, same = agree["separated_pairs"], agree["concordant_separated_pairs"]
+        debiased.append(f"| {name} | {b} | {number(ref['mse']['value'])} ± {number(ref['mse']['standard_error'])} | "
+                        f"{number(values[0])} / {number(values[len(values) // 2])} / {number(values[-1])} | "
+                        + ("–" if tau is None else f"{tau:+.2f}") + ("" if not interval else f" [{interval[0]:+.2f}, {interval[1]:+.2f}]")
+                        + f" | {same}/{sep} | {better} |")
+lines += debiased
 path = os.path.join(out, "reference-validation.md")
 with open(path + ".tmp", "w") as f:
     f.write("\n".join(lines + taus + levels + per_condition) + "\n")

@@ -149,6 +149,60 @@ std::string displayList() {
 }
 
 // Bad input: exit code 2 and exactly one line naming the file and the channel, attribute or size at fault.
+// --reference-seeds: the tests against several noisy copies of the truth; --compare-reference ranks them against a
+// second truth. The halo render is worse than the exact one under both.
+TEST_F(AnalyzeMetricsCommand, ScoresAgainstSeededTruthsAndComparesRankings) {
+    std::string seeds;
+    for (int seed = 0; seed < 4; ++seed) {
+        testing::SyntheticRender noisy = reference;
+        noisy.beauty = reference.beauty.clone();
+        cv::Mat noise(noisy.beauty.size(), CV_32FC3);
+        cv::theRNG().state = 77 + seed;
+        cv::randn(noise, 0.0, 0.03);
+        noisy.beauty += noise;
+        const std::string name = "exr/seed" + std::to_string(seed) + ".exr";
+        testing::writeSyntheticExr(path(name), noisy);
+        seeds += (seed ? "," : "") + path(name);
+    }
+    testing::writeSyntheticExr(path("exr/reference.exr"), reference);
+    testing::writeSyntheticExr(path("exr/halo.exr"), blurred);
+    CommandResult run =
+        runSkinlab("analyze metrics --reference-seeds " + seeds + " --compare-reference " + path("exr/reference.exr") +
+                   " " + path("exr/halo.exr") + " " + path("exr/reference.exr") + " -o " + path("seeded"));
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    const auto json = nlohmann::json::parse(readFile(path("seeded/debiased.json")));
+    ASSERT_EQ(json["seeds"].size(), 4u);
+    ASSERT_EQ(json["tests"].size(), 2u);
+    const auto& halo = json["tests"][0]["regions"]["halo"];
+    const auto& exact = json["tests"][1]["regions"]["halo"];
+    EXPECT_GT(halo["mse"]["value"].get<double>(), 0.0);
+    EXPECT_NEAR(exact["mse"]["value"].get<double>(), 0.0, 3.0 * exact["mse"]["standard_error"].get<double>() + 1e-9);
+    // One noisy seed alone adds its variance (0.03² in each channel, so in Y) to the exact render's error.
+    EXPECT_GT(exact["plain_mse_one_seed"].get<double>(), 0.5 * 0.03 * 0.03);
+    EXPECT_GT(halo["difference_from_compared"]["value"].get<double>(),
+              1.96 * halo["difference_from_compared"]["standard_error"].get<double>());
+    EXPECT_EQ(json["ranking_agreement"]["halo"]["tau_b"]["value"], 1.0);
+    EXPECT_TRUE(fs::exists(path("seeded/debiased.csv")));
+
+    // One seed, or seeds with --reference: one line, exit 2, nothing written.
+    CommandResult one = runSkinlab("analyze metrics --reference-seeds " + path("exr/seed0.exr") + " " +
+                                   path("exr/halo.exr") + " -o " + path("one"));
+    EXPECT_EQ(one.exitCode, 2) << one.output;
+    EXPECT_NE(one.output.find("--reference-seeds: needs at least two"), std::string::npos) << one.output;
+    EXPECT_FALSE(fs::exists(path("one/debiased.json")));
+    CommandResult both = runSkinlab("analyze metrics --reference " + path("exr/reference.exr") + " --reference-seeds " +
+                                    seeds + " " + path("exr/halo.exr") + " -o " + path("both"));
+    EXPECT_EQ(both.exitCode, 2) << both.output;
+    EXPECT_NE(both.output.find("--reference: cannot be combined with --reference-seeds"), std::string::npos)
+        << both.output;
+    CommandResult compareOnly =
+        runSkinlab("analyze metrics --reference " + path("exr/reference.exr") + " --compare-reference " +
+                   path("exr/reference.exr") + " " + path("exr/halo.exr") + " -o " + path("compare"));
+    EXPECT_EQ(compareOnly.exitCode, 2) << compareOnly.output;
+    EXPECT_NE(compareOnly.output.find("--compare-reference: only with --reference-seeds"), std::string::npos)
+        << compareOnly.output;
+}
+
 TEST_F(AnalyzeMetricsCommand, BadInputsFailWithOneLineNamingFileAndChannel) {
     testing::writeSyntheticExr(path("exr/reference.exr"), reference);
     testing::writeSyntheticExr(path("exr/no-depth.exr"), reference, {{"depth.Z"}, {}});

@@ -1,0 +1,158 @@
+// Scoring against several path-traced seeds: the debiased squared error has no noise bias, its jackknife error
+// covers the truth, paired differences and rankings follow the noise-free image (docs/metrics.md).
+#include "analysis/metrics/debiased_error.h"
+#include "common/error.h"
+#include "synthetic_render.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+namespace skinlab::metrics {
+namespace {
+namespace fs = std::filesystem;
+
+class DebiasedError : public ::testing::Test {
+protected:
+    void SetUp() override {
+        folder =
+            fs::temp_directory_path() / ("skinlab-debiased-" + std::to_string(::getpid()) + "-" +
+                                         std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+        fs::remove_all(folder);
+        fs::create_directories(folder);
+        scene.size = 96;
+        scene.farPlaneIsSkin = false;
+        truth = testing::renderDiscScene(scene);
+    }
+    void TearDown() override { fs::remove_all(folder); }
+
+    // The noise-free render plus independent Gaussian noise of standard deviation `sigma` per pixel and channel.
+    fs::path writeSeed(int seed, double sigma, int replicate = 0) {
+        testing::SyntheticRender noisy = truth;
+        noisy.beauty = truth.beauty.clone();
+        std::mt19937 random(static_cast<unsigned>(1000 * replicate + seed + 1));
+        std::normal_distribution<float> noise(0.0f, static_cast<float>(sigma));
+        for (int y = 0; y < noisy.height; ++y)
+            for (int x = 0; x < noisy.width; ++x) {
+                // The same noise on R, G and B: the luminance noise is sigma.
+                const float n = noise(random);
+                auto& pixel = noisy.beauty.at<cv::Vec3f>(y, x);
+                pixel += cv::Vec3f(n, n, n);
+            }
+        const fs::path path = folder / ("seed" + std::to_string(replicate) + "-" + std::to_string(seed) + ".exr");
+        testing::writeSyntheticExr(path, noisy);
+        return path;
+    }
+    // The noise-free render with `offset` added to every skin pixel (a luminance error of exactly `offset`).
+    cv::Mat offsetLuminance(double offset) const {
+        MetricRender render;
+        render.beauty = truth.beauty.clone();
+        for (int y = 0; y < truth.height; ++y)
+            for (int x = 0; x < truth.width; ++x)
+                if (truth.mask.at<float>(y, x) >= 0.5f)
+                    render.beauty.at<cv::Vec3f>(y, x) += cv::Vec3f(float(offset), float(offset), float(offset));
+        return renderLuminance(render, 1.0);
+    }
+    static constexpr std::size_t skin = 4;
+
+    fs::path folder;
+    testing::DiscScene scene;
+    testing::SyntheticRender truth;
+};
+
+TEST_F(DebiasedError, UnbiasedWhereOneNoisySeedIsNotAndTheJackknifeCoversIt) {
+    const double sigma = 0.05;
+    const double offset = 0.02; // true MSE on skin 4e-4, well below the noise variance 2.5e-3
+    int covered = 0;
+    double meanDebiased = 0.0;
+    double meanPlain = 0.0;
+    const int replicates = 12;
+    for (int replicate = 0; replicate < replicates; ++replicate) {
+        std::vector<fs::path> seeds;
+        for (int seed = 0; seed < 4; ++seed) seeds.push_back(writeSeed(seed, sigma, replicate));
+        const SeededTruth seeded = loadSeededTruth(seeds, 1.0, 0.0);
+        const DebiasedScores scores = scoreDebiased(seeded, offsetLuminance(offset), "offset.exr");
+        ASSERT_EQ(scores.mse[skin].leaveOneOut.size(), 4u);
+        ASSERT_GT(scores.pixels[skin], 1000u);
+        meanDebiased += scores.mse[skin].value / replicates;
+        meanPlain += scores.plainMse[skin] / replicates;
+        if (std::abs(scores.mse[skin].value - offset * offset) <= 2.5 * scores.mse[skin].standardError) ++covered;
+    }
+    // One noisy seed adds its variance to the error; the pairs of seeds do not.
+    EXPECT_NEAR(meanPlain, offset * offset + sigma * sigma, 0.1 * sigma * sigma);
+    EXPECT_NEAR(meanDebiased, offset * offset, 0.1 * offset * offset);
+    EXPECT_GE(covered, 10) << "jackknife intervals covered the true squared error in " << covered << " of "
+                           << replicates;
+}
+
+TEST_F(DebiasedError, PairedDifferencesAndRankingsFollowTheNoiseFreeImage) {
+    std::vector<fs::path> seeds;
+    for (int seed = 0; seed < 4; ++seed) seeds.push_back(writeSeed(seed, 0.05));
+    const SeededTruth seeded = loadSeededTruth(seeds, 1.0, 0.0);
+    // Five conditions whose true errors grow 0.004 … 0.02; the compared truth ranks them the same way.
+    std::vector<DebiasedScores> scores;
+    std::vector<double> other;
+    for (int k = 1; k <= 5; ++k) {
+        scores.push_back(scoreDebiased(seeded, offsetLuminance(0.004 * k), "c" + std::to_string(k)));
+        other.push_back(k * 1.0);
+    }
+    const JackknifeEstimate difference = debiasedDifference(scores[4], scores[0], skin);
+    EXPECT_NEAR(difference.value, 0.02 * 0.02 - 0.004 * 0.004, 3.0 * difference.standardError + 1e-6);
+    EXPECT_GT(difference.value, 1.96 * difference.standardError);
+    const RankingAgreement agreement = rankingAgreement(scores, other, skin);
+    EXPECT_EQ(agreement.conditions, 5u);
+    EXPECT_DOUBLE_EQ(agreement.tau.value, 1.0);
+    EXPECT_EQ(agreement.tau.leaveOneOut.size(), 4u);
+    EXPECT_GE(agreement.separatedPairs, 8u);
+    EXPECT_EQ(agreement.concordantSeparated, agreement.separatedPairs);
+    // The reversed ranking disagrees completely.
+    std::vector<double> reversed(other.rbegin(), other.rend());
+    EXPECT_DOUBLE_EQ(rankingAgreement(scores, reversed, skin).tau.value, -1.0);
+}
+
+TEST(KendallTau, TiesAndKnownValues) {
+    EXPECT_DOUBLE_EQ(kendallTauB({1, 2, 3, 4}, {1, 2, 3, 4}), 1.0);
+    EXPECT_DOUBLE_EQ(kendallTauB({1, 2, 3, 4}, {4, 3, 2, 1}), -1.0);
+    // scipy.stats.kendalltau([1, 2, 3, 4, 5], [3, 1, 2, 5, 4]) = 0.4
+    EXPECT_NEAR(kendallTauB({1, 2, 3, 4, 5}, {3, 1, 2, 5, 4}), 0.4, 1e-12);
+    // With ties: scipy.stats.kendalltau([1, 1, 2, 3], [1, 2, 2, 3]) = 0.8
+    EXPECT_NEAR(kendallTauB({1, 1, 2, 3}, {1, 2, 2, 3}), 0.8, 1e-12);
+    EXPECT_TRUE(std::isnan(kendallTauB({1, 1}, {2, 3})));
+}
+
+TEST_F(DebiasedError, RefusesOneSeedRepeatedSeedsAndOtherSizes) {
+    const fs::path a = writeSeed(0, 0.01);
+    const fs::path b = writeSeed(1, 0.01);
+    try {
+        loadSeededTruth({a}, 1.0, 0.0);
+        FAIL() << "one seed accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("--reference-seeds"), std::string::npos) << e.what();
+    }
+    try {
+        loadSeededTruth({a, b, a}, 1.0, 0.0);
+        FAIL() << "a repeated seed accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("given twice"), std::string::npos) << e.what();
+    }
+    testing::DiscScene small = scene;
+    small.size = 64;
+    const fs::path other = folder / "small.exr";
+    testing::writeSyntheticExr(other, testing::renderDiscScene(small));
+    try {
+        loadSeededTruth({a, other}, 1.0, 0.0);
+        FAIL() << "a seed of another size accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("small.exr"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("64x64"), std::string::npos) << e.what();
+    }
+}
+
+} // namespace
+} // namespace skinlab::metrics
