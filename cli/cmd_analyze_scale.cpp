@@ -1,6 +1,7 @@
 // `skinlab analyze scale RESPONSES -o DIR` and `skinlab analyze validate` (docs/analysis.md).
 #include "analysis/scaling/scale_analysis.h"
 #include "analysis/scaling/scale_report.h"
+#include "analysis/scaling/screening.h"
 #include "analysis/scaling/validation.h"
 #include "cli/commands.h"
 #include "common/error.h"
@@ -37,6 +38,7 @@ struct ScaleArguments {
     bool singleBlock = false;
     std::vector<std::string> conditions;
     bool dropFlagged = false;
+    bool keepExcluded = false;
     std::string intervals = "auto";
 };
 
@@ -84,6 +86,10 @@ void runScale(const ScaleArguments& arguments) {
                         dropped.dropped, table.responses.size());
         else std::printf("dropped 0 flagged trials: %s records no page-hidden or focus flags\n", table.file.c_str());
     }
+    if (!arguments.keepExcluded)
+        for (const scaling::ExcludedObserver& e : scaling::excludeObservers(table))
+            std::printf("excluded observer %s: %s (the protocol's rule; --no-exclusion keeps them)\n",
+                        e.observer.c_str(), e.reason.c_str());
     // Likelihood-based intervals stay valid when each observer's pairs depended on earlier answers; the observer
     // bootstrap does not (docs/analysis.md, "Validation of active designs").
     if (arguments.intervals == "percentile") {
@@ -266,6 +272,10 @@ void registerAnalyzeScale(CLI::App& analyze) {
         ->add_option("--conditions", scaleArguments->conditions,
                      "the conditions in display order; any other condition in the file is an error")
         ->delimiter(',');
+    scale->add_flag(
+        "--no-exclusion", scaleArguments->keepExcluded,
+        "scale every observer, also those the protocol's rule excludes (no scaled answers, or more than "
+        "one failed catch trial in four; by default they are left out, as in the dashboard and the report)");
     scale->add_flag("--drop-flagged", scaleArguments->dropFlagged,
                     "leave out trials during which the page was hidden or lost the focus (online studies)");
     scale

@@ -2,6 +2,7 @@
 
 #include "analysis/scaling/responses.h"
 #include "analysis/scaling/scale_analysis.h"
+#include "analysis/scaling/screening.h"
 #include "common/error.h"
 #include "experiments/sqlite_database.h"
 #include "experiments/study_store.h"
@@ -211,6 +212,7 @@ json StudyDashboard::computeScale() const {
     try {
         // The same reading as `skinlab analyze scale study.db` (VIEW responses_long, its own read-only connection).
         table = scaling::readResponses(store_.path());
+        scaling::excludeObservers(table); // the protocol's rule, as `analyze scale` and `report` apply it
         dataset = scaling::buildDataset(table, {});
     } catch (const InputError& e) {
         // No test answers yet: nothing to scale, which is not an error.

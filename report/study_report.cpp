@@ -2,6 +2,7 @@
 
 #include "analysis/agreement/metric_agreement.h"
 #include "analysis/metrics/metrics_run.h"
+#include "analysis/scaling/screening.h"
 #include "analysis/scaling/scale_analysis.h"
 #include "analysis/scaling/scale_report.h"
 #include "common/error.h"
@@ -174,7 +175,7 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
     const fs::path out = options.output;
     ensureDirectory(out);
 
-    // --- Participants and exclusions (catch trials: more than one failure in four excludes; protocol rule). ---
+    // --- Participants and exclusions (scaling::exclusionReason: no answers, or more than one failed catch trial in four). ---
     std::vector<Observer> observers;
     std::map<std::string, std::size_t> observerIndex;
     for (const experiments::ParticipantStatus& status : store.status()) {
@@ -184,14 +185,11 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
         o.total = status.progress.total;
         o.catchAnswered = status.catchAnswered;
         o.catchCorrect = status.catchCorrect;
-        int failures = o.catchAnswered - o.catchCorrect;
-        if (o.answered == 0) {
+        // The protocol's rule, the same function `analyze scale` and the dashboard apply.
+        if (auto reason = scaling::exclusionReason(o.answered - o.catchAnswered, o.catchAnswered,
+                                                   o.catchAnswered - o.catchCorrect)) {
             o.excluded = true;
-            o.reason = "no answers";
-        } else if (o.catchAnswered > 0 && 4 * failures > o.catchAnswered) {
-            o.excluded = true;
-            o.reason =
-                "failed " + std::to_string(failures) + " of " + std::to_string(o.catchAnswered) + " catch trials";
+            o.reason = *reason;
         }
         observerIndex[o.label] = observers.size();
         observers.push_back(o);

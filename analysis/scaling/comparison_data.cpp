@@ -100,6 +100,7 @@ Dataset buildDataset(const ResponseTable& table, const DatasetOptions& options) 
     Dataset dataset;
     dataset.file = table.file;
     dataset.format = table.format;
+    dataset.excluded = table.excludedObservers;
     if (table.format == ResponseFormat::CountMatrix) {
         dataset.blocks.push_back(blockFromMatrix(table, options));
         if (!options.onlyBlock.empty() && options.onlyBlock != dataset.blocks.front().name)

@@ -51,6 +51,7 @@ struct Dataset {
     std::vector<BlockData> blocks;
     std::vector<ObserverAttention> attention; // in first-appearance order
     bool hasSides = false;                    // any trial with a known A_on_left
+    std::vector<ExcludedObserver> excluded;   // left out by the protocol's rule before the dataset was built
 };
 
 struct DatasetOptions {

@@ -38,6 +38,12 @@ struct Response {
 enum class ResponseFormat { StudyDatabase, SkinlabCsv, PwcmpCsv, CountMatrix, SkinlabJson };
 const char* responseFormatName(ResponseFormat format);
 
+// An observer left out of the scale by the protocol's exclusion rule (screening.h, excludeObservers).
+struct ExcludedObserver {
+    std::string observer;
+    std::string reason;
+};
+
 struct ResponseTable {
     std::string file; // as given, used as the prefix of every error message
     ResponseFormat format = ResponseFormat::SkinlabCsv;
@@ -51,6 +57,8 @@ struct ResponseTable {
     std::map<std::string, std::vector<std::string>> designConditionOrder;
     // Long CSVs: header columns that were not read (pwcmp's session_id, criterion, ...), for a note to the user.
     std::vector<std::string> ignoredColumns;
+    // Observers whose responses excludeObservers removed, with the reason.
+    std::vector<ExcludedObserver> excludedObservers;
 };
 
 struct ReadOptions {

@@ -348,6 +348,7 @@ Analysis analyzeDataset(const Dataset& dataset, const AnalysisOptions& options) 
     Analysis analysis;
     analysis.file = dataset.file;
     analysis.format = dataset.format;
+    analysis.excluded = dataset.excluded;
     analysis.options = options;
     std::map<std::string, size_t> observerIndex;
     auto observer = [&](const std::string& name) -> ObserverSummary& {

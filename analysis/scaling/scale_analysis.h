@@ -99,7 +99,8 @@ struct Analysis {
     std::vector<BlockAnalysis> blocks;
     std::vector<ObserverSummary> observers;
     OutlierRule screeningRule;
-    std::vector<std::string> warnings; // every block's warnings too, prefixed by the block name
+    std::vector<ExcludedObserver> excluded; // observers the protocol's rule left out (not scaled)
+    std::vector<std::string> warnings;      // every block's warnings too, prefixed by the block name
 };
 
 BlockAnalysis analyzeBlock(const BlockData& block, const AnalysisOptions& options);

@@ -230,6 +230,9 @@ nlohmann::json analysisJson(const Analysis& analysis) {
              {"catch_trials", s.catchTrials},
              {"catch_failures", s.catchFailures},
              {"left_rate", s.sideTrials > 0 ? nlohmann::json(s.leftChosen / s.sideTrials) : nlohmann::json()}});
+    json["excluded_observers"] = nlohmann::json::array();
+    for (const ExcludedObserver& e : analysis.excluded)
+        json["excluded_observers"].push_back({{"observer", e.observer}, {"reason", e.reason}});
     json["screening"] = {{"first_quartile", finite(analysis.screeningRule.firstQuartile)},
                          {"third_quartile", finite(analysis.screeningRule.thirdQuartile)},
                          {"threshold", finite(analysis.screeningRule.threshold)},

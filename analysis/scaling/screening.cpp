@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <set>
 
 namespace skinlab::analysis::scaling {
 
@@ -42,6 +44,43 @@ std::vector<bool> lowOutliers(const std::vector<double>& values, double whisker,
     }
     if (rule) *rule = computed;
     return flags;
+}
+
+std::optional<std::string> exclusionReason(int scaledAnswers, int catchTrials, int catchFailures) {
+    if (scaledAnswers <= 0) return std::string("no answers");
+    if (catchTrials > 0 && 4 * catchFailures > catchTrials)
+        return "failed " + std::to_string(catchFailures) + " of " + std::to_string(catchTrials) + " catch trials";
+    return std::nullopt;
+}
+
+std::vector<ExcludedObserver> excludeObservers(ResponseTable& table) {
+    struct Counts {
+        int scaled = 0, catchTrials = 0, catchFailures = 0;
+    };
+    std::vector<std::string> order;
+    std::map<std::string, Counts> counts;
+    for (const Response& r : table.responses) {
+        auto [entry, added] = counts.try_emplace(r.observer);
+        if (added) order.push_back(r.observer);
+        if (r.kind == TrialKind::Catch) {
+            ++entry->second.catchTrials;
+            if (r.correct && !*r.correct) ++entry->second.catchFailures;
+        } else if (r.kind != TrialKind::Practice) {
+            ++entry->second.scaled;
+        }
+    }
+    std::vector<ExcludedObserver> excluded;
+    std::set<std::string> names;
+    for (const std::string& observer : order) {
+        const Counts& c = counts.at(observer);
+        if (auto reason = exclusionReason(c.scaled, c.catchTrials, c.catchFailures)) {
+            excluded.push_back({observer, *reason});
+            names.insert(observer);
+        }
+    }
+    if (!names.empty()) std::erase_if(table.responses, [&](const Response& r) { return names.count(r.observer) > 0; });
+    table.excludedObservers.insert(table.excludedObservers.end(), excluded.begin(), excluded.end());
+    return excluded;
 }
 
 } // namespace skinlab::analysis::scaling

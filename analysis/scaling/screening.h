@@ -5,9 +5,12 @@
 // flagged by the inter-quartile rule (Tukey 1977): value < Q1 − w·(Q3 − Q1), w = 1.5 by default.
 #include "analysis/scaling/comparison_data.h"
 #include "analysis/scaling/pairwise_model.h"
+#include "analysis/scaling/responses.h"
 
 #include <Eigen/Dense>
 
+#include <optional>
+#include <string>
 #include <vector>
 
 namespace skinlab::analysis::scaling {
@@ -29,5 +32,16 @@ struct OutlierRule {
 
 // Flags low outliers of `values` (NaN values are never flagged and do not enter the quartiles).
 std::vector<bool> lowOutliers(const std::vector<double>& values, double whisker, OutlierRule* rule = nullptr);
+
+// The exclusion rule fixed before a study (docs/study-protocol.md): an observer is excluded who gave no answer
+// that is scaled, or failed more than one catch trial in four (4 · failures > catch trials). Returns the reason
+// ("no answers", "failed 2 of 4 catch trials"), or nothing to include the observer. `analyze scale`, the dashboard
+// and `report` all decide with it, so they scale the same observers.
+std::optional<std::string> exclusionReason(int scaledAnswers, int catchTrials, int catchFailures);
+
+// Applies exclusionReason to a response table: removes every response of each excluded observer, records them in
+// table.excludedObservers (first-appearance order) and returns them. Tables without catch trials lose nobody who
+// answered.
+std::vector<ExcludedObserver> excludeObservers(ResponseTable& table);
 
 } // namespace skinlab::analysis::scaling

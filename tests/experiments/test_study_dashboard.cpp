@@ -60,7 +60,8 @@ int answer(HttpClient& client, const Participant& p, int count = -1) {
         json body = screen();
         body["token"] = p.token;
         body["trial"] = state.body["trial"]["id"];
-        body["side"] = "left";
+        // An attentive observer: the image, never the blank panel of a catch trial (so nobody is excluded).
+        body["side"] = state.body["trial"]["left"].contains("blank") ? "right" : "left";
         body["session"] = p.session;
         body["response_ms"] = 600.0 + 100.0 * answered;
         body["client_time"] = "2026-11-23T14:00:00.000Z";
@@ -132,10 +133,10 @@ TEST(StudyDashboard, ShowsProgressCatchTrialsResponseTimesAndTheLiveScale) {
     EXPECT_EQ((*p1)["completed"], true);
     EXPECT_EQ((*p1)["client_address"], "127.0.0.1");
     EXPECT_EQ((*p1)["address_source"], "peer");
-    // Blank catch trials: "left" is right or wrong depending on the side of the blank panel.
+    // Blank catch trials, all answered with the image.
     const int catchAnswered = (*p1)["catch_answered"], catchCorrect = (*p1)["catch_correct"];
     EXPECT_GE(catchAnswered, 1);
-    EXPECT_LE(catchCorrect, catchAnswered);
+    EXPECT_EQ(catchCorrect, catchAnswered);
     EXPECT_GE(board.body["totals"]["catch_answered"].get<int>(), catchAnswered);
     // Response times: every non-practice answer in exactly one bin.
     int binned = 0;

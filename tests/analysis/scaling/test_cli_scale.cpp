@@ -1,5 +1,6 @@
 // `skinlab analyze scale` end to end: a CSV export of simulated observers → every output file, well formed;
 // a bad file → exit 2 and one line naming it; an existing output folder is never left half-written.
+#include "analysis/scaling/screening.h"
 #include "analysis/scaling/simulation.h"
 
 #include "tests/common/cli_run.h"
@@ -80,15 +81,48 @@ TEST(CliScale, WritesEveryOutput) {
     EXPECT_TRUE(mid["side_bias"]["available"].get<bool>());
     for (const char* plot : {"scores", "matrix"})
         EXPECT_TRUE(fs::exists(output / mid["plots"][plot].get<std::string>()));
-    // Observer p3 failed its catch trials; p11 answered at random in block 1.
-    bool sawCatch = false;
-    for (const auto& observer : json["observers"])
-        if (observer["observer"] == "p3") sawCatch = observer["catch_failures"] == 2;
-    EXPECT_TRUE(sawCatch);
+    // Observer p3 failed both catch trials: the protocol's rule (the one the dashboard and the report apply) leaves
+    // p3 out of the scale; p11 answered at random in block 1 and stays in (screening flags, it does not exclude).
+    ASSERT_EQ(json["excluded_observers"].size(), 1u);
+    EXPECT_EQ(json["excluded_observers"][0]["observer"], "p3");
+    EXPECT_EQ(json["excluded_observers"][0]["reason"], "failed 2 of 2 catch trials");
+    EXPECT_EQ(mid["observers"], 11);
+    for (const auto& observer : json["observers"]) EXPECT_NE(observer["observer"], "p3");
+    EXPECT_NE(result.output.find("excluded observer p3: failed 2 of 2 catch trials"), std::string::npos)
+        << result.output;
     const std::string html = (std::ostringstream() << std::ifstream(output / "report_section.html").rdbuf()).str();
     EXPECT_EQ(html.rfind("<section class=\"skinlab-scaling\">", 0), 0u);
     EXPECT_NE(html.find("data:image/png;base64,"), std::string::npos);
     EXPECT_NE(result.output.find("builtin:head/close"), std::string::npos);
+}
+
+// --no-exclusion scales every observer, p3 with its two failed catch trials among them.
+TEST(CliScale, NoExclusionKeepsCatchTrialFailures) {
+    const fs::path input = scratch() / "responses-all.csv";
+    std::ofstream(input) << simulatedCsv();
+    const fs::path output = scratch() / "out-all";
+    fs::remove_all(output);
+    const CliRun result =
+        run("analyze scale " + input.string() + " -o " + output.string() + " --bootstrap 100 --no-exclusion");
+    ASSERT_EQ(result.exitCode, 0) << result.output;
+    std::ifstream stream(output / "scale.json");
+    const nlohmann::json json = nlohmann::json::parse(stream);
+    EXPECT_TRUE(json["excluded_observers"].empty());
+    EXPECT_EQ(json["blocks"][0]["observers"], 12);
+    bool sawCatch = false;
+    for (const auto& observer : json["observers"])
+        if (observer["observer"] == "p3") sawCatch = observer["catch_failures"] == 2;
+    EXPECT_TRUE(sawCatch);
+}
+
+TEST(ExclusionRule, NoAnswersOrMoreThanOneFailedCatchTrialInFour) {
+    using skinlab::analysis::scaling::exclusionReason;
+    EXPECT_EQ(exclusionReason(0, 0, 0).value_or(""), "no answers");
+    EXPECT_FALSE(exclusionReason(10, 0, 0));
+    EXPECT_FALSE(exclusionReason(10, 4, 1)); // one in four: kept
+    EXPECT_EQ(exclusionReason(10, 4, 2).value_or(""), "failed 2 of 4 catch trials");
+    EXPECT_EQ(exclusionReason(10, 2, 1).value_or(""), "failed 1 of 2 catch trials");
+    EXPECT_FALSE(exclusionReason(10, 8, 2));
 }
 
 TEST(CliScale, BadInputExitsTwoWithOneLine) {
