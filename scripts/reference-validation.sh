@@ -6,19 +6,22 @@
 #   - the 24 screen-space conditions of the evaluation table (gaussian-sum, separable, artistic, pscbf × none,
 #     follow-surface, +cbf, +lab_weight, +curvature reduce-floor, all) and the `reference` render (2 mm edges) as a
 #     stimulus set;
-#   - `pathtraced` twice, with seeds 0 and 1 (the second measures the path tracer's own noise on every score), with
+#   - `pathtraced` with seeds 0 … SEEDS−1 (default 4; seed 1 against seed 0 measures the path tracer's own noise on
+#     every score, and all of them give the debiased scores below), with
 #     no interreflection, the rasterizer's specular layer and the environment unshadowed (as the rasterizer's
 #     ambient term), so that the two references differ in the subsurface transport only;
 # and scores, with `skinlab analyze metrics` (the bands of docs/metrics.md, from each reference's depth and mask):
 #   - every condition against `reference` and against `pathtraced`;
-#   - `reference` against `pathtraced` (the per-band disagreement), and `pathtraced` seed 1 against seed 0 (noise).
+#   - `reference` against `pathtraced` (the per-band disagreement), and `pathtraced` seed 1 against seed 0 (noise);
+#   - every condition against the noise-free path-traced image (`--reference-seeds`, pairs of seeds, jackknife
+#     errors) and its ranking against `reference`'s (`--compare-reference`: Kendall's τ_b with its interval).
 # The table: per case and band, the leak energy and mean ΔE00 of `reference` against `pathtraced` next to the
 # path tracer's own; and per case and score, Kendall's τ_b between the rankings of the 24 conditions under the
 # two references.
 #
 #   scripts/reference-validation.sh [OUT_DIR] [SIZE] [SAMPLES]       (defaults: out/reference-validation 256 64)
 #
-# Environment: SKINLAB (default build/release/cli/skinlab), SKINLAB_ASSETS (without the scanned head its case is
+# Environment: SKINLAB (default build/release/cli/skinlab), SEEDS (path-traced seeds, default 4, at least 2), SKINLAB_ASSETS (without the scanned head its case is
 # skipped with a message), CASES (a space-separated subset of: halo-5 halo-200 bleed ear head scan).
 # Every scene key that matters is written out below (model, materials, camera, lights, environment, SSS width,
 # the path tracer's settings), so the numbers do not move with the built-in scenes' defaults. Rerunning resumes:
