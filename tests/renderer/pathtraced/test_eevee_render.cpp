@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <nlohmann/json.hpp>
 
 using namespace skinlab::renderer;
@@ -134,6 +135,54 @@ TEST(EeveeRender, SubsurfaceScatteringBlursTheSkin) {
     EXPECT_LT(roughSss[0], 0.95 * roughPlain[0]); // measured 0.90 (green 0.97, blue 0.97)
     EXPECT_GT(difference[0] / level[0], difference[1] / level[1]);
     EXPECT_LT(roughSss[0] / roughPlain[0], roughSss[2] / roughPlain[2]);
+}
+
+// A known answer: a 200 × 200 × 60 mm skin block lit head-on by a light of L_c = 1, camera head-on. Away from the
+// rims the diffuse layer is the albedo: with SSS off within 1 % (half-float passes, 2^-11, and shadow-map
+// filtering), as for Cycles' test. With SSS on the kernel is normalised (light is moved, neither made nor lost),
+// but EEVEE keeps the subsurface irradiance, the blurred result and the albedo in R11G11B10 float textures
+// (Blender 3.x, eevee_subsurface.c): 6-bit mantissas in red and green, 5-bit in blue, three conversions, each at
+// most one step (2^-6, 2^-5) low when a conversion truncates. The test allows that and nothing more.
+TEST(EeveeRender, UniformlyLitSlabKeepsItsEnergy) {
+    SKINLAB_REQUIRE_BLENDER();
+    SKINLAB_REQUIRE_RENDERER(renderer);
+    TempFolder folder("eevee-slab");
+    {
+        std::ofstream obj(folder / "slab.obj");
+        obj << "v -100 -100 0\nv 100 -100 0\nv 100 100 0\nv -100 100 0\n"
+               "v -100 -100 -60\nv 100 -100 -60\nv 100 100 -60\nv -100 100 -60\n"
+               "vn 0 0 1\nvn 0 0 -1\nvn 1 0 0\nvn -1 0 0\nvn 0 1 0\nvn 0 -1 0\n"
+               "f 1//1 2//1 3//1\nf 1//1 3//1 4//1\nf 5//2 7//2 6//2\nf 5//2 8//2 7//2\n"
+               "f 2//3 6//3 7//3\nf 2//3 7//3 3//3\nf 1//4 4//4 8//4\nf 1//4 8//4 5//4\n"
+               "f 4//5 3//5 7//5\nf 4//5 7//5 8//5\nf 1//6 5//6 6//6\nf 1//6 6//6 2//6\n";
+        std::ofstream toml(folder / "slab.toml");
+        toml
+            << "mm_per_unit = 1.0\n[model]\nsource = \"slab.obj\"\n"
+               "[[materials]]\nname = \"*\"\nalbedo = [0.6, 0.42, 0.34]\nskin = true\n"
+               "[camera]\nview = \"explicit\"\nposition = [0.0, 0.0, 400.0]\ntarget = [0.0, 0.0, 0.0]\nfov_deg = 10.0\n"
+               "[[lights]]\ntype = \"directional\"\ndirection = [0.0, 0.0, -1.0]\nintensity = 1.0\nshadow = true\n"
+               "[environment]\nradiance = [0.0, 0.0, 0.0]\nbackground = \"color\"\n";
+    }
+    const double albedo[3] = {0.6, 0.42, 0.34};
+    for (const bool sss : {true, false}) {
+        std::vector<std::string> overrides = {"eevee.taa_samples=2", "eevee.specular=false",
+                                              sss ? "eevee.sss=true" : "eevee.sss=false"};
+        const auto exr = folder / (sss ? "sss.exr" : "plain.exr");
+        renderToExr(*renderer, (folder / "slab.toml").string(), "eevee", overrides, 64, 64, exr);
+        const ExrImage image = readExr(exr);
+        for (int c = 0; c < 3; ++c) {
+            double sum = 0.0;
+            int n = 0;
+            for (int y = 20; y < 44; ++y)
+                for (int x = 20; x < 44; ++x) sum += image.at(std::string("diffuse.") + "RGB"[c], x, y), ++n;
+            std::printf("slab, SSS %s, channel %d: diffuse %.4f, expected %.4f, ratio %.4f\n", sss ? "on" : "off", c,
+                        sum / n, albedo[c], sum / n / albedo[c]);
+            const double step = c == 2 ? std::ldexp(1.0, -5) : std::ldexp(1.0, -6);
+            const double lowest = sss ? std::pow(1.0 - step, 3.0) - 0.01 : 0.99;
+            EXPECT_GE(sum / n / albedo[c], lowest) << (sss ? "sss" : "plain") << " channel " << c;
+            EXPECT_LE(sum / n / albedo[c], 1.01) << (sss ? "sss" : "plain") << " channel " << c;
+        }
+    }
 }
 
 TEST(EeveeRender, MissingBlenderIsAOneLineError) {
