@@ -14,7 +14,7 @@
 #   */metrics/             metrics.csv, metrics.json and the ΔE00 heat maps with the bands outlined
 #   */pathtraced/, */metrics-pathtraced/   each reference stimulus rendered by `pathtraced`, and the block's scores
 #                          against it
-#   */eevee/, */metrics-eevee/, */metrics-eevee-pathtraced/   each reference stimulus's scene rendered by `eevee`
+#   */eevee/, */metrics-eevee/, */metrics-eevee-pathtraced/   each block's scene rendered by `eevee`
 #                          (Blender EEVEE, its own screen-space SSS), scored against the block's reference and
 #                          against the path-traced one: the table's `eevee` row
 #   extensions-table.md    per block: method × extension-set tables of the leak energies and the mean ΔE00 excess,
@@ -76,7 +76,8 @@ for s in m["stimuli"]:
     "$dir/manifest.json" "$root/stimuli/specs")
 }
 
-# The `eevee` row: for every reference stimulus, the same scene and overrides rendered by Blender EEVEE
+# The `eevee` row: for every block, the scene and overrides of its screen-space stimuli (without their [sss] and
+# [transmittance] keys; bleed: the paint inside the mask, as the methods get it) rendered by Blender EEVEE
 # (sss.method = "eevee", docs/pathtraced.md "EEVEE": its own screen-space Christensen-Burley SSS with a depth
 # correction, radii fitted to d'Eon's profile, no skinlab extension), scored against the block's reference in
 # OUT_DIR/SET/metrics-eevee/REFERENCE_ID/ and, when rendered, against the path-traced one in
@@ -104,12 +105,14 @@ print(next(s["files"]["exr"] for s in m["stimuli"] if s["id"] == sys.argv[2]))' 
   done < <(python3 -c '
 import json, os, sys
 m = json.load(open(sys.argv[1]))
-for s in m["stimuli"]:
-    if not s["reference"]: continue
+for r in m["stimuli"]:
+    if not r["reference"]: continue
+    # The scene of the block'"'"'s screen-space stimuli (bleed: the paint inside the mask), not the reference'"'"'s own.
+    s = next(s for s in m["stimuli"] if s["block"] == r["block"] and not s["reference"])
     scene = s["scene"]
     if not scene.startswith("builtin:") and not os.path.isabs(scene): scene = os.path.join(sys.argv[2], scene)
-    keep = [o for o in s["overrides"] if not o.startswith(("sss.method=", "sss.reference_edge_mm="))]  # reference-only keys
-    print(s["id"], scene, "\x1f".join(keep), sep="\t")' \
+    keep = [o for o in s["overrides"] if not o.startswith(("sss.", "transmittance."))]  # the methods'"'"' own keys
+    print(r["id"], scene, "\x1f".join(keep), sep="\t")' \
     "$dir/manifest.json" "$root/stimuli/specs")
 }
 
