@@ -529,10 +529,14 @@ RenderResult Renderer::render(const RenderRequest& request) {
     };
     std::vector<std::vector<float>> readBack;
     for (const Aov& aov : kAovs) readBack.push_back(read((impl.targets.*aov.texture).get(), aov.textureChannels));
-    if (cycles && !eevee &&
-        pathtraced::pathtracedParamsFromJson(spec.pathtraced, spec.source).specularSource == "rasterizer") {
-        // pathtraced.specular_source = "rasterizer": Cycles rendered no specular lobe; its beauty gets the
-        // rasterizer's specular pass (same camera), so only the diffuse/subsurface layer comes from Cycles.
+    const bool rasterizerSpecular =
+        cycles &&
+        (eevee ? pathtraced::eeveeParamsFromJson(spec.eevee, spec.source).specularSource == "rasterizer"
+               : pathtraced::pathtracedParamsFromJson(spec.pathtraced, spec.source).specularSource == "rasterizer");
+    if (rasterizerSpecular) {
+        // pathtraced.specular_source / eevee.specular_source = "rasterizer": Blender rendered no specular lobe; its
+        // beauty gets the rasterizer's specular pass (same camera), so only the diffuse/subsurface layer comes
+        // from Blender.
         const std::vector<float>& specular = readBack[aovIndex("specular")];
         for (std::size_t p = 0; p < pixels; ++p)
             for (std::size_t c = 0; c < 3; ++c) {
@@ -589,7 +593,9 @@ RenderResult Renderer::render(const RenderRequest& request) {
         record["blender_version"] = cycles->blenderVersion;
         record["render_seconds"] = cycles->renderSeconds;
         record["wall_seconds"] = cycles->wallSeconds;
-        record["channels_from_eevee"] = {"R", "G", "B", "diffuse.*", "specular.*", "depth.Z", "mask.Y"};
+        record["channels_from_eevee"] =
+            rasterizerSpecular ? nlohmann::json{"R, G, B: diffuse only", "diffuse.*", "depth.Z", "mask.Y"}
+                               : nlohmann::json{"R", "G", "B", "diffuse.*", "specular.*", "depth.Z", "mask.Y"};
         metadata.strings["skinlab:eevee"] = record.dump();
         metadata.strings["skinlab:blender_version"] = cycles->blenderVersion;
         metadata.floats["skinlab:render_seconds"] = static_cast<float>(cycles->renderSeconds);

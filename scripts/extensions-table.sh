@@ -77,7 +77,8 @@ for s in m["stimuli"]:
 }
 
 # The `eevee` row: for every block, the scene and overrides of its screen-space stimuli (without their [sss] and
-# [transmittance] keys; bleed: the paint inside the mask, as the methods get it) rendered by Blender EEVEE
+# [transmittance] keys; bleed: the paint inside the mask, as the methods get it) rendered by Blender EEVEE with the
+# rasterizer's specular layer (as the path-traced references)
 # (sss.method = "eevee", docs/pathtraced.md "EEVEE": its own screen-space Christensen-Burley SSS with a depth
 # correction, radii fitted to d'Eon's profile, no skinlab extension), scored against the block's reference in
 # OUT_DIR/SET/metrics-eevee/REFERENCE_ID/ and, when rendered, against the path-traced one in
@@ -88,7 +89,7 @@ eevee_renders() {  # eevee_renders SET_NAME
   while IFS=$'\t' read -r id scene overrides; do
     local exr="$dir/eevee/$id.exr" args=()
     while IFS= read -r o; do [ -n "$o" ] && args+=(--set "$o"); done <<< "${overrides//$'\x1f'/$'\n'}"
-    args+=(--set 'sss.method="eevee"')
+    args+=(--set 'sss.method="eevee"' --set 'eevee.specular_source="rasterizer"')
     local stamp; stamp="$scene ${args[*]}"
     if [ ! -e "$exr" ] || [ "$(cat "$exr.inputs" 2> /dev/null)" != "$stamp" ]; then
       "$skinlab" render --scene "$scene" "${args[@]}" -o "$exr" > /dev/null

@@ -23,6 +23,9 @@ EeveeParams readTable(const SpecReader& t) {
     p.taaSamples = static_cast<int>(t.integer("taa_samples", p.taaSamples, 1, 1 << 16));
     p.sss = t.boolean("sss", p.sss);
     p.specular = t.boolean("specular", p.specular);
+    p.specularSource = t.string("specular_source", p.specularSource);
+    if (p.specularSource != "eevee" && p.specularSource != "rasterizer")
+        t.fail("specular_source", "'" + p.specularSource + "' is not one of \"eevee\", \"rasterizer\"");
     p.radiusMm = t.vec3("radius_mm", p.radiusMm, 0.0, 1000.0);
     p.filterWidthPx = t.number("filter_width_px", p.filterWidthPx, 0.01, 10.0);
     p.shadowMapSize = static_cast<int>(t.integer("shadow_map_size", p.shadowMapSize, 512, 4096));
@@ -41,6 +44,7 @@ nlohmann::json EeveeParams::toJson() const {
             {"taa_samples", taaSamples},
             {"sss", sss},
             {"specular", specular},
+            {"specular_source", specularSource},
             {"radius_mm", radiusMm},
             {"filter_width_px", filterWidthPx},
             {"shadow_map_size", shadowMapSize},
@@ -53,6 +57,7 @@ PathtracedParams EeveeParams::sceneParams() const {
     p.samples = taaSamples;
     p.sss = sss;
     p.specular = specular;
+    p.specularSource = specularSource == "rasterizer" ? "rasterizer" : "cycles"; // "rasterizer": Principled specular 0
     p.radiusMm = radiusMm;
     p.environmentShadow = true; // one pass: EEVEE's world light is unshadowed anyway (no ambient occlusion)
     p.sunAngleDeg = 0.0;

@@ -31,6 +31,10 @@ struct EeveeParams {
     int taaSamples = 16;
     bool sss = true;      // subsurface scattering on skin (false: Principled subsurface 0, a plain diffuse surface)
     bool specular = true; // the specular lobe (false: Principled specular 0)
+    // Where the specular layer comes from: "eevee" (the Principled GGX lobe as EEVEE shades it) or "rasterizer"
+    // (EEVEE renders no specular; the beauty is EEVEE's diffuse + the rasterizer's specular pass of the same camera),
+    // so that the image differs from a screen-space render in the diffuse/subsurface layer only.
+    std::string specularSource = "eevee";
     // Subsurface radius per channel (mm) at the profile's own scale; scaled by sss.width_mm / 3 and divided by
     // mm_per_unit like the path-traced radii. EEVEE's kernel reaches 16 d = 0.7346 × radius (d the Burley
     // parameter, below), so a radius of 0 turns the kernel into the centre tap.

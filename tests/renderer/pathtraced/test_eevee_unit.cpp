@@ -68,6 +68,8 @@ TEST(EeveeParams, BadValuesAreOneLineErrorsNamingTheKey) {
     EXPECT_EQ(eeveeError("eevee.taa_samples=0"), "builtin:halo: eevee.taa_samples: 0 is out of range [1, 65536]");
     EXPECT_EQ(eeveeError("eevee.shadow_map_size=1000"),
               "builtin:halo: eevee.shadow_map_size: 1000 is not one of 512, 1024, 2048, 4096");
+    EXPECT_EQ(eeveeError("eevee.specular_source=\"cycles\""),
+              "builtin:halo: eevee.specular_source: 'cycles' is not one of \"eevee\", \"rasterizer\"");
     EXPECT_EQ(eeveeError("eevee.blender=\"\""),
               "builtin:halo: eevee.blender: must name the Blender program (e.g. \"blender\")");
     for (const std::string& bad : {std::string("eevee.radius_mm=[1.0, -1.0, 1.0]"), std::string("eevee.samples=4"),
@@ -101,6 +103,13 @@ TEST(EeveeScene, EngineSettingsAndRadii) {
     EXPECT_EQ(json.at("settings").at("engine"), "eevee");
     EXPECT_EQ(json.at("settings").at("samples"), 16); // TAA samples
     EXPECT_EQ(json.at("settings").at("eevee").at("sss_samples"), 11);
+    EXPECT_GT(json.at("materials").at(0).at("specular").get<double>(), 0.0); // EEVEE's own specular lobe
+    // specular_source = "rasterizer": no Principled specular (the renderer adds the rasterizer's specular pass).
+    const EeveeParams borrowed = eeveeParamsFromJson(
+        loadSceneSpec("builtin:halo", {"sss.method=\"eevee\"", "eevee.specular_source=\"rasterizer\""}, {}).eevee);
+    inputs.params = borrowed.sceneParams();
+    for (const auto& material : blenderSceneJson(inputs, "mesh.bin", "cycles.exr", "cycles.json").at("materials"))
+        EXPECT_EQ(material.at("specular").get<double>(), 0.0);
     EXPECT_TRUE(json.at("world").at("shadow").get<bool>()); // one pass
     // Radii: the profile's mm at width 3 mm, scaled by width_mm / 3 (here 2), in scene units.
     for (int c = 0; c < 3; ++c)
