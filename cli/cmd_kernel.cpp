@@ -120,7 +120,7 @@ void registerKernel(CLI::App& app) {
     kernel
         ->add_option("--method", options->method,
                      names + " (`skinlab methods`; pscbf: its broad Gaussian stage, the pass adds the spike; "
-                             "reference and pathtraced: no taps)")
+                             "reference, pathtraced and eevee: no taps)")
         ->required();
     kernel->add_option("--samples", options->samples,
                        "Taps per 1-D pass, odd, 3…101 (sss.samples; default 21, pscbf 13)");

@@ -25,6 +25,7 @@
 #include "renderer/output/display_output.h"
 #include "renderer/output/exr_writer.h"
 #include "renderer/pathtraced/cycles_render.h"
+#include "renderer/pathtraced/eevee_params.h"
 #include "renderer/scene/builtin_geometry.h"
 #include "renderer/scene/environment.h"
 #include "renderer/scene/mesh_loader.h"
@@ -257,8 +258,8 @@ std::vector<gl::GpuLight> gpuLightsOf(const SceneSpec& spec) {
 
 // --- AOVs ----------------------------------------------------------------------------------------------------
 // One table drives both the read-back and the EXR channels (docs/rendering.md, "EXR layout"): each AOV's frame
-// target, its layout there, its channel names in the EXR and, for sss.method = "pathtraced", the Cycles image that
-// replaces it (the other AOVs come from the rasterizer's passes in every method).
+// target, its layout there, its channel names in the EXR and, for sss.method = "pathtraced" or "eevee", the Blender
+// image that replaces it (the other AOVs come from the rasterizer's passes in every method).
 struct Aov {
     const char* layer;                                   // EXR layer; "" = the beauty's R, G, B
     const char* channels;                                // one letter per EXR channel, e.g. "RGB", "Z"
@@ -403,8 +404,9 @@ float Renderer::Impl::runPasses(const Frame& frame) {
         sssInputs.projection = frame.camera.projection;
         sssInputs.cameraPosition = frame.camera.position;
         sssStage.run(sssInputs, sssSettings, targets.scatteredDiffuse.get());
-        // pathtraced: the support of the profile its radii are matched to (as the object-space reference declares).
-        supportRadiusMm = spec.sss.method == sss::SssMethod::Pathtraced
+        // pathtraced, eevee: the support of the profile their radii are matched to (as the object-space reference
+        // declares).
+        supportRadiusMm = spec.sss.method == sss::SssMethod::Pathtraced || spec.sss.method == sss::SssMethod::Eevee
                               ? gl::ReferenceMethod::supportRadiusMm(spec.sss, spec.source)
                               : sssStage.supportRadiusMm(sssSettings);
     }
@@ -478,17 +480,26 @@ RenderResult Renderer::render(const RenderRequest& request) {
     // (renderer/pathtraced, docs/pathtraced.md) before any pass runs, so a missing or failing Blender leaves
     // nothing done. The passes below still run (the screen-space stage copies through) for the AOVs Cycles does
     // not produce: albedo, normals, transmittance, aux, curvature.
+    // sss.method = "eevee": the same scene handed to Blender EEVEE (docs/pathtraced.md, "EEVEE"), the same way.
     std::optional<pathtraced::CyclesImage> cycles;
-    if (spec.sss.method == sss::SssMethod::Pathtraced) {
+    const bool eevee = spec.sss.method == sss::SssMethod::Eevee;
+    if (spec.sss.method == sss::SssMethod::Pathtraced || eevee) {
         pathtraced::BlenderSceneInputs cyclesInputs;
         cyclesInputs.spec = &spec;
         cyclesInputs.model = frame.model.get();
         for (const gl::GpuMaterial& m : frame.partMaterials)
             cyclesInputs.partMaterials.push_back({m.albedo, m.skin, m.glossiness, m.specularIntensity});
         cyclesInputs.camera = frame.camera;
-        cyclesInputs.params = pathtraced::pathtracedParamsFromJson(spec.pathtraced, spec.source);
         cyclesInputs.sssWidthMm = spec.sss.widthMm;
-        cycles = pathtraced::renderWithCycles(cyclesInputs, frame.exposure);
+        if (eevee) {
+            const pathtraced::EeveeParams params = pathtraced::eeveeParamsFromJson(spec.eevee, spec.source);
+            cyclesInputs.params = params.sceneParams();
+            cyclesInputs.eeveeSettings = params.toJson();
+            cycles = pathtraced::renderWithEevee(cyclesInputs, frame.exposure);
+        } else {
+            cyclesInputs.params = pathtraced::pathtracedParamsFromJson(spec.pathtraced, spec.source);
+            cycles = pathtraced::renderWithCycles(cyclesInputs, frame.exposure);
+        }
     }
 
     // --- sss.method = "reference": check its parameters and tessellate (cached) before the first pass, so bad
@@ -518,9 +529,14 @@ RenderResult Renderer::render(const RenderRequest& request) {
     };
     std::vector<std::vector<float>> readBack;
     for (const Aov& aov : kAovs) readBack.push_back(read((impl.targets.*aov.texture).get(), aov.textureChannels));
-    if (cycles && pathtraced::pathtracedParamsFromJson(spec.pathtraced, spec.source).specularSource == "rasterizer") {
-        // pathtraced.specular_source = "rasterizer": Cycles rendered no specular lobe; its beauty gets the
-        // rasterizer's specular pass (same camera), so only the diffuse/subsurface layer comes from Cycles.
+    const bool rasterizerSpecular =
+        cycles &&
+        (eevee ? pathtraced::eeveeParamsFromJson(spec.eevee, spec.source).specularSource == "rasterizer"
+               : pathtraced::pathtracedParamsFromJson(spec.pathtraced, spec.source).specularSource == "rasterizer");
+    if (rasterizerSpecular) {
+        // pathtraced.specular_source / eevee.specular_source = "rasterizer": Blender rendered no specular lobe; its
+        // beauty gets the rasterizer's specular pass (same camera), so only the diffuse/subsurface layer comes
+        // from Blender.
         const std::vector<float>& specular = readBack[aovIndex("specular")];
         for (std::size_t p = 0; p < pixels; ++p)
             for (std::size_t c = 0; c < 3; ++c) {
@@ -572,7 +588,18 @@ RenderResult Renderer::render(const RenderRequest& request) {
     metadata.floats["skinlab:f_px"] = camera.focalLengthPixels;
     metadata.floats["skinlab:mm_per_unit"] = static_cast<float>(spec.mmPerUnit);
     metadata.floats["skinlab:sss_radius_mm"] = supportRadiusMm;
-    if (cycles) {
+    if (cycles && eevee) {
+        nlohmann::json record = spec.eevee;
+        record["blender_version"] = cycles->blenderVersion;
+        record["render_seconds"] = cycles->renderSeconds;
+        record["wall_seconds"] = cycles->wallSeconds;
+        record["channels_from_eevee"] =
+            rasterizerSpecular ? nlohmann::json{"R, G, B: diffuse only", "diffuse.*", "depth.Z", "mask.Y"}
+                               : nlohmann::json{"R", "G", "B", "diffuse.*", "specular.*", "depth.Z", "mask.Y"};
+        metadata.strings["skinlab:eevee"] = record.dump();
+        metadata.strings["skinlab:blender_version"] = cycles->blenderVersion;
+        metadata.floats["skinlab:render_seconds"] = static_cast<float>(cycles->renderSeconds);
+    } else if (cycles) {
         const nlohmann::json params = spec.pathtraced;
         nlohmann::json fromCycles = nlohmann::json::array(); // "R", "G", "B", "diffuse.*", ..., "depth.Z", "mask.Y"
         for (const Aov& aov : kAovs) {
@@ -609,8 +636,8 @@ RenderResult Renderer::render(const RenderRequest& request) {
     result.timingsMs["cpu"] = {{"load", loadMs}, {"upload", uploadMs}, {"readback", readbackMs}, {"write", writeMs}};
     if (referenceMethod) result.timingsMs["reference"] = impl.referenceMethod.lastRun(); // CPU parts of "sss"
     if (cycles)
-        result.timingsMs["pathtraced"] = {{"render", cycles->renderSeconds * 1000.0},
-                                          {"blender_wall", cycles->wallSeconds * 1000.0}};
+        result.timingsMs[eevee ? "eevee" : "pathtraced"] = {{"render", cycles->renderSeconds * 1000.0},
+                                                            {"blender_wall", cycles->wallSeconds * 1000.0}};
     result.timingsMs["width"] = width;
     result.timingsMs["height"] = height;
     result.timingsMs["gl_renderer"] = result.glRenderer;

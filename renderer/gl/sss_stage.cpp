@@ -68,6 +68,7 @@ void SssStage::run(const SssStageInputs& inputs, const SssStageSettings& setting
     }
     case sss::SssMethod::None:
     case sss::SssMethod::Pathtraced: // Cycles replaces the image afterwards (renderer.cpp); copy through
+    case sss::SssMethod::Eevee:      // EEVEE, likewise
         break;
     }
     // A framebuffer per run: texture names are recycled when the frame is resized, so caching one by name

@@ -85,11 +85,13 @@ std::string lastErrorLine(const std::filesystem::path& logPath) {
 } // namespace
 
 void runBlender(const std::string& program, const std::filesystem::path& script, const std::vector<std::string>& args,
-                const std::filesystem::path& workingDirectory, const std::filesystem::path& logPath) {
+                const std::filesystem::path& workingDirectory, const std::filesystem::path& logPath,
+                std::string_view key) {
     const std::filesystem::path found = findProgram(program);
     if (found.empty())
-        throw InputError("pathtraced.blender: program '" + program +
-                         "' not found (install the Debian package blender, or set pathtraced.blender to its path)");
+        throw InputError(std::string(key) + ": program '" + program +
+                         "' not found (install the Debian package blender, or set " + std::string(key) +
+                         " to its path)");
     std::vector<std::string> all = {"-b", "--factory-startup", "-noaudio",      "--python-exit-code",
                                     "1",  "--python",          script.string(), "--"};
     all.insert(all.end(), args.begin(), args.end());

@@ -3,6 +3,7 @@
 // log file. docs/pathtraced.md, "Running Blender".
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace skinlab::renderer::pathtraced {
@@ -18,8 +19,10 @@ int runProcess(const std::filesystem::path& program, const std::vector<std::stri
                const std::filesystem::path& workingDirectory, const std::filesystem::path& logPath);
 
 // Runs `blender -b --factory-startup -noaudio --python SCRIPT -- ARGS...`. Throws InputError naming the program
-// (missing: how to install it) or, when it fails, its exit status, the last error line of its log and the log's path.
+// (missing: how to install it, and `key`, the spec key that names the program) or, when it fails, its exit status,
+// the last error line of its log and the log's path.
 void runBlender(const std::string& program, const std::filesystem::path& script, const std::vector<std::string>& args,
-                const std::filesystem::path& workingDirectory, const std::filesystem::path& logPath);
+                const std::filesystem::path& workingDirectory, const std::filesystem::path& logPath,
+                std::string_view key = "pathtraced.blender");
 
 } // namespace skinlab::renderer::pathtraced

@@ -85,6 +85,8 @@ nlohmann::json blenderSceneJson(const BlenderSceneInputs& inputs, std::string_vi
     scene["settings"] = {{"width", spec.width}, {"height", spec.height},       {"samples", p.samples},
                          {"seed", p.seed},      {"max_bounces", p.maxBounces}, {"filter_width_px", p.filterWidthPx},
                          {"threads", p.threads}};
+    scene["settings"]["engine"] = inputs.engine;
+    if (inputs.engine == "eevee") scene["settings"]["eevee"] = inputs.eeveeSettings;
     // One object per part (cycles_scene.py), each with its own vertices, in Model::parts order in the file.
     nlohmann::json parts = nlohmann::json::array();
     std::size_t offset = 0;

@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -28,6 +29,10 @@ struct BlenderSceneInputs {
     CameraPose camera;
     PathtracedParams params;
     double sssWidthMm = 3.0; // sss.width_mm: radii scale by width_mm / 3
+    // "cycles" (sss.method = "pathtraced") or "eevee" (sss.method = "eevee"): the same scene, another engine.
+    std::string engine = "cycles";
+    // engine "eevee": EEVEE's own settings (keys of scene.json's settings.eevee, cycles_scene.py configure_eevee).
+    nlohmann::json eeveeSettings = nlohmann::json::object();
 };
 
 // Principled roughness (GGX α = roughness²) for the rasterizer's glossiness s (normalised Blinn-Phong exponent

@@ -25,7 +25,7 @@ std::filesystem::path makeWorkFolder(const std::string& prefix) {
 
 std::map<std::string, std::vector<float>> readExrChannels(const std::filesystem::path& path, int& width, int& height) {
     auto input = OIIO::ImageInput::open(path.string());
-    if (!input) throw InputError(path.string() + ": cannot read Cycles' EXR (" + OIIO::geterror() + ")");
+    if (!input) throw InputError(path.string() + ": cannot read Blender's EXR (" + OIIO::geterror() + ")");
     const OIIO::ImageSpec& spec = input->spec();
     width = spec.width;
     height = spec.height;
@@ -33,7 +33,7 @@ std::map<std::string, std::vector<float>> readExrChannels(const std::filesystem:
     const int channelCount = spec.nchannels;
     std::vector<float> all(pixels * static_cast<std::size_t>(channelCount));
     if (!input->read_image(0, 0, 0, channelCount, OIIO::TypeDesc::FLOAT, all.data()))
-        throw InputError(path.string() + ": cannot read Cycles' EXR (" + input->geterror() + ")");
+        throw InputError(path.string() + ": cannot read Blender's EXR (" + input->geterror() + ")");
     input->close();
     std::map<std::string, std::vector<float>> channels;
     for (int c = 0; c < channelCount; ++c) {
@@ -53,7 +53,7 @@ const std::vector<float>& channelEndingWith(const std::map<std::string, std::vec
             return values;
     std::string names;
     for (const auto& entry : channels) names += (names.empty() ? "" : ", ") + entry.first;
-    throw InputError(file.string() + ": no channel '" + suffix + "' in Cycles' EXR (it has: " + names + ")");
+    throw InputError(file.string() + ": no channel '" + suffix + "' in Blender's EXR (it has: " + names + ")");
 }
 
 nlohmann::json readRecord(const std::filesystem::path& path) {
@@ -64,12 +64,14 @@ nlohmann::json readRecord(const std::filesystem::path& path) {
     }
 }
 
-CyclesImage renderWithCycles(const BlenderSceneInputs& inputs, float exposure) {
+namespace {
+CyclesImage renderWithBlender(const BlenderSceneInputs& inputs, float exposure) {
+    const bool eevee = inputs.engine == "eevee";
     const auto start = std::chrono::steady_clock::now();
-    const std::filesystem::path folder = makeWorkFolder("skinlab-pathtraced");
+    const std::filesystem::path folder = makeWorkFolder(eevee ? "skinlab-eevee" : "skinlab-pathtraced");
     writeBlenderScene(folder, inputs);
     runBlender(inputs.params.blender, folder / "cycles_scene.py", {"render", (folder / "scene.json").string()}, folder,
-               folder / "blender.log");
+               folder / "blender.log", eevee ? "eevee.blender" : "pathtraced.blender");
 
     CyclesImage image;
     const std::filesystem::path exr = folder / "cycles.exr";
@@ -94,7 +96,7 @@ CyclesImage renderWithCycles(const BlenderSceneInputs& inputs, float exposure) {
         }
     }
     if (image.width != inputs.spec->width || image.height != inputs.spec->height)
-        throw InputError(exr.string() + ": Cycles wrote " + std::to_string(image.width) + "x" +
+        throw InputError(exr.string() + ": Blender wrote " + std::to_string(image.width) + "x" +
                          std::to_string(image.height) + ", expected " + std::to_string(inputs.spec->width) + "x" +
                          std::to_string(inputs.spec->height));
     const std::size_t pixels = static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
@@ -104,12 +106,14 @@ CyclesImage renderWithCycles(const BlenderSceneInputs& inputs, float exposure) {
     image.specular.resize(pixels * 3);
     for (int c = 0; c < 3; ++c) {
         const std::string ch = rgb[c];
+        // EEVEE has no indirect passes (its world light is part of the direct ones): zeros stand in for them.
+        const std::vector<float> none(eevee ? pixels : 0, 0.0f);
         const auto& combined = channelEndingWith(channels, "Combined." + ch, exr);
         const auto& diffuseDirect = channelEndingWith(channels, "DiffDir." + ch, exr);
-        const auto& diffuseIndirect = channelEndingWith(channels, "DiffInd." + ch, exr);
+        const auto& diffuseIndirect = eevee ? none : channelEndingWith(channels, "DiffInd." + ch, exr);
         const auto& diffuseColor = channelEndingWith(channels, "DiffCol." + ch, exr);
         const auto& glossyDirect = channelEndingWith(channels, "GlossDir." + ch, exr);
-        const auto& glossyIndirect = channelEndingWith(channels, "GlossInd." + ch, exr);
+        const auto& glossyIndirect = eevee ? none : channelEndingWith(channels, "GlossInd." + ch, exr);
         const auto& glossyColor = channelEndingWith(channels, "GlossCol." + ch, exr);
         for (std::size_t p = 0; p < pixels; ++p) {
             image.beauty[p * 3 + c] = exposure * combined[p];
@@ -118,12 +122,13 @@ CyclesImage renderWithCycles(const BlenderSceneInputs& inputs, float exposure) {
         }
     }
     const auto& depth = channelEndingWith(channels, "Depth.Z", exr);
-    const auto& skin = channelEndingWith(channels, "IndexMA.X", exr);
+    const auto& skin = channelEndingWith(channels, eevee ? "skinlab_skin.X" : "IndexMA.X", exr);
+    // Where a camera ray leaves the scene Cycles writes 1e10, EEVEE (a half-float depth pass) 65504, half's largest.
+    const float background = eevee ? 65504.0f : 1e9f;
     image.depth.resize(pixels);
     image.mask.resize(pixels);
     for (std::size_t p = 0; p < pixels; ++p) {
-        // Cycles writes 1e10 where a camera ray leaves the scene.
-        image.depth[p] = depth[p] >= 1e9f ? std::numeric_limits<float>::infinity() : depth[p];
+        image.depth[p] = depth[p] >= background ? std::numeric_limits<float>::infinity() : depth[p];
         image.mask[p] = skin[p] >= 0.5f ? 1.0f : 0.0f;
         if (std::isinf(image.depth[p])) {
             // Where no surface is seen the rasterizer's diffuse layer holds the background (its background pass
@@ -141,6 +146,20 @@ CyclesImage renderWithCycles(const BlenderSceneInputs& inputs, float exposure) {
     std::error_code ignored;
     std::filesystem::remove_all(folder, ignored);
     return image;
+}
+} // namespace
+
+CyclesImage renderWithCycles(const BlenderSceneInputs& inputs, float exposure) {
+    BlenderSceneInputs cycles = inputs;
+    cycles.engine = "cycles";
+    return renderWithBlender(cycles, exposure);
+}
+
+CyclesImage renderWithEevee(const BlenderSceneInputs& inputs, float exposure) {
+    BlenderSceneInputs eevee = inputs;
+    eevee.engine = "eevee";
+    eevee.params.environmentShadow = true; // one pass
+    return renderWithBlender(eevee, exposure);
 }
 
 } // namespace skinlab::renderer::pathtraced

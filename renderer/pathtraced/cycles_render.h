@@ -1,6 +1,7 @@
 #pragma once
-// One path-traced image: the scene written for Blender into a fresh temporary folder, Blender run headless, its
-// multilayer EXR read back into the channels of skinlab's EXR layout. The folder is removed after a successful
+// One image rendered by Blender (Cycles, or EEVEE for sss.method = "eevee"): the scene written for Blender into a
+// fresh temporary folder, Blender run headless, its multilayer EXR read back into the channels of skinlab's EXR
+// layout. The folder is removed after a successful
 // run and kept (with blender.log) after a failed one; the error names it. docs/pathtraced.md.
 #include "renderer/pathtraced/blender_scene.h"
 
@@ -19,9 +20,9 @@ struct CyclesImage {
     std::vector<float> diffuse;  // (DiffDir + DiffInd) × DiffCol: subsurface light is part of it in Cycles 3.x
     std::vector<float> specular; // (GlossDir + GlossInd) × GlossCol
     std::vector<float> depth;    // view-axis depth, world units; +inf where no surface
-    std::vector<float> mask;     // 1 where the first hit is a skin material (material index pass), else 0
+    std::vector<float> mask;     // 1 where the first hit is a skin material (material index pass / EEVEE's AOV), else 0
     std::string blenderVersion;
-    double renderSeconds = 0.0; // Cycles' render call, as timed by the script
+    double renderSeconds = 0.0; // the engine's render call, as timed by the script (EEVEE: shader compilation too)
     double wallSeconds = 0.0;   // the whole Blender run (start-up, scene building, render, EXR write)
 };
 
@@ -40,5 +41,10 @@ const std::vector<float>& channelEndingWith(const std::map<std::string, std::vec
 nlohmann::json readRecord(const std::filesystem::path& path);
 
 CyclesImage renderWithCycles(const BlenderSceneInputs& inputs, float exposure);
+
+// The same with EEVEE (inputs.engine = "eevee"; docs/pathtraced.md, "EEVEE"): beauty = Combined, diffuse = Diffuse
+// Light × Diffuse Colour (subsurface light included), specular = Specular Light × Specular Colour, depth = Z (view
+// axis), mask = the skin AOV (material flag, averaged over the TAA samples) ≥ 0.5.
+CyclesImage renderWithEevee(const BlenderSceneInputs& inputs, float exposure);
 
 } // namespace skinlab::renderer::pathtraced

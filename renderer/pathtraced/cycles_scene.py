@@ -1,9 +1,11 @@
-# Builds a skinlab scene in Blender and renders it with Cycles (docs/pathtraced.md). Run headless:
+# Builds a skinlab scene in Blender and renders it with Cycles or EEVEE (docs/pathtraced.md). Run headless:
 #   blender -b --factory-startup -noaudio --python cycles_scene.py -- render SCENE.json
 #   blender -b --factory-startup -noaudio --python cycles_scene.py -- profile PROFILE.json
 # "render": SCENE.json is written by renderer/pathtraced/blender_scene.cpp (geometry in a binary file beside it,
 # camera, lights, environment, materials, settings); the script writes a linear multilayer OpenEXR with the
-# passes skinlab reads back, and a small JSON record (Blender version, render time).
+# passes skinlab reads back, and a small JSON record (Blender version, render time). settings.engine chooses the
+# engine: "cycles" (sss.method = "pathtraced") or "eevee" (sss.method = "eevee": the same scene rendered with EEVEE's
+# screen-space subsurface scattering; its skin mask comes from a shader AOV, as EEVEE has no material index pass).
 # "profile": the edge-response scene of the profile fit (renderer/pathtraced/profile_fit.h): a large skin slab
 # lit from straight above by a sun whose light a plate, invisible to the camera, cuts off at x = 0.
 # The script only uses Blender's own Python modules (no numpy). Every failure exits with status 1 and a message.
@@ -28,6 +30,60 @@ def reset_scene():
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     return scene
+
+
+def configure_output(scene, settings):
+    render = scene.render
+    render.resolution_x = int(settings["width"])
+    render.resolution_y = int(settings["height"])
+    render.resolution_percentage = 100
+    render.pixel_aspect_x = 1.0
+    render.pixel_aspect_y = 1.0
+    render.film_transparent = False
+    # Linear output: the view transform does not touch EXR data, but keep it neutral anyway.
+    scene.view_settings.view_transform = "Standard"
+    scene.view_settings.look = "None"
+    scene.view_settings.exposure = 0.0
+    scene.view_settings.gamma = 1.0
+    image = render.image_settings
+    image.file_format = "OPEN_EXR_MULTILAYER"
+    image.color_depth = "32"
+    image.exr_codec = "ZIP"
+    render.use_file_extension = False
+    render.use_stamp = False
+
+
+def configure_eevee(scene, settings):
+    # EEVEE (Blender 3.x): rasterised with GL (headless: Blender falls back to surfaceless EGL, Mesa's llvmpipe on a
+    # machine without GPU). Every effect but subsurface scattering and shadows off: no ambient occlusion, no
+    # screen-space reflections or refraction, no bloom, no motion blur, no volumetrics.
+    scene.render.engine = "BLENDER_EEVEE"
+    eevee = scene.eevee
+    own = settings["eevee"]
+    eevee.taa_render_samples = int(settings["samples"])
+    eevee.sss_samples = int(own["sss_samples"])
+    eevee.sss_jitter_threshold = float(own["sss_jitter_threshold"])
+    eevee.use_soft_shadows = bool(own["soft_shadows"])
+    eevee.shadow_cascade_size = str(int(own["shadow_map_size"]))
+    eevee.shadow_cube_size = str(int(own["shadow_map_size"]))
+    eevee.use_shadow_high_bitdepth = True
+    eevee.use_gtao = False
+    eevee.use_ssr = False
+    eevee.use_bloom = False
+    eevee.use_motion_blur = False
+    eevee.use_volumetric_lights = False
+    eevee.use_volumetric_shadows = False
+    # Lights reach everything they would light (EEVEE otherwise cuts a light off where it falls below 0.01).
+    eevee.light_threshold = 1e-6
+    scene.render.filter_size = float(settings["filter_width_px"])
+    configure_output(scene, settings)
+
+
+def configure_engine(scene, settings):
+    if settings.get("engine", "cycles") == "eevee":
+        configure_eevee(scene, settings)
+    else:
+        configure_cycles(scene, settings)
 
 
 def configure_cycles(scene, settings):
@@ -55,35 +111,34 @@ def configure_cycles(scene, settings):
     cycles.pixel_filter_type = "BOX"
     cycles.filter_width = float(settings["filter_width_px"])
     render = scene.render
-    render.resolution_x = int(settings["width"])
-    render.resolution_y = int(settings["height"])
-    render.resolution_percentage = 100
-    render.pixel_aspect_x = 1.0
-    render.pixel_aspect_y = 1.0
-    render.film_transparent = False
     threads = int(settings.get("threads", 0))
     if threads > 0:
         render.threads_mode = "FIXED"
         render.threads = threads
     else:
         render.threads_mode = "AUTO"
-    # Linear output: the view transform does not touch EXR data, but keep it neutral anyway.
-    scene.view_settings.view_transform = "Standard"
-    scene.view_settings.look = "None"
-    scene.view_settings.exposure = 0.0
-    scene.view_settings.gamma = 1.0
-    image = render.image_settings
-    image.file_format = "OPEN_EXR_MULTILAYER"
-    image.color_depth = "32"
-    image.exr_codec = "ZIP"
-    render.use_file_extension = False
-    render.use_stamp = False
+    configure_output(scene, settings)
 
 
-def configure_passes(scene):
+# The shader AOV that carries the skin flag in EEVEE (a value per pixel, averaged over the TAA samples).
+SKIN_AOV = "skinlab_skin"
+
+
+def configure_passes(scene, engine="cycles"):
     layer = scene.view_layers[0]
     layer.use_pass_combined = True
     layer.use_pass_z = True
+    if engine == "eevee":
+        # EEVEE: Diffuse Light (direct and world light, subsurface scattering included) x Diffuse Colour, Specular
+        # Light x Specular Colour; no indirect or index passes.
+        layer.use_pass_diffuse_direct = True
+        layer.use_pass_diffuse_color = True
+        layer.use_pass_glossy_direct = True
+        layer.use_pass_glossy_color = True
+        aov = layer.aovs.add()
+        aov.name = SKIN_AOV
+        aov.type = "VALUE"
+        return layer
     layer.use_pass_diffuse_direct = True
     layer.use_pass_diffuse_indirect = True
     layer.use_pass_diffuse_color = True
@@ -195,7 +250,7 @@ def multiply_color(nodes, links, a, b):
     return node.outputs[0]
 
 
-def build_material(description, textures):
+def build_material(description, textures, engine="cycles"):
     material = bpy.data.materials.new(description["name"])
     material.use_nodes = True
     # The material index pass (first hit, not averaged) marks skin materials: skinlab's mask.Y.
@@ -232,7 +287,8 @@ def build_material(description, textures):
 
     links.new(albedo, bsdf.inputs["Base Color"])
     links.new(albedo, bsdf.inputs["Subsurface Color"])
-    bsdf.subsurface_method = "RANDOM_WALK_FIXED_RADIUS"
+    # EEVEE ignores the method: its kernel is always Christensen-Burley's (docs/pathtraced.md, "EEVEE").
+    bsdf.subsurface_method = "BURLEY" if engine == "eevee" else "RANDOM_WALK_FIXED_RADIUS"
     bsdf.inputs["Subsurface Radius"].default_value = tuple(float(r) for r in description["radius"])
     if description["sss"]:
         links.new(mask, bsdf.inputs["Subsurface"])
@@ -260,6 +316,10 @@ def build_material(description, textures):
                   normal_map.inputs["Color"])
         links.new(normal_map.outputs["Normal"], bsdf.inputs["Normal"])
     links.new(bsdf.outputs["BSDF"], output.inputs["Surface"])
+    if engine == "eevee":
+        skin_output = nodes.new("ShaderNodeOutputAOV")
+        skin_output.name = SKIN_AOV
+        skin_output.inputs["Value"].default_value = float(material.pass_index)
     return material
 
 
@@ -269,7 +329,7 @@ def aim(obj, direction):
     obj.rotation_quaternion = Vector(direction).normalized().to_track_quat("-Z", "Y")
 
 
-def build_lights(scene, lights):
+def build_lights(scene, lights, engine="cycles", far=1000.0):
     for index, description in enumerate(lights):
         kind = description["type"]
         data = bpy.data.lights.new("skinlab_light_%d" % index, "SUN" if kind == "sun" else "SPOT")
@@ -277,6 +337,15 @@ def build_lights(scene, lights):
         data.cycles.cast_shadow = bool(description["shadow"])
         data.cycles.max_bounces = 1024
         data.cycles.use_multiple_importance_sampling = True
+        if engine == "eevee":
+            data.use_shadow = bool(description["shadow"])
+            data.use_contact_shadow = False
+            if kind == "sun":
+                # The cascades cover everything the camera sees (Blender's default stops at 200 units, 0.2 m
+                # of a scene in millimetres).
+                data.shadow_cascade_max_distance = far
+            else:
+                data.shadow_buffer_clip_start = 1e-3 * far
         if kind == "sun":
             data.energy = float(description["strength"])
             data.angle = float(description["angle_rad"])
@@ -364,12 +433,13 @@ def render_to(scene, folder, output_name):
     bpy.ops.render.render(write_still=True)
     seconds = time.time() - start
     if not os.path.isfile(output):
-        fail("Cycles wrote no image to " + output)
+        fail(scene.render.engine + " wrote no image to " + output)
     return seconds
 
 
 def write_record(folder, record_name, seconds, passes=1):
-    record = {"blender_version": bpy.app.version_string, "render_seconds": seconds, "passes": passes}
+    record = {"blender_version": bpy.app.version_string, "render_seconds": seconds, "passes": passes,
+              "engine": bpy.context.scene.render.engine}
     with open(os.path.join(folder, record_name), "w") as handle:
         json.dump(record, handle)
 
@@ -398,10 +468,11 @@ def render_scene(path):
     folder = os.path.dirname(os.path.abspath(path))
     with open(path) as handle:
         description = json.load(handle)
+    engine = description["settings"].get("engine", "cycles")
     scene = reset_scene()
-    configure_cycles(scene, description["settings"])
-    configure_passes(scene)
-    materials = [build_material(m, description.get("textures", {})) for m in description["materials"]]
+    configure_engine(scene, description["settings"])
+    configure_passes(scene, engine)
+    materials = [build_material(m, description.get("textures", {}), engine) for m in description["materials"]]
     mesh_path = os.path.join(folder, description["mesh"]["file"])
     for index, part in enumerate(description["mesh"]["parts"]):
         mesh = build_mesh(mesh_path, part, "skinlab_part_%d" % index)
@@ -409,7 +480,7 @@ def render_scene(path):
         obj = bpy.data.objects.new("skinlab_part_%d" % index, mesh)
         obj.pass_index = 1
         scene.collection.objects.link(obj)
-    build_lights(scene, description["lights"])
+    build_lights(scene, description["lights"], engine, float(description["camera"]["far"]))
     build_world(scene, description["world"])
     build_camera(scene, description["camera"])
     if description["world"].get("shadow", True):

@@ -85,6 +85,35 @@ EdgeResponse measureEdgeResponse(const EdgeMeasurementSettings& s) {
     return response;
 }
 
+double eeveeEdgeResponseAt(double xMm, double radiusMm) {
+    const double d = kEeveeBurleyDPerRadius * radiusMm;
+    if (!(d > 0.0)) return xMm < 0.0 ? 1.0 : xMm > 0.0 ? 0.0 : 0.5;
+    const double limit = kEeveeBurleyTruncation * d;
+    if (xMm < 0.0) return 1.0 - eeveeEdgeResponseAt(-xMm, radiusMm);
+    if (xMm >= limit) return 0.0;
+    // ∫_x^L (e^{−t/d} + e^{−t/3d}) dt = d (e^{−x/d} − e^{−L/d}) + 3d (e^{−x/3d} − e^{−L/3d}); the whole kernel is
+    // twice that from 0.
+    auto tail = [&](double x) {
+        return d * (std::exp(-x / d) - std::exp(-limit / d)) +
+               3.0 * d * (std::exp(-x / (3.0 * d)) - std::exp(-limit / (3.0 * d)));
+    };
+    return tail(xMm) / (2.0 * tail(0.0));
+}
+
+EdgeResponse eeveeEdgeResponse() {
+    EdgeResponse response;
+    const int pixels = 4096;
+    const double pixelMm = kEeveeBurleyTruncation * kEeveeBurleyDPerRadius / pixels;
+    for (int k = 0; k < pixels; ++k) response.xMm.push_back((k + 0.5) * pixelMm);
+    for (int c = 0; c < 3; ++c) {
+        for (const double x : response.xMm)
+            response.value[static_cast<std::size_t>(c)].push_back(eeveeEdgeResponseAt(x, 1.0));
+        response.plateau[static_cast<std::size_t>(c)] = 1.0;
+    }
+    response.blenderVersion = "analytic";
+    return response;
+}
+
 double deonEdgeResponse(int channel, double xMm) {
     double e = 0.0;
     for (const sss::GaussianLobe& lobe : sss::deonSkinLobes())

@@ -42,6 +42,19 @@ struct EdgeResponse {
 // Renders the edge scene with Blender (temporary folder; kept with its log on failure).
 EdgeResponse measureEdgeResponse(const EdgeMeasurementSettings& settings);
 
+// EEVEE's subsurface kernel (Blender 3.x, source/blender/gpu/intern/gpu_material.c, compute_sss_kernel; applied by
+// draw/engines/eevee/shaders/effect_subsurface_frag.glsl): a 1-D kernel k(t) ∝ exp(−|t|/d) + exp(−|t|/(3d)) on
+// |t| ≤ 16 d (Burley's radial profile r·R(r), Christensen & Burley 2015, Eq. 3, used as a 1-D weight), applied along
+// x and then along y, with d = radius · 0.6 / (4π · s(1)) and s(A) = 1.9 − A + 3.5 (A − 0.8)² evaluated at A = 1
+// (Christensen & Burley 2015, Eq. 6; Blender's code fixes the albedo at 1 and calls 0.6 empirical). Across a
+// straight edge the second pass integrates to 1, so E(x) = ∫_x^{16d} k / ∫_{−16d}^{16d} k, in closed form.
+// The kernel depends on x / d only: radius r gives E_r(x) = E_1(x / r), as the random walk's edge response does.
+inline constexpr double kEeveeBurleyDPerRadius = 0.6 / (4.0 * 3.14159265358979323846 * 1.04);
+inline constexpr double kEeveeBurleyTruncation = 16.0; // in units of d
+double eeveeEdgeResponseAt(double xMm, double radiusMm);
+// E_1 sampled like a measurement (pixel centres over (0, 16 d] at radius 1 mm, 4096 of them), for fitRadii.
+EdgeResponse eeveeEdgeResponse();
+
 // d'Eon's edge response per channel at x mm.
 double deonEdgeResponse(int channel, double xMm);
 

@@ -3,6 +3,7 @@
 #include "common/error.h"
 #include "common/spec.h"
 #include "renderer/scene/builtin_scenes.h"
+#include "renderer/pathtraced/eevee_params.h"
 #include "renderer/pathtraced/pathtraced_params.h"
 #include "renderer/sss/sss_params.h"
 
@@ -304,6 +305,8 @@ SceneSpec loadSceneSpec(const std::string& scene, const std::vector<std::string>
         resolved["transmittance"] = spec.transmittance.toJson();
         spec.pathtraced = pathtraced::readPathtracedParams(root).toJson();
         if (spec.sss.method == sss::SssMethod::Pathtraced) resolved["pathtraced"] = spec.pathtraced;
+        spec.eevee = pathtraced::readEeveeParams(root).toJson();
+        if (spec.sss.method == sss::SssMethod::Eevee) resolved["eevee"] = spec.eevee;
     }
 
     root.finish();

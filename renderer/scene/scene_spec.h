@@ -95,6 +95,9 @@ struct SceneSpec {
     // Resolved [pathtraced] table (renderer/pathtraced/pathtraced_params.h); read for every scene, recorded in
     // `resolved` only when sss.method = "pathtraced" (the other methods do not depend on it).
     nlohmann::json pathtraced = nlohmann::json::object();
+    // Resolved [eevee] table (renderer/pathtraced/eevee_params.h); recorded in `resolved` only when
+    // sss.method = "eevee".
+    nlohmann::json eevee = nlohmann::json::object();
 
     nlohmann::json resolved; // every parameter after defaults and overrides
 };

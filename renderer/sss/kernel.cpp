@@ -53,6 +53,10 @@ Kernel makeKernel(const SssParams& params) {
         // Rendered by Blender Cycles (renderer/pathtraced): no screen-space taps.
         kernel.source = "path-traced (Blender Cycles, random walk)";
         break;
+    case SssMethod::Eevee:
+        // Rendered by Blender EEVEE (renderer/pathtraced): its own screen-space kernel, not skinlab's taps.
+        kernel.source = "Blender EEVEE (screen-space Christensen-Burley)";
+        break;
     case SssMethod::Reference:
         // Computed on the surface (renderer/reference), not with screen-space taps.
         kernel.source = "object-space reference (" + makeMarginal(params)->description() + ", 3-D distances)";

@@ -47,6 +47,7 @@ const std::vector<MethodInfo> kMethods{
      "object-space SSS on the tessellated surface (the ground truth of the metrics)",
      {"profile", "material", "reference_edge_mm", "reference_through_gain"}},
     {SssMethod::Pathtraced, "pathtraced", false, false, "Blender Cycles' random-walk SSS ([pathtraced] table)", {}},
+    {SssMethod::Eevee, "eevee", false, false, "Blender EEVEE's screen-space SSS ([eevee] table)", {}},
 };
 #undef SKINLAB_BLUR_KEYS
 

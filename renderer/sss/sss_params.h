@@ -22,6 +22,7 @@ enum class SssMethod {
     Pscbf,       // Mikkelsen 2010: pseudo-separable cross-bilateral filter, spike + one Gaussian per channel
     Reference,   // object-space SSS on the tessellated surface (the ground truth of the metrics)
     Pathtraced,  // Blender Cycles' random walk (renderer/pathtraced; the screen-space stage copies through)
+    Eevee,       // Blender EEVEE's screen-space Christensen–Burley SSS (renderer/pathtraced; copies through here too)
 };
 
 // How a continuous 1-D kernel is discretised into taps (docs/methods.md, "Discretisation").

@@ -391,7 +391,8 @@ TEST(StimulusOutputFolder, RefusesForeignFolders) {
 namespace {
 // The shipped specs that render the scanned head (the others use built-in scenes only).
 bool needsHead(const std::string& file) {
-    return file.rfind("thesis-", 0) == 0 || file == "extensions-head.toml" || file == "demo-scan.toml";
+    return file.rfind("thesis-", 0) == 0 || file == "extensions-head.toml" || file == "demo-scan.toml" ||
+           file == "eevee-methods-scan.toml";
 }
 } // namespace
 
@@ -409,7 +410,9 @@ TEST(ShippedSpecs, ExpandToTheDocumentedCounts) {
                                                                   {"thesis-fig5.1-samples.toml", 34},
                                                                   {"extensions-halo.toml", 50},
                                                                   {"extensions-bleed.toml", 25},
-                                                                  {"extensions-head.toml", 25}};
+                                                                  {"extensions-head.toml", 25},
+                                                                  {"eevee-methods.toml", 7},
+                                                                  {"eevee-methods-scan.toml", 7}};
     size_t specs = 0;
     for (const auto& entry : fs::directory_iterator(dir))
         if (entry.path().extension() == ".toml") ++specs;

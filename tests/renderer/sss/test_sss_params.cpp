@@ -66,7 +66,7 @@ material = "marble"
 
 TEST(SssParams, ErrorsNameFileKeyAndValue) {
     EXPECT_EQ(sssError("[sss]\nmethod = \"blur\""), "scene.toml: sss.method: 'blur' is not one of: none, gaussian-sum, "
-                                                    "separable, artistic, pscbf, reference, pathtraced");
+                                                    "separable, artistic, pscbf, reference, pathtraced, eevee");
     EXPECT_EQ(sssError("[sss]\nmethod = \"separable\"\nsamples = 20"),
               "scene.toml: sss.samples: 20 is even; a symmetric kernel needs an odd number of taps (3…101)");
     EXPECT_EQ(sssError("[sss]\nmethod = \"separable\"\nsamples = 103"),
@@ -221,7 +221,7 @@ TEST(SssParams, KeyOfAnotherMethodIsAnError) {
 // The method table: names, parse, screen-space flag; every SssMethod has one row, in enum order.
 TEST(SssParams, MethodTable) {
     const auto& table = methodTable();
-    ASSERT_EQ(table.size(), 7u);
+    ASSERT_EQ(table.size(), 8u);
     for (std::size_t i = 0; i < table.size(); ++i) {
         EXPECT_EQ(static_cast<std::size_t>(table[i].method), i);
         EXPECT_EQ(findMethod(table[i].name), &table[i]);

@@ -1,0 +1,95 @@
+#include "renderer/pathtraced/eevee_params.h"
+
+#include "common/error.h"
+#include "common/spec.h"
+#include "renderer/pathtraced/profile_fit.h"
+
+namespace skinlab::renderer::pathtraced {
+
+std::array<double, 3> fittedEeveeRadiusMm() {
+    // Analytic (no render): the fit is deterministic and takes milliseconds.
+    static const std::array<double, 3> radii = [] {
+        const std::array<double, 3> start{1.0, 1.0, 1.0};
+        return fitRadii(eeveeEdgeResponse(), start).radiusMm;
+    }();
+    return radii;
+}
+
+namespace {
+EeveeParams readTable(const SpecReader& t) {
+    EeveeParams p;
+    p.sssSamples = static_cast<int>(t.integer("sss_samples", p.sssSamples, 1, 32));
+    p.sssJitterThreshold = t.number("sss_jitter_threshold", p.sssJitterThreshold, 0.0, 1.0);
+    p.taaSamples = static_cast<int>(t.integer("taa_samples", p.taaSamples, 1, 1 << 16));
+    p.sss = t.boolean("sss", p.sss);
+    p.specular = t.boolean("specular", p.specular);
+    p.specularSource = t.string("specular_source", p.specularSource);
+    if (p.specularSource != "eevee" && p.specularSource != "rasterizer")
+        t.fail("specular_source", "'" + p.specularSource + "' is not one of \"eevee\", \"rasterizer\"");
+    p.radiusMm = t.vec3("radius_mm", p.radiusMm, 0.0, 1000.0);
+    p.filterWidthPx = t.number("filter_width_px", p.filterWidthPx, 0.01, 10.0);
+    p.shadowMapSize = static_cast<int>(t.integer("shadow_map_size", p.shadowMapSize, 512, 4096));
+    if (p.shadowMapSize != 512 && p.shadowMapSize != 1024 && p.shadowMapSize != 2048 && p.shadowMapSize != 4096)
+        t.fail("shadow_map_size", std::to_string(p.shadowMapSize) + " is not one of 512, 1024, 2048, 4096");
+    p.softShadows = t.boolean("soft_shadows", p.softShadows);
+    p.blender = t.string("blender", p.blender);
+    if (p.blender.empty()) t.fail("blender", "must name the Blender program (e.g. \"blender\")");
+    return p;
+}
+} // namespace
+
+nlohmann::json EeveeParams::toJson() const {
+    return {{"sss_samples", sssSamples},
+            {"sss_jitter_threshold", sssJitterThreshold},
+            {"taa_samples", taaSamples},
+            {"sss", sss},
+            {"specular", specular},
+            {"specular_source", specularSource},
+            {"radius_mm", radiusMm},
+            {"filter_width_px", filterWidthPx},
+            {"shadow_map_size", shadowMapSize},
+            {"soft_shadows", softShadows},
+            {"blender", blender}};
+}
+
+PathtracedParams EeveeParams::sceneParams() const {
+    PathtracedParams p;
+    p.samples = taaSamples;
+    p.sss = sss;
+    p.specular = specular;
+    p.specularSource = specularSource == "rasterizer" ? "rasterizer" : "cycles"; // "rasterizer": Principled specular 0
+    p.radiusMm = radiusMm;
+    p.environmentShadow = true; // one pass: EEVEE's world light is unshadowed anyway (no ambient occlusion)
+    p.sunAngleDeg = 0.0;
+    p.filterWidthPx = filterWidthPx;
+    p.blender = blender;
+    return p;
+}
+
+EeveeParams readEeveeParams(const SpecReader& scene) {
+    const SpecReader t = scene.table("eevee");
+    EeveeParams p = readTable(t);
+    t.finish();
+    return p;
+}
+
+EeveeParams eeveeParamsFromJson(const nlohmann::json& json, std::string_view source) {
+    if (!json.is_object()) throwInput(source, "eevee", "expected a JSON object, got " + json.dump());
+    toml::table table;
+    for (const auto& [key, value] : json.items()) {
+        if (value.is_boolean()) table.insert_or_assign(key, value.get<bool>());
+        else if (value.is_number_integer()) table.insert_or_assign(key, value.get<std::int64_t>());
+        else if (value.is_number()) table.insert_or_assign(key, value.get<double>());
+        else if (value.is_string()) table.insert_or_assign(key, value.get<std::string>());
+        else if (value.is_array()) {
+            toml::array array;
+            for (const auto& element : value) array.push_back(element.get<double>());
+            table.insert_or_assign(key, std::move(array));
+        } else throwInput(source, "eevee." + key, "unsupported value " + value.dump());
+    }
+    toml::table root;
+    root.insert_or_assign("eevee", std::move(table));
+    return readEeveeParams(SpecReader(root, std::string(source)));
+}
+
+} // namespace skinlab::renderer::pathtraced
