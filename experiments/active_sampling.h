@@ -83,21 +83,26 @@ double expectedInformationGain(const ScorePosterior& posterior, int i, int j);
 // All pairs' gains, gains[i][j] = gains[j][i]; the diagonal is 0.
 std::vector<std::vector<double>> informationGains(const ScorePosterior& posterior);
 
-// The next batch: the minimum spanning tree over 1/gain (Prim's algorithm, O(m²)), as (i, j) pairs with i < j,
-// in decreasing order of gain. `tieSeed` breaks ties deterministically (equal gains, e.g. before any answer):
+// What a batch maximises, per pair: the expected information gain of the pair (above), or the expected reduction
+// of the summed posterior variance of the mean-centred scores (A-optimal design: what the scale's RMSE depends on),
+// i.e. π/(1 + π v) ‖C Σ a‖² with π the expected precision of one answer on d, v = Var d, C the centring matrix.
+enum class BatchCriterion { informationGain, varianceReduction };
+
+// Every pair's value under `criterion`, values[i][j] = values[j][i]; the diagonal is 0.
+std::vector<std::vector<double>> pairValues(const ScorePosterior& posterior, BatchCriterion criterion);
+
+// The next batch: the minimum spanning tree over 1/value (Prim's algorithm, O(m²)), as (i, j) pairs with i < j,
+// in decreasing order of value. `tieSeed` breaks ties deterministically (equal values, e.g. before any answer):
 // each weight is scaled by a factor in [1, 1 + 1e-6] drawn from the seed, so different participants starting
 // together get different trees, and a given seed always the same one.
-std::vector<std::pair<int, int>> spanningTreeBatch(const ScorePosterior& posterior, std::uint64_t tieSeed);
+std::vector<std::pair<int, int>> spanningTreeBatch(const ScorePosterior& posterior, std::uint64_t tieSeed,
+                                                   BatchCriterion criterion = BatchCriterion::informationGain);
 
 // An alternative batch (compared in bench_active_sampling; the server uses the spanning tree): `size` pairs chosen
 // greedily, each the pair of highest gain under the posterior updated for the pairs already chosen. The update of
 // a chosen pair is the one its answer will make to the covariance (a probit answer's precision on d, averaged over
 // the two answers; the means are left as they are, the answer being unknown), so a batch does not spend several
 // trials on one uncertain region. Ties broken by `tieSeed` as above.
-// `criterion`: the expected information gain of the pair (as above), or the expected reduction of the summed
-// posterior variance of the mean-centred scores (A-optimal design: what the scale's RMSE depends on), i.e.
-// π/(1 + π v) ‖C Σ a‖² with π the expected precision of one answer on d, v = Var d, C the centring matrix.
-enum class BatchCriterion { informationGain, varianceReduction };
 std::vector<std::pair<int, int>> greedyBatch(const ScorePosterior& posterior, int size, std::uint64_t tieSeed,
                                              BatchCriterion criterion = BatchCriterion::informationGain);
 
