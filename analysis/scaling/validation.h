@@ -75,7 +75,9 @@ struct ValidationRow {
     double maximumHalfWidth = 0.0;   // JOD, largest distance from a score to one of its bounds
     double percentileCoverage = 0.0; // pwcmp's percentile bootstrap on the same resamples
     double percentileMeanWidth = 0.0;
-    double bootstrapCoverage = -1.0;  // "active" only: the studentized observer bootstrap on the same data
+    double bootstrapCoverage = -1.0; // "active" only: the studentized observer bootstrap on the same data
+    double unionCoverage = -1.0;     // "active" only: the union of that bootstrap and the profile interval
+    double unionMeanWidth = 0.0;
     double rmse = 0.0;                // JOD, mean-zero scores against mean-zero truth
     double rankCorrelation = 0.0;     // mean Spearman ρ
     double significantCorrect = 0.0;  // fraction of (experiment, pair): significant with the true sign

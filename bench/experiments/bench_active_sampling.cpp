@@ -1,27 +1,38 @@
 // Active sampling against the alternatives (docs/benchmarks.md, "Active sampling"; docs/analysis.md,
-// "Validation of active designs"). For m = 10, 20, 30 conditions with known true scores, simulated Thurstone
-// observers answer three designs of the same length:
+// "Validation of active designs"). Simulated Thurstone observers answer designs of conditions with known true
+// scores (drawn from N(0, sd²) JOD and centred):
 //  - full:   every pair once per round, rounds repeated (each round in a random order);
 //  - random: each comparison a uniformly random pair (an incomplete random design);
-//  - active: batches of m − 1 pairs, each the minimum spanning tree over 1/information gain of the posterior
-//            built from every answer so far (experiments/active_sampling.h, as the study server plans them).
-// Each observer answers m − 1 consecutive comparisons (one active batch). After every m − 1 comparisons the
-// scale is fitted exactly as `analyze scale` fits it (Thurstone Case V MAP, analysis/scaling) and its RMSE
-// against the truth (both mean-zero) recorded; at a few budgets the 95 % studentized bootstrap interval over
-// observers is computed and its coverage of the true scores counted.
-// Also times the planning of one batch at m = 30 with 200 participants' answers (the server's request path).
+//  - active: batches of m − 1 pairs, each the minimum spanning tree over 1/(expected reduction of the summed
+//            variance of the centred scores) of the posterior built from every answer so far
+//            (experiments/active_sampling.h, as the study server plans them; --selection picks another).
+// Each observer answers m − 1 consecutive comparisons (one active batch). The scale is fitted exactly as
+// `analyze scale` fits it (Thurstone Case V MAP, analysis/scaling) and its RMSE against the truth (both
+// mean-zero) recorded.
 //
-// Coverage is counted for two intervals: the studentized bootstrap over observers (`analyze scale`'s default) and
-// the profile-likelihood interval (`analyze scale --intervals profile`, automatic for active studies).
-// Also prints, per m, a bound on the saving any choice of pairs can reach (Fisher information, Cramér–Rao): with N
-// comparisons the information matrix is at most I(0)·(the comparison-count Laplacian), whose trace of the
-// pseudo-inverse is at least (m − 1)²/(2 N I(0)) (Cauchy–Schwarz over its eigenvalues; equality for the complete
-// graph with equal counts), against the full design's trace of (N/M · Σ_pairs I(δ) a aᵀ)⁺.
+// --sweep (the saving, as docs/benchmarks.md reports it): for every (m, sd, budget) cell and each of --seeds
+// seeds, one true scale, one full design up to the budget and one active design up to --horizon × the largest
+// budget, its RMSE after every observer. The saving at a budget B (in full rounds of m(m−1)/2 comparisons) is
+// 1 − N/B, N the comparisons after which the active design first reaches the full design's RMSE at B
+// (interpolated between observers):
+//  - pooled: the mean squared errors averaged over the seeds first (the expected accuracy of a study of that
+//    size), with a 95 % percentile interval from resampling the seeds;
+//  - per seed: the same seed's active curve against its own full design — the spread a single study sees; a
+//    seed whose active design never reaches the target within the horizon counts as a saving below
+//    1 − horizon·B/B and stays in the quantiles and shares.
+// Also per cell: the asymptotic upper bound on the saving of any allocation of comparisons to pairs
+// (analysis/scaling/design_efficiency.h), averaged over the seeds' true scales.
+//
+// Default mode: per m = 10, 20, 30, the RMSE curves averaged over --experiments experiments, coverage of the
+// studentized bootstrap and profile-likelihood intervals at a few budgets, and the planning time of one batch
+// at m = 30 with 200 participants' answers (the server's request path).
 //
 // Usage: bench_active_sampling [--experiments E] [--coverage-experiments C] [--bootstrap B] [--spread S]
-//                              [--truth normal|uniform] [--prior-sd P] [--selection mst|greedy|variance]
-//                              [--rounds R] [--threads T] [--seed N] [--timing 0|1] [--coverage-rounds 1,2]
-//                              [--plot FILE.png]
+//                              [--truth normal|uniform] [--prior-sd P]
+//                              [--selection mst-variance|mst-gain|greedy|variance] [--rounds R] [--threads T]
+//                              [--seed N] [--timing 0|1] [--coverage-rounds 1,2] [--plot FILE.png]
+//        bench_active_sampling --sweep [--seeds S] [--ms 10,20,30,40] [--spreads 1,2,3] [--budgets 1,2]
+//                              [--horizon H] [--selection ...] [--prior-sd P] [--threads T] [--seed N]
 #include "analysis/scaling/bootstrap.h"
 #include "analysis/scaling/design_efficiency.h"
 #include "analysis/scaling/pairwise_model.h"
@@ -63,8 +74,8 @@ struct Settings {
     int bootstrap = 200;
     double spread = 1.0; // true scores ~ N(0, spread²) JOD, or uniform with this sd
     std::string truth = "normal";
-    double priorSd = 1.0;          // prior sd of the active design's posterior (JOD)
-    std::string selection = "mst"; // active batches: spanning tree over 1/gain, or greedy with updates
+    double priorSd = 1.0;                   // prior sd of the active design's posterior (JOD)
+    std::string selection = "mst-variance"; // active batches (the server's), mst-gain, greedy or variance
     bool timing = true;
     std::vector<double> coverageRounds = {0.6, 1.0, 1.2, 2.0, 2.4}; // coverage budgets, in full rounds
     int rounds = 4;                                                 // longest design, in full-design rounds m(m−1)/2
@@ -129,9 +140,9 @@ std::vector<std::pair<int, int>> plan(const ac::ScorePosterior& posterior, int m
     if (settings.selection == "greedy") return ac::greedyBatch(posterior, m - 1, tieSeed);
     if (settings.selection == "variance")
         return ac::greedyBatch(posterior, m - 1, tieSeed, ac::BatchCriterion::varianceReduction);
-    if (settings.selection == "mst-variance")
-        return ac::spanningTreeBatch(posterior, tieSeed, ac::BatchCriterion::varianceReduction);
-    return ac::spanningTreeBatch(posterior, tieSeed);
+    if (settings.selection == "mst-gain")
+        return ac::spanningTreeBatch(posterior, tieSeed, ac::BatchCriterion::informationGain);
+    return ac::spanningTreeBatch(posterior, tieSeed, ac::BatchCriterion::varianceReduction);
 }
 
 std::vector<Trial> simulateDesign(int design, const std::vector<double>& truth, std::size_t length, std::uint64_t seed,
@@ -339,9 +350,9 @@ int runSweep(const Settings& s) {
     const double largestBudget = *std::max_element(s.budgets.begin(), s.budgets.end());
     std::printf("Saving of the active design (%s batches, prior sd %.2f JOD) against the full design, %d seeds per "
                 "cell; true scores ~ N(0, sd^2) JOD; observers answer m-1 trials each; active runs to %.2f x the "
-                "largest budget; hardware threads %u, %d worker threads.\n\n",
-                s.selection.c_str(), s.priorSd, s.seeds, s.horizon * largestBudget, std::thread::hardware_concurrency(),
-                s.threads);
+                "largest budget (%.1f full rounds); hardware threads %u, %d worker threads.\n\n",
+                s.selection.c_str(), s.priorSd, s.seeds, s.horizon, s.horizon * largestBudget,
+                std::thread::hardware_concurrency(), s.threads);
     std::printf("| m | sd | budget: rounds (observers, trials) | RMSE full | RMSE active | pooled saving [95 %% CI] | "
                 "per-seed saving: median [10 %%, 90 %%] | seeds >= 40 %% | seeds never | A-opt bound | time (s) |\n"
                 "|---|---|---|---|---|---|---|---|---|---|---|\n");
