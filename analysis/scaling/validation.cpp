@@ -372,8 +372,8 @@ std::string validationMarkdown(const ValidationReport& report) {
         "'sparse': each observer judges %.0f %% of the pairs; 'disconnected': %d groups never compared "
         "(truth centred per group); 'near-unanimous': true scores x %.1f. 'active': observers one after "
         "another on true scores x %.1f, %d trials each in batches chosen from all earlier answers, "
-        "profile-likelihood intervals and score tests (as `analyze scale` for an active study); its "
-        "studentized observer bootstrap on the same data covers: %s.\n\n",
+        "profile-likelihood intervals and score tests in the columns below; the studentized observer bootstrap "
+        "on the same data (what `analyze scale` uses for an active study) covers: %s.\n\n",
         scores.c_str(), o.trialsPerPair, o.trialsPerPair % 2 == 0 ? "equally often" : "alternating", o.experiments,
         o.bootstrapSamples, correctionName(o.correction), o.alpha, static_cast<unsigned long long>(o.seed), o.lapseRate,
         o.sideBiasStandardDeviation, o.randomObservers, o.invertedObservers, 100.0 * o.sparsePairFraction,
