@@ -644,15 +644,17 @@ int main(int argc, char** argv) {
         allCurves.push_back(curves);
         allX.push_back(x);
     }
-    std::printf("\nCoverage of the 95 %% studentized bootstrap intervals (median width, JOD):\n\n"
-                "| m | comparisons | full | random | active |\n|---|---|---|---|---|\n");
-    for (const std::string& line : coverageLines) std::printf("%s\n", line.c_str());
-    std::printf("\nCoverage of the 95 %% profile-likelihood intervals (median width, JOD):\n\n"
-                "| m | comparisons | full | random | active |\n|---|---|---|---|---|\n");
-    for (const std::string& line : profileLines) std::printf("%s\n", line.c_str());
+    if (s.coverageExperiments > 0) {
+        std::printf("\nCoverage of the 95 %% studentized bootstrap intervals (median width, JOD):\n\n"
+                    "| m | comparisons | full | random | active |\n|---|---|---|---|---|\n");
+        for (const std::string& line : coverageLines) std::printf("%s\n", line.c_str());
+        std::printf("\nCoverage of the 95 %% profile-likelihood intervals (median width, JOD):\n\n"
+                    "| m | comparisons | full | random | active |\n|---|---|---|---|---|\n");
+        for (const std::string& line : profileLines) std::printf("%s\n", line.c_str());
+    }
 
     // Planning time of one batch at m = 30 with 200 participants' answers (as the server plans it).
-    std::printf("\nPlanning one batch (posterior from every answer, gains, spanning tree), m = 30:\n\n"
+    std::printf("\nPlanning one batch (posterior from every answer, pair values, spanning tree), m = 30:\n\n"
                 "| participants | answers | EP sweeps | plan median (ms) | plan min (ms) |\n|---|---|---|---|---|\n");
     for (const int perParticipant : {29, 58, 100}) {
         if (!s.timing) break;
