@@ -189,7 +189,7 @@ void runValidate(ValidateArguments& arguments) {
         if (observers < 2 + arguments.options.randomObservers + arguments.options.invertedObservers)
             throwInput("--observers", "", std::to_string(observers) + " is too few (at least 2 genuine observers)");
     // The "active" scenario plans with the study server's planner (experiments/active_sampling.h): the posterior of
-    // every earlier answer, one batch = the spanning tree over 1/information gain.
+    // every earlier answer, one batch = the spanning tree over 1/(expected variance reduction).
     arguments.options.activePlanner = [](int conditions, const std::vector<scaling::PlannerAnswer>& answers,
                                          std::uint64_t seed) {
         std::vector<experiments::active::Comparison> comparisons;
