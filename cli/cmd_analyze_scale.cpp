@@ -90,19 +90,22 @@ void runScale(const ScaleArguments& arguments) {
         for (const scaling::ExcludedObserver& e : scaling::excludeObservers(table))
             std::printf("excluded observer %s: %s (the protocol's rule; --no-exclusion keeps them)\n",
                         e.observer.c_str(), e.reason.c_str());
-    // Likelihood-based intervals stay valid when each observer's pairs depended on earlier answers; the observer
-    // bootstrap does not (docs/analysis.md, "Validation of active designs").
+    // Active designs get the studentized observer bootstrap too: of the two intervals offered it is the one that
+    // covers closer to 95 % when each observer's pairs depend on earlier answers (docs/analysis.md, "Validation of
+    // active designs").
     if (arguments.intervals == "percentile") {
         options.intervals = scaling::IntervalMethod::percentile;
         options.intervalReason = "--intervals percentile";
-    } else if (arguments.intervals == "profile" || (arguments.intervals == "auto" && table.adaptiveDesign)) {
+    } else if (arguments.intervals == "profile") {
         options.intervals = scaling::IntervalMethod::profile;
-        options.intervalReason = arguments.intervals == "profile" ? "--intervals profile" : "active design";
+        options.intervalReason = "--intervals profile";
     } else {
-        options.intervalReason = arguments.intervals == "bootstrap" ? "--intervals bootstrap" : "fixed design";
+        options.intervalReason = arguments.intervals == "bootstrap" ? "--intervals bootstrap"
+                                 : table.adaptiveDesign             ? "active design"
+                                                                    : "fixed design";
     }
-    if (options.intervals == scaling::IntervalMethod::profile && arguments.intervals == "auto")
-        std::printf("active design (pairs chosen from earlier answers): profile-likelihood intervals\n");
+    if (arguments.intervals == "auto" && table.adaptiveDesign)
+        std::printf("active design (pairs chosen from earlier answers): studentized bootstrap intervals\n");
     const scaling::Dataset dataset = scaling::buildDataset(table, datasetOptions);
     const scaling::Analysis analysis = scaling::analyzeDataset(dataset, options);
     for (const std::string& warning : analysis.warnings) spdlog::warn("{}", warning);
@@ -192,7 +195,7 @@ void runValidate(ValidateArguments& arguments) {
         if (observers < 2 + arguments.options.randomObservers + arguments.options.invertedObservers)
             throwInput("--observers", "", std::to_string(observers) + " is too few (at least 2 genuine observers)");
     // The "active" scenario plans with the study server's planner (experiments/active_sampling.h): the posterior of
-    // every earlier answer, one batch = the spanning tree over 1/information gain.
+    // every earlier answer, one batch = the spanning tree over 1/(expected variance reduction).
     arguments.options.activePlanner = [](int conditions, const std::vector<scaling::PlannerAnswer>& answers,
                                          std::uint64_t seed) {
         std::vector<experiments::active::Comparison> comparisons;
@@ -280,9 +283,8 @@ void registerAnalyzeScale(CLI::App& analyze) {
                     "leave out trials during which the page was hidden or lost the focus (online studies)");
     scale
         ->add_option("--intervals", scaleArguments->intervals,
-                     "bootstrap (studentized, over observers), profile (profile likelihood, valid for active "
-                     "designs), percentile (pwcmp's percentile bootstrap over observers), or auto: profile for a "
-                     "study.db with pairs = \"active\", bootstrap otherwise")
+                     "bootstrap (studentized, over observers), profile (profile likelihood), percentile (pwcmp's "
+                     "percentile bootstrap over observers), or auto: bootstrap (for active designs too)")
         ->check(CLI::IsMember({"auto", "bootstrap", "profile", "percentile"}))
         ->capture_default_str();
     scale->callback([scaleArguments] { runScale(*scaleArguments); });

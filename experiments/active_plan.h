@@ -4,7 +4,7 @@
 // A participant's plan is fixed at joining except for its test trials: planTrials() places practice trials first
 // and catch trials among `trials_per_participant` open slots. Whenever the participant has answered every stored
 // trial, the server stores the next stretch of the plan: the trials up to the next open slot, then one batch —
-// the minimum spanning tree over 1/information gain of one block's posterior (experiments/active_sampling.h),
+// the minimum spanning tree over 1/(expected variance reduction) of one block's posterior (active_sampling.h),
 // built from every stored answer of every participant at that moment — in the open slots, then any trials up to
 // the next open slot (so trailing catch trials come with the last batch). Trials are stored before they are
 // shown; a stored trial is never re-planned, so a restart (the posterior is rebuilt from the stored answers)

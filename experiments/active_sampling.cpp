@@ -268,10 +268,62 @@ std::vector<std::vector<double>> informationGains(const ScorePosterior& posterio
     return gains;
 }
 
-std::vector<std::pair<int, int>> spanningTreeBatch(const ScorePosterior& posterior, std::uint64_t tieSeed) {
+namespace {
+// Expected precision one answer adds to d = q_i − q_j (the variance after either answer, weighted by the
+// predictive probabilities).
+double answerPrecision(double md, double vd) {
+    const double pi = normalCdf(md / std::sqrt(kThurstoneSigma * kThurstoneSigma + vd));
+    const double vAfter = pi * afterAnswer(md, vd).variance + (1.0 - pi) * afterAnswer(-md, vd).variance;
+    return std::max(0.0, 1.0 / vAfter - 1.0 / vd);
+}
+
+// Row means of Σ (for the centring: C Σ a = Σa − mean(Σa)).
+std::vector<double> rowMeans(const ScorePosterior& p) {
+    const std::size_t n = p.mean.size();
+    std::vector<double> out(n, 0.0);
+    for (std::size_t r = 0; r < n; ++r) {
+        for (std::size_t c = 0; c < n; ++c) out[r] += p.covariance[c * n + r];
+        out[r] /= static_cast<double>(n);
+    }
+    return out;
+}
+
+// π/(1 + π v) ‖C Σ a‖² for the pair (i, j).
+double varianceReduction(const ScorePosterior& p, const std::vector<double>& rowMean, int i, int j) {
+    const std::size_t n = p.mean.size();
+    const auto ui = static_cast<std::size_t>(i), uj = static_cast<std::size_t>(j);
+    const double vd =
+        std::max(p.covariance[ui * n + ui] + p.covariance[uj * n + uj] - 2.0 * p.covariance[ui * n + uj], 1e-12);
+    const double precision = answerPrecision(p.mean[ui] - p.mean[uj], vd);
+    const double shift = rowMean[ui] - rowMean[uj];
+    double norm = 0.0;
+    for (std::size_t r = 0; r < n; ++r) {
+        const double x = p.covariance[r * n + ui] - p.covariance[r * n + uj] - shift;
+        norm += x * x;
+    }
+    return precision / (1.0 + precision * vd) * norm;
+}
+} // namespace
+
+std::vector<std::vector<double>> pairValues(const ScorePosterior& posterior, BatchCriterion criterion) {
+    if (criterion == BatchCriterion::informationGain) return informationGains(posterior);
+    const int m = posterior.conditions();
+    const std::vector<double> rowMean = rowMeans(posterior);
+    std::vector<std::vector<double>> values(static_cast<std::size_t>(m),
+                                            std::vector<double>(static_cast<std::size_t>(m), 0.0));
+    for (int i = 0; i < m; ++i)
+        for (int j = i + 1; j < m; ++j)
+            values[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)] =
+                values[static_cast<std::size_t>(j)][static_cast<std::size_t>(i)] =
+                    varianceReduction(posterior, rowMean, i, j);
+    return values;
+}
+
+std::vector<std::pair<int, int>> spanningTreeBatch(const ScorePosterior& posterior, std::uint64_t tieSeed,
+                                                   BatchCriterion criterion) {
     const int m = posterior.conditions();
     if (m < 2) return {};
-    const auto gains = informationGains(posterior);
+    const auto gains = pairValues(posterior, criterion);
     const auto n = static_cast<std::size_t>(m);
     // Edge weights 1/gain with a seeded multiplicative jitter in [1, 1 + 1e-6] (ties only).
     SeededRandom random(tieSeed);
@@ -309,16 +361,6 @@ std::vector<std::pair<int, int>> spanningTreeBatch(const ScorePosterior& posteri
     return edges;
 }
 
-namespace {
-// Expected precision one answer adds to d = q_i − q_j (the variance after either answer, weighted by the
-// predictive probabilities).
-double answerPrecision(double md, double vd) {
-    const double pi = normalCdf(md / std::sqrt(kThurstoneSigma * kThurstoneSigma + vd));
-    const double vAfter = pi * afterAnswer(md, vd).variance + (1.0 - pi) * afterAnswer(-md, vd).variance;
-    return std::max(0.0, 1.0 / vAfter - 1.0 / vd);
-}
-} // namespace
-
 std::vector<std::pair<int, int>> greedyBatch(const ScorePosterior& posterior, int size, std::uint64_t tieSeed,
                                              BatchCriterion criterion) {
     const int m = posterior.conditions();
@@ -333,31 +375,12 @@ std::vector<std::pair<int, int>> greedyBatch(const ScorePosterior& posterior, in
     for (int k = 0; k < size; ++k) {
         double best = -1.0;
         int bi = 0, bj = 1;
-        // Row sums of Σ (for the centring: C Σ a = Σa − mean(Σa)).
-        std::vector<double> rowMean(n, 0.0);
-        if (criterion == BatchCriterion::varianceReduction)
-            for (std::size_t r = 0; r < n; ++r) {
-                for (std::size_t c = 0; c < n; ++c) rowMean[r] += p.covariance[c * n + r];
-                rowMean[r] /= static_cast<double>(n);
-            }
+        const std::vector<double> rowMean =
+            criterion == BatchCriterion::varianceReduction ? rowMeans(p) : std::vector<double>{};
         for (int i = 0; i < m; ++i)
             for (int j = i + 1; j < m; ++j) {
-                double value = 0.0;
-                if (criterion == BatchCriterion::informationGain) {
-                    value = expectedInformationGain(p, i, j);
-                } else {
-                    const auto ui = static_cast<std::size_t>(i), uj = static_cast<std::size_t>(j);
-                    const double vd = std::max(
-                        p.covariance[ui * n + ui] + p.covariance[uj * n + uj] - 2.0 * p.covariance[ui * n + uj], 1e-12);
-                    const double precision = answerPrecision(p.mean[ui] - p.mean[uj], vd);
-                    const double shift = rowMean[ui] - rowMean[uj];
-                    double norm = 0.0;
-                    for (std::size_t r = 0; r < n; ++r) {
-                        const double x = p.covariance[r * n + ui] - p.covariance[r * n + uj] - shift;
-                        norm += x * x;
-                    }
-                    value = precision / (1.0 + precision * vd) * norm;
-                }
+                const double value = criterion == BatchCriterion::informationGain ? expectedInformationGain(p, i, j)
+                                                                                  : varianceReduction(p, rowMean, i, j);
                 const double g = value * jitter[static_cast<std::size_t>(i) * n + static_cast<std::size_t>(j)];
                 if (g > best) {
                     best = g;

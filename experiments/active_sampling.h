@@ -19,9 +19,10 @@
 // posterior after the answer from the posterior now, averaged over the two answers with their predictive
 // probabilities. An answer only reshapes the distribution of d = q_i − q_j (the rest given d is unchanged), so
 // the gain is a one-dimensional KL of d's marginal. It is largest for close pairs (the answer is uncertain) whose
-// difference is uncertain (the answer moves it). A batch is the minimum spanning tree of the complete graph
-// weighted by 1/gain: m − 1 pairs that touch every condition (a connected comparison graph) and favour the
-// informative pairs.
+// difference is uncertain (the answer moves it). The study server ranks pairs by the expected reduction of the
+// summed variance of the centred scores instead (below; it saved more trials over seeds). A batch is the minimum
+// spanning tree of the complete graph weighted by 1/value: m − 1 pairs that touch every condition (a connected
+// comparison graph) and favour the valuable pairs.
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -83,21 +84,28 @@ double expectedInformationGain(const ScorePosterior& posterior, int i, int j);
 // All pairs' gains, gains[i][j] = gains[j][i]; the diagonal is 0.
 std::vector<std::vector<double>> informationGains(const ScorePosterior& posterior);
 
-// The next batch: the minimum spanning tree over 1/gain (Prim's algorithm, O(m²)), as (i, j) pairs with i < j,
-// in decreasing order of gain. `tieSeed` breaks ties deterministically (equal gains, e.g. before any answer):
+// What a batch maximises, per pair: the expected information gain of the pair (above), or the expected reduction
+// of the summed posterior variance of the mean-centred scores (A-optimal design: what the scale's RMSE depends on),
+// i.e. π/(1 + π v) ‖C Σ a‖² with π the expected precision of one answer on d, v = Var d, C the centring matrix.
+enum class BatchCriterion { informationGain, varianceReduction };
+
+// Every pair's value under `criterion`, values[i][j] = values[j][i]; the diagonal is 0.
+std::vector<std::vector<double>> pairValues(const ScorePosterior& posterior, BatchCriterion criterion);
+
+// The next batch: the minimum spanning tree over 1/value (Prim's algorithm, O(m²)), as (i, j) pairs with i < j,
+// in decreasing order of value. `tieSeed` breaks ties deterministically (equal values, e.g. before any answer):
 // each weight is scaled by a factor in [1, 1 + 1e-6] drawn from the seed, so different participants starting
 // together get different trees, and a given seed always the same one.
-std::vector<std::pair<int, int>> spanningTreeBatch(const ScorePosterior& posterior, std::uint64_t tieSeed);
+// The study server plans with the variance-reduction criterion (docs/benchmarks.md, "Active sampling": over
+// seeds it saved more than the information gain at m = 20–40).
+std::vector<std::pair<int, int>> spanningTreeBatch(const ScorePosterior& posterior, std::uint64_t tieSeed,
+                                                   BatchCriterion criterion = BatchCriterion::varianceReduction);
 
 // An alternative batch (compared in bench_active_sampling; the server uses the spanning tree): `size` pairs chosen
 // greedily, each the pair of highest gain under the posterior updated for the pairs already chosen. The update of
 // a chosen pair is the one its answer will make to the covariance (a probit answer's precision on d, averaged over
 // the two answers; the means are left as they are, the answer being unknown), so a batch does not spend several
 // trials on one uncertain region. Ties broken by `tieSeed` as above.
-// `criterion`: the expected information gain of the pair (as above), or the expected reduction of the summed
-// posterior variance of the mean-centred scores (A-optimal design: what the scale's RMSE depends on), i.e.
-// π/(1 + π v) ‖C Σ a‖² with π the expected precision of one answer on d, v = Var d, C the centring matrix.
-enum class BatchCriterion { informationGain, varianceReduction };
 std::vector<std::pair<int, int>> greedyBatch(const ScorePosterior& posterior, int size, std::uint64_t tieSeed,
                                              BatchCriterion criterion = BatchCriterion::informationGain);
 

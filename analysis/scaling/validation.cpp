@@ -28,9 +28,9 @@ struct Tally {
     double pairs = 0, significantCorrect = 0, significantReversed = 0;
     double randomObservers = 0, randomFlagged = 0, invertedObservers = 0, invertedFlagged = 0;
     double genuineObservers = 0, genuineFlagged = 0;
-    double bootstrapCovered = 0;
+    double bootstrapCovered = 0, unionCovered = 0, unionWidth = 0;
     void add(const Tally& o) {
-        bootstrapCovered += o.bootstrapCovered;
+        bootstrapCovered += o.bootstrapCovered, unionCovered += o.unionCovered, unionWidth += o.unionWidth;
         intervals += o.intervals, covered += o.covered, width += o.width, percentileCovered += o.percentileCovered;
         fallbacks += o.fallbacks, maximumHalfWidth = std::max(maximumHalfWidth, o.maximumHalfWidth);
         percentileWidth += o.percentileWidth, squaredError += o.squaredError, rankCorrelation += o.rankCorrelation;
@@ -168,6 +168,10 @@ Tally runActiveExperiment(const ValidationOptions& options, int observers, std::
         if (std::isfinite(analysis.high[i]))
             tally.maximumHalfWidth = std::max(tally.maximumHalfWidth, analysis.high[i] - fit[i]);
         tally.bootstrapCovered += bootstrap.low[i] <= truth[i] && truth[i] <= bootstrap.high[i];
+        const double unionLow = std::min(analysis.low[i], bootstrap.low[i]);
+        const double unionHigh = std::max(analysis.high[i], bootstrap.high[i]);
+        tally.unionCovered += unionLow <= truth[i] && truth[i] <= unionHigh;
+        if (std::isfinite(unionLow) && std::isfinite(unionHigh)) tally.unionWidth += unionHigh - unionLow;
         tally.percentileCovered += bootstrap.percentileLow[i] <= truth[i] && truth[i] <= bootstrap.percentileHigh[i];
         tally.percentileWidth += bootstrap.percentileHigh[i] - bootstrap.percentileLow[i];
         tally.squaredError += (fit[i] - truth[i]) * (fit[i] - truth[i]);
@@ -324,7 +328,11 @@ ValidationReport runValidation(const ValidationOptions& options) {
             row.maximumHalfWidth = total.maximumHalfWidth;
             row.percentileCoverage = total.percentileCovered / total.intervals;
             row.percentileMeanWidth = total.percentileWidth / total.intervals;
-            if (scenario == "active") row.bootstrapCoverage = total.bootstrapCovered / total.intervals;
+            if (scenario == "active") {
+                row.bootstrapCoverage = total.bootstrapCovered / total.intervals;
+                row.unionCoverage = total.unionCovered / total.intervals;
+                row.unionMeanWidth = total.unionWidth / total.intervals;
+            }
             row.rmse = std::sqrt(total.squaredError / total.intervals);
             row.rankCorrelation = total.rankCorrelation / total.experiments;
             row.significantCorrect = total.significantCorrect / total.pairs;
@@ -348,9 +356,10 @@ std::string validationMarkdown(const ValidationReport& report) {
     std::string bootstrapCoverages;
     for (const ValidationRow& r : report.rows)
         if (r.bootstrapCoverage >= 0) {
-            char cell[64];
-            std::snprintf(cell, sizeof cell, "%s%.4f (%d observers)", bootstrapCoverages.empty() ? "" : ", ",
-                          r.bootstrapCoverage, r.observers);
+            char cell[128];
+            std::snprintf(cell, sizeof cell, "%s%.4f (union %.4f, width %.3f; %d observers)",
+                          bootstrapCoverages.empty() ? "" : ", ", r.bootstrapCoverage, r.unionCoverage,
+                          r.unionMeanWidth, r.observers);
             bootstrapCoverages += cell;
         }
     if (bootstrapCoverages.empty()) bootstrapCoverages = "not run";
@@ -363,8 +372,8 @@ std::string validationMarkdown(const ValidationReport& report) {
         "'sparse': each observer judges %.0f %% of the pairs; 'disconnected': %d groups never compared "
         "(truth centred per group); 'near-unanimous': true scores x %.1f. 'active': observers one after "
         "another on true scores x %.1f, %d trials each in batches chosen from all earlier answers, "
-        "profile-likelihood intervals and score tests (as `analyze scale` for an active study); its "
-        "studentized observer bootstrap on the same data covers: %s.\n\n",
+        "profile-likelihood intervals and score tests in the columns below; the studentized observer bootstrap "
+        "on the same data (what `analyze scale` uses for an active study) covers: %s.\n\n",
         scores.c_str(), o.trialsPerPair, o.trialsPerPair % 2 == 0 ? "equally often" : "alternating", o.experiments,
         o.bootstrapSamples, correctionName(o.correction), o.alpha, static_cast<unsigned long long>(o.seed), o.lapseRate,
         o.sideBiasStandardDeviation, o.randomObservers, o.invertedObservers, 100.0 * o.sparsePairFraction,
@@ -442,6 +451,7 @@ nlohmann::json validationJson(const ValidationReport& report) {
         if (r.invertedHitRate >= 0) row["inverted_hit_rate"] = r.invertedHitRate;
         if (r.falseAlarmRate >= 0) row["false_alarm_rate"] = r.falseAlarmRate;
         if (r.bootstrapCoverage >= 0) row["bootstrap_coverage"] = r.bootstrapCoverage;
+        if (r.unionCoverage >= 0) row["union_coverage"] = r.unionCoverage;
         json["rows"].push_back(row);
     }
     return json;

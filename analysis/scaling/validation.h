@@ -9,8 +9,9 @@
 //  - "disconnected": Case V observers, the conditions in groups never compared with each other;
 //  - "near-unanimous": Case V observers on a scale stretched so far pairs are (nearly) always unanimous;
 //  - "active": Case V observers, one after another, each judging pairs an active planner chose from every earlier
-//    answer (pairs = "active" in a study), scaled as `analyze scale` scales an active study: profile-likelihood
-//    intervals (the observer bootstrap is not valid there; its coverage is reported alongside).
+//    answer (pairs = "active" in a study); the coverage columns are those of the profile-likelihood intervals and
+//    score tests, and the coverage of the studentized observer bootstrap (what `analyze scale` uses for an active
+//    study) and of the union of both intervals are reported alongside.
 #include "analysis/scaling/multiple_comparisons.h"
 #include "analysis/scaling/pairwise_model.h"
 
@@ -75,7 +76,9 @@ struct ValidationRow {
     double maximumHalfWidth = 0.0;   // JOD, largest distance from a score to one of its bounds
     double percentileCoverage = 0.0; // pwcmp's percentile bootstrap on the same resamples
     double percentileMeanWidth = 0.0;
-    double bootstrapCoverage = -1.0;  // "active" only: the studentized observer bootstrap on the same data
+    double bootstrapCoverage = -1.0; // "active" only: the studentized observer bootstrap on the same data
+    double unionCoverage = -1.0;     // "active" only: the union of that bootstrap and the profile interval
+    double unionMeanWidth = 0.0;
     double rmse = 0.0;                // JOD, mean-zero scores against mean-zero truth
     double rankCorrelation = 0.0;     // mean Spearman ρ
     double significantCorrect = 0.0;  // fraction of (experiment, pair): significant with the true sign

@@ -1,28 +1,40 @@
 // Active sampling against the alternatives (docs/benchmarks.md, "Active sampling"; docs/analysis.md,
-// "Validation of active designs"). For m = 10, 20, 30 conditions with known true scores, simulated Thurstone
-// observers answer three designs of the same length:
+// "Validation of active designs"). Simulated Thurstone observers answer designs of conditions with known true
+// scores (drawn from N(0, sd²) JOD and centred):
 //  - full:   every pair once per round, rounds repeated (each round in a random order);
 //  - random: each comparison a uniformly random pair (an incomplete random design);
-//  - active: batches of m − 1 pairs, each the minimum spanning tree over 1/information gain of the posterior
-//            built from every answer so far (experiments/active_sampling.h, as the study server plans them).
-// Each observer answers m − 1 consecutive comparisons (one active batch). After every m − 1 comparisons the
-// scale is fitted exactly as `analyze scale` fits it (Thurstone Case V MAP, analysis/scaling) and its RMSE
-// against the truth (both mean-zero) recorded; at a few budgets the 95 % studentized bootstrap interval over
-// observers is computed and its coverage of the true scores counted.
-// Also times the planning of one batch at m = 30 with 200 participants' answers (the server's request path).
+//  - active: batches of m − 1 pairs, each the minimum spanning tree over 1/(expected reduction of the summed
+//            variance of the centred scores) of the posterior built from every answer so far
+//            (experiments/active_sampling.h, as the study server plans them; --selection picks another).
+// Each observer answers m − 1 consecutive comparisons (one active batch). The scale is fitted exactly as
+// `analyze scale` fits it (Thurstone Case V MAP, analysis/scaling) and its RMSE against the truth (both
+// mean-zero) recorded.
 //
-// Coverage is counted for two intervals: the studentized bootstrap over observers (`analyze scale`'s default) and
-// the profile-likelihood interval (`analyze scale --intervals profile`, automatic for active studies).
-// Also prints, per m, a bound on the saving any choice of pairs can reach (Fisher information, Cramér–Rao): with N
-// comparisons the information matrix is at most I(0)·(the comparison-count Laplacian), whose trace of the
-// pseudo-inverse is at least (m − 1)²/(2 N I(0)) (Cauchy–Schwarz over its eigenvalues; equality for the complete
-// graph with equal counts), against the full design's trace of (N/M · Σ_pairs I(δ) a aᵀ)⁺.
+// --sweep (the saving, as docs/benchmarks.md reports it): for every (m, sd, budget) cell and each of --seeds
+// seeds, one true scale, one full design up to the budget and one active design up to --horizon × the largest
+// budget, its RMSE after every observer. The saving at a budget B (in full rounds of m(m−1)/2 comparisons) is
+// 1 − N/B, N the comparisons after which the active design first reaches the full design's RMSE at B
+// (interpolated between observers):
+//  - pooled: the mean squared errors averaged over the seeds first (the expected accuracy of a study of that
+//    size), with a 95 % percentile interval from resampling the seeds;
+//  - per seed: the same seed's active curve against its own full design — the spread a single study sees; a
+//    seed whose active design never reaches the target within the horizon counts as a saving below
+//    1 − horizon·B/B and stays in the quantiles and shares.
+// Also per cell: the asymptotic upper bound on the saving of any allocation of comparisons to pairs
+// (analysis/scaling/design_efficiency.h), averaged over the seeds' true scales.
+//
+// Default mode: per m = 10, 20, 30, the RMSE curves averaged over --experiments experiments, coverage of the
+// studentized bootstrap and profile-likelihood intervals at a few budgets, and the planning time of one batch
+// at m = 30 with 200 participants' answers (the server's request path).
 //
 // Usage: bench_active_sampling [--experiments E] [--coverage-experiments C] [--bootstrap B] [--spread S]
-//                              [--truth normal|uniform] [--prior-sd P] [--selection mst|greedy|variance]
-//                              [--rounds R] [--threads T] [--seed N] [--timing 0|1] [--coverage-rounds 1,2]
-//                              [--plot FILE.png]
+//                              [--truth normal|uniform] [--prior-sd P]
+//                              [--selection mst-variance|mst-gain|greedy|variance] [--rounds R] [--threads T]
+//                              [--seed N] [--timing 0|1] [--coverage-rounds 1,2] [--plot FILE.png]
+//        bench_active_sampling --sweep [--seeds S] [--ms 10,20,30,40] [--spreads 1,2,3] [--budgets 1,2]
+//                              [--horizon H] [--selection ...] [--prior-sd P] [--threads T] [--seed N]
 #include "analysis/scaling/bootstrap.h"
+#include "analysis/scaling/design_efficiency.h"
 #include "analysis/scaling/pairwise_model.h"
 #include "analysis/scaling/profile_likelihood.h"
 #include "experiments/active_sampling.h"
@@ -31,12 +43,15 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <map>
+#include <numeric>
 #include <random>
 #include <string>
 #include <thread>
@@ -59,14 +74,22 @@ struct Settings {
     int bootstrap = 200;
     double spread = 1.0; // true scores ~ N(0, spread²) JOD, or uniform with this sd
     std::string truth = "normal";
-    double priorSd = 1.0;          // prior sd of the active design's posterior (JOD)
-    std::string selection = "mst"; // active batches: spanning tree over 1/gain, or greedy with updates
+    double priorSd = 1.0;                   // prior sd of the active design's posterior (JOD)
+    std::string selection = "mst-variance"; // active batches (the server's), mst-gain, greedy or variance
     bool timing = true;
     std::vector<double> coverageRounds = {0.6, 1.0, 1.2, 2.0, 2.4}; // coverage budgets, in full rounds
     int rounds = 4;                                                 // longest design, in full-design rounds m(m−1)/2
     int threads = 2;
     std::uint64_t seed = 1;
     std::string plot;
+    // --sweep: the saving per seed and pooled, over `seeds` seeds per (m, spread, budget) cell.
+    bool sweep = false;
+    int seeds = 100;
+    std::vector<double> ms = {10, 20, 30, 40};
+    std::vector<double> spreads = {1, 2, 3};
+    std::vector<double> budgets = {1, 2}; // in full rounds
+    double horizon = 1.5;                 // the active design runs to horizon × the largest budget
+    int intervalResamples = 2000;         // bootstrap over seeds for the pooled saving's interval
 };
 
 const char* kDesigns[] = {"full", "random", "active"};
@@ -111,6 +134,17 @@ sc::BlockData blockOf(const std::vector<Trial>& trials, std::size_t count, int m
     return block;
 }
 
+// The active design's selection as the server would run it, or an alternative (--selection).
+std::vector<std::pair<int, int>> plan(const ac::ScorePosterior& posterior, int m, std::uint64_t tieSeed,
+                                      const Settings& settings) {
+    if (settings.selection == "greedy") return ac::greedyBatch(posterior, m - 1, tieSeed);
+    if (settings.selection == "variance")
+        return ac::greedyBatch(posterior, m - 1, tieSeed, ac::BatchCriterion::varianceReduction);
+    if (settings.selection == "mst-gain")
+        return ac::spanningTreeBatch(posterior, tieSeed, ac::BatchCriterion::informationGain);
+    return ac::spanningTreeBatch(posterior, tieSeed, ac::BatchCriterion::varianceReduction);
+}
+
 std::vector<Trial> simulateDesign(int design, const std::vector<double>& truth, std::size_t length, std::uint64_t seed,
                                   const Settings& settings) {
     const int m = static_cast<int>(truth.size());
@@ -142,10 +176,7 @@ std::vector<Trial> simulateDesign(int design, const std::vector<double>& truth, 
         while (trials.size() < length) {
             const ac::ScorePosterior posterior = ac::fitPosterior(m, answers, posteriorOptions);
             const std::uint64_t tieSeed = seed * 1000003u + batch++;
-            const auto pairs = settings.selection == "greedy" ? ac::greedyBatch(posterior, m - 1, tieSeed)
-                               : settings.selection == "variance"
-                                   ? ac::greedyBatch(posterior, m - 1, tieSeed, ac::BatchCriterion::varianceReduction)
-                                   : ac::spanningTreeBatch(posterior, tieSeed);
+            const auto pairs = plan(posterior, m, tieSeed, settings);
             for (const auto& [i, j] : pairs) {
                 if (trials.size() >= length) break;
                 const Trial t = make(random, truth, i, j);
@@ -155,35 +186,6 @@ std::vector<Trial> simulateDesign(int design, const std::vector<double>& truth, 
         }
     }
     return trials;
-}
-
-// Fisher information of one comparison at true difference δ: φ(δ/σ)² / (σ² Φ(δ/σ) Φ(−δ/σ)).
-double comparisonInformation(double delta) {
-    const double z = delta / ac::kThurstoneSigma;
-    const double pdf = std::exp(-0.5 * z * z) / std::sqrt(2.0 * M_PI);
-    const double cdf = 0.5 * std::erfc(-z / std::sqrt(2.0));
-    return pdf * pdf / (ac::kThurstoneSigma * ac::kThurstoneSigma * std::max(cdf * (1.0 - cdf), 1e-300));
-}
-
-// The least share of the full design's comparisons any design needs for the full design's asymptotic mean
-// squared error (see the header): (m − 1)² / (2 I(0) M tr(L⁺)), L = Σ_pairs I(δ_ij) a aᵀ.
-double fisherSavingBound(const std::vector<double>& truth) {
-    const int m = static_cast<int>(truth.size());
-    Eigen::MatrixXd laplacian = Eigen::MatrixXd::Zero(m, m);
-    for (int i = 0; i < m; ++i)
-        for (int j = i + 1; j < m; ++j) {
-            const double w =
-                comparisonInformation(truth[static_cast<std::size_t>(i)] - truth[static_cast<std::size_t>(j)]);
-            laplacian(i, i) += w;
-            laplacian(j, j) += w;
-            laplacian(i, j) -= w;
-            laplacian(j, i) -= w;
-        }
-    // tr(L⁺) = tr((L + J/m)⁻¹) − 1 for a connected graph (J = 1 1ᵀ).
-    const Eigen::MatrixXd shifted = laplacian + Eigen::MatrixXd::Constant(m, m, 1.0 / m);
-    const double trace = shifted.inverse().trace() - 1.0;
-    const double pairs = m * (m - 1) / 2.0;
-    return (m - 1.0) * (m - 1.0) / (2.0 * comparisonInformation(0.0) * pairs * trace);
 }
 
 double rmse(const Eigen::VectorXd& scores, const std::vector<double>& truth) {
@@ -278,12 +280,216 @@ void drawPlot(const std::string& file, const std::vector<int>& ms,
     cv::imwrite(file, image);
 }
 
+// RMSE of `analyze scale`'s fit after each of `points` prefixes of `trials` (prefix lengths ascending).
+std::vector<double> rmseAt(const std::vector<Trial>& trials, const std::vector<std::size_t>& points,
+                           const std::vector<double>& truth) {
+    const int m = static_cast<int>(truth.size());
+    std::map<std::pair<int, int>, std::pair<double, double>> tally;
+    std::vector<double> out;
+    sc::FitOptions fitOptions;
+    Eigen::VectorXd warm;
+    std::size_t done = 0;
+    for (const std::size_t point : points) {
+        for (; done < point; ++done) {
+            auto& entry = tally[{trials[done].first, trials[done].second}];
+            (trials[done].firstWins ? entry.first : entry.second) += 1.0;
+        }
+        sc::PairCounts counts;
+        counts.conditions = m;
+        counts.first.resize(static_cast<Eigen::Index>(tally.size()));
+        counts.second.resize(static_cast<Eigen::Index>(tally.size()));
+        Eigen::Index k = 0;
+        for (const auto& [pair, won] : tally) {
+            counts.pairs.push_back(pair);
+            counts.first[k] = won.first;
+            counts.second[k++] = won.second;
+        }
+        const sc::FitResult fit = sc::fitScores(counts, fitOptions, warm.size() == m ? &warm : nullptr);
+        warm = fit.scores;
+        out.push_back(rmse(fit.scores, truth));
+    }
+    return out;
+}
+
+// One seed of one (m, spread) cell: the full design's RMSE at each budget, the active design's after every
+// observer (m − 1 trials) up to the horizon, and the oracle bound.
+struct SeedOutcome {
+    std::vector<double> full;   // MSE at each budget
+    std::vector<double> active; // MSE after each observer
+    double boundRatio = 0.0;
+};
+
+// Number of comparisons at which a curve of MSEs (after every `step` comparisons) first reaches `target` (linear
+// interpolation in RMSE); −1 if never.
+double firstReach(const std::vector<double>& mse, double step, double target) {
+    std::vector<double> x, y;
+    for (std::size_t k = 0; k < mse.size(); ++k) {
+        x.push_back(step * static_cast<double>(k + 1));
+        y.push_back(std::sqrt(mse[k]));
+    }
+    return reachedAt(x, y, std::sqrt(target));
+}
+
+// q-quantile of values where −∞ stands for "never reached" (nearest rank on the sorted values).
+double quantile(std::vector<double> values, double q) {
+    std::sort(values.begin(), values.end());
+    const auto k = static_cast<std::size_t>(
+        std::clamp(std::floor(q * static_cast<double>(values.size())), 0.0, static_cast<double>(values.size() - 1)));
+    return values[k];
+}
+
+std::string percent(double saving, double floor) {
+    char buffer[32];
+    if (!std::isfinite(saving)) std::snprintf(buffer, sizeof buffer, "< %.0f %%", 100.0 * floor);
+    else std::snprintf(buffer, sizeof buffer, "%.0f %%", 100.0 * saving);
+    return buffer;
+}
+
+int runSweep(const Settings& s) {
+    const auto start = std::chrono::steady_clock::now();
+    const double largestBudget = *std::max_element(s.budgets.begin(), s.budgets.end());
+    std::printf("Saving of the active design (%s batches, prior sd %.2f JOD) against the full design, %d seeds per "
+                "cell; true scores ~ N(0, sd^2) JOD; observers answer m-1 trials each; active runs to %.2f x the "
+                "largest budget (%.1f full rounds); hardware threads %u, %d worker threads.\n\n",
+                s.selection.c_str(), s.priorSd, s.seeds, s.horizon, s.horizon * largestBudget,
+                std::thread::hardware_concurrency(), s.threads);
+    std::printf("| m | sd | budget: rounds (observers, trials) | RMSE full | RMSE active | pooled saving [95 %% CI] | "
+                "per-seed saving: median [10 %%, 90 %%] | seeds >= 40 %% | seeds never | A-opt bound | time (s) |\n"
+                "|---|---|---|---|---|---|---|---|---|---|---|\n");
+    for (const double mValue : s.ms) {
+        const int m = static_cast<int>(mValue);
+        const int M = m * (m - 1) / 2;
+        const int step = m - 1;
+        std::vector<std::size_t> budgetTrials;
+        for (const double r : s.budgets)
+            budgetTrials.push_back(static_cast<std::size_t>(std::lround(r * M / step)) *
+                                   static_cast<std::size_t>(step));
+        const std::size_t fullLength = *std::max_element(budgetTrials.begin(), budgetTrials.end());
+        const std::size_t observersToHorizon =
+            static_cast<std::size_t>(std::ceil(s.horizon * static_cast<double>(fullLength) / step));
+        const std::size_t activeLength = observersToHorizon * static_cast<std::size_t>(step);
+        std::vector<std::size_t> grid;
+        for (std::size_t k = 1; k <= observersToHorizon; ++k) grid.push_back(k * static_cast<std::size_t>(step));
+        for (std::size_t spreadIndex = 0; spreadIndex < s.spreads.size(); ++spreadIndex) {
+            const auto cellStart = std::chrono::steady_clock::now();
+            const double spread = s.spreads[spreadIndex];
+            std::vector<SeedOutcome> outcomes(static_cast<std::size_t>(s.seeds));
+            std::atomic<int> next{0};
+            auto work = [&] {
+                for (int e = next++; e < s.seeds; e = next++) {
+                    const std::uint64_t stream = static_cast<std::uint64_t>(m) * 100000000u +
+                                                 static_cast<std::uint64_t>(spreadIndex) * 1000000u +
+                                                 static_cast<std::uint64_t>(e);
+                    std::mt19937_64 truthRandom(sc::mixSeed(s.seed, stream));
+                    std::normal_distribution<double> draw(0.0, spread);
+                    std::vector<double> truth(static_cast<std::size_t>(m));
+                    double mean = 0;
+                    for (double& q : truth) mean += (q = draw(truthRandom));
+                    for (double& q : truth) q -= mean / m;
+                    SeedOutcome& out = outcomes[static_cast<std::size_t>(e)];
+                    const std::vector<Trial> full =
+                        simulateDesign(0, truth, fullLength, sc::mixSeed(s.seed + 17, stream * 3), s);
+                    for (const double r : rmseAt(full, budgetTrials, truth)) out.full.push_back(r * r);
+                    const std::vector<Trial> active =
+                        simulateDesign(2, truth, activeLength, sc::mixSeed(s.seed + 17, stream * 3 + 2), s);
+                    for (const double r : rmseAt(active, grid, truth)) out.active.push_back(r * r);
+                    out.boundRatio = sc::optimalAllocationShare(truth);
+                }
+            };
+            std::vector<std::thread> pool;
+            for (int t = 1; t < std::max(1, s.threads); ++t) pool.emplace_back(work);
+            work();
+            for (auto& thread : pool) thread.join();
+            const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - cellStart).count();
+            double bound = 0.0;
+            for (const SeedOutcome& o : outcomes) bound += o.boundRatio;
+            bound /= s.seeds;
+            for (std::size_t b = 0; b < budgetTrials.size(); ++b) {
+                const double budget = static_cast<double>(budgetTrials[b]);
+                const double floor = 1.0 - static_cast<double>(activeLength) / budget;
+                const std::size_t atBudget = budgetTrials[b] / static_cast<std::size_t>(step) - 1;
+                // Pooled: mean MSE curves over seeds (the expected accuracy of a study of this size).
+                auto pooled = [&](const std::vector<int>& pick) {
+                    double target = 0.0;
+                    std::vector<double> curve(grid.size(), 0.0);
+                    for (const int e : pick) {
+                        const SeedOutcome& o = outcomes[static_cast<std::size_t>(e)];
+                        target += o.full[b];
+                        for (std::size_t k = 0; k < grid.size(); ++k) curve[k] += o.active[k];
+                    }
+                    const double reached = firstReach(curve, step, target);
+                    return reached < 0 ? -std::numeric_limits<double>::infinity() : 1.0 - reached / budget;
+                };
+                std::vector<int> all(static_cast<std::size_t>(s.seeds));
+                std::iota(all.begin(), all.end(), 0);
+                const double pooledSaving = pooled(all);
+                std::mt19937_64 resampler(sc::mixSeed(s.seed, 99));
+                std::uniform_int_distribution<int> pickSeed(0, s.seeds - 1);
+                std::vector<double> resampled;
+                std::vector<int> pick(static_cast<std::size_t>(s.seeds));
+                for (int r = 0; r < s.intervalResamples; ++r) {
+                    for (int& e : pick) e = pickSeed(resampler);
+                    resampled.push_back(pooled(pick));
+                }
+                // Per seed: that seed's active curve against that seed's full design at the budget.
+                std::vector<double> perSeed;
+                int met = 0, never = 0;
+                double fullMse = 0.0, activeMse = 0.0;
+                for (const SeedOutcome& o : outcomes) {
+                    fullMse += o.full[b] / s.seeds;
+                    activeMse += o.active[atBudget] / s.seeds;
+                    const double reached = firstReach(o.active, step, o.full[b]);
+                    const double saving =
+                        reached < 0 ? -std::numeric_limits<double>::infinity() : 1.0 - reached / budget;
+                    perSeed.push_back(saving);
+                    met += saving >= 0.4;
+                    never += reached < 0;
+                }
+                std::printf("| %d | %.1f | %.1f (%zu, %zu) | %.3f | %.3f | %s [%s, %s] | %s [%s, %s] | %.2f | %.2f | "
+                            "%.0f %% | %.0f |\n",
+                            m, spread, s.budgets[b], budgetTrials[b] / static_cast<std::size_t>(step), budgetTrials[b],
+                            std::sqrt(fullMse), std::sqrt(activeMse), percent(pooledSaving, floor).c_str(),
+                            percent(quantile(resampled, 0.025), floor).c_str(),
+                            percent(quantile(resampled, 0.975), floor).c_str(),
+                            percent(quantile(perSeed, 0.5), floor).c_str(),
+                            percent(quantile(perSeed, 0.1), floor).c_str(),
+                            percent(quantile(perSeed, 0.9), floor).c_str(), static_cast<double>(met) / s.seeds,
+                            static_cast<double>(never) / s.seeds, 100.0 * (1.0 - bound), seconds);
+                std::fflush(stdout);
+            }
+        }
+    }
+    std::printf("\ntotal %.1f s\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    return 0;
+}
+
+std::vector<double> parseList(const char* value) {
+    std::vector<double> out;
+    for (const char* p = value; *p;) {
+        char* end = nullptr;
+        const double x = std::strtod(p, &end);
+        if (end == p) break;
+        out.push_back(x);
+        p = *end == ',' ? end + 1 : end;
+    }
+    return out;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
     Settings s;
-    for (int k = 1; k + 1 < argc; k += 2) {
+    for (int k = 1; k < argc; k += 2) {
         const std::string key = argv[k];
+        if (key == "--sweep") {
+            s.sweep = true;
+            --k;
+            continue;
+        }
+        if (k + 1 >= argc) {
+            std::fprintf(stderr, "bench_active_sampling: option %s needs a value\n", key.c_str());
+            return 2;
+        }
         const char* value = argv[k + 1];
         if (key == "--experiments") s.experiments = std::atoi(value);
         else if (key == "--coverage-experiments") s.coverageExperiments = std::atoi(value);
@@ -297,19 +503,19 @@ int main(int argc, char** argv) {
         else if (key == "--prior-sd") s.priorSd = std::atof(value);
         else if (key == "--selection") s.selection = value;
         else if (key == "--timing") s.timing = std::atoi(value) != 0;
-        else if (key == "--coverage-rounds") {
-            s.coverageRounds.clear();
-            for (const char* p = value; *p;) {
-                char* end = nullptr;
-                s.coverageRounds.push_back(std::strtod(p, &end));
-                p = *end == ',' ? end + 1 : end;
-                if (end == p && *p) break;
-            }
-        } else {
+        else if (key == "--coverage-rounds") s.coverageRounds = parseList(value);
+        else if (key == "--seeds") s.seeds = std::atoi(value);
+        else if (key == "--ms") s.ms = parseList(value);
+        else if (key == "--spreads") s.spreads = parseList(value);
+        else if (key == "--budgets") s.budgets = parseList(value);
+        else if (key == "--horizon") s.horizon = std::atof(value);
+        else if (key == "--interval-resamples") s.intervalResamples = std::atoi(value);
+        else {
             std::fprintf(stderr, "bench_active_sampling: unknown option %s\n", key.c_str());
             return 2;
         }
     }
+    if (s.sweep) return runSweep(s);
     const auto start = std::chrono::steady_clock::now();
     std::printf(
         "hardware threads %u; %d experiments per m (coverage: %d, %d bootstrap samples); true scores ~ "
@@ -349,7 +555,7 @@ int main(int argc, char** argv) {
             for (double& q : truth) mean += (q = s.truth == "uniform" ? flat(truthRandom) : draw(truthRandom));
             mean /= m;
             for (double& q : truth) q -= mean;
-            fisherRatio += fisherSavingBound(truth);
+            fisherRatio += sc::optimalAllocationShare(truth);
             for (int d = 0; d < 3; ++d) {
                 const std::vector<Trial> trials = simulateDesign(
                     d, truth, length, sc::mixSeed(s.seed + 17, static_cast<std::uint64_t>(m * 100000 + e * 3 + d)), s);
@@ -430,22 +636,25 @@ int main(int argc, char** argv) {
                           pa.medianWidth());
             profileLines.push_back(line);
         }
-        std::printf("| %d | Fisher bound: any design needs at least %.0f %% of the full design's comparisons (saving "
-                    "<= %.0f %%) |\n",
-                    m, 100.0 * fisherRatio / s.experiments, 100.0 * (1.0 - fisherRatio / s.experiments));
+        std::printf(
+            "| %d | A-optimal design bound (asymptotic): any design needs at least %.0f %% of the full design's "
+            "comparisons (saving <= %.0f %%) |\n",
+            m, 100.0 * fisherRatio / s.experiments, 100.0 * (1.0 - fisherRatio / s.experiments));
         std::fflush(stdout);
         allCurves.push_back(curves);
         allX.push_back(x);
     }
-    std::printf("\nCoverage of the 95 %% studentized bootstrap intervals (median width, JOD):\n\n"
-                "| m | comparisons | full | random | active |\n|---|---|---|---|---|\n");
-    for (const std::string& line : coverageLines) std::printf("%s\n", line.c_str());
-    std::printf("\nCoverage of the 95 %% profile-likelihood intervals (median width, JOD):\n\n"
-                "| m | comparisons | full | random | active |\n|---|---|---|---|---|\n");
-    for (const std::string& line : profileLines) std::printf("%s\n", line.c_str());
+    if (s.coverageExperiments > 0) {
+        std::printf("\nCoverage of the 95 %% studentized bootstrap intervals (median width, JOD):\n\n"
+                    "| m | comparisons | full | random | active |\n|---|---|---|---|---|\n");
+        for (const std::string& line : coverageLines) std::printf("%s\n", line.c_str());
+        std::printf("\nCoverage of the 95 %% profile-likelihood intervals (median width, JOD):\n\n"
+                    "| m | comparisons | full | random | active |\n|---|---|---|---|---|\n");
+        for (const std::string& line : profileLines) std::printf("%s\n", line.c_str());
+    }
 
     // Planning time of one batch at m = 30 with 200 participants' answers (as the server plans it).
-    std::printf("\nPlanning one batch (posterior from every answer, gains, spanning tree), m = 30:\n\n"
+    std::printf("\nPlanning one batch (posterior from every answer, pair values, spanning tree), m = 30:\n\n"
                 "| participants | answers | EP sweeps | plan median (ms) | plan min (ms) |\n|---|---|---|---|---|\n");
     for (const int perParticipant : {29, 58, 100}) {
         if (!s.timing) break;

@@ -195,7 +195,59 @@ TEST(ActiveSampling, GainIsHighestForCloseUncertainPairs) {
                 gains[static_cast<std::size_t>(best.first)][static_cast<std::size_t>(best.second)])
                 best = {i, j};
     // A minimum spanning tree always holds the lightest edge (the highest gain) — first, as batches are sorted.
-    EXPECT_EQ(spanningTreeBatch(fitted, 5).front(), best);
+    EXPECT_EQ(spanningTreeBatch(fitted, 5, BatchCriterion::informationGain).front(), best);
+}
+
+TEST(ActiveSampling, VarianceReductionFavoursPairsThatShrinkTheScalesUncertainty) {
+    // Equal means: the pair whose difference is uncertain reduces the summed variance of the centred scores more
+    // than the pair already pinned down (strongly correlated scores), and an answer to a near-unanimous pair
+    // teaches little.
+    ScorePosterior p = ScorePosterior::independent({0.0, 0.0, 0.0, 6.0}, {1.0, 1.0, 1.0, 1.0});
+    p.covariance[0 * 4 + 1] = p.covariance[1 * 4 + 0] = 0.95;
+    const auto values = pairValues(p, BatchCriterion::varianceReduction);
+    EXPECT_GT(values[0][2], 3.0 * values[0][1]);
+    EXPECT_GT(values[0][2], values[2][3]);
+    for (int i = 0; i < 4; ++i) {
+        EXPECT_EQ(values[static_cast<std::size_t>(i)][static_cast<std::size_t>(i)], 0.0);
+        for (int j = 0; j < 4; ++j)
+            EXPECT_EQ(values[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)],
+                      values[static_cast<std::size_t>(j)][static_cast<std::size_t>(i)]);
+    }
+    // The same reduction as the greedy batch's first choice (both evaluate π/(1 + π v) ‖C Σ a‖²).
+    const auto greedy = greedyBatch(p, 1, 3, BatchCriterion::varianceReduction);
+    ASSERT_EQ(greedy.size(), 1u);
+    double best = 0.0;
+    for (const auto& row : values)
+        for (const double v : row) best = std::max(best, v);
+    EXPECT_NEAR(values[static_cast<std::size_t>(greedy[0].first)][static_cast<std::size_t>(greedy[0].second)], best,
+                1e-12);
+    // Against the exact update: one answer's expected precision on d applied as a rank-one update of Σ reduces
+    // the trace of C Σ C by the value.
+    const int i = 0, j = 2;
+    const double vd = p.cov(i, i) + p.cov(j, j) - 2 * p.cov(i, j);
+    std::vector<double> sa(4);
+    for (int r = 0; r < 4; ++r) sa[static_cast<std::size_t>(r)] = p.cov(r, i) - p.cov(r, j);
+    auto centredTrace = [](const std::vector<double>& c) {
+        double trace = 0.0, total = 0.0;
+        for (int r = 0; r < 4; ++r) trace += c[static_cast<std::size_t>(r * 4 + r)];
+        for (const double x : c) total += x;
+        return trace - total / 4.0;
+    };
+    // The value is gain·‖CΣa‖² with gain = π/(1 + π v); recover π from it and check that the rank-one update with
+    // that π reduces the centred trace by exactly the value, and that π is positive and below 1/σ² (one answer).
+    double norm = 0.0, meanSa = 0.0;
+    for (const double x : sa) meanSa += x / 4.0;
+    for (const double x : sa) norm += (x - meanSa) * (x - meanSa);
+    const double gain = values[0][2] / norm;
+    const double precision = gain / (1.0 - gain * vd);
+    EXPECT_GT(precision, 0.0);
+    EXPECT_LT(precision, 1.0 / (kThurstoneSigma * kThurstoneSigma));
+    std::vector<double> after = p.covariance;
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c)
+            after[static_cast<std::size_t>(r * 4 + c)] -=
+                gain * sa[static_cast<std::size_t>(r)] * sa[static_cast<std::size_t>(c)];
+    EXPECT_NEAR(centredTrace(p.covariance) - centredTrace(after), values[0][2], 1e-12);
 }
 
 TEST(ActiveSampling, BatchIsAConnectedSpanningTreeReproducibleFromItsSeed) {
@@ -204,6 +256,12 @@ TEST(ActiveSampling, BatchIsAConnectedSpanningTreeReproducibleFromItsSeed) {
         for (int i = 0; i < m; ++i) truth.push_back(0.2 * i);
         for (const bool withData : {false, true}) {
             const ScorePosterior p = fitPosterior(m, withData ? simulate(truth, 2, 4) : std::vector<Comparison>{});
+            for (const BatchCriterion criterion :
+                 {BatchCriterion::informationGain, BatchCriterion::varianceReduction}) {
+                const auto tree = spanningTreeBatch(p, 11, criterion);
+                ASSERT_EQ(tree.size(), static_cast<std::size_t>(m - 1)) << m;
+                EXPECT_TRUE(connected(m, tree)) << m;
+            }
             const auto batch = spanningTreeBatch(p, 11);
             ASSERT_EQ(batch.size(), static_cast<std::size_t>(m - 1)) << m;
             EXPECT_TRUE(connected(m, batch)) << m;

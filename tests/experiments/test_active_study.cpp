@@ -273,24 +273,28 @@ TEST(ActiveStudy, RunsEndToEndOverHttpAndItsPlanSurvivesKillNine) {
         ASSERT_EQ(block.at("conditions").size(), 5u) << block.dump();
     }
     EXPECT_EQ(scale.at("settings").at("intervals"), "bootstrap"); // a CSV export does not say how pairs were chosen
-    // Scaled from study.db, the design is known: an active design gets likelihood intervals, said in the output.
+    // Scaled from study.db, the design is known and said in the output; its intervals are the studentized
+    // bootstrap (the better-covering of the two for active designs), the profile likelihood on request.
     const fs::path fromDatabase = files.folder.path() / "scale-db";
     const CommandResult scaledDb =
-        runSkinlab({"analyze", "scale", files.database.string(), "-o", fromDatabase.string()});
+        runSkinlab({"analyze", "scale", files.database.string(), "-o", fromDatabase.string(), "--bootstrap", "200"});
     ASSERT_EQ(scaledDb.exitCode, 0) << scaledDb.out << scaledDb.err;
-    EXPECT_NE(scaledDb.out.find("active design (pairs chosen from earlier answers): profile-likelihood intervals"),
+    EXPECT_NE(scaledDb.out.find("active design (pairs chosen from earlier answers): studentized bootstrap intervals"),
               std::string::npos)
         << scaledDb.out;
     const nlohmann::json scaleDb = nlohmann::json::parse(skinlab::readFile(fromDatabase / "scale.json"));
-    EXPECT_EQ(scaleDb.at("settings").at("intervals"), "profile");
+    EXPECT_EQ(scaleDb.at("settings").at("intervals"), "bootstrap");
     EXPECT_EQ(scaleDb.at("settings").at("intervals_reason"), "active design");
     for (const auto& block : scaleDb.at("blocks"))
-        EXPECT_EQ(block.at("interval_method"), "profile-likelihood") << block.dump();
+        EXPECT_EQ(block.at("interval_method"), "studentized-bootstrap") << block.dump();
     const CommandResult forced =
-        runSkinlab({"analyze", "scale", files.database.string(), "-o", (files.folder.path() / "scale-boot").string(),
-                    "--intervals", "bootstrap", "--bootstrap", "200"});
+        runSkinlab({"analyze", "scale", files.database.string(), "-o", (files.folder.path() / "scale-profile").string(),
+                    "--intervals", "profile"});
     ASSERT_EQ(forced.exitCode, 0) << forced.out << forced.err;
-    EXPECT_NE(forced.out.find("studentized-bootstrap"), std::string::npos) << forced.out;
+    EXPECT_NE(forced.out.find("profile-likelihood"), std::string::npos) << forced.out;
+    const nlohmann::json scaleProfile =
+        nlohmann::json::parse(skinlab::readFile(files.folder.path() / "scale-profile" / "scale.json"));
+    EXPECT_EQ(scaleProfile.at("settings").at("intervals_reason"), "--intervals profile");
 
     server->kill(SIGTERM);
     EXPECT_EQ(server->wait(), 0);

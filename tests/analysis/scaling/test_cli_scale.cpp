@@ -213,7 +213,8 @@ TEST(CliValidate, DegenerateScenariosGiveFiniteIntervals) {
 
 TEST(CliValidate, ActiveScenarioRunsWithProfileIntervals) {
     // Small numbers: the point is that the scenario runs through the study server's planner and reports the
-    // likelihood intervals next to the bootstrap's coverage; the figures themselves are in docs/analysis.md.
+    // likelihood intervals next to the bootstrap's (analyze scale's choice for active studies) and the union's
+    // coverage; the figures themselves are in docs/analysis.md.
     const fs::path output = scratch() / "validate-active";
     const CliRun result = run("analyze validate --experiments 4 --observers 6 --bootstrap 100 --scores 0,0.5,1,2,3 "
                               "--active-trials 8 --scenarios active -o " +
@@ -228,6 +229,10 @@ TEST(CliValidate, ActiveScenarioRunsWithProfileIntervals) {
     EXPECT_GT(row["coverage"].get<double>(), 0.5) << row.dump();
     EXPECT_LE(row["coverage"].get<double>(), 1.0) << row.dump();
     EXPECT_TRUE(row["bootstrap_coverage"].is_number()) << row.dump();
+    // The union of the two intervals holds every truth either holds.
+    EXPECT_GE(row["union_coverage"].get<double>(), row["coverage"].get<double>()) << row.dump();
+    EXPECT_GE(row["union_coverage"].get<double>(), row["bootstrap_coverage"].get<double>()) << row.dump();
+    EXPECT_LE(row["union_coverage"].get<double>(), 1.0) << row.dump();
     EXPECT_GT(row["mean_width"].get<double>(), 0.0) << row.dump();
     EXPECT_LT(row["maximum_half_width"].get<double>(), 250.0) << row.dump();
     EXPECT_EQ(json["options"]["active_trials"], 8);
