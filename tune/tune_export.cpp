@@ -62,33 +62,18 @@ void checkName(const std::string& name) {
         throw InputError("name: '" + name + "' must be 1-64 characters of a-z 0-9 . _ - (not starting with '.')");
 }
 
-// "key=value" → (key, the value as TOML text), through the same parser as --set.
+// "key=value" → (key, the value as TOML text): as written when it is a TOML value (2.35 stays 2.35), else the bare
+// string --set takes it for, quoted.
 std::pair<std::string, std::string> splitOverride(const std::string& assignment) {
-    toml::table scratch;
-    applyOverride(scratch, assignment, "--set");
-    const std::string key = assignment.substr(0, assignment.find('='));
-    // The value as written by toml++ (strings quoted, arrays bracketed), from the single leaf the override made.
-    const toml::node* node = &scratch;
-    std::string path = key;
-    std::vector<std::string> parts;
-    for (std::size_t start = 0;;) {
-        const std::size_t dot = path.find('.', start);
-        parts.push_back(path.substr(start, dot - start));
-        if (dot == std::string::npos) break;
-        start = dot + 1;
+    const std::size_t equals = assignment.find('=');
+    const std::string key = assignment.substr(0, equals);
+    const std::string written = equals == std::string::npos ? "" : assignment.substr(equals + 1);
+    try {
+        parseTomlString("v = " + written, "--set");
+        return {key, written};
+    } catch (const InputError&) {
+        return {key, nlohmann::json(written).dump()}; // a bare string (camera.view=close)
     }
-    for (const std::string& part : parts) {
-        const auto bracket = part.find('[');
-        const toml::table* t = node->as_table();
-        if (!t) break;
-        node = t->get(part.substr(0, bracket));
-        if (!node) break;
-        if (bracket != std::string::npos) return {key, assignment.substr(assignment.find('=') + 1)};
-    }
-    if (!node) return {key, assignment.substr(assignment.find('=') + 1)};
-    std::ostringstream value;
-    node->visit([&](const auto& v) { value << v; });
-    return {key, value.str()};
 }
 
 } // namespace
