@@ -115,7 +115,8 @@ struct Frame {
 struct Renderer::Impl {
     // The pass pipeline of one frame (shadow map … tone map); returns the SSS support radius in mm.
     float runPasses(const Frame& frame);
-    gl::MainPassSettings runLightingPasses(const Frame& frame);
+    // `shadows` false: the shadow maps of the previous call are kept (same model, lights and shadow settings).
+    gl::MainPassSettings runLightingPasses(const Frame& frame, bool shadows = true);
     float runSssPasses(const Frame& frame, const gl::MainPassSettings& mainSettings);
 
     gl::EglContext context;
@@ -136,6 +137,7 @@ struct Renderer::Impl {
     // scene and overwrites the targets, so it clears `lightingKey`. Declared after the context: destroyed before it.
     std::unique_ptr<gl::GpuScene> residentScene;
     std::string residentSceneKey;
+    std::string shadowKey;
     std::string lightingKey;
     gl::MainPassSettings residentMainSettings;
 
@@ -331,12 +333,14 @@ float Renderer::Impl::runPasses(const Frame& frame) {
 }
 
 // shadow map → main pass → background → surface AOVs → transmittance: everything the SSS stage reads.
-gl::MainPassSettings Renderer::Impl::runLightingPasses(const Frame& frame) {
+gl::MainPassSettings Renderer::Impl::runLightingPasses(const Frame& frame, bool shadows) {
     const SceneSpec& spec = *frame.spec;
     gl::PassTimer& passTimer = timer;
-    passTimer.begin("shadow");
-    shadowMapPass.run(*frame.scene, frame.model->boundsMin, frame.model->boundsMax, spec.shadowResolution);
-    passTimer.end();
+    if (shadows) {
+        passTimer.begin("shadow");
+        shadowMapPass.run(*frame.scene, frame.model->boundsMin, frame.model->boundsMax, spec.shadowResolution);
+        passTimer.end();
+    }
 
     passTimer.begin("main");
     gl::MainPassSettings mainSettings;
@@ -497,6 +501,7 @@ DisplayFrame Renderer::renderDisplay(const RenderRequest& request, bool withLine
     if (!impl.residentScene || impl.residentSceneKey != sceneKey) {
         impl.residentScene.reset();
         impl.residentSceneKey.clear();
+        impl.shadowKey.clear();
         impl.lightingKey.clear();
         const auto albedoMap = spec.textures.albedo.empty() ? frame.model->albedoMap
                                                             : impl.image(spec.textures.albedo, ColorEncoding::sRGB);
@@ -519,7 +524,13 @@ DisplayFrame Renderer::renderDisplay(const RenderRequest& request, bool withLine
     }
     gl::GpuScene& scene = *impl.residentScene;
     frame.scene = &scene;
-    scene.lights = gpuLightsOf(spec);
+    // The shadow maps depend on the model, the lights and the shadow settings only (not on the camera or the
+    // exposure): kept, with the lights' shadow matrices the shadow pass set, while those stay the same.
+    const std::string shadowKey = sceneKey + nlohmann::json{{"lights", spec.resolved.value("lights", nlohmann::json())},
+                                                            {"shadow", spec.resolved.value("shadow", nlohmann::json())}}
+                                                 .dump();
+    const bool shadows = impl.shadowKey != shadowKey;
+    if (shadows) scene.lights = gpuLightsOf(spec);
     glm::vec3 frameMin, frameMax;
     skinBounds(*frame.model, frame.partMaterials, frameMin, frameMax);
     frame.camera = frameCamera(spec.camera, frameMin, frameMax, frame.model->boundsMin, frame.model->boundsMax,
@@ -541,9 +552,12 @@ DisplayFrame Renderer::renderDisplay(const RenderRequest& request, bool withLine
     const std::string lightingKey = lightingKeyOf(spec);
     if (impl.lightingKey != lightingKey) {
         impl.lightingKey.clear();
+        impl.shadowKey.clear();
         impl.targets.resize(spec.width, spec.height);
-        impl.residentMainSettings = impl.runLightingPasses(frame);
+        impl.residentMainSettings = impl.runLightingPasses(frame, shadows);
+        impl.shadowKey = shadowKey;
         impl.lightingKey = lightingKey;
+        if (shadows) out.reran.push_back("shadows");
         out.reran.push_back("lighting");
     }
     // The reference method draws into the frame targets itself: the lighting is not kept after it.
@@ -656,7 +670,8 @@ RenderResult Renderer::render(const RenderRequest& request) {
     }
 
     // --- the pass pipeline ----------------------------------------------------------------------------------
-    impl.lightingKey.clear(); // the targets no longer hold renderDisplay's lighting
+    impl.lightingKey.clear(); // the targets and shadow maps no longer hold renderDisplay's
+    impl.shadowKey.clear();
     const float supportRadiusMm = impl.runPasses(frame);
 
     // --- read back: every AOV of the table, and the display image -------------------------------------------

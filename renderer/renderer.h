@@ -67,12 +67,12 @@ public:
 
     RenderResult render(const RenderRequest& request);
     // The display image of `request` (its exrPath and pngPath are ignored) for live tuning: the uploaded scene
-    // (model, maps, environment) and the lighting passes' targets stay resident between calls, and a call re-runs
-    // only what its values change: the upload when the model, maps, materials or environment differ; the lighting
-    // passes (shadow map … transmittance) when lights, camera, size, exposure, transmittance or an [sss] key the
-    // main pass reads differ; always the SSS stage, add specular and tone map. The image is the same, byte for
-    // byte, as render()'s PNG of the same request. sss.method = "pathtraced" is refused (InputError): it needs
-    // Blender, run it through render().
+    // (model, maps, environment), the shadow maps and the lighting passes' targets stay resident between calls, and
+    // a call re-runs only what its values change: the upload when the model, maps, materials or environment differ;
+    // the shadow maps when the lights or shadow settings differ; the other lighting passes (main … transmittance)
+    // when the camera, size, exposure, transmittance or an [sss] key the main pass reads differ; always the SSS
+    // stage, add specular and tone map. The image is the same, byte for byte, as render()'s PNG of the same
+    // request. sss.method = "pathtraced" is refused (InputError): it needs Blender, run it through render().
     DisplayFrame renderDisplay(const RenderRequest& request, bool withLinear = false);
     std::string glRenderer() const;
     std::string glVersion() const;

@@ -175,16 +175,19 @@ TEST_F(TuneServerTest, SchemaCarriesTheReadersDeclarations) {
 TEST_F(TuneServerTest, SliderChangesRerunOnlyWhatTheyTouch) {
     HttpClient c = client();
     const json first = render(c, with(kSmall, {"sss.method=\"separable\"", "sss.width_mm=2"}));
-    EXPECT_EQ(first["reran"], json({"upload", "lighting", "sss"}));
+    EXPECT_EQ(first["reran"], json({"upload", "shadows", "lighting", "sss"}));
     const json wider = render(c, with(kSmall, {"sss.method=\"separable\"", "sss.width_mm=6"}));
     EXPECT_EQ(wider["reran"], json({"sss"})); // an [sss] key: the SSS stage and tone map only
     EXPECT_EQ(wider["resolved"]["sss"]["width_mm"], 6.0);
     EXPECT_FALSE(identical(imageOf(first), imageOf(wider)));
     const json brighter =
         render(c, with(kSmall, {"sss.method=\"separable\"", "sss.width_mm=6", "lights[0].intensity=2.5"}));
-    EXPECT_EQ(brighter["reran"], json({"lighting", "sss"})); // a light: lighting again, the scene stays resident
+    EXPECT_EQ(brighter["reran"], json({"shadows", "lighting", "sss"})); // a light: the scene stays resident
+    const json orbited = render(c, with(kSmall, {"sss.method=\"separable\"", "sss.width_mm=6",
+                                                 "lights[0].intensity=2.5", "camera.yaw_deg=40"}));
+    EXPECT_EQ(orbited["reran"], json({"lighting", "sss"})); // the camera: the shadow maps stay
     const json otherScene = render(c, kSmall, "test", "builtin:halo");
-    EXPECT_EQ(otherScene["reran"], json({"upload", "lighting", "sss"}));
+    EXPECT_EQ(otherScene["reran"], json({"upload", "shadows", "lighting", "sss"}));
 }
 
 TEST_F(TuneServerTest, IncrementalImagesEqualFullRenders) {
@@ -197,6 +200,7 @@ TEST_F(TuneServerTest, IncrementalImagesEqualFullRenders) {
         with(kSmall, {"sss.method=\"gaussian-sum\"", "transmittance.enabled=true", "sss.width_mm=4"}),
         with(kSmall, {"sss.method=\"gaussian-sum\"", "transmittance.enabled=true", "sss.width_mm=1.5"}),
         with(kSmall, {"sss.method=\"pscbf\"", "camera.yaw_deg=-30", "render.exposure_ev=0.5"}),
+        with(kSmall, {"sss.method=\"pscbf\"", "camera.yaw_deg=10", "camera.pitch_deg=15", "render.exposure_ev=0.5"}),
     };
     int step = 0;
     for (const auto& overrides : steps) {
