@@ -2,8 +2,8 @@
 //   bench_tune [--scene S] [--width W] [--height H] [--frames N] [--assets DIR] [--skinlab PATH]
 // An in-process TuneServer on loopback and the project's HTTP client in the role of the page: for each
 // screen-space method, one warm-up request, then N requests that each move one slider of the method (sss.width_mm
-// up and down: the SSS stage and tone map re-run) and N that move a light's intensity (the lighting passes re-run
-// too). Each figure is the whole round trip the page waits for: request, render, read-back, sRGB encoding, PNG,
+// up and down: the SSS stage and tone map re-run), N that orbit the camera (camera.yaw_deg: the main passes re-run,
+// the shadow maps stay) and N that move a light's intensity (shadow maps and main passes re-run). Each figure is the whole round trip the page waits for: request, render, read-back, sRGB encoding, PNG,
 // base64 and answer. Prints p50 and p95 per method and kind of change.
 #include "experiments/http_client.h"
 #include "renderer/sss/sss_params.h"
@@ -69,13 +69,13 @@ int main(int argc, char** argv) {
                     scene.c_str(), width, height, frames);
         std::printf("%-14s %-8s %8s %8s %8s\n", "method", "change", "p50", "p95", "max");
         for (const std::string& method : skinlab::renderer::sss::screenSpaceMethodNames()) {
-            auto request = [&](double widthMm, double intensity) {
+            auto request = [&](double widthMm, double intensity, double yaw) {
                 const nlohmann::json body = {
                     {"client", "bench"},
                     {"scene", scene},
                     {"overrides",
                      {size, sizeH, "sss.method=\"" + method + "\"", "sss.width_mm=" + std::to_string(widthMm),
-                      "lights[0].intensity=" + std::to_string(intensity)}}};
+                      "lights[0].intensity=" + std::to_string(intensity), "camera.yaw_deg=" + std::to_string(yaw)}}};
                 const auto start = std::chrono::steady_clock::now();
                 const auto answer = client.post("/api/render", body.dump());
                 const double ms =
@@ -86,12 +86,13 @@ int main(int argc, char** argv) {
                 }
                 return ms;
             };
-            request(3.0, 1.0); // warm-up: upload, shaders, lighting
-            std::vector<double> sss, lighting;
-            for (int f = 0; f < frames; ++f) sss.push_back(request(f % 2 ? 3.0 : 2.0, 1.0));
-            for (int f = 0; f < frames; ++f) lighting.push_back(request(3.0, f % 2 ? 1.0 : 1.2));
-            for (const auto& [kind, values] : {std::pair<const char*, std::vector<double>&>{"sss", sss},
-                                               std::pair<const char*, std::vector<double>&>{"lighting", lighting}})
+            request(3.0, 1.0, 20.0); // warm-up: upload, shaders, lighting
+            std::vector<double> sss, camera, lighting;
+            for (int f = 0; f < frames; ++f) sss.push_back(request(f % 2 ? 3.0 : 2.0, 1.0, 20.0));
+            for (int f = 0; f < frames; ++f) camera.push_back(request(3.0, 1.0, f % 2 ? 20.0 : 25.0));
+            for (int f = 0; f < frames; ++f) lighting.push_back(request(3.0, f % 2 ? 1.0 : 1.2, 20.0));
+            using Kind = std::pair<const char*, std::vector<double>&>;
+            for (const auto& [kind, values] : {Kind{"sss", sss}, Kind{"camera", camera}, Kind{"light", lighting}})
                 std::printf("%-14s %-8s %8.1f %8.1f %8.1f\n", method.c_str(), kind, percentile(values, 0.5),
                             percentile(values, 0.95), *std::max_element(values.begin(), values.end()));
             std::fflush(stdout);
