@@ -420,6 +420,21 @@ TEST_F(TuneServerTokenTest, ApiNeedsTheToken) {
     EXPECT_EQ(c.get("/").status, 200); // the page itself holds nothing
 }
 
+TEST_F(TuneServerTest, ScannedHeadOfferedWithTheAssets) {
+    // $SKINLAB_ASSETS (or --assets) holding the scan: the page offers its scene, and it renders.
+    const char* assets = std::getenv("SKINLAB_ASSETS");
+    if (!assets || !std::filesystem::exists(std::filesystem::path(assets) / "LeePerrySmith/LeePerrySmith.glb"))
+        GTEST_SKIP() << "SKINLAB_ASSETS does not hold LeePerrySmith/LeePerrySmith.glb";
+    HttpClient c = client();
+    const json schema = json::parse(c.get("/api/schema").body);
+    std::string scanned;
+    for (const json& scene : schema["scenes"])
+        if (scene.get<std::string>().ends_with("lee-perry-smith.toml")) scanned = scene;
+    ASSERT_FALSE(scanned.empty()) << schema["scenes"].dump();
+    const json frame = render(c, with(kSmall, {"sss.method=\"separable\""}), "scan", scanned);
+    EXPECT_EQ(frame["resolved"]["model"]["source"], "assets:LeePerrySmith/LeePerrySmith.glb");
+}
+
 TEST(TuneServerOptions, BeyondLoopbackOnlyWithAToken) {
     TuneOptions options;
     options.host = "0.0.0.0";
