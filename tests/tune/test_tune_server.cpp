@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
@@ -433,6 +434,47 @@ TEST_F(TuneServerTest, ScannedHeadOfferedWithTheAssets) {
     ASSERT_FALSE(scanned.empty()) << schema["scenes"].dump();
     const json frame = render(c, with(kSmall, {"sss.method=\"separable\""}), "scan", scanned);
     EXPECT_EQ(frame["resolved"]["model"]["source"], "assets:LeePerrySmith/LeePerrySmith.glb");
+}
+
+class TuneServerStimulusTest : public TuneServerTest {
+protected:
+    // A built set's manifest as `stimuli build` writes it (the fields "open" reads): one stimulus of builtin:head.
+    void configure(TuneOptions& options) override {
+        const auto set = work_ / "set";
+        std::filesystem::create_directories(set);
+        const json manifest = {{"format", "skinlab-stimuli"},
+                               {"version", 1},
+                               {"set", "demo"},
+                               {"stimuli",
+                                {{{"id", "head-mid-separable"},
+                                  {"scene", "builtin:head"},
+                                  {"factors", {{"method", "separable"}}},
+                                  {"reference", false},
+                                  {"overrides",
+                                   {"render.width=160", "render.height=90", "camera.view=\"mid\"",
+                                    "sss.method=\"separable\"", "sss.width_mm=2.5"}}}}}};
+        std::ofstream(set / "manifest.json") << manifest.dump(1);
+        options.stimulusSets = {set};
+    }
+};
+
+TEST_F(TuneServerStimulusTest, OpenLoadsAStimulusWithItsExactParameters) {
+    HttpClient c = client();
+    const json schema = json::parse(c.get("/api/schema").body);
+    ASSERT_EQ(schema["stimuli"].size(), 1u);
+    EXPECT_EQ(schema["stimuli"][0]["id"], "head-mid-separable");
+    const HttpAnswer opened = c.get("/api/open?set=0&id=head-mid-separable");
+    ASSERT_EQ(opened.status, 200) << opened.body;
+    const json config = json::parse(opened.body);
+    EXPECT_EQ(config["scene"], "builtin:head");
+    EXPECT_EQ(config["overrides"], json({"render.width=160", "render.height=90", "camera.view=\"mid\"",
+                                         "sss.method=\"separable\"", "sss.width_mm=2.5"}));
+    const json frame = render(c, config["overrides"].get<std::vector<std::string>>());
+    EXPECT_EQ(frame["resolved"]["sss"]["width_mm"], 2.5);
+    const HttpAnswer missing = c.get("/api/open?set=0&id=nothing");
+    EXPECT_EQ(missing.status, 400);
+    EXPECT_NE(json::parse(missing.body)["error"].get<std::string>().find("no stimulus 'nothing'"), std::string::npos);
+    EXPECT_EQ(c.get("/api/open?set=7&id=head-mid-separable").status, 404);
 }
 
 TEST(TuneServerOptions, BeyondLoopbackOnlyWithAToken) {
