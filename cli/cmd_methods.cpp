@@ -34,16 +34,38 @@ void runMethods(const MethodsOptions& options) {
         if (options.list) {
             text += std::string(info.name) + "\n";
         } else if (options.json) {
+            // Each key's declaration (type, range, choices, unit, doc: the reader's own) and its default.
+            const nlohmann::json defaults = sss::sssKeyDefaults(info.method);
+            nlohmann::json parameters = nlohmann::json::array();
+            for (const auto& key : keys) {
+                nlohmann::json declaration = sss::keyInfoJson(sss::sssKey(key));
+                declaration["default"] = defaults.at(key);
+                parameters.push_back(declaration);
+            }
             table.push_back({{"name", info.name},
                              {"screen_space", info.screenSpace},
                              {"blur_passes", info.blurPasses},
                              {"summary", info.summary},
-                             {"keys", keys}});
+                             {"keys", keys},
+                             {"parameters", parameters}});
         } else {
             text += std::string(info.name) + (info.screenSpace ? "  (screen-space)" : "") + "\n    " +
                     std::string(info.summary) + "\n    keys:";
             for (const auto& key : keys) text += " " + key;
             text += "\n";
+            const nlohmann::json defaults = sss::sssKeyDefaults(info.method);
+            for (const auto& key : keys) {
+                const sss::KeyInfo& declaration = sss::sssKey(key);
+                text += "      " + key + " (" + std::string(sss::keyTypeName(declaration.type));
+                if (declaration.type == sss::KeyType::Choice) {
+                    text += ":";
+                    for (const auto& choice : declaration.choices) text += " " + choice;
+                } else if (declaration.type != sss::KeyType::Boolean && declaration.type != sss::KeyType::String) {
+                    text += " " + nlohmann::json(declaration.min).dump() + "…" + nlohmann::json(declaration.max).dump();
+                }
+                if (!declaration.unit.empty()) text += ", " + std::string(declaration.unit);
+                text += ", default " + defaults.at(key).dump() + "): " + std::string(declaration.doc) + "\n";
+            }
         }
     }
     if (options.json) text = table.dump(2) + "\n";
@@ -59,7 +81,8 @@ void registerMethods(CLI::App& app) {
     methods->add_flag("--list", options->list, "Names only, one per line (for scripts)");
     methods->add_flag("--screen-space", options->screenSpace,
                       "Only the methods the screen-space SSS stage runs (tap kernels on the frame's buffers)");
-    methods->add_flag("--json", options->json, "The table as JSON: name, screen_space, blur_passes, summary, keys");
+    methods->add_flag("--json", options->json,
+                      "The table as JSON: name, screen_space, blur_passes, summary, keys, parameters (declarations)");
     methods->callback([options] {
         if (options->list && options->json) throw InputError("--list and --json: give one of them");
         runMethods(*options);

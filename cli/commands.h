@@ -12,6 +12,7 @@ void registerAnalyze(CLI::App& app);
 void registerReport(CLI::App& app);
 void registerPathtraced(CLI::App& app);
 void registerMethods(CLI::App& app);
+void registerTune(CLI::App& app);
 } // namespace skinlab::cli
 
 namespace skinlab::cli {

@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
     skinlab::cli::registerReport(app);
     skinlab::cli::registerPathtraced(app);
     skinlab::cli::registerMethods(app);
+    skinlab::cli::registerTune(app);
 
     try {
         app.parse(argc, argv);

@@ -116,6 +116,9 @@ struct Frame {
 struct Renderer::Impl {
     // The pass pipeline of one frame (shadow map … tone map); returns the SSS support radius in mm.
     float runPasses(const Frame& frame);
+    // `shadows` false: the shadow maps of the previous call are kept (same model, lights and shadow settings).
+    gl::MainPassSettings runLightingPasses(const Frame& frame, bool shadows = true);
+    float runSssPasses(const Frame& frame, const gl::MainPassSettings& mainSettings);
 
     gl::EglContext context;
     gl::ShaderLibrary shaders;
@@ -130,6 +133,14 @@ struct Renderer::Impl {
     gl::ReferenceMethod referenceMethod{shaders}; // sss.method = "reference": replaces the SSS stage
     gl::AddSpecularPass addSpecularPass{shaders};
     gl::ToneMapPass toneMapPass{shaders};
+
+    // renderDisplay's resident state: the uploaded scene and what the frame targets hold. render() uses its own
+    // scene and overwrites the targets, so it clears `lightingKey`. Declared after the context: destroyed before it.
+    std::unique_ptr<gl::GpuScene> residentScene;
+    std::string residentSceneKey;
+    std::string shadowKey;
+    std::string lightingKey;
+    gl::MainPassSettings residentMainSettings;
 
     // CPU-side caches: a stimulus set renders the same model, maps and environment many times.
     std::map<std::string, std::shared_ptr<const Model>> models;
@@ -317,12 +328,20 @@ std::vector<ExrChannel> exrChannels(const std::vector<std::vector<float>>& readB
 // shadow map → main pass → background → surface AOVs → transmittance → SSS stage (or the object-space reference)
 // → add specular → tone map. Returns the SSS support radius for the EXR metadata.
 float Renderer::Impl::runPasses(const Frame& frame) {
+    timer.reset();
+    const gl::MainPassSettings mainSettings = runLightingPasses(frame);
+    return runSssPasses(frame, mainSettings);
+}
+
+// shadow map → main pass → background → surface AOVs → transmittance: everything the SSS stage reads.
+gl::MainPassSettings Renderer::Impl::runLightingPasses(const Frame& frame, bool shadows) {
     const SceneSpec& spec = *frame.spec;
     gl::PassTimer& passTimer = timer;
-    passTimer.reset();
-    passTimer.begin("shadow");
-    shadowMapPass.run(*frame.scene, frame.model->boundsMin, frame.model->boundsMax, spec.shadowResolution);
-    passTimer.end();
+    if (shadows) {
+        passTimer.begin("shadow");
+        shadowMapPass.run(*frame.scene, frame.model->boundsMin, frame.model->boundsMax, spec.shadowResolution);
+        passTimer.end();
+    }
 
     passTimer.begin("main");
     gl::MainPassSettings mainSettings;
@@ -370,7 +389,14 @@ float Renderer::Impl::runPasses(const Frame& frame) {
     transmittanceSettings.curvatureReferenceMm = static_cast<float>(spec.sss.curvatureReferenceMm);
     transmittancePass.run(targets, transmittanceSettings);
     passTimer.end();
+    return mainSettings;
+}
 
+// SSS stage (or the object-space reference) → add specular → tone map, on the lighting passes' targets (which it
+// only reads, so it may run again on them with other [sss] or tone-map values). Returns the SSS support radius.
+float Renderer::Impl::runSssPasses(const Frame& frame, const gl::MainPassSettings& mainSettings) {
+    const SceneSpec& spec = *frame.spec;
+    gl::PassTimer& passTimer = timer;
     passTimer.begin("sss");
     float supportRadiusMm = 0.0f;
     gl::SssStageSettings sssSettings;
@@ -429,6 +455,147 @@ float Renderer::Impl::runPasses(const Frame& frame) {
                     static_cast<float>(spec.filmicWhite), reinhardScale);
     passTimer.end();
     return supportRadiusMm;
+}
+
+namespace {
+// What the upload depends on: the model, its materials and maps, the environment.
+std::string residentSceneKeyOf(const SceneSpec& spec) {
+    const nlohmann::json& r = spec.resolved;
+    return nlohmann::json{{"scene", r.at("scene")},
+                          {"mm_per_unit", r.value("mm_per_unit", nlohmann::json())},
+                          {"model", r.value("model", nlohmann::json())},
+                          {"textures", r.value("textures", nlohmann::json())},
+                          {"materials", r.value("materials", nlohmann::json())},
+                          {"environment", r.value("environment", nlohmann::json())}}
+        .dump();
+}
+
+// What the lighting passes depend on: everything but the tone map and the [sss] keys they do not read (the main
+// pass reads width_mm for the transmittance, the surface AOVs curvature_measure, both curvature_reference_mm).
+std::string lightingKeyOf(const SceneSpec& spec) {
+    nlohmann::json r = spec.resolved;
+    r.erase("tone_map");
+    r.erase("sss");
+    r["sss_lighting"] = {{"curvature_measure", spec.sss.curvatureMeasure},
+                         {"curvature_reference_mm", spec.sss.curvatureReferenceMm},
+                         {"width_mm", spec.transmittance.enabled ? spec.sss.widthMm : 0.0}};
+    return r.dump();
+}
+} // namespace
+
+DisplayFrame Renderer::renderDisplay(const RenderRequest& request, bool withLinear) {
+    const auto start = std::chrono::steady_clock::now();
+    SceneSpec spec = loadSpec(request);
+    if (spec.sss.method == sss::SssMethod::Pathtraced)
+        throw InputError(spec.source + ": sss.method: 'pathtraced' renders through Blender; use skinlab render");
+    Impl& impl = *impl_;
+    impl.context.makeCurrent();
+    DisplayFrame out;
+
+    Frame frame;
+    frame.spec = &spec;
+    frame.model = impl.model(spec);
+    frame.partMaterials = partMaterialsOf(spec, *frame.model);
+    const double loadMs = millisecondsSince(start);
+
+    const auto uploadStart = std::chrono::steady_clock::now();
+    const std::string sceneKey = residentSceneKeyOf(spec);
+    if (!impl.residentScene || impl.residentSceneKey != sceneKey) {
+        impl.residentScene.reset();
+        impl.residentSceneKey.clear();
+        impl.shadowKey.clear();
+        impl.lightingKey.clear();
+        const auto albedoMap = spec.textures.albedo.empty() ? frame.model->albedoMap
+                                                            : impl.image(spec.textures.albedo, ColorEncoding::sRGB);
+        const auto normalMap = spec.textures.normal.empty() ? frame.model->normalMap
+                                                            : impl.image(spec.textures.normal, ColorEncoding::Data);
+        const auto specularMap = impl.image(spec.textures.specular, ColorEncoding::Data);
+        const auto occlusionMap = impl.image(spec.textures.occlusion, ColorEncoding::Data);
+        const auto skinMaskMap = impl.image(spec.textures.skinMask, ColorEncoding::Data);
+        const Impl::CachedEnvironment& environment = impl.environment(spec.environment);
+        auto scene = std::make_unique<gl::GpuScene>();
+        scene->uploadModel(*frame.model, frame.partMaterials);
+        scene->uploadMaps(albedoMap.get(), normalMap.get(), specularMap.get(), occlusionMap.get(), skinMaskMap.get());
+        std::array<glm::vec3, 9> irradiance = irradianceCoefficientsSH9(environment.radianceSH);
+        for (glm::vec3& c : irradiance) c *= static_cast<float>(spec.environment.intensity);
+        const bool environmentBackground = spec.environment.background == "environment" && environment.environment;
+        scene->uploadEnvironment(environmentBackground ? environment.environment.get() : nullptr, irradiance);
+        impl.residentScene = std::move(scene);
+        impl.residentSceneKey = sceneKey;
+        out.reran.push_back("upload");
+    }
+    gl::GpuScene& scene = *impl.residentScene;
+    frame.scene = &scene;
+    // The shadow maps depend on the model, the lights and the shadow settings only (not on the camera or the
+    // exposure): kept, with the lights' shadow matrices the shadow pass set, while those stay the same.
+    const std::string shadowKey = sceneKey + nlohmann::json{{"lights", spec.resolved.value("lights", nlohmann::json())},
+                                                            {"shadow", spec.resolved.value("shadow", nlohmann::json())}}
+                                                 .dump();
+    const bool shadows = impl.shadowKey != shadowKey;
+    if (shadows) scene.lights = gpuLightsOf(spec);
+    glm::vec3 frameMin, frameMax;
+    skinBounds(*frame.model, frame.partMaterials, frameMin, frameMax);
+    frame.camera = frameCamera(spec.camera, frameMin, frameMax, frame.model->boundsMin, frame.model->boundsMax,
+                               spec.width, spec.height);
+    frame.exposure = static_cast<float>(std::exp2(spec.exposureEv));
+    frame.environmentFromWorld = glm::mat3(glm::rotate(
+        glm::mat4(1.0f), static_cast<float>(-glm::radians(spec.environment.rotationDeg)), glm::vec3(0, 1, 0)));
+    const bool referenceMethod = spec.sss.method == sss::SssMethod::Reference;
+    if (referenceMethod) {
+        frame.referenceInputs.model = frame.model;
+        frame.referenceInputs.partMaterials = frame.partMaterials;
+        frame.referenceInputs.mmPerUnit = static_cast<float>(spec.mmPerUnit);
+        frame.referenceInputs.source = spec.source;
+        impl.referenceMethod.prepare(frame.referenceInputs, spec.sss);
+    }
+    const double uploadMs = millisecondsSince(uploadStart);
+
+    impl.timer.reset();
+    const std::string lightingKey = lightingKeyOf(spec);
+    if (impl.lightingKey != lightingKey) {
+        impl.lightingKey.clear();
+        impl.shadowKey.clear();
+        impl.targets.resize(spec.width, spec.height);
+        impl.residentMainSettings = impl.runLightingPasses(frame, shadows);
+        impl.shadowKey = shadowKey;
+        impl.lightingKey = lightingKey;
+        if (shadows) out.reran.push_back("shadows");
+        out.reran.push_back("lighting");
+    }
+    // The reference method draws into the frame targets itself: the lighting is not kept after it.
+    if (referenceMethod) impl.lightingKey.clear();
+    out.supportRadiusMm = impl.runSssPasses(frame, impl.residentMainSettings);
+    out.reran.push_back("sss");
+
+    const auto readbackStart = std::chrono::steady_clock::now();
+    const std::size_t pixels = static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height);
+    std::vector<float> rgba(pixels * 4);
+    gl::readTexture(impl.targets.display.get(), spec.width, spec.height, 4, rgba.data());
+    std::vector<float> display(pixels * 3);
+    for (std::size_t p = 0; p < pixels; ++p)
+        for (std::size_t c = 0; c < 3; ++c) display[p * 3 + c] = rgba[p * 4 + c];
+    out.srgb8 = encodeDisplaySrgb8(display);
+    if (withLinear) {
+        gl::readTexture(impl.targets.beauty.get(), spec.width, spec.height, 4, rgba.data());
+        out.beauty.resize(pixels * 3);
+        for (std::size_t p = 0; p < pixels; ++p)
+            for (std::size_t c = 0; c < 3; ++c) out.beauty[p * 3 + c] = rgba[p * 4 + c];
+        out.depth.resize(pixels);
+        gl::readTexture(impl.targets.linearDepth.get(), spec.width, spec.height, 1, out.depth.data());
+        out.mask.resize(pixels);
+        gl::readTexture(impl.targets.mask.get(), spec.width, spec.height, 1, out.mask.data());
+    }
+    const double readbackMs = millisecondsSince(readbackStart);
+
+    out.width = spec.width;
+    out.height = spec.height;
+    out.focalLengthPixels = frame.camera.focalLengthPixels;
+    out.mmPerUnit = spec.mmPerUnit;
+    out.resolved = spec.resolved;
+    out.timingsMs = impl.timer.json();
+    out.timingsMs["cpu"] = {{"load", loadMs}, {"upload", uploadMs}, {"readback", readbackMs}};
+    out.timingsMs["call_wall"] = millisecondsSince(start);
+    return out;
 }
 
 RenderResult Renderer::render(const RenderRequest& request) {
@@ -514,6 +681,8 @@ RenderResult Renderer::render(const RenderRequest& request) {
     }
 
     // --- the pass pipeline ----------------------------------------------------------------------------------
+    impl.lightingKey.clear(); // the targets and shadow maps no longer hold renderDisplay's
+    impl.shadowKey.clear();
     const float supportRadiusMm = impl.runPasses(frame);
 
     // --- read back: every AOV of the table, and the display image -------------------------------------------

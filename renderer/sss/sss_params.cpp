@@ -1,5 +1,6 @@
 #include "renderer/sss/sss_params.h"
 
+#include "common/check.h"
 #include "common/error.h"
 #include "common/spec.h"
 #include "renderer/sss/materials.h"
@@ -51,12 +52,10 @@ const std::vector<MethodInfo> kMethods{
 };
 #undef SKINLAB_BLUR_KEYS
 
-const std::vector<std::string> kMethodNames = methodNames();
-const std::vector<std::string> kCurvatureNames{"off", "increase", "reduce", "reduce-floor"};
-const std::vector<std::string> kPlacementNames{"quadratic", "importance"};
-const std::vector<std::string> kPscbfSigmaNames{"variance", "std-dev"};
-const std::vector<std::string> kExtensionInputNames{"albedo", "lit"};
-const std::vector<std::string> kCurvatureMeasureNames{"normal", "screen"};
+// Shorthands for the reader: the declared range / choices of a key.
+double lowest(std::string_view key) { return sssKey(key).min; }
+double highest(std::string_view key) { return sssKey(key).max; }
+const std::vector<std::string>& choicesOf(std::string_view key) { return sssKey(key).choices; }
 
 // JSON (as written by toJson) → TOML, so that the JSON form goes through the same strict reader.
 toml::table jsonToToml(const nlohmann::json& object, std::string_view source);
@@ -89,22 +88,24 @@ toml::table jsonToToml(const nlohmann::json& object, std::string_view source) {
 
 SssParams readSssTable(const SpecReader& sss) {
     SssParams p;
-    p.method = findMethod(sss.choice("method", "none", kMethodNames))->method;
+    p.method = findMethod(sss.choice("method", "none", choicesOf("method")))->method;
     // A key of another method would be ignored silently: refuse it, naming the key and the method.
     for (const std::string_view key : allSssKeys())
         if (sss.has(key) && !methodUsesKey(p.method, key)) sss.fail(key, notAParameterMessage(p.method));
     if (p.method == SssMethod::Pscbf) p.samples = SssParams::kDefaultPscbfSamples;
-    p.samples = static_cast<int>(sss.integer("samples", p.samples, 3, 101));
+    p.samples = static_cast<int>(sss.integer("samples", p.samples, static_cast<std::int64_t>(lowest("samples")),
+                                             static_cast<std::int64_t>(highest("samples"))));
     if (p.samples % 2 == 0)
         sss.fail("samples",
                  std::to_string(p.samples) + " is even; a symmetric kernel needs an odd number of taps (3…101)");
-    p.widthMm = sss.number("width_mm", p.widthMm, 0.01, 100.0);
-    p.placement = sss.choice("sampling", "quadratic", kPlacementNames) == "importance" ? TapPlacement::Importance
-                                                                                       : TapPlacement::Quadratic;
+    p.widthMm = sss.number("width_mm", p.widthMm, lowest("width_mm"), highest("width_mm"));
+    p.placement = sss.choice("sampling", "quadratic", choicesOf("sampling")) == "importance" ? TapPlacement::Importance
+                                                                                             : TapPlacement::Quadratic;
     p.followSurface = sss.boolean("follow_surface", p.followSurface);
-    p.followSurfaceK = sss.number("follow_surface_k", p.followSurfaceK, 0.0, 1000.0);
+    p.followSurfaceK =
+        sss.number("follow_surface_k", p.followSurfaceK, lowest("follow_surface_k"), highest("follow_surface_k"));
     p.profile = sss.string("profile", p.profile);
-    p.material = sss.choice("material", p.material, materialNames());
+    p.material = sss.choice("material", p.material, choicesOf("material"));
     if (p.profile.rfind("file:", 0) == 0) {
         if (p.profile.size() == 5) sss.fail("profile", "'file:' needs a path, e.g. file:/path/Skin1_PreInt_DISCSEP.bn");
         try {
@@ -117,32 +118,174 @@ SssParams readSssTable(const SpecReader& sss) {
     }
     if (p.profile == "deon" && p.material != "skin")
         sss.fail("material", "'" + p.material + "' has no d'Eon profile (only 'skin'); use sss.profile = \"burley\"");
-    p.artisticStrength = sss.vec3("artistic_strength", p.artisticStrength, 0.0, 1.0);
-    p.artisticFalloff = sss.vec3("artistic_falloff", p.artisticFalloff, 0.0, 1.0);
+    p.artisticStrength =
+        sss.vec3("artistic_strength", p.artisticStrength, lowest("artistic_strength"), highest("artistic_strength"));
+    p.artisticFalloff =
+        sss.vec3("artistic_falloff", p.artisticFalloff, lowest("artistic_falloff"), highest("artistic_falloff"));
     p.cbf = sss.boolean("cbf", p.cbf);
-    p.cbfLambda = sss.number("cbf_lambda", p.cbfLambda, 0.0, 1000.0);
-    p.labWeight = sss.number("lab_weight", p.labWeight, 0.0, 100.0);
-    p.extensionInput = sss.choice("extension_input", p.extensionInput, kExtensionInputNames);
-    p.curvature = sss.choice("curvature", p.curvature, kCurvatureNames);
-    p.curvatureFloor = sss.number("curvature_floor", p.curvatureFloor, 0.0, 1.0);
-    p.curvatureMeasure = sss.choice("curvature_measure", p.curvatureMeasure, kCurvatureMeasureNames);
-    p.curvatureReferenceMm = sss.number("curvature_reference_mm", p.curvatureReferenceMm, 0.1, 1000.0);
-    p.pscbfSigma = sss.choice("pscbf_sigma", "variance", kPscbfSigmaNames) == "std-dev" ? PscbfSigma::StdDev
-                                                                                        : PscbfSigma::Variance;
-    p.referenceEdgeMm = sss.number("reference_edge_mm", p.referenceEdgeMm, 0.05, 50.0);
-    p.referenceThroughGain = sss.vec3("reference_through_gain", p.referenceThroughGain, 0.0, 100.0);
+    p.cbfLambda = sss.number("cbf_lambda", p.cbfLambda, lowest("cbf_lambda"), highest("cbf_lambda"));
+    p.labWeight = sss.number("lab_weight", p.labWeight, lowest("lab_weight"), highest("lab_weight"));
+    p.extensionInput = sss.choice("extension_input", p.extensionInput, choicesOf("extension_input"));
+    p.curvature = sss.choice("curvature", p.curvature, choicesOf("curvature"));
+    p.curvatureFloor =
+        sss.number("curvature_floor", p.curvatureFloor, lowest("curvature_floor"), highest("curvature_floor"));
+    p.curvatureMeasure = sss.choice("curvature_measure", p.curvatureMeasure, choicesOf("curvature_measure"));
+    p.curvatureReferenceMm = sss.number("curvature_reference_mm", p.curvatureReferenceMm,
+                                        lowest("curvature_reference_mm"), highest("curvature_reference_mm"));
+    p.pscbfSigma = sss.choice("pscbf_sigma", "variance", choicesOf("pscbf_sigma")) == "std-dev" ? PscbfSigma::StdDev
+                                                                                                : PscbfSigma::Variance;
+    p.referenceEdgeMm =
+        sss.number("reference_edge_mm", p.referenceEdgeMm, lowest("reference_edge_mm"), highest("reference_edge_mm"));
+    p.referenceThroughGain = sss.vec3("reference_through_gain", p.referenceThroughGain,
+                                      lowest("reference_through_gain"), highest("reference_through_gain"));
     return p;
 }
 
 TransmittanceParams readTransmittanceTable(const SpecReader& t) {
     TransmittanceParams p;
     p.enabled = t.boolean("enabled", p.enabled);
-    p.translucency = t.number("translucency", p.translucency, 0.0, 1.0);
+    p.translucency = t.number("translucency", p.translucency, transmittanceKey("translucency").min,
+                              transmittanceKey("translucency").max);
     p.curvature = t.boolean("curvature", p.curvature);
-    p.curvatureForm = t.choice("curvature_form", p.curvatureForm, {"scale", "thesis"});
+    p.curvatureForm = t.choice("curvature_form", p.curvatureForm, transmittanceKey("curvature_form").choices);
     return p;
 }
 } // namespace
+
+const std::vector<KeyInfo>& sssKeyTable() {
+    // Built on first use (the choices call methodNames() and materialNames()).
+    static const std::vector<KeyInfo> table{
+        {"method", KeyType::Choice, 0, 0, methodNames(), "", "the SSS method (skinlab methods)"},
+        {"samples", KeyType::Integer, 3, 101, {}, "taps", "taps per 1-D pass (odd)"},
+        {"width_mm", KeyType::Number, 0.01, 100.0, {}, "mm", "physical width of the blur on the surface"},
+        {"sampling", KeyType::Choice, 0, 0, {"quadratic", "importance"}, "", "how the kernel is discretised into taps"},
+        {"follow_surface", KeyType::Boolean, 0, 0, {}, "", "Jimenez's follow-surface correction on depth steps"},
+        {"follow_surface_k",
+         KeyType::Number,
+         0.0,
+         1000.0,
+         {},
+         "1/mm",
+         "follow-surface strength: 1/k mm of depth stops a tap"},
+        {"profile", KeyType::String, 0, 0, {}, "", "diffusion profile: deon, burley or file:PATH (a .bn kernel)"},
+        {"material", KeyType::Choice, 0, 0, materialNames(), "",
+         "material of the profile (burley: Jensen et al. 2001 media)"},
+        {"artistic_strength", KeyType::Vec3, 0.0, 1.0, {}, "", "artistic kernel: per-channel strength (R, G, B)"},
+        {"artistic_falloff", KeyType::Vec3, 0.0, 1.0, {}, "", "artistic kernel: per-channel falloff (R, G, B)"},
+        {"cbf", KeyType::Boolean, 0, 0, {}, "", "E1: cross-bilateral weights on the auxiliary image"},
+        {"cbf_lambda", KeyType::Number, 0.0, 1000.0, {}, "", "E1: lambda of exp(-lambda |F_c - F_tap|)"},
+        {"lab_weight",
+         KeyType::Number,
+         0.0,
+         100.0,
+         {},
+         "1/ΔE",
+         "E2: beta of the CIELAB weight exp(-beta ΔE*ab); 0 = off"},
+        {"extension_input",
+         KeyType::Choice,
+         0,
+         0,
+         {"albedo", "lit"},
+         "",
+         "E1/E2 input: the albedo AOV or the lit colour"},
+        {"curvature",
+         KeyType::Choice,
+         0,
+         0,
+         {"off", "increase", "reduce", "reduce-floor"},
+         "",
+         "E3: curvature modulation of the kernel width"},
+        {"curvature_floor", KeyType::Number, 0.0, 1.0, {}, "", "E3 reduce-floor: width share kept on flat skin"},
+        {"curvature_measure",
+         KeyType::Choice,
+         0,
+         0,
+         {"normal", "screen"},
+         "",
+         "curvature AOV: 3-D normal curvature or the screen-space measure"},
+        {"curvature_reference_mm",
+         KeyType::Number,
+         0.1,
+         1000.0,
+         {},
+         "mm",
+         "radius at or below which a surface counts as fully curved"},
+        {"pscbf_sigma",
+         KeyType::Choice,
+         0,
+         0,
+         {"variance", "std-dev"},
+         "",
+         "pscbf: how Mikkelsen's Table 1 values are read"},
+        {"reference_edge_mm", KeyType::Number, 0.05, 50.0, {}, "mm", "reference: longest skin edge after tessellation"},
+        {"reference_through_gain",
+         KeyType::Vec3,
+         0.0,
+         100.0,
+         {},
+         "",
+         "reference: per-channel gain on light through thin parts"},
+    };
+    return table;
+}
+
+const std::vector<KeyInfo>& transmittanceKeyTable() {
+    static const std::vector<KeyInfo> table{
+        {"enabled", KeyType::Boolean, 0, 0, {}, "", "light through thin parts (Jimenez et al. 2010)"},
+        {"translucency", KeyType::Number, 0.0, 1.0, {}, "", "0 = opaque, 1 = fully translucent"},
+        {"curvature", KeyType::Boolean, 0, 0, {}, "", "curvature modulation of the transmittance (the thesis' option)"},
+        {"curvature_form",
+         KeyType::Choice,
+         0,
+         0,
+         {"scale", "thesis"},
+         "",
+         "scale: × (1 + c); thesis: profile widened by 1 + 2c"},
+    };
+    return table;
+}
+
+namespace {
+const KeyInfo& findKey(const std::vector<KeyInfo>& table, std::string_view name) {
+    const auto found = std::find_if(table.begin(), table.end(), [&](const KeyInfo& key) { return key.name == name; });
+    SKINLAB_CHECK(found != table.end()); // every key the reader reads is declared
+    return *found;
+}
+} // namespace
+
+const KeyInfo& sssKey(std::string_view name) { return findKey(sssKeyTable(), name); }
+const KeyInfo& transmittanceKey(std::string_view name) { return findKey(transmittanceKeyTable(), name); }
+
+std::string_view keyTypeName(KeyType type) {
+    switch (type) {
+    case KeyType::Boolean: return "boolean";
+    case KeyType::Integer: return "integer";
+    case KeyType::Number: return "number";
+    case KeyType::Choice: return "choice";
+    case KeyType::Vec3: return "vec3";
+    case KeyType::String: return "string";
+    }
+    return "string";
+}
+
+nlohmann::json sssKeyDefaults(SssMethod method) {
+    SssParams defaults;
+    defaults.method = method;
+    if (method == SssMethod::Pscbf) defaults.samples = SssParams::kDefaultPscbfSamples;
+    return defaults.toJson();
+}
+
+nlohmann::json transmittanceKeyDefaults() { return TransmittanceParams{}.toJson(); }
+
+nlohmann::json keyInfoJson(const KeyInfo& key) {
+    nlohmann::json out = {{"name", key.name}, {"type", keyTypeName(key.type)}, {"unit", key.unit}, {"doc", key.doc}};
+    if (key.type == KeyType::Integer || key.type == KeyType::Number || key.type == KeyType::Vec3) {
+        out["min"] = key.min;
+        out["max"] = key.max;
+    }
+    if (key.type == KeyType::Choice) out["choices"] = key.choices;
+    return out;
+}
 
 const std::vector<MethodInfo>& methodTable() { return kMethods; }
 

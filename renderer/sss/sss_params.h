@@ -76,6 +76,34 @@ bool methodUsesKey(SssMethod method, std::string_view key);
 // "not a parameter of method 'separable' (its keys: ...)": the message of the error for a key `method` does not read.
 std::string notAParameterMessage(SssMethod method);
 
+// The declaration of one key of [sss] or [transmittance]: the reader takes its type, range and choices from here,
+// and `skinlab methods --json` and `skinlab tune` show them, so the three never disagree. Defaults are the
+// default-constructed SssParams / TransmittanceParams (sssKeyDefaults below).
+enum class KeyType { Boolean, Integer, Number, Choice, Vec3, String };
+std::string_view keyTypeName(KeyType type); // "boolean", "integer", "number", "choice", "vec3", "string"
+
+struct KeyInfo {
+    std::string_view name; // key within its table ("width_mm")
+    KeyType type;
+    double min = 0.0; // Integer, Number, Vec3 (each element): the accepted range, inclusive
+    double max = 0.0;
+    std::vector<std::string> choices; // Choice: the accepted values
+    std::string_view unit;            // "mm", "1/mm", "" (dimensionless)
+    std::string_view doc;             // one line
+};
+
+// Every [sss] key, in reading order; every [transmittance] key.
+const std::vector<KeyInfo>& sssKeyTable();
+const std::vector<KeyInfo>& transmittanceKeyTable();
+// The declaration of an [sss] / [transmittance] key (a check fails for an undeclared name).
+const KeyInfo& sssKey(std::string_view name);
+const KeyInfo& transmittanceKey(std::string_view name);
+// The default of every key `method` reads (the reader's defaults: pscbf's samples is 13, the others' 21).
+nlohmann::json sssKeyDefaults(SssMethod method);
+nlohmann::json transmittanceKeyDefaults();
+// A declaration as JSON: {"name", "type", "min", "max", "choices", "unit", "doc"} (range and choices where they apply).
+nlohmann::json keyInfoJson(const KeyInfo& key);
+
 std::string_view methodName(SssMethod method);
 std::string_view pscbfSigmaName(PscbfSigma reading);
 std::string_view placementName(TapPlacement placement);

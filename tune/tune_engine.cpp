@@ -1,0 +1,256 @@
+#include "tune/tune_engine.h"
+
+#include "common/error.h"
+#include "common/hash.h"
+
+#include <algorithm>
+#include <csignal>
+#include <cstring>
+#include <fcntl.h>
+#include <fstream>
+#include <spawn.h>
+#include <spdlog/spdlog.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+extern char** environ;
+
+namespace skinlab::tune {
+
+namespace {
+double millisecondsBetween(std::chrono::steady_clock::time_point from, std::chrono::steady_clock::time_point to) {
+    return std::chrono::duration<double, std::milli>(to - from).count();
+}
+} // namespace
+
+std::string configKey(const TuneConfig& config) {
+    std::string text = config.scene;
+    for (const std::string& o : config.overrides) text += "\n" + o;
+    return sha256Hex(text).substr(0, 16);
+}
+
+// --- RenderQueue ----------------------------------------------------------------------------------------------
+
+RenderQueue::RenderQueue(std::filesystem::path assetsDir)
+    : assetsDir_(std::move(assetsDir)), thread_([this] { loop(); }) {}
+
+RenderQueue::~RenderQueue() {
+    {
+        std::lock_guard lock(mutex_);
+        stopping_ = true;
+    }
+    wake_.notify_all();
+    thread_.join();
+}
+
+std::string RenderQueue::glRenderer() const {
+    std::lock_guard lock(mutex_);
+    return glRenderer_;
+}
+
+std::uint64_t RenderQueue::rendered() const {
+    std::lock_guard lock(mutex_);
+    return rendered_;
+}
+
+std::optional<TuneFrame> RenderQueue::render(const std::string& client, const TuneConfig& config, bool withLinear) {
+    auto pending = std::make_unique<Pending>();
+    pending->config = config;
+    pending->withLinear = withLinear;
+    pending->arrived = std::chrono::steady_clock::now();
+    std::future<std::optional<TuneFrame>> answer = pending->answer.get_future();
+    {
+        std::lock_guard lock(mutex_);
+        if (stopping_) throw RuntimeError("tune: the render thread is stopping");
+        auto& slot = pending_[client];
+        if (slot) slot->answer.set_value(std::nullopt); // replaced before it started: latest wins
+        else order_.push_back(client);
+        slot = std::move(pending);
+    }
+    wake_.notify_one();
+    return answer.get();
+}
+
+void RenderQueue::loop() {
+    std::unique_ptr<renderer::Renderer> renderer;
+    std::string startError;
+    try {
+        renderer = std::make_unique<renderer::Renderer>();
+        std::lock_guard lock(mutex_);
+        glRenderer_ = renderer->glRenderer();
+    } catch (const std::exception& e) {
+        startError = e.what();
+        spdlog::error("tune: no GL context: {}", startError);
+    }
+    for (;;) {
+        std::unique_ptr<Pending> job;
+        {
+            std::unique_lock lock(mutex_);
+            wake_.wait(lock, [&] { return stopping_ || !order_.empty(); });
+            if (order_.empty()) break; // stopping with nothing left
+            const std::string client = order_.front();
+            order_.pop_front();
+            job = std::move(pending_[client]);
+            pending_.erase(client);
+        }
+        const auto started = std::chrono::steady_clock::now();
+        try {
+            if (!renderer) throw RuntimeError("no GL context: " + startError);
+            renderer::RenderRequest request;
+            request.scene = job->config.scene;
+            request.overrides = job->config.overrides;
+            request.assetsDir = assetsDir_;
+            TuneFrame frame;
+            frame.frame = renderer->renderDisplay(request, job->withLinear);
+            const auto finished = std::chrono::steady_clock::now();
+            frame.queuedMs = millisecondsBetween(job->arrived, started);
+            frame.renderMs = millisecondsBetween(started, finished);
+            {
+                std::lock_guard lock(mutex_);
+                ++rendered_;
+            }
+            job->answer.set_value(std::move(frame));
+        } catch (...) {
+            job->answer.set_exception(std::current_exception());
+        }
+    }
+}
+
+// --- JobRunner ------------------------------------------------------------------------------------------------
+
+struct JobRunner::Job {
+    JobStatus status;
+    std::string key;
+    std::string sizeKey;
+    pid_t pid = -1;
+    std::filesystem::path log;
+    std::chrono::steady_clock::time_point started;
+    std::chrono::steady_clock::time_point finished;
+};
+
+JobRunner::JobRunner(std::filesystem::path executable, std::filesystem::path folder, std::filesystem::path assetsDir)
+    : executable_(std::move(executable)), folder_(std::move(folder)), assetsDir_(std::move(assetsDir)) {
+    std::filesystem::create_directories(folder_);
+    reaper_ = std::thread([this] { reap(); });
+}
+
+JobRunner::~JobRunner() {
+    {
+        std::lock_guard lock(mutex_);
+        stopping_ = true;
+        for (auto& [id, job] : jobs_)
+            if (job->status.state == "running" && job->pid > 0) kill(-job->pid, SIGTERM);
+    }
+    wake_.notify_all();
+    reaper_.join();
+}
+
+std::string JobRunner::start(const TuneConfig& config, const std::string& method, int width, int height) {
+    std::lock_guard lock(mutex_);
+    const std::string key = configKey(config);
+    for (const auto& [id, job] : jobs_)
+        if (job->key == key && (job->status.state == "running" || job->status.state == "done")) return id;
+
+    auto job = std::make_shared<Job>();
+    job->status.id = "job" + std::to_string(next_++);
+    job->status.state = "running";
+    job->status.method = method;
+    job->key = key;
+    job->sizeKey = method + "|" + std::to_string(width) + "x" + std::to_string(height);
+    if (auto found = lastSeconds_.find(job->sizeKey); found != lastSeconds_.end())
+        job->status.expectedSeconds = found->second;
+    job->status.exr = folder_ / (job->status.id + ".exr");
+    job->status.png = folder_ / (job->status.id + ".png");
+    job->log = folder_ / (job->status.id + ".log");
+
+    std::vector<std::string> arguments{executable_.string(), "render", "--scene", config.scene};
+    for (const std::string& o : config.overrides) {
+        arguments.push_back("--set");
+        arguments.push_back(o);
+    }
+    if (!assetsDir_.empty()) {
+        arguments.push_back("--assets");
+        arguments.push_back(assetsDir_.string());
+    }
+    for (const std::string& a :
+         {std::string("-o"), job->status.exr.string(), std::string("--png"), job->status.png.string()})
+        arguments.push_back(a);
+    std::vector<char*> argv;
+    for (std::string& a : arguments) argv.push_back(a.data());
+    argv.push_back(nullptr);
+
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+    posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, job->log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+    posix_spawn_file_actions_addclosefrom_np(&actions, 3); // not the server's sockets
+    posix_spawnattr_t attributes;
+    posix_spawnattr_init(&attributes);
+    posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP);
+    posix_spawnattr_setpgroup(&attributes, 0); // its own group: cancel ends Blender with it
+    pid_t pid = -1;
+    const int error = posix_spawn(&pid, executable_.c_str(), &actions, &attributes, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    posix_spawnattr_destroy(&attributes);
+    if (error != 0)
+        throw RuntimeError(executable_.string() + ": cannot start a background render (" + std::strerror(error) + ")");
+    job->pid = pid;
+    job->started = std::chrono::steady_clock::now();
+    jobs_[job->status.id] = job;
+    wake_.notify_all();
+    return job->status.id;
+}
+
+std::optional<JobStatus> JobRunner::status(const std::string& id) const {
+    std::lock_guard lock(mutex_);
+    const auto found = jobs_.find(id);
+    if (found == jobs_.end()) return std::nullopt;
+    JobStatus status = found->second->status;
+    const auto end = status.state == "running" ? std::chrono::steady_clock::now() : found->second->finished;
+    status.elapsedSeconds = millisecondsBetween(found->second->started, end) / 1000.0;
+    return status;
+}
+
+bool JobRunner::cancel(const std::string& id) {
+    std::lock_guard lock(mutex_);
+    const auto found = jobs_.find(id);
+    if (found == jobs_.end() || found->second->status.state != "running") return false;
+    kill(-found->second->pid, SIGTERM);
+    found->second->status.state = "cancelled";
+    return true;
+}
+
+void JobRunner::reap() {
+    std::unique_lock lock(mutex_);
+    for (;;) {
+        bool running = false;
+        for (auto& [id, job] : jobs_) {
+            if (job->pid <= 0) continue;
+            int status = 0;
+            const pid_t done = waitpid(job->pid, &status, WNOHANG);
+            if (done != job->pid) {
+                running = true;
+                continue;
+            }
+            job->pid = -1;
+            job->finished = std::chrono::steady_clock::now();
+            if (job->status.state == "cancelled") continue;
+            if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {
+                job->status.state = "done";
+                lastSeconds_[job->sizeKey] = millisecondsBetween(job->started, job->finished) / 1000.0;
+            } else {
+                job->status.state = "failed";
+                std::ifstream log(job->log);
+                std::string line, last;
+                while (std::getline(log, line))
+                    if (!line.empty()) last = line;
+                job->status.error = last.empty() ? "the render exited with status " + std::to_string(status) : last;
+            }
+        }
+        if (stopping_ && !running) break;
+        wake_.wait_for(lock, std::chrono::milliseconds(100));
+    }
+}
+
+} // namespace skinlab::tune

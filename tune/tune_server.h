@@ -1,0 +1,69 @@
+#pragma once
+// `skinlab tune`: the live-tuning page and its JSON API on the project's HTTP server (experiments/http_server.h).
+// Loopback by default; bound to any other address only with a token (Authorization: Bearer TOKEN on every /api/
+// request). Routes and limits: docs/tuning.md.
+#include "experiments/http_server.h"
+#include "tune/tune_engine.h"
+
+#include <filesystem>
+#include <memory>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace skinlab::tune {
+
+struct TuneOptions {
+    std::string host = "127.0.0.1";
+    int port = 0;
+    std::string token;               // required unless the host is a loopback address
+    std::vector<std::string> scenes; // the scenes the page offers; the first is shown first
+    std::string method;              // the method shown first (empty: the scene's own)
+    int width = 640;                 // the size the page starts with
+    int height = 360;
+    std::filesystem::path assetsDir;                 // --assets (empty: $SKINLAB_ASSETS)
+    std::filesystem::path exportDir;                 // where "export" writes
+    std::vector<std::filesystem::path> stimulusSets; // built sets "open" reads (manifest.json)
+    std::filesystem::path executable;                // the skinlab binary (background renders)
+    std::filesystem::path workDir;                   // background renders' files
+};
+
+class TuneServer {
+public:
+    explicit TuneServer(TuneOptions options); // throws InputError for bad options
+    ~TuneServer();
+    TuneServer(const TuneServer&) = delete;
+    TuneServer& operator=(const TuneServer&) = delete;
+
+    int bind(); // returns the port
+    void run(); // blocks until stop()
+    void stop();
+    std::string url() const;
+
+    // The request handler (public for tests that call it without a socket).
+    experiments::HttpResponse handle(const experiments::HttpRequest& request);
+
+private:
+    experiments::HttpResponse answer(const experiments::HttpRequest& request);
+    bool hostAllowed(const std::string& hostHeader) const;
+    nlohmann::json schema() const;
+    experiments::HttpResponse render(const nlohmann::json& body);
+    nlohmann::json compare(const nlohmann::json& request, const TuneFrame& frame);
+    nlohmann::json stimulusList() const;
+    nlohmann::json openStimulus(const std::string& id) const;
+
+    TuneOptions options_;
+    int port_ = 0;
+    std::unique_ptr<RenderQueue> queue_;
+    std::unique_ptr<JobRunner> jobs_;
+    std::unique_ptr<experiments::HttpServer> http_;
+    struct PreparedReferences;
+    std::unique_ptr<PreparedReferences> references_;
+};
+
+// The configuration of a request body: {"scene": S, "overrides": ["key=value", ...]}; the scene must be one of
+// `scenes`. Throws RequestError (400) naming the field.
+TuneConfig configOf(const nlohmann::json& body, const std::vector<std::string>& scenes);
+
+} // namespace skinlab::tune
