@@ -457,3 +457,80 @@ TEST(ShippedSpecs, EveryStimulusResolves) {
     }
     EXPECT_GT(resolved, 80u);
 }
+
+// Presentation: [fixed] crop and magnification, [[crop]] per block (first match), every bad value refused naming
+// its key. Whether a crop lies inside the frame needs the render size (tests/stimuli/test_stimuli_build.cpp).
+TEST(StimulusPresentation, FixedAndPerBlockCropsAndMagnification) {
+    const std::string text = kBase + R"(
+[[crop]]
+view = "mid"
+crop = { x = 30, y = 10, width = 32, height = 40 }
+magnification = 2
+)";
+    std::string withFixed = text;
+    withFixed.replace(withFixed.find("render = { width = 96, height = 64 }"), 36,
+                      "render = { width = 96, height = 64 }\ncrop = { x = 20, y = 8, width = 40, height = 30 }\n"
+                      "magnification = 3");
+    const SetSpec s = spec(withFixed);
+    ASSERT_TRUE(s.presentation.crop.has_value());
+    EXPECT_EQ(*s.presentation.crop, (CropRect{20, 8, 40, 30}));
+    EXPECT_EQ(s.presentation.magnification, 3);
+    // crop and magnification are not scene keys: no override carries them.
+    for (const auto& p : s.fixed) EXPECT_EQ(p.key.rfind("render.", 0), 0u) << p.key;
+    const std::vector<Stimulus> all = expand(s);
+    ASSERT_EQ(all.size(), 6u);
+    EXPECT_EQ(all[0].presentation.crop, (CropRect{20, 8, 40, 30}));
+    EXPECT_EQ(all[0].presentation.magnification, 3);
+    EXPECT_EQ(all[0].presentation.cropWhere, "fixed.crop");
+    EXPECT_EQ(all[4].presentation.crop, (CropRect{30, 10, 32, 40}));
+    EXPECT_EQ(all[4].presentation.magnification, 2);
+    EXPECT_EQ(all[4].presentation.cropWhere, "crop[0].crop");
+    EXPECT_EQ(all[4].presentation.magnificationWhere, "crop[0].magnification");
+    for (const auto& o : all[4].overrides) EXPECT_EQ(o.find("crop"), std::string::npos) << o;
+    // Without any: the whole frame at magnification 1.
+    const std::vector<Stimulus> plain = expand(spec(kBase));
+    EXPECT_FALSE(plain[0].presentation.crop.has_value());
+    EXPECT_EQ(plain[0].presentation.magnification, 1);
+    // A reference is presented like its block.
+    const std::vector<Stimulus> refs = expand(spec(text + "[[reference]]\nmethod = \"reference\"\n"));
+    EXPECT_EQ(refs.back().id, "head-mid-reference");
+    EXPECT_EQ(refs.back().presentation.crop, (CropRect{30, 10, 32, 40}));
+}
+
+TEST(StimulusPresentation, BadCropsAndMagnificationsAreRefusedNamingTheKey) {
+    auto fixedError = [](const std::string& lines) {
+        std::string text = kBase;
+        text.replace(text.find("render = { width = 96, height = 64 }"), 36,
+                     "render = { width = 96, height = 64 }\n" + lines);
+        return errorOf([&] { spec(text); });
+    };
+    EXPECT_EQ(fixedError("crop = { x = 0, y = 0, width = 0, height = 10 }"),
+              "set.toml: fixed.crop.width: 0 is out of range [1, 16384]");
+    EXPECT_EQ(fixedError("crop = { x = 0, y = 0, width = 10, height = 0 }"),
+              "set.toml: fixed.crop.height: 0 is out of range [1, 16384]");
+    EXPECT_EQ(fixedError("crop = { x = -1, y = 0, width = 10, height = 10 }"),
+              "set.toml: fixed.crop.x: -1 is out of range [0, 16384]");
+    EXPECT_EQ(fixedError("crop = { x = 0, y = 0, width = 10 }"),
+              "set.toml: fixed.crop.height: missing (a crop has x, y, width, height in pixels)");
+    EXPECT_EQ(fixedError("crop = { x = 0, y = 0, width = 10, height = 10, w = 3 }"),
+              "set.toml: fixed.crop.w: unknown key (a crop has x, y, width, height)");
+    EXPECT_EQ(fixedError("crop = { x = 0, y = 0, width = 10.5, height = 10 }"),
+              "set.toml: fixed.crop.width: expected an integer, got float 10.5");
+    EXPECT_EQ(fixedError("crop = [0, 0, 10, 10]"),
+              "set.toml: fixed.crop: expected a table { x, y, width, height }, got array");
+    EXPECT_EQ(fixedError("magnification = 0"), "set.toml: fixed.magnification: 0 is out of range [1, 16]");
+    EXPECT_EQ(fixedError("magnification = 17"), "set.toml: fixed.magnification: 17 is out of range [1, 16]");
+    EXPECT_EQ(fixedError("magnification = 1.5"), "set.toml: fixed.magnification: expected an integer, got float 1.5");
+    // [[crop]]: only block factors select, with levels of them; something to apply.
+    EXPECT_EQ(
+        errorOf([&] { spec(kBase + "[[crop]]\nmethod = \"none\"\ncrop = { x = 0, y = 0, width = 8, height = 8 }\n"); }),
+        "set.toml: crop[0].method: 'method' is not a block factor of this set (a crop applies to whole blocks, "
+        "so that every condition of a block is presented alike)");
+    EXPECT_EQ(
+        errorOf([&] { spec(kBase + "[[crop]]\nview = \"far\"\ncrop = { x = 0, y = 0, width = 8, height = 8 }\n"); }),
+        "set.toml: crop[0].view: 'far' is not a level of factor 'view'");
+    EXPECT_EQ(errorOf([&] { spec(kBase + "[[crop]]\nview = \"mid\"\n"); }),
+              "set.toml: crop[0]: gives neither crop = { x, y, width, height } nor magnification");
+    EXPECT_EQ(errorOf([&] { spec(kBase + "[[crop]]\nview = \"mid\"\nmagnification = 99\n"); }),
+              "set.toml: crop[0].magnification: 99 is out of range [1, 16]");
+}
