@@ -128,7 +128,8 @@ std::vector<std::string> wrapCaption(const std::string& caption, int width, int 
 
 // How a block is presented, from its first stimulus' manifest entry: "crop 120,40 320×180 of 896×504, ×3 →
 // 960×540 px" (empty for a whole frame at magnification 1, or an entry without a presentation).
-std::string presentationText(const Block& block) {
+std::string presentationText(const Block& block, bool ascii = false) {
+    const std::string times = ascii ? "x" : "×", arrow = ascii ? "->" : "→";
     if (block.stimuli.empty() || !block.stimuli.front()->contains("presentation")) return "";
     const nlohmann::json& p = block.stimuli.front()->at("presentation");
     const nlohmann::json& c = p.at("crop");
@@ -137,11 +138,11 @@ std::string presentationText(const Block& block) {
     const bool whole = c.at("x").get<int>() == 0 && c.at("y").get<int>() == 0 && c.at("width") == r.at("width") &&
                        c.at("height") == r.at("height");
     if (whole && m == 1) return "";
-    std::string text = whole ? "whole " + valueText(r.at("width")) + "×" + valueText(r.at("height")) + " frame"
+    std::string text = whole ? "whole " + valueText(r.at("width")) + times + valueText(r.at("height")) + " frame"
                              : "crop " + valueText(c.at("x")) + "," + valueText(c.at("y")) + " " +
-                                   valueText(c.at("width")) + "×" + valueText(c.at("height")) + " of " +
-                                   valueText(r.at("width")) + "×" + valueText(r.at("height"));
-    text += ", ×" + std::to_string(m) + " → " + valueText(p.at("presented").at("width")) + "×" +
+                                   valueText(c.at("width")) + times + valueText(c.at("height")) + " of " +
+                                   valueText(r.at("width")) + times + valueText(r.at("height"));
+    text += ", " + times + std::to_string(m) + " " + arrow + " " + valueText(p.at("presented").at("width")) + times +
             valueText(p.at("presented").at("height")) + " px";
     return text;
 }
@@ -243,8 +244,9 @@ void writePng(const fs::path& path, const Manifest& manifest, const std::vector<
     };
     int y = margin;
     for (const auto& b : blocks) {
-        const std::string presented = presentationText(b);
-        label(margin, y + 15, (b.name.empty() ? manifest.set : b.name) + (presented.empty() ? "" : "  —  " + presented),
+        // The thumbnails' captions are drawn in ASCII (the font may lack × and →).
+        const std::string presented = presentationText(b, true);
+        label(margin, y + 15, (b.name.empty() ? manifest.set : b.name) + (presented.empty() ? "" : "  -  " + presented),
               text);
         y += titleHeight;
         const int thumbHeight = thumbHeightOf(b);
