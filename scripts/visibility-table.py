@@ -26,7 +26,8 @@ def load(folder):
 
 
 def factors_of(s):
-    return {k: v for k, v in s["factors"].items() if k not in FACTORIAL_IGNORED}
+    """The factors that tell the stimuli of a block apart (block-wide ones, like scene, view or a depth gap, left out)."""
+    return {k: v for k, v in s["factors"].items() if k not in FACTORIAL_IGNORED and k not in s.get("_block_keys", ())}
 
 
 def presented(s):
@@ -76,7 +77,7 @@ def base_of(s, block_stimuli):
 
 
 def main():
-    block_rows, effect_rows = [], []
+    block_rows, effect_rows, seen = [], [], set()
     for folder in sys.argv[1:]:
         m = load(folder)
         blocks = {}
@@ -84,6 +85,10 @@ def main():
             blocks.setdefault(s["block"], []).append(s)
         for block, stimuli in blocks.items():
             tests = [s for s in stimuli if not s["reference"] and "predicted" in s]
+            keys = {k for s in tests for k in s["factors"]}
+            constant = {k for k in keys if len({s["factors"].get(k) for s in tests}) == 1}
+            for s in tests:
+                s["_block_keys"] = constant
             if not tests:
                 continue
             best = max(tests, key=lambda s: s["predicted"]["jod"])
@@ -102,6 +107,9 @@ def main():
                 if name == "without follow-surface":
                     effect, name = -effect, "follow-surface"
                     s, base = base, s
+                if (block, s["id"], name) in seen:  # a pair found from both of its stimuli
+                    continue
+                seen.add((block, s["id"], name))
                 effect_rows.append(
                     f"| {m['set']} | {block} | {name} | {s['id']} | {s['predicted']['jod']:.2f} | "
                     f"{base['predicted']['jod']:.2f} | {effect:+.2f} | {'yes' if abs(effect) >= 0.3 else 'no'} |"
