@@ -13,7 +13,8 @@ Prints two Markdown tables:
 A stimulus is "extended" when its factors are those of another stimulus of the same block (same method) plus
 extension keys, or when it differs from one by sss.follow_surface (true = with). Without its extension keys, an
 include's stimulus keeps the scene's default (follow-surface on): its base is the stimulus with the same method
-and follow-surface on, or the one with no further factors."""
+and follow-surface on, or the one with no further factors; an extension with follow-surface off is compared with the
+same method with follow-surface off."""
 import json
 import sys
 
@@ -67,6 +68,14 @@ def base_of(s, block_stimuli):
         if g.get("sss.follow_surface", "true") != "true":
             continue
         candidates.append(o)
+    if extra and f.get("sss.follow_surface") == "false":
+        # an extension without follow-surface: its base is the same method without follow-surface
+        for o in block_stimuli:
+            g = factors_of(o)
+            if o is not s and g == {"method": method, "sss.follow_surface": "false"}:
+                name = " + ".join(f"{k.removeprefix('sss.')}={v}" for k, v in sorted(extra.items()))
+                return o, f"{name} (follow-surface off)"
+        return None, None
     if f.get("sss.follow_surface") == "false" and not extra:
         # an include without follow-surface: its base is the method with follow-surface (the default)
         return (candidates[0], "without follow-surface") if candidates else (None, None)

@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <gtest/gtest.h>
 
 namespace fs = std::filesystem;
@@ -399,7 +400,7 @@ bool needsHead(const std::string& file) {
 // swapped for builtin:head with a --set override so this runs without the scanned head.
 TEST(ShippedSpecs, ExpandToTheDocumentedCounts) {
     const fs::path dir = fs::path(SKINLAB_SOURCE_DIR) / "stimuli" / "specs";
-    const std::vector<std::pair<std::string, size_t>> expected = {{"demo.toml", 19},
+    const std::vector<std::pair<std::string, size_t>> expected = {{"demo.toml", 22},
                                                                   {"demo-scan.toml", 19},
                                                                   {"thesis-fig5.2-methods.toml", 18},
                                                                   {"thesis-fig3.16-halos.toml", 7},
@@ -431,8 +432,12 @@ TEST(ShippedSpecs, ExpandToTheDocumentedCounts) {
             EXPECT_NE(std::find(fixedKeys.begin(), fixedKeys.end(), key), fixedKeys.end()) << file << " " << key;
     }
     std::vector<Stimulus> demo = expand(readSetSpec(dir / "demo.toml"));
-    EXPECT_EQ(demo.front().id, "head-close-none");
-    EXPECT_EQ(demo.back().id, "head-mid-reference-reference_edge_mm-2.0"); // the references come last
+    EXPECT_EQ(demo.front().id, "halo-silhouette-none");
+    EXPECT_EQ(demo.back().id, "bleed-true-mask-patches-reference"); // the references come last
+    // Two blocks (the silhouette and the patches), each with one reference and its own presentation.
+    std::map<std::string, int> references;
+    for (const Stimulus& st : demo) references[st.block] += st.reference ? 1 : 0;
+    EXPECT_EQ(references, (std::map<std::string, int>{{"explicit", 1}, {"mid", 1}}));
 }
 
 // Every stimulus of every shipped spec resolves against the renderer's scene reader (methods, extension switches
