@@ -480,8 +480,9 @@ TEST(ShippedSpecs, EveryStimulusResolves) {
     for (const auto& entry : fs::directory_iterator(dir)) {
         if (entry.path().extension() != ".toml") continue;
         std::vector<std::string> overrides;
-        const fs::path path =
-            !haveHead && needsHead(entry.path().filename().string()) ? withoutHead(entry.path(), overrides) : entry.path();
+        const fs::path path = !haveHead && needsHead(entry.path().filename().string())
+                                  ? withoutHead(entry.path(), overrides)
+                                  : entry.path();
         BuildPlan plan;
         ASSERT_NO_THROW(plan = planBuild(path, overrides, std::nullopt, haveHead ? fs::path(assets) : fs::path()))
             << entry.path().filename();
