@@ -116,6 +116,12 @@ void runList(const StimuliOptions& o) {
     for (const auto& s : plan.selected) {
         std::string overrides;
         for (const auto& a : s.overrides) overrides += " " + a;
+        // Presentation (docs/stimuli.md): only when it is not the whole frame at magnification 1.
+        if (const auto& c = s.presentation.crop)
+            overrides += " crop=" + std::to_string(c->x) + "," + std::to_string(c->y) + "," + std::to_string(c->width) +
+                         "x" + std::to_string(c->height);
+        if (s.presentation.magnification != 1)
+            overrides += " magnification=" + std::to_string(s.presentation.magnification);
         std::printf("%s\t%s\t%s\tscene=%s%s\n", s.id.c_str(), s.block.c_str(), s.reference ? "reference" : "-",
                     s.factors.front().second.value.c_str(), overrides.c_str());
     }

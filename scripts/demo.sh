@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # The main job, end to end, on a fresh Debian 12 machine (no GPU needed):
 #   1. installs missing packages and builds (scripts/build.sh);
-#   2. builds the demo stimulus set (every SSS method and the main extensions) with a contact sheet: on the scanned
-#      head when its assets are found ($SKINLAB_ASSETS, default ../shared/assets: stimuli/specs/demo-scan.toml),
-#      otherwise on the built-in head (stimuli/specs/demo.toml), with a message saying so;
+#   2. builds the demo stimulus set (every SSS method and the main extensions, each in a view where it makes a
+#      visible difference, cropped and magnified) with a contact sheet: stimuli/specs/demo-scan.toml, with the scanned
+#      head's face, when its assets are found ($SKINLAB_ASSETS, default ../shared/assets), otherwise
+#      stimuli/specs/demo.toml (built-in scenes only), with a message saying so;
 #   3. creates a 2AFC study from it, estimates how many observers it needs for the differences ColorVideoVDP
 #      predicts (study plan), serves it on loopback and runs 20 simulated observers through the real HTTP API, who
 #      answer from those predictions (study simulate --truth predicted);
@@ -20,16 +21,18 @@ skinlab=./build/release/cli/skinlab
 out=out/demo
 mkdir -p "$out"
 
-# The scanned head shows skin as the methods change it best; the built-in head needs no files.
+# Each method and extension where it makes a visible difference (docs/stimuli.md, "Measured visibility"): a
+# silhouette over a backdrop at a depth gap and paint inside the skin mask (built-in scenes), and with the scanned
+# head its nose and lips.
 if [ -e "$SKINLAB_ASSETS/LeePerrySmith/LeePerrySmith.glb" ]; then
   stimuli_spec=stimuli/specs/demo-scan.toml design=experiments/designs/demo-scan.toml
-  echo "demo: the scanned head (assets in $SKINLAB_ASSETS)"
+  echo "demo: with the scanned head (assets in $SKINLAB_ASSETS)"
 else
   stimuli_spec=stimuli/specs/demo.toml design=experiments/designs/demo.toml
   echo "demo: scanned head not found (\$SKINLAB_ASSETS/LeePerrySmith/LeePerrySmith.glb, SKINLAB_ASSETS=$SKINLAB_ASSETS);" \
-    "using the built-in head builtin:head"
+    "built-in scenes only"
 fi
-# A rerun after a switch between the two heads starts from an empty stimulus folder (the set name differs).
+# A rerun after a switch between the two sets starts from an empty stimulus folder (a set folder holds one set).
 set_name=$(sed -n 's/^name = "\(.*\)"$/\1/p' "$stimuli_spec" | head -n 1)  # [set] comes first
 if [ -e "$out/stimuli/manifest.json" ] && ! grep -q "\"set\": *\"$set_name\"" "$out/stimuli/manifest.json"; then
   rm -rf "$out/stimuli"

@@ -119,7 +119,11 @@ for r in m["stimuli"]:
 
 for name in "${sets[@]}"; do
   echo "extensions-table: $name" >&2
-  "$skinlab" stimuli build "$root/stimuli/specs/extensions-$name.toml" -o "$out/$name" --progress lines
+  # The scores are of the whole frame: the specs' crop and magnification are how a study presents the sets.
+  size="width = 256, height = 256"
+  [ "$name" = head ] && size="width = 480, height = 270"
+  whole=(--set "fixed.crop={ x = 0, y = 0, $size }" --set fixed.magnification=1)
+  "$skinlab" stimuli build "$root/stimuli/specs/extensions-$name.toml" -o "$out/$name" --progress lines "${whole[@]}"
   "$skinlab" analyze metrics --stimuli "$out/$name" -o "$out/$name/metrics"
   if [ "${PATHTRACED:-1}" != 0 ]; then
     echo "extensions-table: $name: path-traced references" >&2

@@ -8,6 +8,7 @@
 #include "renderer/sss/sss_params.h"
 #include "stimuli/contact_sheet.h"
 #include "stimuli/prediction.h"
+#include "stimuli/presentation.h"
 #include "stimuli/output_folder.h"
 #include "stimuli/progress.h"
 
@@ -101,6 +102,19 @@ void validateLevels(const SetSpec& spec, const std::vector<Stimulus>& all, const
     }
 }
 
+std::pair<int, int> renderSize(const nlohmann::json& resolved) {
+    const nlohmann::json* width = findDotted(resolved, "render.width");
+    const nlohmann::json* height = findDotted(resolved, "render.height");
+    if (!width || !height || !width->is_number_integer() || !height->is_number_integer())
+        throw RuntimeError("the resolved scene has no render.width/render.height");
+    return {width->get<int>(), height->get<int>()};
+}
+
+nlohmann::json presentationOf(const Stimulus& stimulus, const nlohmann::json& resolved) {
+    auto [width, height] = renderSize(resolved);
+    return presentationJson(stimulus.presentation, width, height);
+}
+
 std::pair<int, int> imageSize(const fs::path& path) {
     auto input = OIIO::ImageInput::open(path.string());
     if (!input) throw RuntimeError(path.string() + ": cannot read the rendered image (" + OIIO::geterror() + ")");
@@ -119,6 +133,7 @@ nlohmann::json renderStimulus(renderer::Renderer& renderer, const Stimulus& stim
     request.exrPath = exr.tempPath();
     request.pngPath = png.tempPath();
     renderer::RenderResult result = renderer.render(request);
+    applyPresentation(exr.tempPath(), png.tempPath(), stimulus.presentation);
     exr.commit();
     png.commit();
     if (result.resolved != resolved)
@@ -128,7 +143,8 @@ nlohmann::json renderStimulus(renderer::Renderer& renderer, const Stimulus& stim
 
     nlohmann::json entry = stimulusEntry(stimulus, resolved);
     entry["sha256"] = {{"exr", sha256File(exr.finalPath())}, {"png", sha256File(png.finalPath())}};
-    auto [width, height] = imageSize(exr.finalPath());
+    // The presented size (what a participant sees at one image pixel per device pixel): the PNG's.
+    auto [width, height] = imageSize(png.finalPath());
     entry["width"] = width;
     entry["height"] = height;
     nlohmann::json timings =
@@ -139,8 +155,10 @@ nlohmann::json renderStimulus(renderer::Renderer& renderer, const Stimulus& stim
 }
 
 // An earlier entry is still valid when its resolved parameters are identical and both files are intact.
-bool entryStillValid(const nlohmann::json& entry, const nlohmann::json& resolved, const fs::path& dir) {
+bool entryStillValid(const nlohmann::json& entry, const nlohmann::json& resolved, const nlohmann::json& presentation,
+                     const fs::path& dir) {
     if (!entry.contains("resolved") || entry["resolved"] != resolved) return false;
+    if (!entry.contains("presentation") || entry["presentation"] != presentation) return false;
     try {
         for (const char* kind : {"exr", "png"}) {
             fs::path file = dir / entry.at("files").at(kind).get<std::string>();
@@ -169,7 +187,8 @@ nlohmann::json stimulusEntry(const Stimulus& stimulus, const nlohmann::json& res
             {"reference", stimulus.reference},
             {"scene", sceneValue},
             {"overrides", stimulus.overrides},
-            {"resolved", resolved}};
+            {"resolved", resolved},
+            {"presentation", presentationOf(stimulus, resolved)}};
 }
 
 BuildPlan planBuild(const fs::path& specPath, const std::vector<std::string>& specOverrides,
@@ -185,6 +204,8 @@ BuildPlan planBuild(const fs::path& specPath, const std::vector<std::string>& sp
         } catch (const InputError& e) {
             throw InputError(plan.spec.fileName + ": stimulus '" + stimulus.id + "': " + e.what());
         }
+        auto [width, height] = renderSize(plan.resolved.back());
+        checkPresentation(stimulus.presentation, width, height, plan.spec.fileName, stimulus.id);
     }
     return plan;
 }
@@ -206,7 +227,9 @@ BuildSummary buildSet(const BuildOptions& options) {
         for (size_t i = 0; i < plan.selected.size(); ++i) {
             const Stimulus& s = plan.selected[i];
             for (const auto& old : existing->stimuli) {
-                if (old.value("id", "") != s.id || !entryStillValid(old, plan.resolved[i], dir)) continue;
+                if (old.value("id", "") != s.id ||
+                    !entryStillValid(old, plan.resolved[i], presentationOf(s, plan.resolved[i]), dir))
+                    continue;
                 nlohmann::json entry = stimulusEntry(s, plan.resolved[i]);
                 for (const char* field : {"sha256", "width", "height", "timings_ms"}) entry[field] = old[field];
                 entries[s.id] = std::move(entry);

@@ -5,6 +5,7 @@
 #include "common/error.h"
 #include "renderer/renderer.h"
 #include "stimuli/build.h"
+#include "stimuli/presentation.h"
 
 #include <algorithm>
 #include <charconv>
@@ -356,6 +357,8 @@ CalibrationReport calibrateLevels(const CalibrateOptions& options) {
         request.pngPath = folder.path() / (name + ".png");
         renderer.render(request);
         ++renders;
+        // Presented like the set presents it (crop, magnification): the prediction is on what an observer sees.
+        applyPresentation(request.exrPath, request.pngPath, stimulus.presentation);
         cv::Mat image =
             metrics::loadMetricRender(request.pngPath, metrics::RenderRole::test, metrics::ImageEncoding::srgb).beauty;
         fs::remove(request.exrPath);

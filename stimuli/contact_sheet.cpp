@@ -126,6 +126,27 @@ std::vector<std::string> wrapCaption(const std::string& caption, int width, int 
     return lines;
 }
 
+// How a block is presented, from its first stimulus' manifest entry: "crop 120,40 320×180 of 896×504, ×3 →
+// 960×540 px" (empty for a whole frame at magnification 1, or an entry without a presentation).
+std::string presentationText(const Block& block, bool ascii = false) {
+    const std::string times = ascii ? "x" : "×", arrow = ascii ? "->" : "→";
+    if (block.stimuli.empty() || !block.stimuli.front()->contains("presentation")) return "";
+    const nlohmann::json& p = block.stimuli.front()->at("presentation");
+    const nlohmann::json& c = p.at("crop");
+    const nlohmann::json& r = p.at("render");
+    const int m = p.at("magnification").get<int>();
+    const bool whole = c.at("x").get<int>() == 0 && c.at("y").get<int>() == 0 && c.at("width") == r.at("width") &&
+                       c.at("height") == r.at("height");
+    if (whole && m == 1) return "";
+    std::string text = whole ? "whole " + valueText(r.at("width")) + times + valueText(r.at("height")) + " frame"
+                             : "crop " + valueText(c.at("x")) + "," + valueText(c.at("y")) + " " +
+                                   valueText(c.at("width")) + times + valueText(c.at("height")) + " of " +
+                                   valueText(r.at("width")) + times + valueText(r.at("height"));
+    text += ", " + times + std::to_string(m) + " " + arrow + " " + valueText(p.at("presented").at("width")) + times +
+            valueText(p.at("presented").at("height")) + " px";
+    return text;
+}
+
 std::string html(const Manifest& manifest, const std::vector<Block>& blocks) {
     std::ostringstream out;
     out << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>" << escapeHtml(manifest.set)
@@ -136,6 +157,7 @@ std::string html(const Manifest& manifest, const std::vector<Block>& blocks) {
         << "figure{margin:0;background:#2c2c2c;padding:6px;border:2px solid transparent}\n"
         << "figure.reference{border-color:#c90}\n"
         << "img{display:block;max-width:320px;height:auto}\n"
+        << ".presentation{color:#aaa;font-size:13px}\n"
         << "figcaption{font-size:12px;margin-top:4px}\n.id{font-family:monospace;color:#aaa}\n"
         << "table{border-collapse:collapse}td{padding:0 .6em 0 0;vertical-align:top}\n"
         << "</style>\n</head>\n<body>\n<h1>Stimulus set " << escapeHtml(manifest.set) << "</h1>\n";
@@ -148,7 +170,10 @@ std::string html(const Manifest& manifest, const std::vector<Block>& blocks) {
         fixed += (fixed.empty() ? "" : ", ") + it.key() + " = " + valueText(it.value());
     out << escapeHtml(fixed.empty() ? "(scene defaults)" : fixed) << ".</p>\n";
     for (const auto& block : blocks) {
-        out << "<h2>" << escapeHtml(block.name.empty() ? "(all)" : block.name) << "</h2>\n<div class=\"grid\">\n";
+        const std::string presented = presentationText(block);
+        out << "<h2>" << escapeHtml(block.name.empty() ? "(all)" : block.name) << "</h2>\n";
+        if (!presented.empty()) out << "<p class=\"presentation\">Presented: " << escapeHtml(presented) << "</p>\n";
+        out << "<div class=\"grid\">\n";
         for (const auto* s : block.stimuli) {
             bool reference = s->at("reference").get<bool>();
             std::string png = s->at("files").at("png").get<std::string>();
@@ -182,10 +207,13 @@ OIIO::ImageBuf thumbnail(const fs::path& png, int width, int height) {
 void writePng(const fs::path& path, const Manifest& manifest, const std::vector<Block>& blocks, int thumbWidth,
               const fs::path& dir) {
     if (manifest.stimuli.empty()) return;
-    const auto& first = manifest.stimuli.front();
-    int imageWidth = std::max(1, first.at("width").get<int>());
-    int imageHeight = std::max(1, first.at("height").get<int>());
-    const int thumbHeight = std::max(1, static_cast<int>(std::lround(double(thumbWidth) * imageHeight / imageWidth)));
+    // Each block's thumbnails keep its stimuli's aspect (blocks may be cropped differently).
+    auto thumbHeightOf = [&](const Block& b) {
+        const auto& first = *b.stimuli.front();
+        const int imageWidth = std::max(1, first.at("width").get<int>());
+        const int imageHeight = std::max(1, first.at("height").get<int>());
+        return std::max(1, static_cast<int>(std::lround(double(thumbWidth) * imageHeight / imageWidth)));
+    };
     // Captions wrap at word boundaries to the thumbnail's width, up to kCaptionLines lines (the last one cut).
     constexpr int margin = 8, titleHeight = 22, lineHeight = 16, kCaptionLines = 3, maxColumns = 8;
     constexpr int captionHeight = lineHeight * kCaptionLines + 2;
@@ -194,7 +222,7 @@ void writePng(const fs::path& path, const Manifest& manifest, const std::vector<
     int height = margin;
     for (const auto& b : blocks) {
         size_t rows = (b.stimuli.size() + maxColumns - 1) / maxColumns;
-        height += titleHeight + static_cast<int>(rows) * (thumbHeight + captionHeight + margin);
+        height += titleHeight + static_cast<int>(rows) * (thumbHeightOf(b) + captionHeight + margin);
     }
     const int width = margin + static_cast<int>(columns) * (thumbWidth + margin);
     OIIO::ImageBuf sheet(OIIO::ImageSpec(width, height, 3, OIIO::TypeDesc::FLOAT));
@@ -216,8 +244,12 @@ void writePng(const fs::path& path, const Manifest& manifest, const std::vector<
     };
     int y = margin;
     for (const auto& b : blocks) {
-        label(margin, y + 15, b.name.empty() ? manifest.set : b.name, text);
+        // The thumbnails' captions are drawn in ASCII (the font may lack × and →).
+        const std::string presented = presentationText(b, true);
+        label(margin, y + 15, (b.name.empty() ? manifest.set : b.name) + (presented.empty() ? "" : "  -  " + presented),
+              text);
         y += titleHeight;
+        const int thumbHeight = thumbHeightOf(b);
         std::vector<std::string> varying = varyingFactors(b);
         for (size_t i = 0; i < b.stimuli.size(); ++i) {
             const auto& s = *b.stimuli[i];

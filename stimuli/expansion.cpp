@@ -170,6 +170,19 @@ private:
         s.factors = combination;
         s.id = makeId(combination, reference);
         s.block = makeBlock(combination);
+        s.presentation = spec_.presentation;
+        for (const auto& rule : spec_.crops) {
+            if (!matches(combination, rule.selection)) continue;
+            if (rule.crop) {
+                s.presentation.crop = rule.crop;
+                s.presentation.cropWhere = rule.selection.where + ".crop";
+            }
+            if (rule.magnification) {
+                s.presentation.magnification = *rule.magnification;
+                s.presentation.magnificationWhere = rule.selection.where + ".magnification";
+            }
+            break;
+        }
         const renderer::sss::MethodInfo* method = methodOf(combination);
         // [fixed] holds for the whole set: an [sss] key there applies to the stimuli whose method reads it (e.g.
         // sss.samples to the screen-space methods, not to the object-space reference).

@@ -18,6 +18,7 @@ struct Stimulus {
     std::vector<std::pair<std::string, Level>> factors; // factor name → level, in factor order (scene first)
     std::vector<std::string> overrides;                 // "key=value": fixed parameters, then the levels
     size_t index = 0;                                   // position in the full expansion (shards keep it)
+    Presentation presentation; // crop and magnification: the first matching [[crop]], else [fixed]
 };
 
 // Expands the spec. Throws InputError ("SPEC: KEY: message") for an empty factorial, clashing ids, or an

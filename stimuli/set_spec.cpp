@@ -104,6 +104,7 @@ public:
         spec.references = readSelections("reference", spec, false);
 
         checkTemplateAndBlocks(spec, set, blockGiven);
+        readCrops(spec);
         reader_.finish();
         return spec;
     }
@@ -157,12 +158,55 @@ private:
         return level;
     }
 
+    // An integer in [min, max] at `field` (a full key path for messages).
+    std::int64_t presentationInteger(const toml::node& node, const std::string& field, std::int64_t min,
+                                     std::int64_t max) {
+        auto* value = node.as_integer();
+        if (!value) throwInput(fileName_, field, "expected an integer, got " + describeNode(node));
+        const std::int64_t v = value->get();
+        if (v < min || v > max)
+            throwInput(fileName_, field,
+                       std::to_string(v) + " is out of range [" + std::to_string(min) + ", " + std::to_string(max) +
+                           "]");
+        return v;
+    }
+
+    // crop = { x, y, width, height }: pixels of the render; whether it lies inside the frame is checked against
+    // the resolved render size (build.cpp), since the size may come from the scene.
+    CropRect readCrop(const toml::node& node, const std::string& field) {
+        auto* table = node.as_table();
+        if (!table) throwInput(fileName_, field, "expected a table { x, y, width, height }, got " + describeNode(node));
+        for (auto&& [k, v] : *table) {
+            const std::string key(k.str());
+            if (key != "x" && key != "y" && key != "width" && key != "height")
+                throwInput(fileName_, field + "." + key, "unknown key (a crop has x, y, width, height)");
+        }
+        CropRect crop;
+        const std::pair<const char*, int*> parts[] = {
+            {"x", &crop.x}, {"y", &crop.y}, {"width", &crop.width}, {"height", &crop.height}};
+        for (const auto& [key, target] : parts) {
+            const toml::node* value = table->get(key);
+            if (!value) throwInput(fileName_, field + "." + key, "missing (a crop has x, y, width, height in pixels)");
+            const bool size = key[0] == 'w' || key[0] == 'h';
+            *target = static_cast<int>(presentationInteger(*value, field + "." + key, size ? 1 : 0, 16384));
+        }
+        return crop;
+    }
+
     void readFixed(SetSpec& spec) {
         const toml::node* fixed = reader_.raw("fixed");
         if (!fixed) return;
         if (!fixed->is_table()) reader_.fail("fixed", "expected a table, got " + describeNode(*fixed));
+        // Presentation keys (applied to the rendered image, not scene keys).
+        toml::table scene = *fixed->as_table();
+        if (const toml::node* crop = scene.get("crop")) spec.presentation.crop = readCrop(*crop, "fixed.crop");
+        if (const toml::node* m = scene.get("magnification"))
+            spec.presentation.magnification =
+                static_cast<int>(presentationInteger(*m, "fixed.magnification", 1, kMaxMagnification));
+        scene.erase("crop");
+        scene.erase("magnification");
         std::vector<std::pair<std::string, const toml::node*>> leaves;
-        flatten(*fixed->as_table(), "", leaves);
+        flatten(scene, "", leaves);
         for (auto& [key, node] : leaves) {
             if (key == "scene") reader_.fail("fixed.scene", "the scene is set by set.scene or a factor, not [fixed]");
             FixedParameter parameter;
@@ -307,6 +351,58 @@ private:
             return valueLevel(node, factor->key, factor->levels.size(), reader, name);
         }
         return valueLevel(node, sceneKeyOf(name), 0, reader, name);
+    }
+
+    // [[crop]]: block-factor levels (one level or a list each) plus crop = {...} and/or magnification.
+    void readCrops(SetSpec& spec) {
+        const toml::node* node = reader_.raw("crop");
+        if (!node) return;
+        auto* array = node->as_array();
+        if (!array || !array->is_array_of_tables())
+            reader_.fail("crop", "expected [[crop]] tables (block levels with crop = { x, y, width, height })");
+        for (size_t i = 0; i < array->size(); ++i) {
+            const toml::table& table = *array->get(i)->as_table();
+            const std::string where = "crop[" + std::to_string(i) + "]";
+            CropRule rule;
+            rule.selection.where = where;
+            for (auto&& [k, v] : table) {
+                const std::string name(k.str());
+                const std::string field = where + "." + name;
+                if (name == "crop") {
+                    rule.crop = readCrop(v, field);
+                    continue;
+                }
+                if (name == "magnification") {
+                    rule.magnification = static_cast<int>(presentationInteger(v, field, 1, kMaxMagnification));
+                    continue;
+                }
+                const Factor* factor = nullptr;
+                for (const auto& f : spec.factors)
+                    if (f.name == name || (!f.key.empty() && f.key == sceneKeyOf(name))) factor = &f;
+                const bool block = factor && std::find(spec.blockFactors.begin(), spec.blockFactors.end(),
+                                                       factor->name) != spec.blockFactors.end();
+                if (!block)
+                    throwInput(fileName_, field,
+                               "'" + name +
+                                   "' is not a block factor of this set (a crop applies to whole blocks, so that "
+                                   "every condition of a block is presented alike)");
+                std::vector<const toml::node*> values;
+                if (auto* a = v.as_array()) {
+                    if (a->empty()) throwInput(fileName_, field, "no levels given");
+                    for (size_t j = 0; j < a->size(); ++j) values.push_back(a->get(j));
+                } else {
+                    values.push_back(&v);
+                }
+                SpecReader reader(table, fileName_, where);
+                std::vector<Level> levels;
+                for (const toml::node* value : values)
+                    levels.push_back(selectionLevel(*value, factor, name, reader, true));
+                rule.selection.levels.emplace_back(factor->name, std::move(levels));
+            }
+            if (!rule.crop && !rule.magnification)
+                throwInput(fileName_, where, "gives neither crop = { x, y, width, height } nor magnification");
+            spec.crops.push_back(std::move(rule));
+        }
     }
 
     void checkTemplateAndBlocks(SetSpec& spec, const SpecReader& set, bool blockGiven) {

@@ -41,6 +41,34 @@ struct FixedParameter {
     Level level;
 };
 
+inline constexpr int kMaxMagnification = 16;
+
+// A crop of the rendered frame, in pixels of the render (x, y: top-left corner; y counts rows from the top).
+struct CropRect {
+    int x = 0;
+    int y = 0;
+    int width = 0;
+    int height = 0;
+    bool operator==(const CropRect&) const = default;
+};
+
+// How the stimuli are presented: the part of the render shown and its integer nearest-neighbour magnification
+// (each render pixel becomes magnification × magnification display pixels at one image pixel per device pixel).
+// `where` names the spec key each value came from, for messages ("fixed.crop", "crop[1]").
+struct Presentation {
+    std::optional<CropRect> crop; // none: the whole frame
+    int magnification = 1;
+    std::string cropWhere = "fixed.crop";
+    std::string magnificationWhere = "fixed.magnification";
+};
+
+// A [[crop]] entry: the crop (and optionally the magnification) of the stimuli whose block-factor levels match.
+struct CropRule {
+    Selection selection; // block factors only, so that every stimulus of a block is presented alike
+    std::optional<CropRect> crop;
+    std::optional<int> magnification;
+};
+
 struct SetSpec {
     std::filesystem::path file;       // the spec file (messages, relative scene paths)
     std::string fileName;             // as given on the command line, for messages
@@ -49,7 +77,9 @@ struct SetSpec {
     std::optional<std::int64_t> seed; // set.seed: recorded in the manifest for downstream use
     std::string idTemplate;           // set.id: "{scene}-{view}-{method}"; empty: every factor's label joined by '-'
     std::vector<std::string> blockFactors; // set.block: factors naming a block (default scene, view)
-    std::vector<FixedParameter> fixed;     // [fixed], flattened to dotted keys (sorted)
+    std::vector<FixedParameter> fixed;     // [fixed], flattened to dotted keys (sorted), without crop/magnification
+    Presentation presentation;             // fixed.crop and fixed.magnification (applied after rendering)
+    std::vector<CropRule> crops;           // [[crop]]: per block (view, scene, ...) crops; the first match wins
     std::vector<Factor> factors;           // "scene" first, then [[factor]] in the order written
     std::vector<Selection> excludes;       // [[exclude]]
     std::vector<Selection> includes;       // [[include]]

@@ -1,4 +1,4 @@
-// Stimulus-set throughput: builds a set spec (default stimuli/specs/demo.toml, 1280×720) into a fresh folder
+// Stimulus-set throughput: builds a set spec (default stimuli/specs/demo.toml) into a fresh folder
 // and reports stimuli per minute, then rebuilds it unchanged (nothing rendered: the cost of the resume check,
 // which re-hashes every file). Prints a table and writes bench_stimuli.csv into the output folder.
 //   bench_stimuli [--spec SPEC] [--jobs N] [-o DIR] [--assets DIR] [--set key=value ...]

@@ -1,4 +1,4 @@
-// Browser test of the window-size check: a study of 896×504 stimuli (the demo's size) fits a 1920×1080 display at
+// Browser test of the window-size check: a study of 896×504 stimuli fits a 1920×1080 display at
 // one image pixel per device pixel, so Chromium at 1920×1080 goes straight to consent and shows trials 1:1; in a
 // 1366×768 window the page says the window is too small, with the size needed, before consent: nobody joins and
 // nothing is stored until the window is large enough. And `study create` refuses a design whose stimuli cannot fit

@@ -137,6 +137,53 @@ TEST(StudyCli, CreateStatusExportAndTheirErrors) {
     EXPECT_EQ(missing.err, "skinlab: error: " + (files.folder.path() / "nope.db").string() + ": no such study file\n");
 }
 
+// A set built by the real renderer with a crop and a magnification: `study create` checks the presented images
+// (the crop magnified, what a participant sees), not the render, against the design's viewport.
+TEST(StudyCli, CreateRefusesPresentedStimuliLargerThanTheViewport) {
+    TemporaryFolder folder{"cli-magnified"};
+    // 40 × 30 renders; a 20 × 15 crop magnified 16× is presented at 320 × 240, two side by side 640 px wide.
+    const fs::path spec = writeText(folder.path(), "tiny.toml", R"(
+[set]
+name = "tiny"
+scene = "builtin:head"
+block = ["view"]
+[fixed]
+render = { width = 40, height = 30, exposure_ev = 0.0 }
+tone_map = { operator = "filmic" }
+shadow = { resolution = 256 }
+camera = { view = "close" }
+crop = { x = 10, y = 8, width = 20, height = 15 }
+magnification = 16
+[[factor]]
+name = "method"
+levels = ["none", "separable"]
+)");
+    const fs::path stimuli = folder.path() / "stimuli";
+    CommandResult built = runSkinlab({"stimuli", "build", spec.string(), "-o", stimuli.string()});
+    ASSERT_EQ(built.exitCode, 0) << built.err;
+    const fs::path design = writeText(folder.path(), "design.toml", std::string(kDesign) + R"(
+[display]
+viewport_width = 500
+viewport_height = 400
+)");
+    // The renders (40 px wide, a pair 80 px) fit 500 × 400; the presented pair (640 px) does not.
+    const fs::path database = folder.path() / "study.db";
+    CommandResult refused = runSkinlab(
+        {"study", "create", "--stimuli", stimuli.string(), "--design", design.string(), "-o", database.string()});
+    EXPECT_EQ(refused.exitCode, 2) << refused.out;
+    EXPECT_EQ(refused.err.rfind("skinlab: error: " + design.string() + ": display.viewport_width: the trials need ", 0),
+              0u)
+        << refused.err;
+    EXPECT_NE(refused.err.find("640 px of images side by side"), std::string::npos) << refused.err;
+    EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
+    EXPECT_FALSE(fs::exists(database));
+    // A viewport the presented pair fits is accepted.
+    CommandResult accepted = runSkinlab({"study", "create", "--stimuli", stimuli.string(), "--design", design.string(),
+                                         "-o", database.string(), "--set", "display.viewport_width=1000"});
+    EXPECT_EQ(accepted.exitCode, 0) << accepted.err;
+    EXPECT_TRUE(fs::exists(database));
+}
+
 TEST(StudyCli, KillNineDuringASessionLosesAndDuplicatesNothing) {
     StudyFiles files;
     ASSERT_EQ(files.create(), 0);

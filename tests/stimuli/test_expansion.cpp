@@ -13,7 +13,10 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <map>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 namespace fs = std::filesystem;
 using namespace skinlab::stimuli;
@@ -394,14 +397,39 @@ bool needsHead(const std::string& file) {
     return file.rfind("thesis-", 0) == 0 || file == "extensions-head.toml" || file == "demo-scan.toml" ||
            file == "eevee-methods-scan.toml";
 }
+
+// The spec to read without the scanned head, and its overrides: set.scene=builtin:head where the head is the set's
+// scene; where it is a level of the scene factor (demo-scan.toml), a copy of the spec in a temporary folder with
+// that level builtin:head and the other scene files' paths absolute.
+fs::path headlessFolder() { return fs::temp_directory_path() / ("skinlab-headless-" + std::to_string(::getpid())); }
+
+fs::path withoutHead(const fs::path& spec, std::vector<std::string>& overrides) {
+    std::ifstream in(spec);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string head = "\"../../renderer/scenes/lee-perry-smith.toml\"";
+    const size_t at = text.find("levels = [" + head);
+    if (at == std::string::npos) {
+        overrides.push_back("set.scene=builtin:head");
+        return spec;
+    }
+    text.replace(at + 10, head.size(), "\"builtin:head\"");
+    const std::string relative = "\"../../renderer/";
+    const std::string absolute = "\"" + (fs::path(SKINLAB_SOURCE_DIR) / "renderer").string() + "/";
+    for (size_t p = text.find(relative); p != std::string::npos; p = text.find(relative, p + absolute.size()))
+        text.replace(p, relative.size(), absolute);
+    const fs::path copy = headlessFolder();
+    fs::create_directories(copy);
+    std::ofstream(copy / spec.filename()) << text;
+    return copy / spec.filename();
+}
 } // namespace
 
 // The shipped specs parse and expand to the documented counts (docs/stimuli.md). The thesis specs' scene is
 // swapped for builtin:head with a --set override so this runs without the scanned head.
 TEST(ShippedSpecs, ExpandToTheDocumentedCounts) {
     const fs::path dir = fs::path(SKINLAB_SOURCE_DIR) / "stimuli" / "specs";
-    const std::vector<std::pair<std::string, size_t>> expected = {{"demo.toml", 19},
-                                                                  {"demo-scan.toml", 19},
+    const std::vector<std::pair<std::string, size_t>> expected = {{"demo.toml", 22},
+                                                                  {"demo-scan.toml", 28},
                                                                   {"thesis-fig5.2-methods.toml", 18},
                                                                   {"thesis-fig3.16-halos.toml", 7},
                                                                   {"thesis-fig3.17-bleeding.toml", 7},
@@ -419,8 +447,8 @@ TEST(ShippedSpecs, ExpandToTheDocumentedCounts) {
     EXPECT_EQ(specs, expected.size()) << "a spec was added or removed: update this test and docs/stimuli.md";
     for (const auto& [file, count] : expected) {
         std::vector<std::string> overrides;
-        if (needsHead(file)) overrides.push_back("set.scene=builtin:head");
-        SetSpec s = readSetSpec(dir / file, overrides);
+        const fs::path path = needsHead(file) ? withoutHead(dir / file, overrides) : dir / file;
+        SetSpec s = readSetSpec(path, overrides);
         std::vector<Stimulus> all = expand(s);
         EXPECT_EQ(all.size(), count) << file;
         for (const auto& st : all) {
@@ -434,8 +462,13 @@ TEST(ShippedSpecs, ExpandToTheDocumentedCounts) {
             EXPECT_NE(std::find(fixedKeys.begin(), fixedKeys.end(), key), fixedKeys.end()) << file << " " << key;
     }
     std::vector<Stimulus> demo = expand(readSetSpec(dir / "demo.toml"));
-    EXPECT_EQ(demo.front().id, "head-close-none");
-    EXPECT_EQ(demo.back().id, "head-mid-reference-reference_edge_mm-2.0"); // the references come last
+    fs::remove_all(headlessFolder());
+    EXPECT_EQ(demo.front().id, "halo-silhouette-none");
+    EXPECT_EQ(demo.back().id, "bleed-true-mask-patches-reference"); // the references come last
+    // Two blocks (the silhouette and the patches), each with one reference and its own presentation.
+    std::map<std::string, int> references;
+    for (const Stimulus& st : demo) references[st.block] += st.reference ? 1 : 0;
+    EXPECT_EQ(references, (std::map<std::string, int>{{"explicit", 1}, {"mid", 1}}));
 }
 
 // Every stimulus of every shipped spec resolves against the renderer's scene reader (methods, extension switches
@@ -450,13 +483,92 @@ TEST(ShippedSpecs, EveryStimulusResolves) {
     for (const auto& entry : fs::directory_iterator(dir)) {
         if (entry.path().extension() != ".toml") continue;
         std::vector<std::string> overrides;
-        if (!haveHead && needsHead(entry.path().filename().string())) overrides.push_back("set.scene=builtin:head");
+        const fs::path path = !haveHead && needsHead(entry.path().filename().string())
+                                  ? withoutHead(entry.path(), overrides)
+                                  : entry.path();
         BuildPlan plan;
-        ASSERT_NO_THROW(plan =
-                            planBuild(entry.path(), overrides, std::nullopt, haveHead ? fs::path(assets) : fs::path()))
+        ASSERT_NO_THROW(plan = planBuild(path, overrides, std::nullopt, haveHead ? fs::path(assets) : fs::path()))
             << entry.path().filename();
         EXPECT_EQ(plan.resolved.size(), plan.all.size()) << entry.path().filename();
         resolved += plan.resolved.size();
     }
+    fs::remove_all(headlessFolder());
     EXPECT_GT(resolved, 80u);
+}
+
+// Presentation: [fixed] crop and magnification, [[crop]] per block (first match), every bad value refused naming
+// its key. Whether a crop lies inside the frame needs the render size (tests/stimuli/test_stimuli_build.cpp).
+TEST(StimulusPresentation, FixedAndPerBlockCropsAndMagnification) {
+    const std::string text = kBase + R"(
+[[crop]]
+view = "mid"
+crop = { x = 30, y = 10, width = 32, height = 40 }
+magnification = 2
+)";
+    std::string withFixed = text;
+    withFixed.replace(withFixed.find("render = { width = 96, height = 64 }"), 36,
+                      "render = { width = 96, height = 64 }\ncrop = { x = 20, y = 8, width = 40, height = 30 }\n"
+                      "magnification = 3");
+    const SetSpec s = spec(withFixed);
+    ASSERT_TRUE(s.presentation.crop.has_value());
+    EXPECT_EQ(*s.presentation.crop, (CropRect{20, 8, 40, 30}));
+    EXPECT_EQ(s.presentation.magnification, 3);
+    // crop and magnification are not scene keys: no override carries them.
+    for (const auto& p : s.fixed) EXPECT_EQ(p.key.rfind("render.", 0), 0u) << p.key;
+    const std::vector<Stimulus> all = expand(s);
+    ASSERT_EQ(all.size(), 6u);
+    EXPECT_EQ(all[0].presentation.crop, (CropRect{20, 8, 40, 30}));
+    EXPECT_EQ(all[0].presentation.magnification, 3);
+    EXPECT_EQ(all[0].presentation.cropWhere, "fixed.crop");
+    EXPECT_EQ(all[4].presentation.crop, (CropRect{30, 10, 32, 40}));
+    EXPECT_EQ(all[4].presentation.magnification, 2);
+    EXPECT_EQ(all[4].presentation.cropWhere, "crop[0].crop");
+    EXPECT_EQ(all[4].presentation.magnificationWhere, "crop[0].magnification");
+    for (const auto& o : all[4].overrides) EXPECT_EQ(o.find("crop"), std::string::npos) << o;
+    // Without any: the whole frame at magnification 1.
+    const std::vector<Stimulus> plain = expand(spec(kBase));
+    EXPECT_FALSE(plain[0].presentation.crop.has_value());
+    EXPECT_EQ(plain[0].presentation.magnification, 1);
+    // A reference is presented like its block.
+    const std::vector<Stimulus> refs = expand(spec(text + "[[reference]]\nmethod = \"reference\"\n"));
+    EXPECT_EQ(refs.back().id, "head-mid-reference");
+    EXPECT_EQ(refs.back().presentation.crop, (CropRect{30, 10, 32, 40}));
+}
+
+TEST(StimulusPresentation, BadCropsAndMagnificationsAreRefusedNamingTheKey) {
+    auto fixedError = [](const std::string& lines) {
+        std::string text = kBase;
+        text.replace(text.find("render = { width = 96, height = 64 }"), 36,
+                     "render = { width = 96, height = 64 }\n" + lines);
+        return errorOf([&] { spec(text); });
+    };
+    EXPECT_EQ(fixedError("crop = { x = 0, y = 0, width = 0, height = 10 }"),
+              "set.toml: fixed.crop.width: 0 is out of range [1, 16384]");
+    EXPECT_EQ(fixedError("crop = { x = 0, y = 0, width = 10, height = 0 }"),
+              "set.toml: fixed.crop.height: 0 is out of range [1, 16384]");
+    EXPECT_EQ(fixedError("crop = { x = -1, y = 0, width = 10, height = 10 }"),
+              "set.toml: fixed.crop.x: -1 is out of range [0, 16384]");
+    EXPECT_EQ(fixedError("crop = { x = 0, y = 0, width = 10 }"),
+              "set.toml: fixed.crop.height: missing (a crop has x, y, width, height in pixels)");
+    EXPECT_EQ(fixedError("crop = { x = 0, y = 0, width = 10, height = 10, w = 3 }"),
+              "set.toml: fixed.crop.w: unknown key (a crop has x, y, width, height)");
+    EXPECT_EQ(fixedError("crop = { x = 0, y = 0, width = 10.5, height = 10 }"),
+              "set.toml: fixed.crop.width: expected an integer, got float 10.5");
+    EXPECT_EQ(fixedError("crop = [0, 0, 10, 10]"),
+              "set.toml: fixed.crop: expected a table { x, y, width, height }, got array");
+    EXPECT_EQ(fixedError("magnification = 0"), "set.toml: fixed.magnification: 0 is out of range [1, 16]");
+    EXPECT_EQ(fixedError("magnification = 17"), "set.toml: fixed.magnification: 17 is out of range [1, 16]");
+    EXPECT_EQ(fixedError("magnification = 1.5"), "set.toml: fixed.magnification: expected an integer, got float 1.5");
+    // [[crop]]: only block factors select, with levels of them; something to apply.
+    EXPECT_EQ(
+        errorOf([&] { spec(kBase + "[[crop]]\nmethod = \"none\"\ncrop = { x = 0, y = 0, width = 8, height = 8 }\n"); }),
+        "set.toml: crop[0].method: 'method' is not a block factor of this set (a crop applies to whole blocks, "
+        "so that every condition of a block is presented alike)");
+    EXPECT_EQ(
+        errorOf([&] { spec(kBase + "[[crop]]\nview = \"far\"\ncrop = { x = 0, y = 0, width = 8, height = 8 }\n"); }),
+        "set.toml: crop[0].view: 'far' is not a level of factor 'view'");
+    EXPECT_EQ(errorOf([&] { spec(kBase + "[[crop]]\nview = \"mid\"\n"); }),
+              "set.toml: crop[0]: gives neither crop = { x, y, width, height } nor magnification");
+    EXPECT_EQ(errorOf([&] { spec(kBase + "[[crop]]\nview = \"mid\"\nmagnification = 99\n"); }),
+              "set.toml: crop[0].magnification: 99 is out of range [1, 16]");
 }

@@ -8,6 +8,8 @@
 //  - bad input that needs the scene spec (unknown factor key or level, missing asset, folder of another set)
 //    fails with one line before anything is rendered.
 // Skips with a message when no EGL platform works.
+#include "analysis/metrics/cvvdp.h"
+#include "analysis/metrics/metric_render.h"
 #include "common/hash.h"
 #include "renderer/renderer.h"
 #include "stimuli/manifest.h"
@@ -424,6 +426,151 @@ TEST_F(StimuliBuild, BadInputFailsBeforeRendering) {
 }
 
 } // namespace
+
+// Presentation: [fixed] crop and magnification and a per-view [[crop]] are applied after rendering. The stimulus
+// EXR is exactly the crop of the full render (every channel), the PNG exactly its crop magnified by nearest
+// neighbour; the manifest records crop, magnification and presented size; the predicted JOD is ColorVideoVDP on the
+// presented PNGs; a crop outside the frame is refused naming its key.
+namespace {
+
+struct Pixels {
+    int width = 0, height = 0, channels = 0;
+    std::vector<float> data;
+    float at(int x, int y, int c) const {
+        return data[(static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x)) *
+                        static_cast<size_t>(channels) +
+                    static_cast<size_t>(c)];
+    }
+};
+
+Pixels readPixels(const fs::path& path) {
+    auto input = OIIO::ImageInput::open(path.string());
+    EXPECT_TRUE(input) << path;
+    Pixels p;
+    if (!input) return p;
+    p.width = input->spec().width;
+    p.height = input->spec().height;
+    p.channels = input->spec().nchannels;
+    p.data.resize(static_cast<size_t>(p.width) * static_cast<size_t>(p.height) * static_cast<size_t>(p.channels));
+    EXPECT_TRUE(input->read_image(0, 0, 0, p.channels, OIIO::TypeDesc::FLOAT, p.data.data())) << path;
+    return p;
+}
+
+// True when `shown` is the crop (x, y, w, h) of `full` magnified m times (nearest neighbour), bit for bit.
+::testing::AssertionResult isCropOf(const Pixels& shown, const Pixels& full, int x, int y, int w, int h, int m) {
+    if (shown.width != w * m || shown.height != h * m || shown.channels != full.channels)
+        return ::testing::AssertionFailure() << "size " << shown.width << "×" << shown.height << "×" << shown.channels
+                                             << ", expected " << w * m << "×" << h * m << "×" << full.channels;
+    for (int j = 0; j < shown.height; ++j)
+        for (int i = 0; i < shown.width; ++i)
+            for (int c = 0; c < shown.channels; ++c)
+                if (shown.at(i, j, c) != full.at(x + i / m, y + j / m, c))
+                    return ::testing::AssertionFailure()
+                           << "pixel (" << i << ", " << j << ") channel " << c << ": " << shown.at(i, j, c) << " vs "
+                           << full.at(x + i / m, y + j / m, c);
+    return ::testing::AssertionSuccess();
+}
+
+std::string presentedSpec(const std::string& name, bool crop) {
+    std::ostringstream s;
+    s << "[set]\nname = \"" << name << "\"\nscene = \"builtin:head\"\n\n"
+      << "[fixed]\nrender = { width = 96, height = 64 }\nshadow = { resolution = 256 }\nsss = { method = \"none\" }\n";
+    if (crop) s << "crop = { x = 20, y = 8, width = 40, height = 30 }\nmagnification = 3\n";
+    s << "\n[[factor]]\nname = \"view\"\nlevels = [\"close\", \"mid\"]\n\n"
+      << "[[factor]]\nname = \"camera.yaw_deg\"\nlevels = [0.0, 30.0]\nlabels = [\"front\", \"side\"]\n\n";
+    if (crop) s << "[[crop]]\nview = \"mid\"\ncrop = { x = 50, y = 0, width = 46, height = 64 }\nmagnification = 2\n\n";
+    s << "[[reference]]\ncamera.yaw_deg = 15.0\n";
+    return s.str();
+}
+
+} // namespace
+
+TEST_F(StimuliBuild, CropAndMagnificationAreAppliedRecordedAndPredictedOn) {
+    const fs::path full = gRoot / "whole", shown = gRoot / "presented";
+    CliRun run = runCli({"stimuli", "build", writeSpec("whole.toml", presentedSpec("whole", false)).string(), "-o",
+                         full.string(), "--no-predict"});
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    run = runCli({"stimuli", "build", writeSpec("presented.toml", presentedSpec("presented", true)).string(), "-o",
+                  shown.string()});
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    const nlohmann::json m = manifestOf(shown);
+    ASSERT_EQ(m["stimuli"].size(), 6u);
+    const skinlab::metrics::CvvdpDisplay display = skinlab::metrics::cvvdpDisplay("standard_fhd");
+    std::map<std::string, std::string> referenceOf; // block → reference PNG
+    for (const auto& s : m["stimuli"])
+        if (s["reference"].get<bool>()) referenceOf[s["block"]] = s["files"]["png"];
+    for (const auto& s : m["stimuli"]) {
+        const std::string id = s["id"];
+        const bool mid = s["block"] == "builtin:head/mid";
+        const int x = mid ? 50 : 20, y = mid ? 0 : 8, w = mid ? 46 : 40, h = mid ? 64 : 30, mag = mid ? 2 : 3;
+        const nlohmann::json expected = {{"render", {{"width", 96}, {"height", 64}}},
+                                         {"crop", {{"x", x}, {"y", y}, {"width", w}, {"height", h}}},
+                                         {"magnification", mag},
+                                         {"presented", {{"width", w * mag}, {"height", h * mag}}}};
+        EXPECT_EQ(s["presentation"], expected) << id;
+        EXPECT_EQ(s["width"], w * mag) << id;
+        EXPECT_EQ(s["height"], h * mag) << id;
+        // The same stimulus rendered whole: the EXR (every AOV) is its crop, the PNG its crop magnified.
+        const Pixels fullExr = readPixels(full / "exr" / (id + ".exr"));
+        EXPECT_GT(fullExr.channels, 3) << id;
+        EXPECT_TRUE(isCropOf(readPixels(shown / "exr" / (id + ".exr")), fullExr, x, y, w, h, 1)) << id;
+        EXPECT_TRUE(isCropOf(readPixels(shown / "png" / (id + ".png")), readPixels(full / "png" / (id + ".png")), x, y,
+                             w, h, mag))
+            << id;
+        if (s["reference"].get<bool>()) continue;
+        // The prediction is ColorVideoVDP on the presented PNGs (at the display's pixels per degree).
+        ASSERT_TRUE(s.contains("predicted")) << id;
+        const auto reference =
+            skinlab::metrics::loadMetricRender(shown / referenceOf.at(s["block"]), skinlab::metrics::RenderRole::test,
+                                               skinlab::metrics::ImageEncoding::srgb);
+        const auto test = skinlab::metrics::loadMetricRender(shown / s["files"]["png"].get<std::string>(),
+                                                             skinlab::metrics::RenderRole::test,
+                                                             skinlab::metrics::ImageEncoding::srgb);
+        const double jod = skinlab::metrics::cvvdp(reference.beauty, test.beauty, display, false).jod;
+        EXPECT_DOUBLE_EQ(s["predicted"]["jod"].get<double>(), jod) << id;
+        EXPECT_LT(jod, 10.0) << id;
+    }
+    // The contact sheet states how each block is presented.
+    std::ifstream html(shown / "contact.html");
+    std::stringstream text;
+    text << html.rdbuf();
+    EXPECT_NE(text.str().find("Presented: crop 20,8 40×30 of 96×64, ×3 → 120×90 px"), std::string::npos);
+    EXPECT_NE(text.str().find("Presented: crop 50,0 46×64 of 96×64, ×2 → 92×128 px"), std::string::npos);
+    // A rebuild keeps everything; a changed crop re-renders its block only.
+    run = runCli({"stimuli", "build", (gRoot / "presented.toml").string(), "-o", shown.string()});
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    EXPECT_NE(run.output.find("(0 rendered, 6 unchanged)"), std::string::npos) << run.output;
+    std::string moved = presentedSpec("presented", true);
+    moved.replace(moved.find("x = 50"), 6, "x = 48");
+    run = runCli({"stimuli", "build", writeSpec("presented.toml", moved).string(), "-o", shown.string()});
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    EXPECT_NE(run.output.find("(3 rendered, 3 unchanged)"), std::string::npos) << run.output;
+    EXPECT_EQ(manifestOf(shown)["stimuli"][3]["presentation"]["crop"]["x"], 48);
+}
+
+TEST_F(StimuliBuild, CropOutsideTheFrameIsRefusedBeforeRendering) {
+    const fs::path out = gRoot / "out";
+    const std::string spec = (gRoot / "bad.toml").string();
+    auto refused = [&](const std::string& from, const std::string& to) {
+        std::string text = presentedSpec("bad", true);
+        text.replace(text.find(from), from.size(), to);
+        CliRun run = runCli({"stimuli", "build", writeSpec("bad.toml", text).string(), "-o", out.string()});
+        EXPECT_EQ(run.exitCode, 2);
+        EXPECT_FALSE(fs::exists(out));
+        return run.output;
+    };
+    EXPECT_EQ(refused("width = 40, height = 30", "width = 80, height = 30"),
+              "skinlab: error: " + spec +
+                  ": fixed.crop.width: x + width = 100 exceeds the render width 96 (stimulus 'head-close-front')\n");
+    EXPECT_EQ(refused("x = 50, y = 0, width = 46, height = 64", "x = 50, y = 1, width = 46, height = 64"),
+              "skinlab: error: " + spec +
+                  ": crop[0].crop.height: y + height = 65 exceeds the render height 64 (stimulus 'head-mid-front')\n");
+    EXPECT_EQ(refused("x = 50, y = 0", "x = 96, y = 0"),
+              "skinlab: error: " + spec +
+                  ": crop[0].crop.x: 96 lies outside the 96 × 64 render (stimulus 'head-mid-front')\n");
+    EXPECT_EQ(refused("magnification = 3", "magnification = 0"),
+              "skinlab: error: " + spec + ": fixed.magnification: 0 is out of range [1, 16]\n");
+}
 
 // `stimuli slurm --dry-run` prints the two sbatch scripts (a job array, one task per shard, and a merge job) and
 // writes nothing; the bad-input cases fail with one line. The real cluster run is tests/stimuli/slurm_cluster_test.sh.
