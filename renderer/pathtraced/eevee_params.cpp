@@ -1,4 +1,5 @@
 #include "renderer/pathtraced/eevee_params.h"
+#include "renderer/pathtraced/json_table.h"
 
 #include "common/error.h"
 #include "common/spec.h"
@@ -74,22 +75,7 @@ EeveeParams readEeveeParams(const SpecReader& scene) {
 }
 
 EeveeParams eeveeParamsFromJson(const nlohmann::json& json, std::string_view source) {
-    if (!json.is_object()) throwInput(source, "eevee", "expected a JSON object, got " + json.dump());
-    toml::table table;
-    for (const auto& [key, value] : json.items()) {
-        if (value.is_boolean()) table.insert_or_assign(key, value.get<bool>());
-        else if (value.is_number_integer()) table.insert_or_assign(key, value.get<std::int64_t>());
-        else if (value.is_number()) table.insert_or_assign(key, value.get<double>());
-        else if (value.is_string()) table.insert_or_assign(key, value.get<std::string>());
-        else if (value.is_array()) {
-            toml::array array;
-            for (const auto& element : value) array.push_back(element.get<double>());
-            table.insert_or_assign(key, std::move(array));
-        } else throwInput(source, "eevee." + key, "unsupported value " + value.dump());
-    }
-    toml::table root;
-    root.insert_or_assign("eevee", std::move(table));
-    return readEeveeParams(SpecReader(root, std::string(source)));
+    return readEeveeParams(SpecReader(jsonAsTomlTable(json, source, "eevee"), std::string(source)));
 }
 
 } // namespace skinlab::renderer::pathtraced

@@ -1,4 +1,5 @@
 #include "renderer/pathtraced/pathtraced_params.h"
+#include "renderer/pathtraced/json_table.h"
 
 #include "common/error.h"
 #include "common/spec.h"
@@ -51,22 +52,7 @@ PathtracedParams readPathtracedParams(const SpecReader& scene) {
 }
 
 PathtracedParams pathtracedParamsFromJson(const nlohmann::json& json, std::string_view source) {
-    if (!json.is_object()) throwInput(source, "pathtraced", "expected a JSON object, got " + json.dump());
-    toml::table table;
-    for (const auto& [key, value] : json.items()) {
-        if (value.is_boolean()) table.insert_or_assign(key, value.get<bool>());
-        else if (value.is_number_integer()) table.insert_or_assign(key, value.get<std::int64_t>());
-        else if (value.is_number()) table.insert_or_assign(key, value.get<double>());
-        else if (value.is_string()) table.insert_or_assign(key, value.get<std::string>());
-        else if (value.is_array()) {
-            toml::array array;
-            for (const auto& element : value) array.push_back(element.get<double>());
-            table.insert_or_assign(key, std::move(array));
-        } else throwInput(source, "pathtraced." + key, "unsupported value " + value.dump());
-    }
-    toml::table root;
-    root.insert_or_assign("pathtraced", std::move(table));
-    return readPathtracedParams(SpecReader(root, std::string(source)));
+    return readPathtracedParams(SpecReader(jsonAsTomlTable(json, source, "pathtraced"), std::string(source)));
 }
 
 } // namespace skinlab::renderer::pathtraced
