@@ -119,6 +119,9 @@ struct Renderer::Impl {
     // `shadows` false: the shadow maps of the previous call are kept (same model, lights and shadow settings).
     gl::MainPassSettings runLightingPasses(const Frame& frame, bool shadows = true);
     float runSssPasses(const Frame& frame, const gl::MainPassSettings& mainSettings);
+    // sss.method = "reference": its inputs from the uploaded model, its parameters checked and the surface
+    // tessellated (cached), before any pass runs.
+    void prepareReferenceMethod(Frame& frame, const SceneSpec& spec);
 
     gl::EglContext context;
     gl::ShaderLibrary shaders;
@@ -457,6 +460,14 @@ float Renderer::Impl::runSssPasses(const Frame& frame, const gl::MainPassSetting
     return supportRadiusMm;
 }
 
+void Renderer::Impl::prepareReferenceMethod(Frame& frame, const SceneSpec& spec) {
+    frame.referenceInputs.model = frame.model;
+    frame.referenceInputs.partMaterials = frame.partMaterials;
+    frame.referenceInputs.mmPerUnit = static_cast<float>(spec.mmPerUnit);
+    frame.referenceInputs.source = spec.source;
+    referenceMethod.prepare(frame.referenceInputs, spec.sss);
+}
+
 namespace {
 // What the upload depends on: the model, its materials and maps, the environment.
 std::string residentSceneKeyOf(const SceneSpec& spec) {
@@ -541,13 +552,7 @@ DisplayFrame Renderer::renderDisplay(const RenderRequest& request, bool withLine
     frame.environmentFromWorld = glm::mat3(glm::rotate(
         glm::mat4(1.0f), static_cast<float>(-glm::radians(spec.environment.rotationDeg)), glm::vec3(0, 1, 0)));
     const bool referenceMethod = spec.sss.method == sss::SssMethod::Reference;
-    if (referenceMethod) {
-        frame.referenceInputs.model = frame.model;
-        frame.referenceInputs.partMaterials = frame.partMaterials;
-        frame.referenceInputs.mmPerUnit = static_cast<float>(spec.mmPerUnit);
-        frame.referenceInputs.source = spec.source;
-        impl.referenceMethod.prepare(frame.referenceInputs, spec.sss);
-    }
+    if (referenceMethod) impl.prepareReferenceMethod(frame, spec);
     const double uploadMs = millisecondsSince(uploadStart);
 
     impl.timer.reset();
@@ -672,13 +677,7 @@ RenderResult Renderer::render(const RenderRequest& request) {
     // --- sss.method = "reference": check its parameters and tessellate (cached) before the first pass, so bad
     // input fails with no pass half done.
     const bool referenceMethod = spec.sss.method == sss::SssMethod::Reference;
-    if (referenceMethod) {
-        frame.referenceInputs.model = frame.model;
-        frame.referenceInputs.partMaterials = frame.partMaterials;
-        frame.referenceInputs.mmPerUnit = static_cast<float>(spec.mmPerUnit);
-        frame.referenceInputs.source = spec.source;
-        impl.referenceMethod.prepare(frame.referenceInputs, spec.sss);
-    }
+    if (referenceMethod) impl.prepareReferenceMethod(frame, spec);
 
     // --- the pass pipeline ----------------------------------------------------------------------------------
     impl.lightingKey.clear(); // the targets and shadow maps no longer hold renderDisplay's
