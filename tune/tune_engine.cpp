@@ -53,7 +53,8 @@ std::uint64_t RenderQueue::rendered() const {
     return rendered_;
 }
 
-std::optional<TuneFrame> RenderQueue::render(const std::string& client, const TuneConfig& config, bool withLinear) {
+std::optional<TuneFrame> RenderQueue::render(const std::string& client, const TuneConfig& config, bool withLinear,
+                                             std::optional<std::uint64_t> sequence) {
     auto pending = std::make_unique<Pending>();
     pending->config = config;
     pending->withLinear = withLinear;
@@ -62,6 +63,11 @@ std::optional<TuneFrame> RenderQueue::render(const std::string& client, const Tu
     {
         std::lock_guard lock(mutex_);
         if (stopping_) throw RuntimeError("tune: the render thread is stopping");
+        if (sequence) {
+            auto [newest, first] = newest_.try_emplace(client, *sequence);
+            if (!first && *sequence < newest->second) return std::nullopt; // a newer one came first
+            newest->second = *sequence;
+        }
         auto& slot = pending_[client];
         if (slot) slot->answer.set_value(std::nullopt); // replaced before it started: latest wins
         else order_.push_back(client);

@@ -34,7 +34,9 @@ struct TuneFrame {
 };
 
 // Renders on one thread; each client (a page) has at most one request waiting: a newer one replaces it, and the
-// replaced request is answered "superseded" (latest wins). Clients are served in turn.
+// replaced request is answered "superseded" (latest wins). "Newer" is the client's own sequence number when it
+// sends one (requests on several kept-alive connections may arrive out of order), else arrival order. Clients are
+// served in turn.
 class RenderQueue {
 public:
     explicit RenderQueue(std::filesystem::path assetsDir);
@@ -42,9 +44,11 @@ public:
     RenderQueue(const RenderQueue&) = delete;
     RenderQueue& operator=(const RenderQueue&) = delete;
 
-    // Blocks until the request is rendered; nullopt when a newer request of the same client replaced it first.
-    // Throws what the render throws (InputError for bad values, RuntimeError for GL failures).
-    std::optional<TuneFrame> render(const std::string& client, const TuneConfig& config, bool withLinear);
+    // Blocks until the request is rendered; nullopt when a newer request of the same client replaced it first, or
+    // at once when `sequence` is below one this client already sent. Throws what the render throws (InputError
+    // for bad values, RuntimeError for GL failures).
+    std::optional<TuneFrame> render(const std::string& client, const TuneConfig& config, bool withLinear,
+                                    std::optional<std::uint64_t> sequence = std::nullopt);
     // GL_RENDERER of the render thread's context ("" until it started, or when EGL failed).
     std::string glRenderer() const;
     std::uint64_t rendered() const;
@@ -63,6 +67,7 @@ private:
     std::condition_variable wake_;
     std::map<std::string, std::unique_ptr<Pending>> pending_; // by client
     std::deque<std::string> order_;                           // clients with a pending request, in arrival order
+    std::map<std::string, std::uint64_t> newest_;             // by client: the highest sequence number received
     bool stopping_ = false;
     std::string glRenderer_;
     std::uint64_t rendered_ = 0;

@@ -119,6 +119,15 @@ std::string clientOf(const json& body) {
     return client;
 }
 
+// The page's own request counter, optional: a non-negative integer.
+std::optional<std::uint64_t> sequenceOf(const json& body) {
+    if (!body.contains("seq")) return std::nullopt;
+    const json& value = body["seq"];
+    if (!value.is_number_unsigned())
+        throw RequestError(400, "seq: expected a non-negative integer, got " + value.dump());
+    return value.get<std::uint64_t>();
+}
+
 json parseBody(const HttpRequest& request) {
     try {
         json body = json::parse(request.body);
@@ -380,7 +389,7 @@ HttpResponse TuneServer::render(const json& body) {
     }
     const bool comparing = body.contains("compare") && body["compare"].is_object();
     const auto start = std::chrono::steady_clock::now();
-    const std::optional<TuneFrame> frame = queue_->render(clientOf(body), config, comparing);
+    const std::optional<TuneFrame> frame = queue_->render(clientOf(body), config, comparing, sequenceOf(body));
     if (!frame) return jsonResponse(200, {{"superseded", true}});
     const auto& f = frame->frame;
     json out = {{"image", pngDataUrl(bgrOf(f))},

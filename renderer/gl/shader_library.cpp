@@ -8,6 +8,8 @@
 #include <fstream>
 #include <functional>
 #include <map>
+#include <mutex>
+#include <epoxy/egl.h>
 #include <glm/gtc/type_ptr.hpp>
 #include <optional>
 #include <sstream>
@@ -131,10 +133,18 @@ struct UniformTable {
     std::string shaders;
     std::map<std::string, GLint, std::less<>> locations;
 };
-std::map<GLuint, UniformTable>& uniformTables() {
-    static std::map<GLuint, UniformTable> tables;
+// Program names are per GL context, and several contexts may render at once on their own threads (a stimulus
+// build's parallel jobs): the tables are keyed on (current context, program) and guarded by one mutex.
+using ProgramKey = std::pair<EGLContext, GLuint>;
+struct UniformTables {
+    std::mutex mutex;
+    std::map<ProgramKey, UniformTable> tables;
+};
+UniformTables& uniformTables() {
+    static UniformTables tables;
     return tables;
 }
+ProgramKey programKey(GLuint program) { return {eglGetCurrentContext(), program}; }
 
 GLuint compile(GLenum stage, const std::string& name, const std::string& text) {
     GLuint shader = glCreateShader(stage);
@@ -227,14 +237,20 @@ GLuint ShaderLibrary::program(const std::string& vertexName, const std::string& 
     for (const std::string* text : {&vertexText, &fragmentText})
         for (const std::string& uniform : declaredUniforms(*text))
             table.locations[uniform] = glGetUniformLocation(name, uniform.c_str());
-    uniformTables()[name] = std::move(table); // replaces the table of a deleted program of the same name
+    {
+        UniformTables& all = uniformTables();
+        std::lock_guard lock(all.mutex);
+        all.tables[programKey(name)] = std::move(table); // replaces the table of a deleted program of the same name
+    }
     programs_.emplace(key, std::move(program));
     return name;
 }
 
 GLint uniformLocation(GLuint program, const char* name) {
-    const auto table = uniformTables().find(program);
-    if (table == uniformTables().end())
+    UniformTables& all = uniformTables();
+    std::lock_guard lock(all.mutex);
+    const auto table = all.tables.find(programKey(program));
+    if (table == all.tables.end())
         throw RuntimeError("uniform " + std::string(name) + ": program " + std::to_string(program) +
                            " was not linked by ShaderLibrary");
     auto& locations = table->second.locations;

@@ -300,8 +300,9 @@ TEST_F(TuneServerTest, TwoClientsAtOnce) {
 }
 
 TEST_F(TuneServerTest, LatestRequestOfAClientWins) {
-    // Three requests of one client sent at once: at most the newest waits, replaced ones are answered
-    // "superseded", and the last answer is the newest values.
+    // Three requests of one client sent at once, numbered as the page numbers them: at most the newest waits,
+    // replaced ones (and older ones that arrive after it: the threads may start in any order) are answered
+    // "superseded", and the newest request's answer has its values.
     std::vector<std::thread> threads;
     std::vector<json> answers(3);
     for (int i = 0; i < 3; ++i) {
@@ -311,6 +312,7 @@ TEST_F(TuneServerTest, LatestRequestOfAClientWins) {
             answers[static_cast<std::size_t>(i)] = json::parse(
                 post(c, "/api/render",
                      {{"client", "same"},
+                      {"seq", i},
                       {"scene", "builtin:head"},
                       {"overrides",
                        with(kSmall, {"sss.method=\"separable\"", "sss.width_mm=" + std::to_string(2 + i)})}})
@@ -321,6 +323,25 @@ TEST_F(TuneServerTest, LatestRequestOfAClientWins) {
     ASSERT_TRUE(answers[2].contains("resolved")) << answers[2].dump();
     EXPECT_EQ(answers[2]["resolved"]["sss"]["width_mm"], 4.0);
     for (const json& a : answers) EXPECT_TRUE(a.contains("superseded") || a.contains("image"));
+}
+
+TEST_F(TuneServerTest, OlderRequestArrivingLateIsSuperseded) {
+    HttpClient c = client();
+    const auto body = [&](int seq, const char* width) {
+        return json{{"client", "late"},
+                    {"seq", seq},
+                    {"scene", "builtin:head"},
+                    {"overrides", with(kSmall, {"sss.method=\"separable\"", std::string("sss.width_mm=") + width})}};
+    };
+    const json newer = json::parse(post(c, "/api/render", body(7, "3")).body);
+    ASSERT_TRUE(newer.contains("image")) << newer.dump();
+    const json older = json::parse(post(c, "/api/render", body(6, "2")).body);
+    EXPECT_EQ(older, json({{"superseded", true}}));
+    const json again = json::parse(post(c, "/api/render", body(7, "3")).body); // the same number is not older
+    EXPECT_TRUE(again.contains("image")) << again.dump();
+    const HttpAnswer bad = post(c, "/api/render", json{{"client", "late"}, {"seq", -1}, {"scene", "builtin:head"}});
+    EXPECT_EQ(bad.status, 400);
+    EXPECT_NE(bad.body.find("seq: expected a non-negative integer, got -1"), std::string::npos) << bad.body;
 }
 
 TEST_F(TuneServerTest, ExportRendersPixelExactWithSkinlabRender) {

@@ -248,7 +248,7 @@ async function send() {
   dirty = false;
   inFlight = true;
   const mine = ++sequence;
-  const body = Object.assign({ client }, config());
+  const body = Object.assign({ client, seq: mine }, config());
   const lightingNow = scene + '|' + overrideList().filter((o) => !o.startsWith('sss.') && !o.startsWith('tone_map.')).join('|');
   const compareOn = $('mode').value === 'difference' && referenceJob && referenceFor === lightingNow;
   if ($('mode').value === 'difference' && referenceJob && !compareOn)

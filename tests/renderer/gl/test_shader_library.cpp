@@ -1,6 +1,7 @@
 // ShaderLibrary (renderer/gl/shader_library.h), label gl: compile errors name the right file and line after an
 // #include, uniform names are checked against the program's sources, and every listed variant compiles and links.
 #include "render_test_support.h"
+#include "renderer/gl/egl_context.h"
 #include "renderer/gl/shader_checks.h"
 #include "renderer/gl/shader_library.h"
 
@@ -10,7 +11,9 @@
 #include <filesystem>
 #include <fstream>
 #include <gtest/gtest.h>
+#include <latch>
 #include <string>
+#include <thread>
 
 namespace skinlab::renderer {
 namespace {
@@ -101,6 +104,41 @@ TEST(ShaderLibrary, UniformNamesAreCheckedAgainstTheSources) {
     const GLuint blur = library.program("fullscreen.vert", "sss_blur.frag");
     EXPECT_NO_THROW(gl::setUniform(blur, "extensionCbf", 0));
     EXPECT_THROW(library.program("fullscreen.vert", "sss_blur.frag", {{"NO_SUCH_SWITCH", "1"}}), RuntimeError);
+}
+
+// Program names are per context: two contexts on two threads (a stimulus build's parallel jobs) link different
+// programs under the same names, and each keeps its own uniform table.
+TEST(ShaderLibrary, ContextsOnOtherThreadsKeepTheirOwnUniformTables) {
+    SKINLAB_REQUIRE_RENDERER(renderer); // skips where no context can be made
+    (void)renderer;
+    std::latch linked(2);
+    std::string errors[2];
+    auto job = [&](int index) {
+        bool counted = false;
+        try {
+            gl::EglContext context; // current on this thread
+            gl::ShaderLibrary library;
+            // Fresh contexts hand out the same names in the same order: thread 0 gets copy.frag, thread 1 the
+            // main pass under that name.
+            const GLuint program = index == 0 ? library.program("fullscreen.vert", "copy.frag")
+                                              : library.program("main_pass.vert", "main_pass.frag");
+            counted = true;
+            linked.arrive_and_wait();
+            for (int i = 0; i < 2000; ++i) {
+                if (index == 0) gl::setUniform(program, "source", 0);
+                else gl::setUniform(program, "irradianceSH[2]", glm::vec3(0.0f));
+            }
+        } catch (const std::exception& e) {
+            errors[index] = e.what();
+            if (!counted) linked.count_down();
+        }
+    };
+    std::thread first(job, 0);
+    std::thread second(job, 1);
+    first.join();
+    second.join();
+    EXPECT_EQ(errors[0], "");
+    EXPECT_EQ(errors[1], "");
 }
 
 // Every variant the passes may ask for compiles and links (shaderVariants(); ShaderLibrary refuses any other).
