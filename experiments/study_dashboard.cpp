@@ -221,6 +221,8 @@ json StudyDashboard::computeScale() const {
         return out;
     }
     scaling::AnalysisOptions options;
+    options.intervals = scaling::defaultIntervals(table.adaptiveDesign); // as `analyze scale` chooses
+    options.intervalReason = table.adaptiveDesign ? "active design" : "fixed design";
     options.bootstrap.samples = scaleOptions_.bootstrapSamples;
     options.bootstrap.threads = scaleOptions_.threads;
     options.bootstrap.seed = 1;

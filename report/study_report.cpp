@@ -200,6 +200,7 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
     scaling::ResponseTable table;
     table.file = options.study.string();
     table.format = scaling::ResponseFormat::StudyDatabase;
+    table.adaptiveDesign = store.definition().design.activePairs;
     // Conditions in design order, as `analyze scale` and the dashboard list them.
     for (const experiments::StudyBlock& block : store.definition().blocks)
         table.designConditionOrder[block.name] = block.conditions;
@@ -236,6 +237,8 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
 
     // --- The scale (existing analysis). ---
     scaling::AnalysisOptions analysisOptions;
+    analysisOptions.intervals = scaling::defaultIntervals(table.adaptiveDesign); // as `analyze scale` chooses
+    analysisOptions.intervalReason = table.adaptiveDesign ? "active design" : "fixed design";
     analysisOptions.bootstrap.samples = options.bootstrapSamples;
     analysisOptions.bootstrap.seed = options.seed;
     analysisOptions.bootstrap.threads = options.threads;

@@ -14,7 +14,8 @@ A stimulus is "extended" when its factors are those of another stimulus of the s
 extension keys, or when it differs from one by sss.follow_surface (true = with). Without its extension keys, an
 include's stimulus keeps the scene's default (follow-surface on): its base is the stimulus with the same method
 and follow-surface on, or the one with no further factors; an extension with follow-surface off is compared with the
-same method with follow-surface off."""
+same method with follow-surface off. Transmittance (transmittance.enabled true, with any other transmittance.* keys
+such as its translucency) is compared with the same stimulus with transmittance.enabled false."""
 import json
 import sys
 
@@ -46,6 +47,18 @@ def base_of(s, block_stimuli):
     """The stimulus `s` extends, and the name of the extension; None when it extends nothing."""
     f = factors_of(s)
     method = f.get("method")
+    # transmittance on (with its own keys, e.g. a translucency) against the same stimulus with it off
+    if f.get("transmittance.enabled") == "true":
+        own = {k: v for k, v in f.items() if k.startswith("transmittance.") and k != "transmittance.enabled"}
+        rest = {k: v for k, v in f.items() if not k.startswith("transmittance.")}
+        for o in block_stimuli:
+            g = factors_of(o)
+            if g.get("transmittance.enabled") == "false" and {
+                k: v for k, v in g.items() if not k.startswith("transmittance.")
+            } == rest:
+                details = "".join(f", {k.removeprefix('transmittance.')}={v}" for k, v in sorted(own.items()))
+                return o, f"transmittance{details}"
+        return None, None
     # follow-surface as a factor level: with (true) against without (false), the rest equal
     if f.get("sss.follow_surface") == "true":
         for o in block_stimuli:

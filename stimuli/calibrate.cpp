@@ -141,7 +141,9 @@ LevelSearchResult searchLevels(const std::function<double(double)>& predictedJod
                 level.note = "not within " + number(tol, "%g") + " JOD after " + std::to_string(probes) + " probes";
                 break;
             }
-            double mid = 0.5 * (a + b);
+            // Rounded to 12 significant digits, so that the level written (shortest round trip) reads as the
+            // binary fraction of the range it is, not as 0.6898437499999999.
+            double mid = std::stod(number(0.5 * (a + b), "%.12g"));
             if (search.integral) {
                 if (b - a <= 1.0) {
                     level.note = "the difference jumps from " + number(seen.at(a)) + " JOD at " + number(a, "%g") +

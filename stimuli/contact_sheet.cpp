@@ -88,14 +88,14 @@ std::string caption(const nlohmann::json& stimulus, const std::vector<std::strin
     // The predicted visibility against the block's reference (ColorVideoVDP), when the build recorded it.
     if (stimulus.contains("predicted") && stimulus["predicted"].contains("jod")) {
         char jod[48];
-        std::snprintf(jod, sizeof jod, " · %.2f JOD", stimulus["predicted"]["jod"].get<double>());
+        std::snprintf(jod, sizeof jod, " - %.2f JOD", stimulus["predicted"]["jod"].get<double>());
         text += jod;
     }
     return text;
 }
 
 // Splits a caption into lines no wider than `width` pixels at 13 px (OpenImageIO's text_size with `font`), at
-// spaces; a word wider than a line is cut. At most `maxLines` lines; "…" marks text left out.
+// spaces; a word wider than a line is cut. At most `maxLines` lines; "..." marks text left out (ASCII: the PNG font has no other glyphs).
 std::vector<std::string> wrapCaption(const std::string& caption, int width, int maxLines, const std::string& font) {
     auto fits = [&](const std::string& text) {
         const OIIO::ROI box = OIIO::ImageBufAlgo::text_size(text, 13, font);
@@ -120,8 +120,8 @@ std::vector<std::string> wrapCaption(const std::string& caption, int width, int 
     if (static_cast<int>(lines.size()) > maxLines) {
         lines.resize(static_cast<size_t>(maxLines));
         std::string& last = lines.back();
-        while (!last.empty() && !fits(last + "…")) last.pop_back();
-        last += "…";
+        while (!last.empty() && !fits(last + "...")) last.pop_back();
+        last += "...";
     }
     return lines;
 }

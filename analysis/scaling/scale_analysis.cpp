@@ -176,7 +176,152 @@ void pwcmpOutlierTerms(const BlockData& block, std::vector<double>& logLikelihoo
     }
 }
 
+// The studentized observer bootstrap's (or, with IntervalMethod::percentile, pwcmp's percentile bootstrap's)
+// score intervals and pairwise tests, with the Bradley–Terry scores' observer-robust errors.
+void bootstrapIntervals(BlockAnalysis& result, const BlockData& block, const FitOptions& thurstoneOptions,
+                        const AnalysisOptions& options) {
+    const int m = block.conditionCount();
+    const int n = block.observerCount();
+    const BootstrapResult bootstrap = bootstrapObservers(block, result.thurstone, thurstoneOptions, options.bootstrap);
+    result.intervalMethod = "studentized-bootstrap";
+    result.bootstrapSamples = bootstrap.samples;
+    result.standardError = bootstrap.standardError;
+    result.low = bootstrap.low;
+    result.high = bootstrap.high;
+    result.percentileLow = bootstrap.percentileLow;
+    result.percentileHigh = bootstrap.percentileHigh;
+    result.intervalFlags = bootstrap.scoreDiagnoses;
+    for (const DifferenceTest& test : bootstrap.differences) result.pairs.push_back({test});
+    if (options.intervals == IntervalMethod::percentile) {
+        // pwcmp's pw_scale_bootstrp: percentiles of the resampled scores and differences.
+        result.intervalMethod = "percentile-bootstrap";
+        result.low = bootstrap.percentileLow;
+        result.high = bootstrap.percentileHigh;
+        result.intervalFlags.assign(m, {});
+        for (PairTest& pair : result.pairs) {
+            pair.test.low = pair.test.percentileLow;
+            pair.test.high = pair.test.percentileHigh;
+            pair.test.pValue = pair.test.percentilePValue;
+            pair.test.diagnosis = {};
+        }
+    }
+    result.bradleyTerryStandardError =
+        robustCovariance(block, Eigen::VectorXd::Ones(n), result.bradleyTerry, Model::BradleyTerry)
+            .diagonal()
+            .cwiseMax(0.0)
+            .cwiseSqrt();
+    if (n < 5)
+        result.warnings.push_back("only " + std::to_string(n) +
+                                  " observers: bootstrap intervals are unreliable below about 10");
+    std::map<std::string, int> reasons;
+    int fallbacks = 0;
+    for (const IntervalDiagnosis& diagnosis : result.intervalFlags) {
+        fallbacks += diagnosis.fallback;
+        for (const std::string& reason : diagnosis.reasons) ++reasons[reason];
+    }
+    if (fallbacks > 0 && options.intervals != IntervalMethod::percentile) {
+        std::string why;
+        for (const auto& [reason, count] : reasons) why += (why.empty() ? "" : ", ") + reason;
+        result.warnings.push_back(std::to_string(fallbacks) + " of " + std::to_string(m) +
+                                  " score intervals are percentile+profile intervals instead of studentized "
+                                  "ones (" +
+                                  why + ")");
+    }
+}
+
+// Profile-posterior intervals (asymmetric where the data are, finite under the prior) and score tests, both
+// model-based (the score test with the observer-robust variance when there are observers): for one observer or a
+// bare count matrix (nothing to resample), and for adaptive designs, where resampling observers is not valid.
+void profileIntervals(BlockAnalysis& result, const BlockData& block, const PairCounts& totals,
+                      const FitOptions& thurstoneOptions, const AnalysisOptions& options) {
+    const int m = block.conditionCount();
+    const int n = block.observerCount();
+    result.pairs.clear();
+    result.intervalMethod = "profile-likelihood";
+    const Eigen::MatrixXd& v = result.thurstone.inverseInformation;
+    result.standardError = v.diagonal().cwiseMax(0.0).cwiseSqrt();
+    result.low.resize(m);
+    result.high.resize(m);
+    result.intervalFlags.assign(m, {});
+    for (int i = 0; i < m; ++i) {
+        // The score relative to its own component's mean (all conditions when the design is connected).
+        const std::vector<int>* members = &result.components.front();
+        for (const auto& component : result.components)
+            if (std::find(component.begin(), component.end(), i) != component.end()) members = &component;
+        Eigen::VectorXd contrast = Eigen::VectorXd::Zero(m);
+        for (int j : *members) contrast[j] = -1.0 / static_cast<double>(members->size());
+        contrast[i] += 1.0;
+        const double shift = result.thurstone.scores[i] - contrast.dot(result.thurstone.scores);
+        const ProfileInterval profile =
+            profileInterval(totals, thurstoneOptions, result.thurstone, contrast, options.bootstrap.level);
+        result.low[i] = profile.low + shift;
+        result.high[i] = profile.high + shift;
+        if (profile.lowAtCap || profile.highAtCap) result.intervalFlags[i].reasons.emplace_back("bound-at-search-cap");
+    }
+    result.percentileLow = Eigen::VectorXd::Constant(m, NAN);
+    result.percentileHigh = Eigen::VectorXd::Constant(m, NAN);
+    result.bradleyTerryStandardError = result.bradleyTerry.inverseInformation.diagonal().cwiseMax(0.0).cwiseSqrt();
+    for (int i = 0; i < m; ++i)
+        for (int j = i + 1; j < m; ++j) {
+            DifferenceTest test;
+            test.first = i;
+            test.second = j;
+            test.difference = result.thurstone.scores[i] - result.thurstone.scores[j];
+            test.standardError = std::sqrt(std::max(v(i, i) + v(j, j) - 2.0 * v(i, j), 0.0));
+            Eigen::VectorXd contrast = Eigen::VectorXd::Zero(m);
+            contrast[i] = 1.0;
+            contrast[j] = -1.0;
+            const ProfileInterval profile =
+                profileInterval(totals, thurstoneOptions, result.thurstone, contrast, options.bootstrap.level);
+            test.low = profile.low;
+            test.high = profile.high;
+            if (profile.lowAtCap || profile.highAtCap) test.diagnosis.reasons.emplace_back("bound-at-search-cap");
+            test.pValue = scoreTestPValue(n >= 2 ? &block : nullptr, totals, thurstoneOptions, result.thurstone, i, j);
+            result.pairs.push_back({test});
+        }
+    if (block.hasObservers && n < 2)
+        result.warnings.push_back("a single observer: intervals are profile-likelihood intervals");
+}
+
+// The union of the two: each score's and each difference's interval from the lower of the two lower ends to the
+// higher of the two upper ends, a pair's p-value the larger of the two (significant only when both tests say so).
+// For adaptive designs, where neither alone reaches nominal coverage at every number of observers (docs/analysis.md,
+// "Validation of active designs"). Standard errors stay the bootstrap's.
+void unionIntervals(BlockAnalysis& result, const BlockData& block, const PairCounts& totals,
+                    const FitOptions& thurstoneOptions, const AnalysisOptions& options) {
+    bootstrapIntervals(result, block, thurstoneOptions, options);
+    BlockAnalysis profiled = result;
+    profileIntervals(profiled, block, totals, thurstoneOptions, options);
+    result.intervalMethod = "studentized-bootstrap+profile-likelihood";
+    result.low = result.low.cwiseMin(profiled.low);
+    result.high = result.high.cwiseMax(profiled.high);
+    for (size_t i = 0; i < result.intervalFlags.size(); ++i)
+        for (const std::string& reason : profiled.intervalFlags[i].reasons)
+            result.intervalFlags[i].reasons.push_back(reason);
+    for (size_t k = 0; k < result.pairs.size(); ++k) {
+        DifferenceTest& test = result.pairs[k].test;
+        const DifferenceTest& other = profiled.pairs[k].test;
+        test.low = std::min(test.low, other.low);
+        test.high = std::max(test.high, other.high);
+        test.pValue = std::max(test.pValue, other.pValue);
+    }
+}
+
 } // namespace
+
+IntervalMethod defaultIntervals(bool adaptiveDesign) {
+    return adaptiveDesign ? IntervalMethod::bootstrapAndProfile : IntervalMethod::bootstrap;
+}
+
+const char* intervalsName(IntervalMethod method) {
+    switch (method) {
+    case IntervalMethod::bootstrap: return "bootstrap";
+    case IntervalMethod::profile: return "profile";
+    case IntervalMethod::percentile: return "percentile";
+    case IntervalMethod::bootstrapAndProfile: return "bootstrap+profile";
+    }
+    return "bootstrap";
+}
 
 BlockAnalysis analyzeBlock(const BlockData& block, const AnalysisOptions& options) {
     BlockAnalysis result;
@@ -184,7 +329,6 @@ BlockAnalysis analyzeBlock(const BlockData& block, const AnalysisOptions& option
     result.conditions = block.conditions;
     result.observers = block.observers;
     result.counts = block.countMatrix();
-    const int m = block.conditionCount();
     const int n = block.observerCount();
     const PairCounts totals = block.totalCounts();
 
@@ -216,106 +360,12 @@ BlockAnalysis analyzeBlock(const BlockData& block, const AnalysisOptions& option
                                   "the data bound their distance on one side only (intervals with one end)");
 
     // Intervals and tests.
+    if (n < 2 || options.intervals == IntervalMethod::profile)
+        profileIntervals(result, block, totals, thurstoneOptions, options);
+    else if (options.intervals == IntervalMethod::bootstrapAndProfile)
+        unionIntervals(result, block, totals, thurstoneOptions, options);
+    else bootstrapIntervals(result, block, thurstoneOptions, options);
     std::vector<double> pValues;
-    if (n >= 2 && options.intervals != IntervalMethod::profile) {
-        const BootstrapResult bootstrap =
-            bootstrapObservers(block, result.thurstone, thurstoneOptions, options.bootstrap);
-        result.intervalMethod = "studentized-bootstrap";
-        result.bootstrapSamples = bootstrap.samples;
-        result.standardError = bootstrap.standardError;
-        result.low = bootstrap.low;
-        result.high = bootstrap.high;
-        result.percentileLow = bootstrap.percentileLow;
-        result.percentileHigh = bootstrap.percentileHigh;
-        result.intervalFlags = bootstrap.scoreDiagnoses;
-        for (const DifferenceTest& test : bootstrap.differences) result.pairs.push_back({test});
-        if (options.intervals == IntervalMethod::percentile) {
-            // pwcmp's pw_scale_bootstrp: percentiles of the resampled scores and differences.
-            result.intervalMethod = "percentile-bootstrap";
-            result.low = bootstrap.percentileLow;
-            result.high = bootstrap.percentileHigh;
-            result.intervalFlags.assign(m, {});
-            for (PairTest& pair : result.pairs) {
-                pair.test.low = pair.test.percentileLow;
-                pair.test.high = pair.test.percentileHigh;
-                pair.test.pValue = pair.test.percentilePValue;
-                pair.test.diagnosis = {};
-            }
-        }
-        result.bradleyTerryStandardError =
-            robustCovariance(block, Eigen::VectorXd::Ones(n), result.bradleyTerry, Model::BradleyTerry)
-                .diagonal()
-                .cwiseMax(0.0)
-                .cwiseSqrt();
-        if (n < 5)
-            result.warnings.push_back("only " + std::to_string(n) +
-                                      " observers: bootstrap intervals are unreliable below about 10");
-        std::map<std::string, int> reasons;
-        int fallbacks = 0;
-        for (const IntervalDiagnosis& diagnosis : result.intervalFlags) {
-            fallbacks += diagnosis.fallback;
-            for (const std::string& reason : diagnosis.reasons) ++reasons[reason];
-        }
-        if (fallbacks > 0 && options.intervals == IntervalMethod::bootstrap) {
-            std::string why;
-            for (const auto& [reason, count] : reasons) why += (why.empty() ? "" : ", ") + reason;
-            result.warnings.push_back(std::to_string(fallbacks) + " of " + std::to_string(m) +
-                                      " score intervals are percentile+profile intervals instead of studentized "
-                                      "ones (" +
-                                      why + ")");
-        }
-    } else {
-        // One observer or a bare count matrix: nothing to resample; or an adaptive design, where resampling
-        // observers is not valid. Profile-posterior intervals (asymmetric where the data are, finite under the
-        // prior) and score tests, both model-based (the score test with the observer-robust variance when there are
-        // observers).
-        result.intervalMethod = "profile-likelihood";
-        const Eigen::MatrixXd& v = result.thurstone.inverseInformation;
-        result.standardError = v.diagonal().cwiseMax(0.0).cwiseSqrt();
-        result.low.resize(m);
-        result.high.resize(m);
-        result.intervalFlags.assign(m, {});
-        for (int i = 0; i < m; ++i) {
-            // The score relative to its own component's mean (all conditions when the design is connected).
-            const std::vector<int>* members = &result.components.front();
-            for (const auto& component : result.components)
-                if (std::find(component.begin(), component.end(), i) != component.end()) members = &component;
-            Eigen::VectorXd contrast = Eigen::VectorXd::Zero(m);
-            for (int j : *members) contrast[j] = -1.0 / static_cast<double>(members->size());
-            contrast[i] += 1.0;
-            const double shift = result.thurstone.scores[i] - contrast.dot(result.thurstone.scores);
-            const ProfileInterval profile =
-                profileInterval(totals, thurstoneOptions, result.thurstone, contrast, options.bootstrap.level);
-            result.low[i] = profile.low + shift;
-            result.high[i] = profile.high + shift;
-            if (profile.lowAtCap || profile.highAtCap)
-                result.intervalFlags[i].reasons.emplace_back("bound-at-search-cap");
-        }
-        result.percentileLow = Eigen::VectorXd::Constant(m, NAN);
-        result.percentileHigh = Eigen::VectorXd::Constant(m, NAN);
-        result.bradleyTerryStandardError = result.bradleyTerry.inverseInformation.diagonal().cwiseMax(0.0).cwiseSqrt();
-        for (int i = 0; i < m; ++i)
-            for (int j = i + 1; j < m; ++j) {
-                DifferenceTest test;
-                test.first = i;
-                test.second = j;
-                test.difference = result.thurstone.scores[i] - result.thurstone.scores[j];
-                test.standardError = std::sqrt(std::max(v(i, i) + v(j, j) - 2.0 * v(i, j), 0.0));
-                Eigen::VectorXd contrast = Eigen::VectorXd::Zero(m);
-                contrast[i] = 1.0;
-                contrast[j] = -1.0;
-                const ProfileInterval profile =
-                    profileInterval(totals, thurstoneOptions, result.thurstone, contrast, options.bootstrap.level);
-                test.low = profile.low;
-                test.high = profile.high;
-                if (profile.lowAtCap || profile.highAtCap) test.diagnosis.reasons.emplace_back("bound-at-search-cap");
-                test.pValue =
-                    scoreTestPValue(n >= 2 ? &block : nullptr, totals, thurstoneOptions, result.thurstone, i, j);
-                result.pairs.push_back({test});
-            }
-        if (block.hasObservers && n < 2)
-            result.warnings.push_back("a single observer: intervals are profile-likelihood intervals");
-    }
     applyDataBounds(result);
     for (PairTest& pair : result.pairs) {
         pair.comparisons =

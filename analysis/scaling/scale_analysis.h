@@ -17,11 +17,17 @@ namespace skinlab::analysis::scaling {
 
 // How the score intervals and pairwise tests are made. `bootstrap`: the studentized bootstrap over observers
 // (profile likelihood with fewer than 2 observers). `profile`: profile-likelihood intervals and score tests for
-// every block — valid when the pairs were chosen from earlier answers (an active design), where resampling
-// observers is not (docs/analysis.md, "Validation of active designs").
+// every block. `bootstrapAndProfile`: the union of the two intervals, a pair's p-value the larger of the two — the
+// default for adaptive (active) designs, where each observer's pairs depend on earlier answers and neither interval
+// alone covers 95 % at every number of observers (docs/analysis.md, "Validation of active designs").
 // `percentile`: pwcmp's percentile bootstrap over observers (pw_scale_bootstrp), for comparison with pwcmp; its
 // coverage is below nominal (docs/analysis.md).
-enum class IntervalMethod { bootstrap, profile, percentile };
+enum class IntervalMethod { bootstrap, profile, percentile, bootstrapAndProfile };
+
+// The default of a study's responses: bootstrapAndProfile for an adaptive design, bootstrap otherwise.
+IntervalMethod defaultIntervals(bool adaptiveDesign);
+// The method's name in scale.json's settings ("bootstrap", "profile", "percentile", "bootstrap+profile").
+const char* intervalsName(IntervalMethod method);
 
 struct AnalysisOptions {
     FitOptions fit; // fit.model is ignored: both models are always fitted

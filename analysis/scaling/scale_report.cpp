@@ -116,13 +116,15 @@ nlohmann::json analysisJson(const Analysis& analysis) {
         {"prior_precision", o.fit.prior == Prior::Gaussian ? nlohmann::json(o.fit.priorPrecision) : nlohmann::json()},
         {"interval", o.intervals == IntervalMethod::percentile
                          ? "percentile bootstrap over observers (pwcmp's pw_scale_bootstrp), bootstrap p-values"
+                     : o.intervals == IntervalMethod::profile ? "profile-posterior intervals and score tests"
+                     : o.intervals == IntervalMethod::bootstrapAndProfile
+                         ? "union of the symmetric studentized bootstrap over observers and the profile-posterior "
+                           "interval; a pair's p-value the larger of the bootstrap and score tests' (active designs)"
                          : "symmetric studentized bootstrap over observers, cluster-robust SE; where the "
                            "studentization is degenerate (flagged per interval) the hull of the percentile "
                            "and the profile-posterior intervals, with a score test; ends the data do not set are "
                            "open (bound)"},
-        {"intervals", o.intervals == IntervalMethod::profile      ? "profile"
-                      : o.intervals == IntervalMethod::percentile ? "percentile"
-                                                                  : "bootstrap"},
+        {"intervals", intervalsName(o.intervals)},
         {"intervals_reason", o.intervalReason},
         {"level", o.bootstrap.level},
         {"bootstrap_samples", o.bootstrap.samples},
@@ -262,6 +264,11 @@ std::string reportSectionHtml(const Analysis& analysis) {
          << "; " << fixed(100 * o.bootstrap.level, 0)
          << (o.intervals == IntervalMethod::profile
                  ? " % profile-likelihood intervals (" + o.intervalReason + ") and score tests; "
+             : o.intervals == IntervalMethod::bootstrapAndProfile
+                 ? " % intervals that are the union of a symmetric studentized bootstrap over observers (" +
+                       std::to_string(o.bootstrap.samples) + " samples, seed " + std::to_string(o.bootstrap.seed) +
+                       ") and the profile-likelihood interval (" + o.intervalReason +
+                       "), with the larger of the bootstrap and score tests' p-values; "
              : o.intervals == IntervalMethod::percentile
                  ? " % percentile bootstrap intervals over observers (pwcmp's construction, " +
                        std::to_string(o.bootstrap.samples) + " samples) and bootstrap p-values; "

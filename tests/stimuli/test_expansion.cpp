@@ -439,6 +439,8 @@ TEST(ShippedSpecs, ExpandToTheDocumentedCounts) {
                                                                   {"extensions-halo.toml", 50},
                                                                   {"extensions-bleed.toml", 25},
                                                                   {"extensions-head.toml", 25},
+                                                                  {"extensions-ear.toml", 16},
+                                                                  {"extensions-flat.toml", 10},
                                                                   {"eevee-methods.toml", 7},
                                                                   {"eevee-methods-scan.toml", 7}};
     size_t specs = 0;
