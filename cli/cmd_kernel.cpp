@@ -67,7 +67,7 @@ nlohmann::json statisticsJson(const sss::SssParams& params, const sss::Kernel& k
     if (params.method == sss::SssMethod::Separable) {
         // The continuous marginal the taps discretise, at the same surface scale (width_mm / 3).
         const auto marginal = sss::makeMarginal(params);
-        const double scale = params.widthMm / 3.0;
+        const double scale = sss::profileScale(params.widthMm);
         std::array<double, 3> rms{}, beyond{};
         for (int c = 0; c < 3; ++c) {
             rms[c] = std::sqrt(marginal->secondMoment(c)) * scale;

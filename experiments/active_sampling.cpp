@@ -166,8 +166,37 @@ ScorePosterior fitPosterior(int conditions, const std::vector<Comparison>& answe
     return fitPosteriorFromCounts(conditions, pairs, options);
 }
 
+namespace {
+ScorePosterior fitWithFixedPrior(int conditions, const std::vector<PairCount>& counts, const PosteriorOptions& options);
+} // namespace
+
 ScorePosterior fitPosteriorFromCounts(int conditions, const std::vector<PairCount>& counts,
                                       const PosteriorOptions& options) {
+    ScorePosterior posterior = fitWithFixedPrior(conditions, counts, options);
+    posterior.priorVariance = options.priorVariance;
+    if (!options.empiricalPrior || counts.empty()) return posterior;
+    // Empirical Bayes: the prior variance that maximises the marginal likelihood, by EM — v ← mean_i E[s_i²] =
+    // mean_i (μ_i² + Σ_ii) under the current posterior — kept within [priorVariance, maxPriorVariance].
+    PosteriorOptions current = options;
+    for (int step = 0; step < 8; ++step) {
+        double second = 0.0;
+        for (int i = 0; i < conditions; ++i)
+            second += posterior.mean[static_cast<std::size_t>(i)] * posterior.mean[static_cast<std::size_t>(i)] +
+                      posterior.variance(i);
+        const double next = std::clamp(second / conditions, options.priorVariance,
+                                       std::max(options.priorVariance, options.maxPriorVariance));
+        const bool settled = std::abs(next - current.priorVariance) < 0.01 * current.priorVariance;
+        current.priorVariance = next;
+        posterior = fitWithFixedPrior(conditions, counts, current);
+        posterior.priorVariance = next;
+        if (settled) break;
+    }
+    return posterior;
+}
+
+namespace {
+ScorePosterior fitWithFixedPrior(int conditions, const std::vector<PairCount>& counts,
+                                 const PosteriorOptions& options) {
     if (conditions < 1) throw RuntimeError("active sampling: a block needs at least one condition");
     std::vector<Comparison> ends; // site k is a function of d_k = q_ends[k].winner − q_ends[k].loser
     std::vector<double> iWon, jWon;
@@ -245,6 +274,8 @@ ScorePosterior fitPosteriorFromCounts(int conditions, const std::vector<PairCoun
     }
     return out;
 }
+
+} // namespace
 
 double expectedInformationGain(const ScorePosterior& p, int i, int j) {
     const double md = p.mean[static_cast<std::size_t>(i)] - p.mean[static_cast<std::size_t>(j)];

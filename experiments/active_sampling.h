@@ -43,6 +43,11 @@ struct PosteriorOptions {
     // chains the comparison graph (measured at m = 30, true sd 1 JOD, 1740 comparisons: RMSE 0.266 with a prior sd
     // of 2 JOD, 0.220 with 1 JOD).
     double priorVariance = 1.0;
+    // Empirical Bayes: the prior's variance estimated from the answers (EM on the marginal likelihood), at least
+    // `priorVariance` and at most `maxPriorVariance`: a study does not know its scores' spread in advance, and the
+    // best fixed prior is the true spread (docs/benchmarks.md, "Active sampling").
+    bool empiricalPrior = false;
+    double maxPriorVariance = 9.0;
     // Sweeps stop when no mean or standard deviation moved more than `tolerance` JOD in a sweep.
     int maxSweeps = 50;
     double tolerance = 1e-6;
@@ -54,6 +59,7 @@ struct ScorePosterior {
     int comparisons = 0;
     int sweeps = 0;
     bool converged = true;
+    double priorVariance = 1.0; // the prior the posterior was fitted with (estimated with empiricalPrior)
     int conditions() const { return static_cast<int>(mean.size()); }
     double cov(int i, int j) const {
         return covariance[static_cast<std::size_t>(i) * mean.size() + static_cast<std::size_t>(j)];

@@ -26,6 +26,15 @@ namespace beast = boost::beast;
 namespace http = beast::http;
 using tcp = asio::ip::tcp;
 
+HttpResponse jsonResponse(int status, const nlohmann::json& body) {
+    HttpResponse res;
+    res.status = status;
+    res.contentType = "application/json";
+    res.headers.emplace_back("Cache-Control", "no-store");
+    res.body = body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+    return res;
+}
+
 namespace {
 
 bool equalsIgnoringCase(std::string_view a, std::string_view b) {

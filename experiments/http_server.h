@@ -10,6 +10,7 @@
 // 400 malformed, 408 too slow, 413 body too large, 431 header too large, 429 too many connections from one address,
 // 501 a transfer coding other than chunked (the connection is closed).
 #include <chrono>
+#include <nlohmann/json_fwd.hpp>
 #include <cstddef>
 #include <functional>
 #include <memory>
@@ -45,6 +46,10 @@ struct HttpResponse {
     std::string body;
     std::shared_ptr<const std::string> sharedBody; // when set, sent instead of `body` (not copied)
 };
+
+// A JSON answer: `body` serialised (invalid UTF-8 replaced), Content-Type application/json, never cached. Every JSON
+// API of skinlab's servers (study, dashboard, tune) answers through it.
+HttpResponse jsonResponse(int status, const nlohmann::json& body);
 
 using HttpHandler = std::function<HttpResponse(const HttpRequest&)>;
 

@@ -1,5 +1,6 @@
 #include "experiments/simulated_observers.h"
 
+#include "common/time.h"
 #include "experiments/recruitment.h"
 
 #include "common/error.h"

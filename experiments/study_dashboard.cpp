@@ -1,5 +1,6 @@
 #include "experiments/study_dashboard.h"
 
+#include "common/time.h"
 #include "analysis/scaling/responses.h"
 #include "analysis/scaling/scale_analysis.h"
 #include "analysis/scaling/screening.h"

@@ -32,15 +32,6 @@ namespace {
 constexpr std::size_t kMaxTokenLength = 64;
 constexpr std::size_t kMaxTextLength = 512;
 
-HttpResponse jsonResponse(int status, const json& body) {
-    HttpResponse res;
-    res.status = status;
-    res.contentType = "application/json";
-    res.headers.emplace_back("Cache-Control", "no-store");
-    res.body = body.dump(-1, ' ', false, json::error_handler_t::replace);
-    return res;
-}
-
 HttpResponse errorResponse(int status, const std::string& message) {
     return jsonResponse(status, json{{"error", message}});
 }

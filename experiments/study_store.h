@@ -274,8 +274,6 @@ std::int64_t trialReference(const std::string& participantToken, std::int64_t tr
 // U+FFFD, and a character cut by the limit is dropped whole. Every client string is stored through this.
 std::string validUtf8(std::string_view text, std::size_t maxBytes);
 
-// Current UTC time as ISO-8601 with milliseconds ("2026-11-23T14:05:31.207Z").
-std::string utcTimestamp();
 // Random lower-case hex string of `bytes` bytes from the OS entropy source (tokens).
 std::string randomHex(std::size_t bytes);
 

@@ -7,6 +7,7 @@
 #include "analysis/scaling/scale_report.h"
 #include "common/error.h"
 #include "common/files.h"
+#include "common/process.h"
 #include "common/html.h"
 #include "common/version.h"
 #include "experiments/study_store.h"
@@ -796,18 +797,22 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
         fs::remove_all(profile);
         const fs::path pdf = out / "report.pdf";
         const fs::path temp = out / (".report.pdf.tmp-" + std::to_string(::getpid()));
-        auto quote = [](const std::string& s) {
-            std::string q = "'";
-            for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-            return q + "'";
-        };
-        std::string command = "timeout 180 " + quote(options.chromium) +
-                              " --headless --no-sandbox --disable-gpu --disable-quic --no-first-run "
-                              "--disable-background-networking --disable-component-update --disable-sync "
-                              "--no-pdf-header-footer --user-data-dir=" +
-                              quote(profile.string()) + " --print-to-pdf=" + quote(temp.string()) + " " +
-                              quote("file://" + fs::absolute(out / "index.html").string()) + " >/dev/null 2>&1";
-        int status = std::system(command.c_str());
+        // Chromium under coreutils' timeout (a hung browser ends the report without a PDF, not the program).
+        const fs::path timeout = findProgram("timeout");
+        const fs::path chromium = findProgram(options.chromium);
+        int status = -1;
+        if (!timeout.empty() && !chromium.empty()) {
+            try {
+                status = waitProcess(
+                    spawnProcess(timeout, {"180", chromium.string(), "--headless", "--no-sandbox", "--disable-gpu",
+                                           "--disable-quic", "--no-first-run", "--disable-background-networking",
+                                           "--disable-component-update", "--disable-sync", "--no-pdf-header-footer",
+                                           "--user-data-dir=" + profile.string(), "--print-to-pdf=" + temp.string(),
+                                           "file://" + fs::absolute(out / "index.html").string()}));
+            } catch (const RuntimeError& e) {
+                spdlog::warn("report: {}", e.what());
+            }
+        }
         fs::remove_all(profile);
         std::error_code ec;
         if (status == 0 && fs::is_regular_file(temp, ec) && fs::file_size(temp, ec) > 0) {

@@ -2,6 +2,8 @@
 
 #include "common/error.h"
 #include "common/files.h"
+#include "common/process.h"
+#include "common/time.h"
 #include "stimuli/manifest.h"
 
 #include <cctype>
@@ -12,13 +14,8 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <poll.h>
-#include <spawn.h>
 #include <sstream>
-#include <sys/wait.h>
 #include <unistd.h>
-
-extern char** environ;
 
 namespace skinlab::stimuli {
 
@@ -31,76 +28,12 @@ constexpr const char* kJobsFormat = "skinlab-slurm";
 
 // ---- running Slurm's commands -------------------------------------------------------------------------------
 
-// The full path of `program` on $PATH, or empty.
-fs::path findOnPath(const std::string& program) {
-    const char* path = std::getenv("PATH");
-    std::stringstream dirs(path ? path : "/usr/local/bin:/usr/bin:/bin");
-    std::string dir;
-    while (std::getline(dirs, dir, ':')) {
-        if (dir.empty()) dir = ".";
-        fs::path candidate = fs::path(dir) / program;
-        if (::access(candidate.c_str(), X_OK) == 0 && fs::is_regular_file(candidate)) return candidate;
-    }
-    return {};
-}
-
-struct ProgramRun {
-    int exitCode = -1;
-    std::string out, err;
-};
-
-// Runs `argv` (argv[0] a full path) and collects its stdout and stderr.
+// Slurm's commands run through common/process.h: found on PATH, stdout and stderr collected.
+using ProgramRun = CapturedRun;
 ProgramRun runProgram(const std::vector<std::string>& argv) {
-    int outPipe[2], errPipe[2];
-    if (::pipe(outPipe) != 0 || ::pipe(errPipe) != 0) throw RuntimeError(std::string("pipe: ") + std::strerror(errno));
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_adddup2(&actions, outPipe[1], 1);
-    posix_spawn_file_actions_adddup2(&actions, errPipe[1], 2);
-    posix_spawn_file_actions_addclose(&actions, outPipe[0]);
-    posix_spawn_file_actions_addclose(&actions, errPipe[0]);
-    std::vector<std::string> copy = argv;
-    std::vector<char*> args;
-    for (auto& a : copy) args.push_back(a.data());
-    args.push_back(nullptr);
-    pid_t pid = 0;
-    int rc = ::posix_spawn(&pid, args[0], &actions, nullptr, args.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    ::close(outPipe[1]);
-    ::close(errPipe[1]);
-    if (rc != 0) {
-        ::close(outPipe[0]);
-        ::close(errPipe[0]);
-        throw RuntimeError(argv[0] + ": cannot run (" + std::strerror(rc) + ")");
-    }
-    ProgramRun run;
-    pollfd fds[2] = {{outPipe[0], POLLIN, 0}, {errPipe[0], POLLIN, 0}};
-    std::string* sinks[2] = {&run.out, &run.err};
-    int open = 2;
-    char buffer[4096];
-    while (open > 0) {
-        if (::poll(fds, 2, -1) < 0) {
-            if (errno == EINTR) continue;
-            break;
-        }
-        for (int k = 0; k < 2; ++k) {
-            if (fds[k].fd < 0 || !(fds[k].revents & (POLLIN | POLLHUP | POLLERR))) continue;
-            ssize_t n = ::read(fds[k].fd, buffer, sizeof buffer);
-            if (n > 0) {
-                sinks[k]->append(buffer, static_cast<size_t>(n));
-            } else if (n == 0 || errno != EINTR) {
-                ::close(fds[k].fd);
-                fds[k].fd = -1;
-                --open;
-            }
-        }
-    }
-    int status = 0;
-    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-    }
-    run.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    return run;
+    return runCaptured(argv.front(), std::vector<std::string>(argv.begin() + 1, argv.end()));
 }
+fs::path findOnPath(const std::string& program) { return findProgram(program); }
 
 std::string trim(std::string text) {
     while (!text.empty() && std::isspace(static_cast<unsigned char>(text.back()))) text.pop_back();
@@ -172,13 +105,6 @@ nlohmann::json readJobs(const fs::path& out) {
     if (!jobs.is_object() || jobs.value("format", "") != kJobsFormat || !jobs.contains("submissions"))
         throwInput(file.string(), "", "is not a skinlab Slurm job record");
     return jobs;
-}
-
-std::string utcNow() {
-    std::time_t now = std::time(nullptr);
-    char text[32];
-    std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
-    return text;
 }
 
 // "1234" from sbatch --parsable's "1234" or "1234;cluster".
@@ -362,7 +288,8 @@ SlurmSubmission submitSlurm(const SlurmOptions& o) {
     }
     // The folder is this set's from now on, even if sbatch refuses the scripts (a corrected command may retry).
     writeFileAtomic(slurmFolder(out) / kJobsFile, jobs.dump(2) + "\n");
-    nlohmann::json record = {{"submitted", utcNow()}, {"shards", submission.scripts.shards}, {"command", o.command}};
+    nlohmann::json record = {
+        {"submitted", utcTimestamp()}, {"shards", submission.scripts.shards}, {"command", o.command}};
 
     ProgramRun array = runProgram({sbatch.string(), "--parsable", submission.scripts.buildPath.string()});
     if (array.exitCode != 0)

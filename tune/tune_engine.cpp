@@ -2,18 +2,15 @@
 
 #include "common/error.h"
 #include "common/hash.h"
+#include "common/process.h"
 
 #include <algorithm>
 #include <csignal>
 #include <cstring>
-#include <fcntl.h>
 #include <fstream>
-#include <spawn.h>
 #include <spdlog/spdlog.h>
 #include <sys/wait.h>
 #include <unistd.h>
-
-extern char** environ;
 
 namespace skinlab::tune {
 
@@ -169,7 +166,7 @@ std::string JobRunner::start(const TuneConfig& config, const std::string& method
     job->status.png = folder_ / (job->status.id + ".png");
     job->log = folder_ / (job->status.id + ".log");
 
-    std::vector<std::string> arguments{executable_.string(), "render", "--scene", config.scene};
+    std::vector<std::string> arguments{"render", "--scene", config.scene};
     for (const std::string& o : config.overrides) {
         arguments.push_back("--set");
         arguments.push_back(o);
@@ -181,26 +178,17 @@ std::string JobRunner::start(const TuneConfig& config, const std::string& method
     for (const std::string& a :
          {std::string("-o"), job->status.exr.string(), std::string("--png"), job->status.png.string()})
         arguments.push_back(a);
-    std::vector<char*> argv;
-    for (std::string& a : arguments) argv.push_back(a.data());
-    argv.push_back(nullptr);
-
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, job->log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-    posix_spawn_file_actions_addclosefrom_np(&actions, 3); // not the server's sockets
-    posix_spawnattr_t attributes;
-    posix_spawnattr_init(&attributes);
-    posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP);
-    posix_spawnattr_setpgroup(&attributes, 0); // its own group: cancel ends Blender with it
+    SpawnOptions options;
+    options.output = job->log;
+    options.appendOutput = false;
+    options.closeInheritedFiles = true; // not the server's sockets
+    options.ownProcessGroup = true;     // cancel ends Blender with it
     pid_t pid = -1;
-    const int error = posix_spawn(&pid, executable_.c_str(), &actions, &attributes, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    posix_spawnattr_destroy(&attributes);
-    if (error != 0)
-        throw RuntimeError(executable_.string() + ": cannot start a background render (" + std::strerror(error) + ")");
+    try {
+        pid = spawnProcess(executable_, arguments, options);
+    } catch (const RuntimeError& e) {
+        throw RuntimeError(std::string("a background render: ") + e.what());
+    }
     job->pid = pid;
     job->started = std::chrono::steady_clock::now();
     jobs_[job->status.id] = job;

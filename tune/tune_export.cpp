@@ -198,7 +198,7 @@ nlohmann::json kernelCurves(const TuneConfig& config) {
     out["kernel"] = kernel.toJson();
 
     // A common radius axis: the widest of the method's support and the comparison profiles' 99.8 % radius.
-    const double scale = params.widthMm / 3.0;
+    const double scale = sss::profileScale(params.widthMm);
     const sss::GaussianSumProfile deon(sss::deonSkinLobes(), "d'Eon six-Gaussian skin profile");
     const sss::BurleyProfile burley(sss::burleyShapeMm("skin"), "Burley normalized diffusion, material skin");
     double radius =

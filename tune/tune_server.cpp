@@ -35,21 +35,13 @@ namespace {
 
 using experiments::HttpRequest;
 using experiments::HttpResponse;
+using experiments::jsonResponse;
 using experiments::RequestError;
 using json = nlohmann::json;
 namespace sss = renderer::sss;
 
 constexpr std::size_t kMaxOverrides = 64;
 constexpr std::size_t kMaxField = 512;
-
-HttpResponse jsonResponse(int status, const json& body) {
-    HttpResponse res;
-    res.status = status;
-    res.contentType = "application/json";
-    res.headers.emplace_back("Cache-Control", "no-store");
-    res.body = body.dump(-1, ' ', false, json::error_handler_t::replace);
-    return res;
-}
 
 std::string lowerCase(std::string text) {
     std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::tolower(c); });

@@ -74,7 +74,8 @@ struct Settings {
     int bootstrap = 200;
     double spread = 1.0; // true scores ~ N(0, spread²) JOD, or uniform with this sd
     std::string truth = "normal";
-    double priorSd = 1.0;                   // prior sd of the active design's posterior (JOD)
+    double priorSd = 1.0;        // prior sd of the active design's posterior (JOD)
+    bool empiricalPrior = false; // --empirical-prior: the prior's sd estimated from the answers (≥ priorSd)
     std::string selection = "mst-variance"; // active batches (the server's), mst-gain, greedy or variance
     bool timing = true;
     std::vector<double> coverageRounds = {0.6, 1.0, 1.2, 2.0, 2.4}; // coverage budgets, in full rounds
@@ -173,6 +174,7 @@ std::vector<Trial> simulateDesign(int design, const std::vector<double>& truth, 
         std::uint64_t batch = 0;
         ac::PosteriorOptions posteriorOptions;
         posteriorOptions.priorVariance = settings.priorSd * settings.priorSd;
+        posteriorOptions.empiricalPrior = settings.empiricalPrior;
         while (trials.size() < length) {
             const ac::ScorePosterior posterior = ac::fitPosterior(m, answers, posteriorOptions);
             const std::uint64_t tieSeed = seed * 1000003u + batch++;
@@ -348,11 +350,11 @@ std::string percent(double saving, double floor) {
 int runSweep(const Settings& s) {
     const auto start = std::chrono::steady_clock::now();
     const double largestBudget = *std::max_element(s.budgets.begin(), s.budgets.end());
-    std::printf("Saving of the active design (%s batches, prior sd %.2f JOD) against the full design, %d seeds per "
+    std::printf("Saving of the active design (%s batches, prior sd %.2f JOD%s) against the full design, %d seeds per "
                 "cell; true scores ~ N(0, sd^2) JOD; observers answer m-1 trials each; active runs to %.2f x the "
                 "largest budget (%.1f full rounds); hardware threads %u, %d worker threads.\n\n",
-                s.selection.c_str(), s.priorSd, s.seeds, s.horizon, s.horizon * largestBudget,
-                std::thread::hardware_concurrency(), s.threads);
+                s.selection.c_str(), s.priorSd, s.empiricalPrior ? ", empirical Bayes above it" : "", s.seeds,
+                s.horizon, s.horizon * largestBudget, std::thread::hardware_concurrency(), s.threads);
     std::printf("| m | sd | budget: rounds (observers, trials) | RMSE full | RMSE active | pooled saving [95 %% CI] | "
                 "per-seed saving: median [10 %%, 90 %%] | seeds >= 40 %% | seeds never | A-opt bound | time (s) |\n"
                 "|---|---|---|---|---|---|---|---|---|---|---|\n");
@@ -483,6 +485,11 @@ int main(int argc, char** argv) {
         const std::string key = argv[k];
         if (key == "--sweep") {
             s.sweep = true;
+            --k;
+            continue;
+        }
+        if (key == "--empirical-prior") {
+            s.empiricalPrior = true;
             --k;
             continue;
         }

@@ -13,6 +13,7 @@
 // Usage: bench_experiments_browser_load [--participants N] [--think-ms MIN:MAX] [--ramp-s S] [--slow-headers N]
 //          [--chunked-floods N] [--kill-at F1,F2] [--image-kib K] [--folder DIR] [--server PATH]
 // Prints a summary (Markdown rows for docs/benchmarks.md).
+#include "bench/bench_stats.h"
 #include "common/files.h"
 #include "bench_stimulus_set.h"
 #include "experiments/study_creation.h"
@@ -137,12 +138,7 @@ struct Stats {
     std::map<int, int> statuses;
 };
 
-double percentile(std::vector<double> v, double p) {
-    if (v.empty()) return NAN;
-    std::sort(v.begin(), v.end());
-    const std::size_t rank = static_cast<std::size_t>(std::ceil(p / 100.0 * static_cast<double>(v.size())));
-    return v[std::min(v.size() - 1, rank == 0 ? 0 : rank - 1)];
-}
+double percentile(const std::vector<double>& v, double p) { return skinlab::bench::nearestRankPercentile(v, p); }
 
 class Participant : public std::enable_shared_from_this<Participant> {
 public:

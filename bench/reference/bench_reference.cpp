@@ -4,6 +4,7 @@
 // median of `repeats` runs. CPU time is the figure to compare on a shared, loaded machine: wall-clock time grows
 // with the load of other processes, CPU time does not.
 //   bench_reference [repeats=3]
+#include "bench/bench_stats.h"
 #include "renderer/reference/radial_profile.h"
 #include "renderer/reference/surface_convolution.h"
 #include "renderer/reference/tessellation.h"
@@ -21,10 +22,8 @@ using namespace skinlab::renderer;
 using namespace skinlab::renderer::reference;
 
 namespace {
-double median(std::vector<double> values) {
-    std::sort(values.begin(), values.end());
-    return values[values.size() / 2];
-}
+
+using skinlab::bench::median;
 
 void run(const char* name, const Model& model, float edgeMm, int repeats) {
     std::vector<double> tessellateMs, convolveMs, convolveCpuMs;

@@ -5,6 +5,7 @@
 // then N measured frames; prints the median per pass (GPU timer queries, cross-checked with glFinish wall
 // clock) and the wall-clock total of the passes, and writes one CSV row per scene and pass. --set overrides a
 // scene key for every scene (repeatable), e.g. --set transmittance.enabled=true.
+#include "bench/bench_stats.h"
 #include "common/files.h"
 #include "renderer/renderer.h"
 
@@ -18,11 +19,7 @@
 
 namespace {
 
-double median(std::vector<double> values) {
-    std::sort(values.begin(), values.end());
-    const std::size_t n = values.size();
-    return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
+using skinlab::bench::median;
 
 } // namespace
 

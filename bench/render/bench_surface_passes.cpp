@@ -6,6 +6,7 @@
 // minimum and median per pass for each setting (the minimum is the figure least disturbed by other processes) and
 // the median of the paired differences of the main pass (on − off), the cost of transmittance inside the main
 // pass. GPU ms from the renderer's timer queries.
+#include "bench/bench_stats.h"
 #include "renderer/renderer.h"
 
 #include <algorithm>
@@ -18,14 +19,10 @@
 
 namespace {
 
+using skinlab::bench::median;
+
 double minimum(const std::vector<double>& values) {
     return values.empty() ? 0.0 : *std::min_element(values.begin(), values.end());
-}
-
-double median(std::vector<double> values) {
-    std::sort(values.begin(), values.end());
-    const std::size_t n = values.size();
-    return n == 0 ? 0.0 : n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
 } // namespace

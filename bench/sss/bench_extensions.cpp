@@ -5,6 +5,7 @@
 // For every method and extension set: one warm-up render (kernel construction, shader compilation), then N measured
 // renders; the SSS stage's GPU time (GL_TIME_ELAPSED) is reported as the median and the minimum (on a machine
 // shared with other work the minimum is the figure least disturbed by it). Prints a Markdown table.
+#include "bench/bench_stats.h"
 #include "renderer/renderer.h"
 #include "renderer/sss/sss_params.h"
 
@@ -18,19 +19,9 @@
 
 namespace {
 
-double median(std::vector<double> values) {
-    std::sort(values.begin(), values.end());
-    const std::size_t n = values.size();
-    return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
+using skinlab::bench::median;
 
-std::vector<std::string> split(const std::string& text) {
-    std::vector<std::string> parts;
-    std::stringstream stream(text);
-    std::string part;
-    while (std::getline(stream, part, ',')) parts.push_back(part);
-    return parts;
-}
+std::vector<std::string> split(const std::string& text) { return skinlab::bench::splitCommas(text); }
 
 struct ExtensionSet {
     const char* name;

@@ -6,6 +6,7 @@
 // measured renders; the SSS stage's GPU time (GL_TIME_ELAPSED, cross-checked against glFinish wall time by the
 // renderer) is reported as the median, and the minimum beside it (on a machine shared with other work the minimum
 // is the figure least disturbed by it). Writes DIR/sss.csv and DIR/sss.png (atomically) and prints a table.
+#include "bench/bench_stats.h"
 #include "common/files.h"
 #include "renderer/renderer.h"
 #include "renderer/sss/sss_params.h"
@@ -22,19 +23,9 @@
 
 namespace {
 
-double median(std::vector<double> values) {
-    std::sort(values.begin(), values.end());
-    const std::size_t n = values.size();
-    return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
+using skinlab::bench::median;
 
-std::vector<std::string> split(const std::string& text) {
-    std::vector<std::string> parts;
-    std::stringstream stream(text);
-    std::string part;
-    while (std::getline(stream, part, ',')) parts.push_back(part);
-    return parts;
-}
+std::vector<std::string> split(const std::string& text) { return skinlab::bench::splitCommas(text); }
 
 // Share of pixels with skin mask > 0 in an EXR written by the renderer.
 double skinShare(const std::filesystem::path& exr) {

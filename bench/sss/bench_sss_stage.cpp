@@ -7,6 +7,7 @@
 // the same textures, timed by glFinish wall clock around SssStage::run (llvmpipe: the GPU is the CPU). The first
 // repeat (shader compilation, kernel construction) is discarded; the minimum and the median of the rest are
 // reported. Writes DIR/sss_stage.csv atomically and prints a table.
+#include "bench/bench_stats.h"
 #include "common/files.h"
 #include "renderer/gl/gl_resources.h"
 #include "renderer/gl/shader_library.h"
@@ -28,21 +29,11 @@
 
 namespace {
 
+using skinlab::bench::median;
+
 using namespace skinlab::renderer;
 
-double median(std::vector<double> values) {
-    std::sort(values.begin(), values.end());
-    const std::size_t n = values.size();
-    return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
-
-std::vector<std::string> split(const std::string& text) {
-    std::vector<std::string> parts;
-    std::stringstream stream(text);
-    std::string part;
-    while (std::getline(stream, part, ',')) parts.push_back(part);
-    return parts;
-}
+std::vector<std::string> split(const std::string& text) { return skinlab::bench::splitCommas(text); }
 
 // The AOVs of one rendered frame as GL textures (rows flipped: the EXR is top row first, GL bottom row first).
 struct FrozenFrame {

@@ -5,6 +5,7 @@
 // up and down: the SSS stage and tone map re-run), N that orbit the camera (camera.yaw_deg: the main passes re-run,
 // the shadow maps stay) and N that move a light's intensity (shadow maps and main passes re-run). Each figure is the whole round trip the page waits for: request, render, read-back, sRGB encoding, PNG,
 // base64 and answer. Prints p50 and p95 per method and kind of change.
+#include "bench/bench_stats.h"
 #include "experiments/http_client.h"
 #include "renderer/sss/sss_params.h"
 #include "tune/tune_server.h"
@@ -22,13 +23,7 @@
 
 namespace {
 
-double percentile(std::vector<double> values, double p) {
-    std::sort(values.begin(), values.end());
-    const double position = p * static_cast<double>(values.size() - 1);
-    const auto below = static_cast<std::size_t>(position);
-    const auto above = std::min(below + 1, values.size() - 1);
-    return values[below] + (position - static_cast<double>(below)) * (values[above] - values[below]);
-}
+using skinlab::bench::percentile;
 
 } // namespace
 

@@ -25,7 +25,7 @@ PscbfMethod::PscbfMethod(ShaderLibrary& shaders) : shaders_(shaders) {}
 
 glm::dvec3 PscbfMethod::depthSigmaMm(const sss::SssParams& params) {
     const auto& variance = sss::mikkelsenSkinProfile(params.pscbfSigma).varianceMm2;
-    const double scale = params.widthMm / 3.0;
+    const double scale = sss::profileScale(params.widthMm);
     return {std::sqrt(variance[0]) * scale, std::sqrt(variance[1]) * scale, std::sqrt(variance[2]) * scale};
 }
 

@@ -1,6 +1,8 @@
 #pragma once
 // Blender as a child process (never linked): found on PATH or by path, run headless with its output kept in a
 // log file. docs/pathtraced.md, "Running Blender".
+#include "common/process.h"
+
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -8,15 +10,7 @@
 
 namespace skinlab::renderer::pathtraced {
 
-// The program's full path: `program` itself when it contains a '/', else the first executable of that name on
-// PATH; empty when there is none.
-std::filesystem::path findProgram(const std::string& program);
-
-// Runs `program args...` in `workingDirectory` with stdin from /dev/null and stdout + stderr appended to
-// `logPath`; waits and returns the exit status (128 + signal when killed by a signal). Throws InputError naming
-// the program when it cannot be started.
-int runProcess(const std::filesystem::path& program, const std::vector<std::string>& args,
-               const std::filesystem::path& workingDirectory, const std::filesystem::path& logPath);
+using skinlab::findProgram; // common/process.h
 
 // Runs `blender -b --factory-startup -noaudio --python SCRIPT -- ARGS...`. Throws InputError naming the program
 // (missing: how to install it, and `key`, the spec key that names the program) or, when it fails, its exit status,

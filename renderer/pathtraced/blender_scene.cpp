@@ -1,4 +1,5 @@
 #include "renderer/pathtraced/blender_scene.h"
+#include "renderer/sss/sss_params.h"
 
 #include "common/error.h"
 #include "common/files.h"
@@ -108,7 +109,7 @@ nlohmann::json blenderSceneJson(const BlenderSceneInputs& inputs, std::string_vi
     scene["record"] = std::string(record);
 
     // Materials: one per part. Radii: the profile's mm at width 3 mm, scaled like every kernel, in scene units.
-    const double radiusScale = inputs.sssWidthMm / 3.0 / spec.mmPerUnit;
+    const double radiusScale = sss::profileScale(inputs.sssWidthMm) / spec.mmPerUnit;
     nlohmann::json materials = nlohmann::json::array();
     for (std::size_t i = 0; i < inputs.partMaterials.size(); ++i) {
         const PartMaterial& m = inputs.partMaterials[i];

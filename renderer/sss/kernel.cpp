@@ -16,9 +16,7 @@
 namespace skinlab::renderer::sss {
 
 namespace {
-// Profile millimetres → surface millimetres: sss.width_mm is where the kernel edge (±3 profile-mm) lands on the
-// surface; the demo's kernel edge lies at 2 · sssWidth world units (widthMmFromDemoSssWidth).
-double widthScale(const SssParams& params) { return params.widthMm / 3.0; }
+double widthScale(const SssParams& params) { return profileScale(params.widthMm); }
 
 void scaleOffsets(std::vector<KernelTap>& taps, double scale) {
     for (auto& tap : taps) tap.offsetMm *= scale;

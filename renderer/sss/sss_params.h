@@ -108,6 +108,14 @@ std::string_view methodName(SssMethod method);
 std::string_view pscbfSigmaName(PscbfSigma reading);
 std::string_view placementName(TapPlacement placement);
 
+// Profile millimetres → surface millimetres. Every profile is tabulated at a width of 3 mm; sss.width_mm is where
+// its kernel edge (±3 profile-mm) lands on the surface (the demo's kernel edge lies at 2 · sssWidth world units,
+// widthMmFromDemoSssWidth), so a profile distance o lies at o · profileScale(width_mm) on the surface. The
+// screen-space kernels, the object-space reference, pscbf's depth sigmas, the kernel views and the Blender radii
+// all scale by it.
+constexpr double kProfileWidthMm = 3.0;
+constexpr double profileScale(double widthMm) { return widthMm / kProfileWidthMm; }
+
 // The typed values of the [sss] table. Which fields the chosen method reads is given by its row of the method
 // table (methodTable()): the reader accepts only those keys, and toJson() writes only those.
 struct SssParams {

@@ -103,6 +103,29 @@ TEST(ActiveSampling, PosteriorConvergesToTheTrueScores) {
     EXPECT_GT(previousSd, 0.01);
 }
 
+// The empirical-Bayes prior follows the spread of the answers: near the spread of widely spaced true scores (sd
+// about 2.4 JOD here), at its floor for scores within a JOD, the fixed prior when there are no answers; and its
+// posterior means are farther apart than the fixed sd-1 prior's (less shrinkage).
+TEST(ActiveSampling, EmpiricalPriorFollowsTheSpreadOfTheAnswers) {
+    PosteriorOptions empirical;
+    empirical.empiricalPrior = true;
+    const std::vector<double> wide = {-4.0, -2.0, -0.5, 0.5, 2.0, 4.0};
+    const ScorePosterior spread = fitPosterior(6, simulate(wide, 20, 7), empirical);
+    const double trueVariance = std::inner_product(wide.begin(), wide.end(), wide.begin(), 0.0) / 6.0; // 7.08
+    EXPECT_GT(spread.priorVariance, 0.6 * trueVariance);
+    EXPECT_LE(spread.priorVariance, empirical.maxPriorVariance);
+    const ScorePosterior fixed = fitPosterior(6, simulate(wide, 20, 7));
+    EXPECT_EQ(fixed.priorVariance, 1.0);
+    EXPECT_GT(spread.mean[5] - spread.mean[0], fixed.mean[5] - fixed.mean[0]);
+
+    const std::vector<double> close = {-0.3, -0.1, 0.0, 0.1, 0.2, 0.3};
+    EXPECT_EQ(fitPosterior(6, simulate(close, 20, 7), empirical).priorVariance, 1.0) << "never below the floor";
+    EXPECT_EQ(fitPosterior(6, {}, empirical).priorVariance, 1.0) << "no answers: the prior as given";
+    PosteriorOptions capped = empirical;
+    capped.maxPriorVariance = 2.0;
+    EXPECT_EQ(fitPosterior(6, simulate(wide, 20, 7), capped).priorVariance, 2.0) << "never above the cap";
+}
+
 TEST(ActiveSampling, PosteriorDependsOnlyOnTheAnswersNotTheirOrder) {
     const std::vector<double> truth = {0.0, 0.4, 1.0, 2.2, -0.7};
     std::vector<Comparison> answers = simulate(truth, 7, 3);
