@@ -75,7 +75,7 @@ double RadialProfile::cutoffRadiusMm(double tail) const {
 std::unique_ptr<RadialProfile> makeRadialProfile(const sss::SssParams& params) {
     if (!(params.widthMm > 0.0)) throwInput("", "sss.width_mm", "must be positive");
     // Surface distance d (mm) ↔ profile distance d / profileScale(width_mm) (renderer/sss/sss_params.h).
-    const double scale = 1.0 / sss::profileScale(params.widthMm);
+    const double scale = sss::kProfileWidthMm / params.widthMm; // 1 / profileScale, as one division
     if (params.profile == "deon") return std::make_unique<GaussianSumRadial>(scale);
     if (params.profile == "burley") return std::make_unique<BurleyRadial>(params.material, scale);
     throwInput("", "sss.profile",
