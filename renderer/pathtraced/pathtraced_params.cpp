@@ -1,7 +1,7 @@
 #include "renderer/pathtraced/pathtraced_params.h"
-#include "renderer/pathtraced/json_table.h"
 
 #include "common/error.h"
+#include "common/json_toml.h"
 #include "common/spec.h"
 
 namespace skinlab::renderer::pathtraced {

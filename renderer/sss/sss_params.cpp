@@ -2,6 +2,7 @@
 
 #include "common/check.h"
 #include "common/error.h"
+#include "common/json_toml.h"
 #include "common/spec.h"
 #include "renderer/sss/materials.h"
 #include "renderer/sss/tabulated_kernel.h"
@@ -56,35 +57,6 @@ const std::vector<MethodInfo> kMethods{
 double lowest(std::string_view key) { return sssKey(key).min; }
 double highest(std::string_view key) { return sssKey(key).max; }
 const std::vector<std::string>& choicesOf(std::string_view key) { return sssKey(key).choices; }
-
-// JSON (as written by toJson) → TOML, so that the JSON form goes through the same strict reader.
-toml::table jsonToToml(const nlohmann::json& object, std::string_view source);
-
-void insertJson(toml::table& table, const std::string& key, const nlohmann::json& value, std::string_view source) {
-    if (value.is_boolean()) table.insert_or_assign(key, value.get<bool>());
-    else if (value.is_number_integer()) table.insert_or_assign(key, value.get<std::int64_t>());
-    else if (value.is_number()) table.insert_or_assign(key, value.get<double>());
-    else if (value.is_string()) table.insert_or_assign(key, value.get<std::string>());
-    else if (value.is_object()) table.insert_or_assign(key, jsonToToml(value, source));
-    else if (value.is_array()) {
-        toml::array array;
-        for (const auto& element : value) {
-            if (element.is_number_integer()) array.push_back(element.get<std::int64_t>());
-            else if (element.is_number()) array.push_back(element.get<double>());
-            else if (element.is_string()) array.push_back(element.get<std::string>());
-            else if (element.is_boolean()) array.push_back(element.get<bool>());
-            else throwInput(source, key, "unsupported array element " + element.dump());
-        }
-        table.insert_or_assign(key, std::move(array));
-    } else throwInput(source, key, "unsupported value " + value.dump());
-}
-
-toml::table jsonToToml(const nlohmann::json& object, std::string_view source) {
-    if (!object.is_object()) throwInput(source, "", "expected a JSON object, got " + object.dump());
-    toml::table table;
-    for (const auto& [key, value] : object.items()) insertJson(table, key, value, source);
-    return table;
-}
 
 SssParams readSssTable(const SpecReader& sss) {
     SssParams p;
@@ -401,15 +373,12 @@ TransmittanceParams readTransmittanceParams(const SpecReader& scene) {
 }
 
 SssParams sssParamsFromJson(const nlohmann::json& sss, std::string_view source) {
-    toml::table root;
-    root.insert_or_assign("sss", jsonToToml(sss, source));
-    return readSssParams(SpecReader(root, std::string(source)));
+    return readSssParams(SpecReader(jsonAsTomlTable(sss, source, "sss"), std::string(source)));
 }
 
 TransmittanceParams transmittanceParamsFromJson(const nlohmann::json& transmittance, std::string_view source) {
-    toml::table root;
-    root.insert_or_assign("transmittance", jsonToToml(transmittance, source));
-    return readTransmittanceParams(SpecReader(root, std::string(source)));
+    return readTransmittanceParams(
+        SpecReader(jsonAsTomlTable(transmittance, source, "transmittance"), std::string(source)));
 }
 
 double widthMmFromDemoSssWidth(double sssWidth, double mmPerUnit) { return 2.0 * sssWidth * mmPerUnit; }
