@@ -48,6 +48,9 @@ std::vector<PlannedTrial> nextActiveTrials(const StudyDefinition& study, std::in
         throw RuntimeError("active plan: posterior of block \"" + block.name + "\" has the wrong size");
     const std::uint64_t batchSeed = combineSeed(seed, static_cast<std::uint64_t>(position));
     std::vector<std::pair<int, int>> batch = active::spanningTreeBatch(posterior, batchSeed);
+    // active_batch: the most valuable pairs of the tree only (they come first); the rest is re-planned later.
+    const auto batchSize = static_cast<std::size_t>(study.design.activeBatch);
+    if (batchSize > 0 && batch.size() > batchSize) batch.resize(batchSize);
     // Never the pair just shown first.
     if (lastTest && lastTest->block == block.name && batch.size() > 1) {
         const auto& [i, j] = batch.front();

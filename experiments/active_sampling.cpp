@@ -84,6 +84,41 @@ Moments tiltedMoments(double m, double v, double a, double b) {
     return {mean, std::max(second / weight - mean * mean, 1e-12)};
 }
 
+// The inverse of a symmetric positive-definite n × n matrix (row-major) by Cholesky, A = L Lᵀ (lower, in place),
+// then the columns of A⁻¹ by forward and back substitution.
+std::vector<double> inverseOfPositiveDefinite(std::size_t n, std::vector<double> a) {
+    // Cholesky A = L Lᵀ (lower, in place).
+    for (std::size_t j = 0; j < n; ++j) {
+        double d = a[j * n + j];
+        for (std::size_t k = 0; k < j; ++k) d -= a[j * n + k] * a[j * n + k];
+        if (!(d > 0.0)) throw RuntimeError("active sampling: posterior precision is not positive definite");
+        const double root = std::sqrt(d);
+        a[j * n + j] = root;
+        for (std::size_t i = j + 1; i < n; ++i) {
+            double x = a[i * n + j];
+            for (std::size_t k = 0; k < j; ++k) x -= a[i * n + k] * a[j * n + k];
+            a[i * n + j] = x / root;
+        }
+    }
+    // Columns of A⁻¹ by forward and back substitution.
+    std::vector<double> inverse(n * n, 0.0);
+    std::vector<double> column(n);
+    for (std::size_t c = 0; c < n; ++c) {
+        for (std::size_t i = 0; i < n; ++i) {
+            double x = i == c ? 1.0 : 0.0;
+            for (std::size_t k = 0; k < i; ++k) x -= a[i * n + k] * column[k];
+            column[i] = x / a[i * n + i];
+        }
+        for (std::size_t i = n; i-- > 0;) {
+            double x = column[i];
+            for (std::size_t k = i + 1; k < n; ++k) x -= a[k * n + i] * column[k];
+            column[i] = x / a[i * n + i];
+        }
+        for (std::size_t i = 0; i < n; ++i) inverse[i * n + c] = column[i];
+    }
+    return inverse;
+}
+
 // Σ = (Λ₀ + Σ_k π̃_k a_k a_kᵀ)⁻¹ and μ = Σ η, recomputed from the sites after every sweep (Cholesky), so that the
 // rounding of thousands of rank-one updates never accumulates across sweeps.
 void recompute(int m, double priorPrecision, const std::vector<Comparison>& answers,
@@ -102,35 +137,7 @@ void recompute(int m, double priorPrecision, const std::vector<Comparison>& answ
         eta[w] += siteShift[k];
         eta[l] -= siteShift[k];
     }
-    // Cholesky A = L Lᵀ (lower, in place).
-    for (std::size_t j = 0; j < n; ++j) {
-        double d = a[j * n + j];
-        for (std::size_t k = 0; k < j; ++k) d -= a[j * n + k] * a[j * n + k];
-        if (!(d > 0.0)) throw RuntimeError("active sampling: posterior precision is not positive definite");
-        const double root = std::sqrt(d);
-        a[j * n + j] = root;
-        for (std::size_t i = j + 1; i < n; ++i) {
-            double x = a[i * n + j];
-            for (std::size_t k = 0; k < j; ++k) x -= a[i * n + k] * a[j * n + k];
-            a[i * n + j] = x / root;
-        }
-    }
-    // Columns of A⁻¹ by forward and back substitution.
-    covariance.assign(n * n, 0.0);
-    std::vector<double> column(n);
-    for (std::size_t c = 0; c < n; ++c) {
-        for (std::size_t i = 0; i < n; ++i) {
-            double x = i == c ? 1.0 : 0.0;
-            for (std::size_t k = 0; k < i; ++k) x -= a[i * n + k] * column[k];
-            column[i] = x / a[i * n + i];
-        }
-        for (std::size_t i = n; i-- > 0;) {
-            double x = column[i];
-            for (std::size_t k = i + 1; k < n; ++k) x -= a[k * n + i] * column[k];
-            column[i] = x / a[i * n + i];
-        }
-        for (std::size_t i = 0; i < n; ++i) covariance[i * n + c] = column[i];
-    }
+    covariance = inverseOfPositiveDefinite(n, std::move(a));
     mean.assign(n, 0.0);
     for (std::size_t i = 0; i < n; ++i)
         for (std::size_t j = 0; j < n; ++j) mean[i] += covariance[i * n + j] * eta[j];
@@ -145,6 +152,20 @@ ScorePosterior ScorePosterior::independent(const std::vector<double>& mean, cons
     p.covariance.assign(n * n, 0.0);
     for (std::size_t i = 0; i < n; ++i) p.covariance[i * n + i] = variance[i];
     return p;
+}
+
+ScorePosterior withPrior(const ScorePosterior& posterior, double priorVariance) {
+    if (!(priorVariance > 0.0) || !(posterior.priorVariance > 0.0))
+        throw RuntimeError("active sampling: a prior variance must be positive");
+    const std::size_t n = posterior.mean.size();
+    if (n == 0 || priorVariance == posterior.priorVariance) return posterior;
+    // Σ⁻¹ = Λ₀ + Σ_k π̃_k a_k a_kᵀ: replace the prior's precision on the diagonal.
+    std::vector<double> precision = inverseOfPositiveDefinite(n, posterior.covariance);
+    for (std::size_t i = 0; i < n; ++i) precision[i * n + i] += 1.0 / priorVariance - 1.0 / posterior.priorVariance;
+    ScorePosterior out = posterior;
+    out.covariance = inverseOfPositiveDefinite(n, std::move(precision));
+    out.priorVariance = priorVariance;
+    return out;
 }
 
 ScorePosterior fitPosterior(int conditions, const std::vector<Comparison>& answers, const PosteriorOptions& options) {

@@ -73,6 +73,13 @@ struct ScorePosterior {
 ScorePosterior fitPosterior(int conditions, const std::vector<Comparison>& answers,
                             const PosteriorOptions& options = {});
 
+// The same sites under another prior N(0, priorVariance) per score: the covariance (Σ⁻¹ − I/v + I/priorVariance)⁻¹
+// with v the prior `posterior` was fitted with; the means are kept. A batch planned from the posterior under a wide
+// prior values the comparisons by what the answers, not the prior, will have told the scale (the scale is fitted
+// with a weak prior): with the fitted sd-1 prior, the differences between far-apart conditions look known from the
+// prior alone.
+ScorePosterior withPrior(const ScorePosterior& posterior, double priorVariance);
+
 // All answers to one pair: i < j, i chosen `iWon` times over j, j `jWon` times over i.
 struct PairCount {
     int i = 0, j = 0;

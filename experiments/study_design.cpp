@@ -61,9 +61,11 @@ StudyDesign designFromToml(toml::table& root, const std::string& file, const std
         if (spec.has("block_order"))
             spec.fail("block_order", "not used with pairs = \"active\" (each batch is planned for one block)");
         d.trialsPerParticipant = static_cast<int>(spec.integer("trials_per_participant", 0, 1, 10000));
+        d.activeBatch = static_cast<int>(spec.integer("active_batch", 0, 0, 10000));
         d.repetitions = 1;
-    } else if (spec.has("trials_per_participant")) {
-        spec.fail("trials_per_participant", "only used with pairs = \"active\"");
+    } else {
+        for (const char* key : {"trials_per_participant", "active_batch"})
+            if (spec.has(key)) spec.fail(key, "only used with pairs = \"active\"");
     }
     d.repetitions = static_cast<int>(spec.integer("repetitions", d.repetitions, 1, 100));
     d.blockOrder = spec.choice("block_order", d.blockOrder, {"interleaved", "grouped"});
@@ -158,40 +160,42 @@ nlohmann::json StudyDesign::toJson() const {
     nlohmann::json catchJson = nlohmann::json::array();
     for (const DeclaredCatchPair& c : catchPairs)
         catchJson.push_back({{"first", c.first}, {"second", c.second}, {"expected", c.expected}, {"repeat", c.repeat}});
-    return {{"title", title},
-            {"question", question},
-            {"instructions", instructions},
-            {"consent", consent},
-            {"seed", seed},
-            {"condition_factor", conditionFactor},
-            {"conditions", conditions},
-            {"blocks", blocks},
-            {"pairs", activePairs ? nlohmann::json("active")
-                      : allPairs  ? nlohmann::json("all")
-                                  : pairsJson},
-            {"trials_per_participant", trialsPerParticipant},
-            {"repetitions", repetitions},
-            {"block_order", blockOrder},
-            {"break_every", breakEvery},
-            {"reference", {{"show", showReference}}},
-            {"practice", {{"trials", practiceTrials}}},
-            {"catch", {{"blank", blankCatchTrials}, {"pairs", catchJson}}},
-            {"recruitment",
-             {{"platform", recruitment.platform},
-              {"id_parameter", recruitment.idParameter},
-              {"completion_url", recruitment.completionUrl},
-              {"completion_code", recruitment.completionCode}}},
-            {"display",
-             {{"calibrate", display.calibrate},
-              {"viewing_distance_mm", display.viewingDistanceMm},
-              {"viewport_width", display.viewportWidth},
-              {"viewport_height", display.viewportHeight}}},
-            {"requirements",
-             {{"min_screen_width", requirements.minScreenWidth},
-              {"min_screen_height", requirements.minScreenHeight},
-              {"no_zoom", requirements.noZoom},
-              {"fullscreen", requirements.fullscreen},
-              {"desktop", requirements.desktop}}}};
+    nlohmann::json out = {{"title", title},
+                          {"question", question},
+                          {"instructions", instructions},
+                          {"consent", consent},
+                          {"seed", seed},
+                          {"condition_factor", conditionFactor},
+                          {"conditions", conditions},
+                          {"blocks", blocks},
+                          {"pairs", activePairs ? nlohmann::json("active")
+                                    : allPairs  ? nlohmann::json("all")
+                                                : pairsJson},
+                          {"trials_per_participant", trialsPerParticipant},
+                          {"repetitions", repetitions},
+                          {"block_order", blockOrder},
+                          {"break_every", breakEvery},
+                          {"reference", {{"show", showReference}}},
+                          {"practice", {{"trials", practiceTrials}}},
+                          {"catch", {{"blank", blankCatchTrials}, {"pairs", catchJson}}},
+                          {"recruitment",
+                           {{"platform", recruitment.platform},
+                            {"id_parameter", recruitment.idParameter},
+                            {"completion_url", recruitment.completionUrl},
+                            {"completion_code", recruitment.completionCode}}},
+                          {"display",
+                           {{"calibrate", display.calibrate},
+                            {"viewing_distance_mm", display.viewingDistanceMm},
+                            {"viewport_width", display.viewportWidth},
+                            {"viewport_height", display.viewportHeight}}},
+                          {"requirements",
+                           {{"min_screen_width", requirements.minScreenWidth},
+                            {"min_screen_height", requirements.minScreenHeight},
+                            {"no_zoom", requirements.noZoom},
+                            {"fullscreen", requirements.fullscreen},
+                            {"desktop", requirements.desktop}}}};
+    if (activePairs && activeBatch > 0) out["active_batch"] = activeBatch; // only where set: designs stay as they were
+    return out;
 }
 
 StudyDesign StudyDesign::fromJson(const nlohmann::json& j) {
@@ -209,6 +213,7 @@ StudyDesign StudyDesign::fromJson(const nlohmann::json& j) {
         d.allPairs = true;
         d.activePairs = j.at("pairs").get<std::string>() == "active";
         d.trialsPerParticipant = j.value("trials_per_participant", 0);
+        d.activeBatch = j.value("active_batch", 0);
     } else {
         d.allPairs = false;
         for (const auto& p : j.at("pairs"))

@@ -66,6 +66,10 @@ struct StudyDesign {
     // (every pair of a block is a candidate).
     bool activePairs = false;
     int trialsPerParticipant = 0;
+    // active_batch: test trials planned at a time (then re-planned from the answers so far); 0 = one spanning tree
+    // of a block, m − 1 trials. Small batches adapt sooner but need the answers of the batch before (one
+    // participant at a time, as in a lab); with many participants at once they compare the same pairs.
+    int activeBatch = 0;
     int repetitions = 2;                    // times each pair is shown to each participant (alternating sides)
     std::string blockOrder = "interleaved"; // interleaved | grouped
     int breakEvery = 40;                    // a pause screen every K trials (0 = none)

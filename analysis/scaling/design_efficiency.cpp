@@ -31,9 +31,14 @@ double comparisonInformation(double delta) {
 // so the ratio returned, (2 φ(w) − max_p d_p) / φ(uniform), is a lower bound whether or not the iteration has
 // converged. Asymptotic: it holds for unbiased estimators at large budgets, not for a prior-regularised fit at a
 // small one.
-double optimalAllocationShare(const std::vector<double>& truth) {
+namespace {
+struct Allocation {
+    std::vector<double> weights; // per pair (i < j), in increasing (i, j) order
+    double share = 1.0;
+};
+
+Allocation optimise(const std::vector<double>& truth) {
     const int m = static_cast<int>(truth.size());
-    if (m < 3) return 1.0; // one pair (or none): nothing to choose
     std::vector<std::pair<int, int>> pairs;
     std::vector<double> information;
     for (int i = 0; i < m; ++i)
@@ -74,7 +79,19 @@ double optimalAllocationShare(const std::vector<double>& truth) {
         for (double& x : w) x /= total;
         phi = evaluate();
     }
-    return bound / full;
+    return {w, bound / full};
+}
+} // namespace
+
+double optimalAllocationShare(const std::vector<double>& truth) {
+    if (truth.size() < 3) return 1.0; // one pair (or none): nothing to choose
+    return optimise(truth).share;
+}
+
+std::vector<double> optimalAllocation(const std::vector<double>& truth) {
+    if (truth.size() < 2) return {};
+    if (truth.size() == 2) return {1.0};
+    return optimise(truth).weights;
 }
 
 } // namespace skinlab::analysis::scaling

@@ -15,4 +15,8 @@ double comparisonInformation(double delta);
 // saving of any design, active sampling included, in the large-budget limit.
 double optimalAllocationShare(const std::vector<double>& trueScores);
 
+// The A-optimal shares w_p themselves (the allocation behind optimalAllocationShare), one per pair (i, j), i < j,
+// in increasing (i, j) order; they sum to 1. The oracle design of bench_active_sampling draws its pairs from them.
+std::vector<double> optimalAllocation(const std::vector<double>& trueScores);
+
 } // namespace skinlab::analysis::scaling

@@ -77,6 +77,8 @@ struct Settings {
     double priorSd = 1.0;        // prior sd of the active design's posterior (JOD)
     bool empiricalPrior = false; // --empirical-prior: the prior's sd estimated from the answers (≥ priorSd)
     std::string selection = "mst-variance"; // active batches (the server's), mst-gain, greedy or variance
+    double planPriorSd = 0.0; // --plan-prior-sd P: batches valued under a prior of sd P (0: the fitted prior)
+    int batch = 0; // --batch K: trials used from each planned batch before re-planning (0: the whole batch, m − 1)
     bool timing = true;
     std::vector<double> coverageRounds = {0.6, 1.0, 1.2, 2.0, 2.4}; // coverage budgets, in full rounds
     int rounds = 4;                                                 // longest design, in full-design rounds m(m−1)/2
@@ -136,8 +138,10 @@ sc::BlockData blockOf(const std::vector<Trial>& trials, std::size_t count, int m
 }
 
 // The active design's selection as the server would run it, or an alternative (--selection).
-std::vector<std::pair<int, int>> plan(const ac::ScorePosterior& posterior, int m, std::uint64_t tieSeed,
+std::vector<std::pair<int, int>> plan(const ac::ScorePosterior& fitted, int m, std::uint64_t tieSeed,
                                       const Settings& settings) {
+    const ac::ScorePosterior posterior =
+        settings.planPriorSd > 0.0 ? ac::withPrior(fitted, settings.planPriorSd * settings.planPriorSd) : fitted;
     if (settings.selection == "greedy") return ac::greedyBatch(posterior, m - 1, tieSeed);
     if (settings.selection == "variance")
         return ac::greedyBatch(posterior, m - 1, tieSeed, ac::BatchCriterion::varianceReduction);
@@ -169,6 +173,22 @@ std::vector<Trial> simulateDesign(int design, const std::vector<double>& truth, 
             while (j == i) j = pick(random);
             trials.push_back(make(random, truth, i, j));
         }
+    } else if (settings.selection == "oracle") {
+        // The A-optimal allocation for the true scores (what no study knows): each trial the pair furthest behind its
+        // share, so the counts follow the shares at every length.
+        const std::vector<double> share = sc::optimalAllocation(truth);
+        std::vector<std::pair<int, int>> pairs;
+        for (int i = 0; i < m; ++i)
+            for (int j = i + 1; j < m; ++j) pairs.emplace_back(i, j);
+        std::vector<double> count(pairs.size(), 0.0);
+        while (trials.size() < length) {
+            const double next = static_cast<double>(trials.size() + 1);
+            std::size_t best = 0;
+            for (std::size_t p = 1; p < pairs.size(); ++p)
+                if (share[p] * next - count[p] > share[best] * next - count[best]) best = p;
+            count[best] += 1.0;
+            trials.push_back(make(random, truth, pairs[best].first, pairs[best].second));
+        }
     } else {
         std::vector<ac::Comparison> answers;
         std::uint64_t batch = 0;
@@ -178,7 +198,9 @@ std::vector<Trial> simulateDesign(int design, const std::vector<double>& truth, 
         while (trials.size() < length) {
             const ac::ScorePosterior posterior = ac::fitPosterior(m, answers, posteriorOptions);
             const std::uint64_t tieSeed = seed * 1000003u + batch++;
-            const auto pairs = plan(posterior, m, tieSeed, settings);
+            auto pairs = plan(posterior, m, tieSeed, settings);
+            if (settings.batch > 0 && pairs.size() > static_cast<std::size_t>(settings.batch))
+                pairs.resize(static_cast<std::size_t>(settings.batch));
             for (const auto& [i, j] : pairs) {
                 if (trials.size() >= length) break;
                 const Trial t = make(random, truth, i, j);
@@ -509,6 +531,8 @@ int main(int argc, char** argv) {
         else if (key == "--truth") s.truth = value;
         else if (key == "--prior-sd") s.priorSd = std::atof(value);
         else if (key == "--selection") s.selection = value;
+        else if (key == "--batch") s.batch = std::atoi(value);
+        else if (key == "--plan-prior-sd") s.planPriorSd = std::atof(value);
         else if (key == "--timing") s.timing = std::atoi(value) != 0;
         else if (key == "--coverage-rounds") s.coverageRounds = parseList(value);
         else if (key == "--seeds") s.seeds = std::atoi(value);

@@ -6,7 +6,9 @@
 //
 // With --active M: M conditions and an active design (pairs = "active", 2(M − 1) test trials per participant), so
 // the measured round trips include planning a batch from the posterior whenever a participant's batch runs out.
+// With --active-batch K as well: the design's active_batch = K (a plan every K test trials of a participant).
 // Usage: bench_experiments_response_logging [--observers 50,200] [--think-ms MIN:MAX] [--folder DIR] [--active M]
+//                                           [--active-batch K]
 // Prints one Markdown table row per run for docs/benchmarks.md.
 #include "common/files.h"
 #include "bench_stimulus_set.h"
@@ -33,6 +35,7 @@ namespace {
 // Five conditions in one block: 10 pairs × 2 repetitions + 2 catch = 22 responses per participant. The image
 // bytes are not decoded by the server, so placeholder bytes (with their real sha256) stand in for PNGs.
 int activeConditions = 0; // --active M (0: the fixed five-condition design)
+int activeBatch = 0;      // --active-batch K: the design's active_batch (0: whole spanning trees)
 
 void writeSet(const fs::path& folder) {
     skinlab::bench::writeBenchStimulusSet(folder, activeConditions > 0 ? activeConditions : 5, 256, 256,
@@ -53,7 +56,8 @@ Run measure(const fs::path& root, int observers, double thinkMin, double thinkMa
     writeSet(folder / "stimuli");
     const std::string pairs =
         activeConditions > 0
-            ? "pairs = \"active\"\ntrials_per_participant = " + std::to_string(2 * (activeConditions - 1)) + "\n"
+            ? "pairs = \"active\"\ntrials_per_participant = " + std::to_string(2 * (activeConditions - 1)) + "\n" +
+                  (activeBatch > 0 ? "active_batch = " + std::to_string(activeBatch) + "\n" : std::string())
             : "repetitions = 2\n";
     skinlab::writeFileAtomic(folder / "design.toml",
                              "seed = 1\n" + pairs + "[practice]\ntrials = 0\n[catch]\nblank = 2\n");
@@ -110,6 +114,8 @@ int main(int argc, char** argv) {
                        std::stod(colon == std::string::npos ? value : value.substr(colon + 1))}};
         } else if (key == "--active") {
             activeConditions = std::stoi(value);
+        } else if (key == "--active-batch") {
+            activeBatch = std::stoi(value);
         } else if (key == "--folder") {
             root = value;
         } else {

@@ -6,6 +6,7 @@
 #include "common/error.h"
 #include "experiments/active_plan.h"
 #include "experiments/active_sampling.h"
+#include "experiments/seeded_random.h"
 #include "experiments/study_definition.h"
 #include "stimulus_set_fixture.h"
 
@@ -300,6 +301,28 @@ TEST(ActiveSampling, BatchIsAConnectedSpanningTreeReproducibleFromItsSeed) {
     EXPECT_TRUE(spanningTreeBatch(fitPosterior(1, {}), 1).empty());
 }
 
+TEST(ActiveSampling, WithPriorReplacesOnlyThePriorsPrecision) {
+    // No answers: the posterior is the prior, so another prior is exactly that prior.
+    const ScorePosterior none = withPrior(fitPosterior(3, {}), 4.0);
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) EXPECT_NEAR(none.cov(i, j), i == j ? 4.0 : 0.0, 1e-12);
+    // With answers: there and back again, and a wider prior leaves far-apart differences less certain.
+    std::vector<Comparison> answers;
+    for (int k = 0; k < 15; ++k) answers.push_back({0, 1}), answers.push_back({1, 2}), answers.push_back({2, 3});
+    const ScorePosterior fitted = fitPosterior(4, answers);
+    const ScorePosterior wide = withPrior(fitted, 100.0);
+    const ScorePosterior back = withPrior(wide, fitted.priorVariance);
+    for (int i = 0; i < 4; ++i) {
+        EXPECT_EQ(wide.mean[static_cast<std::size_t>(i)], fitted.mean[static_cast<std::size_t>(i)]);
+        for (int j = 0; j < 4; ++j) EXPECT_NEAR(back.cov(i, j), fitted.cov(i, j), 1e-9);
+    }
+    auto differenceVariance = [](const ScorePosterior& p, int i, int j) {
+        return p.cov(i, i) + p.cov(j, j) - 2.0 * p.cov(i, j);
+    };
+    EXPECT_GT(differenceVariance(wide, 0, 3), 1.5 * differenceVariance(fitted, 0, 3));
+    EXPECT_THROW(withPrior(fitted, 0.0), skinlab::RuntimeError);
+}
+
 TEST(ActiveSampling, DesignKeysAreCheckedStrictly) {
     const StudyDesign d = parseStudyDesign("pairs = \"active\"\ntrials_per_participant = 30\n", "D.toml");
     EXPECT_TRUE(d.activePairs);
@@ -321,6 +344,14 @@ TEST(ActiveSampling, DesignKeysAreCheckedStrictly) {
               "D.toml: block_order: not used with pairs = \"active\" (each batch is planned for one block)");
     EXPECT_EQ(designError("trials_per_participant = 10\n"),
               "D.toml: trials_per_participant: only used with pairs = \"active\"");
+    EXPECT_EQ(designError("active_batch = 2\n"), "D.toml: active_batch: only used with pairs = \"active\"");
+    EXPECT_EQ(designError("pairs = \"active\"\ntrials_per_participant = 10\nactive_batch = -1\n"),
+              "D.toml: active_batch: -1 is out of range [0, 10000]");
+    const StudyDesign small =
+        parseStudyDesign("pairs = \"active\"\ntrials_per_participant = 30\nactive_batch = 1\n", "D.toml");
+    EXPECT_EQ(small.activeBatch, 1);
+    EXPECT_EQ(StudyDesign::fromJson(small.toJson()).activeBatch, 1);
+    EXPECT_FALSE(d.toJson().contains("active_batch")) << "unset: the stored design is as it was";
     EXPECT_EQ(designError("pairs = \"activ\"\n"),
               "D.toml: pairs: expected \"all\", \"active\" or an array of [A, B] condition pairs, got \"activ\"");
 }
@@ -383,4 +414,48 @@ TEST(ActiveSampling, PlanFillsOpenSlotsBatchByBatchAroundPracticeAndCatchTrials)
         EXPECT_EQ(again[k].conditionA, stored[k].conditionA);
         EXPECT_EQ(again[k].aOnLeft, stored[k].aOnLeft);
     }
+}
+
+TEST(ActiveSampling, ActiveBatchReplansAfterEveryKTestTrials) {
+    const StudyDefinition study = makeStudy("seed = 3\npairs = \"active\"\ntrials_per_participant = 10\n"
+                                            "active_batch = 1\n[practice]\ntrials = 2\n[catch]\nblank = 2\n");
+    const std::uint64_t seed = participantSeed(study.design.seed, 1);
+    const std::vector<PlannedTrial> skeleton = planTrials(study, 1, seed);
+    int posteriorCalls = 0;
+    auto prior = [&](std::size_t b) {
+        ++posteriorCalls;
+        return fitPosterior(static_cast<int>(study.blocks[b].conditions.size()), {});
+    };
+    std::vector<PlannedTrial> stored;
+    for (int guard = 0; guard < 40; ++guard) {
+        const std::vector<PlannedTrial> next = nextActiveTrials(study, 1, seed, stored, prior);
+        if (next.empty()) break;
+        EXPECT_EQ(std::count_if(next.begin(), next.end(),
+                                [](const PlannedTrial& t) { return t.kind == TrialKind::test; }),
+                  1)
+            << "one test trial per stretch";
+        stored.insert(stored.end(), next.begin(), next.end());
+    }
+    ASSERT_EQ(stored.size(), skeleton.size());
+    EXPECT_EQ(posteriorCalls, 10) << "a posterior per test trial";
+    // The trial planned is the most valuable pair of the posterior at that moment: with answers that make two
+    // conditions close and uncertain, the planner compares exactly them.
+    std::vector<Comparison> answers;
+    for (int k = 0; k < 20; ++k) answers.push_back({0, 2}), answers.push_back({1, 3}), answers.push_back({0, 3});
+    answers.push_back({2, 1});
+    const ScorePosterior informed = fitPosterior(4, answers);
+    const auto tree = spanningTreeBatch(informed, combineSeed(seed, 2));
+    const std::vector<PlannedTrial> first = nextActiveTrials(study, 1, seed, {stored.begin(), stored.begin() + 2},
+                                                             [&](std::size_t) { return informed; });
+    ASSERT_FALSE(first.empty());
+    const auto test = *std::find_if(first.begin(), first.end(),
+                                    [](const PlannedTrial& t) { return t.kind == TrialKind::test; });
+    const auto block = std::find_if(study.blocks.begin(), study.blocks.end(),
+                                    [&](const StudyBlock& b) { return b.name == test.block; });
+    ASSERT_NE(block, study.blocks.end());
+    const auto& conditions = block->conditions;
+    const std::pair<std::string, std::string> best = {conditions[static_cast<std::size_t>(tree.front().first)],
+                                                      conditions[static_cast<std::size_t>(tree.front().second)]};
+    EXPECT_TRUE((test.conditionA == best.first && test.conditionB == best.second) ||
+                (test.conditionA == best.second && test.conditionB == best.first));
 }
