@@ -430,9 +430,8 @@ TEST(ActiveSampling, ActiveBatchReplansAfterEveryKTestTrials) {
     for (int guard = 0; guard < 40; ++guard) {
         const std::vector<PlannedTrial> next = nextActiveTrials(study, 1, seed, stored, prior);
         if (next.empty()) break;
-        EXPECT_EQ(std::count_if(next.begin(), next.end(),
-                                [](const PlannedTrial& t) { return t.kind == TrialKind::test; }),
-                  1)
+        EXPECT_EQ(
+            std::count_if(next.begin(), next.end(), [](const PlannedTrial& t) { return t.kind == TrialKind::test; }), 1)
             << "one test trial per stretch";
         stored.insert(stored.end(), next.begin(), next.end());
     }
@@ -445,11 +444,11 @@ TEST(ActiveSampling, ActiveBatchReplansAfterEveryKTestTrials) {
     answers.push_back({2, 1});
     const ScorePosterior informed = fitPosterior(4, answers);
     const auto tree = spanningTreeBatch(informed, combineSeed(seed, 2));
-    const std::vector<PlannedTrial> first = nextActiveTrials(study, 1, seed, {stored.begin(), stored.begin() + 2},
-                                                             [&](std::size_t) { return informed; });
+    const std::vector<PlannedTrial> first =
+        nextActiveTrials(study, 1, seed, {stored.begin(), stored.begin() + 2}, [&](std::size_t) { return informed; });
     ASSERT_FALSE(first.empty());
-    const auto test = *std::find_if(first.begin(), first.end(),
-                                    [](const PlannedTrial& t) { return t.kind == TrialKind::test; });
+    const auto test =
+        *std::find_if(first.begin(), first.end(), [](const PlannedTrial& t) { return t.kind == TrialKind::test; });
     const auto block = std::find_if(study.blocks.begin(), study.blocks.end(),
                                     [&](const StudyBlock& b) { return b.name == test.block; });
     ASSERT_NE(block, study.blocks.end());
