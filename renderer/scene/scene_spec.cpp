@@ -3,8 +3,8 @@
 #include "common/error.h"
 #include "common/spec.h"
 #include "renderer/scene/builtin_scenes.h"
-#include "renderer/pathtraced/eevee_params.h"
-#include "renderer/pathtraced/pathtraced_params.h"
+#include "renderer/sss/eevee_params.h"
+#include "renderer/sss/pathtraced_params.h"
 #include "renderer/sss/sss_params.h"
 
 #include <cmath>
