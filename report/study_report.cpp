@@ -176,7 +176,8 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
     const fs::path out = options.output;
     ensureDirectory(out);
 
-    // --- Participants and exclusions (scaling::exclusionReason: no answers, or more than one failed catch trial in four). ---
+    // --- Participants and exclusions: the protocol's rule (scaling::excludeObservers: no scaled answers, or more
+    // than one failed catch trial in four), applied to the same responses as `analyze scale` and the dashboard. ---
     std::vector<Observer> observers;
     std::map<std::string, std::size_t> observerIndex;
     for (const experiments::ParticipantStatus& status : store.status()) {
@@ -186,12 +187,6 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
         o.total = status.progress.total;
         o.catchAnswered = status.catchAnswered;
         o.catchCorrect = status.catchCorrect;
-        // The protocol's rule, the same function `analyze scale` and the dashboard apply.
-        if (auto reason = scaling::exclusionReason(o.answered - o.catchAnswered, o.catchAnswered,
-                                                   o.catchAnswered - o.catchCorrect)) {
-            o.excluded = true;
-            o.reason = *reason;
-        }
         observerIndex[o.label] = observers.size();
         observers.push_back(o);
     }
@@ -210,8 +205,6 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
         ++line;
         viewports.insert({row.viewportWidth, row.viewportHeight});
         pixelRatios.insert(row.devicePixelRatio);
-        auto found = observerIndex.find(row.observer);
-        if (found != observerIndex.end() && observers[found->second].excluded) continue;
         scaling::Response r;
         r.observer = row.observer;
         r.block = row.scene;
@@ -230,6 +223,20 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
         }
         table.responses.push_back(r);
     }
+    std::set<std::string> answering;
+    for (const scaling::Response& r : table.responses) answering.insert(r.observer);
+    for (const scaling::ExcludedObserver& e : scaling::excludeObservers(table)) {
+        auto found = observerIndex.find(e.observer);
+        if (found == observerIndex.end()) continue;
+        observers[found->second].excluded = true;
+        observers[found->second].reason = e.reason;
+    }
+    // A participant without a single answer is not in the responses: the rule's "no answers".
+    for (Observer& o : observers)
+        if (!answering.count(o.label)) {
+            o.excluded = true;
+            o.reason = scaling::exclusionReason(0, 0, 0).value_or("no answers");
+        }
     const int included = static_cast<int>(
         std::count_if(observers.begin(), observers.end(), [](const Observer& o) { return !o.excluded; }));
     if (included < 2)
