@@ -200,12 +200,7 @@ Participants readParticipants(experiments::StudyStore& store, const ReportOption
         r.correct = row.correct;
         r.responseMs = row.responseMs;
         r.line = line;
-        switch (row.kind) {
-        case experiments::TrialKind::practice: r.kind = scaling::TrialKind::Practice; break;
-        case experiments::TrialKind::test: r.kind = scaling::TrialKind::Test; break;
-        case experiments::TrialKind::repeat: r.kind = scaling::TrialKind::Repeat; break;
-        case experiments::TrialKind::catchTrial: r.kind = scaling::TrialKind::Catch; break;
-        }
+        r.kind = row.kind; // experiments' trial kinds are the analysis' (experiments/trial_plan.h)
         p.table.responses.push_back(r);
     }
     std::set<std::string> answering;
