@@ -3,7 +3,7 @@
 #include "cli/commands.h"
 #include "common/error.h"
 #include "common/files.h"
-#include "renderer/pathtraced/pathtraced_params.h"
+#include "renderer/sss/pathtraced_params.h"
 #include "renderer/pathtraced/profile_fit.h"
 
 #include <cstdio>

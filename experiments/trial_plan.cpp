@@ -7,16 +7,6 @@
 
 namespace skinlab::experiments {
 
-std::string trialKindName(TrialKind kind) {
-    switch (kind) {
-    case TrialKind::practice: return "practice";
-    case TrialKind::test: return "test";
-    case TrialKind::repeat: return "repeat";
-    case TrialKind::catchTrial: return "catch";
-    }
-    return "test";
-}
-
 TrialKind trialKindFromName(const std::string& name) {
     if (name == "practice") return TrialKind::practice;
     if (name == "repeat") return TrialKind::repeat;

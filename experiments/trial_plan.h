@@ -8,6 +8,7 @@
 //  - practice trials come first; catch trials are spread evenly, one per equal segment of the test sequence,
 //    never first, with the right answer alternating between left and right;
 //  - the same pair is never shown twice in a row.
+#include "analysis/scaling/responses.h"
 #include "experiments/study_definition.h"
 
 #include <cstdint>
@@ -16,9 +17,11 @@
 
 namespace skinlab::experiments {
 
-enum class TrialKind { practice, test, repeat, catchTrial };
-std::string trialKindName(TrialKind kind); // "practice", "test", "repeat", "catch" (contract 3)
-TrialKind trialKindFromName(const std::string& name);
+// The trial kinds of analysis/scaling/responses.h (experiments sits above analysis): practice, test, repeat,
+// catchTrial, named "practice", "test", "repeat", "catch" in the study file and its exports (contract 3).
+using analysis::scaling::TrialKind;
+using analysis::scaling::trialKindName;
+TrialKind trialKindFromName(const std::string& name); // RuntimeError for a name the study file should not hold
 
 // Stimulus index standing for the blank grey panel of a blank catch trial.
 constexpr int kBlankStimulus = -1;

@@ -25,7 +25,7 @@
 #include "renderer/output/display_output.h"
 #include "renderer/output/exr_writer.h"
 #include "renderer/pathtraced/cycles_render.h"
-#include "renderer/pathtraced/eevee_params.h"
+#include "renderer/sss/eevee_params.h"
 #include "renderer/scene/builtin_geometry.h"
 #include "renderer/scene/environment.h"
 #include "renderer/scene/mesh_loader.h"

@@ -152,33 +152,22 @@ svg .axis { text-anchor: middle; fill: var(--ink); font-size: 12px; } svg .point
 }
 )CSS";
 
-} // namespace
-
-ReportSummary writeStudyReport(const ReportOptions& options) {
-    const auto started = std::chrono::steady_clock::now();
-    if (!fs::is_regular_file(options.study)) throwInput(options.study.string(), "", "file not found");
-    if (options.output.empty()) throwInput("-o", "", "required: the report folder");
-    experiments::StudyStore store(options.study);
-    const experiments::StudyDefinition& definition = store.definition();
-    const std::vector<std::string> simulated = store.simulatedLabels();
-    const experiments::StudyDesign& design = definition.design;
-    const fs::path stimuliFolder = options.stimuli.empty() ? fs::path(store.meta("stimuli_dir")) : options.stimuli;
-    if (!fs::is_regular_file(stimuliFolder / "manifest.json"))
-        throwInput((stimuliFolder / "manifest.json").string(), "",
-                   "file not found (the study's stimulus folder; give --stimuli DIR if it moved)");
-    if (!options.metrics.empty() && !fs::is_regular_file(options.metrics / "metrics.json"))
-        throwInput((options.metrics / "metrics.json").string(), "",
-                   "file not found (run `skinlab analyze metrics` first)");
-    for (const experiments::StudyStimulus& s : definition.stimuli)
-        if (!fs::is_regular_file(stimuliFolder / s.pngPath))
-            throwInput((stimuliFolder / s.pngPath).string(), "", "file not found (stimulus " + s.id + ")");
-
-    const fs::path out = options.output;
-    ensureDirectory(out);
-
-    // --- Participants and exclusions (scaling::exclusionReason: no answers, or more than one failed catch trial in four). ---
+// Every participant with their answers and catch trials, the response table the scale is computed from, and the
+// viewing conditions the browsers recorded.
+struct Participants {
     std::vector<Observer> observers;
-    std::map<std::string, std::size_t> observerIndex;
+    std::map<std::string, std::size_t> index; // label → observers[index]
+    scaling::ResponseTable table;
+    std::set<std::pair<int, int>> viewports;
+    std::set<double> pixelRatios;
+    int included = 0;
+    int excluded() const { return static_cast<int>(observers.size()) - included; }
+};
+
+// Participants and exclusions: the protocol's rule (scaling::excludeObservers: no scaled answers, or more than one
+// failed catch trial in four), applied to the same responses as `analyze scale` and the dashboard.
+Participants readParticipants(experiments::StudyStore& store, const ReportOptions& options) {
+    Participants p;
     for (const experiments::ParticipantStatus& status : store.status()) {
         Observer o;
         o.label = status.participant.label;
@@ -186,32 +175,21 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
         o.total = status.progress.total;
         o.catchAnswered = status.catchAnswered;
         o.catchCorrect = status.catchCorrect;
-        // The protocol's rule, the same function `analyze scale` and the dashboard apply.
-        if (auto reason = scaling::exclusionReason(o.answered - o.catchAnswered, o.catchAnswered,
-                                                   o.catchAnswered - o.catchCorrect)) {
-            o.excluded = true;
-            o.reason = *reason;
-        }
-        observerIndex[o.label] = observers.size();
-        observers.push_back(o);
+        p.index[o.label] = p.observers.size();
+        p.observers.push_back(o);
     }
     const std::vector<experiments::ResponseRow> rows = store.responses();
-    std::set<std::pair<int, int>> viewports;
-    std::set<double> pixelRatios;
-    scaling::ResponseTable table;
-    table.file = options.study.string();
-    table.format = scaling::ResponseFormat::StudyDatabase;
-    table.adaptiveDesign = store.definition().design.activePairs;
+    p.table.file = options.study.string();
+    p.table.format = scaling::ResponseFormat::StudyDatabase;
+    p.table.adaptiveDesign = store.definition().design.activePairs;
     // Conditions in design order, as `analyze scale` and the dashboard list them.
     for (const experiments::StudyBlock& block : store.definition().blocks)
-        table.designConditionOrder[block.name] = block.conditions;
+        p.table.designConditionOrder[block.name] = block.conditions;
     int line = 0;
     for (const experiments::ResponseRow& row : rows) {
         ++line;
-        viewports.insert({row.viewportWidth, row.viewportHeight});
-        pixelRatios.insert(row.devicePixelRatio);
-        auto found = observerIndex.find(row.observer);
-        if (found != observerIndex.end() && observers[found->second].excluded) continue;
+        p.viewports.insert({row.viewportWidth, row.viewportHeight});
+        p.pixelRatios.insert(row.devicePixelRatio);
         scaling::Response r;
         r.observer = row.observer;
         r.block = row.scene;
@@ -222,43 +200,76 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
         r.correct = row.correct;
         r.responseMs = row.responseMs;
         r.line = line;
-        switch (row.kind) {
-        case experiments::TrialKind::practice: r.kind = scaling::TrialKind::Practice; break;
-        case experiments::TrialKind::test: r.kind = scaling::TrialKind::Test; break;
-        case experiments::TrialKind::repeat: r.kind = scaling::TrialKind::Repeat; break;
-        case experiments::TrialKind::catchTrial: r.kind = scaling::TrialKind::Catch; break;
+        r.kind = row.kind; // experiments' trial kinds are the analysis' (experiments/trial_plan.h)
+        p.table.responses.push_back(r);
+    }
+    std::set<std::string> answering;
+    for (const scaling::Response& r : p.table.responses) answering.insert(r.observer);
+    for (const scaling::ExcludedObserver& e : scaling::excludeObservers(p.table)) {
+        auto found = p.index.find(e.observer);
+        if (found == p.index.end()) continue;
+        p.observers[found->second].excluded = true;
+        p.observers[found->second].reason = e.reason;
+    }
+    // A participant without a single answer is not in the responses: the rule's "no answers".
+    for (Observer& o : p.observers)
+        if (!answering.count(o.label)) {
+            o.excluded = true;
+            o.reason = scaling::exclusionReason(0, 0, 0).value_or("no answers");
         }
-        table.responses.push_back(r);
-    }
-    const int included = static_cast<int>(
-        std::count_if(observers.begin(), observers.end(), [](const Observer& o) { return !o.excluded; }));
-    if (included < 2)
+    p.included = static_cast<int>(
+        std::count_if(p.observers.begin(), p.observers.end(), [](const Observer& o) { return !o.excluded; }));
+    if (p.included < 2)
         throwInput(options.study.string(), "",
-                   "fewer than 2 observers with answers to analyse (" + std::to_string(included) + ")");
+                   "fewer than 2 observers with answers to analyse (" + std::to_string(p.included) + ")");
+    return p;
+}
 
-    // --- The scale (existing analysis). ---
-    scaling::AnalysisOptions analysisOptions;
-    analysisOptions.intervals = scaling::defaultIntervals(table.adaptiveDesign); // as `analyze scale` chooses
-    analysisOptions.intervalReason = table.adaptiveDesign ? "active design" : "fixed design";
-    analysisOptions.bootstrap.samples = options.bootstrapSamples;
-    analysisOptions.bootstrap.seed = options.seed;
-    analysisOptions.bootstrap.threads = options.threads;
-    spdlog::info("report: scaling {} responses of {} observers", table.responses.size(), included);
-    const scaling::Dataset dataset = scaling::buildDataset(table, {});
-    const scaling::Analysis analysis = scaling::analyzeDataset(dataset, analysisOptions);
-    writeFileAtomic(out / "scale.json", scaling::analysisJson(analysis).dump(2) + "\n");
-    for (const scaling::ObserverSummary& summary : analysis.observers) {
-        auto found = observerIndex.find(summary.observer);
-        if (found == observerIndex.end()) continue;
-        observers[found->second].screeningFlag = summary.flagged;
-        observers[found->second].heldOutPerTrial = summary.heldOutPerTrial;
+struct Scale {
+    scaling::AnalysisOptions options;
+    scaling::Dataset dataset;
+    scaling::Analysis analysis;
+};
+
+// The scale (the analysis of `analyze scale`, with its interval choice), written to scale.json; each observer's
+// screening result goes back to the participants.
+Scale scaleStudy(Participants& participants, const ReportOptions& options, const fs::path& out) {
+    Scale scale;
+    scale.options.intervals = scaling::defaultIntervals(participants.table.adaptiveDesign); // as `analyze scale`
+    scale.options.intervalReason = participants.table.adaptiveDesign ? "active design" : "fixed design";
+    scale.options.bootstrap.samples = options.bootstrapSamples;
+    scale.options.bootstrap.seed = options.seed;
+    scale.options.bootstrap.threads = options.threads;
+    spdlog::info("report: scaling {} responses of {} observers", participants.table.responses.size(),
+                 participants.included);
+    scale.dataset = scaling::buildDataset(participants.table, {});
+    scale.analysis = scaling::analyzeDataset(scale.dataset, scale.options);
+    writeFileAtomic(out / "scale.json", scaling::analysisJson(scale.analysis).dump(2) + "\n");
+    for (const scaling::ObserverSummary& summary : scale.analysis.observers) {
+        auto found = participants.index.find(summary.observer);
+        if (found == participants.index.end()) continue;
+        participants.observers[found->second].screeningFlag = summary.flagged;
+        participants.observers[found->second].heldOutPerTrial = summary.heldOutPerTrial;
     }
+    return scale;
+}
 
-    // --- Stimuli: copies, and crops where the conditions differ most. ---
+struct StimulusImages {
     std::map<std::string, std::vector<ConditionImages>> imagesOfBlock;
-    std::map<std::string, std::pair<std::string, std::string>> conditionOfStimulus;
+    std::map<std::string, std::pair<std::string, std::string>> conditionOfStimulus; // id → (block, condition)
     std::map<std::string, Crop> cropOfBlock;
-    std::map<std::string, std::string> referencePng;
+    std::map<std::string, ConditionImages> referenceOfBlock;
+};
+
+// Stimuli: copies, and crops where the conditions differ most; the set's reference render of each block
+// ("reference": true in the manifest), shown beside the conditions.
+StimulusImages copyStimuli(const experiments::StudyDefinition& definition, const fs::path& stimuliFolder,
+                           const fs::path& out) {
+    StimulusImages stimuli;
+    auto& imagesOfBlock = stimuli.imagesOfBlock;
+    auto& conditionOfStimulus = stimuli.conditionOfStimulus;
+    auto& cropOfBlock = stimuli.cropOfBlock;
+    auto& referenceOfBlock = stimuli.referenceOfBlock;
     for (const experiments::StudyBlock& block : definition.blocks) {
         std::vector<cv::Mat> images;
         std::vector<std::string> names;
@@ -274,8 +285,6 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
         }
         cropOfBlock[block.name] = cropWhereTheyDiffer(images, names, out, slug(block.name));
     }
-    // The set's reference render of each block ("reference": true in the manifest), shown beside the conditions.
-    std::map<std::string, ConditionImages> referenceOfBlock;
     try {
         const nlohmann::json manifest = nlohmann::json::parse(readFile(stimuliFolder / "manifest.json"));
         for (const nlohmann::json& s : manifest.value("stimuli", nlohmann::json::array())) {
@@ -289,10 +298,31 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
     } catch (const nlohmann::json::exception& e) {
         throwInput((stimuliFolder / "manifest.json").string(), "", std::string("not valid JSON (") + e.what() + ")");
     }
+    return stimuli;
+}
 
-    // --- Metrics against the set's references (given, or computed here for the study's stimuli). ---
-    nlohmann::json metricsJson;
-    fs::path metricsFolder = options.metrics;
+struct Metrics {
+    nlohmann::json json;
+    fs::path folder;                                 // empty: no metrics
+    std::map<std::string, std::string> referencePng; // block → reference (when computed here)
+    std::vector<agreement::ConditionMetrics> conditions;
+    std::map<std::string, std::string> heatmapOf, flipHeatmapOf, cvvdpHeatmapOf; // stimulus → copied heat map
+    std::map<std::string, std::string> scaleOf; // copied heat map → its colour scale ("0–0.05")
+};
+
+// Metrics against the set's references (given, or computed here for the study's stimuli), their heat maps copied.
+Metrics readMetrics(const ReportOptions& options, const fs::path& stimuliFolder, const fs::path& out,
+                    const std::map<std::string, std::pair<std::string, std::string>>& conditionOfStimulus) {
+    Metrics m;
+    nlohmann::json& metricsJson = m.json;
+    fs::path& metricsFolder = m.folder;
+    std::map<std::string, std::string>& referencePng = m.referencePng;
+    std::vector<agreement::ConditionMetrics>& conditionMetrics = m.conditions;
+    auto& heatmapOf = m.heatmapOf;
+    auto& flipHeatmapOf = m.flipHeatmapOf;
+    auto& cvvdpHeatmapOf = m.cvvdpHeatmapOf;
+    auto& scaleOf = m.scaleOf;
+    metricsFolder = options.metrics;
     if (metricsFolder.empty()) {
         metrics::ComparisonPlan plan;
         try {
@@ -312,9 +342,6 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
             for (const auto& job : plan.jobs) referencePng[job.block] = job.referenceName;
         }
     }
-    std::vector<agreement::ConditionMetrics> conditionMetrics;
-    std::map<std::string, std::string> heatmapOf, flipHeatmapOf, cvvdpHeatmapOf; // stimulus → copied heat map
-    std::map<std::string, std::string> scaleOf; // copied heat map → its colour scale ("0–0.05")
     if (!metricsFolder.empty()) {
         const fs::path file = metricsFolder / "metrics.json";
         try {
@@ -345,152 +372,176 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
             }
         }
     }
-    agreement::AgreementOptions agreementOptions;
-    agreementOptions.samples = options.bootstrapSamples;
-    agreementOptions.seed = options.seed;
-    const agreement::AgreementResult agreementResult =
-        agreement::computeAgreement(dataset, analysis, conditionMetrics, analysisOptions.fit, agreementOptions);
-    if (!conditionMetrics.empty()) {
-        writeFileAtomic(out / "agreement.json", agreement::agreementJson(agreementResult).dump(2) + "\n");
-        writeFileAtomic(out / "agreement.csv", agreement::agreementCsv(agreementResult));
-    }
+    return m;
+}
 
-    // ================= The page =================
-    std::ostringstream html;
-    const int excluded = static_cast<int>(observers.size()) - included;
+// What the page is written from.
+struct ReportData {
+    const ReportOptions& options;
+    experiments::StudyStore& store;
+    const experiments::StudyDefinition& definition;
+    const std::vector<std::string>& simulated;
+    const fs::path& stimuliFolder;
+    const Participants& participants;
+    const Scale& scale;
+    StimulusImages& stimuli;
+    const Metrics& metrics;
+    const agreement::AgreementOptions& agreementOptions;
+    const agreement::AgreementResult& agreement;
+    const nlohmann::json& storedManifest; // the manifest stored in the study file (predictions)
+    const std::vector<PredictionAgreement>& predictions;
+    const std::string& predictionDisplay;
+};
+
+// Title, the question, the contents and, for simulated observers, the banner that says so first.
+void writeTitle(std::ostringstream& html, const ReportData& r) {
+    const experiments::StudyDesign& design = r.definition.design;
     html << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" << h(design.title)
          << " — study report</title><style>" << styleSheet << "</style></head><body><main>\n";
-    html << "<h1>" << h(design.title) << "</h1><p class=\"sub\">Study report · " << h(options.study.filename().string())
-         << " · stimulus set " << h(store.meta("stimulus_set")) << " · skinlab " << h(version()) << "</p>\n";
-    // Predicted JOD (ColorVideoVDP, recorded by `stimuli build`) against the measured scale.
-    const nlohmann::json storedManifest = nlohmann::json::parse(store.meta("manifest_json"));
-    const std::vector<PredictionAgreement> predictions = predictionAgreement(definition, storedManifest, analysis);
-    std::string predictionDisplay;
-    for (const nlohmann::json& s : storedManifest.value("stimuli", nlohmann::json::array()))
-        if (s.contains("predicted") && s["predicted"].contains("display"))
-            predictionDisplay = s["predicted"]["display"].get<std::string>();
+    html << "<h1>" << h(design.title) << "</h1><p class=\"sub\">Study report · "
+         << h(r.options.study.filename().string()) << " · stimulus set " << h(r.store.meta("stimulus_set"))
+         << " · skinlab " << h(version()) << "</p>\n";
     html << "<p class=\"question\">Question put to observers: <strong>" << h(design.question) << "</strong></p>\n";
     html << "<nav class=\"note\">Contents: <a href=\"#findings\">Findings</a> · <a href=\"#design\">Design</a> · "
             "<a href=\"#participants\">Participants</a> · <a href=\"#stimuli\">Stimuli</a> · <a "
             "href=\"#scale\">Scale</a>"
             " · <a href=\"#metrics\">Objective errors</a> · <a href=\"#agreement\">Metrics vs. perception</a>"
-         << (predictions.empty() ? "" : " · <a href=\"#prediction\">Predicted and measured</a>") << "</nav>\n";
+         << (r.predictions.empty() ? "" : " · <a href=\"#prediction\">Predicted and measured</a>") << "</nav>\n";
 
     // Observers sent by `study simulate` answer from a model, not from what they saw: said first, in a banner.
-    if (!simulated.empty()) {
-        html << "<div class=\"banner\"><strong>Simulated observers.</strong> " << simulated.size() << " of "
-             << store.status().size()
+    if (!r.simulated.empty()) {
+        html << "<div class=\"banner\"><strong>Simulated observers.</strong> " << r.simulated.size() << " of "
+             << r.store.status().size()
              << " participants were simulated by <code>skinlab study simulate</code> (their answers come from a "
                 "model of the observer, not from people looking at the stimuli): ";
-        for (std::size_t i = 0; i < simulated.size() && i < 8; ++i) html << (i ? ", " : "") << h(simulated[i]);
-        if (simulated.size() > 8) html << ", …";
+        for (std::size_t i = 0; i < r.simulated.size() && i < 8; ++i) html << (i ? ", " : "") << h(r.simulated[i]);
+        if (r.simulated.size() > 8) html << ", …";
         html << ". The findings below describe the simulation.</div>\n";
     }
-    // --- Findings (generated). ---
+}
+
+// One block's finding on the scale: the best condition against the next, the range, the separated pairs.
+void writeScaleFinding(std::ostringstream& html, const scaling::Analysis& analysis,
+                       const scaling::BlockAnalysis& block) {
+    const std::string anchor = "scale-" + slug(block.name);
+    std::vector<int> order(block.conditions.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(),
+              [&](int a, int b) { return block.thurstone.scores[a] > block.thurstone.scores[b]; });
+    int best = order.front(), worst = order.back();
+    int significant = 0;
+    std::vector<std::string> beaten, tied; // below the best significantly / not separated from it
+    const scaling::PairTest* runnerUp = nullptr;
+    for (const scaling::PairTest& pair : block.pairs) {
+        if (pair.significant) ++significant;
+        int other = pair.test.first == best ? pair.test.second : pair.test.second == best ? pair.test.first : -1;
+        if (other < 0) continue;
+        (pair.significant ? beaten : tied).push_back(block.conditions[static_cast<std::size_t>(other)]);
+        if (order.size() > 1 && other == order[1]) runnerUp = &pair;
+    }
+    const std::size_t pairCount = block.pairs.size();
+    // Differences, not scores against the block mean: the best against the next, and which conditions it is
+    // tied with (their difference is not significant).
+    html << "<li><strong>" << h(block.name) << "</strong>: <em>" << h(block.conditions[static_cast<std::size_t>(best)])
+         << "</em> scored highest";
+    if (runnerUp) {
+        const double sign = runnerUp->test.first == best ? 1.0 : -1.0;
+        const double low = sign > 0 ? runnerUp->test.low : -runnerUp->test.high;
+        const double high = sign > 0 ? runnerUp->test.high : -runnerUp->test.low;
+        html << ", " << linked(anchor, num(sign * runnerUp->test.difference) + " JOD") << " ["
+             << linked(anchor, num(low)) << ", " << linked(anchor, num(high)) << "] above the next, <em>"
+             << h(block.conditions[static_cast<std::size_t>(order[1])]) << "</em> ("
+             << (runnerUp->significant ? "significant" : "not significant")
+             << ", adjusted p = " << num(runnerUp->adjustedPValue, 3) << ")";
+    }
+    html << "; <em>" << h(block.conditions[static_cast<std::size_t>(worst)]) << "</em> lowest, "
+         << linked(anchor, num(block.thurstone.scores[best] - block.thurstone.scores[worst]) + " JOD")
+         << " below the best. " << linked("pairs-" + slug(block.name), std::to_string(significant)) << " of "
+         << pairCount << " pairs are separated significantly ("
+         << h(scaling::correctionName(analysis.options.correction))
+         << "-corrected, α = " << num(analysis.options.alpha, 2) << ")";
+    if (!tied.empty()) {
+        html << "; the best is <strong>tied</strong> (not separated) with ";
+        for (std::size_t i = 0; i < tied.size(); ++i) html << (i ? ", " : "") << "<em>" << h(tied[i]) << "</em>";
+    }
+    if (!beaten.empty()) {
+        html << "; it is significantly above ";
+        for (std::size_t i = 0; i < beaten.size(); ++i) html << (i ? ", " : "") << "<em>" << h(beaten[i]) << "</em>";
+    }
+    html << ".</li>\n";
+}
+
+// The metric that predicts this block's scale best: highest Spearman oriented so that + means agreement.
+void writeMetricFinding(std::ostringstream& html, const ReportData& r, const scaling::BlockAnalysis& block) {
+    const agreement::AgreementResult& agreementResult = r.agreement;
+    const std::vector<agreement::ConditionMetrics>& conditionMetrics = r.metrics.conditions;
+    const agreement::MetricAgreement* bestMetric = nullptr;
+    auto oriented = [](const agreement::MetricAgreement& row) {
+        return (row.metric.higherIsBetter ? 1.0 : -1.0) * row.spearman;
+    };
+    auto orientedPearson = [](const agreement::MetricAgreement& row) {
+        return (row.metric.higherIsBetter ? 1.0 : -1.0) * row.pearson;
+    };
+    for (const agreement::MetricAgreement& row : agreementResult.rows) {
+        if (row.block != block.name || row.conditions < 3 || !std::isfinite(row.spearman) ||
+            !std::isfinite(row.pearson))
+            continue;
+        if (!bestMetric || oriented(row) > oriented(*bestMetric) ||
+            (oriented(row) == oriented(*bestMetric) && orientedPearson(row) > orientedPearson(*bestMetric)))
+            bestMetric = &row;
+    }
+    if (bestMetric) {
+        const std::string a = "agreement-" + slug(block.name);
+        const int compared = static_cast<int>(
+            std::count_if(agreementResult.rows.begin(), agreementResult.rows.end(),
+                          [&](const auto& row) { return row.block == block.name && std::isfinite(row.spearmanP); }));
+        html << "<li>In <strong>" << h(block.name) << "</strong> the metric that agrees best with the scale is <em>"
+             << h(bestMetric->metric.label) << "</em> (" << (bestMetric->metric.higherIsBetter ? "higher" : "lower")
+             << " is better): Spearman ρ = " << linked(a, num(bestMetric->spearman)) << " ["
+             << linked(a, num(bestMetric->spearmanLow)) << ", " << linked(a, num(bestMetric->spearmanHigh))
+             << "], p = " << num(bestMetric->spearmanP) << " (" << num(bestMetric->spearmanPHolm)
+             << " after Holm's correction for choosing the best of " << compared
+             << " metrics), Pearson r = " << linked(a, num(bestMetric->pearson)) << " over " << bestMetric->conditions
+             << " conditions";
+        if (bestMetric->conditions < agreement::kFewConditions)
+            html << " — with so few conditions the intervals are wide and the choice of the best metric is "
+                    "weakly determined";
+        if (!(bestMetric->spearmanPHolm < 0.05))
+            html << "; no metric agrees significantly once the choice is "
+                    "accounted for";
+        if (bestMetric->significantPairs > 0)
+            html << "; it orders " << linked(a, std::to_string(bestMetric->predictedPairs)) << " of "
+                 << linked(a, std::to_string(bestMetric->significantPairs))
+                 << " significantly separated pairs as the observers did";
+        html << ".</li>\n";
+    } else if (!conditionMetrics.empty()) {
+        html << "<li>" << h(block.name) << ": too few conditions with metric values for a correlation.</li>\n";
+    }
+}
+
+// Findings (generated).
+void writeFindings(std::ostringstream& html, const ReportData& r) {
+    const scaling::Analysis& analysis = r.scale.analysis;
+    const int included = r.participants.included, excluded = r.participants.excluded();
     html << "<h2 id=\"findings\">Findings</h2><ul class=\"findings\">\n";
     html << "<li>" << linked("participants", std::to_string(included)) << " observers analysed";
     if (excluded > 0)
         html << "; " << linked("participants", std::to_string(excluded)) << " excluded (reasons in the table)";
     html << ".</li>\n";
     for (const scaling::BlockAnalysis& block : analysis.blocks) {
-        const std::string anchor = "scale-" + slug(block.name);
-        std::vector<int> order(block.conditions.size());
-        std::iota(order.begin(), order.end(), 0);
-        std::sort(order.begin(), order.end(),
-                  [&](int a, int b) { return block.thurstone.scores[a] > block.thurstone.scores[b]; });
-        int best = order.front(), worst = order.back();
-        int significant = 0;
-        std::vector<std::string> beaten, tied; // below the best significantly / not separated from it
-        const scaling::PairTest* runnerUp = nullptr;
-        for (const scaling::PairTest& pair : block.pairs) {
-            if (pair.significant) ++significant;
-            int other = pair.test.first == best ? pair.test.second : pair.test.second == best ? pair.test.first : -1;
-            if (other < 0) continue;
-            (pair.significant ? beaten : tied).push_back(block.conditions[static_cast<std::size_t>(other)]);
-            if (order.size() > 1 && other == order[1]) runnerUp = &pair;
-        }
-        const std::size_t pairCount = block.pairs.size();
-        // Differences, not scores against the block mean: the best against the next, and which conditions it is
-        // tied with (their difference is not significant).
-        html << "<li><strong>" << h(block.name) << "</strong>: <em>"
-             << h(block.conditions[static_cast<std::size_t>(best)]) << "</em> scored highest";
-        if (runnerUp) {
-            const double sign = runnerUp->test.first == best ? 1.0 : -1.0;
-            const double low = sign > 0 ? runnerUp->test.low : -runnerUp->test.high;
-            const double high = sign > 0 ? runnerUp->test.high : -runnerUp->test.low;
-            html << ", " << linked(anchor, num(sign * runnerUp->test.difference) + " JOD") << " ["
-                 << linked(anchor, num(low)) << ", " << linked(anchor, num(high)) << "] above the next, <em>"
-                 << h(block.conditions[static_cast<std::size_t>(order[1])]) << "</em> ("
-                 << (runnerUp->significant ? "significant" : "not significant")
-                 << ", adjusted p = " << num(runnerUp->adjustedPValue, 3) << ")";
-        }
-        html << "; <em>" << h(block.conditions[static_cast<std::size_t>(worst)]) << "</em> lowest, "
-             << linked(anchor, num(block.thurstone.scores[best] - block.thurstone.scores[worst]) + " JOD")
-             << " below the best. " << linked("pairs-" + slug(block.name), std::to_string(significant)) << " of "
-             << pairCount << " pairs are separated significantly ("
-             << h(scaling::correctionName(analysis.options.correction))
-             << "-corrected, α = " << num(analysis.options.alpha, 2) << ")";
-        if (!tied.empty()) {
-            html << "; the best is <strong>tied</strong> (not separated) with ";
-            for (std::size_t i = 0; i < tied.size(); ++i) html << (i ? ", " : "") << "<em>" << h(tied[i]) << "</em>";
-        }
-        if (!beaten.empty()) {
-            html << "; it is significantly above ";
-            for (std::size_t i = 0; i < beaten.size(); ++i)
-                html << (i ? ", " : "") << "<em>" << h(beaten[i]) << "</em>";
-        }
-        html << ".</li>\n";
-        // The metric that predicts this block's scale best: highest Spearman oriented so that + means agreement.
-        const agreement::MetricAgreement* bestMetric = nullptr;
-        auto oriented = [](const agreement::MetricAgreement& row) {
-            return (row.metric.higherIsBetter ? 1.0 : -1.0) * row.spearman;
-        };
-        auto orientedPearson = [](const agreement::MetricAgreement& row) {
-            return (row.metric.higherIsBetter ? 1.0 : -1.0) * row.pearson;
-        };
-        for (const agreement::MetricAgreement& row : agreementResult.rows) {
-            if (row.block != block.name || row.conditions < 3 || !std::isfinite(row.spearman) ||
-                !std::isfinite(row.pearson))
-                continue;
-            if (!bestMetric || oriented(row) > oriented(*bestMetric) ||
-                (oriented(row) == oriented(*bestMetric) && orientedPearson(row) > orientedPearson(*bestMetric)))
-                bestMetric = &row;
-        }
-        if (bestMetric) {
-            const std::string a = "agreement-" + slug(block.name);
-            const int compared = static_cast<int>(
-                std::count_if(agreementResult.rows.begin(), agreementResult.rows.end(), [&](const auto& row) {
-                    return row.block == block.name && std::isfinite(row.spearmanP);
-                }));
-            html << "<li>In <strong>" << h(block.name) << "</strong> the metric that agrees best with the scale is <em>"
-                 << h(bestMetric->metric.label) << "</em> (" << (bestMetric->metric.higherIsBetter ? "higher" : "lower")
-                 << " is better): Spearman ρ = " << linked(a, num(bestMetric->spearman)) << " ["
-                 << linked(a, num(bestMetric->spearmanLow)) << ", " << linked(a, num(bestMetric->spearmanHigh))
-                 << "], p = " << num(bestMetric->spearmanP) << " (" << num(bestMetric->spearmanPHolm)
-                 << " after Holm's correction for choosing the best of " << compared
-                 << " metrics), Pearson r = " << linked(a, num(bestMetric->pearson)) << " over "
-                 << bestMetric->conditions << " conditions";
-            if (bestMetric->conditions < agreement::kFewConditions)
-                html << " — with so few conditions the intervals are wide and the choice of the best metric is "
-                        "weakly determined";
-            if (!(bestMetric->spearmanPHolm < 0.05))
-                html << "; no metric agrees significantly once the choice is "
-                        "accounted for";
-            if (bestMetric->significantPairs > 0)
-                html << "; it orders " << linked(a, std::to_string(bestMetric->predictedPairs)) << " of "
-                     << linked(a, std::to_string(bestMetric->significantPairs))
-                     << " significantly separated pairs as the observers did";
-            html << ".</li>\n";
-        } else if (!conditionMetrics.empty()) {
-            html << "<li>" << h(block.name) << ": too few conditions with metric values for a correlation.</li>\n";
-        }
+        writeScaleFinding(html, analysis, block);
+        writeMetricFinding(html, r, block);
     }
-    if (conditionMetrics.empty())
+    if (r.metrics.conditions.empty())
         html << "<li>No image metrics: the stimulus set has no reference render for the study's blocks (add a "
                 "<code>[[reference]]</code> to the set's spec, or give <code>--metrics DIR</code>).</li>\n";
     html << "</ul>\n";
+}
 
-    // --- Design. ---
+void writeDesign(std::ostringstream& html, const ReportData& r) {
+    const experiments::StudyDefinition& definition = r.definition;
+    const experiments::StudyDesign& design = definition.design;
+    const scaling::Analysis& analysis = r.scale.analysis;
     html << "<h2 id=\"design\">Design</h2><table><tbody>"
          << "<tr><th class=\"l\">Task</th><td class=\"l\">two-alternative forced choice, side by side"
          << (design.showReference ? ", with the reference shown above the pair" : "") << "</td></tr>"
@@ -506,24 +557,27 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
          << design.practiceTrials << " practice (not analysed)</td></tr>"
          << "<tr><th class=\"l\">Seed</th><td class=\"l\">" << design.seed << "</td></tr>"
          << "<tr><th class=\"l\">Design / manifest sha256</th><td class=\"l\"><code>"
-         << h(store.meta("design_sha256").substr(0, 16)) << "…</code> / <code>"
-         << h(store.meta("manifest_sha256").substr(0, 16)) << "…</code></td></tr>"
+         << h(r.store.meta("design_sha256").substr(0, 16)) << "…</code> / <code>"
+         << h(r.store.meta("manifest_sha256").substr(0, 16)) << "…</code></td></tr>"
          << "<tr><th class=\"l\">Analysis</th><td class=\"l\">Thurstone Case V in JOD (1 JOD = 75 % preference), "
          << h(scaling::priorName(analysis.options.fit.prior)) << " prior, "
          << h(analysis.blocks.empty() ? std::string("—") : analysis.blocks.front().intervalMethod) << " intervals ("
-         << options.bootstrapSamples << " resamples, " << num(100.0 * analysisOptions.bootstrap.level, 0)
+         << r.options.bootstrapSamples << " resamples, " << num(100.0 * r.scale.options.bootstrap.level, 0)
          << " %), pairwise tests " << h(scaling::correctionName(analysis.options.correction)) << "-corrected</td></tr>"
          << "</tbody></table>\n";
+}
 
-    // --- Participants. ---
-    html << "<h2 id=\"participants\">Participants</h2><p>" << observers.size() << " joined, " << included
+void writeParticipants(std::ostringstream& html, const ReportData& r) {
+    const Participants& p = r.participants;
+    const int included = p.included, excluded = p.excluded();
+    html << "<h2 id=\"participants\">Participants</h2><p>" << p.observers.size() << " joined, " << included
          << " analysed, " << excluded << " excluded. Exclusion rule (decided before the study, "
          << "as the protocol recommends): more than one failed catch trial in four, or no answers. Screening "
          << "(held-out log-likelihood per trial, low outliers by the inter-quartile rule) is reported, not used to "
          << "exclude.</p>\n<table><thead><tr><th class=\"l\">observer</th><th>answered</th><th>catch correct</th>"
             "<th>held-out log-lik./trial</th><th class=\"l\">screening</th><th "
             "class=\"l\">status</th></tr></thead><tbody>\n";
-    for (const Observer& o : observers)
+    for (const Observer& o : p.observers)
         html << "<tr><td class=\"l\">" << h(o.label) << "</td><td>" << o.answered << " / " << o.total << "</td><td>"
              << o.catchCorrect << " / " << o.catchAnswered << "</td><td>" << num(o.heldOutPerTrial, 3)
              << "</td><td class=\"l\">"
@@ -533,32 +587,37 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
              << "</td><td class=\"l\">" << (o.excluded ? "excluded: " + h(o.reason) : std::string("included"))
              << "</td></tr>\n";
     html << "</tbody></table>\n<p><strong>Viewing conditions.</strong> Recorded per answer by the browser"
-         << (simulated.empty() ? std::string()
-                               : std::string(" (the simulated observers report a fixed 1920×1080 viewport; nobody "
-                                             "looked at a screen)"))
+         << (r.simulated.empty() ? std::string()
+                                 : std::string(" (the simulated observers report a fixed 1920×1080 viewport; nobody "
+                                               "looked at a screen)"))
          << ": viewports ";
     {
         int shown = 0;
-        for (const auto& [w, hgt] : viewports) {
+        for (const auto& [w, hgt] : p.viewports) {
             if (shown++ == 6) {
                 html << ", …";
                 break;
             }
             html << (shown > 1 ? ", " : "") << w << "×" << hgt;
         }
-        if (viewports.empty()) html << "—";
+        if (p.viewports.empty()) html << "—";
         html << "; device pixel ratio ";
         shown = 0;
-        for (double r : pixelRatios) html << (shown++ ? ", " : "") << num(r, 2);
-        if (pixelRatios.empty()) html << "—";
+        for (double ratio : p.pixelRatios) html << (shown++ ? ", " : "") << num(ratio, 2);
+        if (p.pixelRatios.empty()) html << "—";
     }
     html << ". Images are shown at one image pixel per device pixel. Display, room lighting and viewing distance are "
             "not stored in the study file; see the lab notes.</p>\n";
+}
 
-    // --- Stimuli. ---
+void writeStimuli(std::ostringstream& html, const ReportData& r) {
+    const experiments::StudyDesign& design = r.definition.design;
+    auto& imagesOfBlock = r.stimuli.imagesOfBlock;
+    auto& cropOfBlock = r.stimuli.cropOfBlock;
+    auto& referenceOfBlock = r.stimuli.referenceOfBlock;
     html << "<h2 id=\"stimuli\">Stimuli</h2><p class=\"note\">Click a thumbnail for the image at full size (1:1). "
             "Crops: the window where the conditions differ most, enlarged 2× without smoothing.</p>\n";
-    for (const experiments::StudyBlock& block : definition.blocks) {
+    for (const experiments::StudyBlock& block : r.definition.blocks) {
         html << "<h3>" << h(block.name) << "</h3><div class=\"thumbs\">";
         if (referenceOfBlock.count(block.name)) {
             const ConditionImages& image = referenceOfBlock[block.name];
@@ -582,13 +641,45 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
             html << "</div>\n";
         }
     }
+}
 
-    // --- Scale. ---
+// Pairwise significance matrix of one block, rows and columns in `order`.
+void writePairMatrix(std::ostringstream& html, const scaling::BlockAnalysis& block, const std::vector<int>& order) {
+    std::map<std::pair<int, int>, const scaling::PairTest*> pairOf;
+    for (const scaling::PairTest& pair : block.pairs) pairOf[{pair.test.first, pair.test.second}] = &pair;
+    html << "<table id=\"pairs-" << slug(block.name) << "\"><thead><tr><th class=\"l\">row − column</th>";
+    for (int j : order) html << "<th>" << h(block.conditions[static_cast<std::size_t>(j)]) << "</th>";
+    html << "</tr></thead><tbody>";
+    for (int i : order) {
+        html << "<tr><th class=\"l\">" << h(block.conditions[static_cast<std::size_t>(i)]) << "</th>";
+        for (int j : order) {
+            if (i == j) {
+                html << "<td class=\"diag\"></td>";
+                continue;
+            }
+            auto found = pairOf.find({std::min(i, j), std::max(i, j)});
+            if (found == pairOf.end()) {
+                html << "<td class=\"ns\">—</td>";
+                continue;
+            }
+            const scaling::PairTest& pair = *found->second;
+            double difference = block.thurstone.scores[i] - block.thurstone.scores[j];
+            html << "<td class=\"" << (pair.significant ? "sig" : "ns")
+                 << "\" title=\"adjusted p = " << num(pair.adjustedPValue, 4) << "\">" << num(difference)
+                 << "<br><span class=\"note\">p=" << num(pair.adjustedPValue, 3) << (pair.comparisons > 0 ? "" : " n/c")
+                 << "</span></td>";
+        }
+        html << "</tr>";
+    }
+    html << "</tbody></table>\n";
+}
+
+void writeScale(std::ostringstream& html, const ReportData& r) {
     html << "<h2 id=\"scale\">Perceptual scale (JOD)</h2><p class=\"note\">Higher = chosen more often. Bars: "
-         << num(100.0 * analysisOptions.bootstrap.level, 0) << " % confidence intervals; bars running off the axis end "
+         << num(100.0 * r.scale.options.bootstrap.level, 0) << " % confidence intervals; bars running off the axis end "
          << "in a red arrow. Conditions sorted by score here (design order elsewhere). Matrix: row − column in JOD; "
             "green = significant after correction, grey = not; n/c = never compared directly.</p>\n";
-    for (const scaling::BlockAnalysis& block : analysis.blocks) {
+    for (const scaling::BlockAnalysis& block : r.scale.analysis.blocks) {
         std::vector<int> order(block.conditions.size());
         std::iota(order.begin(), order.end(), 0);
         std::sort(order.begin(), order.end(),
@@ -622,69 +713,48 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
                     "(the studentized bootstrap is degenerate there); no standard error is given for it.</p>";
         html << "</tbody></table>";
         for (const std::string& warning : block.warnings) html << "<p class=\"note\">Note: " << h(warning) << "</p>";
-        // Pairwise significance matrix.
-        std::map<std::pair<int, int>, const scaling::PairTest*> pairOf;
-        for (const scaling::PairTest& pair : block.pairs) pairOf[{pair.test.first, pair.test.second}] = &pair;
-        html << "<table id=\"pairs-" << slug(block.name) << "\"><thead><tr><th class=\"l\">row − column</th>";
-        for (int j : order) html << "<th>" << h(block.conditions[static_cast<std::size_t>(j)]) << "</th>";
-        html << "</tr></thead><tbody>";
-        for (int i : order) {
-            html << "<tr><th class=\"l\">" << h(block.conditions[static_cast<std::size_t>(i)]) << "</th>";
-            for (int j : order) {
-                if (i == j) {
-                    html << "<td class=\"diag\"></td>";
-                    continue;
-                }
-                auto found = pairOf.find({std::min(i, j), std::max(i, j)});
-                if (found == pairOf.end()) {
-                    html << "<td class=\"ns\">—</td>";
-                    continue;
-                }
-                const scaling::PairTest& pair = *found->second;
-                double difference = block.thurstone.scores[i] - block.thurstone.scores[j];
-                html << "<td class=\"" << (pair.significant ? "sig" : "ns")
-                     << "\" title=\"adjusted p = " << num(pair.adjustedPValue, 4) << "\">" << num(difference)
-                     << "<br><span class=\"note\">p=" << num(pair.adjustedPValue, 3)
-                     << (pair.comparisons > 0 ? "" : " n/c") << "</span></td>";
-            }
-            html << "</tr>";
-        }
-        html << "</tbody></table>\n";
+        writePairMatrix(html, block, order);
     }
+}
 
-    // --- Predicted and measured (when the stimulus set recorded predictions). ---
+// Predicted and measured (when the stimulus set recorded predictions).
+void writePredictions(std::ostringstream& html, const ReportData& r) {
     std::vector<std::pair<std::string, double>> calibrated; // (observer, pixels per degree) from the card calibration
-    if (!predictions.empty())
-        for (const experiments::SessionViewing& session : store.viewingConditions())
+    if (!r.predictions.empty())
+        for (const experiments::SessionViewing& session : r.store.viewingConditions())
             if (session.viewing && session.viewing->pixelsPerDegree &&
                 std::none_of(calibrated.begin(), calibrated.end(),
                              [&](const auto& c) { return c.first == session.observer; }))
                 calibrated.emplace_back(session.observer, *session.viewing->pixelsPerDegree);
-    html << predictionSectionHtml(predictions, predictionDisplay,
-                                  participantPredictions(storedManifest, stimuliFolder, calibrated));
+    html << predictionSectionHtml(r.predictions, r.predictionDisplay,
+                                  participantPredictions(r.storedManifest, r.stimuliFolder, calibrated));
+}
 
-    // --- Objective errors. ---
+void writeObjectiveErrors(std::ostringstream& html, const ReportData& r) {
+    const Metrics& m = r.metrics;
+    const std::vector<agreement::ConditionMetrics>& conditionMetrics = m.conditions;
+    auto& imagesOfBlock = r.stimuli.imagesOfBlock;
     html << "<h2 id=\"metrics\">Objective errors against the reference</h2>\n";
     if (conditionMetrics.empty()) {
         html << "<p>Not available: the stimulus set has no reference render for the study's blocks.</p>\n";
     } else {
         html << "<p class=\"note\">Each stimulus against its block's reference render";
-        if (!referencePng.empty()) {
+        if (!m.referencePng.empty()) {
             html << " (";
             int k = 0;
-            for (const auto& [block, reference] : referencePng)
+            for (const auto& [block, reference] : m.referencePng)
                 html << (k++ ? ", " : "") << h(block) << ": " << h(reference);
             html << ")";
         }
         html << ". ΔE00 and FLIP: lower is better; PSNR, SSIM and ColorVideoVDP (10 = indistinguishable): higher is "
                 "better. Heat maps: each on its own colour scale (printed under it). Bands: mean ΔE00 in the halo, "
                 "bleed, spill and interior bands (docs/metrics.md). FLIP at "
-             << num(metricsJson.contains("settings") && metricsJson["settings"].contains("flip")
-                        ? metricsJson["settings"]["flip"].value("pixels_per_degree", NAN)
+             << num(m.json.contains("settings") && m.json["settings"].contains("flip")
+                        ? m.json["settings"]["flip"].value("pixels_per_degree", NAN)
                         : NAN,
                     1)
              << " pixels per degree.</p>\n";
-        for (const experiments::StudyBlock& block : definition.blocks) {
+        for (const experiments::StudyBlock& block : r.definition.blocks) {
             html << "<h3 id=\"metrics-" << slug(block.name) << "\">" << h(block.name) << "</h3><table><thead><tr>"
                  << "<th class=\"l\">condition</th><th>PSNR (dB)</th><th>SSIM</th><th>mean ΔE00</th><th>p95 ΔE00</th>"
                     "<th>mean FLIP</th><th>skin FLIP</th><th>halo ΔE00</th><th>bleed ΔE00</th><th>spill ΔE00</th>"
@@ -704,22 +774,27 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
             html << "</tbody></table><div class=\"thumbs heat\">";
             for (const ConditionImages& image : imagesOfBlock[block.name]) {
                 // Each map on its own colour scale (from its data), printed under it.
-                for (const auto& [of, what] : {std::pair{&heatmapOf, "ΔE00"}, std::pair{&flipHeatmapOf, "FLIP"},
-                                               std::pair{&cvvdpHeatmapOf, "ColorVideoVDP (JOD loss)"}}) {
+                for (const auto& [of, what] : {std::pair{&m.heatmapOf, "ΔE00"}, std::pair{&m.flipHeatmapOf, "FLIP"},
+                                               std::pair{&m.cvvdpHeatmapOf, "ColorVideoVDP (JOD loss)"}}) {
                     const auto found = of->find(image.stimulus);
                     if (found == of->end()) continue;
-                    const auto scale = scaleOf.find(found->second);
+                    const auto scale = m.scaleOf.find(found->second);
                     html << "<figure><a href=\"" << h(found->second) << "\"><img src=\"" << h(found->second)
                          << "\" alt=\"" << what << " of " << h(image.condition) << "\"></a><figcaption>" << what << ", "
-                         << h(image.condition) << (scale == scaleOf.end() ? std::string() : ", scale " + scale->second)
+                         << h(image.condition)
+                         << (scale == m.scaleOf.end() ? std::string() : ", scale " + scale->second)
                          << "</figcaption></figure>";
                 }
             }
             html << "</div>\n";
         }
     }
+}
 
-    // --- Metrics against perception. ---
+void writeAgreement(std::ostringstream& html, const ReportData& r) {
+    const std::vector<agreement::ConditionMetrics>& conditionMetrics = r.metrics.conditions;
+    const agreement::AgreementOptions& agreementOptions = r.agreementOptions;
+    const agreement::AgreementResult& agreementResult = r.agreement;
     html << "<h2 id=\"agreement\">Metrics against perception</h2>\n";
     if (conditionMetrics.empty()) {
         html << "<p>Not available without image metrics.</p>\n";
@@ -739,7 +814,7 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
         static const std::vector<std::string> plotted = {"image.psnr_db",        "image.ssim",
                                                          "image.delta_e00_mean", "image.flip_mean",
                                                          "skin.flip_mean",       "bands.halo.delta_e00_mean"};
-        for (const scaling::BlockAnalysis& block : analysis.blocks) {
+        for (const scaling::BlockAnalysis& block : r.scale.analysis.blocks) {
             html << "<h3 id=\"agreement-" << slug(block.name) << "\">" << h(block.name) << "</h3><table><thead><tr>"
                  << "<th class=\"l\">metric</th><th>better</th><th>n</th><th>Pearson r</th><th>95 % interval</th>"
                     "<th>Spearman ρ</th><th>95 % interval</th><th>p</th><th>p (Holm)</th><th>pairs ordered</th></tr>"
@@ -780,50 +855,110 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
         for (const std::string& warning : agreementResult.warnings)
             html << "<p class=\"note\">Note: " << h(warning) << "</p>";
     }
+}
+
+// PDF through headless Chromium (a fresh profile in a temporary folder); empty when none was written.
+fs::path writePdf(const ReportOptions& options, const fs::path& out) {
+    const fs::path profile = fs::temp_directory_path() / ("skinlab-report-chromium-" + std::to_string(::getpid()));
+    fs::remove_all(profile);
+    const fs::path pdf = out / "report.pdf";
+    const fs::path temp = out / (".report.pdf.tmp-" + std::to_string(::getpid()));
+    // Chromium under coreutils' timeout (a hung browser ends the report without a PDF, not the program).
+    const fs::path timeout = findProgram("timeout");
+    const fs::path chromium = findProgram(options.chromium);
+    int status = -1;
+    if (!timeout.empty() && !chromium.empty()) {
+        try {
+            status = waitProcess(spawnProcess(
+                timeout, {"180", chromium.string(), "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
+                          "--no-first-run", "--disable-background-networking", "--disable-component-update",
+                          "--disable-sync", "--no-pdf-header-footer", "--user-data-dir=" + profile.string(),
+                          "--print-to-pdf=" + temp.string(), "file://" + fs::absolute(out / "index.html").string()}));
+        } catch (const RuntimeError& e) {
+            spdlog::warn("report: {}", e.what());
+        }
+    }
+    fs::remove_all(profile);
+    std::error_code ec;
+    if (status == 0 && fs::is_regular_file(temp, ec) && fs::file_size(temp, ec) > 0) {
+        fs::rename(temp, pdf);
+        return pdf;
+    }
+    fs::remove(temp, ec);
+    spdlog::warn("report: no PDF ({} failed or is not installed; give --chromium PATH or --no-pdf)", options.chromium);
+    return {};
+}
+
+} // namespace
+
+ReportSummary writeStudyReport(const ReportOptions& options) {
+    const auto started = std::chrono::steady_clock::now();
+    if (!fs::is_regular_file(options.study)) throwInput(options.study.string(), "", "file not found");
+    if (options.output.empty()) throwInput("-o", "", "required: the report folder");
+    experiments::StudyStore store(options.study);
+    const experiments::StudyDefinition& definition = store.definition();
+    const std::vector<std::string> simulated = store.simulatedLabels();
+    const fs::path stimuliFolder = options.stimuli.empty() ? fs::path(store.meta("stimuli_dir")) : options.stimuli;
+    if (!fs::is_regular_file(stimuliFolder / "manifest.json"))
+        throwInput((stimuliFolder / "manifest.json").string(), "",
+                   "file not found (the study's stimulus folder; give --stimuli DIR if it moved)");
+    if (!options.metrics.empty() && !fs::is_regular_file(options.metrics / "metrics.json"))
+        throwInput((options.metrics / "metrics.json").string(), "",
+                   "file not found (run `skinlab analyze metrics` first)");
+    for (const experiments::StudyStimulus& s : definition.stimuli)
+        if (!fs::is_regular_file(stimuliFolder / s.pngPath))
+            throwInput((stimuliFolder / s.pngPath).string(), "", "file not found (stimulus " + s.id + ")");
+
+    const fs::path out = options.output;
+    ensureDirectory(out);
+
+    Participants participants = readParticipants(store, options);
+    const Scale scale = scaleStudy(participants, options, out);
+    StimulusImages stimuli = copyStimuli(definition, stimuliFolder, out);
+    const Metrics metrics = readMetrics(options, stimuliFolder, out, stimuli.conditionOfStimulus);
+    agreement::AgreementOptions agreementOptions;
+    agreementOptions.samples = options.bootstrapSamples;
+    agreementOptions.seed = options.seed;
+    const agreement::AgreementResult agreementResult = agreement::computeAgreement(
+        scale.dataset, scale.analysis, metrics.conditions, scale.options.fit, agreementOptions);
+    if (!metrics.conditions.empty()) {
+        writeFileAtomic(out / "agreement.json", agreement::agreementJson(agreementResult).dump(2) + "\n");
+        writeFileAtomic(out / "agreement.csv", agreement::agreementCsv(agreementResult));
+    }
+    // Predicted JOD (ColorVideoVDP, recorded by `stimuli build`) against the measured scale.
+    const nlohmann::json storedManifest = nlohmann::json::parse(store.meta("manifest_json"));
+    const std::vector<PredictionAgreement> predictions =
+        predictionAgreement(definition, storedManifest, scale.analysis);
+    std::string predictionDisplay;
+    for (const nlohmann::json& s : storedManifest.value("stimuli", nlohmann::json::array()))
+        if (s.contains("predicted") && s["predicted"].contains("display"))
+            predictionDisplay = s["predicted"]["display"].get<std::string>();
+
+    const ReportData data{options,         store,          definition,  simulated,        stimuliFolder,
+                          participants,    scale,          stimuli,     metrics,          agreementOptions,
+                          agreementResult, storedManifest, predictions, predictionDisplay};
+    std::ostringstream html;
+    writeTitle(html, data);
+    writeFindings(html, data);
+    writeDesign(html, data);
+    writeParticipants(html, data);
+    writeStimuli(html, data);
+    writeScale(html, data);
+    writePredictions(html, data);
+    writeObjectiveErrors(html, data);
+    writeAgreement(html, data);
     html << "<p class=\"note\">Written by <code>skinlab report</code> from " << h(options.study.filename().string())
-         << ". Tables: scale.json" << (conditionMetrics.empty() ? "" : ", agreement.csv, agreement.json")
-         << (options.metrics.empty() && !metricsFolder.empty() ? ", metrics/" : "") << ".</p>\n</main></body></html>\n";
+         << ". Tables: scale.json" << (metrics.conditions.empty() ? "" : ", agreement.csv, agreement.json")
+         << (options.metrics.empty() && !metrics.folder.empty() ? ", metrics/" : "")
+         << ".</p>\n</main></body></html>\n";
     writeFileAtomic(out / "index.html", html.str());
 
     ReportSummary summary;
     summary.html = out / "index.html";
-    summary.observers = included;
-    summary.excluded = excluded;
-    summary.metrics = !conditionMetrics.empty();
-
-    // --- PDF through headless Chromium (a fresh profile in a temporary folder). ---
-    if (options.pdf) {
-        const fs::path profile = fs::temp_directory_path() / ("skinlab-report-chromium-" + std::to_string(::getpid()));
-        fs::remove_all(profile);
-        const fs::path pdf = out / "report.pdf";
-        const fs::path temp = out / (".report.pdf.tmp-" + std::to_string(::getpid()));
-        // Chromium under coreutils' timeout (a hung browser ends the report without a PDF, not the program).
-        const fs::path timeout = findProgram("timeout");
-        const fs::path chromium = findProgram(options.chromium);
-        int status = -1;
-        if (!timeout.empty() && !chromium.empty()) {
-            try {
-                status = waitProcess(
-                    spawnProcess(timeout, {"180", chromium.string(), "--headless", "--no-sandbox", "--disable-gpu",
-                                           "--disable-quic", "--no-first-run", "--disable-background-networking",
-                                           "--disable-component-update", "--disable-sync", "--no-pdf-header-footer",
-                                           "--user-data-dir=" + profile.string(), "--print-to-pdf=" + temp.string(),
-                                           "file://" + fs::absolute(out / "index.html").string()}));
-            } catch (const RuntimeError& e) {
-                spdlog::warn("report: {}", e.what());
-            }
-        }
-        fs::remove_all(profile);
-        std::error_code ec;
-        if (status == 0 && fs::is_regular_file(temp, ec) && fs::file_size(temp, ec) > 0) {
-            fs::rename(temp, pdf);
-            summary.pdf = pdf;
-        } else {
-            fs::remove(temp, ec);
-            spdlog::warn("report: no PDF ({} failed or is not installed; give --chromium PATH or --no-pdf)",
-                         options.chromium);
-        }
-    }
+    summary.observers = participants.included;
+    summary.excluded = participants.excluded();
+    summary.metrics = !metrics.conditions.empty();
+    if (options.pdf) summary.pdf = writePdf(options, out);
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     spdlog::info("report: written in {:.1f} s", seconds);
     return summary;

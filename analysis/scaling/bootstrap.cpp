@@ -1,6 +1,7 @@
 #include "analysis/scaling/bootstrap.h"
 
 #include "analysis/scaling/profile_likelihood.h"
+#include "analysis/scaling/robust_variance.h"
 
 #include <algorithm>
 #include <cmath>
@@ -23,32 +24,6 @@ double sortedQuantile(const std::vector<double>& sorted, double probability) {
     const size_t above = std::min(below + 1, sorted.size() - 1);
     const double fraction = position - static_cast<double>(below);
     return sorted[below] + fraction * (sorted[above] - sorted[below]);
-}
-
-Eigen::MatrixXd robustCovariance(const BlockData& block, const Eigen::VectorXd& weights, const FitResult& fit,
-                                 Model model) {
-    const int m = block.conditionCount();
-    const auto pairCount = static_cast<Eigen::Index>(block.pairs.size());
-    Eigen::RowVectorXd slopeFirst(pairCount), slopeSecond(pairCount);
-    for (Eigen::Index p = 0; p < pairCount; ++p) {
-        const double d = fit.scores[block.pairs[p].first] - fit.scores[block.pairs[p].second];
-        slopeFirst[p] = linkValues(model, d).slope;
-        slopeSecond[p] = linkValues(model, -d).slope;
-    }
-    // Per observer and pair: d/d(q_i − q_j) of that observer's log-likelihood.
-    const Eigen::MatrixXd pairGradient = block.winsFirst.array().rowwise() * slopeFirst.array() -
-                                         block.winsSecond.array().rowwise() * slopeSecond.array();
-    Eigen::MatrixXd gradient = Eigen::MatrixXd::Zero(block.observerCount(), m);
-    for (Eigen::Index p = 0; p < pairCount; ++p) {
-        gradient.col(block.pairs[p].first) += pairGradient.col(p);
-        gradient.col(block.pairs[p].second) -= pairGradient.col(p);
-    }
-    const double total = weights.sum();
-    const Eigen::RowVectorXd mean = (weights.transpose() * gradient) / total;
-    const Eigen::MatrixXd centred = gradient.rowwise() - mean;
-    const Eigen::MatrixXd meat =
-        centred.transpose() * weights.asDiagonal() * centred * (total / std::max(total - 1.0, 1.0));
-    return fit.inverseInformation * meat * fit.inverseInformation;
 }
 
 DesignStructure designStructure(const BlockData& block) {

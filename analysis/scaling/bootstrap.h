@@ -20,6 +20,7 @@
 // p-value to the score test. docs/analysis.md, "When the bootstrap is degenerate".
 #include "analysis/scaling/comparison_data.h"
 #include "analysis/scaling/pairwise_model.h"
+#include "analysis/scaling/robust_variance.h"
 
 #include <Eigen/Dense>
 
@@ -36,11 +37,6 @@ struct BootstrapOptions {
     int threads = 2;
     double level = 0.95; // two-sided confidence level
 };
-
-// Observer-cluster-robust covariance of the mean-zero scores at `fit`, from observers weighted by `weights`
-// (multiplicities). Centred score contributions, small-sample factor N/(N−1) with N = Σ weights.
-Eigen::MatrixXd robustCovariance(const BlockData& block, const Eigen::VectorXd& weights, const FitResult& fit,
-                                 Model model);
 
 // Why an interval is not the studentized one (empty: it is). Names as written to scale.json.
 struct IntervalDiagnosis {

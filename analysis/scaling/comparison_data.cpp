@@ -133,12 +133,12 @@ Dataset buildDataset(const ResponseTable& table, const DatasetOptions& options) 
         if (static_cast<size_t>(attentionIndex) == dataset.attention.size()) dataset.attention.push_back({r.observer});
         ObserverAttention& attention = dataset.attention[attentionIndex];
         if (r.aOnLeft) dataset.hasSides = true;
-        if (r.kind == TrialKind::Catch) {
+        if (r.kind == TrialKind::catchTrial) {
             ++attention.catchTrials;
             if (r.correct && !*r.correct) ++attention.catchFailures;
             continue;
         }
-        if (r.kind == TrialKind::Practice) {
+        if (r.kind == TrialKind::practice) {
             ++attention.practiceTrials;
             continue;
         }
@@ -185,7 +185,7 @@ Dataset buildDataset(const ResponseTable& table, const DatasetOptions& options) 
     }
     // Pairs first (to size the matrices), then the wins.
     for (const Response& r : table.responses) {
-        if (r.kind == TrialKind::Catch || r.kind == TrialKind::Practice) continue;
+        if (r.kind == TrialKind::catchTrial || r.kind == TrialKind::practice) continue;
         const int b = blocks.find(r.block.empty() ? "all" : r.block);
         int a = conditions[b].find(r.conditionA), c = conditions[b].find(r.conditionB);
         const std::pair<int, int> key{std::min(a, c), std::max(a, c)};
@@ -199,7 +199,7 @@ Dataset buildDataset(const ResponseTable& table, const DatasetOptions& options) 
         built[b].sideCounts.assign(built[b].pairs.size(), {0, 0, 0, 0});
     }
     for (const Response& r : table.responses) {
-        if (r.kind == TrialKind::Catch || r.kind == TrialKind::Practice) continue;
+        if (r.kind == TrialKind::catchTrial || r.kind == TrialKind::practice) continue;
         const int b = blocks.find(r.block.empty() ? "all" : r.block);
         BlockData& block = built[b];
         const int a = conditions[b].find(r.conditionA), c = conditions[b].find(r.conditionB);

@@ -1,21 +1,11 @@
 #include "analysis/scaling/profile_likelihood.h"
 
-#include "analysis/scaling/bootstrap.h"
+#include "analysis/scaling/robust_variance.h"
 
 #include <algorithm>
 #include <cmath>
 
 namespace skinlab::analysis::scaling {
-
-double normalQuantile(double probability) {
-    double low = -40.0, high = 40.0;
-    for (int iteration = 0; iteration < 200 && high - low > 1e-14; ++iteration) {
-        const double middle = 0.5 * (low + high);
-        if (0.5 * std::erfc(-middle / std::sqrt(2.0)) < probability) low = middle;
-        else high = middle;
-    }
-    return 0.5 * (low + high);
-}
 
 ProfileInterval profileInterval(const PairCounts& counts, const FitOptions& options, const FitResult& fit,
                                 const Eigen::VectorXd& contrast, double level) {

@@ -11,6 +11,7 @@
 //    agrees with the exact binomial test (docs/analysis.md gives the figures).
 #include "analysis/scaling/comparison_data.h"
 #include "analysis/scaling/pairwise_model.h"
+#include "analysis/scaling/robust_variance.h"
 
 #include <Eigen/Dense>
 
@@ -33,8 +34,5 @@ ProfileInterval profileInterval(const PairCounts& counts, const FitOptions& opti
 // variance (nullptr: model-based only, e.g. a count matrix).
 double scoreTestPValue(const BlockData* block, const PairCounts& counts, const FitOptions& options,
                        const FitResult& fit, int first, int second);
-
-// Φ⁻¹(probability), 0 < probability < 1 (bisection on erfc to double precision).
-double normalQuantile(double probability);
 
 } // namespace skinlab::analysis::scaling

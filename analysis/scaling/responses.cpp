@@ -55,10 +55,10 @@ double parseNumber(const std::string& file, int line, std::string_view column, c
 }
 
 TrialKind parseKind(const std::string& file, int line, const std::string& value) {
-    if (value == "test") return TrialKind::Test;
-    if (value == "repeat") return TrialKind::Repeat;
-    if (value == "catch") return TrialKind::Catch;
-    if (value == "practice") return TrialKind::Practice;
+    if (value == "test") return TrialKind::test;
+    if (value == "repeat") return TrialKind::repeat;
+    if (value == "catch") return TrialKind::catchTrial;
+    if (value == "practice") return TrialKind::practice;
     throwInput(file, where(line, "trial_kind"), "'" + value + "' is not one of test, repeat, catch, practice");
 }
 
@@ -395,10 +395,10 @@ ResponseTable readDatabase(const std::filesystem::path& path) {
 
 const char* trialKindName(TrialKind kind) {
     switch (kind) {
-    case TrialKind::Test: return "test";
-    case TrialKind::Repeat: return "repeat";
-    case TrialKind::Catch: return "catch";
-    case TrialKind::Practice: return "practice";
+    case TrialKind::test: return "test";
+    case TrialKind::repeat: return "repeat";
+    case TrialKind::catchTrial: return "catch";
+    case TrialKind::practice: return "practice";
     }
     return "test";
 }

@@ -18,8 +18,10 @@
 
 namespace skinlab::analysis::scaling {
 
-enum class TrialKind { Test, Repeat, Catch, Practice };
-const char* trialKindName(TrialKind kind);
+// A trial's kind (contract 3's trial_kind). The one enum of the project: experiments' trial plans use it too
+// (experiments/trial_plan.h), so the study's rows reach the scaling without a conversion.
+enum class TrialKind { test, repeat, catchTrial, practice };
+const char* trialKindName(TrialKind kind); // "test", "repeat", "catch", "practice" (contract 3)
 
 struct Response {
     std::string observer;
@@ -28,7 +30,7 @@ struct Response {
     std::string conditionB;
     bool aSelected = false;
     std::optional<bool> aOnLeft; // unknown in pwcmp files
-    TrialKind kind = TrialKind::Test;
+    TrialKind kind = TrialKind::test;
     std::optional<bool> correct; // catch trials only
     std::optional<double> responseMs;
     std::optional<bool> flagged; // page hidden or focus lost while shown (online studies); unknown when absent

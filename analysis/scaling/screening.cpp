@@ -62,10 +62,10 @@ std::vector<ExcludedObserver> excludeObservers(ResponseTable& table) {
     for (const Response& r : table.responses) {
         auto [entry, added] = counts.try_emplace(r.observer);
         if (added) order.push_back(r.observer);
-        if (r.kind == TrialKind::Catch) {
+        if (r.kind == TrialKind::catchTrial) {
             ++entry->second.catchTrials;
             if (r.correct && !*r.correct) ++entry->second.catchFailures;
-        } else if (r.kind != TrialKind::Practice) {
+        } else if (r.kind != TrialKind::practice) {
             ++entry->second.scaled;
         }
     }

@@ -2,7 +2,7 @@
 // The resolved scene written for Blender (GL-free): the same triangles, camera, lights, environment and materials
 // the rasterizer draws, as a JSON description plus one binary geometry file, read by cycles_scene.py (embedded in
 // the binary and written beside them). docs/pathtraced.md, "What Cycles is given".
-#include "renderer/pathtraced/pathtraced_params.h"
+#include "renderer/sss/pathtraced_params.h"
 #include "renderer/scene/mesh.h"
 #include "renderer/scene/scene_spec.h"
 

@@ -3,8 +3,8 @@
 #include "common/error.h"
 #include "common/spec.h"
 #include "renderer/scene/builtin_scenes.h"
-#include "renderer/pathtraced/eevee_params.h"
-#include "renderer/pathtraced/pathtraced_params.h"
+#include "renderer/sss/eevee_params.h"
+#include "renderer/sss/pathtraced_params.h"
 #include "renderer/sss/sss_params.h"
 
 #include <cmath>
@@ -51,106 +51,65 @@ void checkDirection(const SpecReader& reader, std::string_view key, const glm::v
     if (glm::length(v) < 1e-6f) reader.fail(key, "must not be the zero vector");
 }
 
-} // namespace
+// Each reader below reads one table of the spec into `spec` and records its resolved values in `resolved`.
 
-SceneSpec loadSceneSpec(const std::string& scene, const std::vector<std::string>& overrides,
-                        const std::filesystem::path& assetsDirectoryIn) {
-    SceneSpec spec;
-    spec.source = scene;
-    toml::table table;
-    std::string file;
-    std::filesystem::path specDirectory = std::filesystem::current_path();
-    if (scene.rfind("builtin:", 0) == 0) {
-        const auto text = builtinSceneText(scene.substr(8));
-        if (!text) {
-            std::string names;
-            for (const auto& name : builtinSceneNames()) names += (names.empty() ? "builtin:" : ", builtin:") + name;
-            throw InputError("unknown built-in scene '" + scene + "' (known: " + names + ")");
-        }
-        table = parseTomlString(*text, scene);
-        file = scene;
+// [model]: a built-in model or a model file, and the keys that apply to it only.
+void readModel(const SpecReader& root, const PathResolver& paths, SceneSpec& spec, nlohmann::json& resolved) {
+    const SpecReader model = root.table("model");
+    const std::string source = model.requiredString("source");
+    if (source.rfind("builtin:", 0) == 0) {
+        static const std::vector<std::string> known = {"builtin:halo", "builtin:bleed", "builtin:ear", "builtin:head"};
+        bool found = false;
+        for (const auto& k : known) found = found || k == source;
+        if (!found)
+            model.fail("source", "unknown built-in model '" + source +
+                                     "' (known: builtin:halo, builtin:bleed, builtin:ear, builtin:head)");
+        spec.modelSource = source;
     } else {
-        std::error_code error;
-        if (!std::filesystem::is_regular_file(scene, error))
-            throw InputError(scene + ": scene spec not found (give a TOML file or builtin:NAME)");
-        table = parseTomlFile(scene);
-        file = std::filesystem::path(scene).filename().string();
-        specDirectory = std::filesystem::absolute(scene).parent_path();
+        spec.modelSource = paths.resolve(model, "source", source).string();
     }
-    for (const auto& assignment : overrides) applyOverride(table, assignment, "--set");
-
-    std::filesystem::path assetsDirectory = assetsDirectoryIn;
-    if (assetsDirectory.empty())
-        if (const char* environment = std::getenv("SKINLAB_ASSETS"); environment && *environment)
-            assetsDirectory = environment;
-
-    // Errors name the spec file (or builtin:NAME) the way the user wrote it.
-    SpecReader root(table, scene, "");
-    PathResolver paths{&root, specDirectory, assetsDirectory};
-    nlohmann::json resolved;
-    resolved["scene"] = scene;
-
-    spec.mmPerUnit = root.number("mm_per_unit", 1.0, 1e-6, 1e6);
-    resolved["mm_per_unit"] = spec.mmPerUnit;
-
-    // [model]
-    {
-        const SpecReader model = root.table("model");
-        const std::string source = model.requiredString("source");
-        if (source.rfind("builtin:", 0) == 0) {
-            static const std::vector<std::string> known = {"builtin:halo", "builtin:bleed", "builtin:ear",
-                                                           "builtin:head"};
-            bool found = false;
-            for (const auto& k : known) found = found || k == source;
-            if (!found)
-                model.fail("source", "unknown built-in model '" + source +
-                                         "' (known: builtin:halo, builtin:bleed, builtin:ear, builtin:head)");
-            spec.modelSource = source;
-        } else {
-            spec.modelSource = paths.resolve(model, "source", source).string();
-        }
-        resolved["model"]["source"] = source;
-        if (model.has("depth_gap_mm")) {
-            if (source != "builtin:halo") model.fail("depth_gap_mm", "only applies to builtin:halo");
-        }
-        if (model.has("thickness_mm")) {
-            if (source != "builtin:ear") model.fail("thickness_mm", "only applies to builtin:ear");
-        }
-        if (model.has("skin_detail")) {
-            if (source != "builtin:head") model.fail("skin_detail", "only applies to builtin:head");
-        }
-        spec.skinDetail = model.boolean("skin_detail", true);
-        if (source == "builtin:head") resolved["model"]["skin_detail"] = spec.skinDetail;
-        if (model.has("flip_v") && source.rfind("builtin:", 0) == 0)
-            model.fail("flip_v", "only applies to model files");
-        spec.flipV = model.boolean("flip_v", false);
-        if (source.rfind("builtin:", 0) != 0) resolved["model"]["flip_v"] = spec.flipV;
-        spec.depthGapMm = model.number("depth_gap_mm", 200.0, 1e-3, 10000.0);
-        spec.thicknessMm = model.number("thickness_mm", 2.5, 0.05, 20.0);
-        if (source == "builtin:halo") resolved["model"]["depth_gap_mm"] = spec.depthGapMm;
-        if (source == "builtin:ear") resolved["model"]["thickness_mm"] = spec.thicknessMm;
+    resolved["model"]["source"] = source;
+    if (model.has("depth_gap_mm")) {
+        if (source != "builtin:halo") model.fail("depth_gap_mm", "only applies to builtin:halo");
     }
-
-    // [textures]
-    {
-        const SpecReader textures = root.table("textures");
-        const std::string albedo = textures.string("albedo", "");
-        const std::string normal = textures.string("normal", "");
-        const std::string specular = textures.string("specular", "");
-        const std::string occlusion = textures.string("occlusion", "");
-        const std::string skinMask = textures.string("skin_mask", "");
-        spec.textures.albedo = paths.resolve(textures, "albedo", albedo);
-        spec.textures.normal = paths.resolve(textures, "normal", normal);
-        spec.textures.specular = paths.resolve(textures, "specular", specular);
-        spec.textures.occlusion = paths.resolve(textures, "occlusion", occlusion);
-        spec.textures.skinMask = paths.resolve(textures, "skin_mask", skinMask);
-        spec.textures.normalStrength = textures.number("normal_strength", 1.0, 0.0, 4.0);
-        resolved["textures"] = {{"albedo", albedo},      {"normal", normal},
-                                {"specular", specular},  {"occlusion", occlusion},
-                                {"skin_mask", skinMask}, {"normal_strength", spec.textures.normalStrength}};
+    if (model.has("thickness_mm")) {
+        if (source != "builtin:ear") model.fail("thickness_mm", "only applies to builtin:ear");
     }
+    if (model.has("skin_detail")) {
+        if (source != "builtin:head") model.fail("skin_detail", "only applies to builtin:head");
+    }
+    spec.skinDetail = model.boolean("skin_detail", true);
+    if (source == "builtin:head") resolved["model"]["skin_detail"] = spec.skinDetail;
+    if (model.has("flip_v") && source.rfind("builtin:", 0) == 0) model.fail("flip_v", "only applies to model files");
+    spec.flipV = model.boolean("flip_v", false);
+    if (source.rfind("builtin:", 0) != 0) resolved["model"]["flip_v"] = spec.flipV;
+    spec.depthGapMm = model.number("depth_gap_mm", 200.0, 1e-3, 10000.0);
+    spec.thicknessMm = model.number("thickness_mm", 2.5, 0.05, 20.0);
+    if (source == "builtin:halo") resolved["model"]["depth_gap_mm"] = spec.depthGapMm;
+    if (source == "builtin:ear") resolved["model"]["thickness_mm"] = spec.thicknessMm;
+}
 
-    // [[materials]]
+// [textures]: the maps of a model file (paths checked).
+void readTextures(const SpecReader& root, const PathResolver& paths, SceneSpec& spec, nlohmann::json& resolved) {
+    const SpecReader textures = root.table("textures");
+    const std::string albedo = textures.string("albedo", "");
+    const std::string normal = textures.string("normal", "");
+    const std::string specular = textures.string("specular", "");
+    const std::string occlusion = textures.string("occlusion", "");
+    const std::string skinMask = textures.string("skin_mask", "");
+    spec.textures.albedo = paths.resolve(textures, "albedo", albedo);
+    spec.textures.normal = paths.resolve(textures, "normal", normal);
+    spec.textures.specular = paths.resolve(textures, "specular", specular);
+    spec.textures.occlusion = paths.resolve(textures, "occlusion", occlusion);
+    spec.textures.skinMask = paths.resolve(textures, "skin_mask", skinMask);
+    spec.textures.normalStrength = textures.number("normal_strength", 1.0, 0.0, 4.0);
+    resolved["textures"] = {{"albedo", albedo},      {"normal", normal},
+                            {"specular", specular},  {"occlusion", occlusion},
+                            {"skin_mask", skinMask}, {"normal_strength", spec.textures.normalStrength}};
+}
+
+// [[materials]]: overrides per material of the model ("*" for all).
+void readMaterials(const SpecReader& root, SceneSpec& spec, nlohmann::json& resolved) {
     resolved["materials"] = nlohmann::json::array();
     for (const SpecReader& material : root.tables("materials")) {
         MaterialSpec m;
@@ -169,43 +128,44 @@ SceneSpec loadSceneSpec(const std::string& scene, const std::vector<std::string>
         spec.materials.push_back(m);
         resolved["materials"].push_back(entry);
     }
+}
 
-    // [camera]
-    {
-        const SpecReader camera = root.table("camera");
-        CameraSpec& c = spec.camera;
-        c.view = camera.choice("view", "mid", {"close", "mid", "far", "explicit"});
-        c.fovDeg = camera.number("fov_deg", 30.0, 1.0, 179.0);
-        nlohmann::json& r = resolved["camera"];
-        r = {{"view", c.view}, {"fov_deg", c.fovDeg}};
-        if (c.view == "explicit") {
-            if (!camera.has("position"))
-                camera.fail("position", "missing (camera.view = explicit needs position and target)");
-            if (!camera.has("target"))
-                camera.fail("target", "missing (camera.view = explicit needs position and target)");
-            c.position = toVec3(camera.vec3("position", {0, 0, 1}, -kHuge, kHuge));
-            c.target = toVec3(camera.vec3("target", {0, 0, 0}, -kHuge, kHuge));
-            c.up = toVec3(camera.vec3("up", {0, 1, 0}, -kHuge, kHuge));
-            checkDirection(camera, "up", c.up);
-            if (glm::length(c.position - c.target) < 1e-9f) camera.fail("target", "equals camera.position");
-            if (glm::length(glm::cross(glm::normalize(c.target - c.position), glm::normalize(c.up))) < 1e-4f)
-                camera.fail("up", "is parallel to the viewing direction");
-            for (const char* key : {"yaw_deg", "pitch_deg"})
-                if (camera.has(key)) camera.fail(key, "only applies to the named views close|mid|far");
-            r["position"] = jsonVec3(c.position);
-            r["target"] = jsonVec3(c.target);
-            r["up"] = jsonVec3(c.up);
-        } else {
-            for (const char* key : {"position", "target", "up"})
-                if (camera.has(key)) camera.fail(key, "only applies to camera.view = explicit");
-            c.yawDeg = camera.number("yaw_deg", 0.0, -180.0, 180.0);
-            c.pitchDeg = camera.number("pitch_deg", 0.0, -89.0, 89.0);
-            r["yaw_deg"] = c.yawDeg;
-            r["pitch_deg"] = c.pitchDeg;
-        }
+// [camera]: a named view (orbited by yaw and pitch) or an explicit one.
+void readCamera(const SpecReader& root, SceneSpec& spec, nlohmann::json& resolved) {
+    const SpecReader camera = root.table("camera");
+    CameraSpec& c = spec.camera;
+    c.view = camera.choice("view", "mid", {"close", "mid", "far", "explicit"});
+    c.fovDeg = camera.number("fov_deg", 30.0, 1.0, 179.0);
+    nlohmann::json& r = resolved["camera"];
+    r = {{"view", c.view}, {"fov_deg", c.fovDeg}};
+    if (c.view == "explicit") {
+        if (!camera.has("position"))
+            camera.fail("position", "missing (camera.view = explicit needs position and target)");
+        if (!camera.has("target")) camera.fail("target", "missing (camera.view = explicit needs position and target)");
+        c.position = toVec3(camera.vec3("position", {0, 0, 1}, -kHuge, kHuge));
+        c.target = toVec3(camera.vec3("target", {0, 0, 0}, -kHuge, kHuge));
+        c.up = toVec3(camera.vec3("up", {0, 1, 0}, -kHuge, kHuge));
+        checkDirection(camera, "up", c.up);
+        if (glm::length(c.position - c.target) < 1e-9f) camera.fail("target", "equals camera.position");
+        if (glm::length(glm::cross(glm::normalize(c.target - c.position), glm::normalize(c.up))) < 1e-4f)
+            camera.fail("up", "is parallel to the viewing direction");
+        for (const char* key : {"yaw_deg", "pitch_deg"})
+            if (camera.has(key)) camera.fail(key, "only applies to the named views close|mid|far");
+        r["position"] = jsonVec3(c.position);
+        r["target"] = jsonVec3(c.target);
+        r["up"] = jsonVec3(c.up);
+    } else {
+        for (const char* key : {"position", "target", "up"})
+            if (camera.has(key)) camera.fail(key, "only applies to camera.view = explicit");
+        c.yawDeg = camera.number("yaw_deg", 0.0, -180.0, 180.0);
+        c.pitchDeg = camera.number("pitch_deg", 0.0, -89.0, 89.0);
+        r["yaw_deg"] = c.yawDeg;
+        r["pitch_deg"] = c.pitchDeg;
     }
+}
 
-    // [[lights]]
+// [[lights]]: directional and spot lights, at most 4.
+void readLights(const SpecReader& root, SceneSpec& spec, nlohmann::json& resolved) {
     resolved["lights"] = nlohmann::json::array();
     for (const SpecReader& light : root.tables("lights")) {
         LightSpec l;
@@ -243,72 +203,130 @@ SceneSpec loadSceneSpec(const std::string& scene, const std::vector<std::string>
         resolved["lights"].push_back(entry);
     }
     if (spec.lights.size() > 4) root.fail("lights", "at most 4 lights, got " + std::to_string(spec.lights.size()));
+}
 
-    // [shadow]
-    {
-        const SpecReader shadow = root.table("shadow");
-        spec.shadowResolution = static_cast<int>(shadow.integer("resolution", 2048, 64, 8192));
-        spec.shadowPcfRadius = static_cast<int>(shadow.integer("pcf_radius", 1, 0, 4));
-        resolved["shadow"] = {{"resolution", spec.shadowResolution}, {"pcf_radius", spec.shadowPcfRadius}};
+// [shadow]: the shadow map.
+void readShadow(const SpecReader& root, SceneSpec& spec, nlohmann::json& resolved) {
+    const SpecReader shadow = root.table("shadow");
+    spec.shadowResolution = static_cast<int>(shadow.integer("resolution", 2048, 64, 8192));
+    spec.shadowPcfRadius = static_cast<int>(shadow.integer("pcf_radius", 1, 0, 4));
+    resolved["shadow"] = {{"resolution", spec.shadowResolution}, {"pcf_radius", spec.shadowPcfRadius}};
+}
+
+// [environment]: an HDR file or a constant radiance, and the background.
+void readEnvironment(const SpecReader& root, const PathResolver& paths, SceneSpec& spec, nlohmann::json& resolved) {
+    const SpecReader environment = root.table("environment");
+    EnvironmentSpec& e = spec.environment;
+    const std::string environmentFile = environment.string("file", "");
+    e.file = paths.resolve(environment, "file", environmentFile);
+    if (!environmentFile.empty() && environment.has("radiance"))
+        environment.fail("radiance", "only applies without environment.file (a constant environment)");
+    e.radiance = toVec3(environment.vec3("radiance", {0, 0, 0}, 0.0, 1e6));
+    e.intensity = environment.number("intensity", 1.0, 0.0, 1e6);
+    e.rotationDeg = environment.number("rotation_deg", 0.0, -360.0, 360.0);
+    e.background = environment.choice("background", "environment", {"environment", "color"});
+    if (e.background != "color" && environment.has("background_color"))
+        environment.fail("background_color", "only applies to environment.background = color");
+    e.backgroundColor = toVec3(environment.vec3("background_color", {0, 0, 0}, 0.0, 1e6));
+    resolved["environment"] = {{"file", environmentFile},    {"radiance", jsonVec3(e.radiance)},
+                               {"intensity", e.intensity},   {"rotation_deg", e.rotationDeg},
+                               {"background", e.background}, {"background_color", jsonVec3(e.backgroundColor)}};
+}
+
+// [render]: image size and exposure.
+void readRender(const SpecReader& root, SceneSpec& spec, nlohmann::json& resolved) {
+    const SpecReader render = root.table("render");
+    spec.width = static_cast<int>(render.integer("width", 512, 16, 8192));
+    spec.height = static_cast<int>(render.integer("height", 512, 16, 8192));
+    spec.exposureEv = render.number("exposure_ev", 0.0, -30.0, 30.0);
+    resolved["render"] = {{"width", spec.width}, {"height", spec.height}, {"exposure_ev", spec.exposureEv}};
+}
+
+// [tone_map]: the display operator.
+void readToneMap(const SpecReader& root, SceneSpec& spec, nlohmann::json& resolved) {
+    const SpecReader toneMap = root.table("tone_map");
+    spec.toneMapper =
+        toneMap.choice("operator", "filmic", {"linear", "exponential", "reinhard", "reinhard-rgb", "filmic"});
+    spec.exponentialK = toneMap.number("exponential_k", 1.0, 1e-3, 1e3);
+    spec.filmicWhite = toneMap.number("filmic_white", 11.2, 1.0, 1e3);
+    spec.reinhardKey = toneMap.number("reinhard_key", 0.18, 1e-3, 10.0);
+    const std::string display = toneMap.choice("display", "srgb", {"srgb"});
+    resolved["tone_map"] = {{"operator", spec.toneMapper},
+                            {"exponential_k", spec.exponentialK},
+                            {"filmic_white", spec.filmicWhite},
+                            {"reinhard_key", spec.reinhardKey},
+                            {"display", display}};
+}
+
+// [sss], [transmittance], [pathtraced] and [eevee]: read by their typed records in renderer/sss; [pathtraced] and
+// [eevee] are recorded in `resolved` only for the method that renders with them.
+void readMethodTables(const SpecReader& root, SceneSpec& spec, nlohmann::json& resolved) {
+    spec.sss = sss::readSssParams(root);
+    spec.transmittance = sss::readTransmittanceParams(root);
+    resolved["sss"] = spec.sss.toJson();
+    resolved["transmittance"] = spec.transmittance.toJson();
+    spec.pathtraced = pathtraced::readPathtracedParams(root).toJson();
+    if (spec.sss.method == sss::SssMethod::Pathtraced) resolved["pathtraced"] = spec.pathtraced;
+    spec.eevee = pathtraced::readEeveeParams(root).toJson();
+    if (spec.sss.method == sss::SssMethod::Eevee) resolved["eevee"] = spec.eevee;
+}
+
+// The spec's TOML with the overrides applied, and the folder its relative paths are relative to.
+struct SpecSource {
+    toml::table table;
+    std::filesystem::path directory = std::filesystem::current_path();
+};
+
+SpecSource readSpecSource(const std::string& scene, const std::vector<std::string>& overrides) {
+    SpecSource source;
+    if (scene.rfind("builtin:", 0) == 0) {
+        const auto text = builtinSceneText(scene.substr(8));
+        if (!text) {
+            std::string names;
+            for (const auto& name : builtinSceneNames()) names += (names.empty() ? "builtin:" : ", builtin:") + name;
+            throw InputError("unknown built-in scene '" + scene + "' (known: " + names + ")");
+        }
+        source.table = parseTomlString(*text, scene);
+    } else {
+        std::error_code error;
+        if (!std::filesystem::is_regular_file(scene, error))
+            throw InputError(scene + ": scene spec not found (give a TOML file or builtin:NAME)");
+        source.table = parseTomlFile(scene);
+        source.directory = std::filesystem::absolute(scene).parent_path();
     }
+    for (const auto& assignment : overrides) applyOverride(source.table, assignment, "--set");
+    return source;
+}
 
-    // [environment]
-    {
-        const SpecReader environment = root.table("environment");
-        EnvironmentSpec& e = spec.environment;
-        const std::string environmentFile = environment.string("file", "");
-        e.file = paths.resolve(environment, "file", environmentFile);
-        if (!environmentFile.empty() && environment.has("radiance"))
-            environment.fail("radiance", "only applies without environment.file (a constant environment)");
-        e.radiance = toVec3(environment.vec3("radiance", {0, 0, 0}, 0.0, 1e6));
-        e.intensity = environment.number("intensity", 1.0, 0.0, 1e6);
-        e.rotationDeg = environment.number("rotation_deg", 0.0, -360.0, 360.0);
-        e.background = environment.choice("background", "environment", {"environment", "color"});
-        if (e.background != "color" && environment.has("background_color"))
-            environment.fail("background_color", "only applies to environment.background = color");
-        e.backgroundColor = toVec3(environment.vec3("background_color", {0, 0, 0}, 0.0, 1e6));
-        resolved["environment"] = {{"file", environmentFile},    {"radiance", jsonVec3(e.radiance)},
-                                   {"intensity", e.intensity},   {"rotation_deg", e.rotationDeg},
-                                   {"background", e.background}, {"background_color", jsonVec3(e.backgroundColor)}};
-    }
+} // namespace
 
-    // [render]
-    {
-        const SpecReader render = root.table("render");
-        spec.width = static_cast<int>(render.integer("width", 512, 16, 8192));
-        spec.height = static_cast<int>(render.integer("height", 512, 16, 8192));
-        spec.exposureEv = render.number("exposure_ev", 0.0, -30.0, 30.0);
-        resolved["render"] = {{"width", spec.width}, {"height", spec.height}, {"exposure_ev", spec.exposureEv}};
-    }
+SceneSpec loadSceneSpec(const std::string& scene, const std::vector<std::string>& overrides,
+                        const std::filesystem::path& assetsDirectoryIn) {
+    SceneSpec spec;
+    spec.source = scene;
+    SpecSource source = readSpecSource(scene, overrides);
+    std::filesystem::path assetsDirectory = assetsDirectoryIn;
+    if (assetsDirectory.empty())
+        if (const char* environment = std::getenv("SKINLAB_ASSETS"); environment && *environment)
+            assetsDirectory = environment;
 
-    // [tone_map]
-    {
-        const SpecReader toneMap = root.table("tone_map");
-        spec.toneMapper =
-            toneMap.choice("operator", "filmic", {"linear", "exponential", "reinhard", "reinhard-rgb", "filmic"});
-        spec.exponentialK = toneMap.number("exponential_k", 1.0, 1e-3, 1e3);
-        spec.filmicWhite = toneMap.number("filmic_white", 11.2, 1.0, 1e3);
-        spec.reinhardKey = toneMap.number("reinhard_key", 0.18, 1e-3, 10.0);
-        const std::string display = toneMap.choice("display", "srgb", {"srgb"});
-        resolved["tone_map"] = {{"operator", spec.toneMapper},
-                                {"exponential_k", spec.exponentialK},
-                                {"filmic_white", spec.filmicWhite},
-                                {"reinhard_key", spec.reinhardKey},
-                                {"display", display}};
-    }
-
-    // [sss] and [transmittance]: read by renderer/sss/sss_params; stored resolved.
-    {
-        spec.sss = sss::readSssParams(root);
-        spec.transmittance = sss::readTransmittanceParams(root);
-        resolved["sss"] = spec.sss.toJson();
-        resolved["transmittance"] = spec.transmittance.toJson();
-        spec.pathtraced = pathtraced::readPathtracedParams(root).toJson();
-        if (spec.sss.method == sss::SssMethod::Pathtraced) resolved["pathtraced"] = spec.pathtraced;
-        spec.eevee = pathtraced::readEeveeParams(root).toJson();
-        if (spec.sss.method == sss::SssMethod::Eevee) resolved["eevee"] = spec.eevee;
-    }
-
+    // Errors name the spec file (or builtin:NAME) the way the user wrote it.
+    SpecReader root(source.table, scene, "");
+    PathResolver paths{&root, source.directory, assetsDirectory};
+    nlohmann::json resolved;
+    resolved["scene"] = scene;
+    spec.mmPerUnit = root.number("mm_per_unit", 1.0, 1e-6, 1e6);
+    resolved["mm_per_unit"] = spec.mmPerUnit;
+    readModel(root, paths, spec, resolved);
+    readTextures(root, paths, spec, resolved);
+    readMaterials(root, spec, resolved);
+    readCamera(root, spec, resolved);
+    readLights(root, spec, resolved);
+    readShadow(root, spec, resolved);
+    readEnvironment(root, paths, spec, resolved);
+    readRender(root, spec, resolved);
+    readToneMap(root, spec, resolved);
+    readMethodTables(root, spec, resolved);
     root.finish();
     spec.resolved = resolved;
     return spec;

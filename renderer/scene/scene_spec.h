@@ -92,10 +92,10 @@ struct SceneSpec {
     double reinhardKey = 0.18;              // reinhard (Reinhard et al. 2002, Eq. 2): the key a
     sss::SssParams sss;                     // [sss], typed; the method's keys only (sss::methodTable())
     sss::TransmittanceParams transmittance; // [transmittance], typed
-    // Resolved [pathtraced] table (renderer/pathtraced/pathtraced_params.h); read for every scene, recorded in
+    // Resolved [pathtraced] table (renderer/sss/pathtraced_params.h); read for every scene, recorded in
     // `resolved` only when sss.method = "pathtraced" (the other methods do not depend on it).
     nlohmann::json pathtraced = nlohmann::json::object();
-    // Resolved [eevee] table (renderer/pathtraced/eevee_params.h); recorded in `resolved` only when
+    // Resolved [eevee] table (renderer/sss/eevee_params.h); recorded in `resolved` only when
     // sss.method = "eevee".
     nlohmann::json eevee = nlohmann::json::object();
 

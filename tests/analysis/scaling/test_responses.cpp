@@ -154,7 +154,7 @@ TEST(Responses, StudyDatabaseView) {
     ASSERT_EQ(table.responses.size(), 4u);
     EXPECT_EQ(table.responses[1].conditionA, "y");
     EXPECT_EQ(table.responses[1].aOnLeft, std::optional<bool>(false));
-    EXPECT_EQ(table.responses[3].kind, TrialKind::Catch);
+    EXPECT_EQ(table.responses[3].kind, TrialKind::catchTrial);
     const Dataset dataset = buildDataset(table, {});
     EXPECT_EQ(dataset.blocks.front().countMatrix()(1, 0), 2.0); // y beat x twice
 

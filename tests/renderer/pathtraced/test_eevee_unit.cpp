@@ -3,7 +3,7 @@
 // with the radii fitted to d'Eon's profile.
 #include "common/error.h"
 #include "renderer/pathtraced/blender_scene.h"
-#include "renderer/pathtraced/eevee_params.h"
+#include "renderer/sss/eevee_params.h"
 #include "renderer/pathtraced/profile_fit.h"
 #include "renderer/scene/builtin_geometry.h"
 #include "renderer/scene/scene_spec.h"

@@ -4,7 +4,7 @@
 #include "renderer/pathtraced/blender_process.h"
 #include "renderer/pathtraced/blender_scene.h"
 #include "renderer/pathtraced/cycles_render.h"
-#include "renderer/pathtraced/pathtraced_params.h"
+#include "renderer/sss/pathtraced_params.h"
 #include "renderer/pathtraced/profile_fit.h"
 #include "renderer/scene/builtin_geometry.h"
 #include "renderer/scene/environment.h"

@@ -1,4 +1,4 @@
-#include "renderer/pathtraced/pathtraced_params.h"
+#include "renderer/sss/pathtraced_params.h"
 
 #include "common/error.h"
 #include "common/json_toml.h"

@@ -1,6 +1,8 @@
 #pragma once
 // Typed parameters of the scene spec table [pathtraced] (sss.method = "pathtraced": Blender Cycles renders the
 // scene; docs/pathtraced.md lists every key with its unit and range), their strict reader and their JSON form.
+// They live in renderer/sss beside the [sss] table, below both the scene reader (renderer/scene) and the Blender
+// writer (renderer/pathtraced), which both include them; the namespace is the feature's.
 #include <array>
 #include <nlohmann/json.hpp>
 #include <string>

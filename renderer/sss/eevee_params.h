@@ -1,8 +1,8 @@
 #pragma once
 // Typed parameters of the scene spec table [eevee] (sss.method = "eevee": Blender EEVEE renders the scene with its
 // screen-space subsurface scattering; docs/pathtraced.md, "EEVEE", lists every key with its unit and range), their
-// strict reader and their JSON form.
-#include "renderer/pathtraced/pathtraced_params.h"
+// strict reader and their JSON form. Beside pathtraced_params.h, below the scene reader and renderer/pathtraced.
+#include "renderer/sss/pathtraced_params.h"
 
 #include <array>
 #include <nlohmann/json.hpp>
@@ -16,7 +16,8 @@ class SpecReader;
 namespace skinlab::renderer::pathtraced {
 
 // Per-channel subsurface radii (mm) at sss.width_mm = 3 that make the edge response of EEVEE's Christensen–Burley
-// kernel match d'Eon's sum of Gaussians: fitRadii on eeveeEdgeResponse() (profile_fit.h), computed once.
+// kernel match d'Eon's sum of Gaussians: the result of fitRadii on eeveeEdgeResponse() (renderer/pathtraced/
+// profile_fit.h) to the last bit, which the test EeveeProfile.FittedRadiiMatchDeonsProfile checks.
 std::array<double, 3> fittedEeveeRadiusMm();
 
 struct EeveeParams {
