@@ -6,6 +6,7 @@
 #include "experiments/recruitment.h"
 #include "experiments/request_error.h"
 #include "experiments/study_dashboard.h"
+#include "experiments/study_errors.h"
 #include "experiments/study_export.h"
 #include "experiments/viewing_conditions.h"
 
@@ -152,6 +153,24 @@ bool etagMatches(const std::string& ifNoneMatch, const std::string& etag) {
     return ifNoneMatch.find(etag) != std::string::npos;
 }
 
+// The HTTP status of each refusal of the study file (experiments/study_errors.h).
+int httpStatus(Refusal reason) {
+    switch (reason) {
+    case Refusal::invalidValue: return 400;
+    case Refusal::notFound: return 404;
+    case Refusal::conflict: return 409;
+    case Refusal::limitReached: return 429;
+    }
+    return 400;
+}
+
+// A refused request: its status and {"error": message}; a 429 asks the client to wait (Retry-After).
+HttpResponse refusedResponse(const HttpRequest& req, int status, const std::string& message) {
+    spdlog::debug("{} {}: {} {}", req.method, validUtf8(req.path, 128), status, message);
+    HttpResponse res = errorResponse(status, message);
+    if (status == 429) res.headers.emplace_back("Retry-After", "5");
+    return res;
+}
 } // namespace
 
 StudyServer::StudyServer(StudyStore& store, ServerOptions options) : store_(store), options_(std::move(options)) {
@@ -314,10 +333,9 @@ HttpResponse StudyServer::answer(const HttpRequest& req) {
         }
         return route(req);
     } catch (const RequestError& e) {
-        spdlog::debug("{} {}: {} {}", req.method, validUtf8(req.path, 128), e.status(), e.what());
-        HttpResponse res = errorResponse(e.status(), e.what());
-        if (e.status() == 429) res.headers.emplace_back("Retry-After", "5");
-        return res;
+        return refusedResponse(req, e.status(), e.what());
+    } catch (const StudyRefusal& e) {
+        return refusedResponse(req, httpStatus(e.reason()), e.what());
     } catch (const InputError& e) {
         spdlog::debug("{} {}: 400 {}", req.method, validUtf8(req.path, 128), e.what());
         return errorResponse(400, e.what());

@@ -3,7 +3,9 @@
 // stimulus images, and researcher endpoints behind a token. API reference and limits: docs/experiments.md.
 // Transport: HttpServer (event-driven, Boost.Beast; docs/architecture.md, "Study server: threading model").
 //
-// Every rejected request is answered with a 4xx status and JSON {"error": "..."} and changes nothing.
+// Every rejected request is answered with a 4xx status and JSON {"error": "..."} and changes nothing: a
+// RequestError carries its status, a refusal of the study file (experiments/study_errors.h) is mapped to one here
+// (NotFound 404, Conflict 409, LimitReached 429, InvalidValue 400).
 // Only the stimuli listed in the study are served, by number (/stimuli/<n>.png), from the bytes verified against
 // their sha256 when the server started (held in memory); no request path is ever mapped onto the file system.
 #include "experiments/http_server.h"
