@@ -22,13 +22,10 @@
 #include "experiments/trial_plan.h"
 #include "experiments/viewing_conditions.h"
 
-#include <condition_variable>
 #include <cstdint>
-#include <exception>
 #include <filesystem>
 #include <map>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <string>
 #include <string_view>
