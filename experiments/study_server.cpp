@@ -6,7 +6,9 @@
 #include "experiments/recruitment.h"
 #include "experiments/request_error.h"
 #include "experiments/study_dashboard.h"
+#include "experiments/study_errors.h"
 #include "experiments/study_export.h"
+#include "experiments/study_json.h"
 #include "experiments/viewing_conditions.h"
 
 #include <boost/asio/ip/address.hpp>
@@ -29,93 +31,10 @@ using nlohmann::json;
 
 namespace {
 
-constexpr std::size_t kMaxTokenLength = 64;
 constexpr std::size_t kMaxTextLength = 512;
 
 HttpResponse errorResponse(int status, const std::string& message) {
     return jsonResponse(status, json{{"error", message}});
-}
-
-json parseBody(const HttpRequest& req) {
-    const std::string type = req.header("Content-Type");
-    // Requiring JSON also keeps cross-site HTML forms (which cannot send it without a CORS preflight) out.
-    if (type.rfind("application/json", 0) != 0) throw RequestError(415, "expected Content-Type: application/json");
-    json body;
-    try {
-        body = json::parse(req.body);
-    } catch (const json::exception&) {
-        // parse_error, and out_of_range for numbers no double holds (1e400).
-        throw RequestError(400, "request body is not valid JSON");
-    }
-    if (!body.is_object()) throw RequestError(400, "request body must be a JSON object");
-    return body;
-}
-
-std::string stringField(const json& body, const char* name, std::size_t maxLength, bool required = true) {
-    if (!body.contains(name)) {
-        if (required) throw RequestError(400, std::string(name) + ": missing");
-        return "";
-    }
-    if (!body[name].is_string()) throw RequestError(400, std::string(name) + ": expected a string");
-    std::string value = body[name].get<std::string>();
-    if (value.size() > maxLength)
-        throw RequestError(400, std::string(name) + ": longer than " + std::to_string(maxLength) + " characters");
-    return value;
-}
-
-std::int64_t integerField(const json& body, const char* name, std::int64_t min, std::int64_t max) {
-    if (!body.contains(name)) throw RequestError(400, std::string(name) + ": missing");
-    const json& v = body[name];
-    if (!v.is_number_integer()) throw RequestError(400, std::string(name) + ": expected an integer");
-    if (v.is_number_unsigned() && v.get<std::uint64_t>() > static_cast<std::uint64_t>(INT64_MAX))
-        throw RequestError(400, std::string(name) + ": out of range");
-    const std::int64_t value = v.get<std::int64_t>();
-    if (value < min || value > max)
-        throw RequestError(400, std::string(name) + ": " + std::to_string(value) + " is out of range [" +
-                                    std::to_string(min) + ", " + std::to_string(max) + "]");
-    return value;
-}
-
-double numberField(const json& body, const char* name, double min, double max) {
-    if (!body.contains(name)) throw RequestError(400, std::string(name) + ": missing");
-    const json& v = body[name];
-    if (!v.is_number()) throw RequestError(400, std::string(name) + ": expected a number");
-    const double value = v.get<double>();
-    if (!(value >= min && value <= max))
-        throw RequestError(400, std::string(name) + ": out of range [" + std::to_string(min) + ", " +
-                                    std::to_string(max) + "]");
-    return value;
-}
-
-bool booleanField(const json& body, const char* name) {
-    if (!body.contains(name)) throw RequestError(400, std::string(name) + ": missing");
-    if (!body[name].is_boolean()) throw RequestError(400, std::string(name) + ": expected true or false");
-    return body[name].get<bool>();
-}
-
-// The optional per-trial conditions of a response: all three fields or none.
-std::optional<TrialConditions> trialConditionsField(const json& body) {
-    if (!body.contains("page_hidden") && !body.contains("focus_lost") && !body.contains("fullscreen"))
-        return std::nullopt;
-    return TrialConditions{booleanField(body, "page_hidden"), booleanField(body, "focus_lost"),
-                           booleanField(body, "fullscreen")};
-}
-
-// The recruitment parameters the page forwarded from its URL: {"NAME": "value", ...} (strings only).
-std::map<std::string, std::string> recruitmentField(const json& body) {
-    std::map<std::string, std::string> out;
-    if (!body.contains("recruitment")) return out;
-    const json& r = body["recruitment"];
-    if (!r.is_object() || r.size() > 8)
-        throw RequestError(400, "recruitment: expected an object of at most 8 parameters");
-    for (const auto& [name, value] : r.items()) {
-        if (name.size() > 64) throw RequestError(400, "recruitment: parameter name longer than 64 characters");
-        if (!value.is_string()) throw RequestError(400, validUtf8(name, 64) + ": expected a string");
-        const std::string text = value.get<std::string>();
-        if (text.size() > 256) throw RequestError(400, validUtf8(name, 64) + ": longer than 256 characters");
-        out[name] = text;
-    }
-    return out;
 }
 
 std::string userAgentOf(const HttpRequest& req) { return validUtf8(req.header("User-Agent"), kMaxTextLength); }
@@ -152,6 +71,69 @@ bool etagMatches(const std::string& ifNoneMatch, const std::string& etag) {
     return ifNoneMatch.find(etag) != std::string::npos;
 }
 
+// The HTTP status of each refusal of the study file (experiments/study_errors.h).
+int httpStatus(Refusal reason) {
+    switch (reason) {
+    case Refusal::invalidValue: return 400;
+    case Refusal::notFound: return 404;
+    case Refusal::conflict: return 409;
+    case Refusal::limitReached: return 429;
+    }
+    return 400;
+}
+
+// A refused request: its status and {"error": message}; a 429 asks the client to wait (Retry-After).
+HttpResponse refusedResponse(const HttpRequest& req, int status, const std::string& message) {
+    spdlog::debug("{} {}: {} {}", req.method, validUtf8(req.path, 128), status, message);
+    HttpResponse res = errorResponse(status, message);
+    if (status == 429) res.headers.emplace_back("Retry-After", "5");
+    return res;
+}
+
+// A file of the page (experiments/web/, embedded), never cached for long: it changes with the binary.
+HttpResponse webFile(const std::string& name, const char* type) {
+    const auto file = web::embeddedFile(name);
+    if (!file) return errorResponse(404, "not found");
+    HttpResponse res;
+    res.contentType = type;
+    res.headers = {{"Cache-Control", "no-cache"},
+                   {"X-Content-Type-Options", "nosniff"},
+                   {"Content-Security-Policy",
+                    "default-src 'self'; img-src 'self'; style-src 'self'; script-src 'self'; frame-ancestors 'none'"},
+                   // The first load of the page may carry secrets in its address (?p=, a platform's session id): no
+                   // request from the page names it.
+                   {"Referrer-Policy", "no-referrer"}};
+    res.body = std::string(*file);
+    return res;
+}
+
+constexpr const char* kHtml = "text/html; charset=utf-8";
+constexpr const char* kJavaScript = "text/javascript; charset=utf-8";
+constexpr const char* kCss = "text/css; charset=utf-8";
+
+// One endpoint: its method and path (a trailing '*' makes the path a prefix), whether it needs the researcher
+// token, and the handler that answers it.
+struct Route {
+    std::string_view method;
+    std::string_view path;
+    bool researcher;
+    HttpResponse (*handle)(StudyServer& server, const HttpRequest& request);
+
+    bool matches(const HttpRequest& req) const {
+        if (req.method != method) return false;
+        if (path.ends_with('*')) return std::string_view(req.path).starts_with(path.substr(0, path.size() - 1));
+        return req.path == path;
+    }
+};
+
+// The participant's state (experiments/study_json.h) from what the store holds now. The trials are read before
+// nextTrial(), which may store an active design's next batch.
+json participantState(StudyStore& store, const ParticipantRecord& p) {
+    const std::vector<TrialRecord> all = store.trials(p.id);
+    const std::optional<TrialRecord> next = store.nextTrial(p.id);
+    const Progress progress = store.progress(p.id);
+    return participantStateJson(store.definition(), p, all, next, progress);
+}
 } // namespace
 
 StudyServer::StudyServer(StudyStore& store, ServerOptions options) : store_(store), options_(std::move(options)) {
@@ -314,10 +296,9 @@ HttpResponse StudyServer::answer(const HttpRequest& req) {
         }
         return route(req);
     } catch (const RequestError& e) {
-        spdlog::debug("{} {}: {} {}", req.method, validUtf8(req.path, 128), e.status(), e.what());
-        HttpResponse res = errorResponse(e.status(), e.what());
-        if (e.status() == 429) res.headers.emplace_back("Retry-After", "5");
-        return res;
+        return refusedResponse(req, e.status(), e.what());
+    } catch (const StudyRefusal& e) {
+        return refusedResponse(req, httpStatus(e.reason()), e.what());
     } catch (const InputError& e) {
         spdlog::debug("{} {}: 400 {}", req.method, validUtf8(req.path, 128), e.what());
         return errorResponse(400, e.what());
@@ -328,266 +309,160 @@ HttpResponse StudyServer::answer(const HttpRequest& req) {
 }
 
 HttpResponse StudyServer::route(const HttpRequest& req) {
-    const StudyDefinition& definition = store_.definition();
-    const std::string& path = req.path;
-    const bool get = req.method == "GET", post = req.method == "POST";
-
-    auto webFile = [](const std::string& name, const char* type) {
-        const auto file = web::embeddedFile(name);
-        if (!file) return errorResponse(404, "not found");
-        HttpResponse res;
-        res.contentType = type;
-        res.headers = {
-            {"Cache-Control", "no-cache"},
-            {"X-Content-Type-Options", "nosniff"},
-            {"Content-Security-Policy",
-             "default-src 'self'; img-src 'self'; style-src 'self'; script-src 'self'; frame-ancestors 'none'"},
-            // The first load of the page may carry secrets in its address (?p=, a platform's session id): no
-            // request from the page names it.
-            {"Referrer-Policy", "no-referrer"}};
-        res.body = std::string(*file);
-        return res;
+    // Every endpoint (docs/experiments.md, "HTTP API"); the first that matches answers, none: 404.
+    using S = StudyServer;
+    using R = const HttpRequest&;
+    static const Route routes[] = {
+        {"GET", "/", false, [](S&, R) { return webFile("index.html", kHtml); }},
+        {"GET", "/index.html", false, [](S&, R) { return webFile("index.html", kHtml); }},
+        {"GET", "/app.js", false, [](S&, R) { return webFile("app.js", kJavaScript); }},
+        {"GET", "/style.css", false, [](S&, R) { return webFile("style.css", kCss); }},
+        // The researcher's dashboard: the page holds no data; its script asks /api/researcher/dashboard with the
+        // token.
+        {"GET", "/researcher", false, [](S&, R) { return webFile("researcher.html", kHtml); }},
+        {"GET", "/researcher.html", false, [](S&, R) { return webFile("researcher.html", kHtml); }},
+        {"GET", "/researcher.js", false, [](S&, R) { return webFile("researcher.js", kJavaScript); }},
+        {"GET", "/researcher.css", false, [](S&, R) { return webFile("researcher.css", kCss); }},
+        {"GET", "/stimuli/*", false, [](S& s, R r) { return s.getStimulus(r); }},
+        {"GET", "/api/study", false, [](S& s, R) { return jsonResponse(200, studyJson(s.store_.definition())); }},
+        {"POST", "/api/join", false, [](S& s, R r) { return s.postJoin(r); }},
+        {"POST", "/api/session", false, [](S& s, R r) { return s.postSession(r); }},
+        {"GET", "/api/state", false, [](S& s, R r) { return s.getState(r); }},
+        {"POST", "/api/response", false, [](S& s, R r) { return s.postResponse(r); }},
+        {"GET", "/api/researcher/status", true, [](S& s, R) { return jsonResponse(200, statusJson(s.store_)); }},
+        {"GET", "/api/researcher/dashboard", true, [](S& s, R) { return jsonResponse(200, s.dashboard_->snapshot()); }},
+        {"GET", "/api/researcher/export", true, [](S& s, R r) { return s.getExport(r); }},
+        // Any other researcher path: the token is checked first, so no path answers differently without it.
+        {"GET", "/api/researcher/*", true, [](S&, R) -> HttpResponse { throw RequestError(404, "not found"); }},
     };
-    if (get && (path == "/" || path == "/index.html")) return webFile("index.html", "text/html; charset=utf-8");
-    if (get && path == "/app.js") return webFile("app.js", "text/javascript; charset=utf-8");
-    if (get && path == "/style.css") return webFile("style.css", "text/css; charset=utf-8");
-    // The researcher's dashboard: the page holds no data; its script asks /api/researcher/dashboard with the token.
-    if (get && (path == "/researcher" || path == "/researcher.html"))
-        return webFile("researcher.html", "text/html; charset=utf-8");
-    if (get && path == "/researcher.js") return webFile("researcher.js", "text/javascript; charset=utf-8");
-    if (get && path == "/researcher.css") return webFile("researcher.css", "text/css; charset=utf-8");
+    for (const Route& r : routes)
+        if (r.matches(req)) {
+            if (r.researcher) authorizeResearcher(req);
+            return r.handle(*this, req);
+        }
+    throw RequestError(404, "not found");
+}
 
+void StudyServer::authorizeResearcher(const HttpRequest& req) const {
+    // The token travels in a header only: a URL ends up in logs, proxies and the browser's history.
+    const std::string authorization = req.header("Authorization");
+    if (authorization.rfind("Bearer ", 0) != 0) {
+        if (req.queryParameter("token"))
+            throw RequestError(401, "researcher token: send it as Authorization: Bearer TOKEN, never in the URL");
+        throw RequestError(401, "researcher token required (Authorization: Bearer TOKEN)");
+    }
+    if (!constantTimeEqual(authorization.substr(7), options_.researcherToken))
+        throw RequestError(403, "wrong researcher token");
+}
+
+HttpResponse StudyServer::getStimulus(const HttpRequest& req) const {
     // Stimuli by number only: the number indexes the study's own list, so no request can name another file.
     // The bytes never change while the study runs (content-addressed by sha256): cached for good by the browser.
-    if (get && path.rfind("/stimuli/", 0) == 0) {
-        const auto index = stimulusNumber(path);
-        if (!index || *index >= stimuli_.size()) throw RequestError(404, "no such stimulus");
-        const Stimulus& stimulus = stimuli_[*index];
-        HttpResponse res;
-        res.headers = {{"Cache-Control", "private, max-age=31536000, immutable"},
-                       {"ETag", stimulus.etag},
-                       {"X-Content-Type-Options", "nosniff"}};
-        if (etagMatches(req.header("If-None-Match"), stimulus.etag)) {
-            res.status = 304;
-            return res;
-        }
-        res.contentType = "image/png";
-        res.sharedBody = stimulus.bytes;
+    const auto index = stimulusNumber(req.path);
+    if (!index || *index >= stimuli_.size()) throw RequestError(404, "no such stimulus");
+    const Stimulus& stimulus = stimuli_[*index];
+    HttpResponse res;
+    res.headers = {{"Cache-Control", "private, max-age=31536000, immutable"},
+                   {"ETag", stimulus.etag},
+                   {"X-Content-Type-Options", "nosniff"}};
+    if (etagMatches(req.header("If-None-Match"), stimulus.etag)) {
+        res.status = 304;
         return res;
     }
+    res.contentType = "image/png";
+    res.sharedBody = stimulus.bytes;
+    return res;
+}
 
-    auto stimulusJson = [&definition](int index) {
-        const StudyStimulus& s = definition.stimuli[static_cast<std::size_t>(index)];
-        return json{{"url", "/stimuli/" + std::to_string(index) + ".png"}, {"width", s.width}, {"height", s.height}};
-    };
-    auto trialJson = [&definition, stimulusJson](const TrialRecord& t, const std::string& token) {
-        const PlannedTrial& p = t.plan;
-        const StudyStimulus& a = definition.stimuli[static_cast<std::size_t>(p.stimulusA)];
-        json sideA = stimulusJson(p.stimulusA);
-        // The blank panel takes the size of the image it is paired with.
-        json sideB = p.stimulusB == kBlankStimulus ? json{{"blank", true}, {"width", a.width}, {"height", a.height}}
-                                                   : stimulusJson(p.stimulusB);
-        // Catch trials look like any other trial to the participant; only practice is announced.
-        return json{{"id", trialReference(token, t.id)},
-                    {"position", t.position},
-                    {"practice", p.kind == TrialKind::practice},
-                    {"left", p.aOnLeft ? sideA : sideB},
-                    {"right", p.aOnLeft ? sideB : sideA},
-                    {"reference", p.referenceStimulus >= 0 ? stimulusJson(p.referenceStimulus) : json()}};
-    };
-    // The participant's state: progress, the next trial (null when done), and the completion code when done.
-    auto stateJson = [this, trialJson](const ParticipantRecord& p) {
-        const std::vector<TrialRecord> all = store_.trials(p.id);
-        const std::optional<TrialRecord> next = store_.nextTrial(p.id);
-        const Progress progress = store_.progress(p.id);
-        int practiceTotal = 0;
-        for (const TrialRecord& t : all) practiceTotal += t.plan.kind == TrialKind::practice ? 1 : 0;
-        const int practiceAnswered = next ? std::min(next->position, practiceTotal) : practiceTotal;
-        json state{{"observer", p.label},
-                   {"answered", progress.answered - practiceAnswered},
-                   {"total", progress.total - practiceTotal},
-                   {"practice_answered", practiceAnswered},
-                   {"practice_total", practiceTotal},
-                   {"trial", next ? trialJson(*next, p.token) : json()},
-                   {"completed", !next.has_value()}};
-        if (!next) {
-            const RecruitmentDesign& recruitment = store_.definition().design.recruitment;
-            const std::string code = recruitment.completionCode.empty() ? p.completionCode : recruitment.completionCode;
-            state["completion_code"] = code;
-            const std::string url = completionUrl(recruitment, code);
-            if (!url.empty()) state["completion_url"] = url;
-        }
-        return state;
-    };
-
-    if (get && path == "/api/study") {
-        const StudyDesign& d = definition.design;
-        const PlatformParameters names = platformParameters(d.recruitment);
-        json parameters = json::array();
-        for (const std::string& name : {names.id, names.study, names.session})
-            if (!name.empty()) parameters.push_back(name);
-        return jsonResponse(
-            200, {{"title", d.title},
-                  {"question", d.question},
-                  {"instructions", d.instructions},
-                  {"consent", d.consent},
-                  {"break_every", d.breakEvery},
-                  {"recruitment",
-                   {{"platform", d.recruitment.platform}, {"id_parameter", names.id}, {"parameters", parameters}}},
-                  {"display",
-                   {{"calibrate", d.display.calibrate},
-                    {"viewing_distance_mm", d.display.viewingDistanceMm},
-                    {"card_width_mm", kIdCardWidthMm},
-                    {"card_height_mm", kIdCardHeightMm}}},
-                  // What every trial needs at one image pixel per device pixel: the page refuses a smaller window
-                  // before the participant joins, and lays trials out with the same margins.
-                  {"stage", definition.stageNeeds().toJson()},
-                  {"requirements",
-                   {{"min_screen_width", d.requirements.minScreenWidth},
-                    {"min_screen_height", d.requirements.minScreenHeight},
-                    {"no_zoom", d.requirements.noZoom},
-                    {"fullscreen", d.requirements.fullscreen},
-                    {"desktop", d.requirements.desktop}}}});
+HttpResponse StudyServer::postJoin(const HttpRequest& req) {
+    const json body = parseJsonBody(req);
+    const std::string label = stringField(body, "label", kMaxTokenLength, false);
+    for (char c : label)
+        if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.'))
+            throw RequestError(400, "label: only letters, digits, '-', '_' and '.' are allowed");
+    const std::string joinKey = stringField(body, "join_key", kMaxTokenLength, false);
+    for (char c : joinKey)
+        if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_'))
+            throw RequestError(400, "join_key: only letters, digits, '-' and '_' are allowed");
+    // A platform's participant: validated and normalised ids (400 naming the parameter). The same id resumes
+    // only with the secret of its first join (StudyStore::join).
+    const std::optional<ExternalIds> external =
+        validateExternalIds(store_.definition().design.recruitment, recruitmentField(body));
+    // Every join counts against the client's allowance: new participants, resumes, refused attempts and taken
+    // labels alike, so none of them can be probed faster than participants can join.
+    double retryAfter = 0;
+    if (!joinLimiter_->allow(req.clientAddress, retryAfter)) {
+        HttpResponse res = errorResponse(429, "too many joins from this network; retry later");
+        res.headers.emplace_back("Retry-After", std::to_string(static_cast<int>(std::ceil(retryAfter))));
+        return res;
     }
+    const ClientOrigin origin{req.clientAddress, req.forwardedBy.empty() ? "peer" : "forwarded"};
+    const ParticipantRecord p = store_.join(label, joinKey, external, origin);
+    spdlog::info("participant {} {}", p.label, p.resumed ? "returned" : "joined");
+    // A repeated join key answers as its first join did (201); a resumed platform participant answers 200.
+    return jsonResponse(p.resumed && external ? 200 : 201,
+                        {{"token", p.token}, {"observer", p.label}, {"resumed", p.resumed}});
+}
 
-    if (post && path == "/api/join") {
-        const json body = parseBody(req);
-        const std::string label = stringField(body, "label", kMaxTokenLength, false);
-        for (char c : label)
-            if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.'))
-                throw RequestError(400, "label: only letters, digits, '-', '_' and '.' are allowed");
-        const std::string joinKey = stringField(body, "join_key", kMaxTokenLength, false);
-        for (char c : joinKey)
-            if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_'))
-                throw RequestError(400, "join_key: only letters, digits, '-' and '_' are allowed");
-        // A platform's participant: validated and normalised ids (400 naming the parameter). The same id resumes
-        // only with the secret of its first join (StudyStore::join).
-        const std::optional<ExternalIds> external =
-            validateExternalIds(definition.design.recruitment, recruitmentField(body));
-        // Every join counts against the client's allowance: new participants, resumes, refused attempts and taken
-        // labels alike, so none of them can be probed faster than participants can join.
-        double retryAfter = 0;
-        if (!joinLimiter_->allow(req.clientAddress, retryAfter)) {
-            HttpResponse res = errorResponse(429, "too many joins from this network; retry later");
-            res.headers.emplace_back("Retry-After", std::to_string(static_cast<int>(std::ceil(retryAfter))));
-            return res;
-        }
-        const ClientOrigin origin{req.clientAddress, req.forwardedBy.empty() ? "peer" : "forwarded"};
-        const ParticipantRecord p = store_.join(label, joinKey, external, origin);
-        spdlog::info("participant {} {}", p.label, p.resumed ? "returned" : "joined");
-        // A repeated join key answers as its first join did (201); a resumed platform participant answers 200.
-        return jsonResponse(p.resumed && external ? 200 : 201,
-                            {{"token", p.token}, {"observer", p.label}, {"resumed", p.resumed}});
-    }
-
-    if (post && path == "/api/session") {
-        const json body = parseBody(req);
-        const ParticipantRecord p = store_.participant(stringField(body, "token", kMaxTokenLength));
-        const int width = static_cast<int>(integerField(body, "viewport_width", 0, 100000));
-        const int height = static_cast<int>(integerField(body, "viewport_height", 0, 100000));
-        const double dpr = numberField(body, "device_pixel_ratio", 0.1, 16);
-        const StudyDesign& design = definition.design;
-        // Viewing conditions: reported by the page as a group (an older client sends none of them).
-        std::optional<ViewingConditions> viewing;
-        if (body.contains("screen_width")) {
-            ViewingConditions v;
-            v.screenWidth = static_cast<int>(integerField(body, "screen_width", 0, 100000));
-            v.screenHeight = static_cast<int>(integerField(body, "screen_height", 0, 100000));
-            v.screenWidthPx = static_cast<int>(std::lround(v.screenWidth * dpr));
-            v.screenHeightPx = static_cast<int>(std::lround(v.screenHeight * dpr));
-            v.devicePixelRatio = dpr;
-            v.colourDepth = static_cast<int>(integerField(body, "colour_depth", 0, 64));
-            v.viewportWidth = width;
-            v.viewportHeight = height;
-            v.fullscreen = booleanField(body, "fullscreen");
-            v.pointerFine = booleanField(body, "pointer_fine");
-            v.touchPoints = static_cast<int>(integerField(body, "touch_points", 0, 1000));
-            v.mobile = mobileUserAgent(req.header("User-Agent"));
-            if (body.contains("card_width")) {
-                v.pixelsPerMm = pixelsPerMmFromCard(numberField(body, "card_width", 20, 20000), dpr);
-                if (design.display.viewingDistanceMm > 0) {
-                    v.viewingDistanceMm = design.display.viewingDistanceMm;
-                    v.pixelsPerDegree = pixelsPerDegree(*v.pixelsPerMm, *v.viewingDistanceMm);
-                }
-            }
-            viewing = v;
-        }
-        if (design.display.calibrate && !(viewing && viewing->pixelsPerMm))
-            throw RequestError(400, "card_width: missing (the study asks for the card calibration first)");
-        if (design.requirements.any()) {
-            // Refused before the first trial; nothing is stored, so the participant can fix it and try again.
-            if (!viewing) throw RequestError(403, "requirements: the page did not report the screen; reload it");
-            const std::vector<std::string> unmet = unmetRequirements(design.requirements, *viewing);
-            if (!unmet.empty()) {
-                std::string message;
-                for (const std::string& sentence : unmet) message += (message.empty() ? "" : " ") + sentence;
-                return jsonResponse(403, {{"error", message}, {"unmet", unmet}});
-            }
-        }
-        const std::int64_t session =
-            store_.startSession(p.id, userAgentOf(req), width, height, dpr, viewing, options_.sessionsPerParticipant,
-                                ClientOrigin{req.clientAddress, req.forwardedBy.empty() ? "peer" : "forwarded"});
-        json state = stateJson(p);
-        state["session"] = session;
-        return jsonResponse(200, state);
-    }
-
-    if (get && path == "/api/state") {
-        // The token travels in this header only: a URL ends up in logs and the browser's history.
-        if (req.queryParameter("token"))
-            throw RequestError(400, "token: send it in the X-Skinlab-Token header, never in the URL");
-        const std::string token = req.header("X-Skinlab-Token");
-        if (token.empty() || token.size() > kMaxTokenLength) throw RequestError(400, "X-Skinlab-Token: missing");
-        return jsonResponse(200, stateJson(store_.participant(token)));
-    }
-
-    if (post && path == "/api/response") {
-        const json body = parseBody(req);
-        ResponseInput in;
-        in.token = stringField(body, "token", kMaxTokenLength);
-        in.trialId = integerField(body, "trial", 1, INT64_MAX);
-        in.side = stringField(body, "side", 8);
-        if (in.side != "left" && in.side != "right") throw RequestError(400, "side: expected \"left\" or \"right\"");
-        in.sessionId = integerField(body, "session", 1, INT64_MAX);
-        in.responseMs = numberField(body, "response_ms", 0, 86400000.0);
-        in.clientTime = stringField(body, "client_time", 64);
-        in.viewportWidth = static_cast<int>(integerField(body, "viewport_width", 0, 100000));
-        in.viewportHeight = static_cast<int>(integerField(body, "viewport_height", 0, 100000));
-        in.devicePixelRatio = numberField(body, "device_pixel_ratio", 0.1, 16);
-        in.conditions = trialConditionsField(body);
-        in.userAgent = userAgentOf(req);
-        const ResponseOutcome outcome = store_.recordResponse(in);
-        // Reached only after COMMIT: the acknowledgement below promises durability.
-        json state = stateJson(store_.participant(in.token));
-        state["stored"] = outcome == ResponseOutcome::stored;
-        state["duplicate"] = outcome == ResponseOutcome::duplicate;
-        return jsonResponse(200, state);
-    }
-
-    if (get && path.rfind("/api/researcher/", 0) == 0) {
-        // The token travels in a header only: a URL ends up in logs, proxies and the browser's history.
-        const std::string authorization = req.header("Authorization");
-        if (authorization.rfind("Bearer ", 0) != 0) {
-            if (req.queryParameter("token"))
-                throw RequestError(401, "researcher token: send it as Authorization: Bearer TOKEN, never in the URL");
-            throw RequestError(401, "researcher token required (Authorization: Bearer TOKEN)");
-        }
-        if (!constantTimeEqual(authorization.substr(7), options_.researcherToken))
-            throw RequestError(403, "wrong researcher token");
-        if (path == "/api/researcher/status") return jsonResponse(200, statusJson(store_));
-        if (path == "/api/researcher/dashboard") return jsonResponse(200, dashboard_->snapshot());
-        if (path == "/api/researcher/export") {
-            const std::string format = req.queryParameter("format").value_or("csv");
-            if (format != "csv" && format != "json" && format != "pwcmp")
-                throw RequestError(400, "format: \"" + validUtf8(format, 16) + "\" is not one of csv, json, pwcmp");
-            HttpResponse res;
-            res.contentType = format == "json" ? "application/json" : "text/csv";
-            res.headers.emplace_back("Cache-Control", "no-store");
-            res.body = exportResponses(store_, format);
-            return res;
+HttpResponse StudyServer::postSession(const HttpRequest& req) {
+    const json body = parseJsonBody(req);
+    const ParticipantRecord p = store_.participant(stringField(body, "token", kMaxTokenLength));
+    const int width = static_cast<int>(integerField(body, "viewport_width", 0, 100000));
+    const int height = static_cast<int>(integerField(body, "viewport_height", 0, 100000));
+    const double dpr = numberField(body, "device_pixel_ratio", 0.1, 16);
+    const StudyDesign& design = store_.definition().design;
+    // Viewing conditions: reported by the page as a group (an older client sends none of them).
+    const std::optional<ViewingConditions> viewing =
+        viewingConditionsField(body, width, height, dpr, req.header("User-Agent"), design.display);
+    if (design.display.calibrate && !(viewing && viewing->pixelsPerMm))
+        throw RequestError(400, "card_width: missing (the study asks for the card calibration first)");
+    if (design.requirements.any()) {
+        // Refused before the first trial; nothing is stored, so the participant can fix it and try again.
+        if (!viewing) throw RequestError(403, "requirements: the page did not report the screen; reload it");
+        const std::vector<std::string> unmet = unmetRequirements(design.requirements, *viewing);
+        if (!unmet.empty()) {
+            std::string message;
+            for (const std::string& sentence : unmet) message += (message.empty() ? "" : " ") + sentence;
+            return jsonResponse(403, {{"error", message}, {"unmet", unmet}});
         }
     }
-    throw RequestError(404, "not found");
+    const std::int64_t session =
+        store_.startSession(p.id, userAgentOf(req), width, height, dpr, viewing, options_.sessionsPerParticipant,
+                            ClientOrigin{req.clientAddress, req.forwardedBy.empty() ? "peer" : "forwarded"});
+    json state = participantState(store_, p);
+    state["session"] = session;
+    return jsonResponse(200, state);
+}
+
+HttpResponse StudyServer::getState(const HttpRequest& req) {
+    // The token travels in this header only: a URL ends up in logs and the browser's history.
+    if (req.queryParameter("token"))
+        throw RequestError(400, "token: send it in the X-Skinlab-Token header, never in the URL");
+    const std::string token = req.header("X-Skinlab-Token");
+    if (token.empty() || token.size() > kMaxTokenLength) throw RequestError(400, "X-Skinlab-Token: missing");
+    return jsonResponse(200, participantState(store_, store_.participant(token)));
+}
+
+HttpResponse StudyServer::postResponse(const HttpRequest& req) {
+    ResponseInput in = responseInputField(parseJsonBody(req));
+    in.userAgent = userAgentOf(req);
+    const ResponseOutcome outcome = store_.recordResponse(in);
+    // Reached only after COMMIT: the acknowledgement below promises durability.
+    json state = participantState(store_, store_.participant(in.token));
+    state["stored"] = outcome == ResponseOutcome::stored;
+    state["duplicate"] = outcome == ResponseOutcome::duplicate;
+    return jsonResponse(200, state);
+}
+
+HttpResponse StudyServer::getExport(const HttpRequest& req) {
+    const std::string format = req.queryParameter("format").value_or("csv");
+    if (format != "csv" && format != "json" && format != "pwcmp")
+        throw RequestError(400, "format: \"" + validUtf8(format, 16) + "\" is not one of csv, json, pwcmp");
+    HttpResponse res;
+    res.contentType = format == "json" ? "application/json" : "text/csv";
+    res.headers.emplace_back("Cache-Control", "no-store");
+    res.body = exportResponses(store_, format);
+    return res;
 }
 
 } // namespace skinlab::experiments

@@ -3,7 +3,10 @@
 // stimulus images, and researcher endpoints behind a token. API reference and limits: docs/experiments.md.
 // Transport: HttpServer (event-driven, Boost.Beast; docs/architecture.md, "Study server: threading model").
 //
-// Every rejected request is answered with a 4xx status and JSON {"error": "..."} and changes nothing.
+// Every rejected request is answered with a 4xx status and JSON {"error": "..."} and changes nothing: a
+// RequestError carries its status, a refusal of the study file (experiments/study_errors.h) is mapped to one here
+// (NotFound 404, Conflict 409, LimitReached 429, InvalidValue 400). Request bodies and answers as JSON:
+// experiments/study_json.h.
 // Only the stimuli listed in the study are served, by number (/stimuli/<n>.png), from the bytes verified against
 // their sha256 when the server started (held in memory); no request path is ever mapped onto the file system.
 #include "experiments/http_server.h"
@@ -72,7 +75,16 @@ private:
     };
     HttpResponse handle(const HttpRequest& request); // answer() with the headers every response carries
     HttpResponse answer(const HttpRequest& request);
+    // The table of endpoints (method and path → handler); each handler below answers one of them.
     HttpResponse route(const HttpRequest& request);
+    // 401 without the researcher token in Authorization: Bearer (or with it in the URL), 403 with a wrong one.
+    void authorizeResearcher(const HttpRequest& request) const;
+    HttpResponse getStimulus(const HttpRequest& request) const;
+    HttpResponse postJoin(const HttpRequest& request);
+    HttpResponse postSession(const HttpRequest& request);
+    HttpResponse getState(const HttpRequest& request);
+    HttpResponse postResponse(const HttpRequest& request);
+    HttpResponse getExport(const HttpRequest& request);
     bool hostAllowed(const std::string& host) const;
     // The client's address: the peer's, or the one a trusted proxy forwards (X-Forwarded-For, rightmost entry).
     std::string clientAddress(const HttpRequest& request) const;

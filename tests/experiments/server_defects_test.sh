@@ -87,6 +87,9 @@ echo '{"0.0": 0, "20.0": 0.5, "40.0": 1, "60.0": 1.5}' >"$WORK/truth.json"
 start_server() { # DB [extra serve options...]
   local db="$1"
   shift
+  # Emptied here, before the server starts: the redirection below runs in the background, so until then the loop
+  # would read the previous server's address.
+  : >"$WORK/serve.log"
   "$SKINLAB" study serve "$db" --port 0 --token researcher-secret-token "$@" >"$WORK/serve.log" 2>&1 &
   SERVER_PID=$!
   for _ in $(seq 1 100); do
@@ -287,6 +290,7 @@ check "the nginx redirect names the server, listens where asked, logs no query s
 # 18. The researcher token from a file.
 printf 'file-token-%s\n' "$RANDOM$RANDOM$RANDOM" >"$WORK/token"
 file_token=$(head -n 1 "$WORK/token")
+: >"$WORK/serve.log" # (as in start_server)
 "$SKINLAB" study serve "$WORK/study.db" --port 0 --token-file "$WORK/token" >"$WORK/serve.log" 2>&1 &
 SERVER_PID=$!
 URL=""

@@ -2,17 +2,19 @@
 // references, and the round trip of every export format through `analyze scale`'s reader.
 #include "analysis/scaling/responses.h"
 #include "common/files.h"
-#include "experiments/request_error.h"
 #include "experiments/seeded_random.h"
 #include "experiments/sqlite_database.h"
 #include "experiments/study_creation.h"
+#include "experiments/study_errors.h"
 #include "experiments/study_export.h"
 #include "experiments/study_store.h"
 #include "stimulus_set_fixture.h"
 
+#include <functional>
 #include <gtest/gtest.h>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string_view>
 #include <tuple>
 
@@ -58,13 +60,14 @@ ResponseInput answer(const ParticipantRecord& p, std::int64_t session, const Tri
     return in;
 }
 
-int statusOf(const std::function<void()>& f) {
+// What the study file refuses `f` with (nullopt: nothing).
+std::optional<Refusal> refusalOf(const std::function<void()>& f) {
     try {
         f();
-    } catch (const RequestError& e) {
-        return e.status();
+    } catch (const StudyRefusal& e) {
+        return e.reason();
     }
-    return 0;
+    return std::nullopt;
 }
 
 bool wellFormedUtf8(const std::string& s) {
@@ -87,7 +90,7 @@ TEST(StudyStore, AnExplicitLabelEqualToALaterDefaultDoesNotLockOutBareJoins) {
     EXPECT_EQ(study.store->join("").label, "P008");
     EXPECT_EQ(study.store->join("").label, "P010");
     EXPECT_EQ(study.store->join("").label, "P011");
-    EXPECT_EQ(statusOf([&] { study.store->join("P008"); }), 409);
+    EXPECT_EQ(refusalOf([&] { study.store->join("P008"); }), Refusal::conflict);
 }
 
 TEST(StudyStore, ClientTextIsStoredAsWellFormedUtf8AndExportsNeverFail) {
@@ -160,15 +163,16 @@ TEST(StudyStore, TrialReferencesAreTaggedAndScopedToTheirParticipant) {
     const std::string before = exportResponses(*study.store, "csv");
     ResponseInput raw = answer(alice, aliceSession, aliceTrials[0], "left");
     raw.trialId = aliceTrials[0].id; // the row id alone is not a reference
-    EXPECT_EQ(statusOf([&] { study.store->recordResponse(raw); }), 404);
+    EXPECT_EQ(refusalOf([&] { study.store->recordResponse(raw); }), Refusal::notFound);
     // Bob's first trial, with Alice's token: whether tagged for Bob or for Alice, it is simply unknown (no 403).
     ResponseInput other = answer(alice, aliceSession, bobTrials[0], "left");
     other.trialId = trialReference(bob.token, bobTrials[0].id);
-    EXPECT_EQ(statusOf([&] { study.store->recordResponse(other); }), 404);
+    EXPECT_EQ(refusalOf([&] { study.store->recordResponse(other); }), Refusal::notFound);
     other.trialId = trialReference(alice.token, bobTrials[0].id);
-    EXPECT_EQ(statusOf([&] { study.store->recordResponse(other); }), 404);
+    EXPECT_EQ(refusalOf([&] { study.store->recordResponse(other); }), Refusal::notFound);
     // Bob's session with Alice's trial: unknown too.
-    EXPECT_EQ(statusOf([&] { study.store->recordResponse(answer(alice, bobSession, aliceTrials[0], "left")); }), 404);
+    EXPECT_EQ(refusalOf([&] { study.store->recordResponse(answer(alice, bobSession, aliceTrials[0], "left")); }),
+              Refusal::notFound);
     EXPECT_EQ(exportResponses(*study.store, "csv"), before);
     // References fit in a JavaScript number and differ between participants.
     EXPECT_LT(trialReference(alice.token, aliceTrials[0].id), std::int64_t(1) << 53);

@@ -1,0 +1,37 @@
+#pragma once
+// Rows of the study file's tables as records (experiments/study_records.h): the column lists the store's queries
+// select, the readers of those columns, and the insert of planned trials. Shared by the parts of the store.
+#include "experiments/sqlite_database.h"
+#include "experiments/study_records.h"
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+namespace skinlab::experiments {
+
+// Table trials: these columns, in this order, are what readTrial() reads.
+inline constexpr const char* kTrialColumns =
+    "id, participant_id, position, kind, block, condition_a, condition_b, stimulus_a, stimulus_b, a_on_left,"
+    " reference_stimulus, expected";
+TrialRecord readTrial(const SqliteStatement& s);
+
+// Table participants: these columns, in this order, are what readParticipant() reads.
+inline constexpr const char* kParticipantColumns =
+    "id, participant_index, label, token, seed, completion_code, created_at";
+ParticipantRecord readParticipant(const SqliteStatement& s);
+
+// Table viewing_conditions as `v` (LEFT JOINed to a session): readViewing() reads these columns starting at
+// `first`; a NULL first column (no row: not reported) gives nullopt.
+inline constexpr const char* kViewingColumns =
+    "v.screen_width, v.screen_height, v.screen_width_px, v.screen_height_px, v.colour_depth, v.fullscreen,"
+    " v.pointer_fine, v.touch_points, v.mobile, v.pixels_per_mm, v.viewing_distance_mm, v.pixels_per_degree";
+std::optional<ViewingConditions> readViewing(const SqliteStatement& s, int first, double devicePixelRatio,
+                                             int viewportWidth, int viewportHeight);
+
+// Inserts a participant's planned trials at positions firstPosition, firstPosition + 1, ... (inside the caller's
+// transaction).
+void insertTrials(SqliteDatabase& db, std::int64_t participantId, const std::vector<PlannedTrial>& plan,
+                  int firstPosition = 0);
+
+} // namespace skinlab::experiments
