@@ -29,10 +29,15 @@
 //
 // Usage: bench_active_sampling [--experiments E] [--coverage-experiments C] [--bootstrap B] [--spread S]
 //                              [--truth normal|uniform] [--prior-sd P]
-//                              [--selection mst-variance|mst-gain|greedy|variance] [--rounds R] [--threads T]
+//                              [--selection mst-variance|mst-gain|greedy|variance|oracle] [--batch K]
+//                              [--plan-prior-sd P] [--empirical-prior] [--rounds R] [--threads T]
 //                              [--seed N] [--timing 0|1] [--coverage-rounds 1,2] [--plot FILE.png]
 //        bench_active_sampling --sweep [--seeds S] [--ms 10,20,30,40] [--spreads 1,2,3] [--budgets 1,2]
-//                              [--horizon H] [--selection ...] [--prior-sd P] [--threads T] [--seed N]
+//                              [--horizon H] [--selection ...] [--batch K] [--prior-sd P] [--plan-prior-sd P]
+//                              [--threads T] [--seed N]
+// --batch K: only the first K pairs of each planned batch are used before re-planning (the design's active_batch);
+// --plan-prior-sd P: pairs valued under a prior of sd P (same sites, ac::withPrior); --selection oracle: the
+// A-optimal allocation for the true scores (sc::optimalAllocation), each trial the pair furthest behind its share.
 #include "analysis/scaling/bootstrap.h"
 #include "analysis/scaling/design_efficiency.h"
 #include "analysis/scaling/pairwise_model.h"
