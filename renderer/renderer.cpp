@@ -664,12 +664,11 @@ RenderResult Renderer::render(const RenderRequest& request) {
         cyclesInputs.camera = frame.camera;
         cyclesInputs.sssWidthMm = spec.sss.widthMm;
         if (eevee) {
-            const pathtraced::EeveeParams params = pathtraced::eeveeParamsFromJson(spec.eevee, spec.source);
-            cyclesInputs.params = params.sceneParams();
-            cyclesInputs.eeveeSettings = params.toJson();
+            cyclesInputs.params = spec.eevee.sceneParams();
+            cyclesInputs.eeveeSettings = spec.eevee.toJson();
             cycles = pathtraced::renderWithEevee(cyclesInputs, frame.exposure);
         } else {
-            cyclesInputs.params = pathtraced::pathtracedParamsFromJson(spec.pathtraced, spec.source);
+            cyclesInputs.params = spec.pathtraced;
             cycles = pathtraced::renderWithCycles(cyclesInputs, frame.exposure);
         }
     }
@@ -699,8 +698,7 @@ RenderResult Renderer::render(const RenderRequest& request) {
     for (const Aov& aov : kAovs) readBack.push_back(read((impl.targets.*aov.texture).get(), aov.textureChannels));
     const bool rasterizerSpecular =
         cycles &&
-        (eevee ? pathtraced::eeveeParamsFromJson(spec.eevee, spec.source).specularSource == "rasterizer"
-               : pathtraced::pathtracedParamsFromJson(spec.pathtraced, spec.source).specularSource == "rasterizer");
+        (eevee ? spec.eevee.specularSource : spec.pathtraced.specularSource) == "rasterizer";
     if (rasterizerSpecular) {
         // pathtraced.specular_source / eevee.specular_source = "rasterizer": Blender rendered no specular lobe; its
         // beauty gets the rasterizer's specular pass (same camera), so only the diffuse/subsurface layer comes
@@ -757,7 +755,7 @@ RenderResult Renderer::render(const RenderRequest& request) {
     metadata.floats["skinlab:mm_per_unit"] = static_cast<float>(spec.mmPerUnit);
     metadata.floats["skinlab:sss_radius_mm"] = supportRadiusMm;
     if (cycles && eevee) {
-        nlohmann::json record = spec.eevee;
+        nlohmann::json record = spec.eevee.toJson();
         record["blender_version"] = cycles->blenderVersion;
         record["render_seconds"] = cycles->renderSeconds;
         record["wall_seconds"] = cycles->wallSeconds;
@@ -768,7 +766,7 @@ RenderResult Renderer::render(const RenderRequest& request) {
         metadata.strings["skinlab:blender_version"] = cycles->blenderVersion;
         metadata.floats["skinlab:render_seconds"] = static_cast<float>(cycles->renderSeconds);
     } else if (cycles) {
-        const nlohmann::json params = spec.pathtraced;
+        const nlohmann::json params = spec.pathtraced.toJson();
         nlohmann::json fromCycles = nlohmann::json::array(); // "R", "G", "B", "diffuse.*", ..., "depth.Z", "mask.Y"
         for (const Aov& aov : kAovs) {
             if (!aov.cycles) continue;

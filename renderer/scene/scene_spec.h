@@ -6,6 +6,8 @@
 //
 // Paths in a spec: "assets:REL" is REL under the assets folder (--assets DIR or $SKINLAB_ASSETS); any other
 // relative path is relative to the spec file's folder.
+#include "renderer/sss/eevee_params.h"
+#include "renderer/sss/pathtraced_params.h"
 #include "renderer/sss/sss_params.h"
 
 #include <array>
@@ -92,12 +94,11 @@ struct SceneSpec {
     double reinhardKey = 0.18;              // reinhard (Reinhard et al. 2002, Eq. 2): the key a
     sss::SssParams sss;                     // [sss], typed; the method's keys only (sss::methodTable())
     sss::TransmittanceParams transmittance; // [transmittance], typed
-    // Resolved [pathtraced] table (renderer/sss/pathtraced_params.h); read for every scene, recorded in
-    // `resolved` only when sss.method = "pathtraced" (the other methods do not depend on it).
-    nlohmann::json pathtraced = nlohmann::json::object();
-    // Resolved [eevee] table (renderer/sss/eevee_params.h); recorded in `resolved` only when
-    // sss.method = "eevee".
-    nlohmann::json eevee = nlohmann::json::object();
+    // [pathtraced], typed (renderer/sss/pathtraced_params.h); read for every scene, recorded in `resolved` only
+    // when sss.method = "pathtraced" (the other methods do not depend on it).
+    pathtraced::PathtracedParams pathtraced;
+    // [eevee], typed (renderer/sss/eevee_params.h); recorded in `resolved` only when sss.method = "eevee".
+    pathtraced::EeveeParams eevee;
 
     nlohmann::json resolved; // every parameter after defaults and overrides
 };

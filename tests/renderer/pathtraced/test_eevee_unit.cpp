@@ -49,7 +49,7 @@ TEST(EeveeParams, DefaultsAndRecord) {
                                         {"sss.method=\"eevee\"", "eevee.sss_samples=32", "eevee.taa_samples=4",
                                          "eevee.sss_jitter_threshold=0.0", "eevee.radius_mm=[2.0, 1.0, 0.0]"},
                                         {});
-    const EeveeParams p = eeveeParamsFromJson(set.eevee);
+    const EeveeParams p = set.eevee;
     EXPECT_EQ(p.sssSamples, 32);
     EXPECT_EQ(p.taaSamples, 4);
     EXPECT_EQ(p.sssJitterThreshold, 0.0);
@@ -85,7 +85,7 @@ TEST(EeveeScene, EngineSettingsAndRadii) {
     const SceneSpec spec =
         loadSceneSpec("builtin:halo", {"sss.method=\"eevee\"", "sss.width_mm=6", "eevee.sss_samples=11"}, {});
     const Model model = makeHaloScene(static_cast<float>(spec.depthGapMm));
-    const EeveeParams params = eeveeParamsFromJson(spec.eevee);
+    const EeveeParams params = spec.eevee;
     BlenderSceneInputs inputs;
     inputs.spec = &spec;
     inputs.model = &model;
@@ -105,8 +105,8 @@ TEST(EeveeScene, EngineSettingsAndRadii) {
     EXPECT_EQ(json.at("settings").at("eevee").at("sss_samples"), 11);
     EXPECT_GT(json.at("materials").at(0).at("specular").get<double>(), 0.0); // EEVEE's own specular lobe
     // specular_source = "rasterizer": no Principled specular (the renderer adds the rasterizer's specular pass).
-    const EeveeParams borrowed = eeveeParamsFromJson(
-        loadSceneSpec("builtin:halo", {"sss.method=\"eevee\"", "eevee.specular_source=\"rasterizer\""}, {}).eevee);
+    const EeveeParams borrowed =
+        loadSceneSpec("builtin:halo", {"sss.method=\"eevee\"", "eevee.specular_source=\"rasterizer\""}, {}).eevee;
     inputs.params = borrowed.sceneParams();
     for (const auto& material : blenderSceneJson(inputs, "mesh.bin", "cycles.exr", "cycles.json").at("materials"))
         EXPECT_EQ(material.at("specular").get<double>(), 0.0);

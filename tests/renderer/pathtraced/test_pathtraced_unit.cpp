@@ -54,7 +54,7 @@ Exported exportScene(const std::string& scene, std::vector<std::string> override
     }
     inputs.camera = frameCamera(e.spec.camera, e.model.boundsMin, e.model.boundsMax, e.model.boundsMin,
                                 e.model.boundsMax, e.spec.width, e.spec.height);
-    inputs.params = pathtracedParamsFromJson(e.spec.pathtraced);
+    inputs.params = e.spec.pathtraced;
     inputs.sssWidthMm = e.spec.sss.widthMm;
     e.json = blenderSceneJson(inputs, "mesh.bin", "cycles.exr", "cycles.json");
     return e;
