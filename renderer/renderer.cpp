@@ -697,8 +697,7 @@ RenderResult Renderer::render(const RenderRequest& request) {
     std::vector<std::vector<float>> readBack;
     for (const Aov& aov : kAovs) readBack.push_back(read((impl.targets.*aov.texture).get(), aov.textureChannels));
     const bool rasterizerSpecular =
-        cycles &&
-        (eevee ? spec.eevee.specularSource : spec.pathtraced.specularSource) == "rasterizer";
+        cycles && (eevee ? spec.eevee.specularSource : spec.pathtraced.specularSource) == "rasterizer";
     if (rasterizerSpecular) {
         // pathtraced.specular_source / eevee.specular_source = "rasterizer": Blender rendered no specular lobe; its
         // beauty gets the rasterizer's specular pass (same camera), so only the diffuse/subsurface layer comes
