@@ -226,9 +226,8 @@ void runValidate(ValidateArguments& arguments) {
     }
 }
 
-} // namespace
-
-void registerAnalyzeScale(CLI::App& analyze) {
+// `skinlab analyze scale`: its options and what it runs.
+void addScale(CLI::App& analyze) {
     auto scaleArguments = std::make_shared<ScaleArguments>();
     CLI::App* scale = analyze.add_subcommand(
         "scale", "Scale 2AFC responses to JOD (Thurstone Case V) with bootstrap intervals, tests and screening");
@@ -294,7 +293,10 @@ void registerAnalyzeScale(CLI::App& analyze) {
         ->check(CLI::IsMember({"auto", "bootstrap", "profile", "bootstrap+profile", "percentile"}))
         ->capture_default_str();
     scale->callback([scaleArguments] { runScale(*scaleArguments); });
+}
 
+// `skinlab analyze validate`: its options and what it runs.
+void addValidate(CLI::App& analyze) {
     auto validateArguments = std::make_shared<ValidateArguments>();
     scaling::ValidationOptions& o = validateArguments->options;
     CLI::App* validate = analyze.add_subcommand(
@@ -360,6 +362,13 @@ void registerAnalyzeScale(CLI::App& analyze) {
                        "exit 1 unless the validation targets are met (coverage, RMSE, reversals, screening, "
                        "finite intervals)");
     validate->callback([validateArguments] { runValidate(*validateArguments); });
+}
+
+} // namespace
+
+void registerAnalyzeScale(CLI::App& analyze) {
+    addScale(analyze);
+    addValidate(analyze);
 }
 
 } // namespace skinlab::cli

@@ -249,22 +249,19 @@ void runExport(const StudyOptions& o) {
     else writeFileAtomic(o.output, text);
 }
 
-} // namespace
-
-void registerStudy(CLI::App& app) {
-    auto options = std::make_shared<StudyOptions>();
-    CLI::App* study = app.add_subcommand("study", "2AFC experiments: create a study, serve it, simulate observers, "
-                                                  "monitor and export responses");
-    study->require_subcommand(1);
-
-    CLI::App* create = study->add_subcommand("create", "Create study.db from a stimulus folder and a design file");
+// `skinlab study create`: its options and what it runs.
+void addCreate(CLI::App& study, const std::shared_ptr<StudyOptions>& options) {
+    CLI::App* create = study.add_subcommand("create", "Create study.db from a stimulus folder and a design file");
     create->add_option("--stimuli", options->stimuli, "Stimulus folder holding manifest.json")->required();
     create->add_option("--design", options->design, "Design file (TOML)")->required();
     create->add_option("-o,--output", options->output, "Study file to create (never overwritten)")->required();
     create->add_option("--set", options->overrides, "Override a design key: key=value (repeatable)");
     create->callback([options] { runCreate(*options); });
+}
 
-    CLI::App* serve = study->add_subcommand("serve", "Serve the participant page and API");
+// `skinlab study serve`: its options and what it runs.
+void addServe(CLI::App& study, const std::shared_ptr<StudyOptions>& options) {
+    CLI::App* serve = study.add_subcommand("serve", "Serve the participant page and API");
     serve->add_option("study", options->study, "study.db")->required();
     serve->add_option("--host", options->host, "Address to bind (default loopback only)")->capture_default_str();
     serve->add_option("--port", options->port, "Port (0 = any free port)")
@@ -304,8 +301,11 @@ void registerStudy(CLI::App& app) {
         ->check(CLI::Range(32, 128));
     serve->add_option("--stimuli", options->stimuli, "Stimulus folder, if it moved since `study create`");
     serve->callback([options] { runServe(*options); });
+}
 
-    CLI::App* simulate = study->add_subcommand("simulate", "Run simulated Thurstone observers through the server");
+// `skinlab study simulate`: its options and what it runs.
+void addSimulate(CLI::App& study, const std::shared_ptr<StudyOptions>& options) {
+    CLI::App* simulate = study.add_subcommand("simulate", "Run simulated Thurstone observers through the server");
     simulate->add_option("study", options->study, "study.db (the one the server serves)")->required();
     simulate->add_option("--observers", options->observers, "Number of simultaneous observers")
         ->required()
@@ -330,8 +330,11 @@ void registerStudy(CLI::App& app) {
                        "Only the API calls, each on a new connection (default: like a browser — one kept-alive "
                        "connection, the page, the study and each image once)");
     simulate->callback([options] { runSimulate(*options); });
+}
 
-    CLI::App* plan = study->add_subcommand(
+// `skinlab study plan`: its options and what it runs.
+void addPlan(CLI::App& study, const std::shared_ptr<StudyOptions>& options) {
+    CLI::App* plan = study.add_subcommand(
         "plan", "Observers needed for the predicted differences to come out significant (power by simulation)");
     plan->add_option("study", options->study, "study.db")->required();
     plan->add_option("--truth", options->truth,
@@ -345,23 +348,32 @@ void registerStudy(CLI::App& app) {
         ->check(CLI::Range(20, 100000));
     plan->add_option("--seed", options->seed, "Seed of the simulations")->capture_default_str();
     plan->callback([options] { runPlan(*options); });
+}
 
-    CLI::App* status = study->add_subcommand("status", "Per-participant progress and catch-trial accuracy");
+// `skinlab study status`: its options and what it runs.
+void addStatus(CLI::App& study, const std::shared_ptr<StudyOptions>& options) {
+    CLI::App* status = study.add_subcommand("status", "Per-participant progress and catch-trial accuracy");
     status->add_option("study", options->study, "study.db")->required();
     status->add_option("--format", options->format, "text or json")
         ->check(CLI::IsMember({"text", "json"}))
         ->default_val("text");
     status->callback([options] { runStatus(*options); });
+}
 
-    CLI::App* backup = study->add_subcommand("backup", "Consistent copy of a study file, also while it is served "
-                                                       "(SQLite online backup)");
+// `skinlab study backup`: its options and what it runs.
+void addBackup(CLI::App& study, const std::shared_ptr<StudyOptions>& options) {
+    CLI::App* backup = study.add_subcommand("backup", "Consistent copy of a study file, also while it is served "
+                                                      "(SQLite online backup)");
     backup->add_option("study", options->study, "study.db")->required();
     backup->add_option("output", options->output, "Copy to write (atomically)")->required();
     backup->add_flag("--overwrite", options->overwrite, "Replace an existing copy");
     backup->callback([options] { runBackup(*options); });
+}
 
-    CLI::App* deploy = study->add_subcommand("deploy-config", "Write the nginx site file that serves the study over "
-                                                              "HTTPS (docs/deployment.md)");
+// `skinlab study deploy-config`: its options and what it runs.
+void addDeploy(CLI::App& study, const std::shared_ptr<StudyOptions>& options) {
+    CLI::App* deploy = study.add_subcommand("deploy-config", "Write the nginx site file that serves the study over "
+                                                             "HTTPS (docs/deployment.md)");
     deploy->add_option("--server-name", options->site.serverName, "Public host name (also: study serve --public-host)")
         ->required();
     deploy->add_option("--upstream", options->site.upstream, "The study server: IP:PORT (e.g. 127.0.0.1:8080)")
@@ -378,15 +390,35 @@ void registerStudy(CLI::App& app) {
         ->check(CLI::Range(0, 65535));
     deploy->add_option("-o,--output", options->output, "Site file to write (default: standard output)");
     deploy->callback([options] { runDeployConfig(*options); });
+}
 
+// `skinlab study export`: its options and what it runs.
+void addExport(CLI::App& study, const std::shared_ptr<StudyOptions>& options) {
     CLI::App* exportCommand =
-        study->add_subcommand("export", "Export responses (skinlab CSV, pwcmp CSV or JSON; docs/experiments.md)");
+        study.add_subcommand("export", "Export responses (skinlab CSV, pwcmp CSV or JSON; docs/experiments.md)");
     exportCommand->add_option("study", options->study, "study.db")->required();
     exportCommand->add_option("--format", options->format, "csv, json or pwcmp")
         ->check(CLI::IsMember({"csv", "json", "pwcmp"}))
         ->default_val("csv");
     exportCommand->add_option("-o,--output", options->output, "Output file (default: standard output)");
     exportCommand->callback([options] { runExport(*options); });
+}
+
+} // namespace
+
+void registerStudy(CLI::App& app) {
+    auto options = std::make_shared<StudyOptions>();
+    CLI::App* study = app.add_subcommand("study", "2AFC experiments: create a study, serve it, simulate observers, "
+                                                  "monitor and export responses");
+    study->require_subcommand(1);
+    addCreate(*study, options);
+    addServe(*study, options);
+    addSimulate(*study, options);
+    addPlan(*study, options);
+    addStatus(*study, options);
+    addBackup(*study, options);
+    addDeploy(*study, options);
+    addExport(*study, options);
 }
 
 } // namespace skinlab::cli

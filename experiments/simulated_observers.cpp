@@ -96,27 +96,19 @@ double normal(SeededRandom& random) {
     return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
 }
 
-ObserverResult runObserver(StudyStore& store, const SimulationOptions& options, int index, const std::string& kind,
-                           std::vector<double>& latencies) {
-    ObserverResult result;
-    result.kind = kind;
+std::string observerLabel(const SimulationOptions& options, int index, const std::string& kind) {
     char label[96];
     std::snprintf(label, sizeof label, "%s-%03d%s", options.labelPrefix.c_str(), index + 1,
                   kind == "thurstone" ? "" : ("-" + kind).c_str());
-    result.label = label;
-    SeededRandom random(combineSeed(options.seed, static_cast<std::uint64_t>(index)));
-    ApiClient api(options);
+    return label;
+}
 
-    // The page's own sequence: the page and its script and style, the study, then join (the join key follows from
-    // the label, so a second run with the same --label-prefix continues these observers instead of failing).
-    for (const char* asset : {"/", "/app.js", "/style.css"}) api.fetchOnce(asset, result.transportRetries);
-    if (options.browserLike) api.send("GET", "/api/study", json(), result.transportRetries);
-    json join{{"label", result.label}, {"join_key", simulatedJoinKey(result.label)}};
-    const StudyDesign& design = store.definition().design;
+json joinRequest(const StudyDesign& design, const std::string& label) {
+    json join{{"label", label}, {"join_key", simulatedJoinKey(label)}};
     // An online design: the platform's id parameters, as a recruitment link would carry them (derived from the
     // label, so a second run returns the same observers).
     if (const PlatformParameters names = platformParameters(design.recruitment); !names.id.empty()) {
-        const std::string hex = skinlab::sha256Hex("skinlab-simulate-id:" + result.label);
+        const std::string hex = skinlab::sha256Hex("skinlab-simulate-id:" + label);
         std::string upper = hex.substr(0, 20);
         for (char& c : upper) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
         const std::string id = design.recruitment.platform == "prolific" ? hex.substr(0, 24)
@@ -124,13 +116,10 @@ ObserverResult runObserver(StudyStore& store, const SimulationOptions& options, 
                                                                          : "sim" + hex.substr(0, 20);
         join["recruitment"] = {{names.id, id}};
     }
-    HttpResult joined = api.send("POST", "/api/join", join, result.transportRetries);
-    if (joined.status != 201 && joined.status != 200) {
-        result.failure = "join: " + (joined.status ? joined.body.value("error", std::string("?")) : "no answer");
-        return result;
-    }
-    const std::string token = joined.body["token"].get<std::string>();
-    const json screen{{"viewport_width", 1920}, {"viewport_height", 1080}, {"device_pixel_ratio", 1.0}};
+    return join;
+}
+
+json sessionRequest(const StudyDesign& design, const json& screen, const std::string& token) {
     json sessionBody = screen;
     // The viewing conditions a desktop browser in full screen reports (and a calibrated card, if asked for).
     sessionBody.update({{"screen_width", 1920},
@@ -141,7 +130,50 @@ ObserverResult runObserver(StudyStore& store, const SimulationOptions& options, 
                         {"touch_points", 0}});
     if (design.display.calibrate) sessionBody["card_width"] = 323.5;
     sessionBody["token"] = token;
-    HttpResult state = api.send("POST", "/api/session", sessionBody, result.transportRetries);
+    return sessionBody;
+}
+
+// The observer's answer to a trial: a guess at the lapse rate (always, for "random"), the expected answer to a
+// catch trial, else the Thurstone model's choice (qualities negated for "inverted").
+bool choosesA(const SimulationOptions& options, const std::string& kind, double invert, const PlannedTrial& t,
+              SeededRandom& random) {
+    bool chooseA;
+    if (kind == "random" || random.unit() < options.lapseRate) {
+        chooseA = random.coin();
+    } else if (t.kind == TrialKind::catchTrial) {
+        chooseA = (t.expected == 'A') == (kind != "inverted");
+    } else {
+        const double qa = invert * options.truth.quality(t.block, t.conditionA);
+        const double qb = invert * options.truth.quality(t.block, t.conditionB);
+        const double noise = kSigma / std::sqrt(2.0); // ε ~ N(0, σ²/2)
+        const double ua = qa + noise * normal(random) + (t.aOnLeft ? options.sideBias : 0.0);
+        const double ub = qb + noise * normal(random) + (t.aOnLeft ? 0.0 : options.sideBias);
+        chooseA = ua > ub;
+    }
+    return chooseA;
+}
+
+ObserverResult runObserver(StudyStore& store, const SimulationOptions& options, int index, const std::string& kind,
+                           std::vector<double>& latencies) {
+    ObserverResult result;
+    result.kind = kind;
+    result.label = observerLabel(options, index, kind);
+    SeededRandom random(combineSeed(options.seed, static_cast<std::uint64_t>(index)));
+    ApiClient api(options);
+
+    // The page's own sequence: the page and its script and style, the study, then join (the join key follows from
+    // the label, so a second run with the same --label-prefix continues these observers instead of failing).
+    for (const char* asset : {"/", "/app.js", "/style.css"}) api.fetchOnce(asset, result.transportRetries);
+    if (options.browserLike) api.send("GET", "/api/study", json(), result.transportRetries);
+    const StudyDesign& design = store.definition().design;
+    HttpResult joined = api.send("POST", "/api/join", joinRequest(design, result.label), result.transportRetries);
+    if (joined.status != 201 && joined.status != 200) {
+        result.failure = "join: " + (joined.status ? joined.body.value("error", std::string("?")) : "no answer");
+        return result;
+    }
+    const std::string token = joined.body["token"].get<std::string>();
+    const json screen{{"viewport_width", 1920}, {"viewport_height", 1080}, {"device_pixel_ratio", 1.0}};
+    HttpResult state = api.send("POST", "/api/session", sessionRequest(design, screen, token), result.transportRetries);
     if (state.status != 200) {
         result.failure = "session: " + (state.status ? state.body.value("error", std::string("?")) : "no answer");
         return result;
@@ -184,19 +216,7 @@ ObserverResult runObserver(StudyStore& store, const SimulationOptions& options, 
             if (shown.is_object() && shown.contains("url"))
                 api.fetchOnce(shown["url"].get<std::string>(), result.transportRetries);
         }
-        bool chooseA;
-        if (kind == "random" || random.unit() < options.lapseRate) {
-            chooseA = random.coin();
-        } else if (t.kind == TrialKind::catchTrial) {
-            chooseA = (t.expected == 'A') == (kind != "inverted");
-        } else {
-            const double qa = invert * options.truth.quality(t.block, t.conditionA);
-            const double qb = invert * options.truth.quality(t.block, t.conditionB);
-            const double noise = kSigma / std::sqrt(2.0); // ε ~ N(0, σ²/2)
-            const double ua = qa + noise * normal(random) + (t.aOnLeft ? options.sideBias : 0.0);
-            const double ub = qb + noise * normal(random) + (t.aOnLeft ? 0.0 : options.sideBias);
-            chooseA = ua > ub;
-        }
+        const bool chooseA = choosesA(options, kind, invert, t, random);
         const std::string side = chooseA == t.aOnLeft ? "left" : "right";
         if (options.thinkMaxMs > 0) {
             const double ms = options.thinkMinMs + random.unit() * (options.thinkMaxMs - options.thinkMinMs);

@@ -17,21 +17,15 @@ std::string joinNames(const std::vector<std::string>& names) {
     return out;
 }
 
-} // namespace
+std::string conditionOf(const StudyDesign& design, const ManifestStimulus& s) {
+    if (design.conditionFactor == "id") return s.id;
+    auto it = s.factors.find(design.conditionFactor);
+    return it == s.factors.end() ? std::string() : it->second;
+}
 
-StudyDefinition resolveStudy(const StudyDesign& design, const StimulusManifest& manifest) {
+// Blocks in manifest order of first appearance, or the design's own list once every name in it is checked.
+std::vector<std::string> resolveBlockNames(const StudyDesign& design, const StimulusManifest& manifest) {
     const std::string& file = design.sourceName;
-    const std::string manifestWhere = (manifest.folder / "manifest.json").string();
-    StudyDefinition def;
-    def.design = design;
-
-    auto conditionOf = [&](const ManifestStimulus& s) -> std::string {
-        if (design.conditionFactor == "id") return s.id;
-        auto it = s.factors.find(design.conditionFactor);
-        return it == s.factors.end() ? std::string() : it->second;
-    };
-
-    // Blocks in manifest order of first appearance.
     std::vector<std::string> blockNames;
     for (const ManifestStimulus& s : manifest.stimuli)
         if (std::find(blockNames.begin(), blockNames.end(), s.block) == blockNames.end()) blockNames.push_back(s.block);
@@ -40,12 +34,17 @@ StudyDefinition resolveStudy(const StudyDesign& design, const StimulusManifest& 
             throwInput(file, "blocks",
                        "\"" + b + "\" is not a block of the stimulus set (blocks: " + joinNames(blockNames) + ")");
     if (!design.blocks.empty()) blockNames = design.blocks;
+    return blockNames;
+}
 
+// The study's conditions: the design's list (checked against the levels present) or every level present.
+std::vector<std::string> resolveConditions(const StudyDesign& design, const StimulusManifest& manifest) {
+    const std::string& file = design.sourceName;
     // All condition levels present (in manifest order), for defaults and messages.
     std::vector<std::string> levels;
     for (const ManifestStimulus& s : manifest.stimuli) {
         if (s.reference && design.showReference) continue;
-        const std::string c = conditionOf(s);
+        const std::string c = conditionOf(design, s);
         if (!c.empty() && std::find(levels.begin(), levels.end(), c) == levels.end()) levels.push_back(c);
     }
     if (levels.empty())
@@ -62,68 +61,78 @@ StudyDefinition resolveStudy(const StudyDesign& design, const StimulusManifest& 
             if (std::find(conditions.begin(), conditions.end(), c) == conditions.end())
                 throwInput(file, "pairs",
                            "\"" + c + "\" is not one of the study's conditions (" + joinNames(conditions) + ")");
+    return conditions;
+}
 
-    auto addStimulus = [&](const ManifestStimulus& s, const std::string& condition) {
-        for (const StudyStimulus& existing : def.stimuli)
-            if (existing.id == s.id) return existing.index;
-        StudyStimulus st;
-        st.index = static_cast<int>(def.stimuli.size());
-        st.id = s.id;
-        st.block = s.block;
-        st.condition = condition;
-        st.pngPath = s.pngPath;
-        st.sha256 = s.pngSha256;
-        st.width = s.width;
-        st.height = s.height;
-        st.reference = s.reference;
-        def.stimuli.push_back(st);
-        return st.index;
-    };
+// The index of the stimulus in def.stimuli, appended on its first use.
+int addStimulus(StudyDefinition& def, const ManifestStimulus& s, const std::string& condition) {
+    for (const StudyStimulus& existing : def.stimuli)
+        if (existing.id == s.id) return existing.index;
+    StudyStimulus st;
+    st.index = static_cast<int>(def.stimuli.size());
+    st.id = s.id;
+    st.block = s.block;
+    st.condition = condition;
+    st.pngPath = s.pngPath;
+    st.sha256 = s.pngSha256;
+    st.width = s.width;
+    st.height = s.height;
+    st.reference = s.reference;
+    def.stimuli.push_back(st);
+    return st.index;
+}
 
-    for (const std::string& blockName : blockNames) {
-        StudyBlock block;
-        block.name = blockName;
-        std::map<std::string, const ManifestStimulus*> byCondition;
-        for (const ManifestStimulus& s : manifest.stimuli) {
-            if (s.block != blockName) continue;
-            if (s.reference && design.showReference) {
-                if (block.referenceStimulus >= 0)
-                    throwInput(manifestWhere, "stimuli",
-                               "block \"" + blockName + "\" has more than one reference stimulus");
-                block.referenceStimulus = addStimulus(s, "");
-                continue;
-            }
-            const std::string c = conditionOf(s);
-            if (c.empty() || std::find(conditions.begin(), conditions.end(), c) == conditions.end()) continue;
-            if (byCondition.count(c))
-                throwInput(file, "condition_factor",
-                           "block \"" + blockName + "\" has two stimuli with " + design.conditionFactor + "=" + c +
-                               " (\"" + byCondition[c]->id + "\", \"" + s.id +
-                               "\"); choose a factor that tells them apart, or split blocks");
-            byCondition[c] = &s;
+// One block: its reference, one stimulus per condition (in the study's order) and the pairs to compare.
+StudyBlock resolveBlock(StudyDefinition& def, const StimulusManifest& manifest, const std::string& blockName,
+                        const std::vector<std::string>& conditions) {
+    const StudyDesign& design = def.design;
+    const std::string& file = design.sourceName;
+    const std::string manifestWhere = (manifest.folder / "manifest.json").string();
+    StudyBlock block;
+    block.name = blockName;
+    std::map<std::string, const ManifestStimulus*> byCondition;
+    for (const ManifestStimulus& s : manifest.stimuli) {
+        if (s.block != blockName) continue;
+        if (s.reference && design.showReference) {
+            if (block.referenceStimulus >= 0)
+                throwInput(manifestWhere, "stimuli",
+                           "block \"" + blockName + "\" has more than one reference stimulus");
+            block.referenceStimulus = addStimulus(def, s, "");
+            continue;
         }
-        if (design.showReference && block.referenceStimulus < 0)
-            throwInput(file, "reference.show", "block \"" + blockName + "\" has no stimulus with \"reference\": true");
-        for (const std::string& c : conditions) {
-            auto it = byCondition.find(c);
-            if (it == byCondition.end()) continue;
-            block.conditions.push_back(c);
-            block.conditionStimulus.push_back(addStimulus(*it->second, c));
-        }
-        const int n = static_cast<int>(block.conditions.size());
-        for (int i = 0; i < n; ++i)
-            for (int j = i + 1; j < n; ++j) {
-                bool wanted = design.allPairs;
-                for (const auto& [a, b] : design.pairs)
-                    if ((a == block.conditions[i] && b == block.conditions[j]) ||
-                        (b == block.conditions[i] && a == block.conditions[j]))
-                        wanted = true;
-                if (wanted) block.pairs.emplace_back(i, j);
-            }
-        if (!block.pairs.empty()) def.blocks.push_back(std::move(block));
+        const std::string c = conditionOf(design, s);
+        if (c.empty() || std::find(conditions.begin(), conditions.end(), c) == conditions.end()) continue;
+        if (byCondition.count(c))
+            throwInput(file, "condition_factor",
+                       "block \"" + blockName + "\" has two stimuli with " + design.conditionFactor + "=" + c + " (\"" +
+                           byCondition[c]->id + "\", \"" + s.id +
+                           "\"); choose a factor that tells them apart, or split blocks");
+        byCondition[c] = &s;
     }
-    if (def.blocks.empty())
-        throwInput(file, "pairs", "no block holds two of the study's conditions; nothing to compare");
+    if (design.showReference && block.referenceStimulus < 0)
+        throwInput(file, "reference.show", "block \"" + blockName + "\" has no stimulus with \"reference\": true");
+    for (const std::string& c : conditions) {
+        auto it = byCondition.find(c);
+        if (it == byCondition.end()) continue;
+        block.conditions.push_back(c);
+        block.conditionStimulus.push_back(addStimulus(def, *it->second, c));
+    }
+    const int n = static_cast<int>(block.conditions.size());
+    for (int i = 0; i < n; ++i)
+        for (int j = i + 1; j < n; ++j) {
+            bool wanted = design.allPairs;
+            for (const auto& [a, b] : design.pairs)
+                if ((a == block.conditions[i] && b == block.conditions[j]) ||
+                    (b == block.conditions[i] && a == block.conditions[j]))
+                    wanted = true;
+            if (wanted) block.pairs.emplace_back(i, j);
+        }
+    return block;
+}
+
+// Every declared pair must be compared in at least one block.
+void checkDeclaredPairs(const StudyDefinition& def) {
+    const StudyDesign& design = def.design;
     for (const auto& [a, b] : design.pairs) {
         bool found = false;
         for (const StudyBlock& block : def.blocks)
@@ -131,9 +140,13 @@ StudyDefinition resolveStudy(const StudyDesign& design, const StimulusManifest& 
                 if ((block.conditions[i] == a && block.conditions[j] == b) ||
                     (block.conditions[i] == b && block.conditions[j] == a))
                     found = true;
-        if (!found) throwInput(file, "pairs", "no block holds both \"" + a + "\" and \"" + b + "\"");
+        if (!found) throwInput(design.sourceName, "pairs", "no block holds both \"" + a + "\" and \"" + b + "\"");
     }
+}
 
+void resolveCatchPairs(StudyDefinition& def, const StimulusManifest& manifest) {
+    const StudyDesign& design = def.design;
+    const std::string& file = design.sourceName;
     std::size_t index = 0;
     for (const DeclaredCatchPair& c : design.catchPairs) {
         const std::string key = "catch.pairs[" + std::to_string(index++) + "]";
@@ -143,20 +156,25 @@ StudyDefinition resolveStudy(const StudyDesign& design, const StimulusManifest& 
         if (!second) throwInput(file, key + ".second", "no stimulus with id \"" + c.second + "\"");
         StudyCatchPair pair;
         pair.block = first->block;
-        pair.first = addStimulus(*first, conditionOf(*first).empty() ? first->id : conditionOf(*first));
-        pair.second = addStimulus(*second, conditionOf(*second).empty() ? second->id : conditionOf(*second));
+        pair.first =
+            addStimulus(def, *first, conditionOf(design, *first).empty() ? first->id : conditionOf(design, *first));
+        pair.second =
+            addStimulus(def, *second, conditionOf(design, *second).empty() ? second->id : conditionOf(design, *second));
         pair.expectFirst = c.expected == c.first;
         pair.repeat = c.repeat;
         def.catchPairs.push_back(pair);
     }
+}
 
-    // Every trial must fit the declared viewport at one image pixel per device pixel (devicePixelRatio 1).
+// Every trial must fit the declared viewport at one image pixel per device pixel (devicePixelRatio 1).
+void checkViewport(const StudyDefinition& def) {
+    const StudyDesign& design = def.design;
     const StageNeeds needs = def.stageNeeds();
     const int width = needs.cssWidth(), height = needs.cssHeight();
     if (width > design.display.viewportWidth || height > design.display.viewportHeight) {
         const std::string key =
             width > design.display.viewportWidth ? "display.viewport_width" : "display.viewport_height";
-        throwInput(file, key,
+        throwInput(design.sourceName, key,
                    "the trials need " + std::to_string(width) + " × " + std::to_string(height) +
                        " CSS pixels at one image pixel per device pixel (block \"" + needs.widestBlock +
                        "\": " + std::to_string(needs.pairWidth) + " px of images side by side" +
@@ -165,6 +183,24 @@ StudyDefinition resolveStudy(const StudyDesign& design, const StimulusManifest& 
                        std::to_string(design.display.viewportHeight) +
                        " viewport; render smaller stimuli, crop them, or declare a larger viewport");
     }
+}
+
+} // namespace
+
+StudyDefinition resolveStudy(const StudyDesign& design, const StimulusManifest& manifest) {
+    StudyDefinition def;
+    def.design = design;
+    const std::vector<std::string> blockNames = resolveBlockNames(design, manifest);
+    const std::vector<std::string> conditions = resolveConditions(design, manifest);
+    for (const std::string& blockName : blockNames) {
+        StudyBlock block = resolveBlock(def, manifest, blockName, conditions);
+        if (!block.pairs.empty()) def.blocks.push_back(std::move(block));
+    }
+    if (def.blocks.empty())
+        throwInput(design.sourceName, "pairs", "no block holds two of the study's conditions; nothing to compare");
+    checkDeclaredPairs(def);
+    resolveCatchPairs(def, manifest);
+    checkViewport(def);
     return def;
 }
 

@@ -10,22 +10,8 @@ namespace skinlab::experiments {
 
 namespace {
 
-StudyDesign designFromToml(toml::table& root, const std::string& file, const std::vector<std::string>& overrides) {
-    for (const std::string& assignment : overrides) applyOverride(root, assignment, "--set");
-    SpecReader spec(root, file);
-    StudyDesign d;
-    d.sourceName = file;
-    d.title = spec.string("title", d.title);
-    d.question = spec.string("question", d.question);
-    if (d.question.empty()) spec.fail("question", "must not be empty");
-    d.instructions = spec.string("instructions", d.instructions);
-    d.consent = spec.string("consent", d.consent);
-    // Seeds are stored as SQLite integers (signed 64-bit), hence the non-negative int64 range.
-    d.seed = static_cast<std::uint64_t>(spec.integer("seed", 1, 0, std::numeric_limits<std::int64_t>::max()));
-    d.conditionFactor = spec.string("condition_factor", d.conditionFactor);
-    if (d.conditionFactor.empty()) spec.fail("condition_factor", "must not be empty");
-    d.conditions = spec.strings("conditions", {});
-    d.blocks = spec.strings("blocks", {});
+// pairs: "all", "active" or a list of [A, B] condition pairs.
+void readPairs(const SpecReader& spec, StudyDesign& d) {
     if (const toml::node* pairs = spec.raw("pairs")) {
         if (const auto* text = pairs->as_string()) {
             if (text->get() == "active") d.activePairs = true;
@@ -50,6 +36,10 @@ StudyDesign designFromToml(toml::table& root, const std::string& file, const std
             spec.fail("pairs", "expected \"all\" or an array of [A, B] condition pairs, got " + describeNode(*pairs));
         }
     }
+}
+
+// trials_per_participant and active_batch, which only an active design takes.
+void readTrialCounts(const SpecReader& spec, StudyDesign& d) {
     // Active designs (pairs = "active"): trials_per_participant is required, and the keys that only shape a fixed
     // design (repetitions, block_order) are errors rather than silently ignored.
     if (d.activePairs) {
@@ -67,16 +57,10 @@ StudyDesign designFromToml(toml::table& root, const std::string& file, const std
         for (const char* key : {"trials_per_participant", "active_batch"})
             if (spec.has(key)) spec.fail(key, "only used with pairs = \"active\"");
     }
-    d.repetitions = static_cast<int>(spec.integer("repetitions", d.repetitions, 1, 100));
-    d.blockOrder = spec.choice("block_order", d.blockOrder, {"interleaved", "grouped"});
-    d.breakEvery = static_cast<int>(spec.integer("break_every", d.breakEvery, 0, 100000));
+}
 
-    SpecReader reference = spec.table("reference");
-    d.showReference = reference.boolean("show", false);
-
-    SpecReader practice = spec.table("practice");
-    d.practiceTrials = static_cast<int>(practice.integer("trials", d.practiceTrials, 0, 100));
-
+// [catch]: blank catch trials and [[catch.pairs]].
+void readCatch(const SpecReader& spec, StudyDesign& d) {
     SpecReader catchTable = spec.table("catch");
     d.blankCatchTrials = static_cast<int>(catchTable.integer("blank", d.blankCatchTrials, 0, 1000));
     for (const SpecReader& pair : catchTable.tables("pairs")) {
@@ -90,7 +74,10 @@ StudyDesign designFromToml(toml::table& root, const std::string& file, const std
             pair.fail("expected", "must be the first or the second stimulus id, got \"" + c.expected + "\"");
         d.catchPairs.push_back(std::move(c));
     }
+}
 
+// [recruitment]: the platform, its id parameter, the completion link and code.
+void readRecruitment(const SpecReader& spec, StudyDesign& d) {
     SpecReader recruitment = spec.table("recruitment");
     d.recruitment.platform = recruitment.choice("platform", "none", {"none", "prolific", "mturk", "sona", "generic"});
     const bool named = d.recruitment.platform == "sona" || d.recruitment.platform == "generic";
@@ -122,7 +109,10 @@ StudyDesign designFromToml(toml::table& root, const std::string& file, const std
             d.recruitment.completionCode.size() > 64)
             recruitment.fail("completion_code", "\"" + d.recruitment.completionCode +
                                                     "\": only letters, digits, '-' and '_' (at most 64)");
+}
 
+// [display]: calibration, viewing distance and viewport.
+void readDisplay(const SpecReader& spec, StudyDesign& d) {
     SpecReader display = spec.table("display");
     d.display.calibrate = display.boolean("calibrate", false);
     if (d.display.calibrate && !display.has("viewing_distance_mm"))
@@ -130,13 +120,50 @@ StudyDesign designFromToml(toml::table& root, const std::string& file, const std
     d.display.viewingDistanceMm = display.number("viewing_distance_mm", 0, 100, 5000);
     d.display.viewportWidth = static_cast<int>(display.integer("viewport_width", 1920, 320, 16384));
     d.display.viewportHeight = static_cast<int>(display.integer("viewport_height", 1080, 240, 16384));
+}
 
+// [requirements]: what the participant's screen and browser must offer.
+void readRequirements(const SpecReader& spec, StudyDesign& d) {
     SpecReader requirements = spec.table("requirements");
     d.requirements.minScreenWidth = static_cast<int>(requirements.integer("min_screen_width", 0, 0, 100000));
     d.requirements.minScreenHeight = static_cast<int>(requirements.integer("min_screen_height", 0, 0, 100000));
     d.requirements.noZoom = requirements.boolean("no_zoom", false);
     d.requirements.fullscreen = requirements.boolean("fullscreen", false);
     d.requirements.desktop = requirements.boolean("desktop", false);
+}
+
+StudyDesign designFromToml(toml::table& root, const std::string& file, const std::vector<std::string>& overrides) {
+    for (const std::string& assignment : overrides) applyOverride(root, assignment, "--set");
+    SpecReader spec(root, file);
+    StudyDesign d;
+    d.sourceName = file;
+    d.title = spec.string("title", d.title);
+    d.question = spec.string("question", d.question);
+    if (d.question.empty()) spec.fail("question", "must not be empty");
+    d.instructions = spec.string("instructions", d.instructions);
+    d.consent = spec.string("consent", d.consent);
+    // Seeds are stored as SQLite integers (signed 64-bit), hence the non-negative int64 range.
+    d.seed = static_cast<std::uint64_t>(spec.integer("seed", 1, 0, std::numeric_limits<std::int64_t>::max()));
+    d.conditionFactor = spec.string("condition_factor", d.conditionFactor);
+    if (d.conditionFactor.empty()) spec.fail("condition_factor", "must not be empty");
+    d.conditions = spec.strings("conditions", {});
+    d.blocks = spec.strings("blocks", {});
+    readPairs(spec, d);
+    readTrialCounts(spec, d);
+    d.repetitions = static_cast<int>(spec.integer("repetitions", d.repetitions, 1, 100));
+    d.blockOrder = spec.choice("block_order", d.blockOrder, {"interleaved", "grouped"});
+    d.breakEvery = static_cast<int>(spec.integer("break_every", d.breakEvery, 0, 100000));
+
+    SpecReader reference = spec.table("reference");
+    d.showReference = reference.boolean("show", false);
+
+    SpecReader practice = spec.table("practice");
+    d.practiceTrials = static_cast<int>(practice.integer("trials", d.practiceTrials, 0, 100));
+
+    readCatch(spec, d);
+    readRecruitment(spec, d);
+    readDisplay(spec, d);
+    readRequirements(spec, d);
     spec.finish();
     return d;
 }

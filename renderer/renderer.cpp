@@ -603,6 +603,7 @@ DisplayFrame Renderer::renderDisplay(const RenderRequest& request, bool withLine
     return out;
 }
 
+// Long by design: the GL pass sequence of one frame, in order, sharing its targets and timers.
 RenderResult Renderer::render(const RenderRequest& request) {
     if (request.exrPath.empty()) throw InputError("render: an output EXR path is required (-o out.exr)");
     const auto loadStart = std::chrono::steady_clock::now();

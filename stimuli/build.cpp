@@ -210,17 +210,12 @@ BuildPlan planBuild(const fs::path& specPath, const std::vector<std::string>& sp
     return plan;
 }
 
-BuildSummary buildSet(const BuildOptions& options) {
-    auto start = std::chrono::steady_clock::now();
-    if (options.jobs < 1) throwInput("--jobs", "", std::to_string(options.jobs) + " is not a positive number");
-    BuildPlan plan = planBuild(options.spec, options.specOverrides, options.shard, options.assetsDir);
-    const fs::path& dir = options.outputDir;
-    std::optional<Manifest> existing = claimOutputFolder(dir, plan.spec.name, options.shard);
-    ensureDirectory(dir);
-    OutputFolderLock folderLock(dir); // one build per folder at a time (a requeued task whose first run still lives)
-    existing = claimOutputFolder(dir, plan.spec.name, options.shard); // re-read: a build may have ended meanwhile
+namespace {
 
-    Manifest manifest = manifestHeader(plan.spec, plan.all, options.shard);
+// The entries of an earlier build of this version that are still valid, by id (the earlier renderer into
+// manifest.renderer).
+std::map<std::string, nlohmann::json> keptEntries(const BuildPlan& plan, const std::optional<Manifest>& existing,
+                                                  const fs::path& dir, Manifest& manifest) {
     std::map<std::string, nlohmann::json> entries; // id → entry of every stimulus done
     if (existing && existing->renderer.skinlabVersion == version()) {
         manifest.renderer = existing->renderer;
@@ -236,6 +231,102 @@ BuildSummary buildSet(const BuildOptions& options) {
             }
         }
     }
+    return entries;
+}
+
+// The manifest with every entry done so far, in the selection's order; complete once all are there.
+void writeCurrentManifest(const fs::path& dir, const BuildPlan& plan,
+                          const std::map<std::string, nlohmann::json>& entries, Manifest& manifest) {
+    manifest.stimuli.clear();
+    for (const auto& s : plan.selected)
+        if (auto it = entries.find(s.id); it != entries.end()) manifest.stimuli.push_back(it->second);
+    manifest.complete = manifest.stimuli.size() == plan.selected.size();
+    writeManifest(dir, manifest);
+}
+
+// Renders the stimuli of toRender (all of them when the kept ones came from another renderer) on options.jobs
+// threads, the manifest rewritten after each; returns how many were rendered.
+size_t renderStimuli(const BuildOptions& options, const BuildPlan& plan, Manifest& manifest,
+                     std::map<std::string, nlohmann::json>& entries, std::vector<size_t>& toRender) {
+    const fs::path& dir = options.outputDir;
+    auto first = std::make_unique<renderer::Renderer>();
+    RendererInfo current{first->glRenderer(), first->glVersion(), version()};
+    if (!entries.empty() && !(current == manifest.renderer)) {
+        // A set is made by one renderer: images of another GPU/driver are not comparable pixel for pixel.
+        spdlog::warn("stimuli: the set was rendered by '{}', this machine has '{}': re-rendering all of it",
+                     manifest.renderer.glRenderer, current.glRenderer);
+        entries.clear();
+        toRender.clear();
+        for (size_t i = 0; i < plan.selected.size(); ++i) toRender.push_back(i);
+    }
+    manifest.renderer = current;
+    writeCurrentManifest(dir, plan, entries, manifest);
+
+    bool terminal = options.progress == BuildOptions::ProgressStyle::bar ||
+                    (options.progress == BuildOptions::ProgressStyle::automatic && Progress::stderrIsTerminal());
+    Progress progress(toRender.size(), terminal);
+    std::mutex manifestMutex;
+    size_t rendered = 0;
+    std::atomic<size_t> next{0};
+    std::atomic<bool> stop{false};
+    std::exception_ptr failure;
+    // Every renderer lives until all workers are done: they may share one EGL display, which the first
+    // destroyed renderer would terminate under the others.
+    int jobs = std::min<int>(options.jobs, static_cast<int>(toRender.size()));
+    std::vector<std::unique_ptr<renderer::Renderer>> renderers(static_cast<size_t>(jobs));
+    renderers[0] = std::move(first);
+    auto work = [&](size_t slot) {
+        try {
+            if (!renderers[slot]) renderers[slot] = std::make_unique<renderer::Renderer>();
+            renderer::Renderer* renderer = renderers[slot].get();
+            while (!stop) {
+                size_t k = next++;
+                if (k >= toRender.size()) return;
+                const size_t i = toRender[k];
+                auto t0 = std::chrono::steady_clock::now();
+                nlohmann::json entry;
+                try {
+                    entry = renderStimulus(*renderer, plan.selected[i], plan.resolved[i], dir, options.assetsDir);
+                } catch (const InputError& e) {
+                    throw InputError(plan.spec.fileName + ": stimulus '" + plan.selected[i].id + "': " + e.what());
+                } catch (const RuntimeError& e) {
+                    throw RuntimeError("stimulus '" + plan.selected[i].id + "': " + e.what());
+                }
+                std::lock_guard lock(manifestMutex);
+                entries[plan.selected[i].id] = std::move(entry);
+                writeCurrentManifest(dir, plan, entries, manifest);
+                ++rendered;
+                progress.finished(plan.selected[i].id, secondsSince(t0));
+            }
+        } catch (...) {
+            std::lock_guard lock(manifestMutex);
+            if (!failure) failure = std::current_exception();
+            stop = true;
+        }
+    };
+    std::vector<std::thread> threads;
+    for (size_t j = 1; j < renderers.size(); ++j) threads.emplace_back(work, j);
+    work(0);
+    for (auto& t : threads) t.join();
+    progress.close();
+    if (failure) std::rethrow_exception(failure);
+    return rendered;
+}
+
+} // namespace
+
+BuildSummary buildSet(const BuildOptions& options) {
+    auto start = std::chrono::steady_clock::now();
+    if (options.jobs < 1) throwInput("--jobs", "", std::to_string(options.jobs) + " is not a positive number");
+    BuildPlan plan = planBuild(options.spec, options.specOverrides, options.shard, options.assetsDir);
+    const fs::path& dir = options.outputDir;
+    std::optional<Manifest> existing = claimOutputFolder(dir, plan.spec.name, options.shard);
+    ensureDirectory(dir);
+    OutputFolderLock folderLock(dir); // one build per folder at a time (a requeued task whose first run still lives)
+    existing = claimOutputFolder(dir, plan.spec.name, options.shard); // re-read: a build may have ended meanwhile
+
+    Manifest manifest = manifestHeader(plan.spec, plan.all, options.shard);
+    std::map<std::string, nlohmann::json> entries = keptEntries(plan, existing, dir, manifest);
     std::vector<size_t> toRender;
     std::vector<std::string> selectedIds;
     for (size_t i = 0; i < plan.selected.size(); ++i) {
@@ -243,15 +334,8 @@ BuildSummary buildSet(const BuildOptions& options) {
         if (!entries.count(plan.selected[i].id)) toRender.push_back(i);
     }
 
-    std::mutex manifestMutex;
-    auto writeCurrent = [&] {
-        manifest.stimuli.clear();
-        for (const auto& s : plan.selected)
-            if (auto it = entries.find(s.id); it != entries.end()) manifest.stimuli.push_back(it->second);
-        manifest.complete = manifest.stimuli.size() == plan.selected.size();
-        writeManifest(dir, manifest);
-    };
-    writeCurrent(); // marks the folder as this set's before anything renders (or creates a subfolder)
+    // Marks the folder as this set's before anything renders (or creates a subfolder).
+    writeCurrentManifest(dir, plan, entries, manifest);
     ensureDirectory(dir / "exr");
     ensureDirectory(dir / "png");
     tidyOutputFolder(dir, selectedIds);
@@ -260,67 +344,7 @@ BuildSummary buildSet(const BuildOptions& options) {
 
     BuildSummary summary;
     summary.stimuli = plan.selected.size();
-    if (!toRender.empty()) {
-        auto first = std::make_unique<renderer::Renderer>();
-        RendererInfo current{first->glRenderer(), first->glVersion(), version()};
-        if (!entries.empty() && !(current == manifest.renderer)) {
-            // A set is made by one renderer: images of another GPU/driver are not comparable pixel for pixel.
-            spdlog::warn("stimuli: the set was rendered by '{}', this machine has '{}': re-rendering all of it",
-                         manifest.renderer.glRenderer, current.glRenderer);
-            entries.clear();
-            toRender.clear();
-            for (size_t i = 0; i < plan.selected.size(); ++i) toRender.push_back(i);
-        }
-        manifest.renderer = current;
-        writeCurrent();
-
-        bool terminal = options.progress == BuildOptions::ProgressStyle::bar ||
-                        (options.progress == BuildOptions::ProgressStyle::automatic && Progress::stderrIsTerminal());
-        Progress progress(toRender.size(), terminal);
-        std::atomic<size_t> next{0};
-        std::atomic<bool> stop{false};
-        std::exception_ptr failure;
-        // Every renderer lives until all workers are done: they may share one EGL display, which the first
-        // destroyed renderer would terminate under the others.
-        int jobs = std::min<int>(options.jobs, static_cast<int>(toRender.size()));
-        std::vector<std::unique_ptr<renderer::Renderer>> renderers(static_cast<size_t>(jobs));
-        renderers[0] = std::move(first);
-        auto work = [&](size_t slot) {
-            try {
-                if (!renderers[slot]) renderers[slot] = std::make_unique<renderer::Renderer>();
-                renderer::Renderer* renderer = renderers[slot].get();
-                while (!stop) {
-                    size_t k = next++;
-                    if (k >= toRender.size()) return;
-                    const size_t i = toRender[k];
-                    auto t0 = std::chrono::steady_clock::now();
-                    nlohmann::json entry;
-                    try {
-                        entry = renderStimulus(*renderer, plan.selected[i], plan.resolved[i], dir, options.assetsDir);
-                    } catch (const InputError& e) {
-                        throw InputError(plan.spec.fileName + ": stimulus '" + plan.selected[i].id + "': " + e.what());
-                    } catch (const RuntimeError& e) {
-                        throw RuntimeError("stimulus '" + plan.selected[i].id + "': " + e.what());
-                    }
-                    std::lock_guard lock(manifestMutex);
-                    entries[plan.selected[i].id] = std::move(entry);
-                    writeCurrent();
-                    ++summary.rendered;
-                    progress.finished(plan.selected[i].id, secondsSince(t0));
-                }
-            } catch (...) {
-                std::lock_guard lock(manifestMutex);
-                if (!failure) failure = std::current_exception();
-                stop = true;
-            }
-        };
-        std::vector<std::thread> threads;
-        for (size_t j = 1; j < renderers.size(); ++j) threads.emplace_back(work, j);
-        work(0);
-        for (auto& t : threads) t.join();
-        progress.close();
-        if (failure) std::rethrow_exception(failure);
-    }
+    if (!toRender.empty()) summary.rendered = renderStimuli(options, plan, manifest, entries, toRender);
     summary.kept = summary.stimuli - summary.rendered;
     summary.manifest = dir / kManifestFile;
     // Predicted visibility against each block's reference, once every stimulus is there (kept when up to date).

@@ -218,30 +218,22 @@ renderer::RenderRequest requestOf(const Stimulus& stimulus, const std::vector<st
     return request;
 }
 
-} // namespace
-
-CalibrationReport calibrateLevels(const CalibrateOptions& options) {
-    const auto start = std::chrono::steady_clock::now();
-    if (options.factor.empty()) throwInput("--factor", "", "missing (a numeric scene key, e.g. sss.width_mm)");
-    const std::string key = sceneKeyOf(options.factor);
+// The scene key of --factor: a numeric key that no stimulus set holds fixed.
+std::string calibratedKey(const std::string& factor) {
+    if (factor.empty()) throwInput("--factor", "", "missing (a numeric scene key, e.g. sss.width_mm)");
+    const std::string key = sceneKeyOf(factor);
     if (key.empty() || key == "sss.method" || key == "camera.view")
-        throwInput("--factor", "", "'" + options.factor + "' is not a numeric scene key (e.g. sss.width_mm)");
+        throwInput("--factor", "", "'" + factor + "' is not a numeric scene key (e.g. sss.width_mm)");
     for (const auto& fixed : alwaysFixedKeys())
         if (keysOverlap(key, fixed))
             throwInput("--factor", "",
                        "'" + key + "' is held fixed across every stimulus set (" + fixed + "); it cannot vary");
-    // Checked before the spec so that a bad number is reported without reading it.
-    metrics::CvvdpDisplay display = metrics::cvvdpDisplay(options.display);
+    return key;
+}
 
-    BuildPlan plan = planBuild(options.spec, options.specOverrides, std::nullopt, options.assetsDir);
+// The index in plan.all of the stimulus whose parameter varies (--stimulus, else the first that is no reference).
+size_t baseStimulusIndex(const CalibrateOptions& options, const BuildPlan& plan) {
     const std::string& specName = plan.spec.fileName;
-    for (const auto& fixed : plan.spec.fixed)
-        if (keysOverlap(key, fixed.key))
-            throwInput("--factor", "",
-                       "'" + key + "' is the fixed parameter fixed." + fixed.key + " of " + specName +
-                           "; remove it from [fixed] to calibrate it");
-
-    // The stimulus whose parameter varies, and its reference.
     const Stimulus* base = nullptr;
     size_t baseIndex = 0;
     for (size_t i = 0; i < plan.all.size(); ++i) {
@@ -257,27 +249,14 @@ CalibrationReport calibrateLevels(const CalibrateOptions& options) {
     if (!base) throwInput(specName, "", "has no stimulus but references");
     if (base->reference)
         throwInput("--stimulus", "", "'" + base->id + "' is a [[reference]] stimulus; choose one it is compared with");
+    return baseIndex;
+}
 
-    CalibrationReport report;
-    report.set = plan.spec.name;
-    report.factor = options.factor;
-    report.key = key;
-    report.stimulus = base->id;
-    report.display = metrics::describeCvvdpDisplay(display);
-
-    // The base stimulus' overrides without the calibrated key (a factor of the set, or an include's extra key).
-    std::vector<std::string> baseOverrides;
-    for (const auto& o : base->overrides)
-        if (!keysOverlap(keyOf(o), key)) baseOverrides.push_back(o);
-    const nlohmann::json resolvedBase = plan.resolved[baseIndex];
-    const nlohmann::json::json_pointer pointer(pointerOf(key));
-    if (!resolvedBase.contains(pointer) || !resolvedBase.at(pointer).is_number())
-        throwInput("--factor", "",
-                   "'" + key + "' is not a parameter holding one number in stimulus '" + base->id +
-                       "' (see docs/scenes.md)");
-    report.integral = resolvedBase.at(pointer).is_number_integer();
-
-    // The range: as given, else the smallest and largest numeric level of the spec's factor.
+// The search over the range (as given, else the smallest and largest numeric level of the spec's factor), checked
+// with the reference level before anything renders.
+LevelSearch calibrationSearch(const CalibrateOptions& options, const BuildPlan& plan, const std::string& key,
+                              bool integral) {
+    const std::string& specName = plan.spec.fileName;
     std::pair<double, double> range;
     if (options.range) {
         range = *options.range;
@@ -291,12 +270,13 @@ CalibrationReport calibrateLevels(const CalibrateOptions& options) {
             throwInput("--range", "", "missing (LO,HI; " + specName + " has no factor '" + key + "' to take it from)");
         range = {*std::min_element(levels.begin(), levels.end()), *std::max_element(levels.begin(), levels.end())};
     }
-    report.search.lo = range.first;
-    report.search.hi = range.second;
-    report.search.tolerance = options.tolerance;
-    report.search.maxProbes = options.maxProbes;
-    report.search.integral = report.integral;
-    report.search = checkedSearch(report.search, options.targets); // before anything renders
+    LevelSearch search;
+    search.lo = range.first;
+    search.hi = range.second;
+    search.tolerance = options.tolerance;
+    search.maxProbes = options.maxProbes;
+    search.integral = integral;
+    search = checkedSearch(search, options.targets); // before anything renders
     if (options.referenceLevel) {
         const double v = *options.referenceLevel;
         if (!std::isfinite(v)) throwInput("--reference-level", "", "must be a finite number");
@@ -306,32 +286,55 @@ CalibrationReport calibrateLevels(const CalibrateOptions& options) {
                            number(range.second, "%g") +
                            ": the difference grows on both sides of it; give a range on one side");
     }
+    return search;
+}
 
-    auto overridesAt = [&](double v) {
+// The base stimulus with the calibrated key set to a value.
+struct VariedStimulus {
+    const Stimulus* base = nullptr;
+    std::vector<std::string> baseOverrides; // without the calibrated key
+    std::string key;
+    bool integral = false;
+    fs::path assets;
+
+    std::vector<std::string> overridesAt(double v) const {
         std::vector<std::string> o = baseOverrides;
-        o.push_back(key + "=" + levelText(v, report.integral));
+        o.push_back(key + "=" + levelText(v, integral));
         return o;
-    };
-    // Both ends and the reference level must be valid values that change what is rendered.
-    auto resolveAt = [&](double v, const std::string& option) {
+    }
+    nlohmann::json resolveAt(double v, const std::string& option) const {
         try {
-            return renderer::resolveScene(requestOf(*base, overridesAt(v), options.assetsDir));
+            return renderer::resolveScene(requestOf(*base, overridesAt(v), assets));
         } catch (const InputError& e) {
-            throwInput(option, "", key + "=" + levelText(v, report.integral) + ": " + e.what());
+            throwInput(option, "", key + "=" + levelText(v, integral) + ": " + e.what());
         }
-    };
-    const nlohmann::json resolvedLo = resolveAt(report.search.lo, "--range");
-    const nlohmann::json resolvedHi = resolveAt(report.search.hi, "--range");
-    if (options.referenceLevel) resolveAt(*options.referenceLevel, "--reference-level");
+    }
+};
+
+// Both ends and the reference level must be valid values that change what is rendered.
+void checkLevelsRender(const VariedStimulus& varied, const LevelSearch& search,
+                       const std::optional<double>& referenceLevel) {
+    const nlohmann::json resolvedLo = varied.resolveAt(search.lo, "--range");
+    const nlohmann::json resolvedHi = varied.resolveAt(search.hi, "--range");
+    if (referenceLevel) varied.resolveAt(*referenceLevel, "--reference-level");
     if (resolvedLo == resolvedHi)
         throwInput("--factor", "",
-                   "'" + key + "' does not change stimulus '" + base->id + "' (its method does not read it?)");
+                   "'" + varied.key + "' does not change stimulus '" + varied.base->id +
+                       "' (its method does not read it?)");
+}
 
+// What the varied stimulus is compared with: itself at --reference-level, else its block's [[reference]]; its name
+// goes into report.reference.
+std::pair<const Stimulus*, std::vector<std::string>> calibrationReference(const CalibrateOptions& options,
+                                                                          const BuildPlan& plan, size_t baseIndex,
+                                                                          const VariedStimulus& varied,
+                                                                          CalibrationReport& report) {
+    const Stimulus* base = varied.base;
     std::vector<std::string> referenceOverrides;
     const Stimulus* referenceStimulus = &plan.all[baseIndex];
     if (options.referenceLevel) {
-        referenceOverrides = overridesAt(*options.referenceLevel);
-        report.reference = key + "=" + levelText(*options.referenceLevel, report.integral);
+        referenceOverrides = varied.overridesAt(*options.referenceLevel);
+        report.reference = varied.key + "=" + levelText(*options.referenceLevel, report.integral);
     } else {
         referenceStimulus = nullptr;
         for (const auto& s : plan.all)
@@ -341,11 +344,60 @@ CalibrationReport calibrateLevels(const CalibrateOptions& options) {
             }
         if (!referenceStimulus)
             throwInput("--reference-level", "",
-                       "missing: " + specName + " has no [[reference]] in the block '" + base->block +
+                       "missing: " + plan.spec.fileName + " has no [[reference]] in the block '" + base->block +
                            "' of stimulus '" + base->id + "'");
         referenceOverrides = referenceStimulus->overrides;
         report.reference = referenceStimulus->id;
     }
+    return {referenceStimulus, referenceOverrides};
+}
+
+} // namespace
+
+CalibrationReport calibrateLevels(const CalibrateOptions& options) {
+    const auto start = std::chrono::steady_clock::now();
+    const std::string key = calibratedKey(options.factor);
+    // Checked before the spec so that a bad number is reported without reading it.
+    metrics::CvvdpDisplay display = metrics::cvvdpDisplay(options.display);
+
+    BuildPlan plan = planBuild(options.spec, options.specOverrides, std::nullopt, options.assetsDir);
+    const std::string& specName = plan.spec.fileName;
+    for (const auto& fixed : plan.spec.fixed)
+        if (keysOverlap(key, fixed.key))
+            throwInput("--factor", "",
+                       "'" + key + "' is the fixed parameter fixed." + fixed.key + " of " + specName +
+                           "; remove it from [fixed] to calibrate it");
+
+    // The stimulus whose parameter varies, and its reference.
+    const size_t baseIndex = baseStimulusIndex(options, plan);
+    const Stimulus* base = &plan.all[baseIndex];
+
+    CalibrationReport report;
+    report.set = plan.spec.name;
+    report.factor = options.factor;
+    report.key = key;
+    report.stimulus = base->id;
+    report.display = metrics::describeCvvdpDisplay(display);
+
+    // The base stimulus' overrides without the calibrated key (a factor of the set, or an include's extra key).
+    VariedStimulus varied;
+    varied.base = base;
+    varied.key = key;
+    varied.assets = options.assetsDir;
+    for (const auto& o : base->overrides)
+        if (!keysOverlap(keyOf(o), key)) varied.baseOverrides.push_back(o);
+    const nlohmann::json resolvedBase = plan.resolved[baseIndex];
+    const nlohmann::json::json_pointer pointer(pointerOf(key));
+    if (!resolvedBase.contains(pointer) || !resolvedBase.at(pointer).is_number())
+        throwInput("--factor", "",
+                   "'" + key + "' is not a parameter holding one number in stimulus '" + base->id +
+                       "' (see docs/scenes.md)");
+    report.integral = resolvedBase.at(pointer).is_number_integer();
+    varied.integral = report.integral;
+
+    report.search = calibrationSearch(options, plan, key, report.integral);
+    checkLevelsRender(varied, report.search, options.referenceLevel);
+    const auto [referenceStimulus, referenceOverrides] = calibrationReference(options, plan, baseIndex, varied, report);
 
     // Rendering: the set's machinery (scene, fixed parameters, overrides) into a temporary folder; the display
     // PNG (what an observer sees) decoded to linear light.
@@ -369,7 +421,7 @@ CalibrationReport calibrateLevels(const CalibrateOptions& options) {
     };
     const cv::Mat reference = render(*referenceStimulus, referenceOverrides);
     auto predictedJod = [&](double v) {
-        const cv::Mat test = render(*base, overridesAt(v));
+        const cv::Mat test = render(*base, varied.overridesAt(v));
         if (test.size() != reference.size())
             throwInput(specName, "",
                        "stimulus '" + base->id + "' and its reference '" + report.reference + "' differ in size");

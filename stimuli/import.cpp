@@ -343,9 +343,7 @@ void writeImage(const fs::path& path, int width, int height, OIIO::TypeDesc type
         throw RuntimeError(path.string() + ": cannot write the image (" + output->geterror() + ")");
 }
 
-} // namespace
-
-ImportSummary importStimuli(const ImportOptions& options) {
+Table readImportTable(const ImportOptions& options) {
     Table table;
     table.where = options.table.string();
     if (!fs::is_regular_file(options.table)) throwInput(table.where, "", "file not found");
@@ -355,8 +353,11 @@ ImportSummary importStimuli(const ImportOptions& options) {
     else if (extension == ".toml") readTomlTable(table);
     else throwInput(table.where, "", "a table is a .csv or a .toml file");
     if (table.rows.empty()) throwInput(table.where, "", "the table lists no images");
+    return table;
+}
 
-    // The set's name: --name, the table's `name`, or the table's file stem.
+// The set's name: --name, the table's `name`, or the table's file stem.
+std::string importSetName(const ImportOptions& options, const Table& table) {
     std::string set;
     if (!options.name.empty()) {
         if (!isIdSafe(options.name))
@@ -370,96 +371,106 @@ ImportSummary importStimuli(const ImportOptions& options) {
         set = sanitizeLabel(options.table.stem().string());
         if (set.empty()) throwInput(table.where, "", "cannot make a set name of the file name; give --name");
     }
-    const fs::path base = options.images.empty() ? options.table.parent_path() : options.images;
-    if (!options.images.empty() && !fs::is_directory(options.images))
-        throwInput("--images", "", options.images.string() + " is not a folder");
+    return set;
+}
 
-    // Every check, every image read, before anything is written.
-    std::vector<Checked> checked;
+// What the rows checked so far hold, for the checks across rows.
+struct RowsSeen {
     std::map<std::string, int> idLines;
     std::map<std::string, int> referenceLines;                   // block → line of its reference
     std::map<std::string, std::tuple<int, int, int>> blockSizes; // block → width, height, line
-    for (const Row& row : table.rows) {
-        Checked c;
-        c.row = &row;
-        if (row.file.empty()) fail(table, row, "file", "no image file given");
-        if (row.id) {
-            if (!isIdSafe(*row.id)) fail(table, row, "id", "'" + *row.id + "' is not an id (a-z 0-9 . _ -)");
-            c.id = *row.id;
-        } else {
-            c.id = sanitizeLabel(fs::path(row.file).stem().string());
-            if (c.id.empty()) fail(table, row, "file", "cannot make an id of '" + row.file + "'; give an id");
-        }
-        if (auto it = idLines.find(c.id); it != idLines.end())
-            fail(table, row, row.id ? "id" : "file",
-                 "the id '" + c.id + "' is also the id of line " + std::to_string(it->second) +
-                     (row.id ? "" : " (give an id column)"));
-        idLines[c.id] = lineOf(row, row.id ? "id" : "file");
-        c.block = row.block.value_or(set);
-        if (row.reference) {
-            if (auto it = referenceLines.find(c.block); it != referenceLines.end())
-                fail(table, row, "reference",
-                     "block '" + c.block + "' already has its reference on line " + std::to_string(it->second));
-            referenceLines[c.block] = lineOf(row, "reference");
-        }
-        if (row.encoding && *row.encoding != "srgb" && *row.encoding != "linear")
-            fail(table, row, "encoding", "'" + *row.encoding + "' is not one of srgb, linear");
+};
 
-        c.path = fs::path(row.file).is_absolute() ? fs::path(row.file) : base / row.file;
-        std::error_code ec;
-        if (!fs::is_regular_file(c.path, ec))
-            fail(table, row, "file", "'" + row.file + "' not found (" + c.path.string() + ")");
-        std::string reason;
-        std::optional<Pixels> pixels = readPixels(c.path, reason);
-        if (!pixels) fail(table, row, "file", "'" + row.file + "' is not a readable image (" + reason + ")");
-        c.linear = row.encoding ? *row.encoding == "linear" : pixels->floatingPoint;
-        if (row.exposureEv && !c.linear)
-            fail(table, row, "exposure_ev", "applies to linear images only ('" + row.file + "' is sRGB)");
-        c.exposureEv = row.exposureEv.value_or(0.0);
-        c.width = pixels->width;
-        c.height = pixels->height;
-        if (auto it = blockSizes.find(c.block); it != blockSizes.end()) {
-            auto [w, h, line] = it->second;
-            if (w != c.width || h != c.height)
-                fail(table, row, "file",
-                     "'" + row.file + "' is " + std::to_string(c.width) + "x" + std::to_string(c.height) + ", block '" +
-                         c.block + "' holds " + std::to_string(w) + "x" + std::to_string(h) + " images (line " +
-                         std::to_string(line) + "); crop or scale them alike first");
-        } else {
-            blockSizes[c.block] = {c.width, c.height, lineOf(row, "file")};
+// Depth and mask AOVs (for the metrics' skin and band scores), with the camera they need.
+void checkAovs(const Table& table, const Row& row, const fs::path& base, Checked& c) {
+    std::error_code ec;
+    std::string reason;
+    if (row.depth.has_value() != row.mask.has_value())
+        fail(table, row, row.depth ? "mask" : "depth", "depth and mask images are given together");
+    if (row.depth) {
+        for (const char* key : kCameraColumns)
+            if (!row.camera.count(key))
+                fail(table, row, key,
+                     "a depth image needs f_px, mm_per_unit and sss_radius_mm (the camera and kernel of the "
+                     "metrics' bands)");
+        for (const auto& [key, aov] : {std::pair{"depth", &c.depth}, std::pair{"mask", &c.mask}}) {
+            const std::string& name = key == std::string("depth") ? *row.depth : *row.mask;
+            *aov = fs::path(name).is_absolute() ? fs::path(name) : base / name;
+            if (!fs::is_regular_file(*aov, ec))
+                fail(table, row, key, "'" + name + "' not found (" + aov->string() + ")");
+            std::optional<Pixels> plane = readPixels(*aov, reason);
+            if (!plane) fail(table, row, key, "'" + name + "' is not a readable image (" + reason + ")");
+            if (plane->width != c.width || plane->height != c.height)
+                fail(table, row, key,
+                     "'" + name + "' is " + std::to_string(plane->width) + "x" + std::to_string(plane->height) +
+                         ", its image '" + row.file + "' " + std::to_string(c.width) + "x" + std::to_string(c.height));
         }
-        c.originalSha256 = sha256File(c.path);
-
-        // Depth and mask AOVs (for the metrics' skin and band scores), with the camera they need.
-        if (row.depth.has_value() != row.mask.has_value())
-            fail(table, row, row.depth ? "mask" : "depth", "depth and mask images are given together");
-        if (row.depth) {
-            for (const char* key : kCameraColumns)
-                if (!row.camera.count(key))
-                    fail(table, row, key,
-                         "a depth image needs f_px, mm_per_unit and sss_radius_mm (the camera and kernel of the "
-                         "metrics' bands)");
-            for (const auto& [key, aov] : {std::pair{"depth", &c.depth}, std::pair{"mask", &c.mask}}) {
-                const std::string& name = key == std::string("depth") ? *row.depth : *row.mask;
-                *aov = fs::path(name).is_absolute() ? fs::path(name) : base / name;
-                if (!fs::is_regular_file(*aov, ec))
-                    fail(table, row, key, "'" + name + "' not found (" + aov->string() + ")");
-                std::optional<Pixels> plane = readPixels(*aov, reason);
-                if (!plane) fail(table, row, key, "'" + name + "' is not a readable image (" + reason + ")");
-                if (plane->width != c.width || plane->height != c.height)
-                    fail(table, row, key,
-                         "'" + name + "' is " + std::to_string(plane->width) + "x" + std::to_string(plane->height) +
-                             ", its image '" + row.file + "' " + std::to_string(c.width) + "x" +
-                             std::to_string(c.height));
-            }
-        }
-        for (const auto& [key, value] : row.camera) {
-            if (!row.depth) fail(table, row, key, "applies only with depth and mask images");
-            if (!(value > 0.0)) fail(table, row, key, std::to_string(value) + " is not a positive number");
-        }
-        checked.push_back(std::move(c));
     }
+    for (const auto& [key, value] : row.camera) {
+        if (!row.depth) fail(table, row, key, "applies only with depth and mask images");
+        if (!(value > 0.0)) fail(table, row, key, std::to_string(value) + " is not a positive number");
+    }
+}
 
+// Every check of one row, its image and AOVs read, against the rows before it.
+Checked checkRow(const Table& table, const Row& row, const std::string& set, const fs::path& base, RowsSeen& seen) {
+    Checked c;
+    c.row = &row;
+    if (row.file.empty()) fail(table, row, "file", "no image file given");
+    if (row.id) {
+        if (!isIdSafe(*row.id)) fail(table, row, "id", "'" + *row.id + "' is not an id (a-z 0-9 . _ -)");
+        c.id = *row.id;
+    } else {
+        c.id = sanitizeLabel(fs::path(row.file).stem().string());
+        if (c.id.empty()) fail(table, row, "file", "cannot make an id of '" + row.file + "'; give an id");
+    }
+    if (auto it = seen.idLines.find(c.id); it != seen.idLines.end())
+        fail(table, row, row.id ? "id" : "file",
+             "the id '" + c.id + "' is also the id of line " + std::to_string(it->second) +
+                 (row.id ? "" : " (give an id column)"));
+    seen.idLines[c.id] = lineOf(row, row.id ? "id" : "file");
+    c.block = row.block.value_or(set);
+    if (row.reference) {
+        if (auto it = seen.referenceLines.find(c.block); it != seen.referenceLines.end())
+            fail(table, row, "reference",
+                 "block '" + c.block + "' already has its reference on line " + std::to_string(it->second));
+        seen.referenceLines[c.block] = lineOf(row, "reference");
+    }
+    if (row.encoding && *row.encoding != "srgb" && *row.encoding != "linear")
+        fail(table, row, "encoding", "'" + *row.encoding + "' is not one of srgb, linear");
+
+    c.path = fs::path(row.file).is_absolute() ? fs::path(row.file) : base / row.file;
+    std::error_code ec;
+    if (!fs::is_regular_file(c.path, ec))
+        fail(table, row, "file", "'" + row.file + "' not found (" + c.path.string() + ")");
+    std::string reason;
+    std::optional<Pixels> pixels = readPixels(c.path, reason);
+    if (!pixels) fail(table, row, "file", "'" + row.file + "' is not a readable image (" + reason + ")");
+    c.linear = row.encoding ? *row.encoding == "linear" : pixels->floatingPoint;
+    if (row.exposureEv && !c.linear)
+        fail(table, row, "exposure_ev", "applies to linear images only ('" + row.file + "' is sRGB)");
+    c.exposureEv = row.exposureEv.value_or(0.0);
+    c.width = pixels->width;
+    c.height = pixels->height;
+    if (auto it = seen.blockSizes.find(c.block); it != seen.blockSizes.end()) {
+        auto [w, h, line] = it->second;
+        if (w != c.width || h != c.height)
+            fail(table, row, "file",
+                 "'" + row.file + "' is " + std::to_string(c.width) + "x" + std::to_string(c.height) + ", block '" +
+                     c.block + "' holds " + std::to_string(w) + "x" + std::to_string(h) + " images (line " +
+                     std::to_string(line) + "); crop or scale them alike first");
+    } else {
+        seen.blockSizes[c.block] = {c.width, c.height, lineOf(row, "file")};
+    }
+    c.originalSha256 = sha256File(c.path);
+
+    checkAovs(table, row, base, c);
+    return c;
+}
+
+// The set's manifest before its stimuli: name, table, factors and ids.
+Manifest importManifest(const ImportOptions& options, const Table& table, const std::string& set,
+                        const std::vector<Checked>& checked) {
     Manifest manifest;
     manifest.set = set;
     manifest.description = table.description;
@@ -479,6 +490,97 @@ ImportSummary importStimuli(const ImportOptions& options) {
         manifest.factors.push_back({{"name", factor}, {"key", factor}, {"levels", levels}});
     }
     for (const Checked& c : checked) manifest.setIds.push_back(c.id);
+    return manifest;
+}
+
+// The stimulus's EXR (linear, with its AOVs) and PNG (display) in the set's folder.
+void writeStimulusImages(const fs::path& dir, const Checked& c) {
+    std::string reason;
+    std::optional<Pixels> pixels = readPixels(c.path, reason);
+    if (!pixels) throw RuntimeError(c.path.string() + ": cannot read the image any more (" + reason + ")");
+    // Display values (8-bit sRGB PNG) and linear values (float EXR) of the same pixels.
+    std::vector<float> display(pixels->rgb.size()), linear(pixels->rgb.size());
+    const float gain = static_cast<float>(std::exp2(c.exposureEv));
+    for (size_t i = 0; i < pixels->rgb.size(); ++i) {
+        const float v = pixels->rgb[i];
+        if (c.linear) {
+            linear[i] = v * gain;
+            display[i] = linearToSrgb(linear[i]);
+        } else {
+            display[i] = std::clamp(v, 0.0f, 1.0f);
+            linear[i] = srgbToLinear(display[i]);
+        }
+    }
+    std::vector<std::string> channels = {"R", "G", "B"};
+    if (!c.depth.empty()) { // R, G, B, depth.Z, mask.Y (contract 1)
+        std::optional<Pixels> depth = readPixels(c.depth, reason, "depth.Z"),
+                              mask = readPixels(c.mask, reason, "mask.Y");
+        if (!depth || !mask) throw RuntimeError(c.path.string() + ": cannot read its AOVs any more (" + reason + ")");
+        std::vector<float> all;
+        all.reserve(linear.size() / 3 * 5);
+        for (size_t i = 0; i < depth->plane.size(); ++i)
+            all.insert(all.end(), {linear[i * 3], linear[i * 3 + 1], linear[i * 3 + 2], depth->plane[i],
+                                   std::clamp(mask->plane[i], 0.0f, 1.0f)});
+        linear = std::move(all);
+        channels.insert(channels.end(), {"depth.Z", "mask.Y"});
+    }
+    AtomicOutput exr(dir / exrRelativePath(c.id));
+    AtomicOutput png(dir / pngRelativePath(c.id));
+    writeImage(exr.tempPath(), c.width, c.height, OIIO::TypeDesc::FLOAT, linear, channels,
+               {{"skinlab:version", version()}, {"skinlab:imported_from", c.row->file}}, c.row->camera);
+    writeImage(png.tempPath(), c.width, c.height, OIIO::TypeDesc::UINT8, display, {"R", "G", "B"}, {});
+    exr.commit();
+    png.commit();
+}
+
+// The stimulus's manifest entry.
+nlohmann::json stimulusEntry(const fs::path& dir, const Table& table, const Manifest& manifest, const Checked& c) {
+    nlohmann::json factors = nlohmann::json::object();
+    for (const std::string& f : table.factors)
+        if (auto it = c.row->factors.find(f); it != c.row->factors.end()) factors[f] = it->second;
+    nlohmann::json provenance = {
+        {"kind", "imported"},         {"original", c.row->file}, {"original_sha256", c.originalSha256},
+        {"table", manifest.specFile}, {"line", c.row->line},     {"encoding", c.linear ? "linear" : "srgb"}};
+    if (c.linear) provenance["exposure_ev"] = c.exposureEv;
+    if (c.row->depth) {
+        provenance["depth"] = *c.row->depth;
+        provenance["depth_sha256"] = sha256File(c.depth);
+        provenance["mask"] = *c.row->mask;
+        provenance["mask_sha256"] = sha256File(c.mask);
+        for (const auto& [key, value] : c.row->camera) provenance[key] = value;
+    }
+    return {{"id", c.id},
+            {"files", {{"exr", exrRelativePath(c.id)}, {"png", pngRelativePath(c.id)}}},
+            {"sha256",
+             {{"exr", sha256File(dir / exrRelativePath(c.id))}, {"png", sha256File(dir / pngRelativePath(c.id))}}},
+            {"factors", factors},
+            {"block", c.block},
+            {"reference", c.row->reference},
+            {"width", c.width},
+            {"height", c.height},
+            {"scene", factors.value("scene", "")},
+            {"overrides", nlohmann::json::array()},
+            {"resolved", nlohmann::json::object()},
+            {"timings_ms", nlohmann::json::object()},
+            {"provenance", provenance}};
+}
+
+} // namespace
+
+ImportSummary importStimuli(const ImportOptions& options) {
+    const Table table = readImportTable(options);
+
+    const std::string set = importSetName(options, table);
+    const fs::path base = options.images.empty() ? options.table.parent_path() : options.images;
+    if (!options.images.empty() && !fs::is_directory(options.images))
+        throwInput("--images", "", options.images.string() + " is not a folder");
+
+    // Every check, every image read, before anything is written.
+    std::vector<Checked> checked;
+    RowsSeen seen;
+    for (const Row& row : table.rows) checked.push_back(checkRow(table, row, set, base, seen));
+
+    Manifest manifest = importManifest(options, table, set, checked);
 
     const fs::path& dir = options.outputDir;
     claimOutputFolder(dir, set, std::nullopt);
@@ -488,72 +590,8 @@ ImportSummary importStimuli(const ImportOptions& options) {
     ensureDirectory(dir / "exr");
     ensureDirectory(dir / "png");
     for (const Checked& c : checked) {
-        std::string reason;
-        std::optional<Pixels> pixels = readPixels(c.path, reason);
-        if (!pixels) throw RuntimeError(c.path.string() + ": cannot read the image any more (" + reason + ")");
-        // Display values (8-bit sRGB PNG) and linear values (float EXR) of the same pixels.
-        std::vector<float> display(pixels->rgb.size()), linear(pixels->rgb.size());
-        const float gain = static_cast<float>(std::exp2(c.exposureEv));
-        for (size_t i = 0; i < pixels->rgb.size(); ++i) {
-            const float v = pixels->rgb[i];
-            if (c.linear) {
-                linear[i] = v * gain;
-                display[i] = linearToSrgb(linear[i]);
-            } else {
-                display[i] = std::clamp(v, 0.0f, 1.0f);
-                linear[i] = srgbToLinear(display[i]);
-            }
-        }
-        std::vector<std::string> channels = {"R", "G", "B"};
-        if (!c.depth.empty()) { // R, G, B, depth.Z, mask.Y (contract 1)
-            std::optional<Pixels> depth = readPixels(c.depth, reason, "depth.Z"),
-                                  mask = readPixels(c.mask, reason, "mask.Y");
-            if (!depth || !mask)
-                throw RuntimeError(c.path.string() + ": cannot read its AOVs any more (" + reason + ")");
-            std::vector<float> all;
-            all.reserve(linear.size() / 3 * 5);
-            for (size_t i = 0; i < depth->plane.size(); ++i)
-                all.insert(all.end(), {linear[i * 3], linear[i * 3 + 1], linear[i * 3 + 2], depth->plane[i],
-                                       std::clamp(mask->plane[i], 0.0f, 1.0f)});
-            linear = std::move(all);
-            channels.insert(channels.end(), {"depth.Z", "mask.Y"});
-        }
-        AtomicOutput exr(dir / exrRelativePath(c.id));
-        AtomicOutput png(dir / pngRelativePath(c.id));
-        writeImage(exr.tempPath(), c.width, c.height, OIIO::TypeDesc::FLOAT, linear, channels,
-                   {{"skinlab:version", version()}, {"skinlab:imported_from", c.row->file}}, c.row->camera);
-        writeImage(png.tempPath(), c.width, c.height, OIIO::TypeDesc::UINT8, display, {"R", "G", "B"}, {});
-        exr.commit();
-        png.commit();
-
-        nlohmann::json factors = nlohmann::json::object();
-        for (const std::string& f : table.factors)
-            if (auto it = c.row->factors.find(f); it != c.row->factors.end()) factors[f] = it->second;
-        nlohmann::json provenance = {
-            {"kind", "imported"},         {"original", c.row->file}, {"original_sha256", c.originalSha256},
-            {"table", manifest.specFile}, {"line", c.row->line},     {"encoding", c.linear ? "linear" : "srgb"}};
-        if (c.linear) provenance["exposure_ev"] = c.exposureEv;
-        if (c.row->depth) {
-            provenance["depth"] = *c.row->depth;
-            provenance["depth_sha256"] = sha256File(c.depth);
-            provenance["mask"] = *c.row->mask;
-            provenance["mask_sha256"] = sha256File(c.mask);
-            for (const auto& [key, value] : c.row->camera) provenance[key] = value;
-        }
-        manifest.stimuli.push_back(
-            {{"id", c.id},
-             {"files", {{"exr", exrRelativePath(c.id)}, {"png", pngRelativePath(c.id)}}},
-             {"sha256", {{"exr", sha256File(exr.finalPath())}, {"png", sha256File(png.finalPath())}}},
-             {"factors", factors},
-             {"block", c.block},
-             {"reference", c.row->reference},
-             {"width", c.width},
-             {"height", c.height},
-             {"scene", factors.value("scene", "")},
-             {"overrides", nlohmann::json::array()},
-             {"resolved", nlohmann::json::object()},
-             {"timings_ms", nlohmann::json::object()},
-             {"provenance", provenance}});
+        writeStimulusImages(dir, c);
+        manifest.stimuli.push_back(stimulusEntry(dir, table, manifest, c));
     }
     tidyOutputFolder(dir, manifest.setIds);
     manifest.complete = true;
@@ -569,7 +607,7 @@ ImportSummary importStimuli(const ImportOptions& options) {
     }
     summary.set = set;
     summary.stimuli = manifest.stimuli.size();
-    summary.blocks = blockSizes.size();
+    summary.blocks = seen.blockSizes.size();
     summary.manifest = dir / kManifestFile;
     if (options.contactSheet) summary.contactHtml = writeContactSheet(dir, manifest).html;
     return summary;

@@ -160,6 +160,131 @@ double correlationPValue(const std::vector<double>& x, const std::vector<double>
     return std::erfc(std::abs(z) / std::sqrt(2.0));
 }
 
+namespace {
+
+// Metric values per condition of this block (null where a condition has none).
+std::vector<const ConditionMetrics*> metricsByCondition(const scaling::BlockAnalysis& block,
+                                                        const std::vector<ConditionMetrics>& metrics) {
+    const int m = static_cast<int>(block.conditions.size());
+    std::vector<const ConditionMetrics*> byCondition(static_cast<std::size_t>(m), nullptr);
+    for (const ConditionMetrics& row : metrics) {
+        if (row.block != block.name) continue;
+        auto it = std::find(block.conditions.begin(), block.conditions.end(), row.condition);
+        if (it != block.conditions.end()) byCondition[static_cast<std::size_t>(it - block.conditions.begin())] = &row;
+    }
+    return byCondition;
+}
+
+// A condition's value of a metric (NaN where the condition or the metric has none).
+double metricValue(const std::vector<const ConditionMetrics*>& byCondition, int condition, const std::string& key) {
+    const ConditionMetrics* row = byCondition[static_cast<std::size_t>(condition)];
+    if (!row) return notANumber;
+    auto found = row->values.find(key);
+    return found == row->values.end() ? notANumber : found->second;
+}
+
+// Bootstrap over observers: resample, re-fit the scale (none without two observers).
+std::vector<Eigen::VectorXd> resampledScores(const scaling::BlockAnalysis& block, const scaling::BlockData& data,
+                                             const scaling::FitOptions& fit, const AgreementOptions& options) {
+    const int observers = data.observerCount();
+    std::vector<Eigen::VectorXd> resampled;
+    if (observers >= 2 && data.hasObservers) {
+        for (int b = 0; b < options.samples; ++b) {
+            std::mt19937_64 random(scaling::mixSeed(options.seed, static_cast<std::uint64_t>(b)));
+            std::uniform_int_distribution<int> pick(0, observers - 1);
+            Eigen::VectorXd weights = Eigen::VectorXd::Zero(observers);
+            for (int k = 0; k < observers; ++k) weights[pick(random)] += 1.0;
+            scaling::FitOptions options1 = fit;
+            options1.model = scaling::Model::Thurstone;
+            resampled.push_back(
+                scaling::fitScores(data.weightedCounts(weights), options1, &block.thurstone.scores).scores);
+        }
+    }
+    return resampled;
+}
+
+// The observers' share of the uncertainty: the variance of atanh(r) over the resamples.
+double zVariance(const std::vector<double>& samples) {
+    if (samples.size() < 2) return 0.0;
+    double mean = 0.0, squares = 0.0;
+    for (double r : samples) mean += std::atanh(std::clamp(r, -0.999999, 0.999999));
+    mean /= double(samples.size());
+    for (double r : samples) {
+        const double d = std::atanh(std::clamp(r, -0.999999, 0.999999)) - mean;
+        squares += d * d;
+    }
+    return squares / double(samples.size() - 1);
+}
+
+// One metric's agreement with the block's scale: correlations, their intervals and p-values, and the significant
+// pairs it orders like the observers.
+MetricAgreement metricAgreement(const scaling::BlockAnalysis& block, const MetricDefinition& definition,
+                                const std::vector<const ConditionMetrics*>& byCondition,
+                                const std::vector<Eigen::VectorXd>& resampled, const AgreementOptions& options) {
+    const int m = static_cast<int>(block.conditions.size());
+    auto value = [&](int condition, const std::string& key) { return metricValue(byCondition, condition, key); };
+    MetricAgreement row;
+    row.block = block.name;
+    row.metric = definition;
+    std::vector<int> used;
+    for (int i = 0; i < m; ++i)
+        if (std::isfinite(value(i, definition.key))) used.push_back(i);
+    row.conditions = static_cast<int>(used.size());
+    std::vector<double> x, y;
+    for (int i : used) {
+        x.push_back(value(i, definition.key));
+        y.push_back(block.thurstone.scores[i]);
+    }
+    row.pearson = pearsonCorrelation(x, y);
+    row.spearman = spearmanCorrelation(x, y);
+    std::vector<double> pearsons, spearmans;
+    for (const Eigen::VectorXd& scores : resampled) {
+        std::vector<double> yb;
+        for (int i : used) yb.push_back(scores[i]);
+        double p = pearsonCorrelation(x, yb), s = spearmanCorrelation(x, yb);
+        if (std::isfinite(p)) pearsons.push_back(p);
+        if (std::isfinite(s)) spearmans.push_back(s);
+    }
+    row.bootstrapSamples = static_cast<int>(pearsons.size());
+    std::tie(row.pearsonLow, row.pearsonHigh) =
+        correlationInterval(row.pearson, row.conditions, false, zVariance(pearsons), options.level);
+    std::tie(row.spearmanLow, row.spearmanHigh) =
+        correlationInterval(row.spearman, row.conditions, true, zVariance(spearmans), options.level);
+    row.pearsonP = correlationPValue(x, y, false);
+    row.spearmanP = correlationPValue(x, y, true);
+
+    // Pairs the observers separated significantly: does the metric order them the same way?
+    for (const scaling::PairTest& pair : block.pairs) {
+        if (!pair.significant) continue;
+        int i = pair.test.first, j = pair.test.second;
+        double vi = value(i, definition.key), vj = value(j, definition.key);
+        if (!std::isfinite(vi) || !std::isfinite(vj)) continue;
+        ++row.significantPairs;
+        double perceived = block.thurstone.scores[i] - block.thurstone.scores[j];
+        double predicted = (definition.higherIsBetter ? 1.0 : -1.0) * (vi - vj);
+        if (predicted != 0.0 && (predicted > 0.0) == (perceived > 0.0)) ++row.predictedPairs;
+    }
+    row.predictedShare = row.significantPairs ? double(row.predictedPairs) / double(row.significantPairs) : notANumber;
+    return row;
+}
+
+// Holm over the block's metrics: naming the metric with the smallest p picks one of many.
+void holmOverMetrics(std::vector<MetricAgreement>& rows, const std::string& blockName) {
+    std::vector<MetricAgreement*> tested;
+    for (MetricAgreement& row : rows)
+        if (row.block == blockName && std::isfinite(row.spearmanP)) tested.push_back(&row);
+        else if (row.block == blockName) row.spearmanPHolm = notANumber;
+    std::sort(tested.begin(), tested.end(),
+              [](const MetricAgreement* a, const MetricAgreement* b) { return a->spearmanP < b->spearmanP; });
+    double running = 0.0;
+    for (std::size_t k = 0; k < tested.size(); ++k) {
+        running = std::max(running, std::min(1.0, double(tested.size() - k) * tested[k]->spearmanP));
+        tested[k]->spearmanPHolm = running;
+    }
+}
+
+} // namespace
+
 AgreementResult computeAgreement(const scaling::Dataset& dataset, const scaling::Analysis& analysis,
                                  const std::vector<ConditionMetrics>& metrics, const scaling::FitOptions& fit,
                                  const AgreementOptions& options) {
@@ -175,14 +300,7 @@ AgreementResult computeAgreement(const scaling::Dataset& dataset, const scaling:
         for (int i = 0; i < m; ++i) scale.jod.push_back(block.thurstone.scores[i]);
         result.scales.push_back(scale);
 
-        // Metric values per condition of this block (NaN where a condition has none).
-        std::vector<const ConditionMetrics*> byCondition(static_cast<std::size_t>(m), nullptr);
-        for (const ConditionMetrics& row : metrics) {
-            if (row.block != block.name) continue;
-            auto it = std::find(block.conditions.begin(), block.conditions.end(), row.condition);
-            if (it != block.conditions.end())
-                byCondition[static_cast<std::size_t>(it - block.conditions.begin())] = &row;
-        }
+        const std::vector<const ConditionMetrics*> byCondition = metricsByCondition(block, metrics);
         int withMetrics = 0;
         for (int i = 0; i < m; ++i) {
             if (byCondition[static_cast<std::size_t>(i)]) ++withMetrics;
@@ -195,99 +313,11 @@ AgreementResult computeAgreement(const scaling::Dataset& dataset, const scaling:
             result.warnings.push_back(block.name + ": no condition has metric values; no agreement computed");
             continue;
         }
-        auto value = [&](int condition, const std::string& key) {
-            const ConditionMetrics* row = byCondition[static_cast<std::size_t>(condition)];
-            if (!row) return notANumber;
-            auto found = row->values.find(key);
-            return found == row->values.end() ? notANumber : found->second;
-        };
 
-        // Bootstrap over observers: resample, re-fit the scale, recompute every correlation.
-        const int observers = data->observerCount();
-        std::vector<Eigen::VectorXd> resampledScores;
-        if (observers >= 2 && data->hasObservers) {
-            for (int b = 0; b < options.samples; ++b) {
-                std::mt19937_64 random(scaling::mixSeed(options.seed, static_cast<std::uint64_t>(b)));
-                std::uniform_int_distribution<int> pick(0, observers - 1);
-                Eigen::VectorXd weights = Eigen::VectorXd::Zero(observers);
-                for (int k = 0; k < observers; ++k) weights[pick(random)] += 1.0;
-                scaling::FitOptions options1 = fit;
-                options1.model = scaling::Model::Thurstone;
-                resampledScores.push_back(
-                    scaling::fitScores(data->weightedCounts(weights), options1, &block.thurstone.scores).scores);
-            }
-        }
-
-        for (const MetricDefinition& definition : definitions) {
-            MetricAgreement row;
-            row.block = block.name;
-            row.metric = definition;
-            std::vector<int> used;
-            for (int i = 0; i < m; ++i)
-                if (std::isfinite(value(i, definition.key))) used.push_back(i);
-            row.conditions = static_cast<int>(used.size());
-            std::vector<double> x, y;
-            for (int i : used) {
-                x.push_back(value(i, definition.key));
-                y.push_back(block.thurstone.scores[i]);
-            }
-            row.pearson = pearsonCorrelation(x, y);
-            row.spearman = spearmanCorrelation(x, y);
-            std::vector<double> pearsons, spearmans;
-            for (const Eigen::VectorXd& scores : resampledScores) {
-                std::vector<double> yb;
-                for (int i : used) yb.push_back(scores[i]);
-                double p = pearsonCorrelation(x, yb), s = spearmanCorrelation(x, yb);
-                if (std::isfinite(p)) pearsons.push_back(p);
-                if (std::isfinite(s)) spearmans.push_back(s);
-            }
-            row.bootstrapSamples = static_cast<int>(pearsons.size());
-            // The observers' share of the uncertainty: the variance of atanh(r) over the resamples.
-            auto zVariance = [](const std::vector<double>& samples) {
-                if (samples.size() < 2) return 0.0;
-                double mean = 0.0, squares = 0.0;
-                for (double r : samples) mean += std::atanh(std::clamp(r, -0.999999, 0.999999));
-                mean /= double(samples.size());
-                for (double r : samples) {
-                    const double d = std::atanh(std::clamp(r, -0.999999, 0.999999)) - mean;
-                    squares += d * d;
-                }
-                return squares / double(samples.size() - 1);
-            };
-            std::tie(row.pearsonLow, row.pearsonHigh) =
-                correlationInterval(row.pearson, row.conditions, false, zVariance(pearsons), options.level);
-            std::tie(row.spearmanLow, row.spearmanHigh) =
-                correlationInterval(row.spearman, row.conditions, true, zVariance(spearmans), options.level);
-            row.pearsonP = correlationPValue(x, y, false);
-            row.spearmanP = correlationPValue(x, y, true);
-
-            // Pairs the observers separated significantly: does the metric order them the same way?
-            for (const scaling::PairTest& pair : block.pairs) {
-                if (!pair.significant) continue;
-                int i = pair.test.first, j = pair.test.second;
-                double vi = value(i, definition.key), vj = value(j, definition.key);
-                if (!std::isfinite(vi) || !std::isfinite(vj)) continue;
-                ++row.significantPairs;
-                double perceived = block.thurstone.scores[i] - block.thurstone.scores[j];
-                double predicted = (definition.higherIsBetter ? 1.0 : -1.0) * (vi - vj);
-                if (predicted != 0.0 && (predicted > 0.0) == (perceived > 0.0)) ++row.predictedPairs;
-            }
-            row.predictedShare =
-                row.significantPairs ? double(row.predictedPairs) / double(row.significantPairs) : notANumber;
-            result.rows.push_back(row);
-        }
-        // Holm over the block's metrics: naming the metric with the smallest p picks one of many.
-        std::vector<MetricAgreement*> tested;
-        for (MetricAgreement& row : result.rows)
-            if (row.block == block.name && std::isfinite(row.spearmanP)) tested.push_back(&row);
-            else if (row.block == block.name) row.spearmanPHolm = notANumber;
-        std::sort(tested.begin(), tested.end(),
-                  [](const MetricAgreement* a, const MetricAgreement* b) { return a->spearmanP < b->spearmanP; });
-        double running = 0.0;
-        for (std::size_t k = 0; k < tested.size(); ++k) {
-            running = std::max(running, std::min(1.0, double(tested.size() - k) * tested[k]->spearmanP));
-            tested[k]->spearmanPHolm = running;
-        }
+        const std::vector<Eigen::VectorXd> resampled = resampledScores(block, *data, fit, options);
+        for (const MetricDefinition& definition : definitions)
+            result.rows.push_back(metricAgreement(block, definition, byCondition, resampled, options));
+        holmOverMetrics(result.rows, block.name);
         const int used = static_cast<int>(std::count_if(byCondition.begin(), byCondition.end(),
                                                         [](const ConditionMetrics* row) { return row != nullptr; }));
         if (used < kFewConditions)

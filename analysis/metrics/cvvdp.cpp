@@ -503,6 +503,7 @@ double cvvdpMapMean(const cv::Mat& map, const cv::Mat& mask) {
     return count ? sum / static_cast<double>(count) : std::numeric_limits<double>::quiet_NaN();
 }
 
+// Long by design: one model pipeline, stage by stage as in the reference implementation, sharing its band pyramids.
 CvvdpResult cvvdp(const cv::Mat& referenceLinear, const cv::Mat& testLinear, const CvvdpDisplay& display,
                   bool computeMap, CvvdpStageTimes* times) {
     if (referenceLinear.empty() || testLinear.empty()) throw std::invalid_argument("cvvdp(): empty image");

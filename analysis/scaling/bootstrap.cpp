@@ -66,26 +66,29 @@ DesignStructure designStructure(const BlockData& block) {
     return structure;
 }
 
-BootstrapResult bootstrapObservers(const BlockData& block, const FitResult& fit, const FitOptions& fitOptions,
-                                   const BootstrapOptions& options) {
+namespace {
+
+double differenceStandardError(const Eigen::MatrixXd& v, int i, int j) {
+    return std::sqrt(std::max(v(i, i) + v(j, j) - 2.0 * v(i, j), 0.0));
+}
+
+// Per resample: scores and their robust SE, differences and their robust SE.
+struct Resamples {
+    Eigen::MatrixXd scores, scoreSe, differences, differenceSe;
+};
+
+Resamples resampleObservers(const BlockData& block, const FitResult& fit, const FitOptions& fitOptions,
+                            const BootstrapOptions& options) {
     const int m = block.conditionCount();
     const int n = block.observerCount();
     const int samples = options.samples;
     const int differenceCount = m * (m - 1) / 2;
-    BootstrapResult result;
-    result.samples = samples;
-
-    const Eigen::MatrixXd covariance = robustCovariance(block, Eigen::VectorXd::Ones(n), fit, fitOptions.model);
-    const Eigen::MatrixXd& model = fit.inverseInformation;
-    result.standardError = covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
-    result.modelStandardError = model.diagonal().cwiseMax(0.0).cwiseSqrt();
-    auto differenceStandardError = [](const Eigen::MatrixXd& v, int i, int j) {
-        return std::sqrt(std::max(v(i, i) + v(j, j) - 2.0 * v(i, j), 0.0));
-    };
-
-    // Per resample: scores and their robust SE, differences and their robust SE.
-    Eigen::MatrixXd scores(samples, m), scoreSe(samples, m), differences(samples, differenceCount),
-        differenceSe(samples, differenceCount);
+    Resamples resamples{Eigen::MatrixXd(samples, m), Eigen::MatrixXd(samples, m),
+                        Eigen::MatrixXd(samples, differenceCount), Eigen::MatrixXd(samples, differenceCount)};
+    Eigen::MatrixXd& scores = resamples.scores;
+    Eigen::MatrixXd& scoreSe = resamples.scoreSe;
+    Eigen::MatrixXd& differences = resamples.differences;
+    Eigen::MatrixXd& differenceSe = resamples.differenceSe;
     auto work = [&](int begin, int end) {
         Eigen::VectorXd weights(n);
         for (int b = begin; b < end; ++b) {
@@ -117,47 +120,58 @@ BootstrapResult bootstrapObservers(const BlockData& block, const FitResult& fit,
         for (auto& thread : pool) thread.join();
     }
 
+    return resamples;
+}
+
+std::vector<double> sortedColumn(const Eigen::MatrixXd& matrix, int column) {
+    std::vector<double> values(matrix.rows());
+    for (Eigen::Index r = 0; r < matrix.rows(); ++r) values[r] = matrix(r, column);
+    std::sort(values.begin(), values.end());
+    return values;
+}
+
+// Studentization of one quantity: sorted |t*|, and the diagnosis of its spread. A resample whose SE is below
+// a quarter of the full-data SE (e.g. one that drew only observers who answered alike) has an unbounded t*;
+// up to 1 % of such resamples only lengthen the tail (t* = ∞ sits above the quantile), more is degenerate.
+// z is the normal quantile of the interval's upper end.
+std::vector<double> studentize(const Eigen::MatrixXd& values, const Eigen::MatrixXd& se, int column, double estimate,
+                               double standardError, double modelError, IntervalDiagnosis& diagnosis,
+                               const BootstrapOptions& options, double z) {
+    const int samples = options.samples;
+    std::vector<double> t(static_cast<size_t>(samples));
+    int degenerate = 0;
+    const double floor = 0.25 * standardError;
+    for (int b = 0; b < samples; ++b) {
+        if (!(standardError > 0.0) || se(b, column) <= floor) {
+            t[b] = std::numeric_limits<double>::infinity();
+            ++degenerate;
+        } else {
+            t[b] = std::abs((values(b, column) - estimate) / se(b, column));
+        }
+    }
+    std::sort(t.begin(), t.end());
+    auto reason = [&](const char* name) {
+        diagnosis.fallback = true;
+        diagnosis.reasons.emplace_back(name);
+    };
+    // A structural reason (disconnected, unanimous) already decides, and there the model-based SE is inflated
+    // by the prior, so the comparison with it would only add a misleading "observers-agree".
+    if (diagnosis.fallback) return t;
+    if (!(standardError >= 0.25 * modelError) || !(standardError > 0.0)) reason("observers-agree");
+    else if (degenerate > 0.01 * samples) reason("zero-spread-resamples");
+    else if (!(sortedQuantile(t, options.level) <= 2.0 * z)) reason("extreme-t");
+    return t;
+}
+
+// Each score's interval (result.low, result.high) with its diagnosis, and its percentile interval.
+void scoreIntervals(const BlockData& block, const FitResult& fit, const FitOptions& fitOptions,
+                    const BootstrapOptions& options, const Resamples& resamples, const DesignStructure& structure,
+                    const PairCounts& totals, BootstrapResult& result) {
+    const int m = block.conditionCount();
     const double lowerProbability = 0.5 * (1.0 - options.level);
     const double upperProbability = 1.0 - lowerProbability;
     const double z = normalQuantile(upperProbability);
-    auto sortedColumn = [](const Eigen::MatrixXd& matrix, int column) {
-        std::vector<double> values(matrix.rows());
-        for (Eigen::Index r = 0; r < matrix.rows(); ++r) values[r] = matrix(r, column);
-        std::sort(values.begin(), values.end());
-        return values;
-    };
-    // Studentization of one quantity: sorted |t*|, and the diagnosis of its spread. A resample whose SE is below
-    // a quarter of the full-data SE (e.g. one that drew only observers who answered alike) has an unbounded t*;
-    // up to 1 % of such resamples only lengthen the tail (t* = ∞ sits above the quantile), more is degenerate.
-    const PairCounts totals = block.totalCounts();
-    auto studentize = [&](const Eigen::MatrixXd& values, const Eigen::MatrixXd& se, int column, double estimate,
-                          double standardError, double modelError, IntervalDiagnosis& diagnosis) {
-        std::vector<double> t(static_cast<size_t>(samples));
-        int degenerate = 0;
-        const double floor = 0.25 * standardError;
-        for (int b = 0; b < samples; ++b) {
-            if (!(standardError > 0.0) || se(b, column) <= floor) {
-                t[b] = std::numeric_limits<double>::infinity();
-                ++degenerate;
-            } else {
-                t[b] = std::abs((values(b, column) - estimate) / se(b, column));
-            }
-        }
-        std::sort(t.begin(), t.end());
-        auto reason = [&](const char* name) {
-            diagnosis.fallback = true;
-            diagnosis.reasons.emplace_back(name);
-        };
-        // A structural reason (disconnected, unanimous) already decides, and there the model-based SE is inflated
-        // by the prior, so the comparison with it would only add a misleading "observers-agree".
-        if (diagnosis.fallback) return t;
-        if (!(standardError >= 0.25 * modelError) || !(standardError > 0.0)) reason("observers-agree");
-        else if (degenerate > 0.01 * samples) reason("zero-spread-resamples");
-        else if (!(sortedQuantile(t, options.level) <= 2.0 * z)) reason("extreme-t");
-        return t;
-    };
-    const DesignStructure structure = designStructure(block);
-
+    const Eigen::MatrixXd& scores = resamples.scores;
     result.low.resize(m);
     result.high.resize(m);
     result.percentileLow.resize(m);
@@ -177,8 +191,8 @@ BootstrapResult bootstrapObservers(const BlockData& block, const FitResult& fit,
         // Symmetric studentized interval: q̂ ± |t|*_(level)·se. Its coverage error is O(1/n²) against O(1/n)
         // for the equal-tailed one (Hall 1988, Ann. Statist. 16:927); it also reached 95 % at 10 observers
         // in our simulation where the equal-tailed one stopped at 94.8 % (docs/analysis.md).
-        const std::vector<double> t = studentize(scores, scoreSe, i, fit.scores[i], result.standardError[i],
-                                                 result.modelStandardError[i], diagnosis);
+        const std::vector<double> t = studentize(scores, resamples.scoreSe, i, fit.scores[i], result.standardError[i],
+                                                 result.modelStandardError[i], diagnosis, options, z);
         const std::vector<double> q = sortedColumn(scores, i);
         result.percentileLow[i] = sortedQuantile(q, lowerProbability);
         result.percentileHigh[i] = sortedQuantile(q, upperProbability);
@@ -204,6 +218,88 @@ BootstrapResult bootstrapObservers(const BlockData& block, const FitResult& fit,
         result.low[i] = std::min(result.percentileLow[i], profile.low + shift);
         result.high[i] = std::max(result.percentileHigh[i], profile.high + shift);
     }
+}
+
+// The test of the difference between conditions i and j (column k of the resampled differences).
+DifferenceTest differenceTest(const BlockData& block, const FitResult& fit, const FitOptions& fitOptions,
+                              const BootstrapOptions& options, const Resamples& resamples,
+                              const DesignStructure& structure, const PairCounts& totals,
+                              const Eigen::MatrixXd& covariance, int i, int j, int k) {
+    const int m = block.conditionCount();
+    const int samples = options.samples;
+    const Eigen::MatrixXd& model = fit.inverseInformation;
+    const double lowerProbability = 0.5 * (1.0 - options.level);
+    const double upperProbability = 1.0 - lowerProbability;
+    const double z = normalQuantile(upperProbability);
+    const double normalQuantile975 = 1.959963984540054; // Φ⁻¹(0.975)
+    const Eigen::MatrixXd& differences = resamples.differences;
+    DifferenceTest test;
+    test.first = i;
+    test.second = j;
+    test.difference = fit.scores[i] - fit.scores[j];
+    test.standardError = differenceStandardError(covariance, i, j);
+    IntervalDiagnosis& diagnosis = test.diagnosis;
+    if (structure.component[i] != structure.component[j]) {
+        diagnosis.fallback = true;
+        diagnosis.reasons.emplace_back("disconnected");
+    } else if (structure.stronglyConnected[i] != structure.stronglyConnected[j]) {
+        diagnosis.fallback = true;
+        diagnosis.reasons.emplace_back("unanimous");
+    }
+    const std::vector<double> t =
+        studentize(differences, resamples.differenceSe, k, test.difference, test.standardError,
+                   differenceStandardError(model, i, j), diagnosis, options, z);
+    {
+        const std::vector<double> d = sortedColumn(differences, k);
+        test.percentileLow = sortedQuantile(d, lowerProbability);
+        test.percentileHigh = sortedQuantile(d, upperProbability);
+        const auto atMostZero = std::upper_bound(d.begin(), d.end(), 0.0) - d.begin();
+        const auto atLeastZero = d.end() - std::lower_bound(d.begin(), d.end(), 0.0);
+        const double share = static_cast<double>(std::min(atMostZero, atLeastZero)) / static_cast<double>(samples);
+        test.percentilePValue = std::clamp(2.0 * share, 1.0 / samples, 1.0);
+    }
+    if (!diagnosis.fallback) {
+        const double half = sortedQuantile(t, options.level) * test.standardError;
+        test.low = test.difference - half;
+        test.high = test.difference + half;
+        const double scale95 = std::max(sortedQuantile(t, 0.95) / normalQuantile975, 1e-12);
+        const double zObserved = std::abs(test.difference / test.standardError) / scale95;
+        test.pValue = std::erfc(zObserved / std::sqrt(2.0));
+    } else {
+        Eigen::VectorXd contrast = Eigen::VectorXd::Zero(m);
+        contrast[i] = 1.0;
+        contrast[j] = -1.0;
+        const ProfileInterval profile = profileInterval(totals, fitOptions, fit, contrast, options.level);
+        if (profile.lowAtCap || profile.highAtCap) diagnosis.reasons.emplace_back("bound-at-search-cap");
+        const std::vector<double> d = sortedColumn(differences, k);
+        test.low = std::min(sortedQuantile(d, lowerProbability), profile.low);
+        test.high = std::max(sortedQuantile(d, upperProbability), profile.high);
+        test.pValue = scoreTestPValue(&block, totals, fitOptions, fit, i, j);
+    }
+    return test;
+}
+
+} // namespace
+
+BootstrapResult bootstrapObservers(const BlockData& block, const FitResult& fit, const FitOptions& fitOptions,
+                                   const BootstrapOptions& options) {
+    const int m = block.conditionCount();
+    const int n = block.observerCount();
+    const int samples = options.samples;
+    BootstrapResult result;
+    result.samples = samples;
+
+    const Eigen::MatrixXd covariance = robustCovariance(block, Eigen::VectorXd::Ones(n), fit, fitOptions.model);
+    const Eigen::MatrixXd& model = fit.inverseInformation;
+    result.standardError = covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+    result.modelStandardError = model.diagonal().cwiseMax(0.0).cwiseSqrt();
+
+    const Resamples resamples = resampleObservers(block, fit, fitOptions, options);
+    const Eigen::MatrixXd& scores = resamples.scores;
+    const PairCounts totals = block.totalCounts();
+    const DesignStructure structure = designStructure(block);
+
+    scoreIntervals(block, fit, fitOptions, options, resamples, structure, totals, result);
     result.bootstrapMean = scores.colwise().mean().transpose();
     const Eigen::MatrixXd centred = scores.rowwise() - result.bootstrapMean.transpose();
     result.bootstrapCovariance = centred.transpose() * centred / std::max(1.0, samples - 1.0);
@@ -211,54 +307,11 @@ BootstrapResult bootstrapObservers(const BlockData& block, const FitResult& fit,
     // Differences: the same symmetric studentized construction. The p-value reads the spread of |t*| off its
     // 95 % quantile, p = 2Φ(−|t_obs|·1.95996 / |t|*_(0.95)), so p < 0.05 exactly when the 95 % interval excludes 0,
     // and it extrapolates smoothly to the small p-values a Holm correction over many pairs needs.
-    const double normalQuantile975 = 1.959963984540054; // Φ⁻¹(0.975)
     int k = 0;
     for (int i = 0; i < m; ++i)
         for (int j = i + 1; j < m; ++j, ++k) {
-            DifferenceTest test;
-            test.first = i;
-            test.second = j;
-            test.difference = fit.scores[i] - fit.scores[j];
-            test.standardError = differenceStandardError(covariance, i, j);
-            IntervalDiagnosis& diagnosis = test.diagnosis;
-            if (structure.component[i] != structure.component[j]) {
-                diagnosis.fallback = true;
-                diagnosis.reasons.emplace_back("disconnected");
-            } else if (structure.stronglyConnected[i] != structure.stronglyConnected[j]) {
-                diagnosis.fallback = true;
-                diagnosis.reasons.emplace_back("unanimous");
-            }
-            const std::vector<double> t = studentize(differences, differenceSe, k, test.difference, test.standardError,
-                                                     differenceStandardError(model, i, j), diagnosis);
-            {
-                const std::vector<double> d = sortedColumn(differences, k);
-                test.percentileLow = sortedQuantile(d, lowerProbability);
-                test.percentileHigh = sortedQuantile(d, upperProbability);
-                const auto atMostZero = std::upper_bound(d.begin(), d.end(), 0.0) - d.begin();
-                const auto atLeastZero = d.end() - std::lower_bound(d.begin(), d.end(), 0.0);
-                const double share =
-                    static_cast<double>(std::min(atMostZero, atLeastZero)) / static_cast<double>(samples);
-                test.percentilePValue = std::clamp(2.0 * share, 1.0 / samples, 1.0);
-            }
-            if (!diagnosis.fallback) {
-                const double half = sortedQuantile(t, options.level) * test.standardError;
-                test.low = test.difference - half;
-                test.high = test.difference + half;
-                const double scale95 = std::max(sortedQuantile(t, 0.95) / normalQuantile975, 1e-12);
-                const double zObserved = std::abs(test.difference / test.standardError) / scale95;
-                test.pValue = std::erfc(zObserved / std::sqrt(2.0));
-            } else {
-                Eigen::VectorXd contrast = Eigen::VectorXd::Zero(m);
-                contrast[i] = 1.0;
-                contrast[j] = -1.0;
-                const ProfileInterval profile = profileInterval(totals, fitOptions, fit, contrast, options.level);
-                if (profile.lowAtCap || profile.highAtCap) diagnosis.reasons.emplace_back("bound-at-search-cap");
-                const std::vector<double> d = sortedColumn(differences, k);
-                test.low = std::min(sortedQuantile(d, lowerProbability), profile.low);
-                test.high = std::max(sortedQuantile(d, upperProbability), profile.high);
-                test.pValue = scoreTestPValue(&block, totals, fitOptions, fit, i, j);
-            }
-            result.differences.push_back(test);
+            result.differences.push_back(
+                differenceTest(block, fit, fitOptions, options, resamples, structure, totals, covariance, i, j, k));
         }
     return result;
 }

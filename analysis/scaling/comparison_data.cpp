@@ -73,46 +73,20 @@ BlockData blockFromMatrix(const ResponseTable& table, const DatasetOptions& opti
     return block;
 }
 
-} // namespace
-
-PairCounts BlockData::weightedCounts(const Eigen::VectorXd& observerWeights) const {
-    PairCounts counts;
-    counts.conditions = conditionCount();
-    counts.pairs = pairs;
-    counts.first = winsFirst.transpose() * observerWeights;
-    counts.second = winsSecond.transpose() * observerWeights;
-    return counts;
-}
-
-PairCounts BlockData::totalCounts() const { return weightedCounts(Eigen::VectorXd::Ones(observerCount())); }
-
-Eigen::MatrixXd BlockData::countMatrix() const {
-    const PairCounts totals = totalCounts();
-    Eigen::MatrixXd matrix = Eigen::MatrixXd::Zero(conditionCount(), conditionCount());
-    for (size_t p = 0; p < pairs.size(); ++p) {
-        matrix(pairs[p].first, pairs[p].second) = totals.first[static_cast<Eigen::Index>(p)];
-        matrix(pairs[p].second, pairs[p].first) = totals.second[static_cast<Eigen::Index>(p)];
-    }
-    return matrix;
-}
-
-Dataset buildDataset(const ResponseTable& table, const DatasetOptions& options) {
-    Dataset dataset;
-    dataset.file = table.file;
-    dataset.format = table.format;
-    dataset.excluded = table.excludedObservers;
-    if (table.format == ResponseFormat::CountMatrix) {
-        dataset.blocks.push_back(blockFromMatrix(table, options));
-        if (!options.onlyBlock.empty() && options.onlyBlock != dataset.blocks.front().name)
-            throwInput(table.file, "--block",
-                       "no block '" + options.onlyBlock + "' (a count matrix has one block, '" +
-                           dataset.blocks.front().name + "')");
-        return dataset;
-    }
-
-    // Pass 1: blocks, conditions and observers in first-appearance order, with the input checks.
-    NameIndex blocks, allObservers;
+// Blocks, and per block its conditions and observers, in first-appearance order.
+struct ResponseNames {
+    NameIndex blocks;
     std::vector<NameIndex> conditions, observers;
+};
+
+// Pass 1: blocks, conditions and observers in first-appearance order, with the input checks; each observer's
+// attention trials into dataset.attention.
+ResponseNames indexResponses(const ResponseTable& table, const DatasetOptions& options, Dataset& dataset) {
+    ResponseNames names;
+    NameIndex& blocks = names.blocks;
+    std::vector<NameIndex>& conditions = names.conditions;
+    std::vector<NameIndex>& observers = names.observers;
+    NameIndex allObservers;
     std::map<std::string, int> firstLineOfBlock;
     for (const Response& r : table.responses) {
         const std::string blockName = r.block.empty() ? "all" : r.block;
@@ -152,27 +126,33 @@ Dataset buildDataset(const ResponseTable& table, const DatasetOptions& options) 
         }
         observers[b].add(r.observer);
     }
-    // A study database lists each block's conditions in the design's order (conditions it does not name follow
-    // in first-appearance order), so the CLI, the dashboard and the report show them alike.
-    if (options.conditionOrder.empty())
-        for (size_t b = 0; b < conditions.size(); ++b) {
-            const auto design = table.designConditionOrder.find(blocks.names[b]);
-            if (design == table.designConditionOrder.end()) continue;
-            auto rank = [&](const std::string& name) {
-                const auto it = std::find(design->second.begin(), design->second.end(), name);
-                return it - design->second.begin();
-            };
-            std::vector<std::string> names = conditions[b].names;
-            std::stable_sort(names.begin(), names.end(),
-                             [&](const std::string& x, const std::string& y) { return rank(x) < rank(y); });
-            conditions[b] = NameIndex();
-            for (const std::string& name : names) conditions[b].add(name);
-        }
-    if (!options.onlyBlock.empty() && blocks.find(options.onlyBlock) < 0)
-        throwInput(table.file, "--block",
-                   "no block '" + options.onlyBlock + "' (blocks: " + joined(blocks.names) + ")");
+    return names;
+}
 
-    // Pass 2: counts.
+// A study database lists each block's conditions in the design's order (conditions it does not name follow
+// in first-appearance order), so the CLI, the dashboard and the report show them alike.
+void orderByDesign(const ResponseTable& table, ResponseNames& seen) {
+    std::vector<NameIndex>& conditions = seen.conditions;
+    for (size_t b = 0; b < conditions.size(); ++b) {
+        const auto design = table.designConditionOrder.find(seen.blocks.names[b]);
+        if (design == table.designConditionOrder.end()) continue;
+        auto rank = [&](const std::string& name) {
+            const auto it = std::find(design->second.begin(), design->second.end(), name);
+            return it - design->second.begin();
+        };
+        std::vector<std::string> names = conditions[b].names;
+        std::stable_sort(names.begin(), names.end(),
+                         [&](const std::string& x, const std::string& y) { return rank(x) < rank(y); });
+        conditions[b] = NameIndex();
+        for (const std::string& name : names) conditions[b].add(name);
+    }
+}
+
+// Pass 2: counts.
+std::vector<BlockData> countResponses(const ResponseTable& table, const ResponseNames& names) {
+    const NameIndex& blocks = names.blocks;
+    const std::vector<NameIndex>& conditions = names.conditions;
+    const std::vector<NameIndex>& observers = names.observers;
     std::vector<BlockData> built(blocks.names.size());
     std::vector<std::map<std::pair<int, int>, int>> pairIndex(blocks.names.size());
     for (size_t b = 0; b < built.size(); ++b) {
@@ -215,6 +195,53 @@ Dataset buildDataset(const ResponseTable& table, const DatasetOptions& options) 
             if (r.aSelected == *r.aOnLeft) block.leftChosen[o] += 1.0;
         }
     }
+    return built;
+}
+
+} // namespace
+
+PairCounts BlockData::weightedCounts(const Eigen::VectorXd& observerWeights) const {
+    PairCounts counts;
+    counts.conditions = conditionCount();
+    counts.pairs = pairs;
+    counts.first = winsFirst.transpose() * observerWeights;
+    counts.second = winsSecond.transpose() * observerWeights;
+    return counts;
+}
+
+PairCounts BlockData::totalCounts() const { return weightedCounts(Eigen::VectorXd::Ones(observerCount())); }
+
+Eigen::MatrixXd BlockData::countMatrix() const {
+    const PairCounts totals = totalCounts();
+    Eigen::MatrixXd matrix = Eigen::MatrixXd::Zero(conditionCount(), conditionCount());
+    for (size_t p = 0; p < pairs.size(); ++p) {
+        matrix(pairs[p].first, pairs[p].second) = totals.first[static_cast<Eigen::Index>(p)];
+        matrix(pairs[p].second, pairs[p].first) = totals.second[static_cast<Eigen::Index>(p)];
+    }
+    return matrix;
+}
+
+Dataset buildDataset(const ResponseTable& table, const DatasetOptions& options) {
+    Dataset dataset;
+    dataset.file = table.file;
+    dataset.format = table.format;
+    dataset.excluded = table.excludedObservers;
+    if (table.format == ResponseFormat::CountMatrix) {
+        dataset.blocks.push_back(blockFromMatrix(table, options));
+        if (!options.onlyBlock.empty() && options.onlyBlock != dataset.blocks.front().name)
+            throwInput(table.file, "--block",
+                       "no block '" + options.onlyBlock + "' (a count matrix has one block, '" +
+                           dataset.blocks.front().name + "')");
+        return dataset;
+    }
+
+    ResponseNames names = indexResponses(table, options, dataset);
+    if (options.conditionOrder.empty()) orderByDesign(table, names);
+    if (!options.onlyBlock.empty() && names.blocks.find(options.onlyBlock) < 0)
+        throwInput(table.file, "--block",
+                   "no block '" + options.onlyBlock + "' (blocks: " + joined(names.blocks.names) + ")");
+
+    std::vector<BlockData> built = countResponses(table, names);
     for (size_t b = 0; b < built.size(); ++b) {
         if (!options.onlyBlock.empty() && built[b].name != options.onlyBlock) continue;
         if (built[b].pairs.empty()) continue; // a block with only catch/practice trials has nothing to scale

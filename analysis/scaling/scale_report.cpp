@@ -88,27 +88,9 @@ std::string plotName(size_t index, const std::string& kind, const std::string& b
     return "plots/" + kind + "_" + prefix + blockSlug(block) + ".png";
 }
 
-} // namespace
-
-std::string blockSlug(const std::string& name) {
-    std::string slug;
-    for (unsigned char c : name) {
-        const bool keep = std::isalnum(c) || c == '_' || c == '.';
-        if (keep) slug += static_cast<char>(c);
-        else if (!slug.empty() && slug.back() != '-') slug += '-';
-    }
-    while (!slug.empty() && slug.back() == '-') slug.pop_back();
-    return slug.empty() ? "block" : slug;
-}
-
-nlohmann::json analysisJson(const Analysis& analysis) {
-    const AnalysisOptions& o = analysis.options;
-    nlohmann::json json;
-    json["format"] = "skinlab-scaling";
-    json["version"] = 1;
-    json["skinlab_version"] = skinlab::version();
-    json["input"] = {{"file", analysis.file}, {"format", responseFormatName(analysis.format)}};
-    json["settings"] = {
+// The settings the analysis ran with.
+nlohmann::json settingsJson(const AnalysisOptions& o) {
+    return {
         {"model", "thurstone-case-v"},
         {"sigma", kThurstoneSigma},
         {"unit", "JOD (1 JOD = 75 % preference), mean of each block's scores = 0"},
@@ -134,94 +116,130 @@ nlohmann::json analysisJson(const Analysis& analysis) {
         {"screening", "leave-one-out held-out log-likelihood per trial, low outliers by Q1 - w*IQR"},
         {"screening_whisker", o.screeningWhisker},
         {"pwcmp_outliers", o.pwcmpOutliers}};
-    for (const BlockAnalysis& block : analysis.blocks) {
-        nlohmann::json b;
-        b["name"] = block.name;
-        b["conditions"] = block.conditions;
-        b["observers"] = static_cast<int>(block.observers.size());
-        nlohmann::json counts = nlohmann::json::array();
-        for (Eigen::Index i = 0; i < block.counts.rows(); ++i) {
-            std::vector<double> row(block.counts.cols());
-            for (Eigen::Index j = 0; j < block.counts.cols(); ++j) row[j] = block.counts(i, j);
-            counts.push_back(row);
-        }
-        b["counts"] = counts;
-        b["interval_method"] = block.intervalMethod;
-        b["bootstrap_samples"] = block.bootstrapSamples;
-        b["fit"] = {{"converged", block.thurstone.converged},
-                    {"iterations", block.thurstone.iterations},
-                    {"log_likelihood", block.thurstone.logLikelihood},
-                    {"bradley_terry_log_likelihood", block.bradleyTerry.logLikelihood}};
-        for (size_t i = 0; i < block.conditions.size(); ++i) {
-            const auto k = static_cast<Eigen::Index>(i);
-            b["scores"].push_back({{"condition", block.conditions[i]},
-                                   {"jod", block.thurstone.scores[k]},
-                                   {"standard_error", finite(block.standardError[k])},
-                                   {"ci_low", finite(block.low[k])},
-                                   {"ci_high", finite(block.high[k])},
-                                   {"bound", scoreBound(block, i)},
-                                   {"interval_method", scoreMethod(block, i)},
-                                   {"fallback_reasons", scoreReasons(block, i)},
-                                   {"percentile_low", finite(block.percentileLow[k])},
-                                   {"percentile_high", finite(block.percentileHigh[k])},
-                                   {"bradley_terry_jod", block.bradleyTerry.scores[k]},
-                                   {"bradley_terry_standard_error", finite(block.bradleyTerryStandardError[k])}});
-        }
-        nlohmann::json components = nlohmann::json::array();
-        for (const auto& component : block.components) {
-            std::vector<std::string> names;
-            for (int c : component) names.push_back(block.conditions[c]);
-            components.push_back(names);
-        }
-        nlohmann::json unanimous = nlohmann::json::array();
-        for (const auto& [i, j] : block.unanimousPairs) unanimous.push_back({block.conditions[i], block.conditions[j]});
-        b["flags"] = {{"connected", block.components.size() == 1},
-                      {"components", components},
-                      {"mle_exists", block.mleExists},
-                      {"unanimous_pairs", unanimous}};
-        b["pairs"] = nlohmann::json::array();
-        for (const PairTest& pair : block.pairs)
-            b["pairs"].push_back({{"condition_A", block.conditions[pair.test.first]},
-                                  {"condition_B", block.conditions[pair.test.second]},
-                                  {"difference_jod", pair.test.difference},
-                                  {"standard_error", finite(pair.test.standardError)},
-                                  {"ci_low", finite(pair.test.low)},
-                                  {"ci_high", finite(pair.test.high)},
-                                  {"bound", pair.test.diagnosis.bound},
-                                  {"comparisons", pair.comparisons},
-                                  {"interval_method", pairMethod(block, pair)},
-                                  {"fallback_reasons", pair.test.diagnosis.reasons},
-                                  {"p_value", pair.test.pValue},
-                                  {"p_adjusted", pair.adjustedPValue},
-                                  {"significant", pair.significant}});
-        b["kendall_u"] = block.kendallU ? nlohmann::json(*block.kendallU) : nlohmann::json();
-        b["side_bias"] = {
-            {"available", block.sideBias.available},
+}
+
+// The block's comparison counts, row by row.
+nlohmann::json countsJson(const BlockAnalysis& block) {
+    nlohmann::json counts = nlohmann::json::array();
+    for (Eigen::Index i = 0; i < block.counts.rows(); ++i) {
+        std::vector<double> row(block.counts.cols());
+        for (Eigen::Index j = 0; j < block.counts.cols(); ++j) row[j] = block.counts(i, j);
+        counts.push_back(row);
+    }
+    return counts;
+}
+
+// b["scores"]: one entry per condition (absent when the block has none).
+void addScores(nlohmann::json& b, const BlockAnalysis& block) {
+    for (size_t i = 0; i < block.conditions.size(); ++i) {
+        const auto k = static_cast<Eigen::Index>(i);
+        b["scores"].push_back({{"condition", block.conditions[i]},
+                               {"jod", block.thurstone.scores[k]},
+                               {"standard_error", finite(block.standardError[k])},
+                               {"ci_low", finite(block.low[k])},
+                               {"ci_high", finite(block.high[k])},
+                               {"bound", scoreBound(block, i)},
+                               {"interval_method", scoreMethod(block, i)},
+                               {"fallback_reasons", scoreReasons(block, i)},
+                               {"percentile_low", finite(block.percentileLow[k])},
+                               {"percentile_high", finite(block.percentileHigh[k])},
+                               {"bradley_terry_jod", block.bradleyTerry.scores[k]},
+                               {"bradley_terry_standard_error", finite(block.bradleyTerryStandardError[k])}});
+    }
+}
+
+// The design's flags: connectedness, its components, MLE existence, unanimous pairs.
+nlohmann::json flagsJson(const BlockAnalysis& block) {
+    nlohmann::json components = nlohmann::json::array();
+    for (const auto& component : block.components) {
+        std::vector<std::string> names;
+        for (int c : component) names.push_back(block.conditions[c]);
+        components.push_back(names);
+    }
+    nlohmann::json unanimous = nlohmann::json::array();
+    for (const auto& [i, j] : block.unanimousPairs) unanimous.push_back({block.conditions[i], block.conditions[j]});
+    return {{"connected", block.components.size() == 1},
+            {"components", components},
+            {"mle_exists", block.mleExists},
+            {"unanimous_pairs", unanimous}};
+}
+
+// Each pair's difference, interval and (corrected) test.
+nlohmann::json pairsJson(const BlockAnalysis& block) {
+    nlohmann::json pairs = nlohmann::json::array();
+    for (const PairTest& pair : block.pairs)
+        pairs.push_back({{"condition_A", block.conditions[pair.test.first]},
+                         {"condition_B", block.conditions[pair.test.second]},
+                         {"difference_jod", pair.test.difference},
+                         {"standard_error", finite(pair.test.standardError)},
+                         {"ci_low", finite(pair.test.low)},
+                         {"ci_high", finite(pair.test.high)},
+                         {"bound", pair.test.diagnosis.bound},
+                         {"comparisons", pair.comparisons},
+                         {"interval_method", pairMethod(block, pair)},
+                         {"fallback_reasons", pair.test.diagnosis.reasons},
+                         {"p_value", pair.test.pValue},
+                         {"p_adjusted", pair.adjustedPValue},
+                         {"significant", pair.significant}});
+    return pairs;
+}
+
+// The left/right bias of the block (null values where it is not measured).
+nlohmann::json sideBiasJson(const BlockAnalysis& block) {
+    return {{"available", block.sideBias.available},
             {"trials", block.sideBias.trials},
             {"left_rate", block.sideBias.available ? nlohmann::json(block.sideBias.leftRate) : nlohmann::json()},
             {"bias_jod", block.sideBias.available ? nlohmann::json(block.sideBias.bias) : nlohmann::json()},
             {"standard_error", block.sideBias.available ? finite(block.sideBias.standardError) : nlohmann::json()},
             {"p_value", block.sideBias.available ? nlohmann::json(block.sideBias.pValue) : nlohmann::json()}};
-        b["observer_stats"] = nlohmann::json::array();
-        for (size_t k = 0; k < block.observerStats.size(); ++k) {
-            const ObserverInBlock& s = block.observerStats[k];
-            b["observer_stats"].push_back(
-                {{"observer", block.observers[k]},
-                 {"trials", s.trials},
-                 {"held_out_loglik_per_trial", s.trials > 0 && block.observers.size() > 1
-                                                   ? nlohmann::json(s.heldOutLogLikelihood / s.trials)
-                                                   : nlohmann::json()},
-                 {"complete", s.consistency.complete},
-                 {"circular_triads",
-                  s.consistency.complete ? nlohmann::json(s.consistency.circularTriads) : nlohmann::json()},
-                 {"zeta", s.consistency.zeta ? nlohmann::json(*s.consistency.zeta) : nlohmann::json()}});
-        }
-        b["warnings"] = block.warnings;
-        json["blocks"].push_back(b);
+}
+
+// Each observer's fit and consistency within the block.
+nlohmann::json observerStatsJson(const BlockAnalysis& block) {
+    nlohmann::json stats = nlohmann::json::array();
+    for (size_t k = 0; k < block.observerStats.size(); ++k) {
+        const ObserverInBlock& s = block.observerStats[k];
+        stats.push_back({{"observer", block.observers[k]},
+                         {"trials", s.trials},
+                         {"held_out_loglik_per_trial", s.trials > 0 && block.observers.size() > 1
+                                                           ? nlohmann::json(s.heldOutLogLikelihood / s.trials)
+                                                           : nlohmann::json()},
+                         {"complete", s.consistency.complete},
+                         {"circular_triads",
+                          s.consistency.complete ? nlohmann::json(s.consistency.circularTriads) : nlohmann::json()},
+                         {"zeta", s.consistency.zeta ? nlohmann::json(*s.consistency.zeta) : nlohmann::json()}});
     }
-    json["observers"] = nlohmann::json::array();
+    return stats;
+}
+
+// One block of the analysis: data, fit, scores, flags, pairs, side bias and observers.
+nlohmann::json blockJson(const BlockAnalysis& block) {
+    nlohmann::json b;
+    b["name"] = block.name;
+    b["conditions"] = block.conditions;
+    b["observers"] = static_cast<int>(block.observers.size());
+    b["counts"] = countsJson(block);
+    b["interval_method"] = block.intervalMethod;
+    b["bootstrap_samples"] = block.bootstrapSamples;
+    b["fit"] = {{"converged", block.thurstone.converged},
+                {"iterations", block.thurstone.iterations},
+                {"log_likelihood", block.thurstone.logLikelihood},
+                {"bradley_terry_log_likelihood", block.bradleyTerry.logLikelihood}};
+    addScores(b, block);
+    b["flags"] = flagsJson(block);
+    b["pairs"] = pairsJson(block);
+    b["kendall_u"] = block.kendallU ? nlohmann::json(*block.kendallU) : nlohmann::json();
+    b["side_bias"] = sideBiasJson(block);
+    b["observer_stats"] = observerStatsJson(block);
+    b["warnings"] = block.warnings;
+    return b;
+}
+
+// Every observer's summary across blocks.
+nlohmann::json observersJson(const Analysis& analysis) {
+    nlohmann::json observers = nlohmann::json::array();
     for (const ObserverSummary& s : analysis.observers)
-        json["observers"].push_back(
+        observers.push_back(
             {{"observer", s.observer},
              {"trials", s.trials},
              {"held_out_loglik_per_trial", finite(s.heldOutPerTrial)},
@@ -232,6 +250,32 @@ nlohmann::json analysisJson(const Analysis& analysis) {
              {"catch_trials", s.catchTrials},
              {"catch_failures", s.catchFailures},
              {"left_rate", s.sideTrials > 0 ? nlohmann::json(s.leftChosen / s.sideTrials) : nlohmann::json()}});
+    return observers;
+}
+
+} // namespace
+
+std::string blockSlug(const std::string& name) {
+    std::string slug;
+    for (unsigned char c : name) {
+        const bool keep = std::isalnum(c) || c == '_' || c == '.';
+        if (keep) slug += static_cast<char>(c);
+        else if (!slug.empty() && slug.back() != '-') slug += '-';
+    }
+    while (!slug.empty() && slug.back() == '-') slug.pop_back();
+    return slug.empty() ? "block" : slug;
+}
+
+nlohmann::json analysisJson(const Analysis& analysis) {
+    const AnalysisOptions& o = analysis.options;
+    nlohmann::json json;
+    json["format"] = "skinlab-scaling";
+    json["version"] = 1;
+    json["skinlab_version"] = skinlab::version();
+    json["input"] = {{"file", analysis.file}, {"format", responseFormatName(analysis.format)}};
+    json["settings"] = settingsJson(o);
+    for (const BlockAnalysis& block : analysis.blocks) json["blocks"].push_back(blockJson(block));
+    json["observers"] = observersJson(analysis);
     json["excluded_observers"] = nlohmann::json::array();
     for (const ExcludedObserver& e : analysis.excluded)
         json["excluded_observers"].push_back({{"observer", e.observer}, {"reason", e.reason}});

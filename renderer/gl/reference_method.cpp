@@ -193,6 +193,7 @@ void ReferenceMethod::prepare(const ReferenceInputs& inputs, const sss::SssParam
     impl_->tessellated(inputs, static_cast<float>(params.referenceEdgeMm), cached);
 }
 
+// Long by design: the GL pass sequence of the reference method, in order, sharing its buffers.
 void ReferenceMethod::run(const ReferenceInputs& inputs, const sss::SssParams& params, GLuint output) {
     Impl& impl = *impl_;
     const FrameTargets& targets = *inputs.targets;
