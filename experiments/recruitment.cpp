@@ -1,6 +1,6 @@
 #include "experiments/recruitment.h"
 
-#include "experiments/request_error.h"
+#include "experiments/study_errors.h"
 
 #include <cctype>
 
@@ -14,7 +14,7 @@ bool isAlnum(char c) { return std::isalnum(static_cast<unsigned char>(c)) != 0; 
 // Each rule states the accepted form in its message, so a rejected link says what a valid one looks like.
 void checkValue(const std::string& name, const std::string& value, const std::string& platform) {
     auto fail = [&](const std::string& expected) {
-        throw RequestError(400, name + ": malformed " + platform + " parameter (expected " + expected + ")");
+        throw InvalidValue(name + ": malformed " + platform + " parameter (expected " + expected + ")");
     };
     if (platform == "prolific") {
         // Prolific ids are 24 hexadecimal digits.
@@ -77,10 +77,10 @@ std::optional<ExternalIds> validateExternalIds(const RecruitmentDesign& recruitm
     ExternalIds ids;
     ids.platform = recruitment.platform;
     if (recruitment.platform == "mturk" && value("assignmentId") == std::string(kMturkPreviewAssignment))
-        throw RequestError(403, "assignmentId: this is the HIT's preview (ASSIGNMENT_ID_NOT_AVAILABLE); accept the "
+        throw NotAdmitted("assignmentId: this is the HIT's preview (ASSIGNMENT_ID_NOT_AVAILABLE); accept the "
                                 "HIT to take part");
     const std::optional<std::string> id = value(names.id);
-    if (!id) throw RequestError(400, names.id + ": missing; open the study from its " + recruitment.platform + " link");
+    if (!id) throw InvalidValue(names.id + ": missing; open the study from its " + recruitment.platform + " link");
     ids.id = normalised(*id, recruitment.platform);
     checkValue(names.id, ids.id, recruitment.platform);
     if (const auto study = value(names.study)) {

@@ -35,9 +35,9 @@ struct ExternalIds {
 // blanks and trailing dots, lower case. Ids are compared and stored in this form.
 std::string normalisedExternalId(const std::string& platform, const std::string& value);
 
-// Validates (after normalising) the parameters the page forwarded (name -> value) against the design's platform. Throws RequestError:
-// 400 naming the parameter for a missing or malformed value, 403 for MTurk's preview assignment. nullopt for
-// platform "none".
+// Validates (after normalising) the parameters the page forwarded (name -> value) against the design's platform.
+// Throws InvalidValue naming the parameter for a missing or malformed value (the server answers 400) and
+// NotAdmitted for MTurk's preview assignment (403; experiments/study_errors.h). nullopt for platform "none".
 std::optional<ExternalIds> validateExternalIds(const RecruitmentDesign& recruitment,
                                                const std::map<std::string, std::string>& parameters);
 

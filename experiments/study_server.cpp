@@ -78,6 +78,7 @@ int httpStatus(Refusal reason) {
     case Refusal::notFound: return 404;
     case Refusal::conflict: return 409;
     case Refusal::limitReached: return 429;
+    case Refusal::notAdmitted: return 403;
     }
     return 400;
 }
