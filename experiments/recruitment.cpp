@@ -78,7 +78,7 @@ std::optional<ExternalIds> validateExternalIds(const RecruitmentDesign& recruitm
     ids.platform = recruitment.platform;
     if (recruitment.platform == "mturk" && value("assignmentId") == std::string(kMturkPreviewAssignment))
         throw NotAdmitted("assignmentId: this is the HIT's preview (ASSIGNMENT_ID_NOT_AVAILABLE); accept the "
-                                "HIT to take part");
+                          "HIT to take part");
     const std::optional<std::string> id = value(names.id);
     if (!id) throw InvalidValue(names.id + ": missing; open the study from its " + recruitment.platform + " link");
     ids.id = normalised(*id, recruitment.platform);
