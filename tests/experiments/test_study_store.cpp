@@ -9,6 +9,7 @@
 #include "experiments/study_export.h"
 #include "experiments/study_store.h"
 #include "stimulus_set_fixture.h"
+#include "store_answer.h"
 
 #include <functional>
 #include <gtest/gtest.h>
@@ -47,17 +48,7 @@ struct StudyFile {
 };
 
 ResponseInput answer(const ParticipantRecord& p, std::int64_t session, const TrialRecord& t, const std::string& side) {
-    ResponseInput in;
-    in.token = p.token;
-    in.trialId = trialReference(p.token, t.id);
-    in.side = side;
-    in.sessionId = session;
-    in.responseMs = 700;
-    in.clientTime = "2026-11-23T14:00:00.000Z";
-    in.viewportWidth = 1280;
-    in.viewportHeight = 800;
-    in.userAgent = "test";
-    return in;
+    return storeAnswer(p, session, t, side);
 }
 
 // What the study file refuses `f` with (nullopt: nothing).

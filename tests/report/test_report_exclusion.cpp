@@ -3,16 +3,16 @@
 // files list the same excluded observers and scale the same ones (the protocol's rule, scaling::excludeObservers).
 #include "experiments/study_creation.h"
 #include "experiments/study_store.h"
+#include "common/files.h"
 #include "stimulus_set_fixture.h"
+#include "store_answer.h"
 #include "tests/common/cli_run.h"
 
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
 
-#include <fstream>
 #include <set>
-#include <sstream>
 
 using namespace skinlab::experiments;
 using namespace skinlab::experiments::test_support;
@@ -43,26 +43,11 @@ void participate(StudyStore& store, const std::string& label, Attention attentio
         bool chooseA = plan.conditionA < plan.conditionB; // a consistent preference
         if (plan.kind == TrialKind::catchTrial)
             chooseA = (plan.expected == 'A') == (attention != Attention::failsCatchTrials);
-        ResponseInput in;
-        in.token = p.token;
-        in.trialId = trialReference(p.token, trial->id);
-        in.side = chooseA == plan.aOnLeft ? "left" : "right";
-        in.sessionId = session;
-        in.responseMs = 700;
-        in.clientTime = "2026-11-23T14:00:00.000Z";
-        in.viewportWidth = 1280;
-        in.viewportHeight = 800;
-        in.userAgent = "test";
-        store.recordResponse(in);
+        store.recordResponse(storeAnswer(p, session, *trial, chooseA == plan.aOnLeft ? "left" : "right"));
     }
 }
 
-nlohmann::json readJson(const fs::path& path) {
-    std::ifstream in(path);
-    std::stringstream text;
-    text << in.rdbuf();
-    return nlohmann::json::parse(text.str());
-}
+nlohmann::json readJson(const fs::path& path) { return nlohmann::json::parse(skinlab::readFile(path)); }
 
 std::set<std::string> excludedIn(const nlohmann::json& scale) {
     std::set<std::string> names;
@@ -111,8 +96,6 @@ TEST(ReportExclusion, ReportAndAnalyzeScaleLeaveOutTheSameObservers) {
     EXPECT_EQ(scaledIn(fromAnalyze), (std::set<std::string>{"A1", "A2", "A3"}));
     EXPECT_EQ(scaledIn(fromReport), scaledIn(fromAnalyze));
     // The page counts them the same way: 3 analysed; the never-answering participant is excluded there too.
-    std::ifstream page(reportFolder / "index.html");
-    std::stringstream html;
-    html << page.rdbuf();
-    EXPECT_NE(html.str().find("6 joined, 3 analysed, 3 excluded"), std::string::npos);
+    EXPECT_NE(skinlab::readFile(reportFolder / "index.html").find("6 joined, 3 analysed, 3 excluded"),
+              std::string::npos);
 }
