@@ -26,11 +26,9 @@ void runMethods(const MethodsOptions& options) {
     std::string text;
     nlohmann::json table = nlohmann::json::array();
     for (const sss::MethodInfo& info : sss::methodTable()) {
-        if (options.screenSpace && !info.screenSpace) continue;
+        if (options.screenSpace && !info.screenSpace()) continue;
         std::vector<std::string> keys;
-        for (const std::string_view key : sss::kCommonSssKeys)
-            if (key != "method") keys.emplace_back(key);
-        for (const std::string_view key : info.keys) keys.emplace_back(key);
+        for (const std::string_view key : sss::methodKeys(info.method)) keys.emplace_back(key);
         if (options.list) {
             text += std::string(info.name) + "\n";
         } else if (options.json) {
@@ -43,13 +41,14 @@ void runMethods(const MethodsOptions& options) {
                 parameters.push_back(declaration);
             }
             table.push_back({{"name", info.name},
-                             {"screen_space", info.screenSpace},
-                             {"blur_passes", info.blurPasses},
+                             {"screen_space", info.screenSpace()},
+                             {"blur_passes", info.blurPasses()},
+                             {"execution", sss::executionName(info.execution)},
                              {"summary", info.summary},
                              {"keys", keys},
                              {"parameters", parameters}});
         } else {
-            text += std::string(info.name) + (info.screenSpace ? "  (screen-space)" : "") + "\n    " +
+            text += std::string(info.name) + (info.screenSpace() ? "  (screen-space)" : "") + "\n    " +
                     std::string(info.summary) + "\n    keys:";
             for (const auto& key : keys) text += " " + key;
             text += "\n";

@@ -26,6 +26,7 @@
 #include "renderer/output/exr_writer.h"
 #include "renderer/pathtraced/cycles_render.h"
 #include "renderer/sss/eevee_params.h"
+#include "renderer/sss/method.h"
 #include "renderer/scene/builtin_geometry.h"
 #include "renderer/scene/environment.h"
 #include "renderer/scene/mesh_loader.h"
@@ -405,7 +406,8 @@ float Renderer::Impl::runSssPasses(const Frame& frame, const gl::MainPassSetting
     gl::SssStageSettings sssSettings;
     sssSettings.sss = spec.sss;
     sssSettings.transmittance = spec.transmittance;
-    if (spec.sss.method == sss::SssMethod::Reference) {
+    const sss::Execution execution = sss::methodInfo(spec.sss.method).execution;
+    if (execution == sss::Execution::ObjectSpace) {
         // The object-space reference bakes the main pass's shading at the tessellated vertices itself, so it needs
         // the model, the scene and the main pass's settings rather than the screen-space inputs.
         gl::ReferenceInputs referenceInputs = frame.referenceInputs;
@@ -414,7 +416,6 @@ float Renderer::Impl::runSssPasses(const Frame& frame, const gl::MainPassSetting
         referenceInputs.mainSettings = mainSettings;
         referenceInputs.targets = &targets;
         referenceMethod.run(referenceInputs, spec.sss, targets.scatteredDiffuse.get());
-        supportRadiusMm = gl::ReferenceMethod::supportRadiusMm(spec.sss, spec.source);
     } else {
         gl::SssStageInputs sssInputs;
         sssInputs.diffuse = targets.diffuse.get();
@@ -433,12 +434,10 @@ float Renderer::Impl::runSssPasses(const Frame& frame, const gl::MainPassSetting
         sssInputs.projection = frame.camera.projection;
         sssInputs.cameraPosition = frame.camera.position;
         sssStage.run(sssInputs, sssSettings, targets.scatteredDiffuse.get());
-        // pathtraced, eevee: the support of the profile their radii are matched to (as the object-space reference
-        // declares).
-        supportRadiusMm = spec.sss.method == sss::SssMethod::Pathtraced || spec.sss.method == sss::SssMethod::Eevee
-                              ? gl::ReferenceMethod::supportRadiusMm(spec.sss, spec.source)
-                              : sssStage.supportRadiusMm(sssSettings);
     }
+    // The method's support, prepared with its kernel (renderer/sss/method.h; pathtraced, eevee and reference: the
+    // radial profile's).
+    supportRadiusMm = static_cast<float>(sss::prepareMethod(spec.sss)->supportRadiusMm);
     passTimer.end();
 
     passTimer.begin("add_specular");
@@ -497,7 +496,7 @@ std::string lightingKeyOf(const SceneSpec& spec) {
 DisplayFrame Renderer::renderDisplay(const RenderRequest& request, bool withLinear) {
     const auto start = std::chrono::steady_clock::now();
     SceneSpec spec = loadSpec(request);
-    if (spec.sss.method == sss::SssMethod::Pathtraced)
+    if (sss::methodInfo(spec.sss.method).execution == sss::Execution::Cycles)
         throw InputError(spec.source + ": sss.method: 'pathtraced' renders through Blender; use skinlab render");
     Impl& impl = *impl_;
     impl.context.makeCurrent();
@@ -551,7 +550,7 @@ DisplayFrame Renderer::renderDisplay(const RenderRequest& request, bool withLine
     frame.exposure = static_cast<float>(std::exp2(spec.exposureEv));
     frame.environmentFromWorld = glm::mat3(glm::rotate(
         glm::mat4(1.0f), static_cast<float>(-glm::radians(spec.environment.rotationDeg)), glm::vec3(0, 1, 0)));
-    const bool referenceMethod = spec.sss.method == sss::SssMethod::Reference;
+    const bool referenceMethod = sss::methodInfo(spec.sss.method).execution == sss::Execution::ObjectSpace;
     if (referenceMethod) impl.prepareReferenceMethod(frame, spec);
     const double uploadMs = millisecondsSince(uploadStart);
 
@@ -655,8 +654,9 @@ RenderResult Renderer::render(const RenderRequest& request) {
     // not produce: albedo, normals, transmittance, aux, curvature.
     // sss.method = "eevee": the same scene handed to Blender EEVEE (docs/pathtraced.md, "EEVEE"), the same way.
     std::optional<pathtraced::CyclesImage> cycles;
-    const bool eevee = spec.sss.method == sss::SssMethod::Eevee;
-    if (spec.sss.method == sss::SssMethod::Pathtraced || eevee) {
+    const sss::Execution execution = sss::methodInfo(spec.sss.method).execution;
+    const bool eevee = execution == sss::Execution::Eevee;
+    if (execution == sss::Execution::Cycles || eevee) {
         pathtraced::BlenderSceneInputs cyclesInputs;
         cyclesInputs.spec = &spec;
         cyclesInputs.model = frame.model.get();
@@ -676,7 +676,7 @@ RenderResult Renderer::render(const RenderRequest& request) {
 
     // --- sss.method = "reference": check its parameters and tessellate (cached) before the first pass, so bad
     // input fails with no pass half done.
-    const bool referenceMethod = spec.sss.method == sss::SssMethod::Reference;
+    const bool referenceMethod = sss::methodInfo(spec.sss.method).execution == sss::Execution::ObjectSpace;
     if (referenceMethod) impl.prepareReferenceMethod(frame, spec);
 
     // --- the pass pipeline ----------------------------------------------------------------------------------

@@ -270,9 +270,9 @@ json TuneServer::schema() const {
             parameters.push_back(declaration);
         }
         methods.push_back({{"name", info.name},
-                           {"screen_space", info.screenSpace},
+                           {"screen_space", info.screenSpace()},
                            {"summary", info.summary},
-                           {"slow", !info.screenSpace && info.method != sss::SssMethod::None},
+                           {"slow", !info.screenSpace() && info.execution != sss::Execution::CopyThrough},
                            {"parameters", parameters}});
     }
     json transmittance = json::array();

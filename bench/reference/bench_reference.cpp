@@ -5,7 +5,7 @@
 // with the load of other processes, CPU time does not.
 //   bench_reference [repeats=3]
 #include "bench/bench_stats.h"
-#include "renderer/reference/radial_profile.h"
+#include "renderer/sss/radial_profile.h"
 #include "renderer/reference/surface_convolution.h"
 #include "renderer/reference/tessellation.h"
 #include "renderer/scene/builtin_geometry.h"
@@ -29,7 +29,7 @@ void run(const char* name, const Model& model, float edgeMm, int repeats) {
     std::vector<double> tessellateMs, convolveMs, convolveCpuMs;
     ConvolutionReport report;
     std::size_t skinSamples = 0;
-    const auto profile = makeRadialProfile(skinlab::renderer::sss::SssParams{});
+    const auto profile = sss::makeRadialProfile(sss::SssParams{});
     for (int r = 0; r < repeats; ++r) {
         auto start = std::chrono::steady_clock::now();
         const Model fine = tessellateSkin(model, edgeMm, 1.0f);

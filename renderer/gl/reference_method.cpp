@@ -1,10 +1,11 @@
 #include "renderer/gl/reference_method.h"
 
 #include "common/error.h"
-#include "renderer/reference/radial_profile.h"
 #include "renderer/reference/surface_convolution.h"
 #include "renderer/reference/surface_samples.h"
 #include "renderer/reference/tessellation.h"
+#include "renderer/sss/method.h"
+#include "renderer/sss/radial_profile.h"
 
 #include <algorithm>
 #include <chrono>
@@ -21,8 +22,9 @@ namespace {
 // kMaxReferenceVertices, well inside GL 4.5's minimum texture size limit (16384).
 constexpr int kBakeWidth = 2048;
 
-// The cutoff of the convolution (surface_convolution.h): at most 0.1 % of each channel's energy lies beyond it.
-constexpr double kCutoffTail = 1e-3;
+// The cutoff of the convolution (surface_convolution.h): at most 0.1 % of each channel's energy lies beyond it, the
+// method's declared support (renderer/sss/method.h).
+constexpr double kCutoffTail = sss::RadialProfileSupport::kCutoffTail;
 
 // A tessellated fragment is the main pass's surface where its view depth is within this share of the main pass's
 // linear depth (1e-4: 0.03 mm at 300 mm). Both lie in the same triangle planes, so a match differs by float
@@ -42,9 +44,9 @@ double millisecondsSince(std::chrono::steady_clock::time_point start) {
     throwInput(source, key, message);
 }
 
-std::unique_ptr<reference::RadialProfile> profileOf(const sss::SssParams& params, std::string_view source) {
+std::unique_ptr<sss::RadialProfile> profileOf(const sss::SssParams& params, std::string_view source) {
     try {
-        return reference::makeRadialProfile(params);
+        return sss::makeRadialProfile(params);
     } catch (const InputError& error) {
         rethrowWithKey(error, source, "sss.profile", "sss.profile: ");
     }
@@ -182,10 +184,6 @@ struct ReferenceMethod::Impl {
 
 ReferenceMethod::ReferenceMethod(ShaderLibrary& shaders) : impl_(std::make_unique<Impl>(shaders)) {}
 ReferenceMethod::~ReferenceMethod() = default;
-
-float ReferenceMethod::supportRadiusMm(const sss::SssParams& params, const std::string& source) {
-    return static_cast<float>(profileOf(params, source)->cutoffRadiusMm(kCutoffTail));
-}
 
 void ReferenceMethod::prepare(const ReferenceInputs& inputs, const sss::SssParams& params) {
     profileOf(params, inputs.source);

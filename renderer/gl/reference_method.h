@@ -64,10 +64,6 @@ public:
     // Writes every pixel of `output` (GL_RGBA32F, frame size); the same InputErrors as prepare(). Leaves GL state as the SSS stage contract asks (sss_stage.h).
     void run(const ReferenceInputs& inputs, const sss::SssParams& params, GLuint output);
 
-    // The profile's cutoff radius (mm): every channel has at most 0.1 % of its energy beyond it (EXR attribute
-    // skinlab:sss_radius_mm, the metrics' band width). Throws InputError like run() for a tabulated profile.
-    static float supportRadiusMm(const sss::SssParams& params, const std::string& source = "");
-
     // CPU timings and sizes of the last run: {"tessellate_ms", "cached", "samples", "skin_samples",
     // "bake_readback_ms", "convolve_ms", "sources_per_sample", "cutoff_mm", "edge_mm", "longest_edge_mm"}.
     const nlohmann::json& lastRun() const { return lastRun_; }

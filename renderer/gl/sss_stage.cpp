@@ -5,7 +5,7 @@
 #include "renderer/gl/pscbf_method.h" // pscbf (Mikkelsen 2010)
 #include "renderer/gl/shader_library.h"
 #include "renderer/gl/sss_kernel_method.h"
-#include "renderer/sss/kernel.h"
+#include "renderer/sss/method.h"
 #include "renderer/sss/sss_params.h"
 
 namespace skinlab::renderer::gl {
@@ -13,24 +13,10 @@ namespace skinlab::renderer::gl {
 struct SssStage::Impl {
     explicit Impl(ShaderLibrary& library) : shaders(library), kernelMethod(library) {}
     ShaderLibrary& shaders;
-    // gaussian-sum, separable, artistic: the method's kernel run as 1-D passes.
+    // Execution::TapPasses: the method's kernel run as 1-D passes.
     SssKernelMethod kernelMethod;
-    // The kernel of the last settings (computing a Burley or file: kernel takes milliseconds; renders repeat).
-    std::string kernelKey;
-    sss::Kernel kernel;
-    sss::SssParams params;
-    // pscbf (Mikkelsen 2010; renderer/gl/pscbf_method.h), created on first use.
+    // Execution::Pscbf (Mikkelsen 2010; renderer/gl/pscbf_method.h), created on first use.
     std::unique_ptr<PscbfMethod> pscbfMethod;
-
-    const sss::Kernel& kernelFor(const SssStageSettings& settings) {
-        const std::string key = settings.sss.toJson().dump();
-        if (key != kernelKey) {
-            params = settings.sss;
-            kernel = sss::makeKernel(params);
-            kernelKey = key;
-        }
-        return kernel;
-    }
 };
 
 SssStage::SssStage(ShaderLibrary& shaders) : impl_(std::make_unique<Impl>(shaders)) {}
@@ -38,21 +24,22 @@ SssStage::~SssStage() = default;
 
 void SssStage::run(const SssStageInputs& inputs, const SssStageSettings& settings, GLuint output) {
     if (output == inputs.diffuse) throw RuntimeError("SSS stage: output texture must differ from the diffuse input");
-    const sss::Kernel& kernel = impl_->kernelFor(settings);
-    const sss::SssParams& params = impl_->params;
-    switch (params.method) {
-    case sss::SssMethod::Reference:
+    // The kernel of these parameters, built once per parameter set (renderer/sss/method.h).
+    const auto prepared = sss::prepareMethod(settings.sss);
+    const sss::Kernel& kernel = prepared->kernel;
+    const sss::SssParams& params = prepared->params;
+    switch (prepared->info->execution) {
+    case sss::Execution::ObjectSpace:
         // Computed on the surface, not on the screen: renderer.cpp runs ReferenceMethod instead of this stage.
-        throw RuntimeError("SSS stage: method reference is run by ReferenceMethod, not by the screen-space stage");
-    case sss::SssMethod::Pscbf: {
+        throw RuntimeError("SSS stage: method " + std::string(prepared->info->name) +
+                           " is run on the surface (ReferenceMethod), not by the screen-space stage");
+    case sss::Execution::Pscbf: {
         // Mikkelsen 2010: its own two passes (renderer/gl/pscbf_method.h).
         if (!impl_->pscbfMethod) impl_->pscbfMethod = std::make_unique<PscbfMethod>(impl_->shaders);
         impl_->pscbfMethod->run(inputs, params, kernel, output);
         return;
     }
-    case sss::SssMethod::GaussianSum:
-    case sss::SssMethod::Separable:
-    case sss::SssMethod::Artistic: {
+    case sss::Execution::TapPasses: {
         SssBlurPassInputs passInputs;
         passInputs.source = inputs.diffuse;
         passInputs.linearDepth = inputs.linearDepth;
@@ -66,9 +53,9 @@ void SssStage::run(const SssStageInputs& inputs, const SssStageSettings& setting
         impl_->kernelMethod.run(passInputs, kernel, output);
         return;
     }
-    case sss::SssMethod::None:
-    case sss::SssMethod::Pathtraced: // Cycles replaces the image afterwards (renderer.cpp); copy through
-    case sss::SssMethod::Eevee:      // EEVEE, likewise
+    case sss::Execution::CopyThrough:
+    case sss::Execution::Cycles: // Cycles replaces the image afterwards (renderer.cpp); copy through
+    case sss::Execution::Eevee:  // EEVEE, likewise
         break;
     }
     // A framebuffer per run: texture names are recycled when the frame is resized, so caching one by name
@@ -90,7 +77,7 @@ void SssStage::run(const SssStageInputs& inputs, const SssStageSettings& setting
 
 float SssStage::supportRadiusMm(const SssStageSettings& settings) const {
     // 0 for none; pscbf's kernel declares its filter disc r_max × width_mm / 3 (renderer/sss/kernel.h).
-    return static_cast<float>(impl_->kernelFor(settings).supportRadiusMm());
+    return static_cast<float>(sss::prepareMethod(settings.sss)->supportRadiusMm);
 }
 
 } // namespace skinlab::renderer::gl

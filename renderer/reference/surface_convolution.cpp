@@ -12,7 +12,7 @@
 namespace skinlab::renderer::reference {
 
 std::vector<glm::vec3> convolveSurface(const SurfaceSamples& samples, const std::vector<glm::vec3>& irradiance,
-                                       const RadialProfile& profile, const ConvolutionSettings& settings,
+                                       const sss::RadialProfile& profile, const ConvolutionSettings& settings,
                                        const std::vector<std::uint32_t>* receivers, ConvolutionReport* report) {
     SKINLAB_CHECK_EQ(irradiance.size(), samples.size());
     const std::size_t count = samples.size();

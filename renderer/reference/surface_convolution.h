@@ -16,7 +16,7 @@
 //
 // r_c is the radius outside which every channel of the profile has at most `cutoffTail` of its energy
 // (default 1e-3, 0.1 %: 8.0 mm for d'Eon's skin profile at width 3 mm).
-#include "renderer/reference/radial_profile.h"
+#include "renderer/sss/radial_profile.h"
 #include "renderer/reference/surface_samples.h"
 
 #include <array>
@@ -59,7 +59,7 @@ struct ConvolutionReport {
 // irradiance: per sample, linear RGB (same size as samples). receivers: indices of the samples to convolve (all
 // samples when null); skin samples not listed keep E·α. Returns the diffuse radiance E·α after SSS per sample.
 std::vector<glm::vec3> convolveSurface(const SurfaceSamples& samples, const std::vector<glm::vec3>& irradiance,
-                                       const RadialProfile& profile, const ConvolutionSettings& settings = {},
+                                       const sss::RadialProfile& profile, const ConvolutionSettings& settings = {},
                                        const std::vector<std::uint32_t>* receivers = nullptr,
                                        ConvolutionReport* report = nullptr);
 

@@ -266,9 +266,10 @@ void readMethodTables(const SpecReader& root, SceneSpec& spec, nlohmann::json& r
     resolved["sss"] = spec.sss.toJson();
     resolved["transmittance"] = spec.transmittance.toJson();
     spec.pathtraced = pathtraced::readPathtracedParams(root);
-    if (spec.sss.method == sss::SssMethod::Pathtraced) resolved["pathtraced"] = spec.pathtraced.toJson();
+    if (sss::methodInfo(spec.sss.method).execution == sss::Execution::Cycles)
+        resolved["pathtraced"] = spec.pathtraced.toJson();
     spec.eevee = pathtraced::readEeveeParams(root);
-    if (spec.sss.method == sss::SssMethod::Eevee) resolved["eevee"] = spec.eevee.toJson();
+    if (sss::methodInfo(spec.sss.method).execution == sss::Execution::Eevee) resolved["eevee"] = spec.eevee.toJson();
 }
 
 // The spec's TOML with the overrides applied, and the folder its relative paths are relative to.

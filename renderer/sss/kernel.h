@@ -46,7 +46,10 @@ struct Kernel {
 // (the remainder is renormalised into the taps): 0.2 %.
 constexpr double kTruncatedTail = 0.002;
 
-// Builds the kernel of `params` (throws InputError for inconsistent parameters, e.g. an unreadable file: profile,
+// Multiplies every tap's offset by `scale` (profile millimetres → surface millimetres: profileScale(width_mm)).
+void scaleOffsets(std::vector<KernelTap>& taps, double scale);
+
+// Builds the kernel of `params` through its method's class (method.h) (throws InputError for inconsistent parameters, e.g. an unreadable file: profile,
 // or a material without a d'Eon profile). Method "none" gives an empty kernel.
 Kernel makeKernel(const SssParams& params);
 

@@ -3,9 +3,12 @@
 // their JSON form (the "resolved" record stored in EXR metadata and manifests). Every key, unit and default is
 // documented in docs/methods.md; the readers throw InputError naming file and key for bad values.
 #include <array>
+#include <functional>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace skinlab {
@@ -14,7 +17,10 @@ class SpecReader;
 
 namespace skinlab::renderer::sss {
 
-enum class SssMethod {
+// The built-in methods' identifiers (rows 0–7 of the method table, in this order). A method added in its own file
+// (docs/methods.md, "Adding a method") needs no enumerator: it gets the next free value from its row's position
+// (registerMethod, method_table.cpp) and code finds it by name (findMethod).
+enum class SssMethod : int {
     None,        // diffuse copied through
     GaussianSum, // Jimenez & Gutierrez 2010: six incremental Gaussian blurs, 12 passes
     Separable,   // Jimenez et al. 2015: two passes with the marginal of a physical profile
@@ -24,6 +30,19 @@ enum class SssMethod {
     Pathtraced,  // Blender Cycles' random walk (renderer/pathtraced; the screen-space stage copies through)
     Eevee,       // Blender EEVEE's screen-space Christensen–Burley SSS (renderer/pathtraced; copies through here too)
 };
+
+// How the renderer runs a method: each value is one code path of the renderer, shared by every method that names it,
+// so a method whose kernel is a set of 1-D taps (TapPasses) needs no renderer code of its own.
+enum class Execution {
+    CopyThrough, // the diffuse buffer copied through (none)
+    TapPasses,   // the method's Kernel through the shared 1-D blur passes (renderer/gl/sss_kernel_method.h) and
+                 // their CPU mirror (cpu_blur.h): gaussian-sum, separable, artistic
+    Pscbf,       // Mikkelsen's own two passes (renderer/gl/pscbf_method.h) on the method's one broad stage
+    ObjectSpace, // on the tessellated surface (renderer/gl/reference_method.h)
+    Cycles,      // Blender Cycles (renderer/pathtraced); the screen-space stage copies through
+    Eevee,       // Blender EEVEE (renderer/pathtraced), likewise
+};
+std::string_view executionName(Execution execution); // "copy-through", "tap-passes", ...
 
 // How a continuous 1-D kernel is discretised into taps (docs/methods.md, "Discretisation").
 enum class TapPlacement {
@@ -40,45 +59,14 @@ enum class PscbfSigma {
     StdDev,   // σ_c = 2.3 / 1.4 / 1.1 mm, v_c = σ_c²
 };
 
-// The method table: one row per SSS method, the single list the CLI (`skinlab methods`), the scene reader, the
-// stimulus specs, `skinlab kernel`, the benchmarks and the tests that cover "every method" iterate
-// (docs/methods.md, "Adding a method"). `keys` are the [sss] keys the method reads besides the keys every method
-// reads (kCommonSssKeys); any other [sss] key given with the method is an error naming the key and the method.
-struct MethodInfo {
-    SssMethod method;
-    std::string_view name;    // sss.method value
-    bool screenSpace;         // runs in the screen-space SSS stage on the frame's buffers (a 1-D tap kernel)
-    bool blurPasses;          // its kernel runs through the shared 1-D blur passes (renderer/gl/sss_blur_pass.h)
-    std::string_view summary; // one line for `skinlab methods`
-    std::vector<std::string_view> keys;
-};
+std::string_view methodName(SssMethod method);
+std::string_view pscbfSigmaName(PscbfSigma reading);
+std::string_view placementName(TapPlacement placement);
 
-// [sss] keys every method reads: the main pass's transmittance scale (width_mm), the curvature AOV's measure and
-// the curvature scale shared by the extensions and the transmittance.
-inline constexpr std::array<std::string_view, 4> kCommonSssKeys{"method", "width_mm", "curvature_measure",
-                                                                "curvature_reference_mm"};
-
-// Every method, in the order of the SssMethod enum.
-const std::vector<MethodInfo>& methodTable();
-const MethodInfo& methodInfo(SssMethod method);
-// nullptr when `name` names no method.
-const MethodInfo* findMethod(std::string_view name);
-// Every method name, in table order (for choices and help texts).
-std::vector<std::string> methodNames();
-// The screen-space methods' names (those the SSS stage runs as tap kernels), in table order.
-std::vector<std::string> screenSpaceMethodNames();
-// The methods whose kernels run through the shared blur passes (and the CPU mirror, renderer/sss/cpu_blur.h).
-std::vector<std::string> blurPassMethodNames();
-// Every [sss] key of any method.
-std::vector<std::string_view> allSssKeys();
-// Whether `method` reads [sss] key `key` (a common key or one of its own).
-bool methodUsesKey(SssMethod method, std::string_view key);
-// "not a parameter of method 'separable' (its keys: ...)": the message of the error for a key `method` does not read.
-std::string notAParameterMessage(SssMethod method);
-
-// The declaration of one key of [sss] or [transmittance]: the reader takes its type, range and choices from here,
-// and `skinlab methods --json` and `skinlab tune` show them, so the three never disagree. Defaults are the
-// default-constructed SssParams / TransmittanceParams (sssKeyDefaults below).
+// The declaration of one key of [sss] or [transmittance]: name, type, range or choices, unit, one-line doc. The
+// reader takes type, range and choices from here, `skinlab methods --json`, `skinlab tune` and the docs' tables show
+// them, so none of them disagree. The default is the value of a default-constructed SssParams / TransmittanceParams
+// (with the method row's overrides, MethodInfo::defaults).
 enum class KeyType { Boolean, Integer, Number, Choice, Vec3, String };
 std::string_view keyTypeName(KeyType type); // "boolean", "integer", "number", "choice", "vec3", "string"
 
@@ -91,22 +79,6 @@ struct KeyInfo {
     std::string_view unit;            // "mm", "1/mm", "" (dimensionless)
     std::string_view doc;             // one line
 };
-
-// Every [sss] key, in reading order; every [transmittance] key.
-const std::vector<KeyInfo>& sssKeyTable();
-const std::vector<KeyInfo>& transmittanceKeyTable();
-// The declaration of an [sss] / [transmittance] key (a check fails for an undeclared name).
-const KeyInfo& sssKey(std::string_view name);
-const KeyInfo& transmittanceKey(std::string_view name);
-// The default of every key `method` reads (the reader's defaults: pscbf's samples is 13, the others' 21).
-nlohmann::json sssKeyDefaults(SssMethod method);
-nlohmann::json transmittanceKeyDefaults();
-// A declaration as JSON: {"name", "type", "min", "max", "choices", "unit", "doc"} (range and choices where they apply).
-nlohmann::json keyInfoJson(const KeyInfo& key);
-
-std::string_view methodName(SssMethod method);
-std::string_view pscbfSigmaName(PscbfSigma reading);
-std::string_view placementName(TapPlacement placement);
 
 // Profile millimetres → surface millimetres. Every profile is tabulated at a width of 3 mm; sss.width_mm is where
 // its kernel edge (±3 profile-mm) lands on the surface (the demo's kernel edge lies at 2 · sssWidth world units,
@@ -175,9 +147,13 @@ struct SssParams {
     // through the part, as it is. Default: fitted to Blender Cycles' random walk on 1 and 2 mm skin fins
     // (scripts/transmittance-calibration.sh; docs/pathtraced.md, "Through-light: calibration").
     std::array<double, 3> referenceThroughGain{1.72, 5.31, 9.44};
+    // Values of the keys a method declares in its own row (MethodInfo::ownKeys), by key; absent: the declared
+    // default. The built-in methods' keys are the typed fields above.
+    nlohmann::json own = nlohmann::json::object();
 
     // The resolved record: the method and the keys it reads (its row of the method table), nothing else.
     nlohmann::json toJson() const;
+    bool operator==(const SssParams&) const = default;
 };
 
 struct TransmittanceParams {
@@ -193,7 +169,102 @@ struct TransmittanceParams {
     std::string curvatureForm = "scale";
 
     nlohmann::json toJson() const;
+    bool operator==(const TransmittanceParams&) const = default;
 };
+
+// A key declaration bound to where its value lives: the reader, toJson() and the defaults go through get/set, so a
+// key is named once, in its table.
+template <class Params>
+struct BoundKey : KeyInfo {
+    std::function<nlohmann::json(const Params&)> get;
+    std::function<void(Params&, const nlohmann::json&)> set;
+};
+using SssKey = BoundKey<SssParams>;
+using TransmittanceKey = BoundKey<TransmittanceParams>;
+
+// A key bound to a field of Params (enumerations through their JSON names).
+template <class Params, class T>
+BoundKey<Params> boundKey(KeyInfo info, T Params::*field) {
+    return {std::move(info), [field](const Params& p) { return nlohmann::json(p.*field); },
+            [field](Params& p, const nlohmann::json& value) { p.*field = value.get<T>(); }};
+}
+// A key a method declares in its own row: its value lives in SssParams::own, `fallback` when absent.
+SssKey ownKey(KeyInfo info, nlohmann::json fallback);
+
+class Method;
+
+// The method table: one row per SSS method, the single list the CLI (`skinlab methods`), the scene reader, the
+// stimulus specs, `skinlab kernel`, the renderer, the benchmarks and the tests that cover "every method" iterate
+// (docs/methods.md, "Adding a method"). `keys` are the shared [sss] keys the method reads besides the keys every
+// method reads (kCommonSssKeys), `ownKeys` the keys only it declares; any other [sss] key given with the method is
+// an error naming the key and the method.
+struct MethodInfo {
+    SssMethod method;      // assigned from the row's position
+    std::string_view name; // sss.method value
+    Execution execution;   // how the renderer runs it
+    std::string_view summary;
+    std::vector<std::string_view> keys;
+    std::vector<SssKey> ownKeys;
+    // Defaults that differ for this method (pscbf: samples = 13, the paper's count).
+    std::vector<std::pair<std::string_view, nlohmann::json>> defaults;
+    // Prepares the method from typed parameters: its kernel (taps, or the source of a method without taps) and its
+    // support radius (renderer/sss/method.h).
+    std::shared_ptr<const Method> model;
+
+    // Runs in the screen-space SSS stage on the frame's buffers (a 1-D tap kernel: TapPasses or Pscbf).
+    bool screenSpace() const { return execution == Execution::TapPasses || execution == Execution::Pscbf; }
+    // Its kernel runs through the shared 1-D blur passes (and the CPU mirror, renderer/sss/cpu_blur.h).
+    bool blurPasses() const { return execution == Execution::TapPasses; }
+};
+
+// [sss] keys every method reads: the main pass's transmittance scale (width_mm), the curvature AOV's measure and
+// the curvature scale shared by the extensions and the transmittance.
+inline constexpr std::array<std::string_view, 4> kCommonSssKeys{"method", "width_mm", "curvature_measure",
+                                                                "curvature_reference_mm"};
+
+// Every method, in table order (the built-ins in the order of the SssMethod enum, then registered ones).
+const std::vector<MethodInfo>& methodTable();
+const MethodInfo& methodInfo(SssMethod method);
+// nullptr when `name` names no method.
+const MethodInfo* findMethod(std::string_view name);
+// Adds a row after the built-in ones (a method defined outside method_table.cpp, e.g. in a test) and returns its
+// identifier. Call before any spec is read (start-up, a test's static set-up): the table is not locked. Throws
+// RuntimeError for a name already taken or a key another row declares differently.
+SssMethod registerMethod(MethodInfo row);
+// Every method name, in table order (for choices and help texts).
+std::vector<std::string> methodNames();
+// The screen-space methods' names (those the SSS stage runs as tap kernels), in table order.
+std::vector<std::string> screenSpaceMethodNames();
+// The methods whose kernels run through the shared blur passes (and the CPU mirror, renderer/sss/cpu_blur.h).
+std::vector<std::string> blurPassMethodNames();
+// Every [sss] key of any method.
+std::vector<std::string_view> allSssKeys();
+// The [sss] keys `method` reads besides "method": the common ones, its shared ones, its own.
+std::vector<std::string_view> methodKeys(SssMethod method);
+// Whether `method` reads [sss] key `key` (a common key or one of its own).
+bool methodUsesKey(SssMethod method, std::string_view key);
+// "not a parameter of method 'separable' (its keys: ...)": the message of the error for a key `method` does not read.
+std::string notAParameterMessage(SssMethod method);
+
+// Every shared [sss] key, in reading order; every [transmittance] key.
+const std::vector<SssKey>& sssKeyTable();
+const std::vector<TransmittanceKey>& transmittanceKeyTable();
+// The declaration of an [sss] key (shared, or a row's own) / a [transmittance] key (a check fails for an undeclared
+// name).
+const SssKey& sssKey(std::string_view name);
+const TransmittanceKey& transmittanceKey(std::string_view name);
+// The default of every key `method` reads (the reader's defaults: pscbf's samples is 13, the others' 21).
+nlohmann::json sssKeyDefaults(SssMethod method);
+nlohmann::json transmittanceKeyDefaults();
+// A declaration as JSON: {"name", "type", "min", "max", "choices", "unit", "doc"} (range and choices where they apply).
+nlohmann::json keyInfoJson(const KeyInfo& key);
+
+NLOHMANN_JSON_SERIALIZE_ENUM(TapPlacement,
+                             {{TapPlacement::Quadratic, "quadratic"}, {TapPlacement::Importance, "importance"}})
+NLOHMANN_JSON_SERIALIZE_ENUM(PscbfSigma, {{PscbfSigma::Variance, "variance"}, {PscbfSigma::StdDev, "std-dev"}})
+// A method as its name (sss.method); reading an unknown name throws InputError.
+void to_json(nlohmann::json& out, SssMethod method);
+void from_json(const nlohmann::json& in, SssMethod& method);
 
 // Jimenez's separable SSS demo steps `sssWidth · (cot(fovY/2) / z) · dir / 3` in UV per kernel unit (its kernel
 // spans ±3), and one UV unit spans 2 · z · tan(fovY/2) world units at linear depth z (vertically), so its kernel edge

@@ -1,7 +1,7 @@
 // The object-space reference convolution (renderer/reference/surface_convolution.h): the profile's radial CDF,
 // the analytic response to a step, convergence with sample density, skin-only scattering.
 #include "common/error.h"
-#include "renderer/reference/radial_profile.h"
+#include "renderer/sss/radial_profile.h"
 #include "renderer/reference/surface_convolution.h"
 #include "renderer/reference/tessellation.h"
 #include "renderer/scene/builtin_geometry.h"
@@ -17,6 +17,8 @@
 
 using namespace skinlab::renderer;
 using namespace skinlab::renderer::reference;
+using skinlab::renderer::sss::makeRadialProfile;
+using skinlab::renderer::sss::RadialProfile;
 
 namespace {
 sss::SssParams profileParams(const std::string& profile, double widthMm = 3.0) {

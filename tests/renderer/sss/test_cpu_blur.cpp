@@ -34,7 +34,7 @@ SssParams method(SssMethod m, int samples = 21) {
 const std::vector<SssMethod> kMethods = [] {
     std::vector<SssMethod> out;
     for (const MethodInfo& info : methodTable())
-        if (info.blurPasses) out.push_back(info.method);
+        if (info.blurPasses()) out.push_back(info.method);
     return out;
 }();
 

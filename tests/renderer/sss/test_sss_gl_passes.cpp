@@ -122,7 +122,7 @@ sss::SurfaceBuffers flatPlane(int width, int height, float pixelsPerMm) {
 const std::vector<sss::SssMethod> kMethods = [] {
     std::vector<sss::SssMethod> out;
     for (const sss::MethodInfo& info : sss::methodTable())
-        if (info.blurPasses) out.push_back(info.method);
+        if (info.blurPasses()) out.push_back(info.method);
     return out;
 }();
 

@@ -5,7 +5,12 @@
 #include "common/spec.h"
 #include "renderer/sss/kernel.h"
 
+#include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
 
 #include <gtest/gtest.h>
 
@@ -230,4 +235,92 @@ TEST(SssParams, MethodTable) {
     }
     EXPECT_EQ(findMethod("blur"), nullptr);
     EXPECT_EQ(screenSpaceMethodNames(), (std::vector<std::string>{"gaussian-sum", "separable", "artistic", "pscbf"}));
+}
+
+namespace {
+// The rows of the markdown table that follows `heading` in docs/methods.md: each row's cells, backticked names only.
+std::vector<std::vector<std::vector<std::string>>> docTableRows(const std::string& heading) {
+    std::ifstream in(std::string(SKINLAB_SOURCE_DIR) + "/docs/methods.md");
+    std::string line;
+    bool inSection = false, inTable = false;
+    std::vector<std::vector<std::vector<std::string>>> rows;
+    while (std::getline(in, line)) {
+        if (line.rfind("## ", 0) == 0) inSection = line.find(heading) != std::string::npos;
+        if (!inSection) continue;
+        if (line.rfind("|", 0) != 0) {
+            if (inTable && !rows.empty()) break; // the first table of the section
+            continue;
+        }
+        inTable = true;
+        if (line.rfind("|---", 0) == 0) continue;
+        std::vector<std::vector<std::string>> cells;
+        std::stringstream row(line.substr(1));
+        std::string cell;
+        while (std::getline(row, cell, '|')) {
+            std::vector<std::string> names;
+            for (std::size_t at = cell.find('`'); at != std::string::npos; at = cell.find('`', at + 1)) {
+                const std::size_t end = cell.find('`', at + 1);
+                if (end == std::string::npos) break;
+                names.push_back(cell.substr(at + 1, end - at - 1));
+                at = end;
+            }
+            if (cell.find("the extension keys") != std::string::npos)
+                for (const char* k :
+                     {"cbf", "cbf_lambda", "lab_weight", "extension_input", "curvature", "curvature_floor"})
+                    names.emplace_back(k);
+            cells.push_back(names);
+        }
+        rows.push_back(cells);
+    }
+    return rows;
+}
+} // namespace
+
+// The docs' key tables follow the declarations: every declared [sss] key has a row in "Parameters: [sss]", and the
+// table of each method's own keys lists exactly the keys its row of the method table declares.
+TEST(SssParams, MethodsPageTablesFollowTheDeclarations) {
+    std::set<std::string> documented;
+    for (const auto& row : docTableRows("Parameters: `[sss]`"))
+        if (!row.empty()) documented.insert(row[0].begin(), row[0].end());
+    ASSERT_FALSE(documented.empty()) << "no [sss] table in docs/methods.md";
+    for (const SssKey& key : sssKeyTable()) EXPECT_TRUE(documented.count(std::string(key.name))) << key.name;
+
+    std::map<std::string, std::set<std::string>> ownKeys; // method → keys, from the page
+    bool found = false;
+    std::ifstream in(std::string(SKINLAB_SOURCE_DIR) + "/docs/methods.md");
+    std::string line;
+    while (std::getline(in, line)) {
+        if (line.rfind("| method | its own keys |", 0) == 0) found = true;
+        if (!found || line.rfind("| `", 0) != 0) {
+            if (found && !ownKeys.empty() && line.rfind("|", 0) != 0) break;
+            continue;
+        }
+        const std::size_t split = line.find('|', 1);
+        std::vector<std::string> methods, keys;
+        for (auto [text, out] :
+             {std::pair{line.substr(1, split - 1), &methods}, std::pair{line.substr(split), &keys}}) {
+            for (std::size_t at = text.find('`'); at != std::string::npos; at = text.find('`', at + 1)) {
+                const std::size_t end = text.find('`', at + 1);
+                const std::string name = text.substr(at + 1, end - at - 1);
+                // Key and method names only (a cell may also name other tables, e.g. `[pathtraced]`).
+                if (name.find_first_not_of("abcdefghijklmnopqrstuvwxyz_-") == std::string::npos) out->push_back(name);
+                at = end;
+            }
+            if (out == &keys && text.find("the extension keys") != std::string::npos)
+                for (const char* k :
+                     {"cbf", "cbf_lambda", "lab_weight", "extension_input", "curvature", "curvature_floor"})
+                    keys.emplace_back(k);
+        }
+        for (const auto& method : methods) ownKeys[method].insert(keys.begin(), keys.end());
+    }
+    ASSERT_TRUE(found) << "no '| method | its own keys |' table in docs/methods.md";
+    for (const MethodInfo& info : methodTable()) {
+        if (static_cast<int>(info.method) > static_cast<int>(SssMethod::Eevee)) continue; // registered by a test
+        ASSERT_TRUE(ownKeys.count(std::string(info.name))) << info.name << " has no row";
+        std::set<std::string> declared;
+        for (const std::string_view key : methodKeys(info.method))
+            if (std::find(kCommonSssKeys.begin(), kCommonSssKeys.end(), key) == kCommonSssKeys.end())
+                declared.emplace(key);
+        EXPECT_EQ(ownKeys.at(std::string(info.name)), declared) << info.name;
+    }
 }

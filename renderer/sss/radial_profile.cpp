@@ -1,4 +1,4 @@
-#include "renderer/reference/radial_profile.h"
+#include "renderer/sss/radial_profile.h"
 
 #include "common/error.h"
 #include "renderer/sss/burley_profile.h"
@@ -8,14 +8,14 @@
 #include <algorithm>
 #include <cmath>
 
-namespace skinlab::renderer::reference {
+namespace skinlab::renderer::sss {
 
 namespace {
 // d'Eon's sum of Gaussians: the radial CDF of G(v, ·) is 1 − exp(−r²/(2v)).
 class GaussianSumRadial final : public RadialProfile {
 public:
     explicit GaussianSumRadial(double scale)
-        : profile_(sss::deonSkinLobes(), "d'Eon six-Gaussian skin profile"), scale_(scale) {
+        : profile_(deonSkinLobes(), "d'Eon six-Gaussian skin profile"), scale_(scale) {
         for (const auto& lobe : profile_.lobes())
             for (int c = 0; c < 3; ++c) totals_[c] += lobe.weight[c];
     }
@@ -32,7 +32,7 @@ public:
     }
 
 private:
-    sss::GaussianSumProfile profile_;
+    GaussianSumProfile profile_;
     std::array<double, 3> totals_{};
     double scale_;
 };
@@ -40,7 +40,7 @@ private:
 class BurleyRadial final : public RadialProfile {
 public:
     BurleyRadial(const std::string& material, double scale)
-        : profile_(sss::burleyShapeMm(material), "Burley normalized diffusion, material " + material), scale_(scale) {}
+        : profile_(burleyShapeMm(material), "Burley normalized diffusion, material " + material), scale_(scale) {}
     std::string description() const override { return profile_.description(); }
     double radial(int channel, double rMm) const override {
         return scale_ * scale_ * profile_.radial(channel, scale_ * rMm);
@@ -50,7 +50,7 @@ public:
     }
 
 private:
-    sss::BurleyProfile profile_;
+    BurleyProfile profile_;
     double scale_;
 };
 } // namespace
@@ -72,14 +72,14 @@ double RadialProfile::cutoffRadiusMm(double tail) const {
     return high;
 }
 
-std::unique_ptr<RadialProfile> makeRadialProfile(const sss::SssParams& params) {
+std::unique_ptr<RadialProfile> makeRadialProfile(const SssParams& params) {
     if (!(params.widthMm > 0.0)) throwInput("", "sss.width_mm", "must be positive");
     // Surface distance d (mm) ↔ profile distance d / profileScale(width_mm) (renderer/sss/sss_params.h).
-    const double scale = sss::kProfileWidthMm / params.widthMm; // 1 / profileScale, as one division
+    const double scale = kProfileWidthMm / params.widthMm; // 1 / profileScale, as one division
     if (params.profile == "deon") return std::make_unique<GaussianSumRadial>(scale);
     if (params.profile == "burley") return std::make_unique<BurleyRadial>(params.material, scale);
     throwInput("", "sss.profile",
                "'" + params.profile + "' has no radial form for the reference method (use deon or burley)");
 }
 
-} // namespace skinlab::renderer::reference
+} // namespace skinlab::renderer::sss

@@ -9,7 +9,7 @@
 #include <memory>
 #include <string>
 
-namespace skinlab::renderer::reference {
+namespace skinlab::renderer::sss {
 
 class RadialProfile {
 public:
@@ -26,6 +26,6 @@ public:
 
 // The profile of `params` (method-independent: only profile, material and width_mm are read). Throws InputError
 // ("sss.profile: ...") for a tabulated profile.
-std::unique_ptr<RadialProfile> makeRadialProfile(const sss::SssParams& params);
+std::unique_ptr<RadialProfile> makeRadialProfile(const SssParams& params);
 
-} // namespace skinlab::renderer::reference
+} // namespace skinlab::renderer::sss

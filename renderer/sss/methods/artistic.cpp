@@ -1,0 +1,26 @@
+// sss.method = "artistic": the kernel of Jimenez's separable SSS demo (per-channel strength and falloff,
+// artistic_kernel.h), one stage run as a horizontal and a vertical pass.
+#include "renderer/sss/artistic_kernel.h"
+#include "renderer/sss/method.h"
+
+namespace skinlab::renderer::sss {
+
+namespace {
+class ArtisticMethod final : public Method {
+public:
+    Kernel kernel(const SssParams& params) const override {
+        KernelStage stage;
+        stage.taps = artisticTaps(params.samples, params.artisticStrength, params.artisticFalloff);
+        scaleOffsets(stage.taps, profileScale(params.widthMm));
+        stage.accumulate = {1.0, 1.0, 1.0};
+        Kernel kernel;
+        kernel.source = "artistic kernel of Jimenez's demo (slice of d'Eon's red lobes 2-6)";
+        kernel.stages.push_back(std::move(stage));
+        return kernel;
+    }
+};
+} // namespace
+
+std::shared_ptr<const Method> makeArtisticMethod() { return std::make_shared<ArtisticMethod>(); }
+
+} // namespace skinlab::renderer::sss

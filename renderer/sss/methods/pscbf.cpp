@@ -1,0 +1,29 @@
+// sss.method = "pscbf" (Mikkelsen 2010): the broad Gaussian part as one stage whose accumulate weights are
+// 1 − spike; the spike (the unblurred centre) is added by its own passes (Execution::Pscbf,
+// renderer/gl/pscbf_method.h). Offsets scale with width_mm / 3 like every profile.
+#include "renderer/sss/method.h"
+#include "renderer/sss/pscbf_kernel.h"
+
+namespace skinlab::renderer::sss {
+
+namespace {
+class PscbfMethod final : public Method {
+public:
+    Kernel kernel(const SssParams& params) const override {
+        const double scale = profileScale(params.widthMm);
+        const PscbfProfile& profile = mikkelsenSkinProfile(params.pscbfSigma);
+        KernelStage stage = makePscbfKernel(profile, params.samples).broadStage();
+        scaleOffsets(stage.taps, scale);
+        Kernel kernel;
+        kernel.source = "Mikkelsen 2010 pseudo-separable cross-bilateral filter (spike + one Gaussian per channel)";
+        // Its filter reaches the disc r_max that bounds it, while its taps sit at cell medians inside it.
+        kernel.declaredSupportMm = profile.maxRadiusMm * scale;
+        kernel.stages.push_back(std::move(stage));
+        return kernel;
+    }
+};
+} // namespace
+
+std::shared_ptr<const Method> makePscbfMethod() { return std::make_shared<PscbfMethod>(); }
+
+} // namespace skinlab::renderer::sss
