@@ -28,10 +28,10 @@ glm::vec3 linearRec709ToLab(const glm::vec3& rgb);
 float labWeight(const glm::vec3& labCentre, const glm::vec3& labTap, float beta);
 
 // --- E1/E2 input (sss.extension_input) ----------------------------------------------------------------------
-// What the CIELAB weight compares and what grey modulates F: the albedo (the thesis' final separable shader; the
-// default) or the lit colour being blurred, i.e. the input of each pass (the thesis text, Eq. 3.13, "the lab color
-// of the image I", its sum-of-Gaussians passes and earlier separable shaders). They differ at shadow terminators,
-// where the lit form also cuts the blur.
+// What the CIELAB weight compares and what grey modulates F: the albedo (the thesis code's later revision, every
+// method; the default) or the lit colour being blurred, i.e. the input of each pass (the thesis as submitted, every
+// method; its text, Eq. 3.13, "the lab color of the image I"). They differ at shadow terminators, where the lit form
+// also cuts the blur.
 enum class ExtensionInput { Albedo, Lit };
 std::string_view extensionInputName(ExtensionInput input);
 ExtensionInput extensionInputFromName(std::string_view name, std::string_view source);

@@ -125,8 +125,8 @@ struct SssParams {
     double cbfLambda = 10.0; // λ, dimensionless (thesis code: 10)
     // E2: CIELAB weight exp(−β ΔE*ab) on the albedos of centre and tap; β in 1/ΔE, 0 = off.
     double labWeight = 0.0;
-    // E1/E2 input: "albedo" (the albedo AOV; the thesis' final separable shader) or "lit" (the colour each pass
-    // blurs; the thesis text, Eq. 3.13, its sum-of-Gaussians passes and earlier separable shaders).
+    // E1/E2 input: "albedo" (the albedo AOV; every method in the thesis code's later revision) or "lit" (the colour
+    // each pass blurs; the thesis text, Eq. 3.13, and every method of its code as submitted).
     std::string extensionInput = "albedo";
     // E3: curvature modulation of the kernel width from the curvature AOV (curvature.Y).
     std::string curvature = "off"; // off | increase | reduce | reduce-floor
