@@ -327,8 +327,6 @@ TransmittanceParams transmittanceParamsFromJson(const nlohmann::json& transmitta
         SpecReader(jsonAsTomlTable(transmittance, source, "transmittance"), std::string(source)));
 }
 
-double widthMmFromDemoSssWidth(double sssWidth, double mmPerUnit) { return 2.0 * sssWidth * mmPerUnit; }
-
 double transmittanceScalePerUnit(double translucency, double widthMm, double mmPerUnit) {
     const double demoSssWidth = widthMm / (2.0 * mmPerUnit); // world units
     return 8.25 * (1.0 - translucency) / demoSssWidth;

@@ -82,7 +82,7 @@ struct KeyInfo {
 
 // Profile millimetres → surface millimetres. Every profile is tabulated at a width of 3 mm; sss.width_mm is where
 // its kernel edge (±3 profile-mm) lands on the surface (the demo's kernel edge lies at 2 · sssWidth world units,
-// widthMmFromDemoSssWidth), so a profile distance o lies at o · profileScale(width_mm) on the surface. The
+// widthMmFromDemoSssWidth in width_conventions.h), so a profile distance o lies at o · profileScale(width_mm) on the surface. The
 // screen-space kernels, the object-space reference, pscbf's depth sigmas, the kernel views and the Blender radii
 // all scale by it.
 constexpr double kProfileWidthMm = 3.0;
@@ -100,7 +100,7 @@ struct SssParams {
     // Physical width of the blur in millimetres on the surface: a kernel offset of o profile-millimetres is placed
     // at o · width_mm / 3 mm on the surface. 3 is the profile's own physical scale (d'Eon, Burley and the tabulated
     // kernels are measured in mm). Jimenez's demo places its kernel edge (±3) at 2 · sssWidth world units, so
-    // width_mm = 2 × sssWidth × mm_per_unit (widthMmFromDemoSssWidth below).
+    // width_mm = 2 × sssWidth × mm_per_unit (widthMmFromDemoSssWidth, width_conventions.h).
     double widthMm = 3.0;
     TapPlacement placement = TapPlacement::Quadratic;
     // Follow-surface correction (Jimenez): per tap s = saturate(k · |Δz| · mm_per_unit), colour = lerp(tap, centre,
@@ -265,13 +265,6 @@ NLOHMANN_JSON_SERIALIZE_ENUM(PscbfSigma, {{PscbfSigma::Variance, "variance"}, {P
 // A method as its name (sss.method); reading an unknown name throws InputError.
 void to_json(nlohmann::json& out, SssMethod method);
 void from_json(const nlohmann::json& in, SssMethod& method);
-
-// Jimenez's separable SSS demo steps `sssWidth · (cot(fovY/2) / z) · dir / 3` in UV per kernel unit (its kernel
-// spans ±3), and one UV unit spans 2 · z · tan(fovY/2) world units at linear depth z (vertically), so its kernel edge
-// lands at 2 · sssWidth world units. In skinlab the edge lies at width_mm, hence width_mm = 2 · sssWidth · mm_per_unit.
-// (The demo steps the same UV length horizontally, so there its edge lies at 2 · aspect · sssWidth; skinlab uses the
-// vertical, aspect-free scale on both axes.)
-double widthMmFromDemoSssWidth(double sssWidth, double mmPerUnit);
 
 // Transmittance thickness scale, per world unit of thickness: the demo's 8.25 (1 − translucency) / sssWidth with
 // sssWidth = width_mm / (2 · mm_per_unit), i.e. mm_per_unit · 16.5 (1 − translucency) / width_mm. The scaled

@@ -2,6 +2,10 @@
 
 namespace skinlab::renderer::sss {
 
+double widthMmFromDemoSssWidth(double sssWidth, double mmPerUnit) {
+    return kDemoEdgePerSssWidth * sssWidth * mmPerUnit;
+}
+
 double widthMmFromThesisSssWidth(double sssWidth, double mmPerUnit, ThesisBlurShader shader) {
     switch (shader) {
     case ThesisBlurShader::Separable: return kThesisSeparableEdgePerSssWidth * sssWidth * mmPerUnit;

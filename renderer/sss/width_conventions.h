@@ -1,9 +1,9 @@
 #pragma once
 // How published screen-space SSS code scales its kernel by `sssWidth`, converted to sss.width_mm, the distance on
-// the surface at which skinlab places the kernel edge (±3 profile-mm, kProfileWidthMm in sss_params.h). Jimenez's
-// separable SSS demo convention, width_mm = 2 · sssWidth · mm_per_unit, is widthMmFromDemoSssWidth() in
-// sss_params.h; the conventions of the thesis "Physically-based rendering of human skin" (master thesis, UPC, 2015),
-// whose shaders were adapted from that demo, are here. docs/methods.md, "sssWidth in millimetres", derives both.
+// the surface at which skinlab places the kernel edge (±3 profile-mm, kProfileWidthMm in sss_params.h): Jimenez's
+// separable SSS demo convention, width_mm = 2 · sssWidth · mm_per_unit (widthMmFromDemoSssWidth), and the conventions
+// of the thesis "Physically-based rendering of human skin" (master thesis, UPC, 2015), whose shaders were adapted
+// from that demo. docs/methods.md, "sssWidth in millimetres", derives both.
 //
 // `sssWidth` is always the value a blur shader receives (its `sssWidth` uniform), in world units. The thesis'
 // application scaled its width slider before passing it on (× 0.9 · 0.7 for the demo's kernel, × 0.9 · 0.2 for the
@@ -36,5 +36,12 @@ constexpr double kThesisGaussianSumEdgePerSssWidth = kDemoEdgePerSssWidth * 0.1 
 // sss.width_mm for a thesis setting: 1.4 · sssWidth · mm_per_unit (Separable), sssWidth · mm_per_unit / 15
 // (GaussianSum). The demo's conversion gives 2 / 1.4 ≈ 1.43 times the width of the first for the same sssWidth.
 double widthMmFromThesisSssWidth(double sssWidth, double mmPerUnit, ThesisBlurShader shader);
+
+// Jimenez's separable SSS demo steps `sssWidth · (cot(fovY/2) / z) · dir / 3` in UV per kernel unit (its kernel
+// spans ±3), and one UV unit spans 2 · z · tan(fovY/2) world units at linear depth z (vertically), so its kernel edge
+// lands at 2 · sssWidth world units. In skinlab the edge lies at width_mm, hence width_mm = 2 · sssWidth · mm_per_unit.
+// (The demo steps the same UV length horizontally, so there its edge lies at 2 · aspect · sssWidth; skinlab uses the
+// vertical, aspect-free scale on both axes.)
+double widthMmFromDemoSssWidth(double sssWidth, double mmPerUnit);
 
 } // namespace skinlab::renderer::sss

@@ -4,6 +4,7 @@
 #include "common/error.h"
 #include "common/spec.h"
 #include "renderer/sss/kernel.h"
+#include "renderer/sss/width_conventions.h"
 
 #include <algorithm>
 #include <cmath>
