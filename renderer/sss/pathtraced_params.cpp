@@ -4,6 +4,8 @@
 #include "common/json_toml.h"
 #include "common/spec.h"
 
+#include <algorithm>
+
 namespace skinlab::renderer::pathtraced {
 
 std::array<double, 3> fittedRadiusMm() {
@@ -11,6 +13,33 @@ std::array<double, 3> fittedRadiusMm() {
     // skin albedo (0.60, 0.42, 0.34); Blender 3.4.1).
     // rms error of the edge response over (0, 8] mm: 0.0068, 0.0036, 0.0050 (docs/pathtraced.md).
     return {8.663, 2.659, 1.998};
+}
+
+const AlbedoRadiusTable& albedoRadiusTable() {
+    // `skinlab pathtraced fit-profile --albedos 0.1,0.2,…,0.9` (256 samples; preliminary).
+    static const AlbedoRadiusTable table{
+        {0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9},
+        {{{19.7967, 16.3893, 13.8965, 11.7947, 10.0947, 8.6005, 7.3470, 6.0287, 5.0054},
+          {4.6873, 3.7176, 3.2840, 2.7636, 2.3876, 1.9668, 1.6638, 1.3729, 1.1117},
+          {2.9323, 2.5078, 2.1392, 1.8643, 1.6079, 1.3213, 1.1122, 0.8895, 0.6975}}}};
+    return table;
+}
+
+double tableRadiusMm(const AlbedoRadiusTable& table, int channel, double albedo) {
+    const std::vector<double>& knots = table.albedo;
+    const std::vector<double>& radius = table.radiusMm[static_cast<std::size_t>(channel)];
+    if (!(albedo > knots.front())) return radius.front(); // NaN too
+    if (albedo >= knots.back()) return radius.back();
+    const auto upper = static_cast<std::size_t>(std::upper_bound(knots.begin(), knots.end(), albedo) - knots.begin());
+    const double t = (albedo - knots[upper - 1]) / (knots[upper] - knots[upper - 1]);
+    return radius[upper - 1] + t * (radius[upper] - radius[upper - 1]);
+}
+
+double radiusAtAlbedoMm(const PathtracedParams& params, int channel, double albedo) {
+    const auto c = static_cast<std::size_t>(channel);
+    if (params.radiusModel != "albedo") return params.radiusMm[c];
+    const AlbedoRadiusTable& table = albedoRadiusTable();
+    return params.radiusMm[c] * tableRadiusMm(table, channel, albedo) / tableRadiusMm(table, channel, kFitAlbedo[c]);
 }
 
 namespace {
@@ -25,6 +54,9 @@ PathtracedParams readTable(const SpecReader& t) {
     if (p.specularSource != "cycles" && p.specularSource != "rasterizer")
         t.fail("specular_source", "'" + p.specularSource + "' is not one of \"cycles\", \"rasterizer\"");
     p.radiusMm = t.vec3("radius_mm", p.radiusMm, 1e-4, 1000.0);
+    p.radiusModel = t.string("radius_model", p.radiusModel);
+    if (p.radiusModel != "albedo" && p.radiusModel != "constant")
+        t.fail("radius_model", "'" + p.radiusModel + "' is not one of \"albedo\", \"constant\"");
     p.environmentShadow = t.boolean("environment_shadow", p.environmentShadow);
     p.sunAngleDeg = t.number("sun_angle_deg", p.sunAngleDeg, 0.0, 90.0);
     p.filterWidthPx = t.number("filter_width_px", p.filterWidthPx, 0.01, 10.0);
@@ -36,12 +68,19 @@ PathtracedParams readTable(const SpecReader& t) {
 } // namespace
 
 nlohmann::json PathtracedParams::toJson() const {
-    return {{"samples", samples},           {"seed", seed},
-            {"max_bounces", maxBounces},    {"sss", sss},
-            {"specular", specular},         {"specular_source", specularSource},
-            {"radius_mm", radiusMm},        {"environment_shadow", environmentShadow},
-            {"sun_angle_deg", sunAngleDeg}, {"filter_width_px", filterWidthPx},
-            {"threads", threads},           {"blender", blender}};
+    return {{"samples", samples},
+            {"seed", seed},
+            {"max_bounces", maxBounces},
+            {"sss", sss},
+            {"specular", specular},
+            {"specular_source", specularSource},
+            {"radius_mm", radiusMm},
+            {"radius_model", radiusModel},
+            {"environment_shadow", environmentShadow},
+            {"sun_angle_deg", sunAngleDeg},
+            {"filter_width_px", filterWidthPx},
+            {"threads", threads},
+            {"blender", blender}};
 }
 
 PathtracedParams readPathtracedParams(const SpecReader& scene) {
