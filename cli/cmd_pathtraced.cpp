@@ -25,14 +25,20 @@ struct FitOptions {
     std::vector<double> albedo;
     std::vector<double> albedos;
     std::string radiusModel = "scaled";
+    bool reuse = false;
 };
 
-nlohmann::json matchJson(const pt::ProfileMatch& m) {
-    return {{"radius_mm", m.radiusMm},
-            {"rms_error", m.rmsError},
-            {"max_error", m.maxError},
-            {"integral_error", m.integralError},
-            {"crossing_0_1_error", m.crossingError}};
+// `scale` (optional): the fitted radii at this colour; radius / fitted − 1 is the error as a scale of the profile.
+nlohmann::json matchJson(const pt::ProfileMatch& m, const std::array<double, 3>* scale = nullptr) {
+    nlohmann::json out = {{"radius_mm", m.radiusMm},
+                          {"rms_error", m.rmsError},
+                          {"max_error", m.maxError},
+                          {"integral_error", m.integralError},
+                          {"crossing_0_1_error", m.crossingError}};
+    if (scale)
+        out["scale_error"] = {m.radiusMm[0] / (*scale)[0] - 1.0, m.radiusMm[1] / (*scale)[1] - 1.0,
+                              m.radiusMm[2] / (*scale)[2] - 1.0};
+    return out;
 }
 
 // The radii pathtraced.radius_model gives at this slab's colour (default radius_mm), per channel.
@@ -45,27 +51,33 @@ std::array<double, 3> modelRadii(const std::string& model, const std::array<doub
     return radius;
 }
 
-void printMatch(const char* name, const pt::ProfileMatch& m) {
+void printMatch(const char* name, const pt::ProfileMatch& m, const std::array<double, 3>* scale = nullptr) {
     std::printf("%-9s radius %7.3f %7.3f %7.3f  rms %.4f %.4f %.4f  integral %+6.1f%% %+6.1f%% %+6.1f%%  "
-                "E=0.1 at %+6.1f%% %+6.1f%% %+6.1f%%\n",
+                "E=0.1 at %+6.1f%% %+6.1f%% %+6.1f%%",
                 name, m.radiusMm[0], m.radiusMm[1], m.radiusMm[2], m.rmsError[0], m.rmsError[1], m.rmsError[2],
                 100.0 * m.integralError[0], 100.0 * m.integralError[1], 100.0 * m.integralError[2],
                 100.0 * m.crossingError[0], 100.0 * m.crossingError[1], 100.0 * m.crossingError[2]);
+    if (scale)
+        std::printf("  scale %+6.1f%% %+6.1f%% %+6.1f%%", 100.0 * (m.radiusMm[0] / (*scale)[0] - 1.0),
+                    100.0 * (m.radiusMm[1] / (*scale)[1] - 1.0), 100.0 * (m.radiusMm[2] / (*scale)[2] - 1.0));
+    std::printf("\n");
 }
 
 // One slab colour: the render (or, in a sweep, the one already in `folder`), the fit, and how the constant and
 // the albedo-driven radii of [pathtraced] match d'Eon at that colour.
-pt::ProfileFit fitOne(const pt::EdgeMeasurementSettings& settings, const std::filesystem::path& folder, bool reuse) {
+pt::ProfileFit fitOne(pt::EdgeMeasurementSettings settings, const std::filesystem::path& folder, bool reuse) {
     ensureDirectory(folder);
-    const bool scaled = settings.radiusTable.is_null();
+    bool scaled = settings.radiusTable.is_null();
     pt::EdgeResponse response;
     nlohmann::json measurement;
     if (reuse && std::filesystem::exists(folder / "edge_response.csv") &&
         std::filesystem::exists(folder / "profile_fit.json")) {
+        // The colour and the radii are the stored measurement's.
         response = pt::readEdgeResponseCsv(folder / "edge_response.csv");
         measurement = nlohmann::json::parse(readFile(folder / "profile_fit.json")).at("measurement");
-        std::printf("albedo %.3f %.3f %.3f: reusing %s\n", settings.albedo[0], settings.albedo[1], settings.albedo[2],
-                    (folder / "edge_response.csv").string().c_str());
+        settings.albedo = measurement.at("albedo").get<std::array<double, 3>>();
+        scaled = !measurement.contains("radius") || !measurement.at("radius").is_object();
+        std::printf("reusing %s\n", (folder / "edge_response.csv").string().c_str());
     } else {
         response = pt::measureEdgeResponse(settings);
         measurement = {{"samples", settings.samples},
@@ -101,11 +113,11 @@ pt::ProfileFit fitOne(const pt::EdgeMeasurementSettings& settings, const std::fi
         const pt::ProfileMatch constant = pt::matchProfile(response, modelRadii("constant", settings.albedo));
         const pt::ProfileMatch albedo = pt::matchProfile(response, modelRadii("albedo", settings.albedo));
         out["fitted"] = matchJson(fitted);
-        out["radius_model_constant"] = matchJson(constant);
-        out["radius_model_albedo"] = matchJson(albedo);
+        out["radius_model_constant"] = matchJson(constant, &fit.radiusMm);
+        out["radius_model_albedo"] = matchJson(albedo, &fit.radiusMm);
         printMatch("fitted", fitted);
-        printMatch("constant", constant);
-        printMatch("albedo", albedo);
+        printMatch("constant", constant, &fit.radiusMm);
+        printMatch("albedo", albedo, &fit.radiusMm);
         pt::writeFitPlot(folder / "profile_fit.png", response, fit);
     } else {
         // Rendered at the table's radii: x is in mm, compared with d'Eon as it is.
@@ -205,7 +217,7 @@ void runFit(FitOptions options) {
         }
         options.settings.radiusTable = {{"albedo", table.albedo}, {"radius", radius}};
     }
-    fitOne(options.settings, options.output, false);
+    fitOne(options.settings, options.output, options.reuse);
 }
 
 } // namespace
@@ -239,6 +251,9 @@ void registerPathtraced(CLI::App& app) {
                     "\"scaled\" (default: radius 1 mm, fitted) or \"albedo\" (render at the radii of "
                     "pathtraced.radius_model = \"albedo\" through Cycles' shader and compare in mm)")
         ->check(CLI::IsMember({"scaled", "albedo"}));
+    fit->add_flag("--reuse", options->reuse,
+                  "Read the edge response from the output folder (a previous run's edge_response.csv and "
+                  "profile_fit.json) instead of rendering: fits and compares again");
     fit->add_option("--blender", options->settings.blender, "The Blender program");
     fit->add_option("--threads", options->settings.threads, "Cycles threads (0: all cores)")
         ->check(CLI::Range(0, 1024));
