@@ -91,7 +91,7 @@ pt::ProfileFit fitOne(pt::EdgeMeasurementSettings settings, const std::filesyste
                        {"render_seconds", response.renderSeconds},
                        {"plateau", response.plateau}};
         std::ostringstream csv;
-        csv << std::setprecision(9) << "x_mm_at_radius_1mm,E_R,E_G,E_B\n";
+        csv << std::setprecision(9) << (scaled ? "x_mm_at_radius_1mm" : "x_mm") << ",E_R,E_G,E_B\n";
         for (std::size_t i = 0; i < response.xMm.size(); ++i)
             csv << response.xMm[i] << "," << response.value[0][i] << "," << response.value[1][i] << ","
                 << response.value[2][i] << "\n";
@@ -120,8 +120,10 @@ pt::ProfileFit fitOne(pt::EdgeMeasurementSettings settings, const std::filesyste
         printMatch("albedo", albedo, &fit.radiusMm);
         pt::writeFitPlot(folder / "profile_fit.png", response, fit);
     } else {
-        // Rendered at the table's radii: x is in mm, compared with d'Eon as it is.
-        const pt::ProfileMatch table = pt::matchProfile(response, {1.0, 1.0, 1.0});
+        // Rendered at the table's radii: x is in mm, compared with d'Eon as it is (the radii shown are the
+        // model's at this colour).
+        pt::ProfileMatch table = pt::matchProfile(response, {1.0, 1.0, 1.0});
+        table.radiusMm = modelRadii("albedo", settings.albedo);
         out["radius_table"] = matchJson(table);
         printMatch("table", table);
         fit.radiusMm = {1.0, 1.0, 1.0};
