@@ -204,6 +204,8 @@ void runFit(FitOptions options) {
     }
     if (!options.albedos.empty()) {
         if (!options.albedo.empty()) throwInput("fit-profile", "--albedos", "cannot be combined with --albedo");
+        if (options.radiusModel != "scaled")
+            throwInput("fit-profile", "--albedos", "fits radii at radius 1 mm: cannot be combined with --radius-model");
         runSweep(options);
         return;
     }
@@ -246,7 +248,8 @@ void registerPathtraced(CLI::App& app) {
         ->check(CLI::Range(0.0, 1.0));
     fit->add_option("--albedos", options->albedos,
                     "Sweep: grey slab colours a1,a2,... (one render each, radius table in radius_table.json; an "
-                    "albedo whose folder already holds a render is not rendered again)")
+                    "albedo whose folder already holds a render is not rendered again; the strip's half length "
+                    "follows the albedo: 1.5 mm below 0.25, 2 mm below 0.55, else 3 mm)")
         ->delimiter(',')
         ->check(CLI::Range(0.0, 1.0));
     fit->add_option("--radius-model", options->radiusModel,
