@@ -123,6 +123,20 @@ nlohmann::json blenderSceneJson(const BlenderSceneInputs& inputs, std::string_vi
              {"specular",
               p.specular && p.specularSource == "cycles" ? principledSpecular(kSkinF0) * m.specularIntensity : 0.0}});
     }
+    // radius_model "albedo" (Cycles only): the shader maps each channel of the subsurface colour through the table
+    // (piecewise linear, constant beyond its ends), already scaled like the constant radius and by radius_mm over
+    // the table's value at the built-in skin's colour (radiusAtAlbedoMm).
+    if (inputs.engine == "cycles" && p.radiusModel == "albedo") {
+        const AlbedoRadiusTable& table = albedoRadiusTable();
+        nlohmann::json radius = nlohmann::json::array();
+        for (int c = 0; c < 3; ++c) {
+            nlohmann::json channel = nlohmann::json::array();
+            for (const double a : table.albedo) channel.push_back(radiusAtAlbedoMm(p, c, a) * radiusScale);
+            radius.push_back(channel);
+        }
+        const nlohmann::json radiusTable = {{"albedo", table.albedo}, {"radius", radius}};
+        for (auto& material : materials) material["radius_table"] = radiusTable;
+    }
     scene["materials"] = materials;
     scene["textures"] = {{"albedo", spec.textures.albedo.string()},
                          {"normal", spec.textures.normal.string()},

@@ -250,6 +250,40 @@ def multiply_color(nodes, links, a, b):
     return node.outputs[0]
 
 
+def piecewise_linear(nodes, links, value, knots, values):
+    # values[0] up to knots[0], values[-1] from knots[-1] on, linear in between: with a = the input clamped to
+    # [knots[0], knots[-1]], values[0] + s_0 (a - knots[0]) + sum over the interior knots of
+    # (s_i - s_(i-1)) max(a - knots[i], 0), s_i the slope after knot i.
+    clamp = nodes.new("ShaderNodeClamp")
+    clamp.clamp_type = "MINMAX"
+    clamp.inputs["Min"].default_value = float(knots[0])
+    clamp.inputs["Max"].default_value = float(knots[-1])
+    links.new(value, clamp.inputs["Value"])
+    a = clamp.outputs["Result"]
+    slopes = [(float(values[i + 1]) - float(values[i])) / (float(knots[i + 1]) - float(knots[i]))
+              for i in range(len(knots) - 1)]
+    result = multiply(nodes, links, multiply(nodes, links, a, float(knots[0]), "SUBTRACT"), slopes[0])
+    result = multiply(nodes, links, result, float(values[0]), "ADD")
+    for i in range(1, len(knots) - 1):
+        hinge = multiply(nodes, links, multiply(nodes, links, a, float(knots[i]), "SUBTRACT"), 0.0, "MAXIMUM")
+        result = multiply(nodes, links, multiply(nodes, links, hinge, slopes[i] - slopes[i - 1]), result, "ADD")
+    return result
+
+
+def radius_from_albedo(nodes, links, albedo, table):
+    # pathtraced.radius_model = "albedo": each channel's radius follows that channel of the subsurface colour
+    # through the table written by skinlab (renderer/sss/pathtraced_params.h, albedoRadiusTable; already scaled).
+    separate = nodes.new("ShaderNodeSeparateColor")
+    separate.mode = "RGB"
+    links.new(albedo, separate.inputs["Color"])
+    combine = nodes.new("ShaderNodeCombineColor")
+    combine.mode = "RGB"
+    for channel in range(3):
+        links.new(piecewise_linear(nodes, links, separate.outputs[channel], table["albedo"],
+                                   table["radius"][channel]), combine.inputs[channel])
+    return combine.outputs["Color"]
+
+
 def build_material(description, textures, engine="cycles"):
     material = bpy.data.materials.new(description["name"])
     material.use_nodes = True
@@ -290,6 +324,9 @@ def build_material(description, textures, engine="cycles"):
     # EEVEE ignores the method: its kernel is always Christensen-Burley's (docs/pathtraced.md, "EEVEE").
     bsdf.subsurface_method = "BURLEY" if engine == "eevee" else "RANDOM_WALK_FIXED_RADIUS"
     bsdf.inputs["Subsurface Radius"].default_value = tuple(float(r) for r in description["radius"])
+    if description.get("radius_table") and engine != "eevee":
+        links.new(radius_from_albedo(nodes, links, albedo, description["radius_table"]),
+                  bsdf.inputs["Subsurface Radius"])
     if description["sss"]:
         links.new(mask, bsdf.inputs["Subsurface"])
     else:
@@ -536,8 +573,8 @@ def render_profile(path):
     size = float(description["slab_size"])
     slab = box("slab", (-size, -size, -size), (size, size, 0.0))
     material = build_material({"name": "skin", "skin": 1.0, "albedo": description["albedo"],
-                               "radius": description["radius"], "sss": True, "roughness": 0.5,
-                               "specular": 0.0}, {})
+                               "radius": description["radius"], "radius_table": description.get("radius_table"),
+                               "sss": True, "roughness": 0.5, "specular": 0.0}, {})
     slab.data.materials.append(material)
     scene.collection.objects.link(slab)
     # The plate: black, casts the shadow, invisible to camera rays.

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace skinlab::renderer::pathtraced {
 
@@ -29,6 +30,7 @@ EdgeResponse measureEdgeResponse(const EdgeMeasurementSettings& s) {
                                           {"threads", s.threads}}},
                                         {"albedo", s.albedo},
                                         {"radius", {1.0, 1.0, 1.0}},
+                                        {"radius_table", s.radiusTable},
                                         {"slab_size", 20.0 * s.halfLengthMm},
                                         {"strip_length", 2.0 * s.halfLengthMm},
                                         {"strip_centre", 0.0},
@@ -188,6 +190,122 @@ ProfileFit fitRadii(const EdgeResponse& response, const std::array<double, 3>& i
             fitErrors(response, c, initialRadiusMm[static_cast<std::size_t>(c)], range, step).rms;
     }
     return fit;
+}
+
+double deonEdgeIntegral(int channel) {
+    double integral = 0.0;
+    for (const sss::GaussianLobe& lobe : sss::deonSkinLobes())
+        integral += lobe.weight[static_cast<std::size_t>(channel)] * std::sqrt(lobe.varianceMm2) /
+                    std::sqrt(2.0 * 3.14159265358979323846);
+    return integral;
+}
+
+double deonCrossing(int channel, double level) {
+    double low = 0.0, high = 100.0; // E decreases from ½ at 0
+    for (int i = 0; i < 100; ++i) {
+        const double middle = 0.5 * (low + high);
+        (deonEdgeResponse(channel, middle) > level ? low : high) = middle;
+    }
+    return 0.5 * (low + high);
+}
+
+double edgeIntegral(const EdgeResponse& response, int channel, double radiusMm) {
+    const auto& values = response.value[static_cast<std::size_t>(channel)];
+    const double pixel = response.xMm.size() > 1 ? response.xMm[1] - response.xMm[0] : 2.0 * response.xMm.front();
+    double sum = 0.0;
+    for (const double v : values) sum += v;
+    return radiusMm * sum * pixel;
+}
+
+double edgeCrossing(const EdgeResponse& response, int channel, double radiusMm, double level) {
+    const auto& values = response.value[static_cast<std::size_t>(channel)];
+    const auto& xs = response.xMm;
+    double previousX = 0.0, previousE = 0.5;
+    for (std::size_t k = 0; k < values.size(); ++k) {
+        if (values[k] <= level) {
+            const double t = previousE == values[k] ? 0.0 : (previousE - level) / (previousE - values[k]);
+            return radiusMm * (previousX + t * (xs[k] - previousX));
+        }
+        previousX = xs[k];
+        previousE = values[k];
+    }
+    return radiusMm * xs.back();
+}
+
+ProfileMatch matchProfile(const EdgeResponse& response, const std::array<double, 3>& radiusMm, double range,
+                          double step) {
+    ProfileMatch match;
+    match.radiusMm = radiusMm;
+    for (int c = 0; c < 3; ++c) {
+        const auto i = static_cast<std::size_t>(c);
+        const Errors e = fitErrors(response, c, radiusMm[i], range, step);
+        match.rmsError[i] = e.rms;
+        match.maxError[i] = e.max;
+        match.integralError[i] = edgeIntegral(response, c, radiusMm[i]) / deonEdgeIntegral(c) - 1.0;
+        match.crossingError[i] = edgeCrossing(response, c, radiusMm[i], 0.1) / deonCrossing(c, 0.1) - 1.0;
+    }
+    return match;
+}
+
+std::vector<double> smoothRadii(const std::vector<double>& albedo, const std::vector<double>& radiusMm, int degree,
+                                double* rmsLogResidual) {
+    const std::size_t n = albedo.size(), m = static_cast<std::size_t>(degree) + 1;
+    if (radiusMm.size() != n || n < m) throw InputError("smoothRadii: need at least degree + 1 albedos and radii");
+    // Normal equations in t = albedo mapped onto [−1, 1] (well conditioned for the small degrees used).
+    const double low = *std::min_element(albedo.begin(), albedo.end());
+    const double high = *std::max_element(albedo.begin(), albedo.end());
+    auto toT = [&](double a) { return high > low ? 2.0 * (a - low) / (high - low) - 1.0 : 0.0; };
+    std::vector<std::vector<double>> a(m, std::vector<double>(m + 1, 0.0));
+    for (std::size_t k = 0; k < n; ++k) {
+        std::vector<double> power(m, 1.0);
+        for (std::size_t i = 1; i < m; ++i) power[i] = power[i - 1] * toT(albedo[k]);
+        for (std::size_t i = 0; i < m; ++i) {
+            for (std::size_t j = 0; j < m; ++j) a[i][j] += power[i] * power[j];
+            a[i][m] += power[i] * std::log(radiusMm[k]);
+        }
+    }
+    for (std::size_t i = 0; i < m; ++i) { // Gauss-Jordan with partial pivoting
+        std::size_t pivot = i;
+        for (std::size_t r = i + 1; r < m; ++r)
+            if (std::abs(a[r][i]) > std::abs(a[pivot][i])) pivot = r;
+        std::swap(a[i], a[pivot]);
+        if (a[i][i] == 0.0) throw InputError("smoothRadii: the albedos do not determine the polynomial");
+        for (std::size_t r = 0; r < m; ++r) {
+            if (r == i) continue;
+            const double f = a[r][i] / a[i][i];
+            for (std::size_t c = i; c <= m; ++c) a[r][c] -= f * a[i][c];
+        }
+    }
+    std::vector<double> smoothed;
+    double squares = 0.0;
+    for (std::size_t k = 0; k < n; ++k) {
+        double value = 0.0, power = 1.0;
+        for (std::size_t i = 0; i < m; ++i) value += a[i][m] / a[i][i] * power, power *= toT(albedo[k]);
+        squares += (std::log(radiusMm[k]) - value) * (std::log(radiusMm[k]) - value);
+        smoothed.push_back(std::exp(value));
+    }
+    if (rmsLogResidual) *rmsLogResidual = std::sqrt(squares / static_cast<double>(n));
+    return smoothed;
+}
+
+EdgeResponse readEdgeResponseCsv(const std::filesystem::path& path) {
+    const std::string text = readFile(path);
+    EdgeResponse response;
+    std::size_t line = 0, start = 0;
+    while (start < text.size()) {
+        std::size_t end = text.find('\n', start);
+        if (end == std::string::npos) end = text.size();
+        const std::string row = text.substr(start, end - start);
+        start = end + 1;
+        if (line++ == 0 || row.empty()) continue; // the header
+        std::array<double, 4> v{};
+        if (std::sscanf(row.c_str(), "%lf,%lf,%lf,%lf", &v[0], &v[1], &v[2], &v[3]) != 4)
+            throw InputError(path.string() + ":" + std::to_string(line) + ": expected x,E_R,E_G,E_B");
+        response.xMm.push_back(v[0]);
+        for (std::size_t c = 0; c < 3; ++c) response.value[c].push_back(v[c + 1]);
+    }
+    if (response.xMm.size() < 2) throw InputError(path.string() + ": fewer than two rows");
+    return response;
 }
 
 void writeFitPlot(const std::filesystem::path& path, const EdgeResponse& response, const ProfileFit& fit,

@@ -27,6 +27,10 @@ struct EdgeMeasurementSettings {
     // beyond 1 mm, so ±4 mm holds the whole response at 0.004 mm pixels.
     double halfLengthMm = 4.0;
     std::array<double, 3> albedo{0.60, 0.42, 0.34}; // subsurface colour (the built-in scenes' skin)
+    // Empty: radius 1 mm in every channel (the scale-free measurement). Otherwise the radius comes from the
+    // subsurface colour through this table, as pathtraced.radius_model = "albedo" builds it (keys "albedo": knots,
+    // "radius": three lists of mm), and x is in mm: an end-to-end check of the shader's table.
+    nlohmann::json radiusTable;
     std::string blender = "blender";
     int threads = 0;
 };
@@ -64,6 +68,35 @@ struct ProfileFit {
     std::array<double, 3> maxError{};
     std::array<double, 3> initialRmsError{}; // the same with the radii before the fit (for comparison)
 };
+
+// How well E_1(x / r) at given radii matches d'Eon, per channel: the RMS and largest difference over (0, range]
+// mm (as fitRadii measures them), and two widths relative to d'Eon's (ratio − 1): the integral ∫_0^∞ E dx (the
+// mean distance light crosses the edge by) and the distance at which E falls to 0.1.
+struct ProfileMatch {
+    std::array<double, 3> radiusMm{};
+    std::array<double, 3> rmsError{};
+    std::array<double, 3> maxError{};
+    std::array<double, 3> integralError{};
+    std::array<double, 3> crossingError{};
+};
+ProfileMatch matchProfile(const EdgeResponse& response, const std::array<double, 3>& radiusMm, double fitRangeMm = 8.0,
+                          double stepMm = 0.01);
+// d'Eon's widths: ∫_0^∞ E_dEon dx = Σ w_i σ_i / √(2π), and the x where E_dEon = level.
+double deonEdgeIntegral(int channel);
+double deonCrossing(int channel, double level);
+// The walk's: r · ∫ E_1 (midpoint rule over the pixels), and r · the first x where E_1 (interpolated) ≤ level.
+double edgeIntegral(const EdgeResponse& response, int channel, double radiusMm);
+double edgeCrossing(const EdgeResponse& response, int channel, double radiusMm, double level);
+
+// A least-squares polynomial of degree `degree` in albedo through ln r (the per-albedo fits of a sweep), evaluated at
+// the same albedos: smooths the fits' noise along the albedo. `rmsLogResidual` (optional) gets the RMS of
+// ln r − polynomial, i.e. the relative residual.
+std::vector<double> smoothRadii(const std::vector<double>& albedo, const std::vector<double>& radiusMm, int degree,
+                                double* rmsLogResidual = nullptr);
+
+// The edge response as fit-profile writes it (edge_response.csv: x_mm_at_radius_1mm,E_R,E_G,E_B), for a sweep
+// that resumes from the renders it already made.
+EdgeResponse readEdgeResponseCsv(const std::filesystem::path& path);
 
 // Fits the radius of each channel (golden-section search on log r after a coarse scan).
 ProfileFit fitRadii(const EdgeResponse& response, const std::array<double, 3>& initialRadiusMm, double fitRangeMm = 8.0,

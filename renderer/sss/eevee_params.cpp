@@ -56,6 +56,7 @@ PathtracedParams EeveeParams::sceneParams() const {
     p.specular = specular;
     p.specularSource = specularSource == "rasterizer" ? "rasterizer" : "cycles"; // "rasterizer": Principled specular 0
     p.radiusMm = radiusMm;
+    p.radiusModel = "constant"; // EEVEE's Burley kernel has its own fitted radii (one per channel)
     p.environmentShadow = true; // one pass: EEVEE's world light is unshadowed anyway (no ambient occlusion)
     p.sunAngleDeg = 0.0;
     p.filterWidthPx = filterWidthPx;

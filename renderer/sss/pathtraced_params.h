@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace skinlab {
 class SpecReader;
@@ -20,6 +21,20 @@ namespace skinlab::renderer::pathtraced {
 // The values and the measurement that produced them: pathtraced_params.cpp.
 std::array<double, 3> fittedRadiusMm();
 
+// The subsurface colour the single-albedo fit above was made at (the built-in scenes' skin).
+inline constexpr std::array<double, 3> kFitAlbedo{0.60, 0.42, 0.34};
+
+// A random walk's profile width depends on the albedo at a fixed radius, d'Eon's profile does not: the radius that
+// matches d'Eon per channel as a function of the subsurface colour a of that channel (grey slabs, one render per
+// albedo: `skinlab pathtraced fit-profile --albedos`, docs/pathtraced.md "Matched profiles"). Piecewise linear in a
+// between the knots, constant beyond the first and the last. Values: pathtraced_params.cpp.
+struct AlbedoRadiusTable {
+    std::vector<double> albedo;                  // knots, ascending
+    std::array<std::vector<double>, 3> radiusMm; // per channel, one per knot (mm at sss.width_mm = 3)
+};
+const AlbedoRadiusTable& albedoRadiusTable();
+double tableRadiusMm(const AlbedoRadiusTable& table, int channel, double albedo);
+
 struct PathtracedParams {
     int samples = 64;     // camera samples per pixel (no adaptive sampling, no denoising)
     int seed = 0;         // Cycles' sampling seed
@@ -31,8 +46,12 @@ struct PathtracedParams {
     // the same camera), so that a reference differs from a screen-space render in the subsurface transport only.
     std::string specularSource = "cycles";
     // Random-walk radii per channel (mm) at the profile's own scale; scaled by sss.width_mm / 3 like every
-    // screen-space kernel, then divided by mm_per_unit (Cycles takes them in scene units).
+    // screen-space kernel, then divided by mm_per_unit (Cycles takes them in scene units). With radiusModel
+    // "albedo" it is the radius at the built-in skin's colour kFitAlbedo (radiusAtAlbedoMm).
     std::array<double, 3> radiusMm = fittedRadiusMm();
+    // "albedo": the radius of each channel follows the subsurface colour per texel through albedoRadiusTable()
+    // (Cycles evaluates the table in the shader); "constant": radiusMm everywhere, whatever the colour.
+    std::string radiusModel = "albedo";
     // false: the environment lights every point as if nothing occluded it (objects cast no shadow on its light;
     // lights keep theirs), as the rasterizer's SH ambient term does: Cycles then renders the lights and the
     // environment in two passes and sums them. true: the environment is shadowed like any light.
@@ -44,6 +63,11 @@ struct PathtracedParams {
 
     nlohmann::json toJson() const;
 };
+
+// The radius (mm at sss.width_mm = 3) of channel c where the subsurface colour of that channel is `albedo`:
+// "constant": radiusMm[c]; "albedo": radiusMm[c] · T_c(albedo) / T_c(kFitAlbedo[c]) with T = albedoRadiusTable(),
+// so radius_mm is the radius at the built-in skin's colour and a per-channel multiplier of the table elsewhere.
+double radiusAtAlbedoMm(const PathtracedParams& params, int channel, double albedo);
 
 // Reads the [pathtraced] table of a scene spec (read and finished here). Defaults for absent keys; InputError
 // naming file and key for bad ones.

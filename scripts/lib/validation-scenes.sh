@@ -4,7 +4,9 @@
 
 # Settings shared by every scene: the SSS width, and the path tracer set to agree with the rasterizer everywhere
 # but in the subsurface transport: no interreflection, a hard sun, pixel-centre sampling, and the rasterizer's
-# specular layer (docs/pathtraced.md, "Rasterizer and Cycles").
+# specular layer (docs/pathtraced.md, "Rasterizer and Cycles"). The figures in the docs were measured with the
+# constant random-walk radius (radius_model = "constant"); "albedo" would match d'Eon's width at every skin colour
+# (docs/pathtraced.md, "Matched profiles") and changes the head and scan cases.
 common_tail() {
   cat <<EOF
 
@@ -26,6 +28,7 @@ sun_angle_deg = 0.0
 filter_width_px = 0.01
 specular_source = "rasterizer"
 environment_shadow = false
+radius_model = "constant"
 EOF
 }
 

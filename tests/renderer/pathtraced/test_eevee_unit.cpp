@@ -115,6 +115,12 @@ TEST(EeveeScene, EngineSettingsAndRadii) {
     for (int c = 0; c < 3; ++c)
         EXPECT_NEAR(json.at("materials").at(0).at("radius").at(c).get<double>(),
                     fittedEeveeRadiusMm()[static_cast<std::size_t>(c)] * 2.0 / spec.mmPerUnit, 1e-9);
+    // EEVEE's kernel has one radius per channel: no albedo table (pathtraced.radius_model is Cycles').
+    EXPECT_EQ(params.sceneParams().radiusModel, "constant");
+    for (const auto& material : json.at("materials")) EXPECT_FALSE(material.contains("radius_table"));
+    inputs.params.radiusModel = "albedo";
+    for (const auto& material : blenderSceneJson(inputs, "mesh.bin", "cycles.exr", "cycles.json").at("materials"))
+        EXPECT_FALSE(material.contains("radius_table"));
 }
 
 TEST(EeveeProfile, EdgeResponseOfTheBurleyKernel) {

@@ -1,9 +1,10 @@
 // sss.method = "pathtraced" end to end with the real Blender (Cycles on the CPU) at tiny sizes: the EXR layout and
 // metadata, mask and depth against the rasterizer with the same camera, energy on a uniformly lit slab, the same
-// image from the same inputs, the profile fit, and the errors when Blender is missing. Skips when the program
+// image from the same inputs, the profile fit, the albedo-driven radius, and the errors when Blender is missing. Skips when the program
 // `blender` is not installed (scripts/install-deps.sh installs it).
 #include "../gl/render_test_support.h"
 #include "renderer/pathtraced/blender_process.h"
+#include "renderer/pathtraced/profile_fit.h"
 
 #include <gtest/gtest.h>
 
@@ -340,4 +341,32 @@ TEST(PathtracedCli, ProfileFitAtATinySize) {
     EXPECT_GT(fit.at("radius_mm").at(1).get<double>(), fit.at("radius_mm").at(2).get<double>());
     EXPECT_TRUE(std::filesystem::is_regular_file(folder / "fit" / "profile_fit.png"));
     EXPECT_TRUE(std::filesystem::is_regular_file(folder / "fit" / "edge_response.csv"));
+}
+
+TEST(PathtracedRender, AlbedoRadiusTableDrivesTheWalkRadius) {
+    SKINLAB_REQUIRE_BLENDER();
+    // pathtraced.radius_model = "albedo": the shader maps each channel of the subsurface colour through the table
+    // (cycles_scene.py, radius_from_albedo). A table through (0.2, 1 mm) and (0.6, 2 mm) on a slab of colour
+    // (0.2, 0.4, 0.6) must give radii (1, 1.5, 2) mm, as a flat table with those values does (the same seed: the
+    // same paths), and a flat table at twice those radii doubles the width ∫E of the edge response.
+    pathtraced::EdgeMeasurementSettings s;
+    s.samples = 16;
+    s.pixels = 256;
+    s.rows = 4;
+    s.halfLengthMm = 8.0;
+    s.albedo = {0.2, 0.4, 0.6};
+    s.radiusTable = {{"albedo", {0.2, 0.6}}, {"radius", {{1.0, 2.0}, {1.0, 2.0}, {1.0, 2.0}}}};
+    const pathtraced::EdgeResponse ramp = pathtraced::measureEdgeResponse(s);
+    s.radiusTable = {{"albedo", {0.2, 0.6}}, {"radius", {{1.0, 1.0}, {1.5, 1.5}, {2.0, 2.0}}}};
+    const pathtraced::EdgeResponse flat = pathtraced::measureEdgeResponse(s);
+    s.radiusTable = {{"albedo", {0.2, 0.6}}, {"radius", {{2.0, 2.0}, {3.0, 3.0}, {4.0, 4.0}}}};
+    const pathtraced::EdgeResponse wide = pathtraced::measureEdgeResponse(s);
+    for (int c = 0; c < 3; ++c) {
+        const double widthRamp = pathtraced::edgeIntegral(ramp, c, 1.0);
+        const double widthFlat = pathtraced::edgeIntegral(flat, c, 1.0);
+        const double widthWide = pathtraced::edgeIntegral(wide, c, 1.0);
+        std::printf("channel %d: ∫E ramp %.4f flat %.4f twice %.4f mm\n", c, widthRamp, widthFlat, widthWide);
+        EXPECT_NEAR(widthRamp / widthFlat, 1.0, 0.03) << c;
+        EXPECT_NEAR(widthWide / widthFlat, 2.0, 0.3) << c;
+    }
 }

@@ -1,6 +1,7 @@
 // renderer/pathtraced without Blender: the parameters, the scene written for Blender (lights in Blender's units,
 // the environment lookup, open and closed surfaces), the child process's errors, and the profile-fit arithmetic.
 #include "common/error.h"
+#include "common/files.h"
 #include "renderer/pathtraced/blender_process.h"
 #include "renderer/pathtraced/blender_scene.h"
 #include "renderer/pathtraced/cycles_render.h"
@@ -186,6 +187,121 @@ TEST(BlenderScene, PartsAndRadii) {
     EXPECT_NEAR(wide.json.at("materials").at(0).at("radius").at(2).get<double>(), 1.0 * 2.0 / 2.0, 1e-9);
 }
 
+TEST(PathtracedParams, RadiusModelKeyIsStrict) {
+    // Default "albedo", recorded in the resolved parameters and the JSON form; anything else names file and key.
+    const SceneSpec spec = loadSceneSpec("builtin:halo", {"sss.method=\"pathtraced\""}, {});
+    EXPECT_EQ(spec.pathtraced.radiusModel, "albedo");
+    EXPECT_EQ(spec.resolved.at("pathtraced").at("radius_model"), "albedo");
+    EXPECT_EQ(loadSceneSpec("builtin:halo", {"pathtraced.radius_model=\"constant\""}, {}).pathtraced.radiusModel,
+              "constant");
+    const std::string bad = errorOf([] { loadSceneSpec("builtin:halo", {"pathtraced.radius_model=\"linear\""}, {}); });
+    EXPECT_NE(bad.find("pathtraced.radius_model"), std::string::npos) << bad;
+    EXPECT_NE(bad.find("linear"), std::string::npos) << bad;
+    EXPECT_EQ(bad.find('\n'), std::string::npos) << bad;
+    const std::string number = errorOf([] { loadSceneSpec("builtin:halo", {"pathtraced.radius_model=1"}, {}); });
+    EXPECT_NE(number.find("pathtraced.radius_model"), std::string::npos) << number;
+    PathtracedParams p;
+    p.radiusModel = "constant";
+    EXPECT_EQ(p.toJson().at("radius_model"), "constant");
+    EXPECT_EQ(pathtracedParamsFromJson(p.toJson()).radiusModel, "constant");
+    const std::string json = errorOf([] { pathtracedParamsFromJson({{"radius_model", "table"}}, "scene.json"); });
+    EXPECT_NE(json.find("radius_model"), std::string::npos) << json;
+}
+
+TEST(PathtracedParams, AlbedoRadiusTableIsPiecewiseLinearAndClamped) {
+    const AlbedoRadiusTable& table = albedoRadiusTable();
+    ASSERT_GE(table.albedo.size(), 2u);
+    // It covers at least 0.1 … 0.9, in ascending albedo.
+    EXPECT_LE(table.albedo.front(), 0.1 + 1e-12);
+    EXPECT_GE(table.albedo.back(), 0.9 - 1e-12);
+    for (std::size_t k = 1; k < table.albedo.size(); ++k) EXPECT_GT(table.albedo[k], table.albedo[k - 1]);
+    for (int c = 0; c < 3; ++c) {
+        const auto& radius = table.radiusMm[static_cast<std::size_t>(c)];
+        ASSERT_EQ(radius.size(), table.albedo.size());
+        for (std::size_t k = 0; k < table.albedo.size(); ++k) {
+            // The values at the knots, and linear between neighbours.
+            EXPECT_DOUBLE_EQ(tableRadiusMm(table, c, table.albedo[k]), radius[k]);
+            if (k + 1 < table.albedo.size()) {
+                const double middle = 0.5 * (table.albedo[k] + table.albedo[k + 1]);
+                EXPECT_NEAR(tableRadiusMm(table, c, middle), 0.5 * (radius[k] + radius[k + 1]), 1e-12);
+                // A brighter walk scatters further: the matched radius falls with the albedo.
+                EXPECT_LT(radius[k + 1], radius[k]) << c << " at " << table.albedo[k];
+            }
+        }
+        // Constant beyond the ends (NaN takes the first value).
+        EXPECT_DOUBLE_EQ(tableRadiusMm(table, c, 0.0), radius.front());
+        EXPECT_DOUBLE_EQ(tableRadiusMm(table, c, -1.0), radius.front());
+        EXPECT_DOUBLE_EQ(tableRadiusMm(table, c, 1.0), radius.back());
+        EXPECT_DOUBLE_EQ(tableRadiusMm(table, c, 5.0), radius.back());
+        EXPECT_DOUBLE_EQ(tableRadiusMm(table, c, std::nan("")), radius.front());
+        // Red scatters furthest at every albedo, blue least.
+        if (c > 0) {
+            for (double a = 0.0; a <= 1.0; a += 0.01)
+                EXPECT_GT(tableRadiusMm(table, c - 1, a), tableRadiusMm(table, c, a)) << c << " at " << a;
+        }
+    }
+    // The table agrees with the single-albedo fit at the built-in skin's colour (the fits' noise: a few %).
+    for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(tableRadiusMm(table, c, kFitAlbedo[static_cast<std::size_t>(c)]) /
+                        fittedRadiusMm()[static_cast<std::size_t>(c)],
+                    1.0, 0.05)
+            << c;
+}
+
+TEST(PathtracedParams, RadiusAtAlbedoFollowsTheModel) {
+    const AlbedoRadiusTable& table = albedoRadiusTable();
+    PathtracedParams albedo; // default: the albedo model
+    PathtracedParams constant;
+    constant.radiusModel = "constant";
+    for (int c = 0; c < 3; ++c) {
+        const auto i = static_cast<std::size_t>(c);
+        // radius_mm is the radius at the built-in skin's colour in both models.
+        EXPECT_NEAR(radiusAtAlbedoMm(albedo, c, kFitAlbedo[i]), albedo.radiusMm[i], 1e-12);
+        EXPECT_DOUBLE_EQ(radiusAtAlbedoMm(constant, c, kFitAlbedo[i]), constant.radiusMm[i]);
+        for (const double a : {0.05, 0.1, 0.3, 0.5, 0.8, 0.9, 1.0}) {
+            EXPECT_DOUBLE_EQ(radiusAtAlbedoMm(constant, c, a), constant.radiusMm[i]);
+            // Elsewhere the table's shape, scaled by radius_mm over its value at the skin's colour.
+            EXPECT_NEAR(radiusAtAlbedoMm(albedo, c, a),
+                        albedo.radiusMm[i] * tableRadiusMm(table, c, a) / tableRadiusMm(table, c, kFitAlbedo[i]),
+                        1e-12);
+        }
+        // Darker skin: a longer radius than the constant one; lighter: a shorter one.
+        EXPECT_GT(radiusAtAlbedoMm(albedo, c, 0.2), radiusAtAlbedoMm(constant, c, 0.2));
+        EXPECT_LT(radiusAtAlbedoMm(albedo, c, 0.9), radiusAtAlbedoMm(constant, c, 0.9));
+        // radius_mm multiplies the whole curve.
+        PathtracedParams doubled = albedo;
+        doubled.radiusMm[i] *= 2.0;
+        EXPECT_NEAR(radiusAtAlbedoMm(doubled, c, 0.3), 2.0 * radiusAtAlbedoMm(albedo, c, 0.3), 1e-12);
+    }
+}
+
+TEST(BlenderScene, AlbedoRadiusModelWritesTheScaledTable) {
+    // radius_model "albedo" (default): every material carries the table, scaled like the constant radius
+    // (width_mm / 3 / mm_per_unit) and by radius_mm over the table at the skin's colour; "constant": none.
+    const Exported wide = exportScene("builtin:halo", {"sss.width_mm=6.0", "mm_per_unit=2.0"});
+    const AlbedoRadiusTable& table = albedoRadiusTable();
+    const PathtracedParams defaults;
+    ASSERT_FALSE(wide.json.at("materials").empty());
+    for (const auto& material : wide.json.at("materials")) {
+        ASSERT_TRUE(material.contains("radius_table")) << material.dump();
+        const auto& written = material.at("radius_table");
+        EXPECT_EQ(written.at("albedo").get<std::vector<double>>(), table.albedo);
+        for (int c = 0; c < 3; ++c)
+            for (std::size_t k = 0; k < table.albedo.size(); ++k)
+                EXPECT_NEAR(written.at("radius").at(c).at(k).get<double>(),
+                            radiusAtAlbedoMm(defaults, c, table.albedo[k]) * 6.0 / 3.0 / 2.0, 1e-9);
+        // The constant radius stays (the value at the skin's colour, what EEVEE and radius_model "constant" use).
+        EXPECT_NEAR(material.at("radius").at(0).get<double>(), defaults.radiusMm[0] * 6.0 / 3.0 / 2.0, 1e-9);
+    }
+    const Exported constant = exportScene("builtin:halo", {"pathtraced.radius_model=\"constant\""});
+    for (const auto& material : constant.json.at("materials")) EXPECT_FALSE(material.contains("radius_table"));
+    // The script maps the subsurface colour through the table into the Subsurface Radius input.
+    const std::string_view script = cyclesScript();
+    EXPECT_NE(script.find("radius_from_albedo(nodes, links, albedo, description[\"radius_table\"])"),
+              std::string_view::npos);
+    EXPECT_NE(script.find("bsdf.inputs[\"Subsurface Radius\"]"), std::string_view::npos);
+}
+
 TEST(BlenderProcess, MissingAndFailingProgramsAreOneLineErrors) {
     const std::filesystem::path folder = makeWorkFolder("skinlab-test-process");
     const std::string missing =
@@ -230,4 +346,64 @@ TEST(ProfileFit, RecoversTheScaleOfASyntheticResponse) {
         EXPECT_LT(fit.rmsError[static_cast<std::size_t>(c)], 1e-4) << c;
         EXPECT_GT(fit.initialRmsError[static_cast<std::size_t>(c)], fit.rmsError[static_cast<std::size_t>(c)]) << c;
     }
+}
+
+TEST(ProfileFit, WidthsOfAStretchedDeonResponse) {
+    // d'Eon's widths: ∫E = Σ w σ / √(2π) (checked by quadrature) and E(crossing) = 0.1.
+    for (int c = 0; c < 3; ++c) {
+        double quadrature = 0.0;
+        for (double x = 0.00005; x < 30.0; x += 0.0001) quadrature += deonEdgeResponse(c, x) * 0.0001;
+        EXPECT_NEAR(deonEdgeIntegral(c), quadrature, 1e-4 * quadrature) << c;
+        EXPECT_NEAR(deonEdgeResponse(c, deonCrossing(c, 0.1)), 0.1, 1e-9) << c;
+    }
+    // A response that is d'Eon's stretched by k: at radius k every error vanishes, at radius 1.2 k the widths are
+    // 20 % too wide.
+    const std::array<double, 3> k{2.5, 0.8, 0.4};
+    EdgeResponse response;
+    for (int i = 0; i < 16000; ++i) response.xMm.push_back((i + 0.5) * 0.0025);
+    for (int c = 0; c < 3; ++c)
+        for (double x : response.xMm)
+            response.value[static_cast<std::size_t>(c)].push_back(
+                deonEdgeResponse(c, x * k[static_cast<std::size_t>(c)]));
+    const ProfileMatch exact = matchProfile(response, k);
+    const ProfileMatch wide = matchProfile(response, {1.2 * k[0], 1.2 * k[1], 1.2 * k[2]});
+    for (std::size_t c = 0; c < 3; ++c) {
+        EXPECT_LT(exact.rmsError[c], 1e-4) << c;
+        EXPECT_NEAR(exact.integralError[c], 0.0, 2e-3) << c;
+        EXPECT_NEAR(exact.crossingError[c], 0.0, 2e-3) << c;
+        EXPECT_NEAR(wide.integralError[c], 0.2, 3e-3) << c;
+        EXPECT_NEAR(wide.crossingError[c], 0.2, 3e-3) << c;
+        EXPECT_GT(wide.rmsError[c], exact.rmsError[c]) << c;
+    }
+}
+
+TEST(ProfileFit, SmoothRadiiFollowsASmoothCurveAndReadsBackTheCsv) {
+    // ln r exactly cubic in the albedo: reproduced with no residual; noise of ±2 % is reduced.
+    std::vector<double> albedo, exact, noisy;
+    for (int k = 0; k <= 16; ++k) {
+        const double a = 0.1 + 0.05 * k;
+        albedo.push_back(a);
+        exact.push_back(std::exp(3.0 - 2.0 * a + 0.5 * a * a - 0.3 * a * a * a));
+        noisy.push_back(exact.back() * (k % 2 == 0 ? 1.02 : 0.98));
+    }
+    double residual = 1.0;
+    const std::vector<double> same = smoothRadii(albedo, exact, 3, &residual);
+    EXPECT_LT(residual, 1e-9);
+    for (std::size_t k = 0; k < albedo.size(); ++k) EXPECT_NEAR(same[k], exact[k], 1e-9 * exact[k]);
+    const std::vector<double> smoothed = smoothRadii(albedo, noisy, 3, &residual);
+    EXPECT_NEAR(residual, 0.02, 0.002);
+    for (std::size_t k = 1; k + 1 < albedo.size(); ++k) EXPECT_NEAR(smoothed[k] / exact[k], 1.0, 0.01) << k;
+    EXPECT_THROW(smoothRadii({0.1, 0.2}, {1.0, 2.0}, 3), InputError);
+    // edge_response.csv as fit-profile writes it.
+    const std::filesystem::path folder = makeWorkFolder("skinlab-test-csv");
+    writeFileAtomic(folder / "edge_response.csv", "x_mm_at_radius_1mm,E_R,E_G,E_B\n0.001,0.4,0.3,0.2\n0.003,0.3,"
+                                                  "0.2,0.1\n");
+    const EdgeResponse read = readEdgeResponseCsv(folder / "edge_response.csv");
+    ASSERT_EQ(read.xMm.size(), 2u);
+    EXPECT_DOUBLE_EQ(read.xMm[1], 0.003);
+    EXPECT_DOUBLE_EQ(read.value[2][1], 0.1);
+    writeFileAtomic(folder / "bad.csv", "x,E_R,E_G,E_B\n0.001,0.4\n0.002,0.1,0.1,0.1\n");
+    const std::string bad = errorOf([&] { readEdgeResponseCsv(folder / "bad.csv"); });
+    EXPECT_NE(bad.find("bad.csv:2"), std::string::npos) << bad;
+    std::filesystem::remove_all(folder);
 }
