@@ -2,8 +2,9 @@
 # Through-light of thin skin against the path tracer (docs/pathtraced.md, "Through-light: calibration"):
 # builtin:ear (a skin fin lit from behind) at fin thicknesses 1, 2, 2.5 and 4 mm (THICKNESSES), rendered by
 # `pathtraced` (SEEDS seeds, averaged), by the object-space `reference` (2 mm edges; its through-light gain 0, 1,
-# the former constant gain [1.72, 5.31, 9.44], the default, and gain 1 with growth k on a grid of K_GRID values) and by `separable` without and with screen-space
-# transmittance at several `transmittance.translucency` values (TRANSLUCENCIES); prints the mean skin diffuse (R, G, B)
+# the constant gain [1.72, 5.31, 9.44] fitted at 1 and 2 mm alone, the default, and gain 1 with growth k on a grid
+# of K_GRID values) and by `separable` without and with screen-space transmittance at several
+# `transmittance.translucency` values (TRANSLUCENCIES); prints the mean skin diffuse (R, G, B)
 # of each, i.e. the diffuse averaged over the skin pixels weighted by mask.Y (a mean over thousands of pixels: the
 # path tracer's per-pixel noise averages out), fits the reference's far-side kernel gain_c · exp(k_c d²)
 # (sss.reference_through_gain, sss.reference_through_growth_per_mm2) to the path tracer (below), renders the
@@ -76,7 +77,7 @@ for t in $thicknesses; do
   echo "$t|pathtraced|$(skin_means "${exrs[@]}" | awk '{r += $1; g += $2; b += $3} END {printf "%.6f %.6f %.6f", r / NR, g / NR, b / NR}')" >> "$data"
   echo "$t|reference, through gain 0|$(render "reference gain 0" "$t" "${ref[@]}" 'sss.reference_through_gain=[0.0,0.0,0.0]')" >> "$data"
   echo "$t|reference, through gain 1|$(render "reference gain 1" "$t" "${ref[@]}" 'sss.reference_through_gain=[1.0,1.0,1.0]' 'sss.reference_through_growth_per_mm2=[0.0,0.0,0.0]')" >> "$data"
-  echo "$t|reference, old constant gain|$(render "reference constant gain" "$t" "${ref[@]}" 'sss.reference_through_gain=[1.72,5.31,9.44]' 'sss.reference_through_growth_per_mm2=[0.0,0.0,0.0]')" >> "$data"
+  echo "$t|reference, constant gain (1 and 2 mm fit)|$(render "reference constant gain" "$t" "${ref[@]}" 'sss.reference_through_gain=[1.72,5.31,9.44]' 'sss.reference_through_growth_per_mm2=[0.0,0.0,0.0]')" >> "$data"
   echo "$t|reference (default)|$(render "reference default" "$t" "${ref[@]}")" >> "$data"
   for k in $k_grid; do
     echo "$t|growth $k|$(render "reference gain 1 growth $k" "$t" "${ref[@]}" 'sss.reference_through_gain=[1.0,1.0,1.0]' "sss.reference_through_growth_per_mm2=[$k,$k,$k]")" >> "$data"
