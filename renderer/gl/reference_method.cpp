@@ -260,7 +260,13 @@ void ReferenceMethod::run(const ReferenceInputs& inputs, const sss::SssParams& p
     }
     reference::ConvolutionSettings convolution;
     convolution.cutoffTail = kCutoffTail;
-    for (int c = 0; c < 3; ++c) convolution.throughGain[c] = params.referenceThroughGain[c];
+    // The growth is declared at the profile's own scale (width_mm = 3) and scales with the profile: a profile
+    // widened by s has its far-side factor exp(k d²) at d / s, so each Gaussian lobe widens alike at every width.
+    const double scale = sss::profileScale(params.widthMm);
+    for (int c = 0; c < 3; ++c) {
+        convolution.throughGain[c] = params.referenceThroughGain[c];
+        convolution.throughGrowthPerMm2[c] = params.referenceThroughGrowthPerMm2[c] / (scale * scale);
+    }
     reference::ConvolutionReport report;
     const std::vector<glm::vec3> convolved =
         reference::convolveSurface(samples, radiance, *profile, convolution, nullptr, &report);

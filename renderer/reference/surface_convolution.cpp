@@ -69,11 +69,13 @@ std::vector<glm::vec3> convolveSurface(const SurfaceSamples& samples, const std:
                 facing = glm::dot(normal, samples.normal[q]) > 0.0f;
             }
             std::array<double, 3> k;
+            float distance = 0.0f;
             if (q == p) {
                 const double radius = std::sqrt(samples.areaMm2[p] / std::numbers::pi);
                 for (int c = 0; c < 3; ++c) k[c] = profile.cumulative(c, radius);
             } else {
-                const float position = glm::length(samples.positionMm[q] - centre) * inverseStep;
+                distance = glm::length(samples.positionMm[q] - centre);
+                const float position = distance * inverseStep;
                 const int index = std::min(static_cast<int>(position), kProfileTableSize);
                 const float fraction = position - static_cast<float>(index);
                 for (int c = 0; c < 3; ++c)
@@ -81,8 +83,14 @@ std::vector<glm::vec3> convolveSurface(const SurfaceSamples& samples, const std:
                            samples.areaMm2[q];
             }
             const glm::vec3 value = irradiance[q] * samples.albedo[q];
+            if (!facing) // the far side of a thin part: the through-light gain, growing with the distance
+                for (int c = 0; c < 3; ++c)
+                    k[c] *= settings.throughGrowthPerMm2[c] == 0.0
+                                ? settings.throughGain[c]
+                                : settings.throughGain[c] *
+                                      std::exp(settings.throughGrowthPerMm2[c] * double(distance) * distance);
             for (int c = 0; c < 3; ++c) {
-                weighted[c] += (facing ? k[c] : k[c] * settings.throughGain[c]) * value[c];
+                weighted[c] += k[c] * value[c];
                 if (facing) weightSum[c] += k[c];
             }
             ++sources;

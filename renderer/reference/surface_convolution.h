@@ -46,6 +46,12 @@ struct ConvolutionSettings {
     // light the reflectance profile at the 3-D distance under-estimates against a path tracer (calibration:
     // docs/extensions.md). Does not enter the normaliser. 1: the profile as it is.
     std::array<double, 3> throughGain{1.0, 1.0, 1.0};
+    // ThroughTissue: per-channel growth k_c (1/mm²) of that gain with the 3-D distance d (mm) from the far-side
+    // source to the receiver: the far side's kernel is R_c(d) · throughGain_c · exp(k_c d²). The reflectance
+    // profile's Gaussian tails fall faster with distance than the light a path tracer carries through a slab, so
+    // the ratio grows with the thickness of the part; on a sum of Gaussians the factor widens each lobe of variance
+    // v to v / (1 − 2 k_c v) (for 2 k_c v < 1). 0: a constant gain, exactly throughGain.
+    std::array<double, 3> throughGrowthPerMm2{0.0, 0.0, 0.0};
     unsigned threads = 0; // worker threads; 0: std::thread::hardware_concurrency()
 };
 

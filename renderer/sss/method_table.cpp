@@ -73,7 +73,7 @@ std::vector<MethodInfo> builtInRows() {
          "reference",
          Execution::ObjectSpace,
          "object-space SSS on the tessellated surface (the ground truth of the metrics)",
-         {"profile", "material", "reference_edge_mm", "reference_through_gain"},
+         {"profile", "material", "reference_edge_mm", "reference_through_gain", "reference_through_growth_per_mm2"},
          {},
          {},
          makeReferenceMethod()},

@@ -189,8 +189,16 @@ std::vector<SssKey>& sharedSssKeys() {
                   100.0,
                   {},
                   "",
-                  "reference: per-channel gain on light through thin parts"},
+                  "reference: per-channel gain g on light through thin parts"},
                  &SssParams::referenceThroughGain),
+        boundKey({"reference_through_growth_per_mm2",
+                  KeyType::Vec3,
+                  -1.0,
+                  0.1,
+                  {},
+                  "1/mm²",
+                  "reference: growth of that gain with the distance d through the part, g exp(k d²), k at width_mm 3"},
+                 &SssParams::referenceThroughGrowthPerMm2),
     };
     return table;
 }

@@ -142,11 +142,16 @@ struct SssParams {
     PscbfSigma pscbfSigma = PscbfSigma::Variance;
     // reference method: longest skin edge (mm) after tessellation; irradiance is sampled at the vertices.
     double referenceEdgeMm = 1.0;
-    // reference method: per-channel gain on the light that reaches a receiver from the far side of a thin part
-    // (sources whose normal faces away from the receiver's). 1: the reflectance profile at the 3-D distance
-    // through the part, as it is. Default: fitted to Blender Cycles' random walk on 1 and 2 mm skin fins
+    // reference method: the light that reaches a receiver from the far side of a thin part (sources whose normal
+    // faces away from the receiver's) is the reflectance profile at the 3-D distance d through the part times a
+    // per-channel gain g_c · exp(k_c d²): referenceThroughGain holds g_c, referenceThroughGrowthPerMm2 k_c (1/mm² at
+    // width_mm = 3; scaled by profileScale⁻² with the profile, so the factor widens each Gaussian lobe of variance v
+    // to v / (1 − 2 k_c v) at every width; renderer/reference/surface_convolution.h). g = 1, k = 0: the profile as it
+    // is; k = 0: a constant gain.
+    // Defaults: fitted to Blender Cycles' random walk on 1, 2, 2.5 and 4 mm skin fins
     // (scripts/transmittance-calibration.sh; docs/pathtraced.md, "Through-light: calibration").
-    std::array<double, 3> referenceThroughGain{1.72, 5.31, 9.44};
+    std::array<double, 3> referenceThroughGain{1.172, 5.758, 9.743};
+    std::array<double, 3> referenceThroughGrowthPerMm2{0.04, -0.04, 0.0};
     // Values of the keys a method declares in its own row (MethodInfo::ownKeys), by key; absent: the declared
     // default. The built-in methods' keys are the typed fields above.
     nlohmann::json own = nlohmann::json::object();

@@ -311,3 +311,52 @@ TEST(SurfaceConvolution, ThroughTissueStopsLightAcrossAnAirGap) {
         EXPECT_LT(across[lower][c], 1.0f) << c; // the dark upper face dilutes the lit one in the old normaliser
     }
 }
+
+TEST(SurfaceConvolution, ThroughGainGrowsWithTheSquaredDistanceThroughThePart) {
+    // The 2 mm slab of the test above; one back sample lit at a time: the one straight behind the front's centre
+    // (d = 2 mm) and one 3 mm to the side of it (d = √13 mm). The front centre's light from each grows by exactly
+    // exp(k_c d²) against the constant gain; the near side's light and the normaliser do not change.
+    std::uint32_t front = 0, back = 0;
+    const SurfaceSamples slab = twoPlanes(-2.0f, -1.0f, front, back);
+    const std::uint32_t aside = back + 6; // 6 columns of 0.5 mm: 3 mm along x
+    ASSERT_FLOAT_EQ(slab.positionMm[aside].x - slab.positionMm[back].x, 3.0f);
+    const auto profile = makeRadialProfile(profileParams("deon"));
+    ConvolutionSettings constant, growing, redOnly;
+    constant.throughGain = growing.throughGain = redOnly.throughGain = {1.7, 5.3, 9.4};
+    growing.throughGrowthPerMm2 = {0.04, -0.05, -0.2};
+    redOnly.throughGrowthPerMm2 = {0.04, 0.0, 0.0};
+    for (const std::uint32_t lit : {back, aside}) {
+        std::vector<glm::vec3> irradiance(slab.size(), glm::vec3(0.0f));
+        irradiance[lit] = glm::vec3(1.0f);
+        const auto flat = convolveSurface(slab, irradiance, *profile, constant);
+        const auto grown = convolveSurface(slab, irradiance, *profile, growing);
+        const auto red = convolveSurface(slab, irradiance, *profile, redOnly);
+        const double d = glm::length(slab.positionMm[lit] - slab.positionMm[front]);
+        for (int c = 0; c < 3; ++c) {
+            ASSERT_GT(flat[front][c], 0.0f) << c;
+            EXPECT_NEAR(grown[front][c] / flat[front][c], std::exp(growing.throughGrowthPerMm2[c] * d * d), 1e-5)
+                << "d " << d << ", channel " << c;
+        }
+        EXPECT_GT(grown[front][0], flat[front][0]);
+        // k = 0 reproduces the constant gain exactly (green and blue of the red-only growth), everywhere.
+        for (std::size_t i = 0; i < slab.size(); ++i) {
+            EXPECT_EQ(red[i][1], flat[i][1]) << i;
+            EXPECT_EQ(red[i][2], flat[i][2]) << i;
+        }
+    }
+    // Front-lit (its far side dark), the front does not change: the growth acts on the far side's light only and
+    // never enters the normaliser.
+    std::vector<glm::vec3> frontLit(slab.size());
+    for (std::size_t i = 0; i < slab.size(); ++i) frontLit[i] = glm::vec3(slab.normal[i].z > 0.0f ? 1.0f : 0.0f);
+    const auto frontGrowing = convolveSurface(slab, frontLit, *profile, growing);
+    const auto frontConstant = convolveSurface(slab, frontLit, *profile, constant);
+    for (std::size_t i = 0; i < slab.size(); ++i)
+        if (slab.normal[i].z > 0.0f) {
+            EXPECT_EQ(frontGrowing[i], frontConstant[i]) << i;
+        }
+    // The Euclidean transport has no far side: the gain and its growth do not apply.
+    ConvolutionSettings euclidean = growing, euclideanFlat;
+    euclidean.transport = euclideanFlat.transport = Transport::Euclidean;
+    EXPECT_EQ(convolveSurface(slab, frontLit, *profile, euclidean),
+              convolveSurface(slab, frontLit, *profile, euclideanFlat));
+}

@@ -193,6 +193,37 @@ TEST(SssParams, ThesisVariantKeys) {
     EXPECT_THROW(readTransmittanceParams(skinlab::SpecReader(bad, "scene.toml")), skinlab::InputError);
 }
 
+// The reference's through-light: the gain and its growth with the squared distance through the part (defaults fitted
+// to the path tracer, docs/pathtraced.md), read and checked like every key; a bad value is one line naming the file
+// and the key.
+TEST(SssParams, ReferenceThroughLightKeys) {
+    const SssParams defaults = readSss("[sss]\nmethod = \"reference\"\n");
+    EXPECT_EQ(defaults.referenceThroughGain, (std::array<double, 3>{1.172, 5.758, 9.743}));
+    EXPECT_EQ(defaults.referenceThroughGrowthPerMm2, (std::array<double, 3>{0.04, -0.04, 0.0}));
+    const SssParams p = readSss("[sss]\nmethod = \"reference\"\nreference_through_gain = [1.72, 5.31, 9.44]\n"
+                                "reference_through_growth_per_mm2 = [0, 0.0, -0.5]\n");
+    EXPECT_EQ(p.referenceThroughGain, (std::array<double, 3>{1.72, 5.31, 9.44}));
+    EXPECT_EQ(p.referenceThroughGrowthPerMm2, (std::array<double, 3>{0.0, 0.0, -0.5}));
+    EXPECT_EQ(sssParamsFromJson(p.toJson()).toJson(), p.toJson());
+    EXPECT_EQ(p.toJson().at("reference_through_growth_per_mm2"), nlohmann::json({0.0, 0.0, -0.5}));
+    const std::string head = "[sss]\nmethod = \"reference\"\nreference_through_growth_per_mm2 = ";
+    EXPECT_EQ(sssError(head + "[0.0, 0.2, 0.0]"),
+              "scene.toml: sss.reference_through_growth_per_mm2: element 1: 0.2 is out of range [-1, 0.1]");
+    EXPECT_EQ(sssError(head + "[0.0, 0.0, \"x\"]"),
+              "scene.toml: sss.reference_through_growth_per_mm2: element 2: expected a number, got string \"x\"");
+    EXPECT_EQ(sssError(head + "0.03"),
+              "scene.toml: sss.reference_through_growth_per_mm2: expected an array of numbers, got float 0.03");
+    EXPECT_EQ(sssError(head + "[0.03, 0.0]"),
+              "scene.toml: sss.reference_through_growth_per_mm2: expected 3 numbers, got 2");
+    EXPECT_EQ(sssError("[sss]\nmethod = \"reference\"\nreference_through_gain = [1.0, -1.0, 1.0]"),
+              "scene.toml: sss.reference_through_gain: element 1: -1 is out of range [0, 100]");
+    EXPECT_EQ(sssError("[sss]\nmethod = \"separable\"\nreference_through_growth_per_mm2 = [0.0, 0.0, 0.0]")
+                  .rfind("scene.toml: sss.reference_through_growth_per_mm2: not a parameter of method 'separable'", 0),
+              0u);
+    for (const std::string& error : {sssError(head + "[0.0, 0.2, 0.0]"), sssError(head + "0.03")})
+        EXPECT_EQ(error.find('\n'), std::string::npos) << error;
+}
+
 // Every method reads its own keys only: a key of another method is an error naming the key and the method, in a
 // scene file and in the JSON form alike, and the resolved record holds the method's keys only.
 TEST(SssParams, KeyOfAnotherMethodIsAnError) {
@@ -304,7 +335,8 @@ TEST(SssParams, MethodsPageTablesFollowTheDeclarations) {
                 const std::size_t end = text.find('`', at + 1);
                 const std::string name = text.substr(at + 1, end - at - 1);
                 // Key and method names only (a cell may also name other tables, e.g. `[pathtraced]`).
-                if (name.find_first_not_of("abcdefghijklmnopqrstuvwxyz_-") == std::string::npos) out->push_back(name);
+                if (name.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_-") == std::string::npos)
+                    out->push_back(name);
                 at = end;
             }
             if (out == &keys && text.find("the extension keys") != std::string::npos)
