@@ -75,9 +75,4 @@ void SssStage::run(const SssStageInputs& inputs, const SssStageSettings& setting
     checkGl("SSS stage (none)");
 }
 
-float SssStage::supportRadiusMm(const SssStageSettings& settings) const {
-    // 0 for none; pscbf's kernel declares its filter disc r_max × width_mm / 3 (renderer/sss/kernel.h).
-    return static_cast<float>(sss::prepareMethod(settings.sss)->supportRadiusMm);
-}
-
 } // namespace skinlab::renderer::gl

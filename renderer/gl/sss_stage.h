@@ -62,10 +62,6 @@ public:
     // Method "none" copies `inputs.diffuse` through unchanged. Throws InputError for a method it does not know.
     void run(const SssStageInputs& inputs, const SssStageSettings& settings, GLuint output);
 
-    // Support radius of the active kernel in mm (EXR attribute skinlab:sss_radius_mm; metrics derive their band
-    // widths from it). 0 for "none".
-    float supportRadiusMm(const SssStageSettings& settings) const;
-
 private:
     struct Impl;
     std::unique_ptr<Impl> impl_;

@@ -5,6 +5,7 @@
 #include "common/spec.h"
 #include "renderer/sss/kernel.h"
 #include "renderer/sss/width_conventions.h"
+#include "width_views.h"
 
 #include <algorithm>
 #include <cmath>
@@ -129,25 +130,10 @@ TEST(TransmittanceParams, ReadsAndValidates) {
 // width (pixels per mm = f_px / (mm_per_unit · z), f_px = (H/2) / tan(fovY/2)). The old reading width_mm = sssWidth ×
 // mm_per_unit lands at half the demo's distance.
 TEST(SssParams, DemoSssWidthConversion) {
-    constexpr double kPi = 3.14159265358979323846;
-    struct View {
-        double sssWidth, mmPerUnit, fovDeg, z, height;
-    };
-    for (const View v : {View{0.012, 47.9, 20.0, 2.5, 720.0}, View{1.5, 1.0, 30.0, 300.0, 512.0},
-                         View{0.05, 10.0, 45.0, 7.0, 1080.0}}) {
-        const double t = std::tan(0.5 * v.fovDeg * kPi / 180.0);
-        const double demoStepUv = v.sssWidth * (1.0 / t) / v.z / 3.0; // per kernel unit
-        const double demoEdgePixels = 3.0 * demoStepUv * v.height;    // vertical pass, offset 3
-
-        SssParams params;
-        params.method = SssMethod::Artistic;
-        params.samples = 25;
-        params.widthMm = widthMmFromDemoSssWidth(v.sssWidth, v.mmPerUnit);
-        const Kernel kernel = makeKernel(params);
-        ASSERT_EQ(kernel.stages.size(), 1u);
-        const double edgeMm = kernel.stages[0].taps.back().offsetMm;
-        const double fPx = 0.5 * v.height / t;
-        const double edgePixels = edgeMm * fPx / (v.mmPerUnit * v.z);
+    for (const test::View& v : test::kViews) {
+        const double demoStepUv = v.sssWidth * (1.0 / v.tanHalfFov()) / v.z / 3.0; // per kernel unit
+        const double demoEdgePixels = 3.0 * demoStepUv * v.height;                 // vertical pass, offset 3
+        const double edgePixels = test::artisticEdgePixels(widthMmFromDemoSssWidth(v.sssWidth, v.mmPerUnit), v);
         EXPECT_NEAR(edgePixels, demoEdgePixels, 1e-9 * demoEdgePixels) << "sssWidth " << v.sssWidth;
     }
     EXPECT_DOUBLE_EQ(widthMmFromDemoSssWidth(0.012, 47.9), 2.0 * 0.012 * 47.9);
@@ -270,20 +256,20 @@ TEST(SssParams, MethodTable) {
 }
 
 namespace {
-// The rows of the markdown table that follows `heading` in docs/methods.md: each row's cells, backticked names only.
-std::vector<std::vector<std::vector<std::string>>> docTableRows(const std::string& heading) {
+// The body rows of the first markdown table in docs/methods.md whose header row starts with `header`: per cell, the
+// backticked key and method names in it ("the extension keys" stands for their list; other backticked text, such as
+// a table name, is left out).
+std::vector<std::vector<std::vector<std::string>>> docTable(const std::string& header) {
     std::ifstream in(std::string(SKINLAB_SOURCE_DIR) + "/docs/methods.md");
     std::string line;
-    bool inSection = false, inTable = false;
+    bool inTable = false;
     std::vector<std::vector<std::vector<std::string>>> rows;
     while (std::getline(in, line)) {
-        if (line.rfind("## ", 0) == 0) inSection = line.find(heading) != std::string::npos;
-        if (!inSection) continue;
-        if (line.rfind("|", 0) != 0) {
-            if (inTable && !rows.empty()) break; // the first table of the section
+        if (!inTable) {
+            inTable = line.rfind(header, 0) == 0;
             continue;
         }
-        inTable = true;
+        if (line.rfind("|", 0) != 0) break;
         if (line.rfind("|---", 0) == 0) continue;
         std::vector<std::vector<std::string>> cells;
         std::stringstream row(line.substr(1));
@@ -293,7 +279,9 @@ std::vector<std::vector<std::vector<std::string>>> docTableRows(const std::strin
             for (std::size_t at = cell.find('`'); at != std::string::npos; at = cell.find('`', at + 1)) {
                 const std::size_t end = cell.find('`', at + 1);
                 if (end == std::string::npos) break;
-                names.push_back(cell.substr(at + 1, end - at - 1));
+                const std::string name = cell.substr(at + 1, end - at - 1);
+                if (name.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_-") == std::string::npos)
+                    names.push_back(name);
                 at = end;
             }
             if (cell.find("the extension keys") != std::string::npos)
@@ -312,41 +300,16 @@ std::vector<std::vector<std::vector<std::string>>> docTableRows(const std::strin
 // table of each method's own keys lists exactly the keys its row of the method table declares.
 TEST(SssParams, MethodsPageTablesFollowTheDeclarations) {
     std::set<std::string> documented;
-    for (const auto& row : docTableRows("Parameters: `[sss]`"))
+    for (const auto& row : docTable("| key |"))
         if (!row.empty()) documented.insert(row[0].begin(), row[0].end());
-    ASSERT_FALSE(documented.empty()) << "no [sss] table in docs/methods.md";
+    ASSERT_FALSE(documented.empty()) << "no [sss] key table in docs/methods.md";
     for (const SssKey& key : sssKeyTable()) EXPECT_TRUE(documented.count(std::string(key.name))) << key.name;
 
     std::map<std::string, std::set<std::string>> ownKeys; // method → keys, from the page
-    bool found = false;
-    std::ifstream in(std::string(SKINLAB_SOURCE_DIR) + "/docs/methods.md");
-    std::string line;
-    while (std::getline(in, line)) {
-        if (line.rfind("| method | its own keys |", 0) == 0) found = true;
-        if (!found || line.rfind("| `", 0) != 0) {
-            if (found && !ownKeys.empty() && line.rfind("|", 0) != 0) break;
-            continue;
-        }
-        const std::size_t split = line.find('|', 1);
-        std::vector<std::string> methods, keys;
-        for (auto [text, out] :
-             {std::pair{line.substr(1, split - 1), &methods}, std::pair{line.substr(split), &keys}}) {
-            for (std::size_t at = text.find('`'); at != std::string::npos; at = text.find('`', at + 1)) {
-                const std::size_t end = text.find('`', at + 1);
-                const std::string name = text.substr(at + 1, end - at - 1);
-                // Key and method names only (a cell may also name other tables, e.g. `[pathtraced]`).
-                if (name.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_-") == std::string::npos)
-                    out->push_back(name);
-                at = end;
-            }
-            if (out == &keys && text.find("the extension keys") != std::string::npos)
-                for (const char* k :
-                     {"cbf", "cbf_lambda", "lab_weight", "extension_input", "curvature", "curvature_floor"})
-                    keys.emplace_back(k);
-        }
-        for (const auto& method : methods) ownKeys[method].insert(keys.begin(), keys.end());
-    }
-    ASSERT_TRUE(found) << "no '| method | its own keys |' table in docs/methods.md";
+    for (const auto& row : docTable("| method | its own keys |"))
+        if (row.size() >= 2)
+            for (const auto& method : row[0]) ownKeys[method].insert(row[1].begin(), row[1].end());
+    ASSERT_FALSE(ownKeys.empty()) << "no '| method | its own keys |' table in docs/methods.md";
     for (const MethodInfo& info : methodTable()) {
         if (static_cast<int>(info.method) > static_cast<int>(SssMethod::Eevee)) continue; // registered by a test
         ASSERT_TRUE(ownKeys.count(std::string(info.name))) << info.name << " has no row";

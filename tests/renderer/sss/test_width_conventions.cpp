@@ -4,6 +4,7 @@
 
 #include "renderer/sss/kernel.h"
 #include "renderer/sss/sss_params.h"
+#include "width_views.h"
 
 #include <cmath>
 
@@ -11,14 +12,8 @@
 
 using namespace skinlab::renderer::sss;
 
-namespace {
-constexpr double kPi = 3.14159265358979323846;
-struct View {
-    double sssWidth, mmPerUnit, fovDeg, z, height;
-};
-const View kViews[] = {View{0.012, 47.9, 20.0, 2.5, 720.0}, View{1.5, 1.0, 30.0, 300.0, 512.0},
-                       View{0.05, 10.0, 45.0, 7.0, 1080.0}};
-} // namespace
+using test::kViews;
+using test::View;
 
 // By hand: 1.4 × 0.012 × 47.9 = 0.80472 mm; 0.012 × 47.9 / 15 = 0.03832 mm; 1.4 × 1.5 × 1 = 2.1 mm.
 TEST(ThesisWidth, HandComputedValues) {
@@ -46,19 +41,12 @@ TEST(ThesisWidth, DemoConventionIsOnePointFourThreeTimesTheThesisSeparable) {
 // skinlab's artistic kernel (outermost tap at width_mm for more than 20 taps) at the converted width lands there.
 TEST(ThesisWidth, SeparableReplaysTheThesisStep) {
     for (const View v : kViews) {
-        const double t = std::tan(0.5 * v.fovDeg * kPi / 180.0);
+        const double t = v.tanHalfFov();
         for (const double kernelRange : {3.0, 2.0}) {
             const double stepUv = v.sssWidth * (1.0 / t) / v.z * 0.7 / kernelRange; // per kernel unit
             const double thesisEdgePixels = kernelRange * stepUv * v.height;        // vertical pass
-            SssParams params;
-            params.method = SssMethod::Artistic;
-            params.samples = 25;
-            params.widthMm = widthMmFromThesisSssWidth(v.sssWidth, v.mmPerUnit, ThesisBlurShader::Separable);
-            const Kernel kernel = makeKernel(params);
-            ASSERT_EQ(kernel.stages.size(), 1u);
-            const double edgeMm = kernel.stages[0].taps.back().offsetMm;
-            const double fPx = 0.5 * v.height / t;
-            const double edgePixels = edgeMm * fPx / (v.mmPerUnit * v.z);
+            const double edgePixels = test::artisticEdgePixels(
+                widthMmFromThesisSssWidth(v.sssWidth, v.mmPerUnit, ThesisBlurShader::Separable), v);
             EXPECT_NEAR(edgePixels, thesisEdgePixels, 1e-9 * thesisEdgePixels) << "sssWidth " << v.sssWidth;
         }
     }
@@ -69,7 +57,7 @@ TEST(ThesisWidth, SeparableReplaysTheThesisStep) {
 // gaussian-sum stages at the converted width have that σ in pixels, stage by stage (d'Eon's incremental variances).
 TEST(ThesisWidth, GaussianSumReplaysTheThesisStep) {
     for (const View v : kViews) {
-        const double t = std::tan(0.5 * v.fovDeg * kPi / 180.0);
+        const double t = v.tanHalfFov();
         SssParams params;
         params.method = SssMethod::GaussianSum;
         params.widthMm = widthMmFromThesisSssWidth(v.sssWidth, v.mmPerUnit, ThesisBlurShader::GaussianSum);
