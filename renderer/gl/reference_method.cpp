@@ -52,13 +52,14 @@ std::unique_ptr<sss::RadialProfile> profileOf(const sss::SssParams& params, std:
     }
 }
 
-// A tessellated model with its samples and GL buffers, cached by source model, edge length, mm per unit and
-// the parts' skin flags.
+// A tessellated model with its samples and GL buffers, cached by source model, edge length, mm per unit, the
+// parts' skin flags and whether the non-skin parts are refined too (sss.reference_non_skin = "absorbs").
 struct TessellatedModel {
     std::shared_ptr<const Model> source; // held, so the key's pointer cannot be reused by another model
     float edgeMm = 0.0f;
     float mmPerUnit = 0.0f;
     std::vector<bool> skinParts;
+    bool allParts = false;      // non-skin parts refined too
     std::vector<SubMesh> parts; // of the tessellated model (same order as the source's parts)
     reference::SurfaceSamples samples;
     reference::TessellationStatistics statistics;
@@ -72,8 +73,9 @@ struct TessellatedModel {
     VertexArray pointVertexArray;
     std::vector<std::pair<std::uint32_t, std::uint32_t>> pointRanges; // per part: first, count
 
-    bool matches(const ReferenceInputs& inputs, float edge, const std::vector<bool>& skin) const {
-        return source == inputs.model && edgeMm == edge && mmPerUnit == inputs.mmPerUnit && skinParts == skin;
+    bool matches(const ReferenceInputs& inputs, float edge, const std::vector<bool>& skin, bool all) const {
+        return source == inputs.model && edgeMm == edge && mmPerUnit == inputs.mmPerUnit && skinParts == skin &&
+               allParts == all;
     }
 };
 
@@ -92,11 +94,11 @@ struct ReferenceMethod::Impl {
 
     explicit Impl(ShaderLibrary& library) : shaders(library) {}
 
-    TessellatedModel& tessellated(const ReferenceInputs& inputs, float edgeMm, bool& cached) {
+    TessellatedModel& tessellated(const ReferenceInputs& inputs, float edgeMm, bool allParts, bool& cached) {
         std::vector<bool> skinParts;
         for (const GpuMaterial& material : inputs.partMaterials) skinParts.push_back(material.skin > 0.5f);
         for (auto it = cache.begin(); it != cache.end(); ++it)
-            if ((*it)->matches(inputs, edgeMm, skinParts)) {
+            if ((*it)->matches(inputs, edgeMm, skinParts, allParts)) {
                 cached = true;
                 std::rotate(cache.begin(), it, it + 1);
                 return *cache.front();
@@ -108,16 +110,23 @@ struct ReferenceMethod::Impl {
         for (std::size_t p = 0; p < model.parts.size() && p < skinParts.size(); ++p)
             model.materials.at(model.parts[p].material).skin = skinParts[p];
         auto entry = std::make_unique<TessellatedModel>();
+        // allParts: every part is refined alike, so that non-skin parts next to skin, the convolution's absorbers
+        // (reference::NonSkin::Absorbs), are sampled as densely as the skin they border.
+        if (allParts)
+            for (MeshMaterial& material : model.materials) material.skin = true;
         try {
             model = reference::tessellateSkin(model, edgeMm, inputs.mmPerUnit, &entry->statistics);
         } catch (const InputError& error) {
             rethrowWithKey(error, inputs.source, "sss.reference_edge_mm", "reference: edge_mm: ");
         }
+        for (std::size_t p = 0; p < model.parts.size() && p < skinParts.size(); ++p)
+            model.materials.at(model.parts[p].material).skin = skinParts[p];
         entry->samples = reference::gatherSurfaceSamples(model, inputs.mmPerUnit);
         entry->source = inputs.model;
         entry->edgeMm = edgeMm;
         entry->mmPerUnit = inputs.mmPerUnit;
         entry->skinParts = skinParts;
+        entry->allParts = allParts;
         entry->parts = model.parts;
 
         std::vector<std::uint32_t> points;
@@ -188,7 +197,8 @@ ReferenceMethod::~ReferenceMethod() = default;
 void ReferenceMethod::prepare(const ReferenceInputs& inputs, const sss::SssParams& params) {
     profileOf(params, inputs.source);
     bool cached = false;
-    impl_->tessellated(inputs, static_cast<float>(params.referenceEdgeMm), cached);
+    impl_->tessellated(inputs, static_cast<float>(params.referenceEdgeMm), params.referenceNonSkin == "absorbs",
+                       cached);
 }
 
 // Long by design: the GL pass sequence of the reference method, in order, sharing its buffers.
@@ -200,7 +210,7 @@ void ReferenceMethod::run(const ReferenceInputs& inputs, const sss::SssParams& p
 
     // --- 1. tessellation and samples (cached) ---
     bool cached = false;
-    TessellatedModel& mesh = impl.tessellated(inputs, edgeMm, cached);
+    TessellatedModel& mesh = impl.tessellated(inputs, edgeMm, params.referenceNonSkin == "absorbs", cached);
     cached = mesh.renders > 0; // prepare() of this render may have made the entry: count it as this render's
     ++mesh.renders;
     const std::size_t vertexCount = mesh.samples.size();
@@ -267,6 +277,8 @@ void ReferenceMethod::run(const ReferenceInputs& inputs, const sss::SssParams& p
         convolution.throughGain[c] = params.referenceThroughGain[c];
         convolution.throughGrowthPerMm2[c] = params.referenceThroughGrowthPerMm2[c] / (scale * scale);
     }
+    convolution.nonSkin =
+        params.referenceNonSkin == "returns" ? reference::NonSkin::Returns : reference::NonSkin::Absorbs;
     reference::ConvolutionReport report;
     const std::vector<glm::vec3> convolved =
         reference::convolveSurface(samples, radiance, *profile, convolution, nullptr, &report);

@@ -118,6 +118,7 @@ nlohmann::json blenderSceneJson(const BlenderSceneInputs& inputs, std::string_vi
              {"albedo", vec3Json(m.albedo)},
              {"skin", m.skin},
              {"sss", p.sss},
+             {"diffuse", p.diffuse},
              {"radius", {p.radiusMm[0] * radiusScale, p.radiusMm[1] * radiusScale, p.radiusMm[2] * radiusScale}},
              {"roughness", principledRoughness(m.glossiness)},
              {"specular",

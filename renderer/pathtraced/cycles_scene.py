@@ -108,7 +108,11 @@ def configure_cycles(scene, settings):
     cycles.light_sampling_threshold = 0.0
     cycles.caustics_reflective = True
     cycles.caustics_refractive = True
-    cycles.pixel_filter_type = "BOX"
+    # Gaussian over filter_width_px pixels: Blender's sync gives Cycles' box filter a width of 1 pixel whatever
+    # filter_width says (a box always averages the whole pixel), so only a narrow Gaussian samples the pixel
+    # centre as the rasterizer does (docs/pathtraced.md, "Pixel footprint").
+    # The profile fit asks for the box: each pixel the mean over its width, what its integral of E sums.
+    cycles.pixel_filter_type = "BOX" if settings.get("pixel_filter") == "box" else "GAUSSIAN"
     cycles.filter_width = float(settings["filter_width_px"])
     render = scene.render
     threads = int(settings.get("threads", 0))
@@ -284,6 +288,77 @@ def radius_from_albedo(nodes, links, albedo, table):
     return combine.outputs["Color"]
 
 
+def principled_specular(nodes, links, bsdf, description, textures, uv):
+    # The Principled BSDF's specular lobe: F0 = 0.08 x specular (x the specular map), GGX at the given roughness.
+    bsdf.inputs["Metallic"].default_value = 0.0
+    bsdf.inputs["Specular Tint"].default_value = 0.0
+    bsdf.inputs["Sheen"].default_value = 0.0
+    bsdf.inputs["Clearcoat"].default_value = 0.0
+    bsdf.inputs["Roughness"].default_value = float(description["roughness"])
+    specular = float(description["specular"])
+    if specular > 0.0 and textures.get("specular"):
+        separate = nodes.new("ShaderNodeSeparateColor")
+        links.new(image_node(nodes, links, textures["specular"], "Non-Color", uv).outputs["Color"],
+                  separate.inputs["Color"])
+        links.new(multiply(nodes, links, separate.outputs[0], specular), bsdf.inputs["Specular"])
+    else:
+        bsdf.inputs["Specular"].default_value = specular
+
+
+def normal_input(nodes, links, textures, uv):
+    # The tangent-space normal map's output socket, or None without a normal map.
+    if not textures.get("normal"):
+        return None
+    normal_map = nodes.new("ShaderNodeNormalMap")
+    normal_map.space = "TANGENT"
+    normal_map.uv_map = "UVMap"
+    normal_map.inputs["Strength"].default_value = float(textures.get("normal_strength", 1.0))
+    links.new(image_node(nodes, links, textures["normal"], "Non-Color", uv).outputs["Color"],
+              normal_map.inputs["Color"])
+    return normal_map.outputs["Normal"]
+
+
+def lambert_material(material, nodes, links, output, bsdf, albedo, mask, radius, description, textures, uv):
+    # diffuse = "lambert": the rasterizer's diffuse model. Non-skin: a Lambertian Diffuse BSDF; skin: the
+    # Subsurface Scattering node's random walk, whose entry and exit are Lambertian (no Fresnel factor, no
+    # retro-reflection lobe); mixed by the skin mask. The Principled BSDF's diffuse is Burley's, whose
+    # retro-reflection term (which Blender adds beside the random walk too) brightens grazing views
+    # (docs/pathtraced.md, "The rim at grazing view"). The specular lobe stays the Principled BSDF's (black base
+    # colour, no subsurface: its diffuse closure has zero weight), added on top as Blender's Principled adds it.
+    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.inputs["Roughness"].default_value = 0.0
+    links.new(albedo, diffuse.inputs["Color"])
+    shaders = [diffuse]
+    surface = diffuse.outputs["BSDF"]
+    if description["sss"]:
+        walk = nodes.new("ShaderNodeSubsurfaceScattering")
+        walk.falloff = "RANDOM_WALK_FIXED_RADIUS"
+        links.new(albedo, walk.inputs["Color"])
+        walk.inputs["Scale"].default_value = 1.0
+        walk.inputs["Radius"].default_value = tuple(float(r) for r in description["radius"])
+        if radius is not None:
+            links.new(radius, walk.inputs["Radius"])
+        shaders.append(walk)
+        mix = nodes.new("ShaderNodeMixShader")
+        links.new(mask, mix.inputs["Fac"])
+        links.new(diffuse.outputs["BSDF"], mix.inputs[1])
+        links.new(walk.outputs["BSSRDF"], mix.inputs[2])
+        surface = mix.outputs["Shader"]
+    bsdf.inputs["Base Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+    bsdf.inputs["Subsurface"].default_value = 0.0
+    principled_specular(nodes, links, bsdf, description, textures, uv)
+    shaders.append(bsdf)
+    normal = normal_input(nodes, links, textures, uv)
+    if normal is not None:
+        for shader in shaders:
+            links.new(normal, shader.inputs["Normal"])
+    add = nodes.new("ShaderNodeAddShader")
+    links.new(surface, add.inputs[0])
+    links.new(bsdf.outputs["BSDF"], add.inputs[1])
+    links.new(add.outputs["Shader"], output.inputs["Surface"])
+    return material
+
+
 def build_material(description, textures, engine="cycles"):
     material = bpy.data.materials.new(description["name"])
     material.use_nodes = True
@@ -319,39 +394,27 @@ def build_material(description, textures, engine="cycles"):
     links.new(mask, clamp.inputs["Value"])
     mask = clamp.outputs["Result"]
 
+    radius = None
+    if description.get("radius_table") and engine != "eevee":
+        radius = radius_from_albedo(nodes, links, albedo, description["radius_table"])
+    if engine != "eevee" and description.get("diffuse", "principled") == "lambert":
+        return lambert_material(material, nodes, links, output, bsdf, albedo, mask, radius, description, textures, uv)
+
     links.new(albedo, bsdf.inputs["Base Color"])
     links.new(albedo, bsdf.inputs["Subsurface Color"])
     # EEVEE ignores the method: its kernel is always Christensen-Burley's (docs/pathtraced.md, "EEVEE").
     bsdf.subsurface_method = "BURLEY" if engine == "eevee" else "RANDOM_WALK_FIXED_RADIUS"
     bsdf.inputs["Subsurface Radius"].default_value = tuple(float(r) for r in description["radius"])
-    if description.get("radius_table") and engine != "eevee":
-        links.new(radius_from_albedo(nodes, links, albedo, description["radius_table"]),
-                  bsdf.inputs["Subsurface Radius"])
+    if radius is not None:
+        links.new(radius, bsdf.inputs["Subsurface Radius"])
     if description["sss"]:
         links.new(mask, bsdf.inputs["Subsurface"])
     else:
         bsdf.inputs["Subsurface"].default_value = 0.0
-    bsdf.inputs["Metallic"].default_value = 0.0
-    bsdf.inputs["Specular Tint"].default_value = 0.0
-    bsdf.inputs["Sheen"].default_value = 0.0
-    bsdf.inputs["Clearcoat"].default_value = 0.0
-    bsdf.inputs["Roughness"].default_value = float(description["roughness"])
-    specular = float(description["specular"])
-    if specular > 0.0 and textures.get("specular"):
-        separate = nodes.new("ShaderNodeSeparateColor")
-        links.new(image_node(nodes, links, textures["specular"], "Non-Color", uv).outputs["Color"],
-                  separate.inputs["Color"])
-        links.new(multiply(nodes, links, separate.outputs[0], specular), bsdf.inputs["Specular"])
-    else:
-        bsdf.inputs["Specular"].default_value = specular
-    if textures.get("normal"):
-        normal_map = nodes.new("ShaderNodeNormalMap")
-        normal_map.space = "TANGENT"
-        normal_map.uv_map = "UVMap"
-        normal_map.inputs["Strength"].default_value = float(textures.get("normal_strength", 1.0))
-        links.new(image_node(nodes, links, textures["normal"], "Non-Color", uv).outputs["Color"],
-                  normal_map.inputs["Color"])
-        links.new(normal_map.outputs["Normal"], bsdf.inputs["Normal"])
+    principled_specular(nodes, links, bsdf, description, textures, uv)
+    normal = normal_input(nodes, links, textures, uv)
+    if normal is not None:
+        links.new(normal, bsdf.inputs["Normal"])
     links.new(bsdf.outputs["BSDF"], output.inputs["Surface"])
     if engine == "eevee":
         skin_output = nodes.new("ShaderNodeOutputAOV")

@@ -26,7 +26,10 @@ EdgeResponse measureEdgeResponse(const EdgeMeasurementSettings& s) {
                                           {"samples", s.samples},
                                           {"seed", s.seed},
                                           {"max_bounces", 8},
-                                          {"filter_width_px", 0.01},
+                                          // Each pixel the mean of E over its width (a box filter of one
+                                          // pixel): ∫E sums pixel means exactly.
+                                          {"pixel_filter", "box"},
+                                          {"filter_width_px", 1.0},
                                           {"threads", s.threads}}},
                                         {"albedo", s.albedo},
                                         {"radius", {1.0, 1.0, 1.0}},

@@ -22,6 +22,11 @@ std::vector<glm::vec3> convolveSurface(const SurfaceSamples& samples, const std:
     std::vector<std::uint32_t> skinSources;
     for (std::uint32_t i = 0; i < count; ++i)
         if (samples.skin[i] && samples.areaMm2[i] > 0.0f) skinSources.push_back(i);
+    // Non-skin samples: sources of no light that still count in the normaliser (NonSkin::Absorbs).
+    std::vector<std::uint32_t> absorbers;
+    if (settings.nonSkin == NonSkin::Absorbs)
+        for (std::uint32_t i = 0; i < count; ++i)
+            if (!samples.skin[i] && samples.areaMm2[i] > 0.0f) absorbers.push_back(i);
     std::vector<std::uint32_t> targets;
     if (receivers) {
         for (const std::uint32_t i : *receivers)
@@ -33,6 +38,7 @@ std::vector<glm::vec3> convolveSurface(const SurfaceSamples& samples, const std:
 
     const double cutoff = profile.cutoffRadiusMm(settings.cutoffTail);
     const SpatialHashGrid grid(samples.positionMm, skinSources, static_cast<float>(cutoff));
+    const SpatialHashGrid absorberGrid(samples.positionMm, absorbers, static_cast<float>(cutoff));
 
     // R_c(r) tabulated at kProfileTableSize + 1 equal steps of r over [0, r_c], linearly interpolated: one table
     // look-up per source instead of up to 18 exponentials (3 channels × 6 lobes). At 8 mm / 4096 = 2 µm per step
@@ -55,8 +61,9 @@ std::vector<glm::vec3> convolveSurface(const SurfaceSamples& samples, const std:
         std::array<double, 3> weighted{0.0, 0.0, 0.0};
         std::array<double, 3> weightSum{0.0, 0.0, 0.0};
         std::size_t sources = 0;
-        grid.forEachWithin(centre, static_cast<float>(cutoff), [&](std::uint32_t q) {
-            bool facing = true; // q lies on the receiver's side of the surface (counts in the normaliser)
+        // Whether q is reached from p (ThroughTissue: through the body), and whether it faces p's way.
+        const auto reached = [&](std::uint32_t q, bool& facing) {
+            facing = true; // q lies on the receiver's side of the surface (counts in the normaliser)
             if (settings.transport == Transport::ThroughTissue && q != p) {
                 // The chord p → q must run inside the body: it may not leave p's surface outwards, nor reach q
                 // from outside, steeper than 10° (a flat or convex neighbour gives ≤ 0, a concave one a little
@@ -65,9 +72,23 @@ std::vector<glm::vec3> convolveSurface(const SurfaceSamples& samples, const std:
                 const float length = glm::length(chord);
                 if (glm::dot(chord, normal) > kAirGapSine * length ||
                     glm::dot(chord, samples.normal[q]) < -kAirGapSine * length)
-                    return;
+                    return false;
                 facing = glm::dot(normal, samples.normal[q]) > 0.0f;
             }
+            return true;
+        };
+        // K_c(p, q) for q ≠ p: the tabulated profile at the 3-D distance times q's area.
+        const auto kernel = [&](std::uint32_t q, float distance, std::array<double, 3>& k) {
+            const float position = distance * inverseStep;
+            const int index = std::min(static_cast<int>(position), kProfileTableSize);
+            const float fraction = position - static_cast<float>(index);
+            for (int c = 0; c < 3; ++c)
+                k[c] =
+                    double(table[index][c] + fraction * (table[index + 1][c] - table[index][c])) * samples.areaMm2[q];
+        };
+        grid.forEachWithin(centre, static_cast<float>(cutoff), [&](std::uint32_t q) {
+            bool facing = true;
+            if (!reached(q, facing)) return;
             std::array<double, 3> k;
             float distance = 0.0f;
             if (q == p) {
@@ -75,12 +96,7 @@ std::vector<glm::vec3> convolveSurface(const SurfaceSamples& samples, const std:
                 for (int c = 0; c < 3; ++c) k[c] = profile.cumulative(c, radius);
             } else {
                 distance = glm::length(samples.positionMm[q] - centre);
-                const float position = distance * inverseStep;
-                const int index = std::min(static_cast<int>(position), kProfileTableSize);
-                const float fraction = position - static_cast<float>(index);
-                for (int c = 0; c < 3; ++c)
-                    k[c] = double(table[index][c] + fraction * (table[index + 1][c] - table[index][c])) *
-                           samples.areaMm2[q];
+                kernel(q, distance, k);
             }
             const glm::vec3 value = irradiance[q] * samples.albedo[q];
             if (!facing) // the far side of a thin part: the through-light gain, growing with the distance
@@ -94,6 +110,18 @@ std::vector<glm::vec3> convolveSurface(const SurfaceSamples& samples, const std:
                 if (facing) weightSum[c] += k[c];
             }
             ++sources;
+        });
+        // Non-skin neighbours on the receiver's side: the light the profile carries there leaves the skin (a path
+        // tracer's walk ends at the medium's boundary), so they add to the normaliser and nothing to the light.
+        absorberGrid.forEachWithin(centre, static_cast<float>(cutoff), [&](std::uint32_t q) {
+            bool facing = true;
+            if (q == p || !reached(q, facing) || !facing) return;
+            std::array<double, 3> k;
+            kernel(q, glm::length(samples.positionMm[q] - centre), k);
+            // A neighbour closer than its own spacing (the vertex across a material boundary lies at distance 0)
+            // stands for a disc of area A_q: its weight is at most the profile's mass over such a disc.
+            const double disc = std::sqrt(samples.areaMm2[q] / std::numbers::pi);
+            for (int c = 0; c < 3; ++c) weightSum[c] += std::min(k[c], profile.cumulative(c, disc));
         });
         glm::vec3 result = output[p]; // no weight at all (an isolated sample): keep E·α
         for (int c = 0; c < 3; ++c)

@@ -11,8 +11,9 @@
 // the sources facing the receiver's way.)
 // E: irradiance, α: albedo. Non-skin samples neither scatter (they are never sources) nor receive (their output is
 // E·α, unblurred). Dividing by Σ K keeps a uniformly lit, uniformly coloured skin surface unchanged and hands the
-// energy of the tails beyond r_c, of non-skin neighbours and of the quadrature error back to the receiver, as the
-// screen-space methods do when they replace non-skin taps by the centre colour (renderer/sss/cpu_blur.h).
+// energy of the tails beyond r_c and of the quadrature error back to the receiver; the energy carried to non-skin
+// neighbours is handed back too (NonSkin::Returns, the default, as the screen-space methods do when they replace
+// non-skin taps by the centre colour, renderer/sss/cpu_blur.h) or lost (NonSkin::Absorbs: they count in Σ K).
 //
 // r_c is the radius outside which every channel of the profile has at most `cutoffTail` of its energy
 // (default 1e-3, 0.1 %: 8.0 mm for d'Eon's skin profile at width 3 mm).
@@ -39,8 +40,17 @@ namespace skinlab::renderer::reference {
 enum class Transport { Euclidean, ThroughTissue };
 inline constexpr float kAirGapSine = 0.17364818f; // sin 10°
 
+// What becomes of the light the profile carries to non-skin neighbours (paint, an eye, another material):
+//  - Returns (default): the normaliser holds skin sources only and hands that light back to the receiver, as the
+//    screen-space methods do when they replace non-skin taps by the centre colour.
+//  - Absorbs: it leaves the skin. Non-skin samples within r_c facing the receiver's way count in the normaliser
+//    Σ K and give no light, so skin next to another material is darker, as in a path tracer, whose random walk
+//    ends where the skin's medium ends (docs/pathtraced.md, "Skin next to other materials").
+enum class NonSkin { Returns, Absorbs };
+
 struct ConvolutionSettings {
     Transport transport = Transport::ThroughTissue;
+    NonSkin nonSkin = NonSkin::Returns;
     double cutoffTail = 1e-3; // share of each channel's energy allowed outside the cutoff radius
     // ThroughTissue: per-channel gain on the sources facing away from the receiver (a thin part's far side), whose
     // light the reflectance profile at the 3-D distance under-estimates against a path tracer (calibration:

@@ -63,6 +63,9 @@ PathtracedParams readTable(const SpecReader& t) {
     p.radiusModel = t.string("radius_model", p.radiusModel);
     if (p.radiusModel != "albedo" && p.radiusModel != "constant")
         t.fail("radius_model", "'" + p.radiusModel + "' is not one of \"albedo\", \"constant\"");
+    p.diffuse = t.string("diffuse", p.diffuse);
+    if (p.diffuse != "lambert" && p.diffuse != "principled")
+        t.fail("diffuse", "'" + p.diffuse + "' is not one of \"lambert\", \"principled\"");
     p.environmentShadow = t.boolean("environment_shadow", p.environmentShadow);
     p.sunAngleDeg = t.number("sun_angle_deg", p.sunAngleDeg, 0.0, 90.0);
     p.filterWidthPx = t.number("filter_width_px", p.filterWidthPx, 0.01, 10.0);
@@ -74,19 +77,13 @@ PathtracedParams readTable(const SpecReader& t) {
 } // namespace
 
 nlohmann::json PathtracedParams::toJson() const {
-    return {{"samples", samples},
-            {"seed", seed},
-            {"max_bounces", maxBounces},
-            {"sss", sss},
-            {"specular", specular},
-            {"specular_source", specularSource},
-            {"radius_mm", radiusMm},
-            {"radius_model", radiusModel},
-            {"environment_shadow", environmentShadow},
-            {"sun_angle_deg", sunAngleDeg},
-            {"filter_width_px", filterWidthPx},
-            {"threads", threads},
-            {"blender", blender}};
+    return {{"samples", samples},           {"seed", seed},
+            {"max_bounces", maxBounces},    {"sss", sss},
+            {"specular", specular},         {"specular_source", specularSource},
+            {"radius_mm", radiusMm},        {"radius_model", radiusModel},
+            {"diffuse", diffuse},           {"environment_shadow", environmentShadow},
+            {"sun_angle_deg", sunAngleDeg}, {"filter_width_px", filterWidthPx},
+            {"threads", threads},           {"blender", blender}};
 }
 
 PathtracedParams readPathtracedParams(const SpecReader& scene) {

@@ -52,6 +52,10 @@ struct PathtracedParams {
     // "albedo": the radius of each channel follows the subsurface colour per texel through albedoRadiusTable()
     // (Cycles evaluates the table in the shader); "constant": radiusMm everywhere, whatever the colour.
     std::string radiusModel = "albedo";
+    // The diffuse model of Cycles' surfaces: "lambert" (a Lambertian Diffuse BSDF off skin, the Subsurface
+    // Scattering node's random walk with Lambertian entry and exit on skin: the rasterizer's model) or "principled"
+    // (the Principled BSDF's Burley diffuse and its subsurface, whose retro-reflection lobe brightens grazing views).
+    std::string diffuse = "lambert";
     // false: the environment lights every point as if nothing occluded it (objects cast no shadow on its light;
     // lights keep theirs), as the rasterizer's SH ambient term does: Cycles then renders the lights and the
     // environment in two passes and sums them. true: the environment is shadowed like any light.

@@ -199,6 +199,14 @@ std::vector<SssKey>& sharedSssKeys() {
                   "1/mm²",
                   "reference: growth of that gain with the distance d through the part, g exp(k d²), k at width_mm 3"},
                  &SssParams::referenceThroughGrowthPerMm2),
+        boundKey({"reference_non_skin",
+                  KeyType::Choice,
+                  0,
+                  0,
+                  {"absorbs", "returns"},
+                  "",
+                  "reference: light carried to non-skin neighbours leaves the skin or returns to the receiver"},
+                 &SssParams::referenceNonSkin),
     };
     return table;
 }

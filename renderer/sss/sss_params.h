@@ -152,6 +152,11 @@ struct SssParams {
     // (scripts/transmittance-calibration.sh; docs/pathtraced.md, "Through-light: calibration").
     std::array<double, 3> referenceThroughGain{1.172, 5.758, 9.743};
     std::array<double, 3> referenceThroughGrowthPerMm2{0.04, -0.04, 0.0};
+    // reference method: what becomes of the light the profile carries to non-skin neighbours: "returns" (handed
+    // back to the receiver, as the screen-space methods do: skin is judged as if nothing bordered it) or "absorbs"
+    // (it leaves the skin, as a path tracer's walk ends where the skin's medium ends; the reference validation's
+    // setting). renderer/reference/surface_convolution.h, NonSkin.
+    std::string referenceNonSkin = "returns";
     // Values of the keys a method declares in its own row (MethodInfo::ownKeys), by key; absent: the declared
     // default. The built-in methods' keys are the typed fields above.
     nlohmann::json own = nlohmann::json::object();

@@ -4,9 +4,8 @@
 
 # Settings shared by every scene: the SSS width, and the path tracer set to agree with the rasterizer everywhere
 # but in the subsurface transport: no interreflection, a hard sun, pixel-centre sampling, and the rasterizer's
-# specular layer (docs/pathtraced.md, "Rasterizer and Cycles"). The figures in the docs were measured with the
-# constant random-walk radius (radius_model = "constant"); "albedo" would match d'Eon's width at every skin colour
-# (docs/pathtraced.md, "Matched profiles") and changes the head and scan cases.
+# specular layer, Lambertian diffuse (docs/pathtraced.md, "Rasterizer and Cycles"), and the random-walk radius
+# following the albedo per texel (docs/pathtraced.md, "Matched profiles").
 common_tail() {
   cat <<EOF
 
@@ -28,7 +27,8 @@ sun_angle_deg = 0.0
 filter_width_px = 0.01
 specular_source = "rasterizer"
 environment_shadow = false
-radius_model = "constant"
+radius_model = "albedo"
+diffuse = "lambert"
 EOF
 }
 

@@ -208,6 +208,24 @@ TEST(PathtracedParams, RadiusModelKeyIsStrict) {
     EXPECT_NE(json.find("radius_model"), std::string::npos) << json;
 }
 
+TEST(PathtracedParams, DiffuseModelKeyIsStrictAndReachesEveryMaterial) {
+    // Default "lambert" (the rasterizer's diffuse model), recorded and written into every part's material for the
+    // Blender script; "principled" keeps Blender's Principled BSDF; anything else is a one-line error naming the key.
+    const Exported own = exportScene("builtin:bleed", {});
+    EXPECT_EQ(own.spec.pathtraced.diffuse, "lambert");
+    EXPECT_EQ(own.spec.resolved.at("pathtraced").at("diffuse"), "lambert");
+    for (const auto& material : own.json.at("materials")) EXPECT_EQ(material.at("diffuse"), "lambert");
+    const Exported principled = exportScene("builtin:bleed", {"pathtraced.diffuse=\"principled\""});
+    for (const auto& material : principled.json.at("materials")) EXPECT_EQ(material.at("diffuse"), "principled");
+    const std::string bad = errorOf([] { loadSceneSpec("builtin:halo", {"pathtraced.diffuse=\"burley\""}, {}); });
+    EXPECT_NE(bad.find("pathtraced.diffuse"), std::string::npos) << bad;
+    EXPECT_NE(bad.find("burley"), std::string::npos) << bad;
+    EXPECT_EQ(bad.find('\n'), std::string::npos) << bad;
+    PathtracedParams p;
+    p.diffuse = "principled";
+    EXPECT_EQ(pathtracedParamsFromJson(p.toJson()).diffuse, "principled");
+}
+
 TEST(PathtracedParams, AlbedoRadiusTableIsPiecewiseLinearAndClamped) {
     const AlbedoRadiusTable& table = albedoRadiusTable();
     ASSERT_GE(table.albedo.size(), 2u);

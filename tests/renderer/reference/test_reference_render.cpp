@@ -84,6 +84,43 @@ TEST(ReferenceRender, RendersEveryBuiltinScene) {
     }
 }
 
+TEST(ReferenceRender, NonSkinNeighboursAbsorbOnlyWhenAsked) {
+    // builtin:bleed with its true materials under a uniform head-on light: with sss.reference_non_skin = "returns"
+    // (the default) the skin stays E·α up to the paint; with "absorbs" the skin next to the paint loses the light
+    // its profile carries under the paint — darker there, never brighter, and unchanged far from it.
+    SKINLAB_REQUIRE_RENDERER(renderer);
+    TempFolder folder("reference-non-skin");
+    std::vector<std::string> returns = kHeadOnLight, absorbs = kHeadOnLight;
+    returns.push_back("sss.reference_edge_mm=1");
+    absorbs.push_back("sss.reference_edge_mm=1");
+    absorbs.push_back("sss.reference_non_skin=\"absorbs\"");
+    const Rendered kept = renderScene(*renderer, folder, "returns", "builtin:bleed-true-mask", "reference", returns);
+    const Rendered lost = renderScene(*renderer, folder, "absorbs", "builtin:bleed-true-mask", "reference", absorbs);
+    const Rendered none = renderScene(*renderer, folder, "none", "builtin:bleed-true-mask", "none", kHeadOnLight);
+    int skin = 0, darker = 0, brighter = 0;
+    double darkest = 1.0;
+    for (int y = 0; y < 96; ++y)
+        for (int x = 0; x < 96; ++x) {
+            if (kept.image.at("mask.Y", x, y) < 0.5f) continue;
+            ++skin;
+            const double base = none.image.at("diffuse.G", x, y);
+            EXPECT_NEAR(kept.image.at("diffuse.G", x, y), base, 1e-4 * base + 1e-6) << x << ", " << y;
+            const double ratio = lost.image.at("diffuse.G", x, y) / base;
+            darker += ratio < 0.99;
+            brighter += ratio > 1.0 + 1e-4;
+            darkest = std::min(darkest, ratio);
+        }
+    std::printf("bleed, absorbing paint: %d of %d skin pixels darker by > 1 %%, darkest at %.3f of E·α\n", darker, skin,
+                darkest);
+    EXPECT_EQ(brighter, 0);
+    EXPECT_GT(darker, 20);       // a ring around both paint squares
+    EXPECT_LT(darker, skin / 2); // only near the paint
+    EXPECT_LT(darkest, 0.9);
+    EXPECT_GT(darkest, 0.3); // at most about half the profile lies under the paint
+    const nlohmann::json resolved = nlohmann::json::parse(lost.image.strings.at("skinlab:resolved"));
+    EXPECT_EQ(resolved.at("sss").at("reference_non_skin"), "absorbs");
+}
+
 TEST(ReferenceRender, ScannedHeadAtACoarseEdge) {
     SKINLAB_REQUIRE_RENDERER(renderer);
     const char* assets = std::getenv("SKINLAB_ASSETS");

@@ -202,17 +202,65 @@ TEST(SurfaceConvolution, OnlySkinScattersAndReceives) {
         dark[i] = glm::vec3(1.0f);
         bright[i] = samples.skin[i] ? glm::vec3(1.0f) : glm::vec3(1000.0f);
     }
-    const auto a = convolveSurface(samples, dark, *profile);
-    const auto b = convolveSurface(samples, bright, *profile);
+    ConvolutionSettings absorbs;
+    absorbs.nonSkin = NonSkin::Absorbs;
+    const auto a = convolveSurface(samples, dark, *profile, absorbs);
+    const auto b = convolveSurface(samples, bright, *profile, absorbs);
+    const auto returned = convolveSurface(samples, dark, *profile); // NonSkin::Returns, the default
     for (std::size_t i = 0; i < samples.size(); ++i) {
         if (samples.skin[i]) {
-            ASSERT_EQ(a[i], b[i]) << i; // bit-identical: no non-skin source enters the sums
-            // Uniform irradiance on uniformly coloured skin stays E·α after renormalisation, at edges too.
-            for (int c = 0; c < 3; ++c) ASSERT_NEAR(a[i][c], samples.albedo[i][c], 1e-5f) << i;
+            ASSERT_EQ(a[i], b[i]) << i; // bit-identical: no non-skin source enters the light
+            // NonSkin::Returns: uniform irradiance on uniformly coloured skin stays E·α after renormalisation, at
+            // edges too; NonSkin::Absorbs darkens skin next to the paint, never brightens it.
+            for (int c = 0; c < 3; ++c) {
+                ASSERT_NEAR(returned[i][c], samples.albedo[i][c], 1e-5f) << i;
+                ASSERT_LE(a[i][c], samples.albedo[i][c] + 1e-5f) << i;
+            }
         } else {
             ASSERT_EQ(b[i], glm::vec3(1000.0f) * samples.albedo[i]) << i;
         }
     }
+}
+
+TEST(SurfaceConvolution, NonSkinNeighboursAbsorbTheLightCarriedToThem) {
+    // A plane, skin for x > x0 and another material for x < x0, uniformly lit, albedo 1. With NonSkin::Absorbs the
+    // light the profile carries across x0 leaves the skin, as a path tracer's random walk ends where the skin's
+    // medium ends: out(x) = the share of the profile on the skin side = the 1-D marginal's CDF at x − x0 (the same
+    // quadrature as StepResponse). With NonSkin::Returns it is handed back: out = 1 everywhere.
+    TessellationStatistics statistics;
+    const Model plane = tessellateSkin(test_models::makeSquare(40.0f), 0.225f, 1.0f, &statistics);
+    const float spacing = 40.0f / float(1 << statistics.rounds);
+    const float stepX = 0.5f * spacing;
+    SurfaceSamples samples = gatherSurfaceSamples(plane, 1.0f);
+    std::vector<std::uint32_t> receivers;
+    for (std::uint32_t i = 0; i < samples.size(); ++i) {
+        samples.albedo[i] = glm::vec3(1.0f);
+        samples.skin[i] = samples.positionMm[i].x > stepX ? 1 : 0;
+        if (samples.skin[i] && std::abs(samples.positionMm[i].y) < 1e-4f && samples.positionMm[i].x <= 5.0f)
+            receivers.push_back(i);
+    }
+    ASSERT_GT(receivers.size(), 15u);
+    const std::vector<glm::vec3> uniform(samples.size(), glm::vec3(1.0f));
+    const auto profile = makeRadialProfile(profileParams("deon"));
+    const sss::GaussianSumProfile marginal(sss::deonSkinLobes(), "deon");
+    ConvolutionSettings absorbs;
+    absorbs.nonSkin = NonSkin::Absorbs;
+    const auto absorbed = convolveSurface(samples, uniform, *profile, absorbs, &receivers);
+    const auto returned = convolveSurface(samples, uniform, *profile, {}, &receivers); // NonSkin::Returns
+    double worst = 0.0, nearest = 2.0;
+    for (const std::uint32_t i : receivers) {
+        const double x = samples.positionMm[i].x;
+        for (int c = 0; c < 3; ++c) {
+            worst = std::max(worst, std::abs(absorbed[i][c] - marginal.cumulative(c, x - stepX)));
+            EXPECT_NEAR(returned[i][c], 1.0, 1e-5) << x;
+        }
+        if (x - stepX < spacing) nearest = std::min(nearest, double(absorbed[i][1]));
+    }
+    std::printf("absorbing neighbours: worst |out − CDF| = %.5f over %zu receivers; green next to the boundary %.3f\n",
+                worst, receivers.size(), nearest);
+    EXPECT_LT(worst, 0.02);
+    EXPECT_GT(nearest, 0.5); // half the profile lies beyond the boundary, minus what the nearest spacing keeps
+    EXPECT_LT(nearest, 0.9);
 }
 
 TEST(SurfaceConvolution, DeterministicForAnyThreadCount) {
