@@ -138,6 +138,12 @@ nlohmann::json blenderSceneJson(const BlenderSceneInputs& inputs, std::string_vi
         const nlohmann::json radiusTable = {{"albedo", table.albedo}, {"radius", radius}};
         for (auto& material : materials) material["radius_table"] = radiusTable;
     }
+    // diffuse "lambert": the walk's colour divided by its measured excess reflectance (walkReflectanceTable).
+    if (inputs.engine == "cycles" && p.diffuse == "lambert") {
+        const WalkReflectanceTable& walk = walkReflectanceTable();
+        const nlohmann::json gainTable = {{"albedo", walk.albedo}, {"gain", walk.gain}};
+        for (auto& material : materials) material["walk_gain_table"] = gainTable;
+    }
     scene["materials"] = materials;
     scene["textures"] = {{"albedo", spec.textures.albedo.string()},
                          {"normal", spec.textures.normal.string()},

@@ -288,6 +288,22 @@ def radius_from_albedo(nodes, links, albedo, table):
     return combine.outputs["Color"]
 
 
+def walk_colour(nodes, links, albedo, table):
+    # The colour given to the random walk: each channel a divided by the walk's excess reflectance k(a) at that
+    # colour (renderer/sss/pathtraced_params.h, walkReflectanceTable), so flat skin reflects a itself.
+    if not table:
+        return albedo
+    separate = nodes.new("ShaderNodeSeparateColor")
+    separate.mode = "RGB"
+    links.new(albedo, separate.inputs["Color"])
+    combine = nodes.new("ShaderNodeCombineColor")
+    combine.mode = "RGB"
+    for channel in range(3):
+        gain = piecewise_linear(nodes, links, separate.outputs[channel], table["albedo"], table["gain"])
+        links.new(multiply(nodes, links, separate.outputs[channel], gain, "DIVIDE"), combine.inputs[channel])
+    return combine.outputs["Color"]
+
+
 def principled_specular(nodes, links, bsdf, description, textures, uv):
     # The Principled BSDF's specular lobe: F0 = 0.08 x specular (x the specular map), GGX at the given roughness.
     bsdf.inputs["Metallic"].default_value = 0.0
@@ -333,7 +349,7 @@ def lambert_material(material, nodes, links, output, bsdf, albedo, mask, radius,
     if description["sss"]:
         walk = nodes.new("ShaderNodeSubsurfaceScattering")
         walk.falloff = "RANDOM_WALK_FIXED_RADIUS"
-        links.new(albedo, walk.inputs["Color"])
+        links.new(walk_colour(nodes, links, albedo, description.get("walk_gain_table")), walk.inputs["Color"])
         walk.inputs["Scale"].default_value = 1.0
         walk.inputs["Radius"].default_value = tuple(float(r) for r in description["radius"])
         if radius is not None:

@@ -313,6 +313,51 @@ TEST(PathtracedRender, WithoutSssEveryPixelShadesLikeTheRasterizer) {
     EXPECT_NEAR(rimCycles / rimRaster, 1.0, 0.005);
 }
 
+TEST(PathtracedRender, FlatSkinReflectsItsColour) {
+    // builtin:halo's backdrop 200 mm behind the sphere is a flat skin plane; uniformly lit by an unshadowed sun and
+    // sky, Cycles' random walk must return what the rasterizer's Lambertian does, colour × irradiance, at a dark and
+    // a light colour. Uncorrected, the walk reflected 1.1 % (0.2) and 0.9 % (0.8) more (walkReflectanceTable).
+    SKINLAB_REQUIRE_BLENDER();
+    SKINLAB_REQUIRE_RENDERER(renderer);
+    TempFolder folder("pathtraced-flat-skin");
+    for (const double albedo : {0.2, 0.8}) {
+        const std::string a = std::to_string(albedo);
+        {
+            std::ofstream toml(folder / "flat.toml");
+            toml << "mm_per_unit = 1.0\n[model]\nsource = \"builtin:halo\"\ndepth_gap_mm = 200.0\n"
+                    "[[materials]]\nname = \"backdrop\"\nalbedo = ["
+                 << a << ", " << a << ", " << a
+                 << "]\nskin = true\n"
+                    "[camera]\nview = \"explicit\"\nposition = [0.0, 0.0, 300.0]\ntarget = [0.0, 0.0, 0.0]\n"
+                    "fov_deg = 30.0\n"
+                    "[[lights]]\ntype = \"directional\"\ndirection = [0.45, -0.45, -0.77]\nintensity = 1.2\n"
+                    "shadow = false\n"
+                    "[environment]\nradiance = [0.08, 0.085, 0.1]\nbackground = \"color\"\n";
+        }
+        const std::string scene = (folder / "flat.toml").string();
+        renderToExr(*renderer, scene, "pathtraced",
+                    {"pathtraced.samples=512", "pathtraced.specular=false", "pathtraced.max_bounces=0",
+                     "pathtraced.environment_shadow=false"},
+                    64, 64, folder / "cycles.exr");
+        renderToExr(*renderer, scene, "none", {}, 64, 64, folder / "raster.exr");
+        const ExrImage cycles = readExr(folder / "cycles.exr");
+        const ExrImage raster = readExr(folder / "raster.exr");
+        for (const char* c : {"R", "G", "B"}) {
+            const std::string channel = std::string("diffuse.") + c;
+            double sumCycles = 0.0, sumRaster = 0.0;
+            int n = 0;
+            for (int y = 0; y < 64; ++y)
+                for (int x = 0; x < 64; ++x)
+                    if (raster.at("depth.Z", x, y) > 400.0f && std::hypot(x - 31.5, y - 31.5) > 20.0)
+                        sumCycles += cycles.at(channel, x, y), sumRaster += raster.at(channel, x, y), ++n;
+            std::printf("flat skin of colour %.1f, %s: Cycles / rasterizer %.4f over %d pixels\n", albedo, c,
+                        sumCycles / sumRaster, n);
+            EXPECT_GT(n, 1000);
+            EXPECT_NEAR(sumCycles / sumRaster, 1.0, 0.005) << albedo << " " << c; // noise: about 0.2 %
+        }
+    }
+}
+
 TEST(PathtracedRender, SameInputsGiveTheSameImage) {
     SKINLAB_REQUIRE_BLENDER();
     SKINLAB_REQUIRE_RENDERER(renderer);
