@@ -276,6 +276,7 @@ void ReferenceMethod::run(const ReferenceInputs& inputs, const sss::SssParams& p
     for (int c = 0; c < 3; ++c) {
         convolution.throughGain[c] = params.referenceThroughGain[c];
         convolution.throughGrowthPerMm2[c] = params.referenceThroughGrowthPerMm2[c] / (scale * scale);
+        convolution.convexityMm[c] = params.referenceConvexityMm[c] * scale; // a length: scales with the profile
     }
     convolution.nonSkin =
         params.referenceNonSkin == "returns" ? reference::NonSkin::Returns : reference::NonSkin::Absorbs;

@@ -78,37 +78,11 @@ bool rendersEnvironmentSeparately(const BlenderSceneInputs& inputs) {
     return !inputs.params.environmentShadow && !inputs.spec->lights.empty();
 }
 
-nlohmann::json blenderSceneJson(const BlenderSceneInputs& inputs, std::string_view meshFile, std::string_view output,
-                                std::string_view record) {
+namespace {
+// One material per part. Radii: the profile's mm at width 3 mm, scaled like every kernel, in scene units.
+nlohmann::json materialsJson(const BlenderSceneInputs& inputs) {
     const SceneSpec& spec = *inputs.spec;
     const PathtracedParams& p = inputs.params;
-    nlohmann::json scene;
-    scene["settings"] = {{"width", spec.width}, {"height", spec.height},       {"samples", p.samples},
-                         {"seed", p.seed},      {"max_bounces", p.maxBounces}, {"filter_width_px", p.filterWidthPx},
-                         {"threads", p.threads}};
-    scene["settings"]["engine"] = inputs.engine;
-    if (inputs.engine == "eevee") scene["settings"]["eevee"] = inputs.eeveeSettings;
-    // One object per part (cycles_scene.py), each with its own vertices, in Model::parts order in the file.
-    nlohmann::json parts = nlohmann::json::array();
-    std::size_t offset = 0;
-    for (std::size_t i = 0; i < inputs.model->parts.size(); ++i) {
-        const SubMesh& part = inputs.model->parts[i];
-        std::vector<bool> used(inputs.model->vertices.size(), false);
-        std::size_t vertexCount = 0;
-        for (std::uint32_t k = part.firstIndex; k < part.firstIndex + part.indexCount; ++k)
-            if (!used[inputs.model->indices[k]]) used[inputs.model->indices[k]] = true, ++vertexCount;
-        parts.push_back({{"offset", offset},
-                         {"vertex_count", vertexCount},
-                         {"index_count", part.indexCount},
-                         {"material", i},
-                         {"closed", isClosedSurface(*inputs.model, part)}});
-        offset += vertexCount * (3 + 3 + 2 + 3 + 1) * 4 + static_cast<std::size_t>(part.indexCount) * 4;
-    }
-    scene["mesh"] = {{"file", std::string(meshFile)}, {"parts", parts}};
-    scene["output"] = std::string(output);
-    scene["record"] = std::string(record);
-
-    // Materials: one per part. Radii: the profile's mm at width 3 mm, scaled like every kernel, in scene units.
     const double radiusScale = sss::profileScale(inputs.sssWidthMm) / spec.mmPerUnit;
     nlohmann::json materials = nlohmann::json::array();
     for (std::size_t i = 0; i < inputs.partMaterials.size(); ++i) {
@@ -144,7 +118,41 @@ nlohmann::json blenderSceneJson(const BlenderSceneInputs& inputs, std::string_vi
         const nlohmann::json gainTable = {{"albedo", walk.albedo}, {"gain", walk.gain}};
         for (auto& material : materials) material["walk_gain_table"] = gainTable;
     }
-    scene["materials"] = materials;
+    return materials;
+}
+} // namespace
+
+nlohmann::json blenderSceneJson(const BlenderSceneInputs& inputs, std::string_view meshFile, std::string_view output,
+                                std::string_view record) {
+    const SceneSpec& spec = *inputs.spec;
+    const PathtracedParams& p = inputs.params;
+    nlohmann::json scene;
+    scene["settings"] = {{"width", spec.width}, {"height", spec.height},       {"samples", p.samples},
+                         {"seed", p.seed},      {"max_bounces", p.maxBounces}, {"filter_width_px", p.filterWidthPx},
+                         {"threads", p.threads}};
+    scene["settings"]["engine"] = inputs.engine;
+    if (inputs.engine == "eevee") scene["settings"]["eevee"] = inputs.eeveeSettings;
+    // One object per part (cycles_scene.py), each with its own vertices, in Model::parts order in the file.
+    nlohmann::json parts = nlohmann::json::array();
+    std::size_t offset = 0;
+    for (std::size_t i = 0; i < inputs.model->parts.size(); ++i) {
+        const SubMesh& part = inputs.model->parts[i];
+        std::vector<bool> used(inputs.model->vertices.size(), false);
+        std::size_t vertexCount = 0;
+        for (std::uint32_t k = part.firstIndex; k < part.firstIndex + part.indexCount; ++k)
+            if (!used[inputs.model->indices[k]]) used[inputs.model->indices[k]] = true, ++vertexCount;
+        parts.push_back({{"offset", offset},
+                         {"vertex_count", vertexCount},
+                         {"index_count", part.indexCount},
+                         {"material", i},
+                         {"closed", isClosedSurface(*inputs.model, part)}});
+        offset += vertexCount * (3 + 3 + 2 + 3 + 1) * 4 + static_cast<std::size_t>(part.indexCount) * 4;
+    }
+    scene["mesh"] = {{"file", std::string(meshFile)}, {"parts", parts}};
+    scene["output"] = std::string(output);
+    scene["record"] = std::string(record);
+
+    scene["materials"] = materialsJson(inputs);
     scene["textures"] = {{"albedo", spec.textures.albedo.string()},
                          {"normal", spec.textures.normal.string()},
                          {"normal_strength", spec.textures.normalStrength},

@@ -11,84 +11,75 @@
 
 namespace skinlab::renderer::reference {
 
-std::vector<glm::vec3> convolveSurface(const SurfaceSamples& samples, const std::vector<glm::vec3>& irradiance,
-                                       const sss::RadialProfile& profile, const ConvolutionSettings& settings,
-                                       const std::vector<std::uint32_t>* receivers, ConvolutionReport* report) {
-    SKINLAB_CHECK_EQ(irradiance.size(), samples.size());
-    const std::size_t count = samples.size();
-    std::vector<glm::vec3> output(count);
-    for (std::size_t i = 0; i < count; ++i) output[i] = irradiance[i] * samples.albedo[i];
+namespace {
 
-    std::vector<std::uint32_t> skinSources;
-    for (std::uint32_t i = 0; i < count; ++i)
-        if (samples.skin[i] && samples.areaMm2[i] > 0.0f) skinSources.push_back(i);
-    // Non-skin samples: sources of no light that still count in the normaliser (NonSkin::Absorbs).
-    std::vector<std::uint32_t> absorbers;
-    if (settings.nonSkin == NonSkin::Absorbs)
-        for (std::uint32_t i = 0; i < count; ++i)
-            if (!samples.skin[i] && samples.areaMm2[i] > 0.0f) absorbers.push_back(i);
-    std::vector<std::uint32_t> targets;
-    if (receivers) {
-        for (const std::uint32_t i : *receivers)
-            if (i < count && samples.skin[i]) targets.push_back(i);
-    } else {
-        for (std::uint32_t i = 0; i < count; ++i)
-            if (samples.skin[i]) targets.push_back(i);
+// R_c(r) tabulated at kSteps + 1 equal steps of r over [0, r_c], linearly interpolated: one table look-up per source
+// instead of up to 18 exponentials (3 channels × 6 lobes). At 8 mm / 4096 = 2 µm per step the narrowest d'Eon lobe
+// (σ = 80 µm) spans 40 steps, so the interpolation error is below 1e-3 of its peak; r = 0 (Burley's 1/r) is never
+// looked up, sources closer than one step being at least 100× closer than any tessellation places them.
+class ProfileTable {
+public:
+    ProfileTable(const sss::RadialProfile& profile, double cutoff) : table_(kSteps + 2) {
+        const double step = cutoff / kSteps;
+        for (int k = 0; k < kSteps + 2; ++k)
+            for (int c = 0; c < 3; ++c)
+                table_[k][c] = static_cast<float>(profile.radial(c, std::max(k, 1) * step)); // r = 0 → first step
+        inverseStep_ = static_cast<float>(1.0 / step);
+    }
+    // R_c(distance) · area for the three channels.
+    void weights(float distance, float area, std::array<double, 3>& k) const {
+        const float position = distance * inverseStep_;
+        const int index = std::min(static_cast<int>(position), kSteps);
+        const float fraction = position - static_cast<float>(index);
+        for (int c = 0; c < 3; ++c)
+            k[c] = double(table_[index][c] + fraction * (table_[index + 1][c] - table_[index][c])) * area;
     }
 
-    const double cutoff = profile.cutoffRadiusMm(settings.cutoffTail);
-    const SpatialHashGrid grid(samples.positionMm, skinSources, static_cast<float>(cutoff));
-    const SpatialHashGrid absorberGrid(samples.positionMm, absorbers, static_cast<float>(cutoff));
+private:
+    static constexpr int kSteps = 4096;
+    std::vector<std::array<float, 3>> table_;
+    float inverseStep_ = 0.0f;
+};
 
-    // R_c(r) tabulated at kProfileTableSize + 1 equal steps of r over [0, r_c], linearly interpolated: one table
-    // look-up per source instead of up to 18 exponentials (3 channels × 6 lobes). At 8 mm / 4096 = 2 µm per step
-    // the narrowest d'Eon lobe (σ = 80 µm) spans 40 steps, so the interpolation error is below 1e-3 of its peak;
-    // r = 0 (Burley's 1/r) is never looked up, sources closer than one step being at least 100× closer than any
-    // tessellation places them.
-    constexpr int kProfileTableSize = 4096;
-    const double step = cutoff / kProfileTableSize;
-    std::vector<std::array<float, 3>> table(kProfileTableSize + 2);
-    for (int k = 0; k < kProfileTableSize + 2; ++k)
-        for (int c = 0; c < 3; ++c)
-            table[k][c] = static_cast<float>(profile.radial(c, std::max(k, 1) * step)); // r = 0 → first step
-    const float inverseStep = static_cast<float>(1.0 / step);
-    std::vector<std::size_t> sourceCounts(targets.size(), 0);
+// Everything one receiver's sum reads: the samples, the grids of skin sources and of absorbers, the table.
+struct Convolution {
+    const SurfaceSamples& samples;
+    const std::vector<glm::vec3>& irradiance;
+    const sss::RadialProfile& profile;
+    const ConvolutionSettings& settings;
+    double cutoff;
+    const SpatialHashGrid& sources;
+    const SpatialHashGrid& absorbers;
+    const ProfileTable& table;
 
-    const auto convolveOne = [&](std::size_t t) {
-        const std::uint32_t p = targets[t];
+    // Whether q is reached from p (ThroughTissue: through the body), and whether it faces p's way.
+    bool reached(std::uint32_t p, std::uint32_t q, bool& facing) const {
+        facing = true; // q lies on the receiver's side of the surface (counts in the normaliser)
+        if (settings.transport != Transport::ThroughTissue || q == p) return true;
+        // The chord p → q must run inside the body: it may not leave p's surface outwards, nor reach q from
+        // outside, steeper than 10° (a flat or convex neighbour gives ≤ 0, a concave one a little above 0; across
+        // an air gap — lips, a fold, a nostril — the chord leaves through p's surface). A source behind a thin
+        // part (its normal turned away) passes: that is through-light.
+        const glm::vec3 chord = samples.positionMm[q] - samples.positionMm[p];
+        const float length = glm::length(chord);
+        if (glm::dot(chord, samples.normal[p]) > kAirGapSine * length ||
+            glm::dot(chord, samples.normal[q]) < -kAirGapSine * length)
+            return false;
+        facing = glm::dot(samples.normal[p], samples.normal[q]) > 0.0f;
+        return true;
+    }
+
+    // The convolved E·α at receiver p (its own E·α when nothing weighs), and the number of sources summed.
+    glm::vec3 at(std::uint32_t p, glm::vec3 own, std::size_t& sourceCount) const {
         const glm::vec3 centre = samples.positionMm[p];
         const glm::vec3 normal = samples.normal[p];
         std::array<double, 3> weighted{0.0, 0.0, 0.0};
         std::array<double, 3> weightSum{0.0, 0.0, 0.0};
-        std::size_t sources = 0;
-        // Whether q is reached from p (ThroughTissue: through the body), and whether it faces p's way.
-        const auto reached = [&](std::uint32_t q, bool& facing) {
-            facing = true; // q lies on the receiver's side of the surface (counts in the normaliser)
-            if (settings.transport == Transport::ThroughTissue && q != p) {
-                // The chord p → q must run inside the body: it may not leave p's surface outwards, nor reach q
-                // from outside, steeper than 10° (a flat or convex neighbour gives ≤ 0, a concave one a little
-                // above 0; across an air gap — lips, a fold, a nostril — the chord leaves through p's surface). A source behind a thin part (its normal turned away) passes: that is through-light.
-                const glm::vec3 chord = samples.positionMm[q] - centre;
-                const float length = glm::length(chord);
-                if (glm::dot(chord, normal) > kAirGapSine * length ||
-                    glm::dot(chord, samples.normal[q]) < -kAirGapSine * length)
-                    return false;
-                facing = glm::dot(normal, samples.normal[q]) > 0.0f;
-            }
-            return true;
-        };
-        // K_c(p, q) for q ≠ p: the tabulated profile at the 3-D distance times q's area.
-        const auto kernel = [&](std::uint32_t q, float distance, std::array<double, 3>& k) {
-            const float position = distance * inverseStep;
-            const int index = std::min(static_cast<int>(position), kProfileTableSize);
-            const float fraction = position - static_cast<float>(index);
-            for (int c = 0; c < 3; ++c)
-                k[c] =
-                    double(table[index][c] + fraction * (table[index + 1][c] - table[index][c])) * samples.areaMm2[q];
-        };
-        grid.forEachWithin(centre, static_cast<float>(cutoff), [&](std::uint32_t q) {
+        double curvatureSum = 0.0, curvatureWeight = 0.0; // the kernel-weighted curvature at p (convexityMm)
+        std::size_t count = 0;
+        sources.forEachWithin(centre, static_cast<float>(cutoff), [&](std::uint32_t q) {
             bool facing = true;
-            if (!reached(q, facing)) return;
+            if (!reached(p, q, facing)) return;
             std::array<double, 3> k;
             float distance = 0.0f;
             if (q == p) {
@@ -96,7 +87,7 @@ std::vector<glm::vec3> convolveSurface(const SurfaceSamples& samples, const std:
                 for (int c = 0; c < 3; ++c) k[c] = profile.cumulative(c, radius);
             } else {
                 distance = glm::length(samples.positionMm[q] - centre);
-                kernel(q, distance, k);
+                table.weights(distance, samples.areaMm2[q], k);
             }
             const glm::vec3 value = irradiance[q] * samples.albedo[q];
             if (!facing) // the far side of a thin part: the through-light gain, growing with the distance
@@ -109,26 +100,73 @@ std::vector<glm::vec3> convolveSurface(const SurfaceSamples& samples, const std:
                 weighted[c] += k[c] * value[c];
                 if (facing) weightSum[c] += k[c];
             }
-            ++sources;
+            if (facing && q != p && distance > 0.0f) {
+                const double mean = (k[0] + k[1] + k[2]) / 3.0;
+                curvatureSum += mean * glm::dot(normal - samples.normal[q], centre - samples.positionMm[q]) /
+                                (double(distance) * distance);
+                curvatureWeight += mean;
+            }
+            ++count;
         });
         // Non-skin neighbours on the receiver's side: the light the profile carries there leaves the skin (a path
-        // tracer's walk ends at the medium's boundary), so they add to the normaliser and nothing to the light.
-        absorberGrid.forEachWithin(centre, static_cast<float>(cutoff), [&](std::uint32_t q) {
+        // tracer's walk ends at the medium's boundary), so they add to the normaliser and nothing to the light. A
+        // neighbour closer than its own spacing (the vertex across a material boundary lies at distance 0) stands
+        // for a disc of area A_q: its weight is at most the profile's mass over such a disc.
+        absorbers.forEachWithin(centre, static_cast<float>(cutoff), [&](std::uint32_t q) {
             bool facing = true;
-            if (q == p || !reached(q, facing) || !facing) return;
+            if (q == p || !reached(p, q, facing) || !facing) return;
             std::array<double, 3> k;
-            kernel(q, glm::length(samples.positionMm[q] - centre), k);
-            // A neighbour closer than its own spacing (the vertex across a material boundary lies at distance 0)
-            // stands for a disc of area A_q: its weight is at most the profile's mass over such a disc.
+            table.weights(glm::length(samples.positionMm[q] - centre), samples.areaMm2[q], k);
             const double disc = std::sqrt(samples.areaMm2[q] / std::numbers::pi);
             for (int c = 0; c < 3; ++c) weightSum[c] += std::min(k[c], profile.cumulative(c, disc));
         });
-        glm::vec3 result = output[p]; // no weight at all (an isolated sample): keep E·α
+        sourceCount = count;
+        const double curvature = curvatureWeight > 0.0 ? curvatureSum / curvatureWeight : 0.0;
+        glm::vec3 result = own; // no weight at all (an isolated sample): keep E·α
         for (int c = 0; c < 3; ++c)
-            if (weightSum[c] > 0.0) result[c] = static_cast<float>(weighted[c] / weightSum[c]);
-        output[p] = result;
-        sourceCounts[t] = sources;
-    };
+            if (weightSum[c] > 0.0)
+                result[c] = static_cast<float>(weighted[c] / weightSum[c] *
+                                               std::max(0.0, 1.0 + settings.convexityMm[c] * curvature));
+        return result;
+    }
+};
+
+std::vector<std::uint32_t> samplesWhere(const SurfaceSamples& samples, bool skin) {
+    std::vector<std::uint32_t> found;
+    for (std::uint32_t i = 0; i < samples.size(); ++i)
+        if (bool(samples.skin[i]) == skin && samples.areaMm2[i] > 0.0f) found.push_back(i);
+    return found;
+}
+
+} // namespace
+
+std::vector<glm::vec3> convolveSurface(const SurfaceSamples& samples, const std::vector<glm::vec3>& irradiance,
+                                       const sss::RadialProfile& profile, const ConvolutionSettings& settings,
+                                       const std::vector<std::uint32_t>* receivers, ConvolutionReport* report) {
+    SKINLAB_CHECK_EQ(irradiance.size(), samples.size());
+    const std::size_t count = samples.size();
+    std::vector<glm::vec3> output(count);
+    for (std::size_t i = 0; i < count; ++i) output[i] = irradiance[i] * samples.albedo[i];
+
+    std::vector<std::uint32_t> targets;
+    if (receivers) {
+        for (const std::uint32_t i : *receivers)
+            if (i < count && samples.skin[i]) targets.push_back(i);
+    } else {
+        for (std::uint32_t i = 0; i < count; ++i)
+            if (samples.skin[i]) targets.push_back(i);
+    }
+
+    const double cutoff = profile.cutoffRadiusMm(settings.cutoffTail);
+    const SpatialHashGrid sources(samples.positionMm, samplesWhere(samples, true), static_cast<float>(cutoff));
+    // Non-skin samples: sources of no light that still count in the normaliser (NonSkin::Absorbs).
+    const SpatialHashGrid absorbers(samples.positionMm,
+                                    settings.nonSkin == NonSkin::Absorbs ? samplesWhere(samples, false)
+                                                                         : std::vector<std::uint32_t>{},
+                                    static_cast<float>(cutoff));
+    const ProfileTable table(profile, cutoff);
+    const Convolution convolution{samples, irradiance, profile, settings, cutoff, sources, absorbers, table};
+    std::vector<std::size_t> sourceCounts(targets.size(), 0);
 
     unsigned threads = settings.threads ? settings.threads : std::max(1u, std::thread::hardware_concurrency());
     threads = static_cast<unsigned>(std::min<std::size_t>(threads, std::max<std::size_t>(1, targets.size() / 64)));
@@ -138,7 +176,8 @@ std::vector<glm::vec3> convolveSurface(const SurfaceSamples& samples, const std:
     const auto worker = [&] {
         constexpr std::size_t chunk = 256;
         for (std::size_t begin = next.fetch_add(chunk); begin < targets.size(); begin = next.fetch_add(chunk))
-            for (std::size_t t = begin; t < std::min(begin + chunk, targets.size()); ++t) convolveOne(t);
+            for (std::size_t t = begin; t < std::min(begin + chunk, targets.size()); ++t)
+                output[targets[t]] = convolution.at(targets[t], output[targets[t]], sourceCounts[t]);
     };
     std::vector<std::thread> pool;
     for (unsigned i = 1; i < threads; ++i) pool.emplace_back(worker);

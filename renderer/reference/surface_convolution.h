@@ -62,6 +62,13 @@ struct ConvolutionSettings {
     // the ratio grows with the thickness of the part; on a sum of Gaussians the factor widens each lobe of variance
     // v to v / (1 − 2 k_c v) (for 2 k_c v < 1). 0: a constant gain, exactly throughGain.
     std::array<double, 3> throughGrowthPerMm2{0.0, 0.0, 0.0};
+    // Per-channel length L_c (mm) of the convex-surface gain: the output is multiplied by 1 + L_c κ, κ (1/mm) the
+    // surface's curvature at the receiver as its kernel sees it, Σ K · (n_p − n_q)·(p − q) / |p − q|² / Σ K over the
+    // facing skin sources (from the smooth normals, so the flat facets of a tessellated mesh do not bias it: exactly
+    // 1/R on a sphere of radius R, 0 on a plane, negative where the surface is concave). Light in a
+    // convex body reaches the surface again sooner than under a flat one, so a path tracer's skin is brighter there
+    // (docs/pathtraced.md, "A convex body's level"). 0: no gain.
+    std::array<double, 3> convexityMm{0.0, 0.0, 0.0};
     unsigned threads = 0; // worker threads; 0: std::thread::hardware_concurrency()
 };
 

@@ -81,6 +81,7 @@ TransmittanceParams readTransmittanceTable(const SpecReader& t) {
 } // namespace
 
 namespace {
+// Long by design: the declaration table of the [sss] keys, one entry per key (name, type, range, unit, doc, field).
 std::vector<SssKey>& sharedSssKeys() {
     // Built on first use (the choices call methodNames() and materialNames()).
     static std::vector<SssKey> table{
@@ -207,6 +208,14 @@ std::vector<SssKey>& sharedSssKeys() {
                   "",
                   "reference: light carried to non-skin neighbours leaves the skin or returns to the receiver"},
                  &SssParams::referenceNonSkin),
+        boundKey({"reference_convexity_mm",
+                  KeyType::Vec3,
+                  -10.0,
+                  10.0,
+                  {},
+                  "mm",
+                  "reference: per-channel length L of the convex-surface gain 1 + L κ, L at width_mm 3"},
+                 &SssParams::referenceConvexityMm),
     };
     return table;
 }

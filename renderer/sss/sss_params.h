@@ -157,6 +157,11 @@ struct SssParams {
     // (it leaves the skin, as a path tracer's walk ends where the skin's medium ends; the reference validation's
     // setting). renderer/reference/surface_convolution.h, NonSkin.
     std::string referenceNonSkin = "returns";
+    // reference method: per-channel length L_c (mm at width_mm = 3, scaled with the profile) of the convex-surface
+    // gain 1 + L_c κ (κ the curvature the kernel sees, 1/mm; renderer/reference/surface_convolution.h). 0 (the
+    // default): a level-neutral reference, as every screen-space method is; the fit to the path tracer's level on a
+    // sphere is in docs/pathtraced.md, "A convex body's level".
+    std::array<double, 3> referenceConvexityMm{0.0, 0.0, 0.0};
     // Values of the keys a method declares in its own row (MethodInfo::ownKeys), by key; absent: the declared
     // default. The built-in methods' keys are the typed fields above.
     nlohmann::json own = nlohmann::json::object();

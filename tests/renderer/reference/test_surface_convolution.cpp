@@ -263,6 +263,44 @@ TEST(SurfaceConvolution, NonSkinNeighboursAbsorbTheLightCarriedToThem) {
     EXPECT_LT(nearest, 0.9);
 }
 
+TEST(SurfaceConvolution, ConvexityGainFollowsTheCurvature) {
+    // builtin:halo's sphere (radius 40 mm) under uniform irradiance: the kernel-weighted curvature is 1/R, so the
+    // output is α (1 + L_c / R); with L = 0 it is α. A flat plane keeps α whatever L.
+    const Model halo = tessellateSkin(makeHaloScene(200.0f), 1.0f, 1.0f);
+    const SurfaceSamples samples = gatherSurfaceSamples(halo, 1.0f);
+    const auto profile = makeRadialProfile(profileParams("deon"));
+    std::vector<std::uint32_t> receivers;
+    for (std::uint32_t i = 0; i < samples.size(); i += 11)
+        if (samples.skin[i] && glm::length(samples.positionMm[i]) < kHaloSphereRadiusMm + 0.5f) receivers.push_back(i);
+    ASSERT_GT(receivers.size(), 100u);
+    const std::vector<glm::vec3> uniform(samples.size(), glm::vec3(1.0f));
+    ConvolutionSettings convex;
+    convex.convexityMm = {2.0, 1.0, 0.0};
+    const auto plain = convolveSurface(samples, uniform, *profile, {}, &receivers);
+    const auto gained = convolveSurface(samples, uniform, *profile, convex, &receivers);
+    double worst = 0.0;
+    for (const std::uint32_t i : receivers)
+        for (int c = 0; c < 3; ++c) {
+            const double expected = 1.0 + convex.convexityMm[static_cast<std::size_t>(c)] / kHaloSphereRadiusMm;
+            if (std::abs(gained[i][c] / plain[i][c] - expected) > worst) {
+                worst = std::abs(gained[i][c] / plain[i][c] - expected);
+                if (worst > 0.002)
+                    std::printf("at (%.2f, %.2f, %.2f) channel %d: %.4f\n", samples.positionMm[i].x,
+                                samples.positionMm[i].y, samples.positionMm[i].z, c, gained[i][c] / plain[i][c]);
+            }
+            EXPECT_NEAR(plain[i][c], samples.albedo[i][c], 1e-4) << i;
+        }
+    std::printf("convexity gain on a 40 mm sphere: worst |gain − (1 + L/R)| = %.5f over %zu receivers\n", worst,
+                receivers.size());
+    EXPECT_LT(worst, 0.002); // L/R = 0.05 in red: the estimate of 1/R within 4 %
+
+    const Model plane = tessellateSkin(test_models::makeSquare(40.0f), 1.0f, 1.0f);
+    const SurfaceSamples flat = gatherSurfaceSamples(plane, 1.0f);
+    const auto onPlane = convolveSurface(flat, std::vector<glm::vec3>(flat.size(), glm::vec3(1.0f)), *profile, convex);
+    for (std::size_t i = 0; i < flat.size(); ++i)
+        for (int c = 0; c < 3; ++c) ASSERT_NEAR(onPlane[i][c], flat.albedo[i][c], 1e-4) << i;
+}
+
 TEST(SurfaceConvolution, DeterministicForAnyThreadCount) {
     const Model plane = tessellateSkin(test_models::makeSquare(20.0f), 0.8f, 1.0f);
     const SurfaceSamples samples = gatherSurfaceSamples(plane, 1.0f);
