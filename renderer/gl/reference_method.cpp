@@ -278,6 +278,7 @@ void ReferenceMethod::run(const ReferenceInputs& inputs, const sss::SssParams& p
         convolution.throughGrowthPerMm2[c] = params.referenceThroughGrowthPerMm2[c] / (scale * scale);
         convolution.convexityMm[c] = params.referenceConvexityMm[c] * scale; // a length: scales with the profile
     }
+    convolution.convexityRadiusMinMm = 20.0 * scale; // 20 mm at width 3 mm: the nose tip, the ear's rim
     convolution.nonSkin =
         params.referenceNonSkin == "returns" ? reference::NonSkin::Returns : reference::NonSkin::Absorbs;
     reference::ConvolutionReport report;

@@ -76,6 +76,7 @@ struct Convolution {
         std::array<double, 3> weighted{0.0, 0.0, 0.0};
         std::array<double, 3> weightSum{0.0, 0.0, 0.0};
         double curvatureSum = 0.0, curvatureWeight = 0.0; // the kernel-weighted curvature at p (convexityMm)
+        double farWeight = 0.0;                           // the kernel weight of a thin part's far side
         std::size_t count = 0;
         sources.forEachWithin(centre, static_cast<float>(cutoff), [&](std::uint32_t q) {
             bool facing = true;
@@ -100,6 +101,7 @@ struct Convolution {
                 weighted[c] += k[c] * value[c];
                 if (facing) weightSum[c] += k[c];
             }
+            if (!facing) farWeight += (k[0] + k[1] + k[2]) / 3.0;
             if (facing && q != p && distance > 0.0f) {
                 const double mean = (k[0] + k[1] + k[2]) / 3.0;
                 curvatureSum += mean * glm::dot(normal - samples.normal[q], centre - samples.positionMm[q]) /
@@ -121,7 +123,16 @@ struct Convolution {
             for (int c = 0; c < 3; ++c) weightSum[c] += std::min(k[c], profile.cumulative(c, disc));
         });
         sourceCount = count;
-        const double curvature = curvatureWeight > 0.0 ? curvatureSum / curvatureWeight : 0.0;
+        // The gain is a first-order model of a body thick against the profile: where the kernel reaches a thin
+        // part's far side (whose light the through-light gain already carries), it fades out, gone once that side
+        // holds 5 % of the weight.
+        const double farShare = farWeight / std::max(farWeight + curvatureWeight, 1e-30);
+        // Curvatures tighter than 1 / convexityRadiusMinMm (a rounded rim, a nostril's edge: parts thin against
+        // the profile) count as that radius: the first-order model does not extrapolate there.
+        const double bound = 1.0 / settings.convexityRadiusMinMm;
+        const double curvature = curvatureWeight > 0.0 ? std::clamp(curvatureSum / curvatureWeight, -bound, bound) *
+                                                             std::max(0.0, 1.0 - 20.0 * farShare)
+                                                       : 0.0;
         glm::vec3 result = own; // no weight at all (an isolated sample): keep E·α
         for (int c = 0; c < 3; ++c)
             if (weightSum[c] > 0.0)

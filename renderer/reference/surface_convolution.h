@@ -67,8 +67,12 @@ struct ConvolutionSettings {
     // facing skin sources (from the smooth normals, so the flat facets of a tessellated mesh do not bias it: exactly
     // 1/R on a sphere of radius R, 0 on a plane, negative where the surface is concave). Light in a
     // convex body reaches the surface again sooner than under a flat one, so a path tracer's skin is brighter there
-    // (docs/pathtraced.md, "A convex body's level"). 0: no gain.
+    // (docs/pathtraced.md, "A convex body's level"). A first-order model of a body thick against the profile: the
+    // term fades out where the kernel reaches a thin part's far side (gone at 5 % of the weight there), whose light
+    // throughGain carries, and |κ| is clamped to 1 / convexityRadiusMinMm. 0: no gain.
     std::array<double, 3> convexityMm{0.0, 0.0, 0.0};
+    // The tightest radius (mm) the convexity gain follows: |κ| is clamped to 1 / convexityRadiusMinMm.
+    double convexityRadiusMinMm = 20.0;
     unsigned threads = 0; // worker threads; 0: std::thread::hardware_concurrency()
 };
 
