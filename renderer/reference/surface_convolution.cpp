@@ -65,7 +65,7 @@ struct Convolution {
         if (glm::dot(chord, samples.normal[p]) > kAirGapSine * length ||
             glm::dot(chord, samples.normal[q]) < -kAirGapSine * length)
             return false;
-        facing = glm::dot(samples.normal[p], samples.normal[q]) > 0.0f;
+        facing = glm::dot(samples.normal[p], samples.normal[q]) > -0.5f;
         return true;
     }
 

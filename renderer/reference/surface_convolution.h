@@ -34,7 +34,9 @@ namespace skinlab::renderer::reference {
 //    surface nor reaches q from outside at more than asin(kAirGapSine) = 10° to the tangent plane; a concave
 //    surface of radius R keeps its sources up to 2R · 0.17 mm away, the rest of the kernel's energy is handed back
 //    by the normaliser; two faces across a gap g lose each other up to g / 0.17 mm apart), and Σ K of the
-//    normaliser holds only the sources facing the receiver's way (n_p · n_q > 0): a uniformly lit flat surface
+//    normaliser holds only the sources facing the receiver's way (n_p · n_q > −½, within 120°: the far side of a
+//    thin part faces away by nearly 180°, while a body's edge — a neck's cut, a box's corner — turns by about 90°
+//    and is no thin part; at 0 such an edge's sources got the through-light gain): a uniformly lit flat surface
 //    stays unchanged, the energy of tails and non-skin neighbours is still handed back, and the light of a thin
 //    part's back face adds to its front (through-light) instead of averaging with it.
 enum class Transport { Euclidean, ThroughTissue };

@@ -150,7 +150,7 @@ struct SssParams {
     // is; k = 0: a constant gain.
     // Defaults: fitted to Blender Cycles' random walk on 1, 2, 2.5 and 4 mm skin fins
     // (scripts/transmittance-calibration.sh; docs/pathtraced.md, "Through-light: calibration").
-    std::array<double, 3> referenceThroughGain{1.172, 5.758, 9.743};
+    std::array<double, 3> referenceThroughGain{1.181, 5.727, 9.723};
     std::array<double, 3> referenceThroughGrowthPerMm2{0.04, -0.04, 0.0};
     // reference method: what becomes of the light the profile carries to non-skin neighbours: "returns" (handed
     // back to the receiver, as the screen-space methods do: skin is judged as if nothing bordered it) or "absorbs"

@@ -184,7 +184,7 @@ TEST(SssParams, ThesisVariantKeys) {
 // and the key.
 TEST(SssParams, ReferenceThroughLightKeys) {
     const SssParams defaults = readSss("[sss]\nmethod = \"reference\"\n");
-    EXPECT_EQ(defaults.referenceThroughGain, (std::array<double, 3>{1.172, 5.758, 9.743}));
+    EXPECT_EQ(defaults.referenceThroughGain, (std::array<double, 3>{1.181, 5.727, 9.723}));
     EXPECT_EQ(defaults.referenceThroughGrowthPerMm2, (std::array<double, 3>{0.04, -0.04, 0.0}));
     const SssParams p = readSss("[sss]\nmethod = \"reference\"\nreference_through_gain = [1.72, 5.31, 9.44]\n"
                                 "reference_through_growth_per_mm2 = [0, 0.0, -0.5]\n");
