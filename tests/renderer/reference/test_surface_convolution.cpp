@@ -318,6 +318,38 @@ TEST(SurfaceConvolution, ConvexityGainFollowsTheCurvature) {
         for (int c = 0; c < 3; ++c) ASSERT_NEAR(onPlane[i][c], flat.albedo[i][c], 1e-4) << i;
 }
 
+TEST(SurfaceConvolution, AConvexEdgeIsNoThinPart) {
+    // Two half-planes meeting at a right angle (z = 0 for x ≤ 0, normal +z; x = 0 for z ≤ 0, normal +x), uniformly
+    // lit: a body's edge, like builtin:head's neck meeting its cap. The sources round the corner turn by 90°; they
+    // are no thin part's far side, so a through-light gain must not touch them: every receiver keeps E·α. (With the
+    // far side bounded at 90°, n_p · n_q ≤ 0, they got the gain: receivers near the edge came out brighter.)
+    SurfaceSamples s;
+    const float h = 0.25f;
+    std::vector<std::uint32_t> receivers;
+    for (int j = -40; j <= 40; ++j)
+        for (int i = 1; i <= 60; ++i) {
+            if (j == 0) receivers.push_back(static_cast<std::uint32_t>(s.size()));
+            s.positionMm.push_back(glm::vec3(-(i - 0.5f) * h, j * h, 0.0f)); // the top face
+            s.normal.push_back(glm::vec3(0.0f, 0.0f, 1.0f));
+            s.positionMm.push_back(glm::vec3(0.0f, j * h, -(i - 0.5f) * h)); // the side face
+            s.normal.push_back(glm::vec3(1.0f, 0.0f, 0.0f));
+            for (int k = 0; k < 2; ++k) {
+                s.albedo.push_back(glm::vec3(1.0f));
+                s.areaMm2.push_back(h * h);
+                s.skin.push_back(1);
+            }
+        }
+    ConvolutionSettings settings;
+    settings.throughGain = {10.0, 10.0, 10.0};
+    const auto out = convolveSurface(s, std::vector<glm::vec3>(s.size(), glm::vec3(1.0f)),
+                                     *makeRadialProfile(profileParams("deon")), settings, &receivers);
+    double worst = 0.0;
+    for (const std::uint32_t i : receivers)
+        for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(double(out[i][c]) - 1.0));
+    std::printf("convex edge, through gain 10: worst |out − E·α| = %.6f over %zu receivers\n", worst, receivers.size());
+    EXPECT_LT(worst, 1e-5);
+}
+
 TEST(SurfaceConvolution, DeterministicForAnyThreadCount) {
     const Model plane = tessellateSkin(test_models::makeSquare(20.0f), 0.8f, 1.0f);
     const SurfaceSamples samples = gatherSurfaceSamples(plane, 1.0f);
