@@ -445,6 +445,22 @@ def aim(obj, direction):
     obj.rotation_quaternion = Vector(direction).normalized().to_track_quat("-Z", "Y")
 
 
+def undo_spot_cosine(data):
+    # Cycles' spot multiplies its smoothstep cone by the cosine to its axis; the rasterizer's does not. The light's
+    # emission is divided by that cosine: the direction leaving the light, in the light's frame (the "Normal" of
+    # its texture coordinates), has z = -cos (the spot looks along its -Z).
+    data.use_nodes = True
+    nodes = data.node_tree.nodes
+    links = data.node_tree.links
+    emission = next(node for node in nodes if node.type == "EMISSION")
+    coordinates = nodes.new("ShaderNodeTexCoord")
+    separate = nodes.new("ShaderNodeSeparateXYZ")
+    links.new(coordinates.outputs["Normal"], separate.inputs["Vector"])
+    cosine = multiply(nodes, links, separate.outputs["Z"], -1.0)
+    cosine = multiply(nodes, links, cosine, 1e-3, "MAXIMUM")
+    links.new(multiply(nodes, links, 1.0, cosine, "DIVIDE"), emission.inputs["Strength"])
+
+
 def build_lights(scene, lights, engine="cycles", far=1000.0):
     for index, description in enumerate(lights):
         kind = description["type"]
@@ -471,6 +487,8 @@ def build_lights(scene, lights, engine="cycles", far=1000.0):
             data.spot_size = float(description["spot_size_rad"])
             data.spot_blend = float(description["spot_blend"])
             data.show_cone = False
+            if engine == "cycles":
+                undo_spot_cosine(data)
         obj = bpy.data.objects.new("skinlab_light_%d" % index, data)
         if kind == "spot":
             obj.location = Vector(description["position"])
