@@ -274,18 +274,23 @@ def piecewise_linear(nodes, links, value, knots, values):
     return result
 
 
-def radius_from_albedo(nodes, links, albedo, table):
-    # pathtraced.radius_model = "albedo": each channel's radius follows that channel of the subsurface colour
-    # through the table written by skinlab (renderer/sss/pathtraced_params.h, albedoRadiusTable; already scaled).
+def per_channel(nodes, links, colour, channel_socket):
+    # A colour whose channel c is channel_socket(c, the input's channel c), through Separate / Combine Color.
     separate = nodes.new("ShaderNodeSeparateColor")
     separate.mode = "RGB"
-    links.new(albedo, separate.inputs["Color"])
+    links.new(colour, separate.inputs["Color"])
     combine = nodes.new("ShaderNodeCombineColor")
     combine.mode = "RGB"
     for channel in range(3):
-        links.new(piecewise_linear(nodes, links, separate.outputs[channel], table["albedo"],
-                                   table["radius"][channel]), combine.inputs[channel])
+        links.new(channel_socket(channel, separate.outputs[channel]), combine.inputs[channel])
     return combine.outputs["Color"]
+
+
+def radius_from_albedo(nodes, links, albedo, table):
+    # pathtraced.radius_model = "albedo": each channel's radius follows that channel of the subsurface colour
+    # through the table written by skinlab (renderer/sss/pathtraced_params.h, albedoRadiusTable; already scaled).
+    return per_channel(nodes, links, albedo, lambda c, a: piecewise_linear(nodes, links, a, table["albedo"],
+                                                                           table["radius"][c]))
 
 
 def walk_colour(nodes, links, albedo, table):
@@ -293,15 +298,8 @@ def walk_colour(nodes, links, albedo, table):
     # colour (renderer/sss/pathtraced_params.h, walkReflectanceTable), so flat skin reflects a itself.
     if not table:
         return albedo
-    separate = nodes.new("ShaderNodeSeparateColor")
-    separate.mode = "RGB"
-    links.new(albedo, separate.inputs["Color"])
-    combine = nodes.new("ShaderNodeCombineColor")
-    combine.mode = "RGB"
-    for channel in range(3):
-        gain = piecewise_linear(nodes, links, separate.outputs[channel], table["albedo"], table["gain"])
-        links.new(multiply(nodes, links, separate.outputs[channel], gain, "DIVIDE"), combine.inputs[channel])
-    return combine.outputs["Color"]
+    return per_channel(nodes, links, albedo, lambda c, a: multiply(
+        nodes, links, a, piecewise_linear(nodes, links, a, table["albedo"], table["gain"]), "DIVIDE"))
 
 
 def principled_specular(nodes, links, bsdf, description, textures, uv):

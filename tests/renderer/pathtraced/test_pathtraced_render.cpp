@@ -66,6 +66,18 @@ bool nearDepthEdge(const ExrImage& image, int x, int y) {
     return false;
 }
 
+// builtin:halo at the given depth gap with `materials` (TOML), seen head-on from 300 mm, lit by an unshadowed sun
+// from the upper left and a bluish constant sky: the scene of the per-pixel and flat-level checks. Returns its path.
+std::string writeLitHalo(const std::filesystem::path& path, double gapMm, const std::string& materials) {
+    std::ofstream toml(path);
+    toml << "mm_per_unit = 1.0\n[model]\nsource = \"builtin:halo\"\ndepth_gap_mm = " << gapMm << "\n"
+         << materials
+         << "[camera]\nview = \"explicit\"\nposition = [0.0, 0.0, 300.0]\ntarget = [0.0, 0.0, 0.0]\nfov_deg = 30.0\n"
+            "[[lights]]\ntype = \"directional\"\ndirection = [0.45, -0.45, -0.77]\nintensity = 1.2\nshadow = false\n"
+            "[environment]\nradiance = [0.08, 0.085, 0.1]\nbackground = \"color\"\n";
+    return path.string();
+}
+
 } // namespace
 
 namespace {
@@ -272,18 +284,10 @@ TEST(PathtracedRender, WithoutSssEveryPixelShadesLikeTheRasterizer) {
     SKINLAB_REQUIRE_BLENDER();
     SKINLAB_REQUIRE_RENDERER(renderer);
     TempFolder folder("pathtraced-every-pixel");
-    {
-        std::ofstream toml(folder / "halo.toml");
-        toml << "mm_per_unit = 1.0\n[model]\nsource = \"builtin:halo\"\ndepth_gap_mm = 30.0\n"
-                "[[materials]]\nname = \"skin\"\nalbedo = [0.60, 0.42, 0.34]\nskin = true\n"
-                "[[materials]]\nname = \"backdrop\"\nalbedo = [0.5, 0.5, 0.5]\nskin = false\n"
-                "[camera]\nview = \"explicit\"\nposition = [0.0, 0.0, 300.0]\ntarget = [0.0, 0.0, 0.0]\n"
-                "fov_deg = 30.0\n"
-                "[[lights]]\ntype = \"directional\"\ndirection = [0.45, -0.45, -0.77]\nintensity = 1.2\n"
-                "shadow = false\n"
-                "[environment]\nradiance = [0.08, 0.085, 0.1]\nbackground = \"color\"\n";
-    }
-    const std::string scene = (folder / "halo.toml").string();
+    const std::string scene =
+        writeLitHalo(folder / "halo.toml", 30.0,
+                     "[[materials]]\nname = \"skin\"\nalbedo = [0.60, 0.42, 0.34]\nskin = true\n"
+                     "[[materials]]\nname = \"backdrop\"\nalbedo = [0.5, 0.5, 0.5]\nskin = false\n");
     const std::vector<std::string> agree = {"pathtraced.samples=64", "pathtraced.sss=false",
                                             "pathtraced.specular=false", "pathtraced.max_bounces=0",
                                             "pathtraced.environment_shadow=false"};
@@ -322,19 +326,9 @@ TEST(PathtracedRender, FlatSkinReflectsItsColour) {
     TempFolder folder("pathtraced-flat-skin");
     for (const double albedo : {0.2, 0.8}) {
         const std::string a = std::to_string(albedo);
-        {
-            std::ofstream toml(folder / "flat.toml");
-            toml << "mm_per_unit = 1.0\n[model]\nsource = \"builtin:halo\"\ndepth_gap_mm = 200.0\n"
-                    "[[materials]]\nname = \"backdrop\"\nalbedo = ["
-                 << a << ", " << a << ", " << a
-                 << "]\nskin = true\n"
-                    "[camera]\nview = \"explicit\"\nposition = [0.0, 0.0, 300.0]\ntarget = [0.0, 0.0, 0.0]\n"
-                    "fov_deg = 30.0\n"
-                    "[[lights]]\ntype = \"directional\"\ndirection = [0.45, -0.45, -0.77]\nintensity = 1.2\n"
-                    "shadow = false\n"
-                    "[environment]\nradiance = [0.08, 0.085, 0.1]\nbackground = \"color\"\n";
-        }
-        const std::string scene = (folder / "flat.toml").string();
+        const std::string scene = writeLitHalo(folder / "flat.toml", 200.0,
+                                               "[[materials]]\nname = \"backdrop\"\nalbedo = [" + a + ", " + a + ", " +
+                                                   a + "]\nskin = true\n");
         renderToExr(*renderer, scene, "pathtraced",
                     {"pathtraced.samples=512", "pathtraced.specular=false", "pathtraced.max_bounces=0",
                      "pathtraced.environment_shadow=false"},
