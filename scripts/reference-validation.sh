@@ -4,7 +4,7 @@
 # paint inside the skin mask (references: the true materials), builtin:ear, builtin:head and (with SKINLAB_ASSETS)
 # the scanned head — it renders
 #   - the 24 screen-space conditions of the evaluation table (gaussian-sum, separable, artistic, pscbf × none,
-#     follow-surface, +cbf, +lab_weight, +curvature reduce-floor, all) and the `reference` render (1 mm edges, light at non-skin neighbours absorbed) as a
+#     follow-surface, +cbf, +lab_weight, +curvature reduce-floor, all) and the `reference` render (1 mm edges, 0.5 mm on bleed; light at non-skin neighbours absorbed) as a
 #     stimulus set;
 #   - `pathtraced` with seeds 0 … SEEDS−1 (default 4; seed 1 against seed 0 measures the path tracer's own noise on
 #     every score, and all of them give the debiased scores below), with
@@ -22,10 +22,11 @@
 #   scripts/reference-validation.sh [OUT_DIR] [SIZE] [SAMPLES]       (defaults: out/reference-validation 256 64)
 #
 # Environment: SKINLAB (default build/release/cli/skinlab), SEEDS (path-traced seeds, default 4, at least 2),
-# REFERENCE_EDGE_MM (the reference's tessellation, default 1.0 mm), REFERENCE_NON_SKIN (sss.reference_non_skin of
+# REFERENCE_EDGE_MM (the reference's tessellation, default 1.0 mm, 0.5 mm on bleed, whose paint edge needs it), REFERENCE_NON_SKIN (sss.reference_non_skin of
 # the reference: default "absorbs", the path tracer's boundary; "returns" is the evaluation table's),
 # REFERENCE_CONVEXITY_MM (sss.reference_convexity_mm: default [0.88, 0.32, 0.28], the path tracer's level on convex
-# skin; [0, 0, 0] is the evaluation table's), SKINLAB_ASSETS (without the scanned head its case is
+# skin; [0, 0, 0] is the evaluation table's), HEAD_SKIN_DETAIL (builtin:head's model.skin_detail, default true;
+# false gives the smooth head), SKINLAB_ASSETS (without the scanned head its case is
 # skipped with a message), CASES (a space-separated subset of: halo-5 halo-200 bleed ear head scan).
 # Every scene key that matters is written out below (model, materials, camera, lights, environment, SSS width,
 # the path tracer's settings), so the numbers do not move with the built-in scenes' defaults. Rerunning resumes:
@@ -38,9 +39,13 @@ out="${1:-out/reference-validation}"
 size="${2:-256}"
 samples="${3:-64}"
 seeds="${SEEDS:-4}"
-edge_mm="${REFERENCE_EDGE_MM:-1.0}"
+# The reference's edge length per case: REFERENCE_EDGE_MM for all, or 1 mm and 0.5 mm on bleed (the paint's edge).
+edge_mm_of() { if [ -n "${REFERENCE_EDGE_MM:-}" ]; then echo "$REFERENCE_EDGE_MM"; elif [ "$1" = bleed ]; then echo 0.5; else echo 1.0; fi; }
+edge_mm="${REFERENCE_EDGE_MM:-1.0 (bleed: 0.5)}"
 non_skin="${REFERENCE_NON_SKIN:-absorbs}"
 convexity="${REFERENCE_CONVEXITY_MM:-[0.88, 0.32, 0.28]}"
+head_detail="${HEAD_SKIN_DETAIL:-true}"
+case "$head_detail" in true|false) ;; *) echo "reference-validation: HEAD_SKIN_DETAIL=$head_detail must be true or false" >&2; exit 2 ;; esac
 [ "$seeds" -ge 2 ] 2>/dev/null || { echo "reference-validation: SEEDS=$seeds must be at least 2" >&2; exit 2; }
 skinlab="${SKINLAB:-$root/build/release/cli/skinlab}"
 [ -x "$skinlab" ] || { echo "reference-validation: $skinlab not found (build it: scripts/build.sh, or set SKINLAB)" >&2; exit 2; }
@@ -161,6 +166,7 @@ mm_per_unit = 1.0
 
 [model]
 source = "builtin:head"
+skin_detail = ${head_detail}
 
 [[materials]]
 name = "skin"
@@ -281,7 +287,7 @@ labels = ["none", "follow"]
 [[reference]]
 scene = "$3"
 method = "reference"
-sss.reference_edge_mm = $edge_mm
+sss.reference_edge_mm = $(edge_mm_of "$1")
 sss.reference_non_skin = "$non_skin"
 sss.reference_convexity_mm = [$convexity]  # one level: the array
 EOF
@@ -427,15 +433,21 @@ def skin_mean(exr):
     area = means(exr, "--ch", "mask.Y")[0]
     return [v / area for v in means(exr, "--ch", "diffuse.R,diffuse.G,diffuse.B", exr, "--ch", "mask.Y,mask.Y,mask.Y", "--mul")]
 levels = ["", "## Skin level: mask-weighted mean skin diffuse (R, G, B)", "",
-          "| case | `reference` | `pathtraced` seed 0 | seed 1 | reference − pathtraced (relative) |", "|---|---|---|---|---|"]
+          f"`pathtraced`: the mean over its {seeds} seeds, and the standard deviation of one seed's level around it "
+          "(relative); the difference is against the mean.", "",
+          "| case | `reference` | `pathtraced` (mean of seeds) | one seed's sd | reference − pathtraced (relative) |",
+          "|---|---|---|---|---|"]
 for name in cases:
     manifest = json.load(open(os.path.join(out, name, "set", "manifest.json")))
     ref_exr = os.path.join(out, name, "set", next(s["files"]["exr"] for s in manifest["stimuli"] if s["reference"]))
-    r, p0, p1 = (skin_mean(f) for f in (ref_exr, os.path.join(out, name, "pathtraced.exr"),
-                                        os.path.join(out, name, "pathtraced-seed1.exr")))
+    r = skin_mean(ref_exr)
+    per_seed = [skin_mean(os.path.join(out, name, "pathtraced.exr" if k == 0 else f"pathtraced-seed{k}.exr"))
+                for k in range(seeds)]
+    p = [sum(v[c] for v in per_seed) / seeds for c in range(3)]
+    sd = [(sum((v[c] - p[c]) ** 2 for v in per_seed) / (seeds - 1)) ** 0.5 / p[c] * 100 for c in range(3)]
     fmt = lambda v: ", ".join(f"{x:.4f}" for x in v)
-    levels.append(f"| {name} | {fmt(r)} | {fmt(p0)} | {fmt(p1)} | "
-                  + ", ".join(f"{(a - b) / b * 100:+.1f} %" for a, b in zip(r, p0)) + " |")
+    levels.append(f"| {name} | {fmt(r)} | {fmt(p)} | " + ", ".join(f"{x:.1f} %" for x in sd) + " | "
+                  + ", ".join(f"{(a - b) / b * 100:+.1f} %" for a, b in zip(r, p)) + " |")
 per_condition = ["", "## Scores per condition under both references", "",
                  "| case | condition | halo E (ref / pt) | bleed E (ref / pt) | skin ΔE00 mean (ref / pt) |", "|---|---|---|---|---|"]
 for name in cases:

@@ -1,4 +1,6 @@
 #include "renderer/pathtraced/blender_scene.h"
+#include "renderer/output/exr_writer.h"
+#include "renderer/scene/texture.h"
 #include "renderer/sss/sss_params.h"
 
 #include "common/error.h"
@@ -72,6 +74,15 @@ std::string_view cyclesScript() {
     const auto script = pathtraced_files::embeddedFile("cycles_scene.py");
     if (!script) throw RuntimeError("cycles_scene.py is not embedded in this build");
     return *script;
+}
+
+std::vector<ModelMapFile> modelMapFiles(const BlenderSceneInputs& inputs) {
+    std::vector<ModelMapFile> files;
+    if (inputs.spec->textures.albedo.empty() && inputs.model->albedoMap)
+        files.push_back({"albedo", "model-albedo.exr", inputs.model->albedoMap.get()});
+    if (inputs.spec->textures.normal.empty() && inputs.model->normalMap)
+        files.push_back({"normal", "model-normal.exr", inputs.model->normalMap.get()});
+    return files;
 }
 
 bool rendersEnvironmentSeparately(const BlenderSceneInputs& inputs) {
@@ -158,6 +169,12 @@ nlohmann::json blenderSceneJson(const BlenderSceneInputs& inputs, std::string_vi
                          {"normal_strength", spec.textures.normalStrength},
                          {"specular", spec.textures.specular.string()},
                          {"skin_mask", spec.textures.skinMask.string()}};
+    // Maps the model generates in memory (builtin:head's skin detail) where the spec names none, as the rasterizer
+    // chooses them: written beside the scene as linear float EXRs, read without a colour transform.
+    for (const ModelMapFile& map : modelMapFiles(inputs)) {
+        scene["textures"][map.key] = map.file;
+        scene["textures"][map.key + "_colorspace"] = "Non-Color";
+    }
 
     // Lights. L_c (spec intensity × colour) is the radiance of a white Lambertian facing the light, so the
     // irradiance is π L_c: a sun of strength π L_c (W/m²); a spot whose irradiance at the target distance d is
@@ -256,6 +273,15 @@ void writeBlenderScene(const std::filesystem::path& folder, const BlenderSceneIn
     }
     ensureDirectory(folder);
     writeFileAtomic(folder / "mesh.bin", bytes);
+    for (const ModelMapFile& map : modelMapFiles(inputs)) {
+        const Image& image = *map.image;
+        std::vector<ExrChannel> channels{{"R", {}}, {"G", {}}, {"B", {}}};
+        for (int c = 0; c < 3; ++c) {
+            channels[c].values.resize(static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height));
+            for (std::size_t p = 0; p < channels[c].values.size(); ++p) channels[c].values[p] = image.pixels[p * 4 + c];
+        }
+        writeExr(folder / map.file, image.width, image.height, channels, {});
+    }
     writeFileAtomic(folder / "scene.json", blenderSceneJson(inputs, "mesh.bin", "cycles.exr", "cycles.json").dump(1));
     writeFileAtomic(folder / "cycles_scene.py", cyclesScript());
 }

@@ -47,6 +47,17 @@ double principledSpecular(double f0);
 // such as builtin:bleed's scatters like a semi-infinite slab, except for light that walks past its rim.
 bool isClosedSurface(const Model& model, const SubMesh& part);
 
+// The maps a model generates in memory (Model::albedoMap, normalMap: builtin:head's skin detail) that the scene
+// uses because the spec names no texture file in their place (as the rasterizer chooses). writeBlenderScene
+// writes each as a linear float EXR `file` in the scene's folder; the JSON names it under textures.`key`, with
+// textures.`key`_colorspace "Non-Color" (the values are linear: the albedo a multiplier, the normal 0.5 + 0.5 n).
+struct ModelMapFile {
+    std::string key;  // "albedo" or "normal"
+    std::string file; // relative to the scene's folder
+    const Image* image = nullptr;
+};
+std::vector<ModelMapFile> modelMapFiles(const BlenderSceneInputs& inputs);
+
 // pathtraced.environment_shadow = false with lights in the scene: Cycles renders the lights (with their shadows)
 // into the output and the unshadowed environment into `folder`/kEnvironmentOutput, and the two are summed.
 inline constexpr std::string_view kEnvironmentOutput = "cycles-environment.exr";

@@ -396,7 +396,8 @@ def build_material(description, textures, engine="cycles"):
     albedo = multiply_color(nodes, links, vertex_color.outputs["Color"], description["albedo"])
     if textures.get("albedo"):
         albedo = multiply_color(nodes, links, albedo,
-                                image_node(nodes, links, textures["albedo"], "sRGB", uv).outputs["Color"])
+                                image_node(nodes, links, textures["albedo"], textures.get("albedo_colorspace", "sRGB"),
+                                           uv).outputs["Color"])
     # skin mask = material flag x vertex skin x mask map (red), clamped to [0, 1]
     mask = multiply(nodes, links, vertex_skin.outputs["Fac"], float(description["skin"]))
     if textures.get("skin_mask"):
@@ -596,6 +597,16 @@ def unshadowed_environment(scene):
             obj.visible_volume_scatter = False
 
 
+def resolved_textures(textures, folder):
+    # Maps skinlab wrote beside the scene (a model's generated maps: they come with a "<key>_colorspace") are named
+    # relative to the scene's folder; the spec's texture files by their own paths.
+    resolved = dict(textures)
+    for key in ("albedo", "normal"):
+        if resolved.get(key) and resolved.get(key + "_colorspace"):
+            resolved[key] = os.path.join(folder, resolved[key])
+    return resolved
+
+
 def render_scene(path):
     folder = os.path.dirname(os.path.abspath(path))
     with open(path) as handle:
@@ -604,7 +615,8 @@ def render_scene(path):
     scene = reset_scene()
     configure_engine(scene, description["settings"])
     configure_passes(scene, engine)
-    materials = [build_material(m, description.get("textures", {}), engine) for m in description["materials"]]
+    textures = resolved_textures(description.get("textures", {}), folder)
+    materials = [build_material(m, textures, engine) for m in description["materials"]]
     mesh_path = os.path.join(folder, description["mesh"]["file"])
     for index, part in enumerate(description["mesh"]["parts"]):
         mesh = build_mesh(mesh_path, part, "skinlab_part_%d" % index)

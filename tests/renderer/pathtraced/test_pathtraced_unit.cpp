@@ -9,6 +9,7 @@
 #include "renderer/pathtraced/profile_fit.h"
 #include "renderer/scene/builtin_geometry.h"
 #include "renderer/scene/environment.h"
+#include "renderer/scene/texture.h"
 #include "renderer/sss/sss_params.h"
 
 #include <gtest/gtest.h>
@@ -185,6 +186,48 @@ TEST(BlenderScene, PartsAndRadii) {
         exportScene("builtin:halo", {"sss.width_mm=6.0", "mm_per_unit=2.0", "pathtraced.radius_mm=[3.0, 2.0, 1.0]"});
     EXPECT_NEAR(wide.json.at("materials").at(0).at("radius").at(0).get<double>(), 3.0 * 2.0 / 2.0, 1e-9);
     EXPECT_NEAR(wide.json.at("materials").at(0).at("radius").at(2).get<double>(), 1.0 * 2.0 / 2.0, 1e-9);
+}
+
+TEST(BlenderScene, TheModelsGeneratedMapsAreWrittenUnlessTheSpecNamesFiles) {
+    // A model's in-memory maps (builtin:head's skin detail) go to Blender as linear EXRs beside the scene, as the
+    // rasterizer uses them: only where the spec names no file of its own.
+    SceneSpec spec = loadSceneSpec("builtin:halo", {"sss.method=\"pathtraced\""}, {});
+    Model model = makeHaloScene(200.0f);
+    Image albedo;
+    albedo.width = 3, albedo.height = 2;
+    for (int i = 0; i < 6; ++i) albedo.pixels.insert(albedo.pixels.end(), {0.5f + 0.1f * i, 1.25f, 0.01f * i, 1.0f});
+    model.albedoMap = std::make_shared<const Image>(albedo);
+    Image normal = albedo;
+    for (float& v : normal.pixels) v = 0.5f;
+    model.normalMap = std::make_shared<const Image>(normal);
+    BlenderSceneInputs inputs;
+    inputs.spec = &spec;
+    inputs.model = &model;
+    for (const SubMesh& part : model.parts) {
+        const MeshMaterial& m = model.materials[part.material];
+        inputs.partMaterials.push_back({m.albedo, m.skin ? 1.0f : 0.0f, m.glossiness, m.specularIntensity});
+    }
+    inputs.params = spec.pathtraced;
+    const nlohmann::json json = blenderSceneJson(inputs, "mesh.bin", "cycles.exr", "cycles.json");
+    EXPECT_EQ(json.at("textures").at("albedo"), "model-albedo.exr");
+    EXPECT_EQ(json.at("textures").at("albedo_colorspace"), "Non-Color");
+    EXPECT_EQ(json.at("textures").at("normal"), "model-normal.exr");
+    const std::filesystem::path folder = makeWorkFolder("skinlab-test-model-maps");
+    writeBlenderScene(folder, inputs);
+    int width = 0, height = 0;
+    const auto written = readExrChannels(folder / "model-albedo.exr", width, height);
+    std::filesystem::remove_all(folder);
+    ASSERT_EQ(width, 3);
+    ASSERT_EQ(height, 2);
+    for (int i = 0; i < 6; ++i)
+        for (int c = 0; c < 3; ++c)
+            EXPECT_FLOAT_EQ(written.at(std::string(1, "RGB"[c]))[i], albedo.pixels[i * 4 + c]) << i << " " << c;
+    // A spec's file replaces the model's map (the albedo here); the other map still comes from the model.
+    spec.textures.albedo = "skin.png";
+    const nlohmann::json replaced = blenderSceneJson(inputs, "mesh.bin", "cycles.exr", "cycles.json");
+    EXPECT_EQ(replaced.at("textures").at("albedo"), "skin.png");
+    EXPECT_FALSE(replaced.at("textures").contains("albedo_colorspace"));
+    EXPECT_EQ(replaced.at("textures").at("normal"), "model-normal.exr");
 }
 
 TEST(PathtracedParams, RadiusModelKeyIsStrict) {
