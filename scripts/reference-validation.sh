@@ -26,7 +26,8 @@
 # the reference: default "absorbs", the path tracer's boundary; "returns" is the evaluation table's),
 # REFERENCE_CONVEXITY_MM (sss.reference_convexity_mm: default [0.88, 0.32, 0.28], the path tracer's level on convex
 # skin; [0, 0, 0] is the evaluation table's), HEAD_SKIN_DETAIL (builtin:head's model.skin_detail, default true;
-# false gives the smooth head), SKINLAB_ASSETS (without the scanned head its case is
+# false gives the smooth head), EAR_KEY_LIGHT (builtin:ear's key light: back, the default, shows the through-light;
+# front does not), SKINLAB_ASSETS (without the scanned head its case is
 # skipped with a message), CASES (a space-separated subset of: halo-5 halo-200 bleed ear head scan).
 # Every scene key that matters is written out below (model, materials, camera, lights, environment, SSS width,
 # the path tracer's settings), so the numbers do not move with the built-in scenes' defaults. Rerunning resumes:
@@ -45,6 +46,8 @@ edge_mm="${REFERENCE_EDGE_MM:-1.0 (bleed: 0.5)}"
 non_skin="${REFERENCE_NON_SKIN:-absorbs}"
 convexity="${REFERENCE_CONVEXITY_MM:-[0.88, 0.32, 0.28]}"
 head_detail="${HEAD_SKIN_DETAIL:-true}"
+ear_light="${EAR_KEY_LIGHT:-back}"
+case "$ear_light" in back|front) ;; *) echo "reference-validation: EAR_KEY_LIGHT=$ear_light must be back or front" >&2; exit 2 ;; esac
 case "$head_detail" in true|false) ;; *) echo "reference-validation: HEAD_SKIN_DETAIL=$head_detail must be true or false" >&2; exit 2 ;; esac
 [ "$seeds" -ge 2 ] 2>/dev/null || { echo "reference-validation: SEEDS=$seeds must be at least 2" >&2; exit 2; }
 skinlab="${SKINLAB:-$root/build/release/cli/skinlab}"
@@ -321,7 +324,7 @@ for name in $cases; do
     halo-5) halo_scene 5.0 > "$dir/test.toml"; cp "$dir/test.toml" "$dir/ref.toml" ;;
     halo-200) halo_scene 200.0 > "$dir/test.toml"; cp "$dir/test.toml" "$dir/ref.toml" ;;
     bleed) bleed_scene true > "$dir/test.toml"; bleed_scene false > "$dir/ref.toml" ;;
-    ear) ear_scene 2.5 > "$dir/test.toml"; cp "$dir/test.toml" "$dir/ref.toml" ;;
+    ear) ear_scene 2.5 "$ear_light" > "$dir/test.toml"; cp "$dir/test.toml" "$dir/ref.toml" ;;
     head) head_scene > "$dir/test.toml"; cp "$dir/test.toml" "$dir/ref.toml" ;;
     scan) scan_scene > "$dir/test.toml"; cp "$dir/test.toml" "$dir/ref.toml" ;;
     *) echo "reference-validation: unknown case '$name' in CASES (halo-5 halo-200 bleed ear head scan)" >&2; exit 2 ;;

@@ -32,8 +32,11 @@ diffuse = "lambert"
 EOF
 }
 
-# builtin:ear: a skin fin THICKNESS_MM thick, lit from behind (through-light) and weakly from the front.
-ear_scene() {  # ear_scene THICKNESS_MM
+# builtin:ear: a skin fin THICKNESS_MM thick, lit from behind (through-light) and weakly from the front; with
+# SIDE = front the key light comes from the camera's side instead (no through-light to see).
+ear_scene() {  # ear_scene THICKNESS_MM [SIDE: back (default) | front]
+  local key_z=0.97
+  case "${2:-back}" in back) ;; front) key_z=-0.97 ;; *) echo "ear_scene: side '$2' is neither back nor front" >&2; return 2 ;; esac
   cat <<EOF
 mm_per_unit = 1.0
 
@@ -56,7 +59,7 @@ pitch_deg = 0.0
 
 [[lights]]
 type = "directional"
-direction = [0.15, -0.2, 0.97]
+direction = [0.15, -0.2, $key_z]
 color = [1.0, 0.95, 0.88]
 intensity = 3.0
 shadow = true
