@@ -8,12 +8,15 @@
 #
 # Environment: SKINLAB (the skinlab executable; default build/release/cli/skinlab), SKINLAB_ASSETS (the shared
 # assets; without the scanned head its set is skipped with a message), PATHTRACED (0: no path-traced reference),
-# PATHTRACED_SAMPLES (its samples, default 64), EEVEE (0: no `eevee` row), SETS (a subset of the sets: "halo bleed head"). Needs python3 for the table and blender for the second reference.
+# PATHTRACED_SAMPLES (its samples, default 64), PATHTRACED_SEEDS (path-traced seeds per reference, default 4, at
+# least 2: the debiased scores), EEVEE (0: no `eevee` row), SETS (a subset of the sets: "halo bleed head"). Needs python3 for the table and blender for the second reference.
 # Writes, under OUT_DIR:
 #   halo/, bleed/, head/   the stimulus sets (stimuli/specs/extensions-*.toml): exr/, png/, manifest, contact.png
 #   */metrics/             metrics.csv, metrics.json and the ΔE00 heat maps with the bands outlined
-#   */pathtraced/, */metrics-pathtraced/   each reference stimulus rendered by `pathtraced`, and the block's scores
-#                          against it
+#   */pathtraced/, */metrics-pathtraced/   each reference stimulus rendered by `pathtraced` (seed 0, and ID-seedK.exr
+#                          for the other seeds), and the block's scores against seed 0
+#   */metrics-debiased/    the block's squared errors against the noise-free path-traced image (`analyze metrics
+#                          --reference-seeds`, jackknife over the seeds) and their ranking against `reference`'s
 #   */eevee/, */metrics-eevee/, */metrics-eevee-pathtraced/   each block's scene rendered by `eevee`
 #                          (Blender EEVEE, its own screen-space SSS), scored against the block's reference and
 #                          against the path-traced one: the table's `eevee` row
@@ -27,6 +30,8 @@ skinlab="${SKINLAB:-$root/build/release/cli/skinlab}"
 [ -x "$skinlab" ] || { echo "extensions-table: $skinlab not found (build it: scripts/build.sh, or set SKINLAB)" >&2; exit 2; }
 command -v python3 > /dev/null || { echo "extensions-table: python3 is needed to write the table" >&2; exit 2; }
 mkdir -p "$out"
+pathtraced_seeds="${PATHTRACED_SEEDS:-4}"
+[ "$pathtraced_seeds" -ge 2 ] 2>/dev/null || { echo "extensions-table: PATHTRACED_SEEDS=$pathtraced_seeds must be at least 2" >&2; exit 2; }
 
 sets=(halo bleed)
 if [ -n "${SETS:-}" ]; then
@@ -41,7 +46,19 @@ fi
 # (PATHTRACED_SAMPLES samples, default 64; no interreflection, the rasterizer's specular layer and the environment
 # unshadowed like the rasterizer's ambient term, so that it
 # differs from the screen-space renders in the subsurface transport only: docs/pathtraced.md), and the block's
-# stimuli scored against it in OUT_DIR/SET/metrics-pathtraced/REFERENCE_ID/. PATHTRACED=0 skips it (no Blender).
+# stimuli scored against it in OUT_DIR/SET/metrics-pathtraced/REFERENCE_ID/; with PATHTRACED_SEEDS seeds (default 4)
+# also without the path tracer's noise, and ranked against `reference` (τ_b with its interval), in
+# OUT_DIR/SET/metrics-debiased/REFERENCE_ID/ (docs/pathtraced.md, "Rankings without the noise: pairs of seeds").
+# PATHTRACED=0 skips it (no Blender).
+render_pathtraced() {  # render_pathtraced OUT.exr SCENE ARGS... (skipped when rendered with the same inputs)
+  local exr="$1" scene="$2"; shift 2
+  local stamp; stamp="$scene $*"
+  if [ ! -e "$exr" ] || [ "$(cat "$exr.inputs" 2> /dev/null)" != "$stamp" ]; then
+    "$skinlab" render --scene "$scene" "$@" -o "$exr" > /dev/null
+    printf '%s' "$stamp" > "$exr.inputs"
+  fi
+}
+
 pathtraced_references() {  # pathtraced_references SET_NAME
   local dir="$out/$1" id scene overrides
   mkdir -p "$dir/pathtraced"
@@ -51,11 +68,12 @@ pathtraced_references() {  # pathtraced_references SET_NAME
     args+=(--set 'sss.method="pathtraced"' --set "pathtraced.samples=${PATHTRACED_SAMPLES:-64}"
            --set 'pathtraced.max_bounces=0' --set 'pathtraced.specular_source="rasterizer"'
            --set 'pathtraced.environment_shadow=false')
-    local stamp; stamp="$scene ${args[*]}"
-    if [ ! -e "$exr" ] || [ "$(cat "$exr.inputs" 2> /dev/null)" != "$stamp" ]; then
-      "$skinlab" render --scene "$scene" "${args[@]}" -o "$exr" > /dev/null
-      printf '%s' "$stamp" > "$exr.inputs"
-    fi
+    render_pathtraced "$exr" "$scene" "${args[@]}"
+    local seed_files="$exr" seed
+    for seed in $(seq 1 $((pathtraced_seeds - 1))); do
+      render_pathtraced "$dir/pathtraced/$id-seed$seed.exr" "$scene" "${args[@]}" --set "pathtraced.seed=$seed"
+      seed_files+=",$dir/pathtraced/$id-seed$seed.exr"
+    done
     local tests=()
     while IFS= read -r f; do tests+=("$dir/$f"); done < <(python3 -c '
 import json, sys
@@ -64,6 +82,12 @@ block = next(s["block"] for s in m["stimuli"] if s["id"] == sys.argv[2])
 for s in m["stimuli"]:
     if s["block"] == block and not s["reference"]: print(s["files"]["exr"])' "$dir/manifest.json" "$id")
     "$skinlab" analyze metrics --reference "$exr" "${tests[@]}" -o "$dir/metrics-pathtraced/$id" > /dev/null
+    local reference; reference="$dir/$(python3 -c '
+import json, sys
+m = json.load(open(sys.argv[1]))
+print(next(s["files"]["exr"] for s in m["stimuli"] if s["id"] == sys.argv[2]))' "$dir/manifest.json" "$id")"
+    "$skinlab" analyze metrics --reference-seeds "$seed_files" --compare-reference "$reference" "${tests[@]}" \
+      -o "$dir/metrics-debiased/$id" > /dev/null
   done < <(python3 -c '
 import json, os, sys
 m = json.load(open(sys.argv[1]))
@@ -162,7 +186,8 @@ lines = ["# Halo / bleed / spill scores per method and extension set", "",
          "Generated by `scripts/extensions-table.sh`. Leak energy E = Σ_band |Y_test − Y_ref| / Σ_skin Y_ref "
          "(docs/metrics.md); ΔE00 excess = band mean − interior mean. Reference: the object-space `reference` render of "
          "the same block; the `pathtraced` columns score the same stimuli against a Cycles render of the reference's "
-         "scene (no interreflection, the rasterizer's specular layer). β: 0.5 for gaussian-sum, 0.09 for the others; curvature: reduce-floor, floor 0.5. "
+         "scene (no interreflection, the rasterizer's specular layer, seed 0), the debiased tables against the "
+         "noise-free Cycles image estimated from all its seeds (docs/pathtraced.md). β: 0.5 for gaussian-sum, 0.09 for the others; curvature: reduce-floor, floor 0.5. "
          "The `eevee` row is Blender EEVEE's own screen-space SSS on the reference's scene (docs/pathtraced.md, \"EEVEE\"): it has "
          "no skinlab extension but a depth correction of its own, so it stands in the follow-surface column.", ""]
 for name in sets:
@@ -183,6 +208,15 @@ for name in sets:
         c["pathtraced"] = json.load(open(pt))["comparisons"][0] if os.path.exists(pt) else None
         block = next(s["block"] for s in manifest["stimuli"] if s["id"] == ref_id)
         eevee[block] = c
+    # Debiased squared errors against the noise-free path-traced image, per reference (absent: PATHTRACED=0).
+    stimulus_of_file = {os.path.normpath(os.path.join(out, name, s["files"]["exr"])): s["id"] for s in manifest["stimuli"]}
+    debiased = {}
+    for s in manifest["stimuli"]:
+        path = os.path.join(out, name, "metrics-debiased", s["id"], "debiased.json")
+        if s["reference"] and os.path.exists(path):
+            d = json.load(open(path))
+            d["by_stimulus"] = {stimulus_of_file.get(os.path.normpath(t["test"])): t for t in d["tests"]}
+            debiased[s["block"]] = d
     table = {}
     for c in metrics["comparisons"]:
         sss = resolved[c["test"]["name"]]["sss"]
@@ -213,6 +247,25 @@ for name in sets:
                 if all(c is None for c in row): continue
                 lines.append(f"| {method} | " + " | ".join(
                     "–" if c is None else number(c["bands"][band][score], 2) for c in row) + " |")
+            lines.append("")
+        d = debiased.get(block)
+        for band in ["halo", "bleed"] if d else []:
+            own = d["compared_reference"]["regions"][band]
+            if not own["pixels"]: continue
+            agree = d["ranking_agreement"][band]
+            lo, hi = agree["tau_b_interval_95"]
+            lines += [f"{band} band, MSE of Y against the noise-free path-traced image ({len(d['seeds'])} seeds, "
+                      f"debiased): `reference` itself {number(own['mse']['value'])} ± {number(own['mse']['standard_error'])}; "
+                      f"τ_b between the conditions' rankings under the two references {agree['tau_b']['value']:+.2f} "
+                      f"[{lo:+.2f}, {hi:+.2f}], {agree['concordant_separated_pairs']} of {agree['separated_pairs']} "
+                      "pairs the path tracer separates ordered alike:", "",
+                      "| method | " + " | ".join(extension_sets) + " |", "|---|" + "---|" * len(extension_sets)]
+            for method in methods:
+                row = [table.get((block, method, e)) for e in extension_sets]
+                row = [None if c is None else d["by_stimulus"].get(c["test"]["name"]) for c in row]
+                if all(t is None for t in row): continue
+                lines.append(f"| {method} | " + " | ".join(
+                    "–" if t is None else number(t["regions"][band]["mse"]["value"], 2) for t in row) + " |")
             lines.append("")
         lines += ["All scores:", "",
                   "| method | extensions | halo E | bleed E | spill E | halo ΔE00 excess | bleed ΔE00 excess | skin ΔE00 mean "

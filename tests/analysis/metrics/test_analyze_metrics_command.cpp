@@ -38,6 +38,11 @@ CommandResult runSkinlab(const std::string& arguments) {
 
 class AnalyzeMetricsCommand : public ::testing::Test {
 protected:
+    // A passing test leaves nothing behind; a failing one keeps its files to look at.
+    void TearDown() override {
+        std::error_code ignored;
+        if (!HasFailure()) fs::remove_all(folder, ignored);
+    }
     void SetUp() override {
         folder =
             fs::temp_directory_path() / ("skinlab-metrics-cli-" + std::to_string(::getpid()) + "-" +

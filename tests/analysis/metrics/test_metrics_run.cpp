@@ -22,6 +22,11 @@ using testing::SyntheticRender;
 
 class MetricsRun : public ::testing::Test {
 protected:
+    // A passing test leaves nothing behind; a failing one keeps its files to look at.
+    void TearDown() override {
+        std::error_code ignored;
+        if (!HasFailure()) fs::remove_all(folder, ignored);
+    }
     void SetUp() override {
         folder =
             fs::temp_directory_path() / ("skinlab-metrics-run-" + std::to_string(::getpid()) + "-" +

@@ -27,6 +27,11 @@ namespace fs = std::filesystem;
 
 class PlainImages : public ::testing::Test {
 protected:
+    // A passing test leaves nothing behind; a failing one keeps its files to look at.
+    void TearDown() override {
+        std::error_code ignored;
+        if (!HasFailure()) fs::remove_all(folder, ignored);
+    }
     void SetUp() override {
         folder =
             fs::temp_directory_path() / ("skinlab-plain-images-" + std::to_string(::getpid()) + "-" +

@@ -18,12 +18,25 @@ namespace fs = std::filesystem;
 using testing::DiscScene;
 using testing::SyntheticRender;
 
-fs::path freshFolder(const std::string& name) {
-    fs::path folder = fs::temp_directory_path() / ("skinlab-metrics-" + name + "-" + std::to_string(::getpid()));
-    fs::remove_all(folder);
-    fs::create_directories(folder);
-    return folder;
-}
+// An empty scratch folder, removed again when the test passes (a failing one keeps its files to look at).
+class ScratchFolder {
+public:
+    explicit ScratchFolder(const std::string& name)
+        : path_(fs::temp_directory_path() / ("skinlab-metrics-" + name + "-" + std::to_string(::getpid()))) {
+        fs::remove_all(path_);
+        fs::create_directories(path_);
+    }
+    ~ScratchFolder() {
+        std::error_code ignored;
+        if (!::testing::Test::HasFailure()) fs::remove_all(path_, ignored);
+    }
+    ScratchFolder(const ScratchFolder&) = delete;
+    ScratchFolder& operator=(const ScratchFolder&) = delete;
+    operator const fs::path&() const { return path_; }
+
+private:
+    fs::path path_;
+};
 
 // Writes both renders as EXR and compares them through the file path a user's renders take.
 ComparisonResult compareFiles(const fs::path& folder, const SyntheticRender& reference, const SyntheticRender& test,
@@ -44,7 +57,7 @@ DiscScene sceneWithEveryBand(int size) {
 }
 
 TEST(RenderComparison, IdenticalRendersScoreZeroEverywhere) {
-    fs::path folder = freshFolder("identity");
+    const ScratchFolder folder("identity");
     SyntheticRender render = testing::renderDiscScene(sceneWithEveryBand(160));
     ComparisonResult result = compareFiles(folder, render, render);
     EXPECT_EQ(cv::countNonZero(result.deltaE00), 0);
@@ -68,7 +81,7 @@ TEST(RenderComparison, IdenticalRendersScoreZeroEverywhere) {
 // the excess over the interior is 0, the spill band (non-skin) is untouched, and the leak energy of a band is
 // 0.05·N_band / (N_skin·Y_skin), because the RGB→Y row sums to 1.
 TEST(RenderComparison, UniformSkinChangeGivesKnownScores) {
-    fs::path folder = freshFolder("uniform");
+    const ScratchFolder folder("uniform");
     SyntheticRender reference = testing::renderDiscScene(sceneWithEveryBand(160));
     SyntheticRender test = reference;
     test.beauty = reference.beauty.clone();
@@ -135,7 +148,7 @@ SyntheticRender withEdgeErrors(const DiscScene& scene, const SyntheticRender& re
 
 // docs/metrics.md: energy scores agree within 5% between 512² and 1024² renders of the same scene.
 TEST(RenderComparison, LeakEnergiesAreResolutionIndependent) {
-    fs::path folder = freshFolder("resolution");
+    const ScratchFolder folder("resolution");
     const double errorWidth = 0.8 * 0.008; // 80% of r_w = 8 mm, so the error lies inside the bands
     BandScores scores[2][4];
     double haloFraction[2] = {};
