@@ -59,7 +59,8 @@ active::ScorePosterior ActiveDesignState::blockPosterior(std::size_t b, std::uin
             counts.push_back({pair.first, pair.second, won.first, won.second});
     }
     cache.posterior =
-        active::fitPosteriorFromCounts(static_cast<int>(connection_.definition.blocks[b].conditions.size()), counts);
+        active::fitPosteriorFromCounts(static_cast<int>(connection_.definition.blocks[b].conditions.size()), counts,
+                                       plannerPosteriorOptions(connection_.definition.design));
     cache.generation = latest;
     cache.valid = true;
     return cache.posterior;

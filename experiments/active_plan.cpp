@@ -87,6 +87,12 @@ std::vector<PlannedTrial> nextActiveTrials(const StudyDefinition& study, std::in
     return out;
 }
 
+active::PosteriorOptions plannerPosteriorOptions(const StudyDesign& design) {
+    active::PosteriorOptions options;
+    options.priorVariance = design.activePriorSd * design.activePriorSd;
+    return options;
+}
+
 std::vector<active::Comparison> blockComparisons(const StudyBlock& block, const std::vector<PlannedTrial>& trials,
                                                  const std::vector<bool>& aSelected) {
     std::map<std::string, int> index;

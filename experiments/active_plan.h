@@ -34,6 +34,9 @@ std::vector<PlannedTrial> nextActiveTrials(const StudyDefinition& study, std::in
 
 // Test answers of one block as comparisons for the posterior (condition indices of the block); `aSelected` per
 // trial. Trials of other blocks or kinds are skipped.
+// The options of the planner's posterior for a design: its prior N(0, active_prior_sd²) on every score.
+active::PosteriorOptions plannerPosteriorOptions(const StudyDesign& design);
+
 std::vector<active::Comparison> blockComparisons(const StudyBlock& block, const std::vector<PlannedTrial>& trials,
                                                  const std::vector<bool>& aSelected);
 

@@ -455,4 +455,42 @@ std::vector<std::pair<int, int>> greedyBatch(const ScorePosterior& posterior, in
     return out;
 }
 
+std::vector<std::pair<int, int>> sequentialTreeBatch(const ScorePosterior& posterior, std::uint64_t tieSeed) {
+    const int m = posterior.conditions();
+    if (m < 2) return {};
+    const auto n = static_cast<std::size_t>(m);
+    ScorePosterior p = posterior;
+    SeededRandom random(tieSeed);
+    std::vector<double> jitter(n * n);
+    for (double& j : jitter) j = 1.0 + 1e-6 * random.unit();
+    std::vector<bool> inTree(n, false);
+    inTree[static_cast<std::size_t>(random.below(n))] = true;
+    std::vector<std::pair<int, int>> out;
+    std::vector<double> sa(n);
+    for (std::size_t added = 1; added < n; ++added) {
+        const std::vector<double> rowMean = rowMeans(p);
+        double best = -1.0;
+        std::size_t bi = 0, bj = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+            if (!inTree[i]) continue;
+            for (std::size_t j = 0; j < n; ++j) {
+                if (inTree[j]) continue;
+                const double g = varianceReduction(p, rowMean, static_cast<int>(i), static_cast<int>(j)) *
+                                 jitter[std::min(i, j) * n + std::max(i, j)];
+                if (g > best) best = g, bi = i, bj = j;
+            }
+        }
+        inTree[bj] = true;
+        out.emplace_back(static_cast<int>(std::min(bi, bj)), static_cast<int>(std::max(bi, bj)));
+        for (std::size_t r = 0; r < n; ++r) sa[r] = p.covariance[r * n + bi] - p.covariance[r * n + bj];
+        const double md = p.mean[bi] - p.mean[bj];
+        const double vd = std::max(sa[bi] - sa[bj], 1e-12);
+        const double precision = answerPrecision(md, vd);
+        const double gain = precision / (1.0 + precision * vd);
+        for (std::size_t r = 0; r < n; ++r)
+            for (std::size_t c = 0; c < n; ++c) p.covariance[r * n + c] -= gain * sa[r] * sa[c];
+    }
+    return out;
+}
+
 } // namespace skinlab::experiments::active

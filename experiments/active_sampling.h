@@ -122,4 +122,9 @@ std::vector<std::pair<int, int>> spanningTreeBatch(const ScorePosterior& posteri
 std::vector<std::pair<int, int>> greedyBatch(const ScorePosterior& posterior, int size, std::uint64_t tieSeed,
                                              BatchCriterion criterion = BatchCriterion::informationGain);
 
+// An alternative batch (bench_active_sampling --selection tree-sequential; the server uses spanningTreeBatch): a
+// spanning tree grown from a seeded root, each edge the most valuable (variance reduction) pair joining a new
+// condition, the values recomputed after each edge under the covariance its answer will leave (as greedyBatch).
+std::vector<std::pair<int, int>> sequentialTreeBatch(const ScorePosterior& posterior, std::uint64_t tieSeed);
+
 } // namespace skinlab::experiments::active

@@ -38,7 +38,7 @@ void readPairs(const SpecReader& spec, StudyDesign& d) {
     }
 }
 
-// trials_per_participant and active_batch, which only an active design takes.
+// trials_per_participant, active_batch and active_prior_sd, which only an active design takes.
 void readTrialCounts(const SpecReader& spec, StudyDesign& d) {
     // Active designs (pairs = "active"): trials_per_participant is required, and the keys that only shape a fixed
     // design (repetitions, block_order) are errors rather than silently ignored.
@@ -52,9 +52,10 @@ void readTrialCounts(const SpecReader& spec, StudyDesign& d) {
             spec.fail("block_order", "not used with pairs = \"active\" (each batch is planned for one block)");
         d.trialsPerParticipant = static_cast<int>(spec.integer("trials_per_participant", 0, 1, 10000));
         d.activeBatch = static_cast<int>(spec.integer("active_batch", 0, 0, 10000));
+        d.activePriorSd = spec.number("active_prior_sd", 1.0, 0.25, 10.0);
         d.repetitions = 1;
     } else {
-        for (const char* key : {"trials_per_participant", "active_batch"})
+        for (const char* key : {"trials_per_participant", "active_batch", "active_prior_sd"})
             if (spec.has(key)) spec.fail(key, "only used with pairs = \"active\"");
     }
 }
@@ -222,6 +223,7 @@ nlohmann::json StudyDesign::toJson() const {
                             {"fullscreen", requirements.fullscreen},
                             {"desktop", requirements.desktop}}}};
     if (activePairs && activeBatch > 0) out["active_batch"] = activeBatch; // only where set: designs stay as they were
+    if (activePairs && activePriorSd != 1.0) out["active_prior_sd"] = activePriorSd;
     return out;
 }
 
@@ -241,6 +243,7 @@ StudyDesign StudyDesign::fromJson(const nlohmann::json& j) {
         d.activePairs = j.at("pairs").get<std::string>() == "active";
         d.trialsPerParticipant = j.value("trials_per_participant", 0);
         d.activeBatch = j.value("active_batch", 0);
+        d.activePriorSd = j.value("active_prior_sd", 1.0);
     } else {
         d.allPairs = false;
         for (const auto& p : j.at("pairs"))

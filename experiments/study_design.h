@@ -70,6 +70,10 @@ struct StudyDesign {
     // of a block, m − 1 trials. Small batches adapt sooner but need the answers of the batch before (one
     // participant at a time, as in a lab); with many participants at once they compare the same pairs.
     int activeBatch = 0;
+    // active_prior_sd: the sd (JOD) of the planner's prior on every score (experiments/active_sampling.h,
+    // PosteriorOptions). 1 suits scores within a few JOD of each other; scores spread wider are planned better
+    // with a wider prior (docs/benchmarks.md, "Active sampling").
+    double activePriorSd = 1.0;
     int repetitions = 2;                    // times each pair is shown to each participant (alternating sides)
     std::string blockOrder = "interleaved"; // interleaved | grouped
     int breakEvery = 40;                    // a pause screen every K trials (0 = none)

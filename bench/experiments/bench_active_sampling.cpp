@@ -29,7 +29,7 @@
 //
 // Usage: bench_active_sampling [--experiments E] [--coverage-experiments C] [--bootstrap B] [--spread S]
 //                              [--truth normal|uniform] [--prior-sd P]
-//                              [--selection mst-variance|mst-gain|greedy|variance|oracle] [--batch K]
+//                              [--selection mst-variance|mst-gain|greedy|variance|tree-sequential|oracle] [--batch K]
 //                              [--plan-prior-sd P] [--empirical-prior] [--rounds R] [--threads T]
 //                              [--seed N] [--timing 0|1] [--coverage-rounds 1,2] [--plot FILE.png]
 //        bench_active_sampling --sweep [--seeds S] [--ms 10,20,30,40] [--spreads 1,2,3] [--budgets 1,2]
@@ -37,7 +37,8 @@
 //                              [--threads T] [--seed N]
 // --batch K: only the first K pairs of each planned batch are used before re-planning (the design's active_batch);
 // --plan-prior-sd P: pairs valued under a prior of sd P (same sites, ac::withPrior); --selection oracle: the
-// A-optimal allocation for the true scores (sc::optimalAllocation), each trial the pair furthest behind its share.
+// A-optimal allocation for the true scores (sc::optimalAllocation), each trial the pair furthest behind its share;
+// --selection tree-sequential: ac::sequentialTreeBatch.
 #include "analysis/scaling/bootstrap.h"
 #include "analysis/scaling/design_efficiency.h"
 #include "analysis/scaling/pairwise_model.h"
@@ -150,6 +151,7 @@ std::vector<std::pair<int, int>> plan(const ac::ScorePosterior& fitted, int m, s
     if (settings.selection == "greedy") return ac::greedyBatch(posterior, m - 1, tieSeed);
     if (settings.selection == "variance")
         return ac::greedyBatch(posterior, m - 1, tieSeed, ac::BatchCriterion::varianceReduction);
+    if (settings.selection == "tree-sequential") return ac::sequentialTreeBatch(posterior, tieSeed);
     if (settings.selection == "mst-gain")
         return ac::spanningTreeBatch(posterior, tieSeed, ac::BatchCriterion::informationGain);
     return ac::spanningTreeBatch(posterior, tieSeed, ac::BatchCriterion::varianceReduction);

@@ -181,6 +181,28 @@ TEST(ActiveSampling, GreedyBatchSpreadsItsPairs) {
     EXPECT_TRUE(greedyBatch(fitPosterior(1, {}), 3, 1).empty());
 }
 
+TEST(ActiveSampling, SequentialTreeBatchIsASpanningTree) {
+    // The tree grown edge by edge (each edge valued under the covariance the earlier edges' answers will leave):
+    // m − 1 pairs that connect every condition, reproducible from its seed.
+    const std::vector<double> truth = {0.0, 0.1, 0.2, 2.0, 4.0, 6.0};
+    const ScorePosterior p = fitPosterior(6, simulate(truth, 3, 5));
+    const auto tree = sequentialTreeBatch(p, 3);
+    ASSERT_EQ(tree.size(), 5u);
+    std::vector<int> component = {0, 1, 2, 3, 4, 5};
+    auto root = [&](int x) {
+        while (component[static_cast<std::size_t>(x)] != x) x = component[static_cast<std::size_t>(x)];
+        return x;
+    };
+    for (const auto& [a, b] : tree) {
+        EXPECT_LT(a, b);
+        EXPECT_NE(root(a), root(b)) << "no cycle";
+        component[static_cast<std::size_t>(root(a))] = root(b);
+    }
+    for (int c = 1; c < 6; ++c) EXPECT_EQ(root(c), root(0)) << "connected";
+    EXPECT_EQ(tree, sequentialTreeBatch(p, 3));
+    EXPECT_TRUE(sequentialTreeBatch(fitPosterior(1, {}), 1).empty());
+}
+
 TEST(ActiveSampling, GainIsHighestForCloseUncertainPairs) {
     const ScorePosterior p = ScorePosterior::independent({0.0, 0.2, 3.0, 0.2}, {1.0, 1.0, 1.0, 0.01});
     // Close beats far at equal uncertainty.
@@ -352,6 +374,18 @@ TEST(ActiveSampling, DesignKeysAreCheckedStrictly) {
     EXPECT_EQ(small.activeBatch, 1);
     EXPECT_EQ(StudyDesign::fromJson(small.toJson()).activeBatch, 1);
     EXPECT_FALSE(d.toJson().contains("active_batch")) << "unset: the stored design is as it was";
+    // active_prior_sd: the planner's prior, stored only where set; the posterior options follow it.
+    EXPECT_EQ(d.activePriorSd, 1.0);
+    EXPECT_FALSE(d.toJson().contains("active_prior_sd"));
+    EXPECT_EQ(plannerPosteriorOptions(d).priorVariance, 1.0);
+    const StudyDesign wide =
+        parseStudyDesign("pairs = \"active\"\ntrials_per_participant = 30\nactive_prior_sd = 2.0\n", "D.toml");
+    EXPECT_EQ(wide.activePriorSd, 2.0);
+    EXPECT_EQ(StudyDesign::fromJson(wide.toJson()).activePriorSd, 2.0);
+    EXPECT_EQ(plannerPosteriorOptions(wide).priorVariance, 4.0);
+    EXPECT_EQ(designError("active_prior_sd = 2.0\n"), "D.toml: active_prior_sd: only used with pairs = \"active\"");
+    EXPECT_EQ(designError("pairs = \"active\"\ntrials_per_participant = 10\nactive_prior_sd = 0.1\n"),
+              "D.toml: active_prior_sd: 0.1 is out of range [0.25, 10]");
     EXPECT_EQ(designError("pairs = \"activ\"\n"),
               "D.toml: pairs: expected \"all\", \"active\" or an array of [A, B] condition pairs, got \"activ\"");
 }

@@ -321,3 +321,26 @@ TEST(ActiveStudy, RunsEndToEndOverHttpAndItsPlanSurvivesKillNine) {
     server->kill(SIGTERM);
     EXPECT_EQ(server->wait(), 0);
 }
+
+TEST(ActiveStudy, ThePlannersPriorComesFromTheDesign) {
+    // The same study with the default prior (sd 1 JOD) and with active_prior_sd = 4: the first batch is planned
+    // before any answer, so both plans begin alike; once answers are stored the planner's posterior depends on its
+    // prior, and the plans part.
+    std::vector<std::vector<std::string>> plans[2];
+    for (int copy = 0; copy < 2; ++copy) {
+        StudyFiles files;
+        if (copy == 1) {
+            std::string wide = kDesign;
+            wide.insert(wide.find("[practice]"), "active_prior_sd = 4.0\n"); // a top-level key, before the tables
+            files.design = writeText(files.folder.path(), "wide.toml", wide);
+        }
+        createStudy(files.stimuli, files.design, {}, files.database);
+        EXPECT_EQ(StudyStore(files.database).definition().design.activePriorSd, copy == 0 ? 1.0 : 4.0);
+        for (const char* label : {"A", "B", "C"}) plans[copy].push_back(answerAll(files.database, label, false));
+    }
+    ASSERT_EQ(plans[0][0].size(), plans[1][0].size());
+    // The first participant's first batch (practice, three test trials, a catch trial) comes from the prior alone.
+    for (std::size_t k = 0; k < 4; ++k) EXPECT_EQ(plans[0][0][k], plans[1][0][k]) << k;
+    EXPECT_NE(plans[0][0], plans[1][0]) << "the answers weigh differently against a wider prior";
+    EXPECT_NE(plans[0][2], plans[1][2]);
+}
