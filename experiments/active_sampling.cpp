@@ -413,6 +413,21 @@ std::vector<std::pair<int, int>> spanningTreeBatch(const ScorePosterior& posteri
     return edges;
 }
 
+namespace {
+// The covariance after an answer to (i, j) not yet given: d's variance shrinks as after either answer (weighted by
+// their predictive probabilities); as a site of precision π on d, Σ ← Σ − π/(1 + π v) (Σa)(Σa)ᵀ. The means are
+// left as they are. `sa` is scratch space of m values.
+void foldExpectedAnswer(ScorePosterior& p, std::size_t i, std::size_t j, std::vector<double>& sa) {
+    const std::size_t n = p.mean.size();
+    for (std::size_t r = 0; r < n; ++r) sa[r] = p.covariance[r * n + i] - p.covariance[r * n + j];
+    const double vd = std::max(sa[i] - sa[j], 1e-12);
+    const double precision = answerPrecision(p.mean[i] - p.mean[j], vd);
+    const double gain = precision / (1.0 + precision * vd);
+    for (std::size_t r = 0; r < n; ++r)
+        for (std::size_t c = 0; c < n; ++c) p.covariance[r * n + c] -= gain * sa[r] * sa[c];
+}
+} // namespace
+
 std::vector<std::pair<int, int>> greedyBatch(const ScorePosterior& posterior, int size, std::uint64_t tieSeed,
                                              BatchCriterion criterion) {
     const int m = posterior.conditions();
@@ -441,16 +456,7 @@ std::vector<std::pair<int, int>> greedyBatch(const ScorePosterior& posterior, in
                 }
             }
         out.emplace_back(bi, bj);
-        // The covariance after the answer: d's variance shrinks as after either answer (weighted by their
-        // predictive probabilities); as a site of precision π on d, Σ ← Σ − π/(1 + π v) (Σa)(Σa)ᵀ.
-        const auto wi = static_cast<std::size_t>(bi), wj = static_cast<std::size_t>(bj);
-        for (std::size_t r = 0; r < n; ++r) sa[r] = p.covariance[r * n + wi] - p.covariance[r * n + wj];
-        const double md = p.mean[wi] - p.mean[wj];
-        const double vd = std::max(sa[wi] - sa[wj], 1e-12);
-        const double precision = answerPrecision(md, vd);
-        const double gain = precision / (1.0 + precision * vd);
-        for (std::size_t r = 0; r < n; ++r)
-            for (std::size_t c = 0; c < n; ++c) p.covariance[r * n + c] -= gain * sa[r] * sa[c];
+        foldExpectedAnswer(p, static_cast<std::size_t>(bi), static_cast<std::size_t>(bj), sa);
     }
     return out;
 }
@@ -482,13 +488,7 @@ std::vector<std::pair<int, int>> sequentialTreeBatch(const ScorePosterior& poste
         }
         inTree[bj] = true;
         out.emplace_back(static_cast<int>(std::min(bi, bj)), static_cast<int>(std::max(bi, bj)));
-        for (std::size_t r = 0; r < n; ++r) sa[r] = p.covariance[r * n + bi] - p.covariance[r * n + bj];
-        const double md = p.mean[bi] - p.mean[bj];
-        const double vd = std::max(sa[bi] - sa[bj], 1e-12);
-        const double precision = answerPrecision(md, vd);
-        const double gain = precision / (1.0 + precision * vd);
-        for (std::size_t r = 0; r < n; ++r)
-            for (std::size_t c = 0; c < n; ++c) p.covariance[r * n + c] -= gain * sa[r] * sa[c];
+        foldExpectedAnswer(p, bi, bj, sa);
     }
     return out;
 }

@@ -41,22 +41,28 @@ struct Exported {
     nlohmann::json json;
 };
 
+// The inputs the renderer would hand Blender for `model` under `spec` (materials as the model has them).
+BlenderSceneInputs inputsFor(const SceneSpec& spec, const Model& model) {
+    BlenderSceneInputs inputs;
+    inputs.spec = &spec;
+    inputs.model = &model;
+    for (const SubMesh& part : model.parts) {
+        const MeshMaterial& m = model.materials[part.material];
+        inputs.partMaterials.push_back({m.albedo, m.skin ? 1.0f : 0.0f, m.glossiness, m.specularIntensity});
+    }
+    inputs.params = spec.pathtraced;
+    return inputs;
+}
+
 Exported exportScene(const std::string& scene, std::vector<std::string> overrides) {
     Exported e;
     overrides.push_back("sss.method=\"pathtraced\"");
     e.spec = loadSceneSpec(scene, overrides, {});
     e.model =
         e.spec.modelSource == "builtin:halo" ? makeHaloScene(static_cast<float>(e.spec.depthGapMm)) : makeBleedScene();
-    BlenderSceneInputs inputs;
-    inputs.spec = &e.spec;
-    inputs.model = &e.model;
-    for (const SubMesh& part : e.model.parts) {
-        const MeshMaterial& m = e.model.materials[part.material];
-        inputs.partMaterials.push_back({m.albedo, m.skin ? 1.0f : 0.0f, m.glossiness, m.specularIntensity});
-    }
+    BlenderSceneInputs inputs = inputsFor(e.spec, e.model);
     inputs.camera = frameCamera(e.spec.camera, e.model.boundsMin, e.model.boundsMax, e.model.boundsMin,
                                 e.model.boundsMax, e.spec.width, e.spec.height);
-    inputs.params = e.spec.pathtraced;
     inputs.sssWidthMm = e.spec.sss.widthMm;
     e.json = blenderSceneJson(inputs, "mesh.bin", "cycles.exr", "cycles.json");
     return e;
@@ -200,14 +206,7 @@ TEST(BlenderScene, TheModelsGeneratedMapsAreWrittenUnlessTheSpecNamesFiles) {
     Image normal = albedo;
     for (float& v : normal.pixels) v = 0.5f;
     model.normalMap = std::make_shared<const Image>(normal);
-    BlenderSceneInputs inputs;
-    inputs.spec = &spec;
-    inputs.model = &model;
-    for (const SubMesh& part : model.parts) {
-        const MeshMaterial& m = model.materials[part.material];
-        inputs.partMaterials.push_back({m.albedo, m.skin ? 1.0f : 0.0f, m.glossiness, m.specularIntensity});
-    }
-    inputs.params = spec.pathtraced;
+    const BlenderSceneInputs inputs = inputsFor(spec, model);
     const nlohmann::json json = blenderSceneJson(inputs, "mesh.bin", "cycles.exr", "cycles.json");
     EXPECT_EQ(json.at("textures").at("albedo"), "model-albedo.exr");
     EXPECT_EQ(json.at("textures").at("albedo_colorspace"), "Non-Color");
