@@ -3,6 +3,7 @@
 #include "common/error.h"
 
 #include <cerrno>
+#include <csignal>
 #include <cstdlib>
 #include <cstring>
 #include <fcntl.h>
@@ -34,10 +35,19 @@ std::vector<char*> argvOf(const std::filesystem::path& program, const std::vecto
 struct SpawnSetup {
     posix_spawn_file_actions_t actions;
     posix_spawnattr_t attributes;
+    // Every child starts with no signal blocked and the default action for every signal: a server blocks SIGINT
+    // and SIGTERM in its threads (one thread waits for them), and a child inheriting that would outlive a cancel.
     SpawnSetup() {
         posix_spawn_file_actions_init(&actions);
         posix_spawnattr_init(&attributes);
+        sigset_t none, all;
+        sigemptyset(&none);
+        sigfillset(&all);
+        posix_spawnattr_setsigmask(&attributes, &none);
+        posix_spawnattr_setsigdefault(&attributes, &all);
+        posix_spawnattr_setflags(&attributes, kSignalFlags);
     }
+    static constexpr short kSignalFlags = POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF;
     ~SpawnSetup() {
         posix_spawn_file_actions_destroy(&actions);
         posix_spawnattr_destroy(&attributes);
@@ -87,7 +97,7 @@ pid_t spawnProcess(const std::filesystem::path& program, const std::vector<std::
         posix_spawn_file_actions_addchdir_np(&setup.actions, options.workingDirectory.c_str());
     if (options.closeInheritedFiles) posix_spawn_file_actions_addclosefrom_np(&setup.actions, 3);
     if (options.ownProcessGroup) {
-        posix_spawnattr_setflags(&setup.attributes, POSIX_SPAWN_SETPGROUP);
+        posix_spawnattr_setflags(&setup.attributes, SpawnSetup::kSignalFlags | POSIX_SPAWN_SETPGROUP);
         posix_spawnattr_setpgroup(&setup.attributes, 0);
     }
     std::vector<std::string> storage;

@@ -21,7 +21,8 @@ struct SpawnOptions {
     bool closeInheritedFiles = false;       // close every descriptor ≥ 3 (a server's sockets)
 };
 
-// Starts `program args...` with stdin from /dev/null. Returns its pid; throws RuntimeError naming the program and
+// Starts `program args...` with stdin from /dev/null, no signal blocked and every signal's action the default
+// (whatever the calling thread blocks or ignores). Returns its pid; throws RuntimeError naming the program and
 // the reason when it cannot be started (missing, not executable, output file not writable).
 pid_t spawnProcess(const std::filesystem::path& program, const std::vector<std::string>& args,
                    const SpawnOptions& options = {});
@@ -33,7 +34,7 @@ struct CapturedRun {
     int exitCode = -1;
     std::string out, err;
 };
-// Runs `program args...` to its end, collecting its stdout and stderr.
+// Runs `program args...` to its end (signals as spawnProcess), collecting its stdout and stderr.
 CapturedRun runCaptured(const std::filesystem::path& program, const std::vector<std::string>& args);
 
 } // namespace skinlab

@@ -3,10 +3,12 @@
 #include "common/error.h"
 #include "common/process.h"
 
+#include <chrono>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <gtest/gtest.h>
+#include <pthread.h>
 #include <sstream>
 #include <unistd.h>
 
@@ -69,6 +71,63 @@ TEST(Process, SignalsAndOwnProcessGroup) {
     EXPECT_EQ(::getpgid(pid), pid); // the leader of its own group
     ASSERT_EQ(::kill(-pid, SIGTERM), 0);
     EXPECT_EQ(waitProcess(pid), 128 + SIGTERM);
+}
+
+// A field of /proc/PID/status ("SigBlk", "SigIgn"): its hexadecimal mask.
+unsigned long long statusMask(const std::string& status, const std::string& field) {
+    const std::size_t at = status.find("\n" + field + ":");
+    if (at == std::string::npos) return ~0ull;
+    return std::stoull(status.substr(at + field.size() + 2), nullptr, 16);
+}
+
+// Restores the calling thread's signal mask and SIGTERM's disposition.
+struct SignalsChanged {
+    sigset_t mask;
+    struct sigaction term;
+    SignalsChanged() {
+        pthread_sigmask(SIG_SETMASK, nullptr, &mask);
+        sigaction(SIGTERM, nullptr, &term);
+    }
+    ~SignalsChanged() {
+        pthread_sigmask(SIG_SETMASK, &mask, nullptr);
+        sigaction(SIGTERM, &term, nullptr);
+    }
+};
+
+TEST(Process, ChildrenStartWithNoBlockedOrIgnoredSignals) {
+    // A server blocks SIGINT and SIGTERM in its threads (one thread waits for them); its children must not inherit
+    // that, or SIGTERM (cancel, shutdown) never ends them.
+    SignalsChanged restore;
+    sigset_t blocked;
+    sigemptyset(&blocked);
+    sigaddset(&blocked, SIGINT);
+    sigaddset(&blocked, SIGTERM);
+    ASSERT_EQ(pthread_sigmask(SIG_BLOCK, &blocked, nullptr), 0);
+    struct sigaction ignore = {};
+    ignore.sa_handler = SIG_IGN;
+    ASSERT_EQ(sigaction(SIGTERM, &ignore, nullptr), 0);
+
+    const CapturedRun captured = runCaptured(findProgram("cat"), {"/proc/self/status"});
+    ASSERT_EQ(captured.exitCode, 0);
+    EXPECT_EQ(statusMask(captured.out, "SigBlk"), 0u) << captured.out;
+    EXPECT_EQ(statusMask(captured.out, "SigIgn") & (1ull << (SIGTERM - 1)), 0u) << captured.out;
+
+    TempFolder folder;
+    SpawnOptions options;
+    options.output = folder.path / "status.txt";
+    EXPECT_EQ(waitProcess(spawnProcess(findProgram("cat"), {"/proc/self/status"}, options)), 0);
+    const std::string spawned = readAll(options.output);
+    EXPECT_EQ(statusMask(spawned, "SigBlk"), 0u) << spawned;
+    EXPECT_EQ(statusMask(spawned, "SigIgn") & (1ull << (SIGTERM - 1)), 0u) << spawned;
+
+    // And SIGTERM ends a child at once.
+    options.ownProcessGroup = true;
+    const pid_t pid = spawnProcess(findProgram("sleep"), {"30"}, options);
+    ::usleep(100 * 1000); // let it reach sleep
+    const auto sent = std::chrono::steady_clock::now();
+    ASSERT_EQ(::kill(-pid, SIGTERM), 0);
+    EXPECT_EQ(waitProcess(pid), 128 + SIGTERM);
+    EXPECT_LT(std::chrono::steady_clock::now() - sent, std::chrono::seconds(5));
 }
 
 TEST(Process, FailuresNameTheProgramOrTheFile) {
