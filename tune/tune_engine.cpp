@@ -125,10 +125,25 @@ struct JobRunner::Job {
     JobStatus status;
     std::string key;
     std::string sizeKey;
-    pid_t pid = -1;
+    pid_t pid = -1; // until reaped
     std::filesystem::path log;
     std::chrono::steady_clock::time_point started;
     std::chrono::steady_clock::time_point finished;
+    std::optional<std::chrono::steady_clock::time_point> terminated; // when SIGTERM was sent to its group
+    bool killed = false;                                             // SIGKILL sent
+
+    // SIGTERM to the job's process group, once; SIGKILL when it outlives the grace period.
+    void end() {
+        if (pid <= 0) return;
+        const auto now = std::chrono::steady_clock::now();
+        if (!terminated) {
+            terminated = now;
+            kill(-pid, SIGTERM);
+        } else if (!killed && now - *terminated >= kKillGrace) {
+            killed = true;
+            kill(-pid, SIGKILL);
+        }
+    }
 };
 
 JobRunner::JobRunner(std::filesystem::path executable, std::filesystem::path folder, std::filesystem::path assetsDir)
@@ -141,8 +156,7 @@ JobRunner::~JobRunner() {
     {
         std::lock_guard lock(mutex_);
         stopping_ = true;
-        for (auto& [id, job] : jobs_)
-            if (job->status.state == "running" && job->pid > 0) kill(-job->pid, SIGTERM);
+        for (auto& [id, job] : jobs_) job->end();
     }
     wake_.notify_all();
     reaper_.join();
@@ -150,9 +164,12 @@ JobRunner::~JobRunner() {
 
 std::string JobRunner::start(const TuneConfig& config, const std::string& method, int width, int height) {
     std::lock_guard lock(mutex_);
+    if (stopping_) throw RuntimeError("tune: stopping");
     const std::string key = configKey(config);
     for (const auto& [id, job] : jobs_)
         if (job->key == key && (job->status.state == "running" || job->status.state == "done")) return id;
+    for (const auto& [id, job] : jobs_)
+        if (job->pid > 0 && job->status.method == method) throw JobBusy(method, id);
 
     auto job = std::make_shared<Job>();
     job->status.id = "job" + std::to_string(next_++);
@@ -210,8 +227,11 @@ bool JobRunner::cancel(const std::string& id) {
     std::lock_guard lock(mutex_);
     const auto found = jobs_.find(id);
     if (found == jobs_.end() || found->second->status.state != "running") return false;
-    kill(-found->second->pid, SIGTERM);
-    found->second->status.state = "cancelled";
+    Job& job = *found->second;
+    job.end();
+    job.status.state = "cancelled";
+    job.finished = std::chrono::steady_clock::now();
+    wake_.notify_all();
     return true;
 }
 
@@ -225,12 +245,15 @@ void JobRunner::reap() {
             const pid_t done = waitpid(job->pid, &status, WNOHANG);
             if (done != job->pid) {
                 running = true;
+                if (job->status.state == "cancelled" || stopping_) job->end(); // SIGKILL after the grace period
                 continue;
             }
             job->pid = -1;
+            if (job->status.state == "cancelled") continue; // its time stopped at the cancel
             job->finished = std::chrono::steady_clock::now();
-            if (job->status.state == "cancelled") continue;
-            if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {
+            if (stopping_) {
+                job->status.state = "cancelled";
+            } else if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {
                 job->status.state = "done";
                 lastSeconds_[job->sizeKey] = millisecondsBetween(job->started, job->finished) / 1000.0;
             } else {
@@ -243,7 +266,7 @@ void JobRunner::reap() {
             }
         }
         if (stopping_ && !running) break;
-        wake_.wait_for(lock, std::chrono::milliseconds(100));
+        wake_.wait_for(lock, std::chrono::milliseconds(50));
     }
 }
 

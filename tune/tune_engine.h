@@ -15,6 +15,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -86,6 +87,18 @@ struct JobStatus {
     std::filesystem::path exr, png;
 };
 
+// Thrown by JobRunner::start while a render of the same method runs: at most one runs per method.
+class JobBusy : public std::runtime_error {
+public:
+    JobBusy(const std::string& method, std::string running)
+        : std::runtime_error("a " + method + " render is already running (" + running + "): wait for it or cancel it"),
+          running_(std::move(running)) {}
+    const std::string& running() const { return running_; }
+
+private:
+    std::string running_;
+};
+
 class JobRunner {
 public:
     // `executable`: the skinlab binary; `folder`: where jobs write (created).
@@ -95,10 +108,14 @@ public:
     JobRunner& operator=(const JobRunner&) = delete;
 
     // Starts a render of `config` unless one of the same configuration runs or is done (then returns its id).
+    // Throws JobBusy while another render of `method` runs (a cancelled one counts until its process has ended).
     std::string start(const TuneConfig& config, const std::string& method, int width, int height);
     std::optional<JobStatus> status(const std::string& id) const;
-    // false when no such job or it no longer runs.
+    // Ends the job's process group (SIGTERM, then SIGKILL after kKillGrace); false when no such job or it no
+    // longer runs. Its elapsed time stops at the cancel.
     bool cancel(const std::string& id);
+
+    static constexpr std::chrono::milliseconds kKillGrace{1000};
 
 private:
     struct Job;

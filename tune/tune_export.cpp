@@ -12,17 +12,18 @@
 #include "renderer/sss/sss_params.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <sstream>
+#include <unistd.h>
 
 namespace skinlab::tune {
 
 namespace sss = renderer::sss;
 
-namespace {
-
-toml::table baseTable(const std::string& scene) {
+toml::table sceneTable(const std::string& scene) {
     if (scene.rfind("builtin:", 0) == 0) {
         const auto text = renderer::builtinSceneText(scene.substr(8));
         if (!text) throw InputError("unknown built-in scene '" + scene + "'");
@@ -30,6 +31,8 @@ toml::table baseTable(const std::string& scene) {
     }
     return parseTomlFile(scene);
 }
+
+namespace {
 
 // Relative file paths of a scene file, made absolute against its folder ("assets:" and "builtin:" stay).
 void absolutePaths(toml::table& table, const std::filesystem::path& folder) {
@@ -79,7 +82,7 @@ std::pair<std::string, std::string> splitOverride(const std::string& assignment)
 } // namespace
 
 std::string exportedSceneText(const TuneConfig& config, const std::filesystem::path& assetsDir) {
-    toml::table table = baseTable(config.scene);
+    toml::table table = sceneTable(config.scene);
     for (const std::string& o : config.overrides) applyOverride(table, o, "--set");
     if (config.scene.rfind("builtin:", 0) != 0)
         absolutePaths(table, std::filesystem::absolute(config.scene).parent_path());
@@ -116,8 +119,34 @@ std::string includeSnippet(const TuneConfig& config) {
     return text;
 }
 
+namespace {
+std::string existingList(const std::vector<std::filesystem::path>& files) {
+    std::string names;
+    for (const auto& f : files) names += (names.empty() ? "" : ", ") + f.filename().string();
+    return names;
+}
+
+// Writes `text` to `path` atomically unless `path` exists: the complete file is linked to its final name, which
+// link(2) refuses when the name is taken. False when it exists.
+bool writeNewFileAtomic(const std::filesystem::path& path, const std::string& text) {
+    const std::filesystem::path temporary =
+        path.parent_path() / ("." + path.filename().string() + ".new-" + std::to_string(::getpid()));
+    writeFileAtomic(temporary, text);
+    const int linked = ::link(temporary.c_str(), path.c_str());
+    const int error = errno;
+    std::filesystem::remove(temporary);
+    if (linked == 0) return true;
+    if (error == EEXIST) return false;
+    throw InputError(path.string() + ": cannot write (" + std::strerror(error) + ")");
+}
+} // namespace
+
+ExportExists::ExportExists(std::vector<std::filesystem::path> files)
+    : InputError("name: " + existingList(files) + " already in the export folder; replacing needs \"overwrite\": true"),
+      files_(std::move(files)) {}
+
 ExportedFiles exportConfig(const TuneConfig& config, const std::filesystem::path& folder, const std::string& name,
-                           const std::filesystem::path& assetsDir) {
+                           const std::filesystem::path& assetsDir, bool overwrite) {
     checkName(name);
     ExportedFiles files;
     files.sceneText = exportedSceneText(config, assetsDir);
@@ -125,8 +154,22 @@ ExportedFiles exportConfig(const TuneConfig& config, const std::filesystem::path
     std::filesystem::create_directories(folder);
     files.scene = folder / (name + ".toml");
     files.include = folder / (name + ".include.toml");
-    writeFileAtomic(files.scene, files.sceneText);
-    writeFileAtomic(files.include, files.includeText);
+    if (overwrite) {
+        writeFileAtomic(files.scene, files.sceneText);
+        writeFileAtomic(files.include, files.includeText);
+        return files;
+    }
+    std::vector<std::filesystem::path> existing;
+    for (const auto& f : {files.scene, files.include}) {
+        std::error_code error;
+        if (std::filesystem::exists(std::filesystem::symlink_status(f, error))) existing.push_back(f);
+    }
+    if (!existing.empty()) throw ExportExists(existing);
+    if (!writeNewFileAtomic(files.scene, files.sceneText)) throw ExportExists({files.scene});
+    if (!writeNewFileAtomic(files.include, files.includeText)) {
+        std::filesystem::remove(files.scene); // written just now: nothing of this export is left
+        throw ExportExists({files.include});
+    }
     return files;
 }
 
@@ -168,11 +211,18 @@ TuneConfig stimulusConfig(const std::filesystem::path& setFolder, const std::str
         TuneConfig config;
         config.scene = s.value("scene", "");
         if (config.scene.empty()) throw InputError(where + ": stimuli[" + id + "].scene: missing");
-        // A scene file is named relative to the set spec's folder, which the manifest records beside the set.
+        // A relative scene file: taken from the manifest's folder when it is there, else the file the build
+        // rendered (the manifest's resolved scene, absolute; the spec named it relative to the spec's folder).
         if (config.scene.rfind("builtin:", 0) != 0 && !std::filesystem::path(config.scene).is_absolute()) {
-            const std::filesystem::path spec = manifest.value("spec", "");
-            const std::filesystem::path specFolder = spec.is_absolute() ? spec.parent_path() : setFolder;
-            config.scene = (specFolder / config.scene).lexically_normal().string();
+            const std::filesystem::path beside =
+                (std::filesystem::absolute(setFolder) / config.scene).lexically_normal();
+            const std::filesystem::path rendered =
+                s.contains("resolved") && s["resolved"].is_object() ? s["resolved"].value("scene", "") : "";
+            std::error_code error;
+            const bool besideExists = std::filesystem::is_regular_file(beside, error);
+            if (!besideExists && rendered.is_absolute() && std::filesystem::is_regular_file(rendered, error))
+                config.scene = rendered.lexically_normal().string();
+            else config.scene = beside.string();
         }
         for (const auto& o : s.value("overrides", nlohmann::json::array())) {
             if (!o.is_string()) throw InputError(where + ": stimuli[" + id + "].overrides: not a list of strings");
@@ -186,7 +236,7 @@ TuneConfig stimulusConfig(const std::filesystem::path& setFolder, const std::str
 nlohmann::json kernelCurves(const TuneConfig& config) {
     // The [sss] table of the configuration: the base scene's and its sss.* overrides, read by the scene reader.
     toml::table root;
-    const toml::table base = baseTable(config.scene);
+    const toml::table base = sceneTable(config.scene);
     if (const toml::table* table = base["sss"].as_table()) root.insert_or_assign("sss", *table);
     for (const std::string& o : config.overrides)
         if (o.rfind("sss.", 0) == 0) applyOverride(root, o, "--set");

@@ -14,12 +14,15 @@
 #include <algorithm>
 #include <boost/asio/ip/address.hpp>
 #include <cmath>
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <spdlog/spdlog.h>
+#include <sys/random.h>
 
 namespace skinlab::tune {
 
@@ -120,6 +123,46 @@ std::optional<std::uint64_t> sequenceOf(const json& body) {
     return value.get<std::uint64_t>();
 }
 
+// 32 random bytes as hexadecimal (getrandom(2)).
+std::string randomHex() {
+    unsigned char bytes[32];
+    std::size_t filled = 0;
+    while (filled < sizeof bytes) {
+        const ssize_t n = ::getrandom(bytes + filled, sizeof bytes - filled, 0);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) throw RuntimeError(std::string("tune: no random bytes (") + std::strerror(errno) + ")");
+        filled += static_cast<std::size_t>(n);
+    }
+    static const char* digits = "0123456789abcdef";
+    std::string out;
+    for (const unsigned char b : bytes) {
+        out += digits[b >> 4];
+        out += digits[b & 15];
+    }
+    return out;
+}
+
+// Whether `path` (made canonical; it need not exist) lies in one of the canonical `folders`.
+bool insideAny(const std::filesystem::path& path, const std::vector<std::filesystem::path>& folders) {
+    std::error_code error;
+    const std::filesystem::path canonical = std::filesystem::weakly_canonical(path, error);
+    if (error) return false;
+    return std::any_of(folders.begin(), folders.end(), [&](const std::filesystem::path& folder) {
+        return std::mismatch(folder.begin(), folder.end(), canonical.begin(), canonical.end()).first == folder.end();
+    });
+}
+
+// The path-valued keys of a scene: files the renderer reads ("assets:" and relative paths resolved as the scene
+// reader does) and the programs the slow methods run.
+struct PathKey {
+    const char* table;
+    const char* key;
+};
+constexpr PathKey kFileKeys[] = {{"model", "source"},      {"textures", "albedo"},    {"textures", "normal"},
+                                 {"textures", "specular"}, {"textures", "occlusion"}, {"textures", "skin_mask"},
+                                 {"environment", "file"}};
+constexpr PathKey kProgramKeys[] = {{"pathtraced", "blender"}, {"eevee", "blender"}};
+
 json parseBody(const HttpRequest& request) {
     try {
         json body = json::parse(request.body);
@@ -163,11 +206,11 @@ TuneServer::TuneServer(TuneOptions options) : options_(std::move(options)) {
     if (options_.workDir.empty()) throw InputError("tune: a work folder is required");
     // The scanned head, when the assets folder holds it: its scene spec (renderer/scenes/lee-perry-smith.toml, whose
     // paths are all "assets:") written into the work folder.
-    std::filesystem::path assets = options_.assetsDir;
-    if (const char* environment = std::getenv("SKINLAB_ASSETS"); assets.empty() && environment && *environment)
-        assets = environment;
+    assets_ = options_.assetsDir;
+    if (const char* environment = std::getenv("SKINLAB_ASSETS"); assets_.empty() && environment && *environment)
+        assets_ = environment;
     std::error_code error;
-    if (!assets.empty() && std::filesystem::is_regular_file(assets / "LeePerrySmith/LeePerrySmith.glb", error)) {
+    if (!assets_.empty() && std::filesystem::is_regular_file(assets_ / "LeePerrySmith/LeePerrySmith.glb", error)) {
         const std::filesystem::path spec = options_.workDir / "lee-perry-smith.toml";
         std::filesystem::create_directories(options_.workDir);
         writeFileAtomic(spec, std::string(*scenes::embeddedFile("lee-perry-smith.toml")));
@@ -177,7 +220,8 @@ TuneServer::TuneServer(TuneOptions options) : options_(std::move(options)) {
         if (!given) options_.scenes.insert(options_.scenes.begin() + 1, spec.string());
     }
     // The scenes of the stimulus sets "open" may load join the page's scenes (read once: the list is fixed while
-    // the server runs).
+    // the server runs); a set's relative scene files are found from its manifest's folder.
+    for (std::filesystem::path& set : options_.stimulusSets) set = std::filesystem::absolute(set);
     for (const std::filesystem::path& set : options_.stimulusSets) {
         std::vector<std::string> seen;
         for (const json& entry : stimulusEntries(set)) {
@@ -189,6 +233,17 @@ TuneServer::TuneServer(TuneOptions options) : options_(std::move(options)) {
                 options_.scenes.push_back(scene);
         }
     }
+    // The folders whose files the page may name: the offered scenes' folders, the assets folder, the sets.
+    std::vector<std::filesystem::path> folders(options_.stimulusSets.begin(), options_.stimulusSets.end());
+    if (!assets_.empty()) folders.push_back(assets_);
+    for (const std::string& scene : options_.scenes)
+        if (scene.rfind("builtin:", 0) != 0) folders.push_back(std::filesystem::absolute(scene).parent_path());
+    for (const std::filesystem::path& folder : folders) {
+        const std::filesystem::path canonical = std::filesystem::weakly_canonical(folder, error);
+        if (!error && std::find(readable_.begin(), readable_.end(), canonical) == readable_.end())
+            readable_.push_back(canonical);
+    }
+    pageToken_ = randomHex();
     queue_ = std::make_unique<RenderQueue>(options_.assetsDir);
     jobs_ = std::make_unique<JobRunner>(options_.executable, options_.workDir / "jobs", options_.assetsDir);
     references_ = std::make_unique<PreparedReferences>();
@@ -245,6 +300,12 @@ HttpResponse TuneServer::handle(const HttpRequest& request) {
     HttpResponse res;
     try {
         res = answer(request);
+    } catch (const JobBusy& e) {
+        res = jsonResponse(409, {{"error", e.what()}, {"running", e.running()}});
+    } catch (const ExportExists& e) {
+        json files = json::array();
+        for (const auto& f : e.files()) files.push_back(f.string());
+        res = jsonResponse(409, {{"error", e.what()}, {"exists", files}});
     } catch (const RequestError& e) {
         res = jsonResponse(e.status(), {{"error", e.what()}});
     } catch (const InputError& e) {
@@ -255,6 +316,7 @@ HttpResponse TuneServer::handle(const HttpRequest& request) {
     }
     res.headers.emplace_back("X-Frame-Options", "DENY");
     res.headers.emplace_back("Content-Security-Policy", "frame-ancestors 'none'");
+    res.headers.emplace_back("Referrer-Policy", "same-origin");
     return res;
 }
 
@@ -364,7 +426,7 @@ json TuneServer::compare(const json& request, const TuneFrame& frame) {
 }
 
 HttpResponse TuneServer::render(const json& body) {
-    const TuneConfig config = configOf(body, options_.scenes);
+    const TuneConfig config = requestConfig(body);
     renderer::RenderRequest probe;
     probe.scene = config.scene;
     probe.overrides = config.overrides;
@@ -398,6 +460,175 @@ HttpResponse TuneServer::render(const json& body) {
     return jsonResponse(200, out);
 }
 
+HttpResponse TuneServer::page(const std::string& path) const {
+    const std::string name = path == "/" ? "index.html" : path.substr(1);
+    const auto file = web::embeddedFile(name);
+    if (!file) throw RequestError(404, "not found");
+    HttpResponse res;
+    res.body = std::string(*file);
+    if (name == "index.html") {
+        // This start's token, for the page's POSTs; the page is never stored.
+        const std::string placeholder = "SKINLAB_PAGE_TOKEN";
+        res.body.replace(res.body.find(placeholder), placeholder.size(), pageToken_);
+        res.headers.emplace_back("Cache-Control", "no-store");
+    } else {
+        res.headers.emplace_back("Cache-Control", "no-cache");
+    }
+    res.contentType = name.ends_with(".js")    ? "text/javascript; charset=utf-8"
+                      : name.ends_with(".css") ? "text/css; charset=utf-8"
+                                               : "text/html; charset=utf-8";
+    return res;
+}
+
+void TuneServer::checkSameOrigin(const HttpRequest& request) const {
+    // A browser says where a request comes from: Sec-Fetch-Site (every current browser) and Origin (every POST, and
+    // cross-origin GETs). Either, when present, must name this page; a client that sends neither is not a browser.
+    if (request.headerCount("Sec-Fetch-Site") > 1 || request.headerCount("Origin") > 1)
+        throw RequestError(400, "Origin, Sec-Fetch-Site: at most one of each");
+    const std::string site = lowerCase(request.header("Sec-Fetch-Site"));
+    if (!site.empty() && site != "same-origin" && site != "none")
+        throw RequestError(403, "Sec-Fetch-Site: \"" + site.substr(0, 32) + "\": only this page's own requests");
+    if (request.headerCount("Origin") == 0) return;
+    const std::string origin = lowerCase(request.header("Origin"));
+    const std::string own = "http://" + lowerCase(request.header("Host"));
+    const bool defaultPort = port_ == 80 && own.ends_with(":80") && origin == own.substr(0, own.size() - 3);
+    if (origin != own && !defaultPort)
+        throw RequestError(403, "Origin: \"" + origin.substr(0, 64) + "\" is not this page's origin (" + own + ")");
+}
+
+void TuneServer::checkPageRequest(const HttpRequest& request) const {
+    std::string type = lowerCase(request.header("Content-Type"));
+    type = type.substr(0, type.find(';'));
+    while (!type.empty() && (type.back() == ' ' || type.back() == '\t')) type.pop_back();
+    if (type != "application/json")
+        throw RequestError(415, "Content-Type: \"" + type.substr(0, 64) + "\" is not application/json");
+    if (request.headerCount("X-Skinlab-Token") != 1 ||
+        !constantTimeEqual(request.header("X-Skinlab-Token"), pageToken_))
+        throw RequestError(403, "X-Skinlab-Token: missing or not this start's (reload the page)");
+}
+
+TuneConfig TuneServer::requestConfig(const json& body) const {
+    TuneConfig config = configOf(body, options_.scenes);
+    checkPathKeys(config);
+    return config;
+}
+
+void TuneServer::checkPathKeys(const TuneConfig& config) const {
+    // The scene with the page's overrides: a path key whose value differs from the scene's own must name a file
+    // inside the readable folders (a value the scene file itself holds was chosen by whoever gave the scene).
+    toml::table base, table;
+    try {
+        base = sceneTable(config.scene);
+        table = base;
+        for (const std::string& o : config.overrides) applyOverride(table, o, "--set");
+    } catch (const InputError&) {
+        return; // the scene reader reports it, naming the fault
+    }
+    const bool builtin = config.scene.rfind("builtin:", 0) == 0;
+    const std::filesystem::path folder =
+        builtin ? std::filesystem::current_path() : std::filesystem::absolute(config.scene).parent_path();
+    const auto refuse = [](const std::string& key, const std::string& value) {
+        throw RequestError(403, key + ": '" + value.substr(0, 200) +
+                                    "' is outside the folders this page may read (the offered scenes' folders, the "
+                                    "assets folder and the stimulus sets)");
+    };
+    const auto changed = [&](const char* t, const char* k) -> std::optional<std::string> {
+        const auto value = table[t][k].value<std::string>();
+        if (!value || value->empty() || value == base[t][k].value<std::string>()) return std::nullopt;
+        return value;
+    };
+    for (const PathKey& p : kFileKeys) {
+        const auto value = changed(p.table, p.key);
+        if (!value || value->rfind("builtin:", 0) == 0) continue;
+        std::filesystem::path path = *value;
+        if (value->rfind("assets:", 0) == 0) {
+            if (assets_.empty()) continue; // the scene reader asks for the assets folder
+            path = assets_ / value->substr(7);
+        } else if (path.is_relative()) {
+            path = folder / path;
+        }
+        if (!insideAny(path, readable_)) refuse(std::string(p.table) + "." + p.key, *value);
+    }
+    if (const auto profile = changed("sss", "profile"); profile && profile->rfind("file:", 0) == 0)
+        if (!insideAny(std::filesystem::absolute(profile->substr(5)), readable_)) refuse("sss.profile", *profile);
+    for (const PathKey& p : kProgramKeys)
+        if (changed(p.table, p.key))
+            throw RequestError(403, std::string(p.table) + "." + p.key +
+                                        ": the program is not chosen from the page (the scene's own applies)");
+}
+
+HttpResponse TuneServer::reference(const json& body) {
+    // The object-space reference of the configuration's scene, view, lights and size (its [sss] keys dropped: the
+    // reference reads its own), rendered once in the background.
+    TuneConfig config = requestConfig(body);
+    std::erase_if(config.overrides, [](const std::string& o) { return o.rfind("sss.", 0) == 0; });
+    config.overrides.push_back("sss.method=\"reference\"");
+    renderer::RenderRequest probe;
+    probe.scene = config.scene;
+    probe.overrides = config.overrides;
+    probe.assetsDir = options_.assetsDir;
+    const json resolved = renderer::resolveScene(probe);
+    const std::string id = jobs_->start(config, "reference", resolved["render"]["width"].get<int>(),
+                                        resolved["render"]["height"].get<int>());
+    return jsonResponse(200, {{"job", {{"id", id}, {"state", jobs_->status(id)->state}}}});
+}
+
+HttpResponse TuneServer::exportFiles(const json& body) {
+    const TuneConfig config = requestConfig(body);
+    bool overwrite = false;
+    if (body.contains("overwrite")) {
+        if (!body["overwrite"].is_boolean())
+            throw RequestError(400, "overwrite: expected true or false, got " + body["overwrite"].dump());
+        overwrite = body["overwrite"].get<bool>();
+    }
+    const ExportedFiles files =
+        exportConfig(config, options_.exportDir, stringField(body, "name"), options_.assetsDir, overwrite);
+    return jsonResponse(200,
+                        {{"scene_file", files.scene.string()},
+                         {"include_file", files.include.string()},
+                         {"scene_text", files.sceneText},
+                         {"include_text", files.includeText},
+                         {"command", "skinlab render --scene " + files.scene.string() + " -o out.exr --png out.png"}});
+}
+
+HttpResponse TuneServer::job(const HttpRequest& request) const {
+    const auto id = request.queryParameter("id");
+    if (!id) throw RequestError(400, "id: missing");
+    const auto status = jobs_->status(*id);
+    if (!status) throw RequestError(404, "id: no job '" + id->substr(0, 64) + "'");
+    if (request.path == "/api/job")
+        return jsonResponse(200, {{"id", status->id},
+                                  {"state", status->state},
+                                  {"method", status->method},
+                                  {"elapsed_s", status->elapsedSeconds},
+                                  {"expected_s", status->expectedSeconds ? json(*status->expectedSeconds) : json()},
+                                  {"error", status->error}});
+    if (status->state != "done") throw RequestError(409, "id: job '" + *id + "' is " + status->state);
+    std::ifstream in(status->png, std::ios::binary);
+    HttpResponse res;
+    res.contentType = "image/png";
+    res.headers.emplace_back("Cache-Control", "no-store");
+    res.body.assign(std::istreambuf_iterator<char>(in), {});
+    return res;
+}
+
+HttpResponse TuneServer::open(const HttpRequest& request) const {
+    const auto id = request.queryParameter("id");
+    const auto set = request.queryParameter("set");
+    if (!id) throw RequestError(400, "id: missing");
+    std::size_t index = 0;
+    if (set) {
+        try {
+            index = static_cast<std::size_t>(std::stoul(*set));
+        } catch (const std::exception&) {
+            throw RequestError(400, "set: not an index");
+        }
+    }
+    if (index >= options_.stimulusSets.size()) throw RequestError(404, "set: no stimulus set " + std::to_string(index));
+    const TuneConfig config = stimulusConfig(options_.stimulusSets[index], *id);
+    return jsonResponse(200, {{"scene", config.scene}, {"overrides", config.overrides}});
+}
+
 HttpResponse TuneServer::answer(const HttpRequest& request) {
     if (request.headerCount("Host") != 1) throw RequestError(400, "Host: exactly one Host header is required");
     if (!hostAllowed(request.header("Host")))
@@ -406,98 +637,28 @@ HttpResponse TuneServer::answer(const HttpRequest& request) {
     const bool get = request.method == "GET";
     const bool post = request.method == "POST";
 
-    if (get && (path == "/" || path == "/index.html" || path == "/app.js" || path == "/style.css")) {
-        const std::string name = path == "/" ? "index.html" : path.substr(1);
-        const auto file = web::embeddedFile(name);
-        if (!file) throw RequestError(404, "not found");
-        HttpResponse res;
-        res.contentType = name.ends_with(".js")    ? "text/javascript; charset=utf-8"
-                          : name.ends_with(".css") ? "text/css; charset=utf-8"
-                                                   : "text/html; charset=utf-8";
-        res.headers.emplace_back("Cache-Control", "no-cache");
-        res.body = std::string(*file);
-        return res;
-    }
+    if (get && (path == "/" || path == "/index.html" || path == "/app.js" || path == "/style.css")) return page(path);
     if (path.rfind("/api/", 0) != 0) throw RequestError(404, "not found");
+    checkSameOrigin(request);
     if (!options_.token.empty()) {
         const std::string authorization = request.header("Authorization");
         if (authorization.rfind("Bearer ", 0) != 0)
             throw RequestError(401, "token required (Authorization: Bearer TOKEN)");
         if (!constantTimeEqual(authorization.substr(7), options_.token)) throw RequestError(403, "wrong token");
     }
+    if (post) checkPageRequest(request);
 
     if (get && path == "/api/schema") return jsonResponse(200, schema());
     if (post && path == "/api/render") return render(parseBody(request));
-    if (post && path == "/api/kernel")
-        return jsonResponse(200, kernelCurves(configOf(parseBody(request), options_.scenes)));
-    if (post && path == "/api/reference") {
-        // The object-space reference of the configuration's scene, view, lights and size (its [sss] keys dropped:
-        // the reference reads its own), rendered once in the background.
-        TuneConfig config = configOf(parseBody(request), options_.scenes);
-        std::erase_if(config.overrides, [](const std::string& o) { return o.rfind("sss.", 0) == 0; });
-        config.overrides.push_back("sss.method=\"reference\"");
-        renderer::RenderRequest probe;
-        probe.scene = config.scene;
-        probe.overrides = config.overrides;
-        probe.assetsDir = options_.assetsDir;
-        const json resolved = renderer::resolveScene(probe);
-        const std::string id = jobs_->start(config, "reference", resolved["render"]["width"].get<int>(),
-                                            resolved["render"]["height"].get<int>());
-        return jsonResponse(200, {{"job", {{"id", id}, {"state", jobs_->status(id)->state}}}});
-    }
-    if (get && (path == "/api/job" || path == "/api/job/image")) {
-        const auto id = request.queryParameter("id");
-        if (!id) throw RequestError(400, "id: missing");
-        const auto status = jobs_->status(*id);
-        if (!status) throw RequestError(404, "id: no job '" + id->substr(0, 64) + "'");
-        if (path == "/api/job")
-            return jsonResponse(200, {{"id", status->id},
-                                      {"state", status->state},
-                                      {"method", status->method},
-                                      {"elapsed_s", status->elapsedSeconds},
-                                      {"expected_s", status->expectedSeconds ? json(*status->expectedSeconds) : json()},
-                                      {"error", status->error}});
-        if (status->state != "done") throw RequestError(409, "id: job '" + *id + "' is " + status->state);
-        std::ifstream in(status->png, std::ios::binary);
-        HttpResponse res;
-        res.contentType = "image/png";
-        res.headers.emplace_back("Cache-Control", "no-store");
-        res.body.assign(std::istreambuf_iterator<char>(in), {});
-        return res;
-    }
+    if (post && path == "/api/kernel") return jsonResponse(200, kernelCurves(requestConfig(parseBody(request))));
+    if (post && path == "/api/reference") return reference(parseBody(request));
+    if (get && (path == "/api/job" || path == "/api/job/image")) return job(request);
     if (post && path == "/api/job/cancel") {
         const std::string id = stringField(parseBody(request), "id");
         return jsonResponse(200, {{"cancelled", jobs_->cancel(id)}});
     }
-    if (post && path == "/api/export") {
-        const json body = parseBody(request);
-        const TuneConfig config = configOf(body, options_.scenes);
-        const ExportedFiles files =
-            exportConfig(config, options_.exportDir, stringField(body, "name"), options_.assetsDir);
-        return jsonResponse(
-            200, {{"scene_file", files.scene.string()},
-                  {"include_file", files.include.string()},
-                  {"scene_text", files.sceneText},
-                  {"include_text", files.includeText},
-                  {"command", "skinlab render --scene " + files.scene.string() + " -o out.exr --png out.png"}});
-    }
-    if (get && path == "/api/open") {
-        const auto id = request.queryParameter("id");
-        const auto set = request.queryParameter("set");
-        if (!id) throw RequestError(400, "id: missing");
-        std::size_t index = 0;
-        if (set) {
-            try {
-                index = static_cast<std::size_t>(std::stoul(*set));
-            } catch (const std::exception&) {
-                throw RequestError(400, "set: not an index");
-            }
-        }
-        if (index >= options_.stimulusSets.size())
-            throw RequestError(404, "set: no stimulus set " + std::to_string(index));
-        const TuneConfig config = stimulusConfig(options_.stimulusSets[index], *id);
-        return jsonResponse(200, {{"scene", config.scene}, {"overrides", config.overrides}});
-    }
+    if (post && path == "/api/export") return exportFiles(parseBody(request));
+    if (get && path == "/api/open") return open(request);
     throw RequestError(404, "not found");
 }
 

@@ -1,7 +1,10 @@
 #pragma once
 // `skinlab tune`: the live-tuning page and its JSON API on the project's HTTP server (experiments/http_server.h).
 // Loopback by default; bound to any other address only with a token (Authorization: Bearer TOKEN on every /api/
-// request). Routes and limits: docs/tuning.md.
+// request). Requests from other sites are refused: every /api/ request must come from the page's own origin
+// (Origin, Sec-Fetch-Site), and every POST must be JSON and carry the page's token, random per start (embedded in
+// the page it serves). Paths the page sends are read only inside the offered scenes' folders, the assets folder and
+// the stimulus sets. Routes and limits: docs/tuning.md.
 #include "experiments/http_server.h"
 #include "tune/tune_engine.h"
 
@@ -44,9 +47,21 @@ public:
     // The request handler (public for tests that call it without a socket).
     experiments::HttpResponse handle(const experiments::HttpRequest& request);
 
+    // The folders the page's path-valued keys may name (canonical).
+    const std::vector<std::filesystem::path>& readableFolders() const { return readable_; }
+
 private:
     experiments::HttpResponse answer(const experiments::HttpRequest& request);
+    experiments::HttpResponse page(const std::string& path) const;
     bool hostAllowed(const std::string& hostHeader) const;
+    void checkSameOrigin(const experiments::HttpRequest& request) const;
+    void checkPageRequest(const experiments::HttpRequest& request) const;
+    TuneConfig requestConfig(const nlohmann::json& body) const;
+    void checkPathKeys(const TuneConfig& config) const;
+    experiments::HttpResponse reference(const nlohmann::json& body);
+    experiments::HttpResponse exportFiles(const nlohmann::json& body);
+    experiments::HttpResponse job(const experiments::HttpRequest& request) const;
+    experiments::HttpResponse open(const experiments::HttpRequest& request) const;
     nlohmann::json schema() const;
     experiments::HttpResponse render(const nlohmann::json& body);
     nlohmann::json compare(const nlohmann::json& request, const TuneFrame& frame);
@@ -54,6 +69,9 @@ private:
     nlohmann::json openStimulus(const std::string& id) const;
 
     TuneOptions options_;
+    std::filesystem::path assets_;                // --assets or $SKINLAB_ASSETS
+    std::string pageToken_;                       // random per start: the page sends it with every POST
+    std::vector<std::filesystem::path> readable_; // see readableFolders()
     int port_ = 0;
     std::unique_ptr<RenderQueue> queue_;
     std::unique_ptr<JobRunner> jobs_;

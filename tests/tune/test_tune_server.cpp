@@ -1,21 +1,28 @@
 // skinlab tune over real HTTP on loopback (an in-process TuneServer on an ephemeral port, the project's Beast
 // client), real EGL rendering, and the real `skinlab` executable for the CLI's errors and the export round trip.
 #include "common/error.h"
+#include "common/process.h"
 #include "experiments/http_client.h"
 #include "renderer/renderer.h"
+#include "renderer/scene/builtin_scenes.h"
 #include "renderer/sss/sss_params.h"
 #include "tests/common/cli_run.h"
 #include "tune/tune_server.h"
 
 #include <atomic>
+#include <csignal>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <gtest/gtest.h>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <pthread.h>
+#include <sstream>
+#include <sys/wait.h>
 #include <thread>
 #include <unistd.h>
 
@@ -89,6 +96,39 @@ bool identical(const cv::Mat& a, const cv::Mat& b) {
     return a.size() == b.size() && a.type() == b.type() && cv::norm(a, b, cv::NORM_INF) == 0.0;
 }
 
+std::string readAll(const std::filesystem::path& file) {
+    std::ifstream in(file);
+    return {std::istreambuf_iterator<char>(in), {}};
+}
+
+// The live (not zombie) processes whose parent is `parent`, from /proc.
+std::vector<pid_t> childProcesses(pid_t parent) {
+    std::vector<pid_t> out;
+    for (const auto& entry : std::filesystem::directory_iterator("/proc")) {
+        const std::string name = entry.path().filename().string();
+        if (name.find_first_not_of("0123456789") != std::string::npos) continue;
+        const std::string stat = readAll(entry.path() / "stat");
+        const std::size_t close = stat.rfind(')');
+        if (close == std::string::npos || close + 4 >= stat.size()) continue;
+        std::istringstream fields(stat.substr(close + 2));
+        char state = 0;
+        pid_t ppid = 0;
+        fields >> state >> ppid;
+        if (ppid == parent && state != 'Z') out.push_back(std::stoi(name));
+    }
+    return out;
+}
+
+// Waits up to `limit` until `parent` has no live child; whether it has none.
+bool childrenEnd(pid_t parent, std::chrono::milliseconds limit) {
+    const auto until = std::chrono::steady_clock::now() + limit;
+    while (!childProcesses(parent).empty()) {
+        if (std::chrono::steady_clock::now() > until) return false;
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return true;
+}
+
 class TuneServerTest : public ::testing::Test {
 protected:
     void SetUp() override {
@@ -118,13 +158,30 @@ protected:
         c.setTimeout(std::chrono::seconds(120));
         return c;
     }
-    HttpAnswer post(HttpClient& c, const std::string& path, const json& body) const {
-        experiments::HttpHeaders headers;
+    // This start's token, read from the page the server serves (as the page's script reads it).
+    std::string pageToken() {
+        if (pageToken_.empty()) {
+            HttpClient c = client();
+            const std::string page = c.get("/").body;
+            const std::string marker = "<meta name=\"skinlab-token\" content=\"";
+            const std::size_t at = page.find(marker);
+            EXPECT_NE(at, std::string::npos) << page.substr(0, 400);
+            if (at != std::string::npos)
+                pageToken_ = page.substr(at + marker.size(), page.find('"', at + marker.size()) - at - marker.size());
+        }
+        return pageToken_;
+    }
+    // The headers of the page's own POSTs.
+    experiments::HttpHeaders pageHeaders() {
+        experiments::HttpHeaders headers{{"X-Skinlab-Token", pageToken()}};
         if (!token_.empty()) headers.emplace_back("Authorization", "Bearer " + token_);
-        return c.send("POST", path, body.dump(), headers);
+        return headers;
+    }
+    HttpAnswer post(HttpClient& c, const std::string& path, const json& body) {
+        return c.send("POST", path, body.dump(), pageHeaders());
     }
     json render(HttpClient& c, const std::vector<std::string>& overrides, const std::string& clientId = "test",
-                const std::string& scene = "builtin:head") const {
+                const std::string& scene = "builtin:head") {
         const HttpAnswer answer =
             post(c, "/api/render", {{"client", clientId}, {"scene", scene}, {"overrides", overrides}});
         EXPECT_EQ(answer.status, 200) << answer.body;
@@ -133,6 +190,7 @@ protected:
 
     std::filesystem::path work_;
     std::string token_;
+    std::string pageToken_;
     std::unique_ptr<TuneServer> server_;
     std::thread thread_;
     int port_ = 0;
@@ -255,7 +313,7 @@ TEST_F(TuneServerTest, BadInputNeverCrashesTheServer) {
         {"/api/reference", R"({"scene": "builtin:nothing"})"},
     };
     for (const auto& [path, body] : requests) {
-        const HttpAnswer answer = c.send("POST", path, body);
+        const HttpAnswer answer = c.send("POST", path, body, pageHeaders());
         EXPECT_GE(answer.status, 400) << path << " " << body << ": " << answer.body;
         EXPECT_LT(answer.status, 500) << path << " " << body << ": " << answer.body;
         EXPECT_TRUE(json::parse(answer.body).contains("error"));
@@ -496,6 +554,350 @@ TEST_F(TuneServerStimulusTest, OpenLoadsAStimulusWithItsExactParameters) {
     EXPECT_EQ(missing.status, 400);
     EXPECT_NE(json::parse(missing.body)["error"].get<std::string>().find("no stimulus 'nothing'"), std::string::npos);
     EXPECT_EQ(c.get("/api/open?set=7&id=head-mid-separable").status, 404);
+}
+
+TEST_F(TuneServerTest, OtherSitesRequestsAreRefused) {
+    // What any web page can make a browser send to this server: no-cors fetches and forms (text/plain, another
+    // Origin, Sec-Fetch-Site cross-site or same-site), without the page's token. None writes or starts anything.
+    HttpClient c = client();
+    const std::string own = "http://127.0.0.1:" + std::to_string(port_);
+    std::string wrong = pageToken();
+    wrong[0] = wrong[0] == 'a' ? 'b' : 'a';
+    const json body = {{"scene", "builtin:head"}, {"overrides", kSmall}, {"name", "pwned"}};
+    struct Attempt {
+        const char* what;
+        experiments::HttpHeaders headers;
+        std::string contentType;
+        int status;
+    };
+    const std::vector<Attempt> attempts{
+        {"no-cors fetch from another port",
+         {{"Origin", "http://127.0.0.1:1"}, {"Sec-Fetch-Site", "cross-site"}},
+         "text/plain",
+         403},
+        {"another origin of the same site, with the token",
+         {{"Origin", "http://localhost:" + std::to_string(port_ + 1)},
+          {"Sec-Fetch-Site", "same-site"},
+          {"X-Skinlab-Token", pageToken()}},
+         "application/json",
+         403},
+        {"another origin, Origin only",
+         {{"Origin", "http://127.0.0.1:1"}, {"X-Skinlab-Token", pageToken()}},
+         "application/json",
+         403},
+        {"an opaque origin", {{"Origin", "null"}, {"X-Skinlab-Token", pageToken()}}, "application/json", 403},
+        {"cross-site, Sec-Fetch-Site only",
+         {{"Sec-Fetch-Site", "cross-site"}, {"X-Skinlab-Token", pageToken()}},
+         "application/json",
+         403},
+        {"text/plain with the token", {{"Origin", own}, {"X-Skinlab-Token", pageToken()}}, "text/plain", 415},
+        {"a form", {{"Origin", own}, {"X-Skinlab-Token", pageToken()}}, "application/x-www-form-urlencoded", 415},
+        {"no token", {{"Origin", own}, {"Sec-Fetch-Site", "same-origin"}}, "application/json", 403},
+        {"a wrong token", {{"Origin", own}, {"X-Skinlab-Token", wrong}}, "application/json", 403},
+    };
+    for (const Attempt& a : attempts) {
+        for (const std::string path : {"/api/export", "/api/reference", "/api/render", "/api/job/cancel"}) {
+            const HttpAnswer answer = c.send("POST", path, body.dump(), a.headers, a.contentType);
+            EXPECT_EQ(answer.status, a.status) << a.what << " " << path << ": " << answer.body;
+            EXPECT_TRUE(json::parse(answer.body).contains("error")) << answer.body;
+        }
+    }
+    EXPECT_FALSE(std::filesystem::exists(work_ / "exports" / "pwned.toml"));
+    EXPECT_TRUE(childProcesses(::getpid()).empty()) << "a render was started";
+    EXPECT_EQ(c.get("/api/job?id=job1").status, 404);
+    // Reading from another site is refused too; the page's own reads pass.
+    EXPECT_EQ(c.get("/api/schema", {{"Sec-Fetch-Site", "cross-site"}}).status, 403);
+    EXPECT_EQ(c.get("/api/schema", {{"Sec-Fetch-Site", "same-origin"}}).status, 200);
+    // The page's own request: its origin, JSON and its token.
+    const HttpAnswer mine = c.send(
+        "POST", "/api/export", body.dump(),
+        {{"Origin", own}, {"Sec-Fetch-Site", "same-origin"}, {"X-Skinlab-Token", pageToken()}}, "application/json");
+    EXPECT_EQ(mine.status, 200) << mine.body;
+    EXPECT_TRUE(std::filesystem::exists(work_ / "exports" / "pwned.toml"));
+    // Each start has its own token.
+    TuneOptions options;
+    options.workDir = work_ / "other";
+    options.executable = SKINLAB_CLI;
+    TuneServer second(options);
+    experiments::HttpRequest request;
+    request.method = "GET";
+    request.path = "/";
+    request.target = "/";
+    request.headers = {{"host", "127.0.0.1:" + std::to_string(second.bind())}};
+    const std::string page = second.handle(request).body;
+    const std::string marker = "<meta name=\"skinlab-token\" content=\"";
+    ASSERT_NE(page.find(marker), std::string::npos);
+    const std::string other = page.substr(page.find(marker) + marker.size(), 64);
+    EXPECT_EQ(other.find_first_not_of("0123456789abcdef"), std::string::npos) << other;
+    EXPECT_EQ(pageToken().size(), 64u);
+    EXPECT_NE(other, pageToken());
+}
+
+TEST_F(TuneServerTest, ExportReplacesAFileOnlyWhenAsked) {
+    HttpClient c = client();
+    const auto folder = work_ / "exports";
+    std::filesystem::create_directories(folder);
+    std::ofstream(folder / "notes.toml") << "# the researcher's own\n";
+    json body = {{"scene", "builtin:head"}, {"overrides", kSmall}, {"name", "notes"}};
+    const HttpAnswer refused = post(c, "/api/export", body);
+    EXPECT_EQ(refused.status, 409) << refused.body;
+    EXPECT_EQ(json::parse(refused.body)["exists"], json({(folder / "notes.toml").string()}));
+    EXPECT_EQ(readAll(folder / "notes.toml"), "# the researcher's own\n");
+    EXPECT_FALSE(std::filesystem::exists(folder / "notes.include.toml")); // nothing of the export was written
+
+    body["name"] = "tuned";
+    ASSERT_EQ(post(c, "/api/export", body).status, 200);
+    const std::string first = readAll(folder / "tuned.toml");
+    body["overrides"] = with(kSmall, {"sss.method=\"separable\"", "sss.width_mm=3"});
+    const HttpAnswer again = post(c, "/api/export", body);
+    EXPECT_EQ(again.status, 409);
+    EXPECT_EQ(json::parse(again.body)["exists"].size(), 2u);
+    EXPECT_EQ(readAll(folder / "tuned.toml"), first);
+    body["overwrite"] = "yes";
+    EXPECT_EQ(post(c, "/api/export", body).status, 400);
+    body["overwrite"] = true;
+    ASSERT_EQ(post(c, "/api/export", body).status, 200);
+    EXPECT_NE(readAll(folder / "tuned.toml").find("width_mm = 3"), std::string::npos);
+    std::vector<std::string> left;
+    for (const auto& entry : std::filesystem::directory_iterator(folder)) left.push_back(entry.path().filename());
+    std::sort(left.begin(), left.end());
+    EXPECT_EQ(left, (std::vector<std::string>{"notes.toml", "tuned.include.toml", "tuned.toml"})); // no temporaries
+}
+
+// As `skinlab tune` runs: SIGINT and SIGTERM blocked in every thread (one thread waits for them).
+class TuneServerBlockedSignalsTest : public TuneServerTest {
+protected:
+    void SetUp() override {
+        sigset_t blocked;
+        sigemptyset(&blocked);
+        sigaddset(&blocked, SIGINT);
+        sigaddset(&blocked, SIGTERM);
+        pthread_sigmask(SIG_BLOCK, &blocked, &saved_);
+        TuneServerTest::SetUp();
+    }
+    void TearDown() override {
+        TuneServerTest::TearDown();
+        pthread_sigmask(SIG_SETMASK, &saved_, nullptr);
+    }
+    sigset_t saved_;
+};
+
+TEST_F(TuneServerBlockedSignalsTest, OneReferenceAtATimeAndCancelEndsIt) {
+    HttpClient c = client();
+    std::vector<std::string> started, running;
+    for (int i = 0; i < 6; ++i) {
+        const HttpAnswer answer =
+            post(c, "/api/reference",
+                 {{"scene", "builtin:head"},
+                  {"overrides", {"render.width=" + std::to_string(640 + 16 * i), "render.height=360"}}});
+        const json body = json::parse(answer.body);
+        if (answer.status == 200) started.push_back(body["job"]["id"]);
+        else {
+            EXPECT_EQ(answer.status, 409) << answer.body;
+            running.push_back(body.value("running", ""));
+        }
+    }
+    ASSERT_EQ(started.size(), 1u);
+    EXPECT_EQ(running, std::vector<std::string>(5, started[0]));
+    EXPECT_EQ(childProcesses(::getpid()).size(), 1u);
+
+    std::this_thread::sleep_for(std::chrono::milliseconds(300)); // the render is under way
+    const HttpAnswer cancelled = post(c, "/api/job/cancel", {{"id", started[0]}});
+    EXPECT_EQ(json::parse(cancelled.body)["cancelled"], true);
+    EXPECT_TRUE(childrenEnd(::getpid(), std::chrono::milliseconds(3000))) << "the render outlived its cancel";
+    const json status = json::parse(c.get("/api/job?id=" + started[0]).body);
+    EXPECT_EQ(status["state"], "cancelled");
+    EXPECT_GE(status["elapsed_s"].get<double>(), 0.0);
+    EXPECT_LT(status["elapsed_s"].get<double>(), 5.0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    EXPECT_EQ(json::parse(c.get("/api/job?id=" + started[0]).body)["elapsed_s"], status["elapsed_s"]); // stopped
+
+    // The next one starts; the server's end ends it.
+    const HttpAnswer next = post(c, "/api/reference", {{"scene", "builtin:head"}, {"overrides", {"render.width=320"}}});
+    EXPECT_EQ(next.status, 200) << next.body;
+    EXPECT_EQ(childProcesses(::getpid()).size(), 1u);
+    const auto stopping = std::chrono::steady_clock::now();
+    server_->stop();
+    thread_.join();
+    server_.reset();
+    EXPECT_LT(std::chrono::steady_clock::now() - stopping, std::chrono::seconds(3));
+    EXPECT_TRUE(childProcesses(::getpid()).empty());
+}
+
+TEST(TuneCli, SigtermStopsPromptlyAndEndsRenders) {
+    REQUIRE_EGL();
+    const auto work = temporaryFolder("sigterm");
+    SpawnOptions options;
+    options.output = work / "out.txt";
+    const pid_t tune =
+        spawnProcess(SKINLAB_CLI, {"tune", "--port", "0", "--export-dir", (work / "exports").string()}, options);
+    const std::string prefix = "tuning on http://127.0.0.1:";
+    int port = 0;
+    for (int i = 0; i < 600 && port == 0; ++i) {
+        const std::string out = readAll(options.output);
+        if (const std::size_t at = out.find(prefix); at != std::string::npos && out.find('\n', at) != std::string::npos)
+            port = std::stoi(out.substr(at + prefix.size()));
+        else std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    ASSERT_NE(port, 0) << readAll(options.output);
+    HttpClient c("127.0.0.1", port);
+    const std::string page = c.get("/").body;
+    const std::string marker = "<meta name=\"skinlab-token\" content=\"";
+    const std::size_t at = page.find(marker);
+    EXPECT_NE(at, std::string::npos);
+    const std::string token = page.substr(at + marker.size(), 64);
+    const HttpAnswer started =
+        c.send("POST", "/api/reference", json{{"scene", "builtin:head"}, {"overrides", {"render.width=640"}}}.dump(),
+               {{"X-Skinlab-Token", at == std::string::npos ? "" : token}});
+    EXPECT_EQ(started.status, 200) << started.body;
+    std::vector<pid_t> renders;
+    for (int i = 0; i < 200 && renders.empty(); ++i) {
+        renders = childProcesses(tune);
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    EXPECT_EQ(renders.size(), 1u);
+    std::this_thread::sleep_for(std::chrono::milliseconds(300)); // the render is under way
+
+    const auto sent = std::chrono::steady_clock::now();
+    ASSERT_EQ(::kill(tune, SIGTERM), 0);
+    int status = 0;
+    while (::waitpid(tune, &status, WNOHANG) == 0 && std::chrono::steady_clock::now() - sent < std::chrono::seconds(20))
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    const auto took = std::chrono::steady_clock::now() - sent;
+    if (took >= std::chrono::seconds(20)) { // never: end what is left
+        ::kill(tune, SIGKILL);
+        for (pid_t r : renders) ::kill(-r, SIGKILL);
+        waitProcess(tune);
+    }
+    EXPECT_LT(took, std::chrono::seconds(3)) << readAll(options.output);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;
+    for (pid_t r : renders) EXPECT_NE(::kill(r, 0), 0) << "render " << r << " outlived skinlab tune";
+    EXPECT_NE(readAll(options.output).find("stopped"), std::string::npos);
+    std::filesystem::remove_all(work);
+}
+
+// A scene file, an assets folder and a stimulus set: the folders the page may name files in.
+class TuneServerFoldersTest : public TuneServerTest {
+protected:
+    void configure(TuneOptions& options) override {
+        std::filesystem::create_directories(work_ / "scenes");
+        std::filesystem::create_directories(work_ / "assets");
+        std::filesystem::create_directories(work_ / "set");
+        std::ofstream(work_ / "scenes" / "lab.toml") << *renderer::builtinSceneText("halo");
+        for (const auto& file : {work_ / "scenes" / "k.bn", work_ / "assets" / "k.bn", work_ / "set" / "k.bn"})
+            std::ofstream(file) << "not a kernel\n";
+        std::ofstream(work_ / "set" / "manifest.json")
+            << json{{"format", "skinlab-stimuli"}, {"version", 1}, {"set", "s"}, {"stimuli", json::array()}}.dump();
+        options.scenes.push_back((work_ / "scenes" / "lab.toml").string());
+        options.assetsDir = work_ / "assets";
+        options.stimulusSets = {work_ / "set"};
+    }
+};
+
+TEST_F(TuneServerFoldersTest, PathKeysStayInsideTheOfferedFolders) {
+    HttpClient c = client();
+    const std::string lab = (work_ / "scenes" / "lab.toml").string();
+    const std::vector<std::string> separable = with(kSmall, {"sss.method=\"separable\""});
+    struct Case {
+        std::string path, scene;
+        std::vector<std::string> overrides;
+        std::string key;
+    };
+    const std::vector<Case> outside{
+        {"/api/render", "builtin:head", with(separable, {"sss.profile=\"file:/etc/passwd\""}), "sss.profile"},
+        {"/api/kernel", "builtin:head", with(separable, {"sss.profile=\"file:/etc/passwd\""}), "sss.profile"},
+        {"/api/render", "builtin:head", with(kSmall, {"textures.albedo=\"/etc/passwd\""}), "textures.albedo"},
+        {"/api/render", "builtin:head", with(kSmall, {"textures={normal=\"/etc/passwd\"}"}), "textures.normal"},
+        {"/api/render", "builtin:head", with(kSmall, {"model.source=\"/etc/passwd\""}), "model.source"},
+        {"/api/render", "builtin:head", with(kSmall, {"environment.file=\"/etc/passwd\""}), "environment.file"},
+        {"/api/render", "builtin:head", with(kSmall, {"textures.albedo=\"assets:../../../../../../../etc/passwd\""}),
+         "textures.albedo"},
+        {"/api/render", lab, with(kSmall, {"model.source=\"../../../../../../../../etc/passwd\""}), "model.source"},
+        {"/api/render", lab, with(kSmall, {"textures.skin_mask=\"../set/../../../../../../../etc/passwd\""}),
+         "textures.skin_mask"},
+        {"/api/export", "builtin:head", with(kSmall, {"textures.albedo=\"/etc/passwd\""}), "textures.albedo"},
+        {"/api/reference", "builtin:head", with(kSmall, {"model.source=\"/etc/passwd\""}), "model.source"},
+        {"/api/render", "builtin:head", with(kSmall, {"sss.method=\"pathtraced\"", "pathtraced.blender=\"/bin/sh\""}),
+         "pathtraced.blender"},
+        {"/api/render", "builtin:head", with(kSmall, {"sss.method=\"eevee\"", "eevee.blender=\"sh\""}),
+         "eevee.blender"},
+    };
+    for (const Case& k : outside) {
+        const HttpAnswer answer =
+            post(c, k.path, {{"scene", k.scene}, {"overrides", k.overrides}, {"name", "leak"}, {"client", "x"}});
+        EXPECT_EQ(answer.status, 403) << k.path << " " << k.overrides.back() << ": " << answer.body;
+        const std::string error = json::parse(answer.body).value("error", "");
+        EXPECT_EQ(error.rfind(k.key + ": ", 0), 0u) << error;
+        EXPECT_EQ(error.find('\n'), std::string::npos) << error;
+    }
+    EXPECT_FALSE(std::filesystem::exists(work_ / "exports" / "leak.toml"));
+    EXPECT_TRUE(childProcesses(::getpid()).empty());
+    // Inside the scene's folder, the assets folder or a set: read (here: not a kernel, the reader's own error).
+    for (const auto& file : {work_ / "scenes" / "k.bn", work_ / "assets" / "k.bn", work_ / "set" / "k.bn"}) {
+        const HttpAnswer answer =
+            post(c, "/api/render",
+                 {{"scene", "builtin:head"},
+                  {"overrides", with(separable, {"sss.profile=\"file:" + file.string() + "\""})}});
+        EXPECT_EQ(answer.status, 400) << answer.body;
+        EXPECT_EQ(json::parse(answer.body)["error"].get<std::string>().find("outside"), std::string::npos)
+            << answer.body;
+    }
+    // The scene's own values and its folder's files render.
+    EXPECT_EQ(render(c, kSmall, "x", lab)["width"], 160);
+}
+
+// A set as `stimuli build` writes it: the spec's file name, each stimulus's scene as the spec wrote it (relative to
+// the spec's folder) and the scene it rendered (resolved.scene, absolute). Given to the server by a relative path.
+class TuneServerBuiltSetTest : public TuneServerTest {
+protected:
+    void configure(TuneOptions& options) override {
+        const auto set = work_ / "out" / "demo";
+        std::filesystem::create_directories(set);
+        std::filesystem::create_directories(work_ / "scenes");
+        std::filesystem::create_directories(work_ / "specs");
+        std::ofstream(work_ / "scenes" / "lab.toml") << *renderer::builtinSceneText("halo");
+        std::ofstream(set / "beside.toml") << *renderer::builtinSceneText("halo");
+        std::ofstream(work_ / "scenes" / "k.bn") << "not a kernel\n";
+        const std::vector<std::string> small{"render.width=96", "render.height=64", "shadow.resolution=256"};
+        const json stimuli = {{{"id", "lab-separable"},
+                               {"scene", "../scenes/lab.toml"},
+                               {"overrides", with(small, {"sss.method=\"separable\""})},
+                               {"resolved", {{"scene", (work_ / "specs" / ".." / "scenes" / "lab.toml").string()}}}},
+                              {{"id", "beside-separable"},
+                               {"scene", "beside.toml"},
+                               {"overrides", with(small, {"sss.method=\"separable\""})},
+                               {"resolved", {{"scene", (work_ / "elsewhere" / "beside.toml").string()}}}}};
+        std::ofstream(set / "manifest.json") << json{
+            {"format", "skinlab-stimuli"},
+            {"version", 1},
+            {"set", "demo"},
+            {"spec", "demo.toml"},
+            {"stimuli", stimuli}}.dump(1);
+        options.stimulusSets = {std::filesystem::relative(set)};
+    }
+};
+
+TEST_F(TuneServerBuiltSetTest, OpenFindsTheScenesTheBuildRendered) {
+    HttpClient c = client();
+    const HttpAnswer lab = c.get("/api/open?set=0&id=lab-separable");
+    ASSERT_EQ(lab.status, 200) << lab.body;
+    EXPECT_EQ(json::parse(lab.body)["scene"], (work_ / "scenes" / "lab.toml").string());
+    const HttpAnswer beside = c.get("/api/open?set=0&id=beside-separable");
+    ASSERT_EQ(beside.status, 200) << beside.body;
+    EXPECT_EQ(json::parse(beside.body)["scene"], (work_ / "out" / "demo" / "beside.toml").string());
+    // Opened scenes render, and their folders are readable.
+    for (const HttpAnswer& opened : {lab, beside}) {
+        const json config = json::parse(opened.body);
+        const json frame = render(c, config["overrides"].get<std::vector<std::string>>(), "x", config["scene"]);
+        EXPECT_EQ(frame["width"], 96) << frame.dump().substr(0, 300);
+    }
+    const HttpAnswer kernel =
+        post(c, "/api/kernel",
+             {{"scene", json::parse(lab.body)["scene"]},
+              {"overrides",
+               {"sss.method=\"separable\"", "sss.profile=\"file:" + (work_ / "scenes" / "k.bn").string() + "\""}}});
+    EXPECT_EQ(kernel.status, 400) << kernel.body;
+    EXPECT_EQ(kernel.body.find("outside"), std::string::npos) << kernel.body;
 }
 
 TEST(TuneServerOptions, BeyondLoopbackOnlyWithAToken) {

@@ -4,6 +4,9 @@
 'use strict';
 
 const token = new URLSearchParams(location.hash.slice(1)).get('token') || '';
+// This start's token (the server writes it into the page): sent with every request, as the server requires for
+// POSTs; another site's page cannot read it.
+const pageToken = document.querySelector('meta[name="skinlab-token"]').content;
 const client = 'tab-' + Math.random().toString(36).slice(2, 10);
 const $ = (id) => document.getElementById(id);
 
@@ -23,18 +26,24 @@ let lastImage = '';
 let refreshers = []; // {key, element, apply(value)}: controls shown with the last resolved values
 
 function headers(extra) {
-  const h = Object.assign({}, extra || {});
+  const h = Object.assign({ 'X-Skinlab-Token': pageToken }, extra || {});
   if (token) h['Authorization'] = 'Bearer ' + token;
   return h;
 }
 
+// A JSON request; a refusal throws an Error with the server's line, its status and its answer.
 async function api(path, body) {
   const options = body === undefined ? { headers: headers() }
     : { method: 'POST', headers: headers({ 'Content-Type': 'application/json' }), body: JSON.stringify(body) };
   const response = await fetch(path, options);
   let data = null;
   try { data = await response.json(); } catch (e) { data = { error: 'answer is not JSON (' + response.status + ')' }; }
-  if (!response.ok) throw new Error(data && data.error ? data.error : 'HTTP ' + response.status);
+  if (!response.ok) {
+    const error = new Error(data && data.error ? data.error : 'HTTP ' + response.status);
+    error.status = response.status;
+    error.data = data;
+    throw error;
+  }
   return data;
 }
 
@@ -501,8 +510,17 @@ async function start() {
     try { await api('/api/job/cancel', { id: $('cancel').dataset.job }); } catch (e) { showError(e.message); }
   });
   $('export').addEventListener('click', async () => {
+    const request = Object.assign({ name: $('export-name').value }, config());
     try {
-      const answer = await api('/api/export', Object.assign({ name: $('export-name').value }, config()));
+      let answer;
+      try {
+        answer = await api('/api/export', request);
+      } catch (e) {
+        // Files of that name exist: replaced only when the user says so.
+        if (e.status !== 409 || !e.data || !e.data.exists) throw e;
+        if (!confirm('Replace ' + e.data.exists.join(' and ') + '?')) { showError(e.message); return; }
+        answer = await api('/api/export', Object.assign({ overwrite: true }, request));
+      }
       $('export-result').textContent = `${answer.scene_file}\n${answer.include_file}\n\n${answer.command}\n\n${answer.include_text}`;
       $('export-result').hidden = false;
       showError('');
