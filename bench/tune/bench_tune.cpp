@@ -58,6 +58,15 @@ int main(int argc, char** argv) {
         std::thread serving([&] { server.run(); });
         skinlab::experiments::HttpClient client("127.0.0.1", port);
         client.setTimeout(std::chrono::seconds(300));
+        // This start's token, from the page (as the page's script sends it with every POST).
+        const std::string page = client.get("/").body;
+        const std::string marker = "<meta name=\"skinlab-token\" content=\"";
+        const std::size_t at = page.find(marker);
+        if (at == std::string::npos) {
+            std::fprintf(stderr, "bench_tune: the page holds no token\n");
+            std::exit(1);
+        }
+        const skinlab::experiments::HttpHeaders token{{"X-Skinlab-Token", page.substr(at + marker.size(), 64)}};
         const std::string size = "render.width=" + std::to_string(width);
         const std::string sizeH = "render.height=" + std::to_string(height);
         std::printf("scene %s at %dx%d, %d changes per kind; milliseconds from request to image (HTTP round trip)\n",
@@ -72,7 +81,7 @@ int main(int argc, char** argv) {
                      {size, sizeH, "sss.method=\"" + method + "\"", "sss.width_mm=" + std::to_string(widthMm),
                       "lights[0].intensity=" + std::to_string(intensity), "camera.yaw_deg=" + std::to_string(yaw)}}};
                 const auto start = std::chrono::steady_clock::now();
-                const auto answer = client.post("/api/render", body.dump());
+                const auto answer = client.send("POST", "/api/render", body.dump(), token);
                 const double ms =
                     std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
                 if (answer.status != 200) {
