@@ -72,7 +72,7 @@ const created = spawnSync(cli, ['study', 'create', '--stimuli', path.join(work, 
 if (created.status !== 0) { console.error(created.stderr); process.exit(1); }
 const TRIALS = 5; // 1 practice + 3 pairs + 1 catch
 
-const server = spawn(cli, ['study', 'serve', database, '--port', '0', '--token', 'browser-token'],
+const server = spawn(cli, ['study', 'serve', database, '--port', '0', '--token', 'browser-researcher-token-0123'],
   { stdio: ['ignore', 'pipe', 'inherit'] });
 const port = await new Promise((resolve, reject) => {
   const timer = setTimeout(() => reject(new Error('server did not start')), 20000);
