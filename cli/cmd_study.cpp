@@ -109,10 +109,7 @@ std::pair<std::string, bool> researcherToken(const StudyOptions& o) {
         if (!o.tokenFile.empty()) throw InputError(o.tokenFile + ": the researcher token file is empty");
         return {"", false};
     }
-    if (token.size() > 256) throw InputError(source + ": the researcher token is longer than 256 characters");
-    for (char c : token)
-        if (c <= ' ' || c > '~')
-            throw InputError(source + ": the researcher token must be printable ASCII without blanks");
+    ex::checkResearcherToken(token, source); // >= 128 bits (docs/deployment.md)
     return {token, true};
 }
 
@@ -175,7 +172,7 @@ ex::SimulationTruth truthOf(ex::StudyStore& store, const StudyOptions& o, bool p
 }
 
 void runPlan(const StudyOptions& o) {
-    ex::StudyStore store(o.study);
+    ex::StudyStore store(o.study, ex::StudyAccess::readOnly); // also on a read-only mount
     const ex::SimulationTruth truth = truthOf(store, o, true);
     ex::PlanOptions options;
     options.simulations = o.planSimulations;
@@ -186,7 +183,7 @@ void runPlan(const StudyOptions& o) {
 }
 
 void runSimulate(const StudyOptions& o) {
-    ex::StudyStore store(o.study);
+    ex::StudyStore store(o.study, ex::StudyAccess::readOnly); // also on a read-only mount
     ex::SimulationOptions options;
     std::smatch m;
     static const std::regex urlPattern(R"(http://([A-Za-z0-9.\-]+|\[[0-9a-fA-F:]+\]):(\d{1,5})/?)");
@@ -225,7 +222,7 @@ void runSimulate(const StudyOptions& o) {
 }
 
 void runStatus(const StudyOptions& o) {
-    ex::StudyStore store(o.study);
+    ex::StudyStore store(o.study, ex::StudyAccess::readOnly); // also on a read-only mount
     if (o.format == "json") std::printf("%s\n", ex::statusJson(store).dump(2).c_str());
     else std::printf("%s", ex::statusText(store).c_str());
 }
@@ -243,7 +240,7 @@ void runDeployConfig(const StudyOptions& o) {
 }
 
 void runExport(const StudyOptions& o) {
-    ex::StudyStore store(o.study);
+    ex::StudyStore store(o.study, ex::StudyAccess::readOnly); // also on a read-only mount
     const std::string text = ex::exportResponses(store, o.format);
     if (o.output.empty() || o.output == "-") std::fwrite(text.data(), 1, text.size(), stdout);
     else writeFileAtomic(o.output, text);

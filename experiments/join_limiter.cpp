@@ -30,6 +30,18 @@ std::size_t JoinLimiter::size() const {
     return buckets_.size();
 }
 
+bool JoinLimiter::available(const std::string& address, double& retryAfterSeconds, Clock::time_point now) const {
+    const std::string key = clientNetwork(address, prefixBits_);
+    std::lock_guard lock(mutex_);
+    const auto it = buckets_.find(key);
+    if (it == buckets_.end()) return burst_ >= 1;
+    const double elapsed = std::max(0.0, std::chrono::duration<double>(now - it->second.updated).count());
+    const double tokens = std::min(burst_, it->second.tokens + perSecond_ * elapsed);
+    if (tokens >= 1) return true;
+    retryAfterSeconds = perSecond_ > 0 ? (1 - tokens) / perSecond_ : 60;
+    return false;
+}
+
 bool JoinLimiter::allow(const std::string& address, double& retryAfterSeconds, Clock::time_point now) {
     const std::string key = clientNetwork(address, prefixBits_);
     std::lock_guard lock(mutex_);

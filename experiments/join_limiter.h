@@ -1,5 +1,5 @@
 #pragma once
-// The study server's limit on joins per client: a token bucket per client network (an IPv4 address, an IPv6 /64 by
+// The study server's limit on joins per client (also used for wrong researcher tokens per client): a token bucket per client network (an IPv4 address, an IPv6 /64 by
 // default — one subscriber usually holds a whole /64, so per address it would not limit anyone), in a table of
 // bounded size. When the table is full, the bucket closest to refilled is evicted (a full bucket carries no
 // information), never the whole table: an address-spraying flood cannot reset the bucket of a client it wants to
@@ -24,6 +24,8 @@ public:
 
     // Takes one join from the client's bucket: true when allowed; otherwise false and the seconds until one is.
     bool allow(const std::string& address, double& retryAfterSeconds, Clock::time_point now = Clock::now());
+    // Whether allow() would allow one now, taking nothing: otherwise false and the seconds until it would.
+    bool available(const std::string& address, double& retryAfterSeconds, Clock::time_point now = Clock::now()) const;
     std::size_t size() const;
 
 private:

@@ -7,11 +7,15 @@ namespace skinlab::experiments {
 
 class RequestError : public InputError {
 public:
-    RequestError(int status, const std::string& message) : InputError(message), status_(status) {}
+    // `retryAfterSeconds` (> 0): a 429's Retry-After.
+    RequestError(int status, const std::string& message, int retryAfterSeconds = 0)
+        : InputError(message), status_(status), retryAfter_(retryAfterSeconds) {}
     int status() const { return status_; }
+    int retryAfter() const { return retryAfter_; }
 
 private:
     int status_;
+    int retryAfter_;
 };
 
 } // namespace skinlab::experiments

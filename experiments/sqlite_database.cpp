@@ -1,6 +1,7 @@
 #include "experiments/sqlite_database.h"
 
 #include "common/error.h"
+#include "common/sqlite_read.h"
 
 #include <cerrno>
 #include <cstring>
@@ -30,7 +31,13 @@ SqliteDatabase::SqliteDatabase(const std::string& path, bool create) : path_(pat
     sqlite3_busy_timeout(db_, 10000);
 }
 
+std::unique_ptr<SqliteDatabase> SqliteDatabase::openReadOnly(const std::string& path) {
+    return std::unique_ptr<SqliteDatabase>(new SqliteDatabase(path, openSqliteReadOnly(path).handle));
+}
+
 SqliteDatabase::~SqliteDatabase() { sqlite3_close(db_); }
+
+bool SqliteDatabase::writable() const { return sqlite3_db_readonly(db_, "main") == 0; }
 
 void SqliteDatabase::fail(std::string_view what) const {
     throw RuntimeError(path_ + ": SQLite: " + std::string(what) + ": " + sqlite3_errmsg(db_));

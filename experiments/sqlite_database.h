@@ -2,9 +2,11 @@
 // A thin RAII layer over the SQLite C API: a connection and prepared statements. Every SQLite failure becomes a
 // RuntimeError carrying the database file and sqlite3_errmsg.
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 
 struct sqlite3;
 struct sqlite3_stmt;
@@ -17,6 +19,9 @@ class SqliteDatabase {
 public:
     // Opens (creating when `create`) the database file; a file it creates has mode 0600.
     SqliteDatabase(const std::string& path, bool create);
+    // Opens an existing database for reading only, also on a read-only mount or in a folder this process may not
+    // write (common/sqlite_read.h); InputError naming the file when it cannot be read.
+    static std::unique_ptr<SqliteDatabase> openReadOnly(const std::string& path);
     ~SqliteDatabase();
     SqliteDatabase(const SqliteDatabase&) = delete;
     SqliteDatabase& operator=(const SqliteDatabase&) = delete;
@@ -27,8 +32,11 @@ public:
     const std::string& path() const { return path_; }
     [[noreturn]] void fail(std::string_view what) const;
     sqlite3* handle() const { return db_; }
+    // Whether SQLite can write through this connection (a file opened read-write may still be read-only to it).
+    bool writable() const;
 
 private:
+    SqliteDatabase(std::string path, sqlite3* handle) : db_(handle), path_(std::move(path)) {}
     sqlite3* db_ = nullptr;
     std::string path_;
 };

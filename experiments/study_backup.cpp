@@ -16,7 +16,9 @@ BackupSummary backupStudy(const fs::path& study, const fs::path& output, bool ov
         if (fs::equivalent(study, output, ec)) throw InputError(output.string() + ": is the study file itself");
         if (!overwrite) throw InputError(output.string() + ": already exists; choose another name or pass --overwrite");
     }
-    SqliteDatabase source(study.string(), false);
+    // Read only: a study on a read-only mount is backed up too (common/sqlite_read.h).
+    const std::unique_ptr<SqliteDatabase> opened = SqliteDatabase::openReadOnly(study.string());
+    SqliteDatabase& source = *opened;
     {
         SqliteStatement s = source.prepare("SELECT value FROM meta WHERE key = 'format'");
         if (!s.step() || s.text(0) != "skinlab-study") throw InputError(study.string() + ": not a skinlab study file");

@@ -49,6 +49,7 @@ json StudyDashboard::snapshot() {
     out["scale"] = scale(out["totals"]["responses"].get<std::int64_t>());
     out["viewing_conditions"] = viewingConditions();
     out["flagged_trials"] = flaggedTrials();
+    out["refused_platform_ids"] = refusedPlatformIds();
     return out;
 }
 
@@ -97,6 +98,28 @@ json StudyDashboard::flaggedTrials() {
             {"note", recorded ? "" : "not recorded"},
             {"count", count},
             {"trials", std::move(trials)}};
+}
+
+json StudyDashboard::refusedPlatformIds() {
+    // A platform id joined with again without the participant's join key or platform session id: the participant in
+    // another browser or from another link, or someone else who knows the id — possibly the one who joined first
+    // with another person's id (squatting). Remedy: docs/deployment.md ("Refused platform ids").
+    std::lock_guard lock(readMutex_);
+    SqliteStatement s = db_->prepare(
+        "SELECT p.label, rec.platform, rec.external_id, COUNT(*), COUNT(DISTINCT v.client_address), MIN(v.recorded_at),"
+        " MAX(v.recorded_at) FROM participant_visits v JOIN participants p ON p.id = v.participant_id"
+        " JOIN recruitment rec ON rec.participant_id = p.id WHERE v.outcome = 'refused' GROUP BY p.id ORDER BY p.id");
+    json rows = json::array();
+    while (s.step())
+        rows.push_back({{"observer", s.text(0)},
+                        {"platform", s.text(1)},
+                        {"external_id", s.text(2)},
+                        {"attempts", s.integer(3)},
+                        {"attempts_capped", s.integer(3) >= kMaxVisitsPerParticipant},
+                        {"addresses", s.integer(4)},
+                        {"first_attempt_at", s.text(5)},
+                        {"last_attempt_at", s.text(6)}});
+    return rows;
 }
 
 json StudyDashboard::counts() {

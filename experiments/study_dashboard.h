@@ -32,9 +32,10 @@ public:
     nlohmann::json snapshot();
 
 private:
-    nlohmann::json counts();            // participants, progress, catch trials, response times (fresh)
-    nlohmann::json viewingConditions(); // per session: screen, zoom, full screen, pixels per degree (fresh)
-    nlohmann::json flaggedTrials();     // trials shown while the page was hidden or unfocused (fresh)
+    nlohmann::json counts();             // participants, progress, catch trials, response times (fresh)
+    nlohmann::json viewingConditions();  // per session: screen, zoom, full screen, pixels per degree (fresh)
+    nlohmann::json flaggedTrials();      // trials shown while the page was hidden or unfocused (fresh)
+    nlohmann::json refusedPlatformIds(); // participants whose platform id others tried to join with (fresh)
     nlohmann::json scale(std::int64_t responseCount); // cached (see above)
     nlohmann::json computeScale() const;
 

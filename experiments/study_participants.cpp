@@ -29,11 +29,10 @@ void ParticipantRegistry::insertVisit(std::int64_t participantId, const char* ou
     s.run();
 }
 
-int ParticipantRegistry::visitCount(std::int64_t participantId) {
+int ParticipantRegistry::visitCount(std::int64_t participantId, const char* outcome) {
     SqliteStatement s =
-        connection_.db->prepare("SELECT COUNT(*) FROM participant_visits WHERE participant_id = ? AND outcome IN"
-                                " ('resumed', 'refused')");
-    s.bind(1, participantId);
+        connection_.db->prepare("SELECT COUNT(*) FROM participant_visits WHERE participant_id = ? AND outcome = ?");
+    s.bind(1, participantId).bind(2, outcome);
     s.step();
     return static_cast<int>(s.integer(0));
 }
@@ -44,10 +43,11 @@ ParticipantRecord ParticipantRegistry::join(const std::string& requestedLabel, c
     std::lock_guard lock(connection_.mutex);
     SqliteDatabase& db = *connection_.db;
     SqliteTransaction tx(db);
-    // A returning participant: recorded (address, time) with every resume; bounded per participant.
+    // A returning participant: recorded (address, time) with every resume; bounded per participant, counting its own
+    // resumes only (refused attempts by others never use them up).
     auto resume = [&](ParticipantRecord existing) {
         if (origin) {
-            if (visitCount(existing.id) >= kMaxVisitsPerParticipant)
+            if (visitCount(existing.id, "resumed") >= kMaxVisitsPerParticipant)
                 throw LimitReached("this participant has resumed too often; contact the researcher");
             insertVisit(existing.id, "resumed", *origin);
             tx.commit();
@@ -71,7 +71,7 @@ ParticipantRecord ParticipantRegistry::join(const std::string& requestedLabel, c
             const bool sameBrowser = !joinKey.empty() && joinKey == storedKey;
             const bool sameAttempt = !external->session.empty() && external->session == storedSession;
             if (sameBrowser || sameAttempt) return resume(existing);
-            if (origin && visitCount(existing.id) < kMaxVisitsPerParticipant) {
+            if (origin && visitCount(existing.id, "refused") < kMaxVisitsPerParticipant) {
                 insertVisit(existing.id, "refused", *origin);
                 tx.commit();
             }

@@ -37,7 +37,8 @@ private:
                                         const std::optional<ExternalIds>& external,
                                         const std::optional<ClientOrigin>& origin);
     void insertVisit(std::int64_t participantId, const char* outcome, const ClientOrigin& origin);
-    int visitCount(std::int64_t participantId);
+    // The participant's visits with this outcome ("resumed", "refused").
+    int visitCount(std::int64_t participantId, const char* outcome);
 
     StudyConnection& connection_;
 };

@@ -30,10 +30,16 @@ struct ClientOrigin {
     std::string source = "peer";
 };
 
+// How a study file is opened: to serve it (readWrite; refused at start when it cannot be written), or only to read it
+// (readOnly: `study status`, `export`, `backup`, `plan`, `simulate`; also on a read-only mount, common/sqlite_read.h).
+enum class StudyAccess { readWrite, readOnly };
+
 // At most this many sessions per participant (each page load starts one); more are refused (LimitReached).
 inline constexpr int kDefaultSessionsPerParticipant = 32;
-// At most this many resumes and refused attempts (joins) are recorded per participant; beyond, a resume is refused
-// (LimitReached) and a refused attempt is refused without a row. (Session rows are bounded by the sessions' limit.)
+// At most this many resumes per participant (beyond: LimitReached), and apart from them at most this many refused
+// attempts (joins with its platform id, without its secret) recorded per participant (beyond: refused without a
+// row). Refused attempts never count against the participant's resumes: others cannot use them up. (Session rows
+// are bounded by the sessions' limit.)
 inline constexpr int kMaxVisitsPerParticipant = 100;
 
 // What the page saw while one trial was shown (sent with the response).

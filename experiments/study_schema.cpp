@@ -6,6 +6,8 @@
 #include "common/version.h"
 #include "experiments/sqlite_database.h"
 
+#include <cerrno>
+#include <cstring>
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -126,21 +128,58 @@ CREATE VIEW responses_long AS
   ORDER BY p.id, t.position;
 )SQL";
 
+// Added after format version 1 first shipped: the address each participant joined from, and every later visit of a
+// participant: a join that resumed it (with its secret) or was refused (a platform id without it), each bounded by
+// kMaxVisitsPerParticipant; and every session (page load), bounded by the sessions' limit.
+constexpr const char* kVisitsSchema = R"SQL(
+CREATE TABLE IF NOT EXISTS participant_addresses (
+  participant_id INTEGER PRIMARY KEY REFERENCES participants(id),
+  client_address TEXT NOT NULL,
+  source TEXT NOT NULL CHECK (source IN ('peer','forwarded')),
+  recorded_at TEXT NOT NULL);
+CREATE TABLE IF NOT EXISTS participant_visits (
+  id INTEGER PRIMARY KEY,
+  participant_id INTEGER NOT NULL REFERENCES participants(id),
+  outcome TEXT NOT NULL CHECK (outcome IN ('resumed','refused','session')),
+  client_address TEXT NOT NULL,
+  source TEXT NOT NULL CHECK (source IN ('peer','forwarded')),
+  recorded_at TEXT NOT NULL);
+)SQL";
+
+// Whether the file holds every table and view this version reads and writes.
+bool schemaCurrent(SqliteDatabase& db) {
+    SqliteStatement s = db.prepare(
+        "SELECT (SELECT COUNT(*) FROM sqlite_master WHERE name IN ('trial_conditions', 'participant_addresses',"
+        " 'participant_visits')), (SELECT COUNT(*) FROM pragma_table_info('responses_long') WHERE name = 'flagged')");
+    s.step();
+    return s.integer(0) == 3 && s.integer(1) == 1;
+}
+
 // Brings a study file's schema up to date (idempotent; writes only when something is missing).
 void upgradeSchema(SqliteDatabase& db) {
-    bool current = false;
-    {
-        SqliteStatement s =
-            db.prepare("SELECT (SELECT COUNT(*) FROM sqlite_master WHERE name = 'trial_conditions'),"
-                       " (SELECT COUNT(*) FROM pragma_table_info('responses_long') WHERE name = 'flagged')");
-        s.step();
-        current = s.integer(0) == 1 && s.integer(1) == 1;
-    }
-    if (current) return;
+    if (schemaCurrent(db)) return;
     SqliteTransaction tx(db);
     db.execute(kOnlineSchema);
     db.execute(kResponsesView);
+    db.execute(kVisitsSchema);
     tx.commit();
+}
+
+bool writable(const fs::path& path) { return ::access(path.c_str(), W_OK) == 0; }
+
+// The server writes every join and answer: a file or folder it cannot write is refused before it starts (not with
+// a 500 for every participant). The folder holds SQLite's -wal and -shm files.
+void requireWritable(const fs::path& path) {
+    const fs::path folder = fs::absolute(path).parent_path();
+    if (!writable(path))
+        throw InputError(path.string() + ": the study file is not writable here (" + std::strerror(errno) +
+                         "); the server stores every join and answer in it: fix its permissions, or serve a "
+                         "writable copy");
+    if (!writable(folder))
+        throw InputError(path.string() + ": its folder " + folder.string() + " is not writable here (" +
+                         std::strerror(errno) +
+                         "); SQLite keeps the study's write-ahead log beside the file: serve "
+                         "it from a writable folder");
 }
 
 void configureConnection(SqliteDatabase& db) {
@@ -169,6 +208,7 @@ void createStudyFile(const fs::path& path, const StudyDefinition& definition, co
         db.execute(kSchema);
         db.execute(kOnlineSchema);
         db.execute(kResponsesView);
+        db.execute(kVisitsSchema);
         SqliteStatement meta = db.prepare("INSERT INTO meta (key, value) VALUES (?, ?)");
         auto putMeta = [&](const std::string& key, const std::string& value) {
             meta.bind(1, key).bind(2, value);
@@ -209,35 +249,35 @@ void createStudyFile(const fs::path& path, const StudyDefinition& definition, co
     }
 }
 
-OpenedStudyFile openStudyFile(const fs::path& path) {
+OpenedStudyFile openStudyFile(const fs::path& path, StudyAccess access) {
     std::error_code ec;
     if (!fs::is_regular_file(path, ec)) throw InputError(path.string() + ": no such study file");
     OpenedStudyFile file;
-    file.db = std::make_unique<SqliteDatabase>(path.string(), false);
+    if (access == StudyAccess::readWrite) {
+        requireWritable(path);
+        file.db = std::make_unique<SqliteDatabase>(path.string(), false);
+        if (!file.db->writable())
+            throw InputError(path.string() + ": SQLite opened the study file read-only; the server stores every "
+                                             "join and answer in it: serve a writable copy");
+        configureConnection(*file.db);
+    } else {
+        file.db = SqliteDatabase::openReadOnly(path.string());
+    }
     SqliteDatabase& db = *file.db;
-    configureConnection(db);
     if (studyMeta(db, path, "format") != kFormat) throw InputError(path.string() + ": not a skinlab study file");
     if (studyMeta(db, path, "format_version") != std::to_string(kFormatVersion))
         throw InputError(path.string() + ": study file version " + studyMeta(db, path, "format_version") +
                          " is not supported");
-    upgradeSchema(db);
+    if (access == StudyAccess::readWrite) {
+        upgradeSchema(db);
+    } else if (!schemaCurrent(db)) {
+        // Written by an older skinlab: brought up to date where it can be written, as a served file would be.
+        if (writable(path) && writable(fs::absolute(path).parent_path()))
+            return openStudyFile(path, StudyAccess::readWrite);
+        throw InputError(path.string() + ": written by an older skinlab (tables added since are missing) and "
+                                         "read-only here; copy it to a writable folder and read the copy");
+    }
     file.definition = StudyDefinition::fromJson(nlohmann::json::parse(studyMeta(db, path, "definition")));
-    // Added after format version 1 first shipped: created on open, so older study files gain it too.
-    db.execute("CREATE TABLE IF NOT EXISTS participant_addresses ("
-               " participant_id INTEGER PRIMARY KEY REFERENCES participants(id),"
-               " client_address TEXT NOT NULL,"
-               " source TEXT NOT NULL CHECK (source IN ('peer','forwarded')),"
-               " recorded_at TEXT NOT NULL)");
-    // Every later visit of a participant: a join that resumed it (with its secret) or was refused (a platform id
-    // without it), bounded by kMaxVisitsPerParticipant; and every session (page load), bounded by the sessions'
-    // limit.
-    db.execute("CREATE TABLE IF NOT EXISTS participant_visits ("
-               " id INTEGER PRIMARY KEY,"
-               " participant_id INTEGER NOT NULL REFERENCES participants(id),"
-               " outcome TEXT NOT NULL CHECK (outcome IN ('resumed','refused','session')),"
-               " client_address TEXT NOT NULL,"
-               " source TEXT NOT NULL CHECK (source IN ('peer','forwarded')),"
-               " recorded_at TEXT NOT NULL)");
     return file;
 }
 

@@ -4,6 +4,7 @@
 // ("The study file").
 #include "experiments/stimulus_manifest.h"
 #include "experiments/study_definition.h"
+#include "experiments/study_records.h"
 
 #include <filesystem>
 #include <memory>
@@ -23,9 +24,12 @@ struct OpenedStudyFile {
     StudyDefinition definition;
 };
 
-// Opens a study file: WAL journal, synchronous=FULL (COMMIT fsyncs the WAL), foreign keys; checks its format and
-// version (InputError otherwise), brings its schema up to date and reads its definition.
-OpenedStudyFile openStudyFile(const std::filesystem::path& path);
+// Opens a study file and checks its format and version (InputError otherwise), then reads its definition.
+// readWrite: WAL journal, synchronous=FULL (COMMIT fsyncs the WAL), foreign keys, the schema brought up to date; a
+// file or folder this process cannot write is refused (InputError) before anything else.
+// readOnly: nothing is written (SqliteDatabase::openReadOnly); a file written by an older skinlab that lacks tables
+// is brought up to date only where it can be written (else InputError saying so).
+OpenedStudyFile openStudyFile(const std::filesystem::path& path, StudyAccess access = StudyAccess::readWrite);
 
 // The value of `key` in table meta ("" for a missing "format"; RuntimeError for any other missing key).
 std::string studyMeta(SqliteDatabase& db, const std::filesystem::path& path, const std::string& key);

@@ -13,6 +13,7 @@
 
 #include <boost/asio/ip/address.hpp>
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -83,11 +84,12 @@ int httpStatus(Refusal reason) {
     return 400;
 }
 
-// A refused request: its status and {"error": message}; a 429 asks the client to wait (Retry-After).
-HttpResponse refusedResponse(const HttpRequest& req, int status, const std::string& message) {
+// A refused request: its status and {"error": message}; a 429 asks the client to wait (Retry-After: the seconds
+// given, else 5).
+HttpResponse refusedResponse(const HttpRequest& req, int status, const std::string& message, int retryAfter = 0) {
     spdlog::debug("{} {}: {} {}", req.method, validUtf8(req.path, 128), status, message);
     HttpResponse res = errorResponse(status, message);
-    if (status == 429) res.headers.emplace_back("Retry-After", "5");
+    if (status == 429) res.headers.emplace_back("Retry-After", std::to_string(retryAfter > 0 ? retryAfter : 5));
     return res;
 }
 
@@ -137,8 +139,29 @@ json participantState(StudyStore& store, const ParticipantRecord& p) {
 }
 } // namespace
 
+void checkResearcherToken(const std::string& token, const std::string& source) {
+    if (token.size() > 256) throw InputError(source + ": the researcher token is longer than 256 characters");
+    for (char c : token)
+        if (c <= ' ' || c > '~')
+            throw InputError(source + ": the researcher token must be printable ASCII without blanks");
+    std::string_view counted(token);
+    while (!counted.empty() && counted.back() == '=') counted.remove_suffix(1);
+    const bool hex = std::all_of(counted.begin(), counted.end(),
+                                 [](char c) { return std::isxdigit(static_cast<unsigned char>(c)) != 0; });
+    const std::size_t needed = hex ? 32 : 22;
+    std::string distinct(counted);
+    std::sort(distinct.begin(), distinct.end());
+    distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+    if (counted.size() < needed || distinct.size() < 8)
+        throw InputError(source + ": the researcher token is too weak (" + std::to_string(counted.size()) +
+                         " characters, " + std::to_string(distinct.size()) +
+                         " different): at least 128 bits are required — 32 hexadecimal digits or 22 characters of "
+                         "another alphabet, 8 of them different (make one with `openssl rand -hex 16`)");
+}
+
 StudyServer::StudyServer(StudyStore& store, ServerOptions options) : store_(store), options_(std::move(options)) {
     if (options_.researcherToken.empty()) options_.researcherToken = randomHex(16);
+    else checkResearcherToken(options_.researcherToken, "researcher token");
     if (options_.stimuliDir.empty()) options_.stimuliDir = store_.meta("stimuli_dir");
     std::error_code ec;
     const fs::path folder = fs::weakly_canonical(options_.stimuliDir, ec);
@@ -171,6 +194,8 @@ StudyServer::StudyServer(StudyStore& store, ServerOptions options) : store_(stor
     }
     joinLimiter_ = std::make_unique<JoinLimiter>(options_.joinsPerMinute, options_.joinBurst, options_.joinTableSize,
                                                  options_.joinIpv6Prefix);
+    wrongTokens_ = std::make_unique<JoinLimiter>(options_.wrongTokensPerMinute, options_.wrongTokenBurst,
+                                                 options_.joinTableSize, options_.joinIpv6Prefix);
     dashboard_ = std::make_unique<StudyDashboard>(store_, options_.dashboardInterval);
     HttpLimits limits;
     limits.uncappedClients = options_.trustedProxies;
@@ -297,7 +322,7 @@ HttpResponse StudyServer::answer(const HttpRequest& req) {
         }
         return route(req);
     } catch (const RequestError& e) {
-        return refusedResponse(req, e.status(), e.what());
+        return refusedResponse(req, e.status(), e.what(), e.retryAfter());
     } catch (const StudyRefusal& e) {
         return refusedResponse(req, httpStatus(e.reason()), e.what());
     } catch (const InputError& e) {
@@ -344,7 +369,7 @@ HttpResponse StudyServer::route(const HttpRequest& req) {
     throw RequestError(404, "not found");
 }
 
-void StudyServer::authorizeResearcher(const HttpRequest& req) const {
+void StudyServer::authorizeResearcher(const HttpRequest& req) {
     // The token travels in a header only: a URL ends up in logs, proxies and the browser's history.
     const std::string authorization = req.header("Authorization");
     if (authorization.rfind("Bearer ", 0) != 0) {
@@ -352,8 +377,20 @@ void StudyServer::authorizeResearcher(const HttpRequest& req) const {
             throw RequestError(401, "researcher token: send it as Authorization: Bearer TOKEN, never in the URL");
         throw RequestError(401, "researcher token required (Authorization: Bearer TOKEN)");
     }
-    if (!constantTimeEqual(authorization.substr(7), options_.researcherToken))
+    // A network that sent too many wrong tokens waits: its tokens are not even compared meanwhile, so guessing runs
+    // at the refill rate (wrongTokensPerMinute) at most.
+    double retryAfter = 0;
+    if (!wrongTokens_->available(req.clientAddress, retryAfter)) {
+        spdlog::debug("researcher token: {} still waiting after wrong tokens", validUtf8(req.clientAddress, 64));
+        throw RequestError(429, "too many wrong researcher tokens from this network; retry later",
+                           static_cast<int>(std::ceil(retryAfter)));
+    }
+    if (!constantTimeEqual(authorization.substr(7), options_.researcherToken)) {
+        wrongTokens_->allow(req.clientAddress, retryAfter);
+        spdlog::warn("researcher token: wrong token from {} ({} {})", validUtf8(req.clientAddress, 64), req.method,
+                     validUtf8(req.path, 128));
         throw RequestError(403, "wrong researcher token");
+    }
 }
 
 HttpResponse StudyServer::getStimulus(const HttpRequest& req) const {

@@ -28,7 +28,7 @@ struct ServerOptions {
     int port = 8080;                       // 0 = any free port
     int threads = 8;                       // worker threads running the handlers (connections need none)
     int ioThreads = 2;                     // threads holding the connections
-    std::string researcherToken;           // empty = a random one
+    std::string researcherToken;           // empty = a random one; otherwise checkResearcherToken()
     std::filesystem::path stimuliDir;      // empty = the folder recorded at `study create`
     std::size_t maxBodyBytes = 16 * 1024;  // larger request bodies are refused with 413 (chunked too)
     std::size_t maxHeaderBytes = 8 * 1024; // larger request headers are refused with 431
@@ -45,7 +45,18 @@ struct ServerOptions {
     // any other peer the header is ignored. Empty = loopback (127.0.0.1, ::1) when publicHost is set, none otherwise.
     std::vector<std::string> trustedProxies;
     std::chrono::milliseconds dashboardInterval{5000}; // the dashboard's JOD scale is recomputed at most this often
+    // Wrong researcher tokens per client network (as joins: an IPv4 address, an IPv6 /64): a burst, then a rate;
+    // beyond, every researcher request from there gets 429 with Retry-After, the token unchecked.
+    double wrongTokenBurst = 10;
+    double wrongTokensPerMinute = 6;
 };
+
+// A researcher token must carry at least 128 bits if it were random: at least 32 characters when it is hexadecimal
+// digits only (4 bits each), at least 22 otherwise (base64 and the like: 6 bits each; trailing '=' padding is not
+// counted), with at least 8 different characters; printable ASCII without blanks, at most 256 characters. The rule
+// counts characters: it cannot tell a random token from a phrase (make one with `openssl rand -hex 16`). InputError
+// naming `source` otherwise.
+void checkResearcherToken(const std::string& token, const std::string& source);
 
 class StudyDashboard;
 
@@ -77,8 +88,9 @@ private:
     HttpResponse answer(const HttpRequest& request);
     // The table of endpoints (method and path → handler); each handler below answers one of them.
     HttpResponse route(const HttpRequest& request);
-    // 401 without the researcher token in Authorization: Bearer (or with it in the URL), 403 with a wrong one.
-    void authorizeResearcher(const HttpRequest& request) const;
+    // 401 without the researcher token in Authorization: Bearer (or with it in the URL), 403 with a wrong one (logged
+    // with the client's address, never the token), 429 once the client's network sent too many wrong ones.
+    void authorizeResearcher(const HttpRequest& request);
     HttpResponse getStimulus(const HttpRequest& request) const;
     HttpResponse postJoin(const HttpRequest& request);
     HttpResponse postSession(const HttpRequest& request);
@@ -96,6 +108,7 @@ private:
     std::unique_ptr<HttpServer> http_;
     int port_ = 0;
     std::unique_ptr<JoinLimiter> joinLimiter_;
+    std::unique_ptr<JoinLimiter> wrongTokens_; // wrong researcher tokens per client network
     // Requests in progress per forwarded client address (behind a proxy every connection is the proxy's).
     std::mutex inFlightMutex_;
     std::map<std::string, int> inFlight_;

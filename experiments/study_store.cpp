@@ -16,8 +16,8 @@ void StudyStore::create(const fs::path& path, const StudyDefinition& definition,
     createStudyFile(path, definition, designText, manifest);
 }
 
-StudyStore::StudyStore(const fs::path& path) : connection_(std::make_unique<StudyConnection>()) {
-    OpenedStudyFile file = openStudyFile(path);
+StudyStore::StudyStore(const fs::path& path, StudyAccess access) : connection_(std::make_unique<StudyConnection>()) {
+    OpenedStudyFile file = openStudyFile(path, access);
     connection_->path = path;
     connection_->db = std::move(file.db);
     connection_->definition = std::move(file.definition);

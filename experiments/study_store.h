@@ -46,7 +46,9 @@ public:
     static void create(const std::filesystem::path& path, const StudyDefinition& definition,
                        const std::string& designText, const StimulusManifest& manifest);
 
-    explicit StudyStore(const std::filesystem::path& path);
+    // readWrite (serving): a file or folder this process cannot write is refused (InputError) at once. readOnly: the
+    // file is only read (also on a read-only mount); any write is refused by SQLite.
+    explicit StudyStore(const std::filesystem::path& path, StudyAccess access = StudyAccess::readWrite);
     ~StudyStore();
 
     const StudyDefinition& definition() const;

@@ -3,6 +3,7 @@
 #include "analysis/scaling/csv_reader.h"
 #include "common/error.h"
 #include "common/files.h"
+#include "common/sqlite_read.h"
 
 #include <nlohmann/json.hpp>
 #include <sqlite3.h>
@@ -285,30 +286,12 @@ ResponseTable readJson(const std::filesystem::path& path) {
     return table;
 }
 
-// True when SQLite opens `path` as a database (read-only, through its own descriptor, which it keeps or closes
-// without dropping other connections' locks). An empty file is not taken for one (SQLite would).
-bool isSqliteDatabase(const std::filesystem::path& path) {
-    std::error_code ec;
-    const auto size = std::filesystem::file_size(path, ec);
-    if (ec || size == 0) return false;
-    sqlite3* database = nullptr;
-    bool isDatabase = sqlite3_open_v2(path.c_str(), &database, SQLITE_OPEN_READONLY, nullptr) == SQLITE_OK;
-    isDatabase = isDatabase &&
-                 sqlite3_exec(database, "SELECT count(*) FROM sqlite_master", nullptr, nullptr, nullptr) == SQLITE_OK;
-    sqlite3_close(database);
-    return isDatabase;
-}
-
 ResponseTable readDatabase(const std::filesystem::path& path) {
     ResponseTable table;
     table.file = path.string();
     table.format = ResponseFormat::StudyDatabase;
-    sqlite3* database = nullptr;
-    if (sqlite3_open_v2(table.file.c_str(), &database, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) {
-        const std::string message = database ? sqlite3_errmsg(database) : "cannot open";
-        sqlite3_close(database);
-        throwInput(table.file, "", "cannot open the study database: " + message);
-    }
+    // Read only, also on a read-only mount or folder (common/sqlite_read.h).
+    sqlite3* database = openSqliteReadOnly(path).handle;
     struct Closer {
         sqlite3* database;
         sqlite3_stmt* statement = nullptr;
@@ -438,7 +421,7 @@ ResponseTable readResponses(const std::filesystem::path& path, const ReadOptions
     // this process holds on it; another process then believes it holds the last connection and removes the
     // write-ahead log under the server (sqlite.org/howtocorrupt.html, section 2.2). So SQLite itself is asked
     // whether the file is a database, before anything else reads it.
-    if (isSqliteDatabase(path)) return readDatabase(path);
+    if (looksLikeSqliteDatabase(path)) return readDatabase(path);
     const std::string text = readFile(path);
     const size_t first = text.find_first_not_of(" \t\r\n");
     if (first != std::string::npos && text[first] == '{') return readJson(path);

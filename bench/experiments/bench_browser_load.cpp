@@ -94,7 +94,7 @@ struct Server {
             ::dup2(devNull, 2); // its log (one line per join) is not part of the measurement
             const std::string portText = std::to_string(wantedPort);
             ::execl(o.server.c_str(), o.server.c_str(), "study", "serve", db.c_str(), "--port", portText.c_str(),
-                    "--token", "bench-token", static_cast<char*>(nullptr));
+                    "--token", "bench-researcher-token-0123", static_cast<char*>(nullptr));
             ::_exit(127);
         }
         ::close(pipeFds[1]);

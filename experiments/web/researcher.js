@@ -58,6 +58,12 @@ async function refresh() {
     showLogin(response.status === 403 ? 'Wrong researcher token.' : 'The researcher token is required.');
     return;
   }
+  if (response.status === 429) {
+    $('updated').textContent = 'Too many wrong researcher tokens from this address; retrying in ' +
+      (response.headers.get('Retry-After') || '?') + ' s';
+    timer = setTimeout(refresh, 1000 * Math.max(REFRESH_MS / 1000, Number(response.headers.get('Retry-After')) || 0));
+    return;
+  }
   if (!response.ok) {
     $('updated').textContent = 'Server answered ' + response.status + '; retrying';
     timer = setTimeout(refresh, REFRESH_MS);
@@ -86,6 +92,29 @@ function render(data) {
   renderScale(data.scale);
   renderFlagged(data.flagged_trials);
   renderViewing(data.viewing_conditions);
+  renderRefusedIds(data.refused_platform_ids || []);
+}
+
+// Platform ids that someone joined with again without the participant's browser or platform link: the participant
+// switching browser, or someone else using the id — a participant who writes that their id is "already started"
+// may have been squatted (what to do: docs/deployment.md, "Refused platform ids").
+function renderRefusedIds(rows) {
+  const note = $('refused-ids');
+  note.dataset.count = String(rows.length);
+  if (!rows.length) {
+    note.classList.add('placeholder');
+    note.textContent = 'none';
+    return;
+  }
+  note.classList.remove('placeholder');
+  const list = element('ul', { id: 'refused-list' });
+  list.append(...rows.map((r) => element('li', { 'data-observer': r.observer }, r.observer + ' (' + r.platform + ' ' +
+    r.external_id + '): ' + (r.attempts_capped ? 'at least ' : '') + r.attempts + ' refused join' +
+    (r.attempts > 1 ? 's' : '') + ' from ' + r.addresses + ' address' + (r.addresses > 1 ? 'es' : '') +
+    ', last ' + r.last_attempt_at)));
+  note.replaceChildren(document.createTextNode('Joins with a known platform id, refused without the participant\'s ' +
+    'browser or platform link. If the id\'s owner reports being refused, this participation may not be theirs: ' +
+    'compare its platform session id with the platform\'s submission before paying or analysing it.'), list);
 }
 
 function renderFlagged(flagged) {

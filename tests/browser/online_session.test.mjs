@@ -72,7 +72,7 @@ const created = spawnSync(cli, ['study', 'create', '--stimuli', path.join(work, 
 if (created.status !== 0) { console.error(created.stderr); process.exit(1); }
 const TRIALS = 5; // 1 practice + 3 pairs + 1 catch
 
-const server = spawn(cli, ['study', 'serve', database, '--port', '0', '--token', 'browser-token'],
+const server = spawn(cli, ['study', 'serve', database, '--port', '0', '--token', 'browser-researcher-token-0123'],
   { stdio: ['ignore', 'pipe', 'inherit'] });
 const port = await new Promise((resolve, reject) => {
   const timer = setTimeout(() => reject(new Error('server did not start')), 20000);
@@ -231,6 +231,20 @@ try {
   // The participant page never receives a platform id from the server.
   const status = await (await fetch(`http://127.0.0.1:${port}/api/study`)).text();
   check(!status.includes(PID), '/api/study shows a platform id');
+  // The researcher's dashboard lists the platform id the stranger tried, with the attempt.
+  const board = await chromium.launchPersistentContext(fs.mkdtempSync(path.join(work, 'profile-')),
+    { executablePath: CHROMIUM, headless: true, args: FLAGS, viewport: { width: 1000, height: 700 } });
+  const dashboard = board.pages()[0] || await board.newPage();
+  const dashboardErrors = [];
+  dashboard.on('pageerror', (e) => dashboardErrors.push(e.message));
+  await dashboard.goto(`http://127.0.0.1:${port}/researcher#token=browser-researcher-token-0123`);
+  await dashboard.waitForFunction(() => Number(document.body.dataset.refreshes || 0) >= 1, null, { timeout: 10000 });
+  const refusedCount = await dashboard.getAttribute('#refused-ids', 'data-count');
+  const refusedText = await dashboard.textContent('#refused-list');
+  check(refusedCount === '1' && refusedText.includes(`(prolific ${PID}): 1 refused join from 1 address`),
+    `refused platform ids on the dashboard: ${refusedCount} "${refusedText}"`);
+  check(dashboardErrors.length === 0, 'dashboard errors: ' + dashboardErrors.join('; '));
+  await board.close();
   exitCode = failures === 0 ? 0 : 1;
 } catch (e) {
   console.error(e);

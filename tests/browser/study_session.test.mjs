@@ -102,7 +102,7 @@ if (created.status !== 0) { console.error(created.stderr); process.exit(1); }
 const TRIALS = 5; // 1 practice + 3 pairs (active: 3 planned test trials, batches of 2) + 1 catch
 
 // --- the real server ---
-const server = spawn(cli, ['study', 'serve', database, '--port', '0', '--token', 'browser-token'],
+const server = spawn(cli, ['study', 'serve', database, '--port', '0', '--token', 'browser-researcher-token-0123'],
   { stdio: ['ignore', 'pipe', 'inherit'] });
 const port = await new Promise((resolve, reject) => {
   const timer = setTimeout(() => reject(new Error('server did not start')), 20000);

@@ -60,8 +60,8 @@ CommandResult runSkinlab(std::vector<std::string> arguments) {
 
 int startServer(std::unique_ptr<ChildProcess>& child, const fs::path& database, int port) {
     child = std::make_unique<ChildProcess>(std::vector<std::string>{SKINLAB_CLI, "study", "serve", database.string(),
-                                                                    "--port", std::to_string(port), "--token", "t0ken",
-                                                                    "--threads", "16"});
+                                                                    "--port", std::to_string(port), "--token",
+                                                                    "researcher-token-0123456789", "--threads", "16"});
     static const std::regex serving(R"(serving .* on http://127\.0\.0\.1:(\d+)/)");
     for (int i = 0; i < 10; ++i) {
         bool ok = false;

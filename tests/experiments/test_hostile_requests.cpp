@@ -21,6 +21,9 @@
 #include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <poll.h>
+#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/spdlog.h>
+#include <sstream>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <thread>
@@ -730,6 +733,93 @@ TEST(HostileRequests, PlatformIdAloneNeverTakesOverAParticipation) {
         EXPECT_EQ(recorded[i].address, "127.0.0.1");
         EXPECT_EQ(recorded[i].source, "peer");
     }
+}
+
+// Others knowing a participant's platform id cannot use up the participant's resumes: 110 refused joins with the id
+// from three addresses, then the participant resumes from their own browser (join key) and their own platform link
+// (session id). The researcher sees the refused attempts (the dashboard's refused platform ids).
+TEST(HostileRequests, RefusedJoinsByOthersNeverLockTheParticipantOut) {
+    RunningStudy study(recruitingDesign("[recruitment]\nplatform = \"prolific\"\ncompletion_code = \"C1ABCDEF\"\n"));
+    const std::string pid = "5f8a1b2c3d4e5f6a7b8c9d0e";
+    const json own{{"PROLIFIC_PID", pid}, {"SESSION_ID", "60bb1b2c3d4e5f6a7b8c9d22"}};
+    HttpClient owner = study.client();
+    const JsonAnswer first = joinWith(owner, own, "browser-secret-of-the-owner-0001");
+    ASSERT_EQ(first.status, 201) << first.raw;
+
+    int refused = 0;
+    for (int i = 0; i < 110; ++i) {
+        HttpClient other = study.client();
+        other.setSourceAddress("127.0.0." + std::to_string(2 + i % 3));
+        const JsonAnswer attempt = joinWith(other, {{"PROLIFIC_PID", pid}});
+        EXPECT_EQ(attempt.status, 409) << i << ": " << attempt.raw;
+        refused += attempt.status == 409;
+    }
+    EXPECT_EQ(refused, 110);
+
+    // The owner's own browser and the owner's own platform link (a new browser) both resume.
+    const JsonAnswer sameBrowser = joinWith(owner, own, "browser-secret-of-the-owner-0001");
+    EXPECT_EQ(sameBrowser.status, 200) << sameBrowser.raw;
+    EXPECT_EQ(sameBrowser.body.value("token", ""), first.body["token"]);
+    HttpClient newBrowser = study.client();
+    const JsonAnswer sameLink = joinWith(newBrowser, own, "another-browser-of-the-owner-0002");
+    EXPECT_EQ(sameLink.status, 200) << sameLink.raw;
+    EXPECT_EQ(sameLink.body.value("token", ""), first.body["token"]);
+
+    // The researcher sees the refused attempts: how many (rows kept up to the cap), from how many addresses.
+    const JsonAnswer board =
+        get(owner, "/api/researcher/dashboard", {{"Authorization", std::string("Bearer ") + kResearcherToken}});
+    ASSERT_EQ(board.status, 200) << board.raw;
+    EXPECT_EQ(board.body["participants"][0]["resumes"], 2);
+    EXPECT_EQ(board.body["participants"][0]["refused_attempts"], kMaxVisitsPerParticipant);
+    ASSERT_EQ(board.body["refused_platform_ids"].size(), 1u) << board.raw;
+    const json& row = board.body["refused_platform_ids"][0];
+    EXPECT_EQ(row["observer"], first.body["observer"]);
+    EXPECT_EQ(row["platform"], "prolific");
+    EXPECT_EQ(row["external_id"], pid);
+    EXPECT_EQ(row["attempts"], kMaxVisitsPerParticipant);
+    EXPECT_EQ(row["attempts_capped"], true);
+    EXPECT_EQ(row["addresses"], 3);
+}
+
+// Guessing the researcher token: every wrong token is logged with the client's address (never the token); after a
+// burst of 10 the client's network gets 429 with Retry-After and its tokens are not compared, not even the right
+// one; another network is not affected.
+TEST(HostileRequests, WrongResearcherTokensAreThrottledAndLogged) {
+    std::ostringstream log; // the server's log (added before it starts, removed after it stopped)
+    const auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(log);
+    spdlog::default_logger()->sinks().push_back(sink);
+    struct RemoveSink {
+        std::shared_ptr<spdlog::sinks::sink> sink;
+        ~RemoveSink() { std::erase(spdlog::default_logger()->sinks(), sink); }
+    } removeSink{sink};
+    RunningStudy study(kDesign);
+
+    HttpClient guesser = study.client();
+    guesser.setSourceAddress("127.0.0.7");
+    auto status = [&](HttpClient& client, const std::string& token) {
+        return client.get("/api/researcher/status", {{"Authorization", "Bearer " + token}});
+    };
+    for (int i = 0; i < 10; ++i) {
+        const HttpAnswer wrong = status(guesser, "guessed-token-" + std::to_string(1000 + i));
+        EXPECT_EQ(wrong.status, 403) << i << ": " << wrong.body;
+    }
+    const HttpAnswer throttled = status(guesser, "guessed-token-2000");
+    EXPECT_EQ(throttled.status, 429) << throttled.body;
+    EXPECT_GE(std::atoi(throttled.header("Retry-After").c_str()), 1) << throttled.header("Retry-After");
+    EXPECT_EQ(status(guesser, kResearcherToken).status, 429) << "a throttled network's token was compared";
+
+    HttpClient researcher = study.client();
+    EXPECT_EQ(status(researcher, kResearcherToken).status, 200);
+
+    spdlog::default_logger()->flush();
+    const std::string text = log.str();
+    std::size_t warnings = 0;
+    for (std::size_t at = 0; (at = text.find("researcher token: wrong token from 127.0.0.7", at)) != std::string::npos;
+         ++at)
+        ++warnings;
+    EXPECT_EQ(warnings, 10u) << text;
+    EXPECT_EQ(text.find("guessed-token"), std::string::npos) << "a token was logged: " << text;
+    EXPECT_EQ(text.find(kResearcherToken), std::string::npos) << "the token was logged: " << text;
 }
 
 // One person, one platform id, whatever the letter case (or, on generic systems, trailing dots and blanks).

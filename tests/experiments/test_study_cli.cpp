@@ -9,6 +9,7 @@
 #include "experiments/sqlite_database.h"
 #include "experiments/study_store.h"
 #include "stimulus_set_fixture.h"
+#include "store_answer.h"
 
 #include <algorithm>
 #include <atomic>
@@ -63,8 +64,8 @@ int StudyFiles::create() const {
 // Starts `skinlab study serve` and returns the port it printed.
 int startServer(std::unique_ptr<ChildProcess>& child, const fs::path& database, int port) {
     child = std::make_unique<ChildProcess>(std::vector<std::string>{SKINLAB_CLI, "study", "serve", database.string(),
-                                                                    "--port", std::to_string(port), "--token", "t0ken",
-                                                                    "--threads", "16"});
+                                                                    "--port", std::to_string(port), "--token",
+                                                                    "researcher-token-0123456789", "--threads", "16"});
     static const std::regex serving(R"(serving .* on http://127\.0\.0\.1:(\d+)/)");
     for (int i = 0; i < 10; ++i) {
         bool ok = false;
@@ -282,7 +283,8 @@ std::vector<std::string> deletedDescriptors(pid_t pid, const fs::path& database)
 void readWhileServing(const StudyFiles& files, int port, int round) {
     HttpClient client("127.0.0.1", port);
     for (int attempt = 0; attempt < 100; ++attempt) {
-        const HttpAnswer answer = client.get("/api/researcher/dashboard", {{"Authorization", "Bearer t0ken"}});
+        const HttpAnswer answer =
+            client.get("/api/researcher/dashboard", {{"Authorization", "Bearer researcher-token-0123456789"}});
         ASSERT_EQ(answer.status, 200) << answer.body;
         // The first request may find the scale still being computed; the reading is what matters.
         if (answer.body.find("\"computing\"") == std::string::npos) break;
@@ -454,4 +456,171 @@ TEST(StudyCli, ResearcherTokenFromAFileOrTheEnvironmentAndPrivateFiles) {
         runSkinlab({"study", "serve", files.database.string(), "--token", "x", "--token-file", tokenFile.string()});
     EXPECT_EQ(both.exitCode, 2) << both.err;
     ::umask(previous);
+}
+
+namespace {
+
+const char* kUnshare = "/usr/bin/unshare"; // util-linux
+// Mounts $1 read-only at $2, then runs the rest of the arguments.
+const char* kReadOnlyMount = R"(mount --bind "$1" "$2" && mount -o remount,bind,ro "$2" && shift 2 && exec "$@")";
+
+// Runs `skinlab COMMAND…` with `folder` seen read-only at `mountPoint`: a bind mount remounted read-only in a mount
+// namespace of the command's own (`unshare -rm`: no privilege needed where user namespaces are allowed). At most
+// `seconds` (then killed: exit code 124).
+CommandResult runOnReadOnlyMount(const fs::path& folder, const fs::path& mountPoint,
+                                 const std::vector<std::string>& command, int seconds = 120) {
+    std::vector<std::string> arguments{kUnshare,
+                                       "-rm",
+                                       "sh",
+                                       "-c",
+                                       kReadOnlyMount,
+                                       "sh",
+                                       folder.string(),
+                                       mountPoint.string(),
+                                       "/usr/bin/timeout",
+                                       std::to_string(seconds),
+                                       SKINLAB_CLI};
+    arguments.insert(arguments.end(), command.begin(), command.end());
+    return runCommand(arguments);
+}
+
+// Whether this machine gives a process a read-only bind mount (a file cannot be created through it).
+bool readOnlyMountsWork(const fs::path& scratch) {
+    if (!fs::exists(kUnshare)) return false;
+    fs::create_directories(scratch / "folder");
+    fs::create_directories(scratch / "mounted");
+    const fs::path probe = scratch / "mounted" / "probe";
+    return runCommand({kUnshare, "-rm", "sh", "-c", kReadOnlyMount, "sh", (scratch / "folder").string(),
+                       (scratch / "mounted").string(), "/bin/sh", "-c", "! touch \"$0\" 2>/dev/null", probe.string()})
+               .exitCode == 0;
+}
+
+// A participant answering every trial through the store: catch trials right, test trials for the panel A.
+void answerEveryTrial(StudyStore& store, const std::string& label) {
+    const ParticipantRecord p = store.join(label);
+    const std::int64_t session = store.startSession(p.id, "test", 1280, 800, 1.0);
+    while (const std::optional<TrialRecord> t = store.nextTrial(p.id)) {
+        const bool chooseA = t->plan.expected != 'B';
+        store.recordResponse(storeAnswer(p, session, *t, chooseA == t->plan.aOnLeft ? "left" : "right"));
+    }
+}
+
+bool oneLine(const std::string& text) { return !text.empty() && text.find('\n') == text.size() - 1; }
+
+} // namespace
+
+// A study file on a read-only mount: `study status`, `export`, `backup` and `analyze scale` read it — with no
+// write-ahead log beside it, and with the log and index of a server writing it through another (writable) mount —
+// and say in one line when they cannot (a log without its index); `study serve` refuses it at start, in one line,
+// before printing the participant link.
+TEST(StudyCli, ReadOnlyStudyFilesAreReadAndNeverServed) {
+    StudyFiles files;
+    ASSERT_EQ(files.create(), 0);
+    if (!readOnlyMountsWork(files.folder.path() / "probe"))
+        GTEST_SKIP() << "no read-only bind mount on this machine (unshare -rm)";
+    const fs::path data = files.folder.path() / "data", mounted = files.folder.path() / "mounted";
+    fs::create_directories(data);
+    fs::create_directories(mounted);
+    {
+        StudyStore store(files.database);
+        answerEveryTrial(store, "P-one");
+        answerEveryTrial(store, "P-two");
+    }
+    fs::copy_file(files.database, data / "study.db");
+    ASSERT_FALSE(fs::exists(data / "study.db-wal")) << "closed: every answer is in the file itself";
+    const std::string seen = (mounted / "study.db").string();
+    const fs::path out = files.folder.path();
+
+    const CommandResult status = runOnReadOnlyMount(data, mounted, {"study", "status", seen});
+    EXPECT_EQ(status.exitCode, 0) << status.err;
+    EXPECT_NE(status.out.find("P-two"), std::string::npos) << status.out;
+    const CommandResult exported =
+        runOnReadOnlyMount(data, mounted, {"study", "export", seen, "-o", (out / "export.csv").string()});
+    EXPECT_EQ(exported.exitCode, 0) << exported.err;
+    ASSERT_EQ(runSkinlab({"study", "export", files.database.string(), "-o", (out / "expected.csv").string()}).exitCode,
+              0);
+    EXPECT_TRUE(fs::exists(out / "export.csv") &&
+                skinlab::sha256File(out / "export.csv") == skinlab::sha256File(out / "expected.csv"))
+        << "the export differs from the writable file's";
+    const CommandResult backup =
+        runOnReadOnlyMount(data, mounted, {"study", "backup", seen, (out / "copy.db").string()});
+    EXPECT_EQ(backup.exitCode, 0) << backup.err;
+    EXPECT_NE(backup.out.find("2 participants, 54 responses"), std::string::npos) << backup.out;
+    const CommandResult scaled = runOnReadOnlyMount(
+        data, mounted, {"analyze", "scale", seen, "-o", (out / "scale").string(), "--bootstrap", "100"});
+    EXPECT_EQ(scaled.exitCode, 0) << scaled.err;
+    EXPECT_EQ(scaled.err.find("missing column"), std::string::npos) << "read as a CSV file: " << scaled.err;
+
+    // A server writing the file through a writable mount: its log and index lie beside the file, and the readers
+    // on the read-only mount see its latest answers.
+    StudyStore live(data / "study.db");
+    answerEveryTrial(live, "P-three");
+    ASSERT_TRUE(fs::exists(data / "study.db-wal") && fs::file_size(data / "study.db-wal") > 0);
+    const CommandResult liveStatus = runOnReadOnlyMount(data, mounted, {"study", "status", seen});
+    EXPECT_EQ(liveStatus.exitCode, 0) << liveStatus.err;
+    EXPECT_NE(liveStatus.out.find("P-three"), std::string::npos) << liveStatus.out;
+
+    // Served from the read-only mount: refused at start, before the participant link.
+    const CommandResult served = runOnReadOnlyMount(data, mounted, {"study", "serve", seen, "--port", "0"}, 10);
+    EXPECT_EQ(served.exitCode, 2) << served.out << served.err;
+    EXPECT_TRUE(oneLine(served.err)) << served.err;
+    EXPECT_NE(served.err.find(seen + ": the study file is not writable here"), std::string::npos) << served.err;
+    EXPECT_EQ(served.out.find("participant link"), std::string::npos) << served.out;
+
+    // The log of a killed server without its index: not readable without writing; one line says so.
+    const fs::path stranded = files.folder.path() / "stranded";
+    fs::create_directories(stranded);
+    fs::copy_file(data / "study.db", stranded / "study.db");
+    fs::copy_file(data / "study.db-wal", stranded / "study.db-wal");
+    for (const char* command : {"status", "export"}) {
+        const CommandResult refused = runOnReadOnlyMount(stranded, mounted, {"study", command, seen});
+        EXPECT_EQ(refused.exitCode, 2) << command << ": " << refused.err;
+        EXPECT_TRUE(oneLine(refused.err)) << refused.err;
+        EXPECT_NE(refused.err.find("study.db-wal (committed transactions not yet in the file)"), std::string::npos)
+            << refused.err;
+    }
+}
+
+// A researcher token must carry 128 bits: a short one, from any source, is refused at start in one line naming its
+// source, before anything is served.
+TEST(StudyCli, WeakResearcherTokensAreRefused) {
+    StudyFiles files;
+    ASSERT_EQ(files.create(), 0);
+    const fs::path shortFile = writeText(files.folder.path(), "short-token", "ab\n");
+    const fs::path repeated = writeText(files.folder.path(), "repeated-token", std::string(40, 'a') + "\n");
+    const fs::path hex = writeText(files.folder.path(), "hex-token", "0123456789abcdef0123456789abcde\n"); // 124 bits
+    const fs::path good = writeText(files.folder.path(), "good-token", randomHex(16) + "\n");
+    // `study serve` with these options, stopped after 10 s should it serve (exit code 124).
+    auto serveFor10s = [&](const std::vector<std::string>& options) {
+        std::vector<std::string> arguments{"/usr/bin/timeout",      "10",     SKINLAB_CLI, "study", "serve",
+                                           files.database.string(), "--port", "0"};
+        arguments.insert(arguments.end(), options.begin(), options.end());
+        return runCommand(arguments);
+    };
+    for (const fs::path& weak : {shortFile, repeated, hex}) {
+        const CommandResult served = serveFor10s({"--token-file", weak.string()});
+        EXPECT_EQ(served.exitCode, 2) << weak << ": " << served.err;
+        EXPECT_EQ(served.err.rfind("skinlab: error: " + weak.string() + ": the researcher token is too weak (", 0), 0u)
+            << served.err;
+        EXPECT_TRUE(std::count(served.err.begin(), served.err.end(), '\n') == 1) << served.err;
+        EXPECT_EQ(served.out.find("participant link"), std::string::npos) << served.out;
+    }
+    const CommandResult onCommandLine = serveFor10s({"--token", "t0ken"});
+    EXPECT_EQ(onCommandLine.exitCode, 2) << onCommandLine.err;
+    EXPECT_NE(onCommandLine.err.find("--token: the researcher token is too weak"), std::string::npos);
+    ::setenv("SKINLAB_RESEARCHER_TOKEN", "short-secret", 1);
+    const CommandResult fromEnvironment = serveFor10s({});
+    ::unsetenv("SKINLAB_RESEARCHER_TOKEN");
+    EXPECT_EQ(fromEnvironment.exitCode, 2) << fromEnvironment.err;
+    EXPECT_NE(fromEnvironment.err.find("SKINLAB_RESEARCHER_TOKEN: the researcher token is too weak"),
+              std::string::npos);
+
+    // 32 hexadecimal digits (openssl rand -hex 16) are enough.
+    ChildProcess server(
+        {SKINLAB_CLI, "study", "serve", files.database.string(), "--port", "0", "--token-file", good.string()});
+    bool ok = false;
+    const std::string first = server.readLine(std::chrono::seconds(20), ok);
+    EXPECT_TRUE(ok && first.rfind("serving ", 0) == 0) << first;
+    server.kill(SIGTERM);
+    server.wait();
 }

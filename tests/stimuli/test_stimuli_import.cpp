@@ -393,7 +393,8 @@ TEST(StimuliImport, ImportedSetThroughStudyAnalysisAndReport) {
         runSkinlab({"study", "create", "--stimuli", set.string(), "--design", design.string(), "-o", study.string()});
     ASSERT_EQ(created.exitCode, 0) << created.out << created.err;
 
-    ChildProcess server({SKINLAB_CLI, "study", "serve", study.string(), "--port", "0", "--token", "t0ken"});
+    ChildProcess server(
+        {SKINLAB_CLI, "study", "serve", study.string(), "--port", "0", "--token", "researcher-token-0123456789"});
     int port = -1;
     static const std::regex serving(R"(serving .* on http://127\.0\.0\.1:(\d+)/)");
     for (int i = 0; i < 10 && port < 0; ++i) {
