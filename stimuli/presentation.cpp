@@ -70,6 +70,9 @@ OIIO::ImageBuf readWhole(const fs::path& path) {
 void writeOver(OIIO::ImageBuf& image, const fs::path& path, const OIIO::ImageSpec& original) {
     if (!original.channelformats.empty()) image.set_write_format(original.channelformats);
     else image.set_write_format(original.format);
+    // The spec read back has no DateTime (the renderer writes none), and ImageBuf::write would stamp the current time
+    // into an EXR without one: an empty value keeps it out (same inputs ⇒ same bytes).
+    image.specmod().attribute("DateTime", "");
     // Written beside the file, then renamed over it (the file itself is still a temporary of the build).
     fs::path temp = path.parent_path() / ("." + path.stem().string() + ".present" + path.extension().string());
     if (!image.write(temp.string())) {

@@ -4,6 +4,7 @@
 // median of `repeats` runs. CPU time is the figure to compare on a shared, loaded machine: wall-clock time grows
 // with the load of other processes, CPU time does not.
 //   bench_reference [repeats=3]
+//   bench_reference --smoke   (ctest's smoke run: one repeat of the 2 mm cases)
 #include "bench/bench_stats.h"
 #include "renderer/sss/radial_profile.h"
 #include "renderer/reference/surface_convolution.h"
@@ -58,15 +59,18 @@ void run(const char* name, const Model& model, float edgeMm, int repeats) {
 } // namespace
 
 int main(int argc, char** argv) {
-    const int repeats = argc > 1 ? std::max(1, std::atoi(argv[1])) : 3;
+    const bool smoke = argc > 1 && std::string(argv[1]) == "--smoke";
+    const int repeats = smoke ? 1 : argc > 1 ? std::max(1, std::atoi(argv[1])) : 3;
+    const std::vector<float> haloEdges = smoke ? std::vector<float>{2.0f} : std::vector<float>{2.0f, 1.0f, 0.5f};
+    const std::vector<float> headEdges = smoke ? std::vector<float>{2.0f} : std::vector<float>{2.0f, 1.0f};
     std::printf(
         "| model | edge (mm) | skin samples | sources per sample | tessellate + gather, wall (ms) | convolve, wall "
         "(ms) | convolve, CPU (ms) |\n");
     std::printf("|---|---|---|---|---|---|---|\n");
     const Model halo = makeHaloScene(200.0f);
-    for (const float edge : {2.0f, 1.0f, 0.5f}) run("builtin:halo sphere", halo, edge, repeats);
+    for (const float edge : haloEdges) run("builtin:halo sphere", halo, edge, repeats);
     const Model head = makeHeadScene(false);
     // Adaptive tessellation: 2 mm gives 0.17 M samples (the former uniform rounds: 1.6 M), so 1 mm is timed too.
-    for (const float edge : {2.0f, 1.0f}) run("builtin:head", head, edge, repeats);
+    for (const float edge : headEdges) run("builtin:head", head, edge, repeats);
     return 0;
 }

@@ -1,10 +1,11 @@
 // Speed of the object-space reference as a render method (sss.method = "reference", renderer/gl/reference_method.h):
 // whole renders through Renderer (EGL; llvmpipe on the CI machine) of builtin:halo and, when $SKINLAB_ASSETS holds
-// it, the scanned head in its close view, at edge lengths 2 and 1 mm. Prints one Markdown table row per case: the
-// render's wall time, the "sss" pass (bake + read back + convolution + draw), the tessellation (done once per model
-// and edge length, then cached; measured here on the first render of each case), and the sample counts. Each case
-// renders twice; the second row shows the cached tessellation.
-//   bench_reference_render [width=1280] [height=720]
+// it, the scanned head in its close view, at edge lengths 2 and 1 mm (or those given). Prints one Markdown table row
+// per case: the render's wall time, the "sss" pass (bake + read back + convolution + draw), the tessellation (done
+// once per model and edge length, then cached; measured here on the first render of each case), and the sample
+// counts. Each case renders twice; the second row shows the cached tessellation.
+//   bench_reference_render [width=1280] [height=720] [edges=2,1]   (edge lengths in mm, comma-separated)
+#include "bench/bench_stats.h"
 #include "renderer/renderer.h"
 
 #include <chrono>
@@ -19,6 +20,7 @@ using namespace skinlab::renderer;
 int main(int argc, char** argv) {
     const int width = argc > 1 ? std::atoi(argv[1]) : 1280;
     const int height = argc > 2 ? std::atoi(argv[2]) : 720;
+    const std::vector<std::string> edges = skinlab::bench::splitCommas(argc > 3 ? argv[3] : "2,1");
     const char* assets = std::getenv("SKINLAB_ASSETS");
     struct Case {
         std::string name, scene;
@@ -37,12 +39,12 @@ int main(int argc, char** argv) {
         "(ms) | convolve (ms) | sss pass, wall (ms) | render, wall (ms) "
         "|\n|---|---|---|---|---|---|---|---|---|---|\n");
     for (const Case& c : cases)
-        for (const char* edge : {"2", "1"})
+        for (const std::string& edge : edges)
             for (int repeat = 0; repeat < 2; ++repeat) {
                 RenderRequest request;
                 request.scene = c.scene;
                 request.overrides = c.overrides;
-                request.overrides.push_back(std::string("sss.reference_edge_mm=") + edge);
+                request.overrides.push_back("sss.reference_edge_mm=" + edge);
                 request.method = "reference";
                 request.width = width;
                 request.height = height;
@@ -54,7 +56,7 @@ int main(int argc, char** argv) {
                     std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
                 const auto& run = result.timingsMs.at("reference");
                 std::printf("| %s | %s | %s | %d (%d) | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f |\n", c.name.c_str(),
-                            edge, repeat == 0 ? "first" : "cached", run.at("samples").get<int>(),
+                            edge.c_str(), repeat == 0 ? "first" : "cached", run.at("samples").get<int>(),
                             run.at("skin_samples").get<int>(), run.at("sources_per_sample").get<double>(),
                             run.at("tessellate_ms").get<double>(), run.at("bake_readback_ms").get<double>(),
                             run.at("convolve_ms").get<double>(),

@@ -39,9 +39,13 @@ double skinShare(const std::filesystem::path& exr) {
     return double(std::count_if(mask.begin(), mask.end(), [](float m) { return m > 0.0f; })) / double(mask.size());
 }
 
-} // namespace
+// Whether `method` reads sss.samples (the screen-space methods do; "none", the copy, does not and refuses the key).
+bool readsSamples(const std::string& method) {
+    const auto* info = skinlab::renderer::sss::findMethod(method);
+    return info && skinlab::renderer::sss::methodUsesKey(info->method, "samples");
+}
 
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
     std::string scene = "builtin:head";
     int width = 640, height = 360, frames = 3;
     std::vector<int> samples{5, 11, 21, 51, 101};
@@ -80,7 +84,8 @@ int main(int argc, char** argv) {
         skinlab::renderer::RenderRequest request;
         request.scene = scene;
         request.method = method;
-        request.overrides = {"camera.view=" + view, "sss.samples=" + std::to_string(n)};
+        request.overrides = {"camera.view=" + view};
+        if (readsSamples(method)) request.overrides.push_back("sss.samples=" + std::to_string(n));
         request.width = width;
         request.height = height;
         request.assetsDir = assets;
@@ -137,4 +142,15 @@ int main(int argc, char** argv) {
     skinlab::writeFileAtomic(std::filesystem::path(out) / "sss.png", skinlab::bench::plotSssTimings(panels, title));
     std::printf("wrote %s/sss.csv and %s/sss.png\n", out.c_str(), out.c_str());
     return 0;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    try {
+        return run(argc, argv);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "bench_sss: %s\n", e.what());
+        return 1;
+    }
 }

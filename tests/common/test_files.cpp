@@ -1,6 +1,7 @@
 #include "common/error.h"
 #include "common/files.h"
 #include "common/hash.h"
+#include "tests/common/temp_folder.h"
 
 #include <filesystem>
 #include <gtest/gtest.h>
@@ -9,8 +10,8 @@
 namespace fs = std::filesystem;
 
 TEST(Files, AtomicWriteReplacesAndLeavesNoTemporary) {
-    fs::path dir = fs::temp_directory_path() / ("skinlab_test_files-" + std::to_string(::getpid()));
-    fs::remove_all(dir);
+    const skinlab::test_support::TempFolder folder;
+    const fs::path dir = folder / "out"; // absent: the write creates it
     skinlab::writeFileAtomic(dir / "a.txt", "first");
     skinlab::writeFileAtomic(dir / "a.txt", "second");
     EXPECT_EQ(skinlab::readFile(dir / "a.txt"), "second");
@@ -20,12 +21,11 @@ TEST(Files, AtomicWriteReplacesAndLeavesNoTemporary) {
         ++n;
     }
     EXPECT_EQ(n, 1);
-    fs::remove_all(dir);
 }
 
 TEST(Files, UncommittedOutputIsRemoved) {
-    fs::path dir = fs::temp_directory_path() / ("skinlab_test_files2-" + std::to_string(::getpid()));
-    fs::remove_all(dir);
+    const skinlab::test_support::TempFolder folder;
+    const fs::path dir = folder / "out";
     {
         skinlab::AtomicOutput out(dir / "b.bin");
         skinlab::writeFileAtomic(out.tempPath(), "partial");
@@ -33,7 +33,6 @@ TEST(Files, UncommittedOutputIsRemoved) {
     }
     EXPECT_FALSE(fs::exists(dir / "b.bin"));
     EXPECT_TRUE(fs::is_empty(dir));
-    fs::remove_all(dir);
 }
 
 TEST(Files, UnreadableFileNamesThePath) {

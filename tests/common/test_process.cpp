@@ -2,6 +2,7 @@
 // renders, Chromium): PATH lookup, output to a file or captured, exit status and signals, a group of its own.
 #include "common/error.h"
 #include "common/process.h"
+#include "tests/common/temp_folder.h"
 
 #include <chrono>
 #include <csignal>
@@ -24,11 +25,7 @@ std::string readAll(const fs::path& file) {
     return text.str();
 }
 
-struct TempFolder {
-    fs::path path = fs::temp_directory_path() / ("skinlab-process-" + std::to_string(::getpid()));
-    TempFolder() { fs::create_directories(path); }
-    ~TempFolder() { fs::remove_all(path); }
-};
+using skinlab::test_support::TempFolder;
 
 TEST(Process, FindsProgramsOnThePathOrByPath) {
     const fs::path sh = findProgram("sh");
@@ -51,14 +48,14 @@ TEST(Process, CapturesOutputAndExitStatus) {
 
 TEST(Process, OutputToAFileInItsWorkingDirectoryAppendedOrTruncated) {
     TempFolder folder;
-    const fs::path log = folder.path / "log.txt";
+    const fs::path log = folder.path() / "log.txt";
     SpawnOptions options;
     options.output = log;
-    options.workingDirectory = folder.path;
+    options.workingDirectory = folder.path();
     const fs::path sh = findProgram("sh");
     EXPECT_EQ(waitProcess(spawnProcess(sh, {"-c", "pwd; echo e >&2"}, options)), 0);
     EXPECT_EQ(waitProcess(spawnProcess(sh, {"-c", "echo second"}, options)), 0);
-    EXPECT_EQ(readAll(log), fs::canonical(folder.path).string() + "\ne\nsecond\n");
+    EXPECT_EQ(readAll(log), fs::canonical(folder.path()).string() + "\ne\nsecond\n");
     options.appendOutput = false;
     EXPECT_EQ(waitProcess(spawnProcess(sh, {"-c", "echo only"}, options)), 0);
     EXPECT_EQ(readAll(log), "only\n");

@@ -5,6 +5,8 @@
 //  - a build killed (SIGKILL) after its first stimulus leaves no corrupt file under a final name, and the rerun
 //    completes it with the same hashes as an uninterrupted build;
 //  - shards 1/2 + 2/2 merged equal the full build (ids, order, hashes);
+//  - a cropped and magnified set built twice, in different seconds, once killed and resumed, gives byte-identical
+//    image files;
 //  - bad input that needs the scene spec (unknown factor key or level, missing asset, folder of another set)
 //    fails with one line before anything is rendered.
 // Skips with a message when no EGL platform works.
@@ -118,6 +120,25 @@ std::vector<std::string> idsOf(const fs::path& dir) {
     return ids;
 }
 
+// For runCli: kills the build (SIGKILL) as soon as the manifest in `dir` records its first stimulus; `doneAtKill`
+// receives the number of stimuli recorded then.
+std::function<void(pid_t)> killAfterFirstStimulus(const fs::path& dir, size_t& doneAtKill) {
+    return [&dir, &doneAtKill](pid_t pid) {
+        auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+        while (std::chrono::steady_clock::now() < deadline) {
+            if (fs::exists(dir / "manifest.json")) {
+                try {
+                    doneAtKill = manifestOf(dir)["stimuli"].size();
+                } catch (const std::exception&) {
+                }
+                if (doneAtKill >= 1) break;
+            }
+            std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        }
+        ::kill(pid, SIGKILL);
+    };
+}
+
 class StimuliBuild : public ::testing::Test {
 protected:
     static void SetUpTestSuite() {
@@ -220,21 +241,7 @@ TEST_F(StimuliBuild, KilledBuildResumesToTheSameHashes) {
     fs::remove_all(dir);
     size_t doneAtKill = 0;
     CliRun killed = runCli({"stimuli", "build", (gRoot / "small.toml").string(), "-o", dir.string()},
-                           gRoot / "killed.log", [&](pid_t pid) {
-                               // Kill as soon as the manifest records the first stimulus.
-                               auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-                               while (std::chrono::steady_clock::now() < deadline) {
-                                   if (fs::exists(dir / "manifest.json")) {
-                                       try {
-                                           doneAtKill = manifestOf(dir)["stimuli"].size();
-                                       } catch (const std::exception&) {
-                                       }
-                                       if (doneAtKill >= 1) break;
-                                   }
-                                   std::this_thread::sleep_for(std::chrono::milliseconds(2));
-                               }
-                               ::kill(pid, SIGKILL);
-                           });
+                           gRoot / "killed.log", killAfterFirstStimulus(dir, doneAtKill));
     ASSERT_EQ(killed.exitCode, 128 + SIGKILL) << killed.output;
     nlohmann::json partial = manifestOf(dir);
     ASSERT_LT(partial["stimuli"].size(), 6u) << "the build finished before it could be killed";
@@ -546,6 +553,57 @@ TEST_F(StimuliBuild, CropAndMagnificationAreAppliedRecordedAndPredictedOn) {
     ASSERT_EQ(run.exitCode, 0) << run.output;
     EXPECT_NE(run.output.find("(3 rendered, 3 unchanged)"), std::string::npos) << run.output;
     EXPECT_EQ(manifestOf(shown)["stimuli"][3]["presentation"]["crop"]["x"], 48);
+}
+
+namespace {
+
+// Every image file of a built set (exr/, png/, contact.png) → the sha256 of its bytes.
+std::map<std::string, std::string> imageFileHashes(const fs::path& dir) {
+    std::map<std::string, std::string> out;
+    for (const auto& entry : fs::recursive_directory_iterator(dir)) {
+        const std::string extension = entry.path().extension().string();
+        if (entry.is_regular_file() && (extension == ".exr" || extension == ".png"))
+            out[fs::relative(entry.path(), dir).string()] = skinlab::sha256File(entry.path());
+    }
+    return out;
+}
+
+// Returns once the wall clock's second has changed (image timestamps such as EXR's DateTime count whole seconds).
+void waitForTheNextSecond() {
+    const auto second = [] {
+        return std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch());
+    };
+    const auto start = second();
+    while (second() == start) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+}
+
+} // namespace
+
+// Same inputs, same bytes: a presented set (its cropped and magnified images are rewritten after rendering) built
+// twice in different seconds, the second build killed after its first stimulus and resumed, gives byte-identical
+// image files, EXRs, PNGs and the contact sheet alike.
+TEST_F(StimuliBuild, ResumedBuildIsByteIdenticalToACleanOne) {
+    const fs::path spec = writeSpec("presented.toml", presentedSpec("presented", true));
+    const fs::path clean = gRoot / "clean", resumed = gRoot / "resumed";
+    CliRun run = runCli({"stimuli", "build", spec.string(), "-o", clean.string(), "--no-predict"});
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    waitForTheNextSecond();
+    size_t doneAtKill = 0;
+    run = runCli({"stimuli", "build", spec.string(), "-o", resumed.string(), "--no-predict"}, gRoot / "killed.log",
+                 killAfterFirstStimulus(resumed, doneAtKill));
+    ASSERT_EQ(run.exitCode, 128 + SIGKILL) << run.output;
+    const size_t kept = manifestOf(resumed)["stimuli"].size();
+    ASSERT_LT(kept, 6u) << "the build finished before it could be killed";
+    waitForTheNextSecond();
+    run = runCli({"stimuli", "build", spec.string(), "-o", resumed.string(), "--no-predict"});
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    EXPECT_NE(run.output.find("(" + std::to_string(6 - kept) + " rendered, " + std::to_string(kept) + " unchanged)"),
+              std::string::npos)
+        << run.output;
+    const auto expected = imageFileHashes(clean);
+    EXPECT_EQ(expected.size(), 2u * 6u + 1u); // an EXR and a PNG per stimulus, and contact.png
+    EXPECT_EQ(imageFileHashes(resumed), expected);
+    EXPECT_EQ(verifiedHashes(resumed), verifiedHashes(clean));
 }
 
 TEST_F(StimuliBuild, CropOutsideTheFrameIsRefusedBeforeRendering) {

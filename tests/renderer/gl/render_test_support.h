@@ -3,6 +3,7 @@
 // with the EGL failure message when no platform works; EXR reading; temporary folders.
 #include "common/error.h"
 #include "renderer/renderer.h"
+#include "tests/common/temp_folder.h"
 
 #include <OpenImageIO/imageio.h>
 #include <filesystem>
@@ -93,25 +94,7 @@ inline std::vector<unsigned char> readPng(const std::filesystem::path& path, int
     return rgb;
 }
 
-class TempFolder {
-public:
-    explicit TempFolder(const std::string& tag) {
-        static int counter = 0;
-        path_ = std::filesystem::path(SKINLAB_BINARY_DIR) / "test-output" /
-                (tag + "-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
-        std::filesystem::remove_all(path_);
-        std::filesystem::create_directories(path_);
-    }
-    ~TempFolder() {
-        if (!keep) std::filesystem::remove_all(path_);
-    }
-    const std::filesystem::path& path() const { return path_; }
-    std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
-    bool keep = false;
-
-private:
-    std::filesystem::path path_;
-};
+using skinlab::test_support::TempFolder;
 
 // Renders `scene` with `method` (and the `overrides`, as --set) at width × height into `exrPath`; the assets come
 // from $SKINLAB_ASSETS (the renderer's default).

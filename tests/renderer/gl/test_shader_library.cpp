@@ -24,20 +24,16 @@ namespace fs = std::filesystem;
 // a copy.frag (a listed variant) that includes it and fails in main() at line 6.
 class ShaderFolder {
 public:
-    ShaderFolder() : path_(fs::temp_directory_path() / ("skinlab-shader-lines-" + std::to_string(::getpid()))) {
-        fs::create_directories(path_);
-        fs::copy_file(fs::path(SKINLAB_SOURCE_DIR) / "renderer/shaders/fullscreen.vert", path_ / "fullscreen.vert",
+    ShaderFolder() {
+        fs::copy_file(fs::path(SKINLAB_SOURCE_DIR) / "renderer/shaders/fullscreen.vert", folder_ / "fullscreen.vert",
                       fs::copy_options::overwrite_existing);
     }
-    ~ShaderFolder() {
-        ::unsetenv("SKINLAB_SHADER_DIR");
-        fs::remove_all(path_);
-    }
-    void write(const std::string& name, const std::string& text) const { std::ofstream(path_ / name) << text; }
-    const fs::path& path() const { return path_; }
+    ~ShaderFolder() { ::unsetenv("SKINLAB_SHADER_DIR"); }
+    void write(const std::string& name, const std::string& text) const { folder_.write(name, text); }
+    const fs::path& path() const { return folder_.path(); }
 
 private:
-    fs::path path_;
+    const test_support::TempFolder folder_{"shader-lines"};
 };
 
 std::string compileError(const ShaderFolder& folder) {

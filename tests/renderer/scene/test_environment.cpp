@@ -2,6 +2,7 @@
 // (Ramamoorthi & Hanrahan 2001) against analytic irradiance.
 #include "common/error.h"
 #include "renderer/scene/environment.h"
+#include "tests/common/temp_folder.h"
 
 #include <gtest/gtest.h>
 
@@ -174,13 +175,6 @@ TEST(IrradianceSH9, SmallBrightSourceStaysWithinTheBandLimitBound) {
 
 class EnvironmentFiles : public ::testing::Test {
 protected:
-    void SetUp() override {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        folder_ = fs::temp_directory_path() / ("skinlab-env-" + std::to_string(::getpid()) + "-" + info->name());
-        fs::remove_all(folder_);
-        fs::create_directories(folder_);
-    }
-    void TearDown() override { fs::remove_all(folder_); }
     fs::path writeExr(const std::string& name, int width, int height, const glm::vec3& value) const {
         const fs::path path = folder_ / name;
         std::vector<float> pixels(static_cast<std::size_t>(width * height * 3));
@@ -196,7 +190,7 @@ protected:
         output->close();
         return path;
     }
-    fs::path folder_;
+    const test_support::TempFolder folder_;
 };
 
 std::string inputErrorOf(const std::function<void()>& f) {

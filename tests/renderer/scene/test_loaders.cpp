@@ -4,6 +4,7 @@
 #include "common/error.h"
 #include "renderer/scene/mesh_loader.h"
 #include "renderer/scene/texture.h"
+#include "tests/common/temp_folder.h"
 
 #include <gtest/gtest.h>
 
@@ -22,23 +23,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A fresh folder per test, removed afterwards.
-class TempFolder : public ::testing::Test {
+// A fresh folder per test (tests/common/temp_folder.h), removed afterwards.
+class InTempFolder : public ::testing::Test {
 protected:
-    void SetUp() override {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        folder_ = fs::temp_directory_path() /
-                  ("skinlab-assets-" + std::to_string(::getpid()) + "-" + info->test_suite_name() + "-" + info->name());
-        fs::remove_all(folder_);
-        fs::create_directories(folder_);
-    }
-    void TearDown() override { fs::remove_all(folder_); }
-    fs::path write(const std::string& name, const std::string& content) const {
-        const fs::path path = folder_ / name;
-        std::ofstream(path, std::ios::binary) << content;
-        return path;
-    }
-    fs::path folder_;
+    fs::path write(const std::string& name, const std::string& content) const { return folder_.write(name, content); }
+    const test_support::TempFolder folder_;
 };
 
 std::string expectInputError(const std::function<void()>& f) {
@@ -83,7 +72,7 @@ newmtl paintMaterial
 Kd 0.1 0.2 0.3
 )";
 
-class ObjLoader : public TempFolder {};
+class ObjLoader : public InTempFolder {};
 
 TEST_F(ObjLoader, TriangulatesGeneratesFlatNormalsAndKeepsMaterials) {
     write("cube.mtl", kCubeMtl);
@@ -206,7 +195,7 @@ std::string triangleGltf() {
 })";
 }
 
-class GltfLoader : public TempFolder {};
+class GltfLoader : public InTempFolder {};
 
 TEST_F(GltfLoader, AppliesNestedNodeTransformsToPositionsAndNormals) {
     const Model model = loadModel(write("triangle.gltf", triangleGltf()));
@@ -239,7 +228,7 @@ TEST_F(GltfLoader, KeepsGltfUvsAndDerivesMirroredHandedness) {
 
 // --- bad model files ----------------------------------------------------------------------------------------
 
-class BadModel : public TempFolder {};
+class BadModel : public InTempFolder {};
 
 TEST_F(BadModel, MissingFileNamesThePath) {
     const fs::path path = folder_ / "absent.glb";
@@ -414,7 +403,7 @@ TEST(SrgbTransfer, MatchesTheFormulaAndRoundTrips) {
     EXPECT_LT(worstRoundTrip, 2e-6);
 }
 
-class TextureLoader : public TempFolder {
+class TextureLoader : public InTempFolder {
 protected:
     // Writes an 8-bit image with the given channel count; pixel values row-major, top row first.
     fs::path writeImage(const std::string& name, int width, int height, int channels,

@@ -2,6 +2,7 @@
 #include "common/error.h"
 #include "renderer/scene/builtin_scenes.h"
 #include "renderer/scene/scene_spec.h"
+#include "tests/common/temp_folder.h"
 
 #include <cmath>
 #include <fstream>
@@ -22,24 +23,7 @@ std::string errorOf(const std::string& scene, const std::vector<std::string>& ov
     return "";
 }
 
-class TempFolder {
-public:
-    TempFolder() {
-        path_ = std::filesystem::temp_directory_path() /
-                ("skinlab-scene-spec-" + std::to_string(::getpid()) + "-" + std::to_string(counter_++));
-        std::filesystem::create_directories(path_);
-    }
-    ~TempFolder() { std::filesystem::remove_all(path_); }
-    const std::filesystem::path& path() const { return path_; }
-    std::filesystem::path write(const std::string& name, const std::string& text) const {
-        std::ofstream(path_ / name) << text;
-        return path_ / name;
-    }
-
-private:
-    std::filesystem::path path_;
-    static inline int counter_ = 0;
-};
+using test_support::TempFolder;
 
 TEST(SceneSpec, EveryBuiltinSceneLoadsWithItsDefaults) {
     for (const std::string& name : builtinSceneNames()) {

@@ -7,6 +7,7 @@
 #include "renderer/sss/gaussian_sum_profile.h"
 #include "renderer/sss/kernel.h"
 #include "renderer/sss/tabulated_kernel.h"
+#include "tests/common/temp_folder.h"
 
 #include "common/error.h"
 #include "common/files.h"
@@ -209,11 +210,6 @@ TEST(Kernels, InconsistentParametersAreInputErrors) {
 // --- tabulated kernels (.bn) ---
 
 namespace {
-fs::path scratchDir() {
-    fs::path dir = fs::temp_directory_path() / ("skinlab_test_bn-" + std::to_string(::getpid()));
-    fs::create_directories(dir);
-    return dir;
-}
 std::string floats(std::initializer_list<float> values) {
     std::string bytes;
     for (float v : values) bytes.append(reinterpret_cast<const char*>(&v), 4);
@@ -230,7 +226,8 @@ std::string errorOf(const fs::path& path) {
 } // namespace
 
 TEST(TabulatedKernel, ReadsAWellFormedFile) {
-    const fs::path file = scratchDir() / "three.bn";
+    const skinlab::test_support::TempFolder folder;
+    const fs::path file = folder / "three.bn";
     skinlab::writeFileAtomic(file, floats({12, 0.25f, 0.2f, 0.1f, -1, 0.5f, 0.6f, 0.8f, 0, 0.25f, 0.2f, 0.1f, 1}));
     const auto rows = readTabulatedKernel(file);
     ASSERT_EQ(rows.size(), 3u);
@@ -245,7 +242,8 @@ TEST(TabulatedKernel, ReadsAWellFormedFile) {
 }
 
 TEST(TabulatedKernel, BadFilesAreNamedInTheError) {
-    const fs::path dir = scratchDir();
+    const skinlab::test_support::TempFolder folder;
+    const fs::path& dir = folder.path();
     EXPECT_EQ(errorOf(dir / "missing.bn"), (dir / "missing.bn").string() + ": kernel file not found");
     skinlab::writeFileAtomic(dir / "short.bn", floats({12, 0.25f, 0.2f, 0.1f, -1, 0.5f}));
     EXPECT_EQ(errorOf(dir / "short.bn"),
@@ -293,7 +291,8 @@ TEST(TabulatedKernel, TruncatedCopyOfPublishedKernelIsRejected) {
     const fs::path skin2 = skinlab::test::referenceKernel("Skin2");
     SKINLAB_REQUIRE_REFERENCE(skin2);
     const std::string bytes = skinlab::readFile(skin2);
-    const fs::path cut = scratchDir() / "Skin2_cut.bn";
+    const skinlab::test_support::TempFolder folder;
+    const fs::path cut = folder / "Skin2_cut.bn";
     skinlab::writeFileAtomic(cut, std::string_view(bytes).substr(0, bytes.size() / 2));
     EXPECT_EQ(errorOf(cut), cut.string() + ": truncated: header says 2248 floats, file holds 1123");
 }
