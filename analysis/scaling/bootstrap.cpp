@@ -97,7 +97,9 @@ Resamples resampleObservers(const BlockData& block, const FitResult& fit, const 
             weights.setZero();
             for (int k = 0; k < n; ++k) weights[pick(random)] += 1.0;
             // Warm start at the full-data scores: a resample's optimum is near, so 2–4 Newton steps suffice.
-            const FitResult resampled = fitScores(block.weightedCounts(weights), fitOptions, &fit.scores);
+            // pwcmp's prior: the full-data fit's prior Hessian (its gradient is exact, so the optimum is).
+            const FitResult resampled = fitScores(block.weightedCounts(weights), fitOptions, &fit.scores,
+                                                  fitOptions.prior == Prior::Pwcmp ? &fit.priorInformation : nullptr);
             const Eigen::MatrixXd v = robustCovariance(block, weights, resampled, fitOptions.model);
             for (int i = 0; i < m; ++i) {
                 scores(b, i) = resampled.scores[i];

@@ -90,6 +90,10 @@ const char* modelName(Model model) { return model == Model::Thurstone ? "thursto
 
 const char* priorName(Prior prior) { return prior == Prior::Gaussian ? "gaussian" : "pwcmp"; }
 
+double priorPrecisionPerScore(const FitOptions& options, int conditions) {
+    return options.prior == Prior::Gaussian ? options.priorPrecision * conditions : NAN;
+}
+
 double pwcmpLogPrior(const PairCounts& counts, const Eigen::VectorXd& scores, Eigen::VectorXd* gradient, Model model) {
     // Every compared pair in both orders, as pw_scale's matrices: o = (i, j) with k_o answers for i out of n_o.
     struct Ordered {
@@ -124,31 +128,37 @@ double pwcmpLogPrior(const PairCounts& counts, const Eigen::VectorXd& scores, Ei
         slopeQ[o] = -backward.slope;
     }
     // R(o, b) = P_o^k_b (1 − P_o)^(n_b − k_b) / Σ_o' (same): the probability of outcome b at distance o, normalised
-    // over the distances (a softmax over o, computed in logs so that large counts do not underflow).
-    Eigen::MatrixXd share(size, size);
+    // over the distances (a softmax over o, computed in logs so that large counts do not underflow). The exponent is
+    // the rank-2 matrix log P kᵀ + log(1 − P) (n − k)ᵀ.
+    Eigen::VectorXd k(size), rest(size);
     for (Eigen::Index b = 0; b < size; ++b) {
-        const double k = ordered[b].k, rest = ordered[b].n - ordered[b].k;
-        for (Eigen::Index o = 0; o < size; ++o)
-            share(o, b) = (k > 0 ? k * logP[o] : 0.0) + (rest > 0 ? rest * logQ[o] : 0.0);
-        const double top = share.col(b).maxCoeff();
-        share.col(b) = (share.col(b).array() - top).exp();
-        share.col(b) /= share.col(b).sum();
+        k[b] = ordered[b].k;
+        rest[b] = ordered[b].n - ordered[b].k;
     }
+    Eigen::MatrixXd share(size, size);
+    share.noalias() = logP * k.transpose();
+    share.noalias() += logQ * rest.transpose();
+    const Eigen::RowVectorXd top = share.colwise().maxCoeff();
+    share.rowwise() -= top;
+    share = share.array().exp().matrix();
+    const Eigen::RowVectorXd columnSums = share.colwise().sum();
+    share.array().rowwise() /= columnSums.array();
     const Eigen::VectorXd prior = share.rowwise().sum(); // π_o
     // Each unordered pair appears twice with π equal in both orders; pw_scale's objective also counts the data
     // twice, so its log posterior is this sum halved.
     const double value = 0.5 * (prior.array() + 0.1).log().sum();
     if (gradient) {
         // ∂π_o/∂d_c = δ_oc Σ_b R(o,b) ℓ'_b(d_o) − Σ_b R(o,b) R(c,b) ℓ'_b(d_c), ℓ_b = k_b log P + (n_b − k_b) log(1 − P),
-        // so ∂/∂d_c ½ Σ_o log(π_o + 0.1) = ½ Σ_b R(c,b) ℓ'_b(d_c) (w_c − u_b), w = 1/(π + 0.1), u_b = Σ_o w_o R(o,b).
+        // so ∂/∂d_c ½ Σ_o log(π_o + 0.1) = ½ Σ_b R(c,b) ℓ'_b(d_c) (w_c − u_b), w = 1/(π + 0.1), u_b = Σ_o w_o R(o,b);
+        // with ℓ'_b(d_c) = k_b P'_c + (n_b − k_b) Q'_c that is ½ [P'_c (w_c (R k)_c − (R (k∘u))_c) + Q'_c (same with
+        // n − k)], four matrix–vector products.
         const Eigen::VectorXd w = (prior.array() + 0.1).inverse();
         const Eigen::VectorXd u = share.transpose() * w;
+        const Eigen::VectorXd shareK = share * k, shareRest = share * rest;
+        const Eigen::VectorXd shareKU = share * k.cwiseProduct(u), shareRestU = share * rest.cwiseProduct(u);
         for (Eigen::Index c = 0; c < size; ++c) {
-            double total = 0.0;
-            for (Eigen::Index b = 0; b < size; ++b) {
-                const double slope = ordered[b].k * slopeP[c] + (ordered[b].n - ordered[b].k) * slopeQ[c];
-                total += share(c, b) * slope * (w[c] - u[b]);
-            }
+            const double total =
+                slopeP[c] * (w[c] * shareK[c] - shareKU[c]) + slopeQ[c] * (w[c] * shareRest[c] - shareRestU[c]);
             (*gradient)[ordered[c].i] += 0.5 * total;
             (*gradient)[ordered[c].j] -= 0.5 * total;
         }
@@ -194,9 +204,16 @@ void addMeanPenalty(const PairCounts& counts, const FitOptions& options, const E
     }
 }
 
+void addData(const PairCounts& counts, const FitOptions& options, const Eigen::VectorXd& q, Eigen::VectorXd& gradient,
+             Eigen::MatrixXd& information);
+
 // Gradient and negative Hessian (plus the mean penalty's) of the log posterior at q.
+// `priorInformation` (pwcmp's prior only, optional): the prior's negative Hessian to use instead of differencing
+// its gradient (the bootstrap passes the full-data fit's); Newton's method then still converges to the same
+// optimum. `priorInformationOut` (optional) receives the prior's negative Hessian that was used.
 void assemble(const PairCounts& counts, const FitOptions& options, const Eigen::VectorXd& q, Eigen::VectorXd& gradient,
-              Eigen::MatrixXd& information) {
+              Eigen::MatrixXd& information, const Eigen::MatrixXd* priorInformation = nullptr,
+              Eigen::MatrixXd* priorInformationOut = nullptr) {
     const int m = counts.conditions;
     const double md = static_cast<double>(m);
     gradient.setZero(m);
@@ -210,19 +227,30 @@ void assemble(const PairCounts& counts, const FitOptions& options, const Eigen::
         // pwcmp's prior: analytic gradient; its Hessian by central differences of the gradient (the prior is a
         // smooth function of the distances; h = 10⁻⁵ JOD leaves an error near 10⁻¹⁰).
         pwcmpLogPrior(counts, q, &gradient, options.model);
-        constexpr double h = 1e-5;
-        Eigen::VectorXd up(m), down(m);
-        for (int k = 0; k < m; ++k) {
-            Eigen::VectorXd shifted = q;
-            shifted[k] += h;
-            pwcmpLogPrior(counts, shifted, &up, options.model);
-            shifted[k] -= 2.0 * h;
-            pwcmpLogPrior(counts, shifted, &down, options.model);
-            information.col(k) = -(up - down) / (2.0 * h);
+        if (priorInformation != nullptr && priorInformation->rows() == m) {
+            information = *priorInformation;
+        } else {
+            constexpr double h = 1e-5;
+            Eigen::VectorXd up(m), down(m);
+            for (int k = 0; k < m; ++k) {
+                Eigen::VectorXd shifted = q;
+                shifted[k] += h;
+                pwcmpLogPrior(counts, shifted, &up, options.model);
+                shifted[k] -= 2.0 * h;
+                pwcmpLogPrior(counts, shifted, &down, options.model);
+                information.col(k) = -(up - down) / (2.0 * h);
+            }
+            information = 0.5 * (information + information.transpose()).eval();
         }
-        information = 0.5 * (information + information.transpose()).eval();
+        if (priorInformationOut) *priorInformationOut = information;
     }
     addMeanPenalty(counts, options, q, gradient, information);
+    addData(counts, options, q, gradient, information);
+}
+
+// The data term's gradient and negative Hessian.
+void addData(const PairCounts& counts, const FitOptions& options, const Eigen::VectorXd& q, Eigen::VectorXd& gradient,
+             Eigen::MatrixXd& information) {
     for (size_t p = 0; p < counts.pairs.size(); ++p) {
         const auto [i, j] = counts.pairs[p];
         const double d = q[i] - q[j];
@@ -265,7 +293,8 @@ double logPosterior(const PairCounts& counts, const FitOptions& options, const E
     return objective(counts, options, scores, nullptr);
 }
 
-FitResult fitScores(const PairCounts& counts, const FitOptions& options, const Eigen::VectorXd* start) {
+FitResult fitScores(const PairCounts& counts, const FitOptions& options, const Eigen::VectorXd* start,
+                    const Eigen::MatrixXd* priorInformation) {
     const int m = counts.conditions;
     FitResult result;
     result.scores = start ? *start : Eigen::VectorXd::Zero(m);
@@ -274,7 +303,7 @@ FitResult fitScores(const PairCounts& counts, const FitOptions& options, const E
     double current = objective(counts, options, result.scores, nullptr);
 
     for (result.iterations = 0; result.iterations < options.maxIterations; ++result.iterations) {
-        assemble(counts, options, result.scores, gradient, information);
+        assemble(counts, options, result.scores, gradient, information, priorInformation);
         const Eigen::LDLT<Eigen::MatrixXd> solver = newtonSolver(information);
         Eigen::VectorXd step = solver.solve(gradient);
         // Backtracking: the log posterior is concave, so a full Newton step is accepted except far from the
@@ -295,7 +324,8 @@ FitResult fitScores(const PairCounts& counts, const FitOptions& options, const E
             break;
         }
     }
-    assemble(counts, options, result.scores, gradient, information);
+    assemble(counts, options, result.scores, gradient, information, priorInformation,
+             options.prior == Prior::Pwcmp ? &result.priorInformation : nullptr);
     result.inverseInformation = newtonSolver(information).solve(Eigen::MatrixXd::Identity(m, m));
     // `information` has eigenvalue |c| along 1_c/√|c| for the mean penalty of each centred group c (all conditions
     // under the Gaussian prior, each connected component under pwcmp's); remove those directions so the matrix is
