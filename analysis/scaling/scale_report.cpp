@@ -290,6 +290,35 @@ nlohmann::json observersJson(const Analysis& analysis) {
     return observers;
 }
 
+// The report section's observer table: screening, catch trials, side (exact binomial test), pwcmp's outliers.
+void observersHtml(std::ostringstream& html, const Analysis& analysis) {
+    const AnalysisOptions& o = analysis.options;
+    html << "<h3>Observers</h3>\n<table>\n<tr><th>observer</th><th>trials</th><th>held-out log-likelihood / trial</th>"
+            "<th>outlier</th><th>catch failures</th><th>left chosen</th><th>side bias (p, "
+         << correctionName(o.correction) << ")</th></tr>\n";
+    for (const ObserverSummary& s : analysis.observers)
+        html << "<tr><td>" << escapeHtml(s.observer) << "</td><td>" << s.trials << "</td><td>"
+             << fixed(s.heldOutPerTrial, 3) << "</td><td>" << (s.flagged ? "<strong>yes</strong>" : "no") << "</td><td>"
+             << s.catchFailures << " / " << s.catchTrials << "</td><td>"
+             << (s.sideTrials > 0 ? fixed(100.0 * s.leftChosen / s.sideTrials, 1) + " %" : std::string("–"))
+             << "</td><td>"
+             << (s.sideTrials > 0
+                     ? (s.sideBiased ? "<strong>yes</strong> (" : "no (") + number(s.sidePAdjusted, 3) + ")"
+                     : std::string("–"))
+             << "</td></tr>\n";
+    html << "</table>\n<p>Outlier rule: held-out log-likelihood per trial below Q1 − " << o.screeningWhisker
+         << "·IQR = " << fixed(analysis.screeningRule.threshold, 3) << ".</p>\n";
+    if (o.pwcmpOutliers) {
+        std::string flagged;
+        for (const ObserverSummary& s : analysis.observers)
+            if (s.pwcmpOutlier)
+                flagged +=
+                    (flagged.empty() ? "" : ", ") + escapeHtml(s.observer) + " (" + fixed(s.pwcmpDistance, 2) + ")";
+        html << "<p>pwcmp's outlier analysis (dist_L &gt; 1.5): " << (flagged.empty() ? "no observer" : flagged)
+             << ".</p>\n";
+    }
+}
+
 } // namespace
 
 std::string blockSlug(const std::string& name) {
@@ -420,30 +449,7 @@ std::string reportSectionHtml(const Analysis& analysis) {
                  << "</td><td>" << (pair.significant ? "yes" : "no") << "</td></tr>\n";
         html << "</table>\n";
     }
-    html << "<h3>Observers</h3>\n<table>\n<tr><th>observer</th><th>trials</th><th>held-out log-likelihood / trial</th>"
-            "<th>outlier</th><th>catch failures</th><th>left chosen</th><th>side bias (p, "
-         << correctionName(o.correction) << ")</th></tr>\n";
-    for (const ObserverSummary& s : analysis.observers)
-        html << "<tr><td>" << escapeHtml(s.observer) << "</td><td>" << s.trials << "</td><td>"
-             << fixed(s.heldOutPerTrial, 3) << "</td><td>" << (s.flagged ? "<strong>yes</strong>" : "no") << "</td><td>"
-             << s.catchFailures << " / " << s.catchTrials << "</td><td>"
-             << (s.sideTrials > 0 ? fixed(100.0 * s.leftChosen / s.sideTrials, 1) + " %" : std::string("–"))
-             << "</td><td>"
-             << (s.sideTrials > 0
-                     ? (s.sideBiased ? "<strong>yes</strong> (" : "no (") + number(s.sidePAdjusted, 3) + ")"
-                     : std::string("–"))
-             << "</td></tr>\n";
-    html << "</table>\n<p>Outlier rule: held-out log-likelihood per trial below Q1 − " << o.screeningWhisker
-         << "·IQR = " << fixed(analysis.screeningRule.threshold, 3) << ".</p>\n";
-    if (o.pwcmpOutliers) {
-        std::string flagged;
-        for (const ObserverSummary& s : analysis.observers)
-            if (s.pwcmpOutlier)
-                flagged +=
-                    (flagged.empty() ? "" : ", ") + escapeHtml(s.observer) + " (" + fixed(s.pwcmpDistance, 2) + ")";
-        html << "<p>pwcmp's outlier analysis (dist_L &gt; 1.5): " << (flagged.empty() ? "no observer" : flagged)
-             << ".</p>\n";
-    }
+    observersHtml(html, analysis);
     html << "</section>\n";
     return html.str();
 }
