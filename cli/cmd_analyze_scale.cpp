@@ -127,6 +127,10 @@ void runScale(const ScaleArguments& arguments) {
                     note += (note.empty() ? "" : ", ") + reason;
                 note = "  percentile+profile (" + note + ")";
             }
+            if (i < block.measured.size() && !block.measured[i]) {
+                std::printf("  %-24s not measured (never compared)\n", block.conditions[i].c_str());
+                continue;
+            }
             char interval[96];
             const double low = block.low[k], high = block.high[k];
             if (std::isfinite(low) && std::isfinite(high))
@@ -134,8 +138,9 @@ void runScale(const ScaleArguments& arguments) {
             else if (std::isfinite(low)) std::snprintf(interval, sizeof interval, "at least %+.3f", low);
             else if (std::isfinite(high)) std::snprintf(interval, sizeof interval, "at most %+.3f", high);
             else std::snprintf(interval, sizeof interval, "not measured");
-            std::printf("  %-24s %+7.3f JOD  %s%s\n", block.conditions[i].c_str(), block.thurstone.scores[k], interval,
-                        note.c_str());
+            const bool priorDriven = i < block.intervalFlags.size() && block.intervalFlags[i].priorDriven;
+            std::printf("  %-24s %+7.3f JOD%s  %s%s\n", block.conditions[i].c_str(), block.thurstone.scores[k],
+                        priorDriven ? " (value set by the prior)" : "", interval, note.c_str());
         }
     }
     for (const scaling::ObserverSummary& observer : analysis.observers)

@@ -257,10 +257,13 @@ json StudyDashboard::computeScale() const {
         for (std::size_t i = 0; i < block.conditions.size(); ++i) {
             const auto k = static_cast<Eigen::Index>(i);
             const bool fallback = i < block.intervalFlags.size() && block.intervalFlags[i].fallback;
+            // A condition never compared has no score: null values, "measured": false (shown as "not measured").
+            const bool measured = i >= block.measured.size() || block.measured[i];
             conditions.push_back({{"condition", block.conditions[i]},
-                                  {"jod", number(block.thurstone.scores[k])},
-                                  {"low", number(block.low[k])},
-                                  {"high", number(block.high[k])},
+                                  {"measured", measured},
+                                  {"jod", measured ? number(block.thurstone.scores[k]) : json()},
+                                  {"low", measured ? number(block.low[k]) : json()},
+                                  {"high", measured ? number(block.high[k]) : json()},
                                   {"interval_fallback", fallback}});
         }
         blocks.push_back({{"block", block.name},

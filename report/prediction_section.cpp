@@ -1,6 +1,7 @@
 #include "report/prediction_section.h"
 
 #include "analysis/agreement/metric_agreement.h"
+#include "analysis/scaling/bootstrap.h"
 #include "analysis/metrics/cvvdp.h"
 #include "analysis/metrics/metric_render.h"
 #include "common/html.h"
@@ -10,6 +11,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <random>
 #include <sstream>
 #include <tuple>
 
@@ -17,10 +19,134 @@ namespace skinlab::report {
 namespace scaling = skinlab::analysis::scaling;
 namespace agreement = skinlab::analysis::agreement;
 
+namespace {
+
+constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
+
+// Slope of y on x with an intercept, and the RMS of y − x about its mean (n − 1 dof); NaN where undefined.
+std::pair<double, double> slopeAndRmse(const std::vector<double>& x, const std::vector<double>& y) {
+    const auto n = static_cast<double>(x.size());
+    if (x.size() < 3) return {kNan, kNan};
+    double mx = 0.0, my = 0.0, md = 0.0;
+    for (std::size_t i = 0; i < x.size(); ++i) mx += x[i] / n, my += y[i] / n, md += (y[i] - x[i]) / n;
+    double xy = 0.0, xx = 0.0, squares = 0.0;
+    for (std::size_t i = 0; i < x.size(); ++i) {
+        xy += (x[i] - mx) * (y[i] - my);
+        xx += (x[i] - mx) * (x[i] - mx);
+        squares += (y[i] - x[i] - md) * (y[i] - x[i] - md);
+    }
+    return {xx > 0.0 ? xy / xx : kNan, std::sqrt(squares / (n - 1.0))};
+}
+
+// Student's t quantile at probability p with `df` degrees of freedom (Hill 1970's series, ample for 2 ≤ df).
+double studentQuantile(double p, int df) {
+    const double z = scaling::normalQuantile(p), n = df;
+    const double z2 = z * z;
+    return z + z * (z2 + 1.0) / (4.0 * n) + z * ((5.0 * z2 + 16.0) * z2 + 3.0) / (96.0 * n * n) +
+           z * (((3.0 * z2 + 19.0) * z2 + 17.0) * z2 - 15.0) / (384.0 * n * n * n);
+}
+
+// The interval of `estimate` from its bootstrap over `observers` observers: estimate − bias ± t·sd·√(n/(n − 1)),
+// bias = mean(resamples) − estimate when `biasCorrected`, t with n − 1 degrees of freedom. The percentile interval
+// of the resampled slopes covered the true slope in 86 % of simulated 5-condition studies at 10 observers; this
+// one in 97 % (docs/report.md). NaN with fewer than 20 finite resamples.
+std::pair<double, double> bootstrapInterval(double estimate, std::vector<double> values, int observers, double level,
+                                            bool biasCorrected) {
+    std::erase_if(values, [](double v) { return !std::isfinite(v); });
+    if (values.size() < 20 || observers < 2) return {kNan, kNan};
+    double mean = 0.0, variance = 0.0;
+    for (double v : values) mean += v / double(values.size());
+    for (double v : values) variance += (v - mean) * (v - mean) / double(values.size() - 1);
+    const double centre = biasCorrected ? 2.0 * estimate - mean : estimate;
+    const double half = studentQuantile(0.5 + 0.5 * level, observers - 1) * std::sqrt(variance) *
+                        std::sqrt(double(observers) / double(observers - 1));
+    return {centre - half, centre + half};
+}
+
+// The bootstrap of slope and RMSE: observers resampled (the scale re-fitted), and the conditions too from
+// kFewConditions on.
+void bootstrapAgreement(PredictionAgreement& a, const std::vector<int>& used, const scaling::BlockAnalysis& block,
+                        const scaling::BlockData& data, const PredictionOptions& options) {
+    const int observers = data.observerCount();
+    if (!data.hasObservers || observers < 2) return;
+    a.overConditions = static_cast<int>(used.size()) >= agreement::kFewConditions;
+    scaling::FitOptions fit = options.fit;
+    fit.model = scaling::Model::Thurstone;
+    std::vector<double> slopes, rmses;
+    for (int b = 0; b < options.samples; ++b) {
+        std::mt19937_64 random(scaling::mixSeed(options.seed, static_cast<std::uint64_t>(b)));
+        std::uniform_int_distribution<int> pick(0, observers - 1);
+        Eigen::VectorXd weights = Eigen::VectorXd::Zero(observers);
+        for (int k = 0; k < observers; ++k) weights[pick(random)] += 1.0;
+        const Eigen::VectorXd scores =
+            scaling::fitScores(data.weightedCounts(weights), fit, &block.thurstone.scores).scores;
+        std::vector<double> x, y;
+        std::uniform_int_distribution<std::size_t> condition(0, used.size() - 1);
+        for (std::size_t k = 0; k < used.size(); ++k) {
+            const std::size_t c = a.overConditions ? condition(random) : k;
+            x.push_back(a.predicted[c]);
+            y.push_back(scores[used[c]]);
+        }
+        const auto [slope, rmse] = slopeAndRmse(x, y);
+        slopes.push_back(slope);
+        rmses.push_back(rmse);
+    }
+    std::tie(a.slopeLow, a.slopeHigh) = bootstrapInterval(a.slope, slopes, observers, options.level, false);
+    // The RMSE includes the measurement noise, which inflates it: its bootstrap bias is removed; never below 0.
+    std::tie(a.rmseLow, a.rmseHigh) = bootstrapInterval(a.rmse, rmses, observers, options.level, true);
+    a.rmseLow = std::max(a.rmseLow, 0.0);
+    a.rmseHigh = std::max(a.rmseHigh, 0.0);
+    a.bootstrapSamples = options.samples;
+}
+
+} // namespace
+
+std::optional<PredictionAgreement> blockPredictionAgreement(const scaling::BlockAnalysis& block,
+                                                            const std::vector<double>& predicted,
+                                                            const scaling::BlockData* data,
+                                                            const PredictionOptions& options) {
+    std::vector<int> used;
+    int anchor = -1;
+    for (std::size_t i = 0; i < predicted.size(); ++i) {
+        const int k = static_cast<int>(i);
+        if (!std::isfinite(predicted[i]) || (i < block.measured.size() && !block.measured[i])) continue;
+        used.push_back(k);
+        if (anchor < 0 || predicted[i] > predicted[static_cast<std::size_t>(anchor)]) anchor = k;
+    }
+    if (used.size() < 3) return std::nullopt;
+    PredictionAgreement a;
+    a.block = block.name;
+    a.anchor = block.conditions[static_cast<std::size_t>(anchor)];
+    a.observers = static_cast<int>(block.observers.size());
+    double predictedMean = 0.0, measuredMean = 0.0;
+    for (int k : used) {
+        predictedMean += (predicted[k] - predicted[anchor]) / double(used.size());
+        measuredMean += block.thurstone.scores[k] / double(used.size());
+    }
+    const double shift = predictedMean - measuredMean;
+    for (int k : used) {
+        a.conditions.push_back(block.conditions[static_cast<std::size_t>(k)]);
+        a.predicted.push_back(predicted[k] - predicted[anchor]);
+        a.measured.push_back(block.thurstone.scores[k] + shift);
+        a.low.push_back(block.low[k] + shift);
+        a.high.push_back(block.high[k] + shift);
+    }
+    std::tie(a.slope, a.rmse) = slopeAndRmse(a.predicted, a.measured);
+    a.slopeLow = a.slopeHigh = a.rmseLow = a.rmseHigh = kNan;
+    if (data) bootstrapAgreement(a, used, block, *data, options);
+    const int n = static_cast<int>(used.size());
+    a.spearman = agreement::spearmanCorrelation(a.predicted, a.measured);
+    a.spearmanP = agreement::correlationPValue(a.predicted, a.measured, true);
+    std::tie(a.spearmanLow, a.spearmanHigh) =
+        n < agreement::kFewConditions ? agreement::spearmanExactInterval(a.spearman, n, options.level)
+                                      : agreement::correlationInterval(a.spearman, n, true, 0.0, options.level);
+    return a;
+}
+
 std::vector<PredictionAgreement> predictionAgreement(const experiments::StudyDefinition& definition,
-                                                     const nlohmann::json& manifest,
-                                                     const scaling::Analysis& analysis) {
-    constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+                                                     const nlohmann::json& manifest, const scaling::Analysis& analysis,
+                                                     const scaling::Dataset* dataset,
+                                                     const PredictionOptions& options) {
     std::map<std::string, double> predictedOfStimulus;
     if (manifest.contains("stimuli"))
         for (const nlohmann::json& s : manifest["stimuli"])
@@ -30,7 +156,7 @@ std::vector<PredictionAgreement> predictionAgreement(const experiments::StudyDef
     std::vector<PredictionAgreement> out;
     for (const scaling::BlockAnalysis& block : analysis.blocks) {
         // Predicted JOD of each of the block's conditions (through the stimulus showing it).
-        std::vector<double> predicted(block.conditions.size(), nan);
+        std::vector<double> predicted(block.conditions.size(), kNan);
         for (const experiments::StudyStimulus& s : definition.stimuli) {
             if (s.block != block.name || s.condition.empty()) continue;
             const auto it = std::find(block.conditions.begin(), block.conditions.end(), s.condition);
@@ -38,44 +164,11 @@ std::vector<PredictionAgreement> predictionAgreement(const experiments::StudyDef
             if (it != block.conditions.end() && p != predictedOfStimulus.end())
                 predicted[static_cast<std::size_t>(it - block.conditions.begin())] = p->second;
         }
-        int anchor = -1;
-        for (std::size_t i = 0; i < predicted.size(); ++i)
-            if (std::isfinite(predicted[i]) &&
-                (anchor < 0 || predicted[i] > predicted[static_cast<std::size_t>(anchor)]))
-                anchor = static_cast<int>(i);
-        if (anchor < 0) continue;
-        PredictionAgreement a;
-        a.block = block.name;
-        a.anchor = block.conditions[static_cast<std::size_t>(anchor)];
-        for (std::size_t i = 0; i < predicted.size(); ++i) {
-            if (!std::isfinite(predicted[i])) continue;
-            const int k = static_cast<int>(i);
-            a.conditions.push_back(block.conditions[i]);
-            a.predicted.push_back(predicted[i] - predicted[static_cast<std::size_t>(anchor)]);
-            a.measured.push_back(block.thurstone.scores[k] - block.thurstone.scores[anchor]);
-            double low = nan, high = nan;
-            if (k == anchor) low = high = 0.0;
-            for (const scaling::PairTest& pair : block.pairs) {
-                if (k == anchor) break;
-                if (pair.test.first == k && pair.test.second == anchor) low = pair.test.low, high = pair.test.high;
-                if (pair.test.first == anchor && pair.test.second == k) low = -pair.test.high, high = -pair.test.low;
-            }
-            a.low.push_back(low);
-            a.high.push_back(high);
-        }
-        if (a.conditions.size() < 3) continue;
-        double xy = 0.0, xx = 0.0, squares = 0.0;
-        for (std::size_t i = 0; i < a.predicted.size(); ++i) {
-            xy += a.predicted[i] * a.measured[i];
-            xx += a.predicted[i] * a.predicted[i];
-            squares += (a.measured[i] - a.predicted[i]) * (a.measured[i] - a.predicted[i]);
-        }
-        a.slope = xx > 0 ? xy / xx : nan;
-        a.rmse = std::sqrt(squares / double(a.predicted.size()));
-        a.spearman = agreement::spearmanCorrelation(a.predicted, a.measured);
-        std::tie(a.spearmanLow, a.spearmanHigh) =
-            agreement::correlationInterval(a.spearman, static_cast<int>(a.predicted.size()), true, 0.0, 0.95);
-        out.push_back(std::move(a));
+        const scaling::BlockData* data = nullptr;
+        if (dataset)
+            for (const scaling::BlockData& candidate : dataset->blocks)
+                if (candidate.name == block.name) data = &candidate;
+        if (auto a = blockPredictionAgreement(block, predicted, data, options)) out.push_back(std::move(*a));
     }
     return out;
 }
@@ -144,33 +237,52 @@ std::vector<ParticipantPrediction> participantPredictions(const nlohmann::json& 
 }
 
 std::string predictionSectionHtml(const std::vector<PredictionAgreement>& agreementRows, const std::string& display,
-                                  const std::vector<ParticipantPrediction>& participants) {
+                                  const std::vector<ParticipantPrediction>& participants, int simulatedObservers) {
     if (agreementRows.empty()) return {};
     std::ostringstream html;
     html << "<h2 id=\"prediction\">Predicted and measured</h2><p class=\"note\">Each condition's JOD predicted by "
             "ColorVideoVDP against the block's reference"
          << (display.empty() ? std::string() : " (display " + escapeHtml(display) + ")")
-         << ", and the JOD the observers' answers gave, both as differences to the condition predicted closest to the "
-            "reference (the anchor). Dashed: measured = predicted. Bars: the measured difference's interval. Slope: "
-            "least squares through the anchor (1 = the study saw the differences the model predicts; below 1, "
-            "smaller ones). Spearman's interval: over the conditions (Fisher z, Bonett–Wright).</p>\n";
+         << ", as the difference to the condition predicted closest to the reference (the anchor), and the JOD the "
+            "observers' answers gave, shifted as a whole onto the predictions' mean (the measured scale's zero is "
+            "arbitrary; no condition, the anchor included, is a fixed point). Dashed: measured = predicted. Bars: each "
+            "measured score's interval. Slope: least squares with an intercept (1 = the study saw the differences the "
+            "model predicts; below 1, smaller ones); RMSE about the mean difference. Their intervals: bootstrap over "
+            "observers, each resample re-fitting the scale (and over conditions too from "
+         << agreement::kFewConditions
+         << " conditions): over a handful of conditions a slope of 0.75 can be noise. Spearman's ρ with its exact "
+            "p over all orderings of the conditions and an interval consistent with it.</p>\n";
+    if (simulatedObservers > 0)
+        html << "<p class=\"warning\"><strong>Simulated observers.</strong> " << simulatedObservers
+             << " participants were simulated by <code>skinlab study simulate</code>: their answers come from the "
+                "truth given to it. If that truth was this prediction (<code>--truth predicted</code>), the agreement "
+                "below is circular: it shows how well the study recovers its own input, not whether ColorVideoVDP "
+                "predicts what people see.</p>\n";
     for (const PredictionAgreement& a : agreementRows) {
         std::vector<ScatterPoint> points;
         for (std::size_t i = 0; i < a.conditions.size(); ++i)
             points.push_back({a.conditions[i], a.predicted[i], a.measured[i], a.low[i], a.high[i]});
         ScatterOptions options;
         options.identity = true;
-        options.yLabel = "measured Δ JOD";
+        options.yLabel = "measured JOD (shifted)";
+        auto interval = [](double low, double high) {
+            return std::isfinite(low) && std::isfinite(high)
+                       ? " [" + formatNumber(low, 2) + ", " + formatNumber(high, 2) + "]"
+                       : std::string(" (no interval: fewer than two observers)");
+        };
         html << "<h3 id=\"prediction-" << escapeHtml(a.block) << "\">" << escapeHtml(a.block) << " (anchor <em>"
              << escapeHtml(a.anchor) << "</em>)</h3><div class=\"scatters\"><figure>"
              << scatterSvg(points, "predicted Δ JOD", options) << "</figure></div>"
-             << "<p>Slope " << formatNumber(a.slope, 2) << ", RMSE " << formatNumber(a.rmse, 2)
-             << " JOD, Spearman ρ = " << formatNumber(a.spearman, 2) << " [" << formatNumber(a.spearmanLow, 2) << ", "
-             << formatNumber(a.spearmanHigh, 2) << "] over " << a.conditions.size() << " conditions"
+             << "<p>Slope " << formatNumber(a.slope, 2) << interval(a.slopeLow, a.slopeHigh) << ", RMSE "
+             << formatNumber(a.rmse, 2) << " JOD" << interval(a.rmseLow, a.rmseHigh) << " ("
+             << (a.overConditions ? "bootstrap over observers and conditions" : "bootstrap over observers") << ", "
+             << a.observers << " observers), Spearman ρ = " << formatNumber(a.spearman, 2) << " ["
+             << formatNumber(a.spearmanLow, 2) << ", " << formatNumber(a.spearmanHigh, 2)
+             << "], exact p = " << formatNumber(a.spearmanP, 3) << ", over " << a.conditions.size() << " conditions"
              << (static_cast<int>(a.conditions.size()) < agreement::kFewConditions
                      ? " (few conditions: a wide interval)"
                      : "")
-             << ".</p>\n<table><thead><tr><th class=\"l\">condition</th><th>predicted Δ</th><th>measured Δ</th>"
+             << ".</p>\n<table><thead><tr><th class=\"l\">condition</th><th>predicted Δ</th><th>measured</th>"
                 "<th>interval</th></tr></thead><tbody>";
         for (std::size_t i = 0; i < a.conditions.size(); ++i)
             html << "<tr><td class=\"l\">" << escapeHtml(a.conditions[i]) << "</td><td>"

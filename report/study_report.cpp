@@ -538,6 +538,19 @@ void writeFindings(std::ostringstream& html, const ReportData& r) {
     html << "</ul>\n";
 }
 
+// The Gaussian prior's strength on each score, which grows with the number of conditions m (τ·m); empty for pwcmp's.
+std::string priorStrengthText(const scaling::Analysis& analysis) {
+    int conditions = 0;
+    for (const auto& block : analysis.blocks)
+        conditions = std::max(conditions, static_cast<int>(block.conditions.size()));
+    const double precision = scaling::priorPrecisionPerScore(analysis.options.fit, conditions);
+    if (!std::isfinite(precision)) return "";
+    return " (precision " + num(analysis.options.fit.priorPrecision, 3) +
+           " JOD⁻² on every difference, so τ·m = " + num(precision, 3) + " JOD⁻² on each of the " +
+           std::to_string(conditions) + " scores: sd " + num(1.0 / std::sqrt(precision), 1) +
+           " JOD, stronger with more conditions)";
+}
+
 void writeDesign(std::ostringstream& html, const ReportData& r) {
     const experiments::StudyDefinition& definition = r.definition;
     const experiments::StudyDesign& design = definition.design;
@@ -560,7 +573,7 @@ void writeDesign(std::ostringstream& html, const ReportData& r) {
          << h(r.store.meta("design_sha256").substr(0, 16)) << "…</code> / <code>"
          << h(r.store.meta("manifest_sha256").substr(0, 16)) << "…</code></td></tr>"
          << "<tr><th class=\"l\">Analysis</th><td class=\"l\">Thurstone Case V in JOD (1 JOD = 75 % preference), "
-         << h(scaling::priorName(analysis.options.fit.prior)) << " prior, "
+         << h(scaling::priorName(analysis.options.fit.prior)) << " prior" << priorStrengthText(analysis) << ", "
          << h(analysis.blocks.empty() ? std::string("—") : analysis.blocks.front().intervalMethod) << " intervals ("
          << r.options.bootstrapSamples << " resamples, " << num(100.0 * r.scale.options.bootstrap.level, 0)
          << " %), pairwise tests " << h(scaling::correctionName(analysis.options.correction)) << "-corrected</td></tr>"
@@ -727,7 +740,8 @@ void writePredictions(std::ostringstream& html, const ReportData& r) {
                              [&](const auto& c) { return c.first == session.observer; }))
                 calibrated.emplace_back(session.observer, *session.viewing->pixelsPerDegree);
     html << predictionSectionHtml(r.predictions, r.predictionDisplay,
-                                  participantPredictions(r.storedManifest, r.stimuliFolder, calibrated));
+                                  participantPredictions(r.storedManifest, r.stimuliFolder, calibrated),
+                                  static_cast<int>(r.simulated.size()));
 }
 
 void writeObjectiveErrors(std::ostringstream& html, const ReportData& r) {
@@ -928,7 +942,8 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
     // Predicted JOD (ColorVideoVDP, recorded by `stimuli build`) against the measured scale.
     const nlohmann::json storedManifest = nlohmann::json::parse(store.meta("manifest_json"));
     const std::vector<PredictionAgreement> predictions =
-        predictionAgreement(definition, storedManifest, scale.analysis);
+        predictionAgreement(definition, storedManifest, scale.analysis, &scale.dataset,
+                            {options.bootstrapSamples, options.seed, scale.options.bootstrap.level, scale.options.fit});
     std::string predictionDisplay;
     for (const nlohmann::json& s : storedManifest.value("stimuli", nlohmann::json::array()))
         if (s.contains("predicted") && s["predicted"].contains("display"))

@@ -45,8 +45,13 @@ struct IntervalDiagnosis {
                                       // "extreme-t", "bound-at-search-cap"
     // Which ends of the interval the data set (docs/analysis.md, "Intervals the data support"): "two-sided";
     // "lower" (the data bound it from below only: unanimous answers; the upper end is +∞), "upper", or "none"
-    // (neither end: e.g. conditions in different components of a disconnected design, which cannot be compared).
+    // (neither end: e.g. conditions in different components of a disconnected design, which cannot be compared), or
+    // "not-measured" (a condition never compared). The finite end of a "lower" or "upper" interval is the profile
+    // bound at oneSidedProfileThreshold (profile_likelihood.h) where that is farther out.
     std::string bound = "two-sided";
+    // The point value is partly the prior's: an end the data leave open means the data do not fix the value
+    // either (a unanimous distance is the prior's 4.96 JOD for 10:0). Marked wherever the value is shown.
+    bool priorDriven = false;
 };
 
 struct DifferenceTest {

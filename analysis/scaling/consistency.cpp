@@ -44,7 +44,15 @@ SideBias estimateSideBias(const BlockData& block, const Eigen::VectorXd& scores,
     result.trials = block.sideTrials.sum();
     if (result.trials <= 0) return result;
     result.available = true;
-    result.leftRate = block.leftChosen.sum() / result.trials;
+    result.leftChosen = block.leftChosen.sum();
+    result.leftRate = result.leftChosen / result.trials;
+    result.pValue = binomialHalfPValue(result.leftChosen, result.trials);
+    if (result.leftChosen <= 0.0 || result.leftChosen >= result.trials) {
+        // Every answer on one side: the likelihood of b increases without bound.
+        result.bias = result.leftChosen > 0.0 ? INFINITY : -INFINITY;
+        result.standardError = NAN;
+        return result;
+    }
     // Newton's method on the concave 1-D log-likelihood of b.
     double information = 0.0;
     for (int iteration = 0; iteration < 50; ++iteration) {
@@ -69,9 +77,27 @@ SideBias estimateSideBias(const BlockData& block, const Eigen::VectorXd& scores,
         result.bias += step;
         if (std::abs(step) < 1e-10) break;
     }
-    result.standardError = information > 0 ? 1.0 / std::sqrt(information) : INFINITY;
-    result.pValue = std::erfc(std::abs(result.bias / result.standardError) / std::sqrt(2.0));
+    result.standardError = information > 0 ? 1.0 / std::sqrt(information) : NAN;
     return result;
+}
+
+double binomialHalfPValue(double successes, double trials) {
+    const double n = std::round(trials);
+    if (!(n > 0.0)) return 1.0;
+    const double k = std::clamp(std::round(successes), 0.0, n);
+    const double tail = std::min(k, n - k);
+    if (2.0 * tail >= n) return 1.0;
+    // P(X ≤ tail) = Σ_{x ≤ tail} C(n, x) 2^−n, summed in logs from the largest term down.
+    const double logHalf = n * std::log(0.5);
+    auto logTerm = [&](double x) { return std::lgamma(n + 1.0) - std::lgamma(x + 1.0) - std::lgamma(n - x + 1.0); };
+    const double top = logTerm(tail);
+    double sum = 0.0;
+    for (double x = tail; x >= 0.0; x -= 1.0) {
+        const double term = std::exp(logTerm(x) - top);
+        sum += term;
+        if (term < 1e-17 * sum) break;
+    }
+    return std::min(1.0, 2.0 * std::exp(top + logHalf + std::log(sum)));
 }
 
 } // namespace skinlab::analysis::scaling

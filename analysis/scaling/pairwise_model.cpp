@@ -90,6 +90,10 @@ const char* modelName(Model model) { return model == Model::Thurstone ? "thursto
 
 const char* priorName(Prior prior) { return prior == Prior::Gaussian ? "gaussian" : "pwcmp"; }
 
+double priorPrecisionPerScore(const FitOptions& options, int conditions) {
+    return options.prior == Prior::Gaussian ? options.priorPrecision * conditions : NAN;
+}
+
 double pwcmpLogPrior(const PairCounts& counts, const Eigen::VectorXd& scores, Eigen::VectorXd* gradient, Model model) {
     // Every compared pair in both orders, as pw_scale's matrices: o = (i, j) with k_o answers for i out of n_o.
     struct Ordered {
@@ -124,31 +128,51 @@ double pwcmpLogPrior(const PairCounts& counts, const Eigen::VectorXd& scores, Ei
         slopeQ[o] = -backward.slope;
     }
     // R(o, b) = P_o^k_b (1 − P_o)^(n_b − k_b) / Σ_o' (same): the probability of outcome b at distance o, normalised
-    // over the distances (a softmax over o, computed in logs so that large counts do not underflow).
-    Eigen::MatrixXd share(size, size);
-    for (Eigen::Index b = 0; b < size; ++b) {
-        const double k = ordered[b].k, rest = ordered[b].n - ordered[b].k;
-        for (Eigen::Index o = 0; o < size; ++o)
-            share(o, b) = (k > 0 ? k * logP[o] : 0.0) + (rest > 0 ? rest * logQ[o] : 0.0);
-        const double top = share.col(b).maxCoeff();
-        share.col(b) = (share.col(b).array() - top).exp();
-        share.col(b) /= share.col(b).sum();
+    // over the distances (a softmax over o, computed in logs so that large counts do not underflow). The exponent is
+    // the rank-2 matrix log P kᵀ + log(1 − P) (n − k)ᵀ.
+    // `ordered` holds each compared pair in both orders, forward at 2h, reversed at 2h + 1, with the reversed
+    // outcome k' = n − k and d' = −d: outcome 2h + 1 at distance o has the likelihood of outcome 2h at distance
+    // swap(o) (2h ↔ 2h + 1). So R(o, 2h + 1) = R(swap(o), 2h), and only the forward columns are computed (half the
+    // exponentials); sums over all outcomes b are sums over the forward ones of R(o, ·) and R(swap(o), ·).
+    const Eigen::Index half = size / 2;
+    Eigen::VectorXd k(half), rest(half);
+    for (Eigen::Index h = 0; h < half; ++h) {
+        k[h] = ordered[2 * h].k;
+        rest[h] = ordered[2 * h].n - ordered[2 * h].k;
     }
-    const Eigen::VectorXd prior = share.rowwise().sum(); // π_o
+    Eigen::MatrixXd share(size, half);
+    share.noalias() = logP * k.transpose();
+    share.noalias() += logQ * rest.transpose();
+    const Eigen::RowVectorXd top = share.colwise().maxCoeff();
+    share.rowwise() -= top;
+    share = share.array().exp().matrix();
+    const Eigen::RowVectorXd columnSums = share.colwise().sum();
+    share.array().rowwise() /= columnSums.array();
+    auto swapped = [&](const Eigen::VectorXd& v) { // v at swap(o)
+        Eigen::VectorXd out(v.size());
+        for (Eigen::Index h = 0; h < half; ++h) out[2 * h] = v[2 * h + 1], out[2 * h + 1] = v[2 * h];
+        return out;
+    };
+    const Eigen::VectorXd forwardSums = share.rowwise().sum();
+    const Eigen::VectorXd prior = forwardSums + swapped(forwardSums); // π_o
     // Each unordered pair appears twice with π equal in both orders; pw_scale's objective also counts the data
     // twice, so its log posterior is this sum halved.
     const double value = 0.5 * (prior.array() + 0.1).log().sum();
     if (gradient) {
         // ∂π_o/∂d_c = δ_oc Σ_b R(o,b) ℓ'_b(d_o) − Σ_b R(o,b) R(c,b) ℓ'_b(d_c), ℓ_b = k_b log P + (n_b − k_b) log(1 − P),
-        // so ∂/∂d_c ½ Σ_o log(π_o + 0.1) = ½ Σ_b R(c,b) ℓ'_b(d_c) (w_c − u_b), w = 1/(π + 0.1), u_b = Σ_o w_o R(o,b).
+        // so ∂/∂d_c ½ Σ_o log(π_o + 0.1) = ½ Σ_b R(c,b) ℓ'_b(d_c) (w_c − u_b), w = 1/(π + 0.1), u_b = Σ_o w_o R(o,b);
+        // with ℓ'_b(d_c) = k_b P'_c + (n_b − k_b) Q'_c that is ½ [P'_c (w_c (R k)_c − (R (k∘u))_c) + Q'_c (same with
+        // n − k)]: matrix–vector products with the forward columns, the reversed ones by swap (u is the same for
+        // both orders of an outcome, since w is).
         const Eigen::VectorXd w = (prior.array() + 0.1).inverse();
         const Eigen::VectorXd u = share.transpose() * w;
+        const Eigen::VectorXd sk = share * k, sr = share * rest;
+        const Eigen::VectorXd sku = share * k.cwiseProduct(u), sru = share * rest.cwiseProduct(u);
+        const Eigen::VectorXd shareK = sk + swapped(sr), shareRest = sr + swapped(sk);
+        const Eigen::VectorXd shareKU = sku + swapped(sru), shareRestU = sru + swapped(sku);
         for (Eigen::Index c = 0; c < size; ++c) {
-            double total = 0.0;
-            for (Eigen::Index b = 0; b < size; ++b) {
-                const double slope = ordered[b].k * slopeP[c] + (ordered[b].n - ordered[b].k) * slopeQ[c];
-                total += share(c, b) * slope * (w[c] - u[b]);
-            }
+            const double total =
+                slopeP[c] * (w[c] * shareK[c] - shareKU[c]) + slopeQ[c] * (w[c] * shareRest[c] - shareRestU[c]);
             (*gradient)[ordered[c].i] += 0.5 * total;
             (*gradient)[ordered[c].j] -= 0.5 * total;
         }
@@ -194,9 +218,17 @@ void addMeanPenalty(const PairCounts& counts, const FitOptions& options, const E
     }
 }
 
+void addData(const PairCounts& counts, const FitOptions& options, const Eigen::VectorXd& q, Eigen::VectorXd& gradient,
+             Eigen::MatrixXd& information);
+
 // Gradient and negative Hessian (plus the mean penalty's) of the log posterior at q.
+// `priorInformation` (pwcmp's prior only, optional): the prior's negative Hessian to use instead of differencing
+// its gradient (the bootstrap passes the full-data fit's); Newton's method then still converges to the same
+// optimum. `priorInformationOut` (optional) receives the prior's negative Hessian that was used.
+// `priorGradient` false: the prior's gradient is not needed (only the information), which saves its evaluation.
 void assemble(const PairCounts& counts, const FitOptions& options, const Eigen::VectorXd& q, Eigen::VectorXd& gradient,
-              Eigen::MatrixXd& information) {
+              Eigen::MatrixXd& information, const Eigen::MatrixXd* priorInformation = nullptr,
+              Eigen::MatrixXd* priorInformationOut = nullptr, bool priorGradient = true) {
     const int m = counts.conditions;
     const double md = static_cast<double>(m);
     gradient.setZero(m);
@@ -209,20 +241,31 @@ void assemble(const PairCounts& counts, const FitOptions& options, const Eigen::
     } else {
         // pwcmp's prior: analytic gradient; its Hessian by central differences of the gradient (the prior is a
         // smooth function of the distances; h = 10⁻⁵ JOD leaves an error near 10⁻¹⁰).
-        pwcmpLogPrior(counts, q, &gradient, options.model);
-        constexpr double h = 1e-5;
-        Eigen::VectorXd up(m), down(m);
-        for (int k = 0; k < m; ++k) {
-            Eigen::VectorXd shifted = q;
-            shifted[k] += h;
-            pwcmpLogPrior(counts, shifted, &up, options.model);
-            shifted[k] -= 2.0 * h;
-            pwcmpLogPrior(counts, shifted, &down, options.model);
-            information.col(k) = -(up - down) / (2.0 * h);
+        if (priorGradient) pwcmpLogPrior(counts, q, &gradient, options.model);
+        if (priorInformation != nullptr && priorInformation->rows() == m) {
+            information = *priorInformation;
+        } else {
+            constexpr double h = 1e-5;
+            Eigen::VectorXd up(m), down(m);
+            for (int k = 0; k < m; ++k) {
+                Eigen::VectorXd shifted = q;
+                shifted[k] += h;
+                pwcmpLogPrior(counts, shifted, &up, options.model);
+                shifted[k] -= 2.0 * h;
+                pwcmpLogPrior(counts, shifted, &down, options.model);
+                information.col(k) = -(up - down) / (2.0 * h);
+            }
+            information = 0.5 * (information + information.transpose()).eval();
         }
-        information = 0.5 * (information + information.transpose()).eval();
+        if (priorInformationOut) *priorInformationOut = information;
     }
     addMeanPenalty(counts, options, q, gradient, information);
+    addData(counts, options, q, gradient, information);
+}
+
+// The data term's gradient and negative Hessian.
+void addData(const PairCounts& counts, const FitOptions& options, const Eigen::VectorXd& q, Eigen::VectorXd& gradient,
+             Eigen::MatrixXd& information) {
     for (size_t p = 0; p < counts.pairs.size(); ++p) {
         const auto [i, j] = counts.pairs[p];
         const double d = q[i] - q[j];
@@ -265,22 +308,45 @@ double logPosterior(const PairCounts& counts, const FitOptions& options, const E
     return objective(counts, options, scores, nullptr);
 }
 
-FitResult fitScores(const PairCounts& counts, const FitOptions& options, const Eigen::VectorXd* start) {
+FitResult fitScores(const PairCounts& counts, const FitOptions& options, const Eigen::VectorXd* start,
+                    const Eigen::MatrixXd* priorInformation) {
     const int m = counts.conditions;
     FitResult result;
     result.scores = start ? *start : Eigen::VectorXd::Zero(m);
     Eigen::VectorXd gradient(m);
     Eigen::MatrixXd information(m, m); // negative Hessian of the log posterior, plus 1 1ᵀ for the mean
-    double current = objective(counts, options, result.scores, nullptr);
+    double current = 0.0;
+    bool stale = true; // `current` is not (yet) the posterior at result.scores: evaluated when a step needs it
 
+    // pwcmp's prior without a given Hessian: differenced at the first two steps, then reused (the prior changes
+    // slowly near the optimum; the gradient is exact, so the optimum is the same), and differenced again at the
+    // optimum for inverseInformation.
+    Eigen::MatrixXd lastPriorInformation;
     for (result.iterations = 0; result.iterations < options.maxIterations; ++result.iterations) {
-        assemble(counts, options, result.scores, gradient, information);
+        const bool reuse = options.prior == Prior::Pwcmp && priorInformation == nullptr && result.iterations >= 2;
+        assemble(
+            counts, options, result.scores, gradient, information, reuse ? &lastPriorInformation : priorInformation,
+            options.prior == Prior::Pwcmp && priorInformation == nullptr && !reuse ? &lastPriorInformation : nullptr);
         const Eigen::LDLT<Eigen::MatrixXd> solver = newtonSolver(information);
         Eigen::VectorXd step = solver.solve(gradient);
         // Backtracking: the log posterior is concave, so a full Newton step is accepted except far from the
-        // optimum (large unanimous differences), where halving keeps every iteration an ascent.
+        // optimum (large unanimous differences), where halving keeps every iteration an ascent. With pwcmp's prior
+        // and a given prior Hessian (a warm-started resample near its optimum), a step below 0.25 JOD is taken
+        // without evaluating the posterior: the gradient alone decides convergence, at half the cost a step.
         double scale = 1.0;
         Eigen::VectorXd candidate = result.scores + step;
+        if (priorInformation != nullptr && options.prior == Prior::Pwcmp && step.cwiseAbs().maxCoeff() < 0.25) {
+            result.scores = candidate;
+            stale = true;
+            if (step.cwiseAbs().maxCoeff() < options.tolerance) {
+                result.converged = true;
+                ++result.iterations;
+                break;
+            }
+            continue;
+        }
+        if (stale) current = objective(counts, options, result.scores, nullptr);
+        stale = false;
         double value = objective(counts, options, candidate, nullptr);
         while (value < current - 1e-12 * std::abs(current) && scale > 1e-6) {
             scale *= 0.5;
@@ -295,7 +361,8 @@ FitResult fitScores(const PairCounts& counts, const FitOptions& options, const E
             break;
         }
     }
-    assemble(counts, options, result.scores, gradient, information);
+    assemble(counts, options, result.scores, gradient, information, priorInformation,
+             options.prior == Prior::Pwcmp ? &result.priorInformation : nullptr, false);
     result.inverseInformation = newtonSolver(information).solve(Eigen::MatrixXd::Identity(m, m));
     // `information` has eigenvalue |c| along 1_c/√|c| for the mean penalty of each centred group c (all conditions
     // under the Gaussian prior, each connected component under pwcmp's); remove those directions so the matrix is
@@ -309,7 +376,7 @@ FitResult fitScores(const PairCounts& counts, const FitOptions& options, const E
         for (int j = 0; j < m; ++j)
             if (label[i] == label[j])
                 result.inverseInformation(i, j) -= 1.0 / (groupSize[label[i]] * groupSize[label[i]]);
-    objective(counts, options, result.scores, &result.logLikelihood);
+    result.logLikelihood = logLikelihood(options.model, counts.pairs, counts.first, counts.second, result.scores);
     return result;
 }
 

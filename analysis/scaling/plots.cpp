@@ -63,7 +63,7 @@ cv::Mat plotScores(const BlockAnalysis& block) {
     double scoreLow = 0.0, scoreHigh = 0.0;
     for (int i = 0; i < m; ++i) {
         const double q = block.thurstone.scores[i];
-        if (!std::isfinite(q)) continue;
+        if (!std::isfinite(q) || (static_cast<size_t>(i) < block.measured.size() && !block.measured[i])) continue;
         scoreLow = std::min(scoreLow, q);
         scoreHigh = std::max(scoreHigh, q);
     }
@@ -76,6 +76,7 @@ cv::Mat plotScores(const BlockAnalysis& block) {
     double low = scoreLow, high = scoreHigh;
     bool anyClipped = false, anyFallback = false;
     for (int i = 0; i < m; ++i) {
+        if (static_cast<size_t>(i) < block.measured.size() && !block.measured[i]) continue;
         low = std::min(low, clip(block.low[i], windowLow));
         high = std::max(high, clip(block.high[i], windowHigh));
         anyClipped = anyClipped || clipped(block.low[i]) || clipped(block.high[i]);
@@ -105,6 +106,11 @@ cv::Mat plotScores(const BlockAnalysis& block) {
     const double columnWidth = static_cast<double>(width - left - right) / m;
     for (int i = 0; i < m; ++i) {
         const int x = static_cast<int>(std::lround(left + (i + 0.5) * columnWidth));
+        text(image, label(block.conditions[i], 14), {x, plotBottom + 22 + (i % 2) * 20}, 0.45, kBlack, 1);
+        if (static_cast<size_t>(i) < block.measured.size() && !block.measured[i]) {
+            text(image, "not measured", {x, plotBottom + 68}, 0.4, kGrey, 1);
+            continue;
+        }
         const bool fallback = static_cast<size_t>(i) < block.intervalFlags.size() && block.intervalFlags[i].fallback;
         const cv::Scalar colour = fallback ? kOrange : kBlue;
         const int yLow = y(clip(block.low[i], windowLow)), yHigh = y(clip(block.high[i], windowHigh));
@@ -120,8 +126,6 @@ cv::Mat plotScores(const BlockAnalysis& block) {
         else cv::line(image, {x - 8, yHigh}, {x + 8, yHigh}, colour, 2, cv::LINE_AA);
         if (std::isfinite(block.thurstone.scores[i]))
             cv::circle(image, {x, y(block.thurstone.scores[i])}, 5, kBlack, cv::FILLED, cv::LINE_AA);
-        // Alternate label rows so long names of neighbours do not overlap.
-        text(image, label(block.conditions[i], 14), {x, plotBottom + 22 + (i % 2) * 20}, 0.45, kBlack, 1);
         text(image, format("%+.2f", block.thurstone.scores[i]), {x, plotBottom + 68}, 0.4, kGrey, 1);
     }
     int legend = plotBottom + 92;

@@ -30,6 +30,18 @@ struct ProfileInterval {
 ProfileInterval profileInterval(const PairCounts& counts, const FitOptions& options, const FitResult& fit,
                                 const Eigen::VectorXd& contrast, double level);
 
+// One end of a profile interval: the value of θ = aᵀq on `side` (−1: below the estimate, +1: above) where twice the
+// fall of the log posterior from its maximum reaches `threshold`. `atCap`: not reached within kProfileSearchCap.
+double profileBound(const PairCounts& counts, const FitOptions& options, const FitResult& fit,
+                    const Eigen::VectorXd& contrast, int side, double threshold, bool* atCap = nullptr);
+
+// The threshold for the one end of an interval whose other end the data leave open (unanimous answers,
+// docs/analysis.md, "Intervals the data support"): −2·log((1 − level)/2), 7.38 at 95 %. For one pair answered
+// n:0 the profile likelihood ratio is then exactly the probability of n:0, so the bound is the exact
+// (Clopper–Pearson) one-sided bound at (1 + level)/2; χ²₁(level) = 3.84 would give p ≥ 0.825 for 10:0, which a
+// true p of 0.80 produces 11 % of the time.
+double oneSidedProfileThreshold(double level);
+
 // Two-sided p-value of the score test of q_first = q_second. `block` supplies the observers for the robust
 // variance (nullptr: model-based only, e.g. a count matrix).
 double scoreTestPValue(const BlockData* block, const PairCounts& counts, const FitOptions& options,

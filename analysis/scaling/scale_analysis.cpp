@@ -5,6 +5,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -81,7 +82,7 @@ bool winGraphStronglyConnected(const BlockData& block, const PairCounts& totals)
 // For a contrast aᵀq the upper end is the prior's iff some such v has aᵀv > 0 — for q_i − q_j iff j did not
 // (transitively) beat i; for a score (relative to its component's mean) iff some condition of the component did
 // not transitively beat it — and symmetrically for the lower end.
-void applyDataBounds(BlockAnalysis& result) {
+void applyDataBounds(BlockAnalysis& result, const PairCounts& totals, const FitOptions& options, double level) {
     const auto m = static_cast<int>(result.conditions.size());
     std::vector<int> component(m, 0);
     for (size_t c = 0; c < result.components.size(); ++c)
@@ -105,7 +106,22 @@ void applyDataBounds(BlockAnalysis& result) {
         return lowerFree ? (upperFree ? "none" : "upper") : (upperFree ? "lower" : "two-sided");
     };
     const double infinity = std::numeric_limits<double>::infinity();
+    // The finite end of an interval the data bound on one side only: the profile bound at the one-sided threshold
+    // (the exact binomial bound for a single unanimous pair) where it is farther out than the end found so far.
+    const double threshold = oneSidedProfileThreshold(level);
+    auto oneSidedEnd = [&](double& low, double& high, double shift, const Eigen::VectorXd& contrast) {
+        const int side = std::isfinite(low) ? -1 : 1;
+        const double bound = shift + profileBound(totals, options, result.thurstone, contrast, side, threshold);
+        if (side < 0) low = std::min(low, bound);
+        else high = std::max(high, bound);
+    };
     for (int i = 0; i < m; ++i) {
+        if (!result.measured[i]) {
+            result.low[i] = -infinity;
+            result.high[i] = infinity;
+            result.intervalFlags[i].bound = "not-measured";
+            continue;
+        }
         bool upperFree = false, lowerFree = false;
         for (int j = 0; j < m; ++j) {
             if (component[j] != component[i]) continue;
@@ -115,6 +131,17 @@ void applyDataBounds(BlockAnalysis& result) {
         if (upperFree) result.high[i] = infinity;
         if (lowerFree) result.low[i] = -infinity;
         result.intervalFlags[i].bound = label(lowerFree, upperFree);
+        result.intervalFlags[i].priorDriven = upperFree || lowerFree;
+        if (upperFree != lowerFree) {
+            Eigen::VectorXd contrast = Eigen::VectorXd::Zero(m);
+            int members = 0;
+            for (int j = 0; j < m; ++j) members += component[j] == component[i];
+            for (int j = 0; j < m; ++j)
+                if (component[j] == component[i]) contrast[j] = -1.0 / members;
+            contrast[i] += 1.0;
+            oneSidedEnd(result.low[i], result.high[i],
+                        result.thurstone.scores[i] - contrast.dot(result.thurstone.scores), contrast);
+        }
     }
     for (PairTest& pair : result.pairs) {
         DifferenceTest& test = pair.test;
@@ -124,7 +151,15 @@ void applyDataBounds(BlockAnalysis& result) {
         const bool lowerFree = !connected || !beatenBy[j][i];
         if (upperFree) test.high = infinity;
         if (lowerFree) test.low = -infinity;
-        test.diagnosis.bound = label(lowerFree, upperFree);
+        test.diagnosis.bound =
+            !result.measured[i] || !result.measured[j] ? "not-measured" : label(lowerFree, upperFree);
+        test.diagnosis.priorDriven = upperFree || lowerFree;
+        if (upperFree != lowerFree) {
+            Eigen::VectorXd contrast = Eigen::VectorXd::Zero(m);
+            contrast[i] = 1.0;
+            contrast[j] = -1.0;
+            oneSidedEnd(test.low, test.high, 0.0, contrast);
+        }
         if (!connected) {
             // Not measured at all: no test either.
             test.pValue = 1.0;
@@ -134,6 +169,13 @@ void applyDataBounds(BlockAnalysis& result) {
                 reasons.insert(reasons.begin(), "disconnected");
         }
     }
+}
+
+// A p-value for a message: 3 significant digits ("0.0123", "1.6e-30").
+std::string formatP(double p) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%.3g", p);
+    return buffer;
 }
 
 // Quantile as MATLAB's quantile/prctile (and Octave's default, method 5): the sorted values sit at probabilities
@@ -307,6 +349,40 @@ void unionIntervals(BlockAnalysis& result, const BlockData& block, const PairCou
     }
 }
 
+// Per observer, the exact binomial test of the left rate = 1/2, corrected over the observers with a known side;
+// per block, a warning where the panel as a whole chose one side more often than chance.
+void screenSideBias(Analysis& analysis, const AnalysisOptions& options) {
+    for (const BlockAnalysis& block : analysis.blocks)
+        if (block.sideBias.available && block.sideBias.pValue < options.alpha)
+            analysis.warnings.push_back(block.name + ": the left image was chosen in " +
+                                        std::to_string(static_cast<long long>(block.sideBias.leftChosen)) + " of " +
+                                        std::to_string(static_cast<long long>(block.sideBias.trials)) +
+                                        " trials (exact binomial p = " + formatP(block.sideBias.pValue) +
+                                        "): the panel has a side bias");
+    std::vector<size_t> tested;
+    std::vector<double> pValues;
+    for (size_t k = 0; k < analysis.observers.size(); ++k) {
+        ObserverSummary& s = analysis.observers[k];
+        if (!(s.sideTrials > 0)) continue;
+        s.sidePValue = binomialHalfPValue(s.leftChosen, s.sideTrials);
+        tested.push_back(k);
+        pValues.push_back(s.sidePValue);
+    }
+    const std::vector<double> adjusted = adjustPValues(pValues, options.correction);
+    for (size_t t = 0; t < tested.size(); ++t) {
+        ObserverSummary& s = analysis.observers[tested[t]];
+        s.sidePAdjusted = adjusted[t];
+        s.sideBiased = adjusted[t] < options.alpha;
+        if (s.sideBiased)
+            analysis.warnings.push_back("observer '" + s.observer + "' chose the left image in " +
+                                        std::to_string(static_cast<long long>(s.leftChosen)) + " of " +
+                                        std::to_string(static_cast<long long>(s.sideTrials)) +
+                                        " trials (exact binomial p = " + formatP(s.sidePValue) + ", " +
+                                        correctionName(options.correction) + " " + formatP(s.sidePAdjusted) +
+                                        "): a side bias");
+    }
+}
+
 } // namespace
 
 IntervalMethod defaultIntervals(bool adaptiveDesign) {
@@ -354,6 +430,14 @@ BlockAnalysis analyzeBlock(const BlockData& block, const AnalysisOptions& option
     }
     for (size_t p = 0; p < block.pairs.size(); ++p)
         if ((totals.first[p] > 0) != (totals.second[p] > 0)) result.unanimousPairs.push_back(block.pairs[p]);
+    result.measured.assign(block.conditionCount(), false);
+    for (size_t p = 0; p < block.pairs.size(); ++p)
+        if (totals.first[p] + totals.second[p] > 0)
+            result.measured[block.pairs[p].first] = result.measured[block.pairs[p].second] = true;
+    for (int i = 0; i < block.conditionCount(); ++i)
+        if (!result.measured[i])
+            result.warnings.push_back("condition '" + block.conditions[i] +
+                                      "' was never compared: not measured (no score, no interval)");
     result.mleExists = winGraphStronglyConnected(block, totals);
     if (!result.mleExists && result.components.size() == 1)
         result.warnings.push_back("some conditions won or lost every comparison with the rest (unanimous answers): "
@@ -366,7 +450,7 @@ BlockAnalysis analyzeBlock(const BlockData& block, const AnalysisOptions& option
         unionIntervals(result, block, totals, thurstoneOptions, options);
     else bootstrapIntervals(result, block, thurstoneOptions, options);
     std::vector<double> pValues;
-    applyDataBounds(result);
+    applyDataBounds(result, totals, thurstoneOptions, options.bootstrap.level);
     for (PairTest& pair : result.pairs) {
         pair.comparisons =
             result.counts(pair.test.first, pair.test.second) + result.counts(pair.test.second, pair.test.first);
@@ -466,6 +550,7 @@ Analysis analyzeDataset(const Dataset& dataset, const AnalysisOptions& options) 
             }
         }
     }
+    screenSideBias(analysis, options);
     const std::vector<bool> flags = lowOutliers(perTrial, options.screeningWhisker, &analysis.screeningRule);
     for (size_t k = 0; k < analysis.observers.size(); ++k) {
         analysis.observers[k].flagged = flags[k];

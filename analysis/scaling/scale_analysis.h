@@ -72,6 +72,9 @@ struct BlockAnalysis {
     std::vector<std::vector<int>> components;      // connected components of the comparison graph
     bool mleExists = true; // win graph strongly connected (Ford 1957); otherwise the prior sets some distances
     std::vector<std::pair<int, int>> unanimousPairs; // compared pairs where one side never won
+    // Per condition: compared at least once. A condition never compared has no score (its JOD is the prior's 0, its
+    // interval the whole line): every output says "not measured" (bound "not-measured") instead of a number.
+    std::vector<bool> measured;
     std::optional<double> kendallU;
     SideBias sideBias;
     std::vector<ObserverInBlock> observerStats;
@@ -87,6 +90,11 @@ struct ObserverSummary {
     int catchFailures = 0;
     double sideTrials = 0.0;
     double leftChosen = 0.0;
+    // Exact binomial test of the left rate = 1/2 over all the observer's trials with a known side (NaN without any);
+    // `sideBiased` when it is significant after the analysis's correction over the observers tested, at its α.
+    double sidePValue = NAN;
+    double sidePAdjusted = NAN;
+    bool sideBiased = false;
     // pwcmp's outlier analysis (AnalysisOptions::pwcmpOutliers): mean log10 binomial likelihood of the observer's
     // counts per compared pair under the leave-one-out scale (pwcmp's prior), and the distance below the first
     // quartile in inter-quartile ranges, dist_L = max(0, (Q1 − L)/IQR); pwcmp's rule flags dist_L > 1.5.

@@ -7,6 +7,7 @@
 #include "common/files.h"
 #include "common/version.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -65,6 +66,21 @@ std::string joined(const std::vector<std::string>& values, const char* separator
 }
 std::vector<std::string> scoreReasons(const BlockAnalysis& block, size_t i) {
     return i < block.intervalFlags.size() ? block.intervalFlags[i].reasons : std::vector<std::string>{};
+}
+
+bool measured(const BlockAnalysis& block, size_t i) { return i >= block.measured.size() || block.measured[i]; }
+bool measured(const BlockAnalysis& block, const PairTest& pair) {
+    return measured(block, static_cast<size_t>(pair.test.first)) &&
+           measured(block, static_cast<size_t>(pair.test.second));
+}
+// A value of a measured condition (or pair), null/empty for one never compared.
+nlohmann::json measuredJson(bool isMeasured, double value) { return isMeasured ? finite(value) : nlohmann::json(); }
+std::string measuredNumber(bool isMeasured, double value, int digits) {
+    return isMeasured ? number(value, digits) : "";
+}
+
+bool scorePriorDriven(const BlockAnalysis& block, size_t i) {
+    return i < block.intervalFlags.size() && block.intervalFlags[i].priorDriven;
 }
 
 std::string scoreBound(const BlockAnalysis& block, size_t i) {
@@ -133,18 +149,21 @@ nlohmann::json countsJson(const BlockAnalysis& block) {
 void addScores(nlohmann::json& b, const BlockAnalysis& block) {
     for (size_t i = 0; i < block.conditions.size(); ++i) {
         const auto k = static_cast<Eigen::Index>(i);
+        const bool is = measured(block, i);
         b["scores"].push_back({{"condition", block.conditions[i]},
-                               {"jod", block.thurstone.scores[k]},
-                               {"standard_error", finite(block.standardError[k])},
-                               {"ci_low", finite(block.low[k])},
-                               {"ci_high", finite(block.high[k])},
+                               {"measured", is},
+                               {"jod", measuredJson(is, block.thurstone.scores[k])},
+                               {"standard_error", measuredJson(is, block.standardError[k])},
+                               {"ci_low", measuredJson(is, block.low[k])},
+                               {"ci_high", measuredJson(is, block.high[k])},
                                {"bound", scoreBound(block, i)},
+                               {"prior_driven", scorePriorDriven(block, i)},
                                {"interval_method", scoreMethod(block, i)},
                                {"fallback_reasons", scoreReasons(block, i)},
-                               {"percentile_low", finite(block.percentileLow[k])},
-                               {"percentile_high", finite(block.percentileHigh[k])},
-                               {"bradley_terry_jod", block.bradleyTerry.scores[k]},
-                               {"bradley_terry_standard_error", finite(block.bradleyTerryStandardError[k])}});
+                               {"percentile_low", measuredJson(is, block.percentileLow[k])},
+                               {"percentile_high", measuredJson(is, block.percentileHigh[k])},
+                               {"bradley_terry_jod", measuredJson(is, block.bradleyTerry.scores[k])},
+                               {"bradley_terry_standard_error", measuredJson(is, block.bradleyTerryStandardError[k])}});
     }
 }
 
@@ -170,11 +189,12 @@ nlohmann::json pairsJson(const BlockAnalysis& block) {
     for (const PairTest& pair : block.pairs)
         pairs.push_back({{"condition_A", block.conditions[pair.test.first]},
                          {"condition_B", block.conditions[pair.test.second]},
-                         {"difference_jod", pair.test.difference},
+                         {"difference_jod", measuredJson(measured(block, pair), pair.test.difference)},
                          {"standard_error", finite(pair.test.standardError)},
                          {"ci_low", finite(pair.test.low)},
                          {"ci_high", finite(pair.test.high)},
                          {"bound", pair.test.diagnosis.bound},
+                         {"prior_driven", pair.test.diagnosis.priorDriven},
                          {"comparisons", pair.comparisons},
                          {"interval_method", pairMethod(block, pair)},
                          {"fallback_reasons", pair.test.diagnosis.reasons},
@@ -189,8 +209,11 @@ nlohmann::json sideBiasJson(const BlockAnalysis& block) {
     return {{"available", block.sideBias.available},
             {"trials", block.sideBias.trials},
             {"left_rate", block.sideBias.available ? nlohmann::json(block.sideBias.leftRate) : nlohmann::json()},
-            {"bias_jod", block.sideBias.available ? nlohmann::json(block.sideBias.bias) : nlohmann::json()},
+            {"left_chosen", block.sideBias.available ? nlohmann::json(block.sideBias.leftChosen) : nlohmann::json()},
+            // null where every answer was on one side (no finite estimate; see left_rate and p_value)
+            {"bias_jod", block.sideBias.available ? finite(block.sideBias.bias) : nlohmann::json()},
             {"standard_error", block.sideBias.available ? finite(block.sideBias.standardError) : nlohmann::json()},
+            {"test", "exact binomial, left rate = 1/2, two-sided"},
             {"p_value", block.sideBias.available ? nlohmann::json(block.sideBias.pValue) : nlohmann::json()}};
 }
 
@@ -212,11 +235,22 @@ nlohmann::json observerStatsJson(const BlockAnalysis& block) {
     return stats;
 }
 
+// The prior's strength on this block's scores (the Gaussian prior strengthens with the number of conditions).
+nlohmann::json priorJson(const BlockAnalysis& block, const FitOptions& fit) {
+    const double precision = priorPrecisionPerScore(fit, static_cast<int>(block.conditions.size()));
+    if (!std::isfinite(precision)) return {{"name", priorName(fit.prior)}, {"data_dependent", true}};
+    return {{"name", priorName(fit.prior)},
+            {"precision_per_difference", fit.priorPrecision},
+            {"precision_per_score", precision},
+            {"sd_per_score_jod", 1.0 / std::sqrt(precision)}};
+}
+
 // One block of the analysis: data, fit, scores, flags, pairs, side bias and observers.
-nlohmann::json blockJson(const BlockAnalysis& block) {
+nlohmann::json blockJson(const BlockAnalysis& block, const FitOptions& fit) {
     nlohmann::json b;
     b["name"] = block.name;
     b["conditions"] = block.conditions;
+    b["prior"] = priorJson(block, fit);
     b["observers"] = static_cast<int>(block.observers.size());
     b["counts"] = countsJson(block);
     b["interval_method"] = block.intervalMethod;
@@ -249,8 +283,40 @@ nlohmann::json observersJson(const Analysis& analysis) {
              {"pwcmp_outlier", std::isnan(s.pwcmpDistance) ? nlohmann::json() : nlohmann::json(s.pwcmpOutlier)},
              {"catch_trials", s.catchTrials},
              {"catch_failures", s.catchFailures},
-             {"left_rate", s.sideTrials > 0 ? nlohmann::json(s.leftChosen / s.sideTrials) : nlohmann::json()}});
+             {"left_rate", s.sideTrials > 0 ? nlohmann::json(s.leftChosen / s.sideTrials) : nlohmann::json()},
+             {"side_p_value", finite(s.sidePValue)},
+             {"side_p_adjusted", finite(s.sidePAdjusted)},
+             {"side_biased", s.sideBiased}});
     return observers;
+}
+
+// The report section's observer table: screening, catch trials, side (exact binomial test), pwcmp's outliers.
+void observersHtml(std::ostringstream& html, const Analysis& analysis) {
+    const AnalysisOptions& o = analysis.options;
+    html << "<h3>Observers</h3>\n<table>\n<tr><th>observer</th><th>trials</th><th>held-out log-likelihood / trial</th>"
+            "<th>outlier</th><th>catch failures</th><th>left chosen</th><th>side bias (p, "
+         << correctionName(o.correction) << ")</th></tr>\n";
+    for (const ObserverSummary& s : analysis.observers)
+        html << "<tr><td>" << escapeHtml(s.observer) << "</td><td>" << s.trials << "</td><td>"
+             << fixed(s.heldOutPerTrial, 3) << "</td><td>" << (s.flagged ? "<strong>yes</strong>" : "no") << "</td><td>"
+             << s.catchFailures << " / " << s.catchTrials << "</td><td>"
+             << (s.sideTrials > 0 ? fixed(100.0 * s.leftChosen / s.sideTrials, 1) + " %" : std::string("–"))
+             << "</td><td>"
+             << (s.sideTrials > 0
+                     ? (s.sideBiased ? "<strong>yes</strong> (" : "no (") + number(s.sidePAdjusted, 3) + ")"
+                     : std::string("–"))
+             << "</td></tr>\n";
+    html << "</table>\n<p>Outlier rule: held-out log-likelihood per trial below Q1 − " << o.screeningWhisker
+         << "·IQR = " << fixed(analysis.screeningRule.threshold, 3) << ".</p>\n";
+    if (o.pwcmpOutliers) {
+        std::string flagged;
+        for (const ObserverSummary& s : analysis.observers)
+            if (s.pwcmpOutlier)
+                flagged +=
+                    (flagged.empty() ? "" : ", ") + escapeHtml(s.observer) + " (" + fixed(s.pwcmpDistance, 2) + ")";
+        html << "<p>pwcmp's outlier analysis (dist_L &gt; 1.5): " << (flagged.empty() ? "no observer" : flagged)
+             << ".</p>\n";
+    }
 }
 
 } // namespace
@@ -274,7 +340,7 @@ nlohmann::json analysisJson(const Analysis& analysis) {
     json["skinlab_version"] = skinlab::version();
     json["input"] = {{"file", analysis.file}, {"format", responseFormatName(analysis.format)}};
     json["settings"] = settingsJson(o);
-    for (const BlockAnalysis& block : analysis.blocks) json["blocks"].push_back(blockJson(block));
+    for (const BlockAnalysis& block : analysis.blocks) json["blocks"].push_back(blockJson(block, o.fit));
     json["observers"] = observersJson(analysis);
     json["excluded_observers"] = nlohmann::json::array();
     for (const ExcludedObserver& e : analysis.excluded)
@@ -325,11 +391,19 @@ std::string reportSectionHtml(const Analysis& analysis) {
         const BlockAnalysis& block = analysis.blocks[b];
         html << "<h3>" << escapeHtml(block.name) << "</h3>\n<p>" << block.observers.size() << " observer(s), "
              << block.conditions.size() << " conditions, intervals: " << block.intervalMethod;
+        const double precision = priorPrecisionPerScore(o.fit, static_cast<int>(block.conditions.size()));
+        if (std::isfinite(precision))
+            html << ", prior on each score: precision τ·m = " << number(precision, 3) << " JOD⁻² (sd "
+                 << fixed(1.0 / std::sqrt(precision), 1) << " JOD)";
         if (block.kendallU) html << ", Kendall's u = " << fixed(*block.kendallU, 3);
         if (block.sideBias.available)
-            html << ", side bias " << fixed(block.sideBias.bias, 3)
-                 << " JOD toward the left (p = " << fixed(block.sideBias.pValue, 3) << ", left chosen "
-                 << fixed(100 * block.sideBias.leftRate, 1) << " %)";
+            html << ", left image chosen in " << fixed(100 * block.sideBias.leftRate, 1) << " % of "
+                 << block.sideBias.trials << " trials (exact binomial p = " << number(block.sideBias.pValue, 3)
+                 << "; side bias "
+                 << (std::isfinite(block.sideBias.bias) ? fixed(block.sideBias.bias, 3) + " JOD toward the left"
+                                                        : std::string("without a finite estimate: every answer on one "
+                                                                      "side"))
+                 << ")";
         html << ".</p>\n";
         for (const std::string& warning : block.warnings)
             html << "<p class=\"warning\"><strong>Warning:</strong> " << escapeHtml(warning) << "</p>\n";
@@ -341,22 +415,33 @@ std::string reportSectionHtml(const Analysis& analysis) {
                 "<th>Bradley–Terry (JOD)</th></tr>\n";
         for (size_t i = 0; i < block.conditions.size(); ++i) {
             const auto k = static_cast<Eigen::Index>(i);
+            if (!measured(block, i)) {
+                html << "<tr><td>" << escapeHtml(block.conditions[i])
+                     << "</td><td colspan=\"4\">not measured (never compared)</td></tr>\n";
+                continue;
+            }
             html << "<tr><td>" << escapeHtml(block.conditions[i]) << "</td><td>" << fixed(block.thurstone.scores[k], 3)
-                 << "</td><td>" << intervalText(block.low[k], block.high[k]) << "</td><td>"
-                 << escapeHtml(scoreMethod(block, i))
+                 << (scorePriorDriven(block, i) ? " (prior)" : "") << "</td><td>"
+                 << intervalText(block.low[k], block.high[k]) << "</td><td>" << escapeHtml(scoreMethod(block, i))
                  << (scoreReasons(block, i).empty() ? std::string()
                                                     : " † (" + escapeHtml(joined(scoreReasons(block, i), ", ")) + ")")
                  << "</td><td>" << fixed(block.bradleyTerry.scores[k], 3) << "</td></tr>\n";
         }
-        html << "</table>\n<table>\n<tr><th>A</th><th>B</th><th>A − B (JOD)</th><th>95 % "
+        html << "</table>\n";
+        if (std::any_of(block.intervalFlags.begin(), block.intervalFlags.end(),
+                        [](const IntervalDiagnosis& d) { return d.priorDriven; }))
+            html << "<p>(prior): the data bound this value on one side only (unanimous answers) or not at all; the "
+                    "value shown is set by the prior, not measured; its interval's open end says so.</p>\n";
+        html << "<table>\n<tr><th>A</th><th>B</th><th>A − B (JOD)</th><th>95 % "
                 "interval</th><th>method</th><th>p</th>"
                 "<th>p ("
              << correctionName(o.correction) << ")</th><th>significant</th></tr>\n";
         for (const PairTest& pair : block.pairs)
             html << "<tr><td>" << escapeHtml(block.conditions[pair.test.first]) << "</td><td>"
-                 << escapeHtml(block.conditions[pair.test.second]) << "</td><td>" << fixed(pair.test.difference, 3)
-                 << "</td><td>" << intervalText(pair.test.low, pair.test.high) << "</td><td>"
-                 << escapeHtml(pairMethod(block, pair))
+                 << escapeHtml(block.conditions[pair.test.second]) << "</td><td>"
+                 << (measured(block, pair) ? fixed(pair.test.difference, 3) : std::string("not measured"))
+                 << (pair.test.diagnosis.priorDriven && measured(block, pair) ? " (prior)" : "") << "</td><td>"
+                 << intervalText(pair.test.low, pair.test.high) << "</td><td>" << escapeHtml(pairMethod(block, pair))
                  << (pair.test.diagnosis.reasons.empty()
                          ? std::string()
                          : " † (" + escapeHtml(joined(pair.test.diagnosis.reasons, ", ")) + ")")
@@ -364,25 +449,7 @@ std::string reportSectionHtml(const Analysis& analysis) {
                  << "</td><td>" << (pair.significant ? "yes" : "no") << "</td></tr>\n";
         html << "</table>\n";
     }
-    html << "<h3>Observers</h3>\n<table>\n<tr><th>observer</th><th>trials</th><th>held-out log-likelihood / trial</th>"
-            "<th>outlier</th><th>catch failures</th><th>left chosen</th></tr>\n";
-    for (const ObserverSummary& s : analysis.observers)
-        html << "<tr><td>" << escapeHtml(s.observer) << "</td><td>" << s.trials << "</td><td>"
-             << fixed(s.heldOutPerTrial, 3) << "</td><td>" << (s.flagged ? "<strong>yes</strong>" : "no") << "</td><td>"
-             << s.catchFailures << " / " << s.catchTrials << "</td><td>"
-             << (s.sideTrials > 0 ? fixed(100.0 * s.leftChosen / s.sideTrials, 1) + " %" : std::string("–"))
-             << "</td></tr>\n";
-    html << "</table>\n<p>Outlier rule: held-out log-likelihood per trial below Q1 − " << o.screeningWhisker
-         << "·IQR = " << fixed(analysis.screeningRule.threshold, 3) << ".</p>\n";
-    if (o.pwcmpOutliers) {
-        std::string flagged;
-        for (const ObserverSummary& s : analysis.observers)
-            if (s.pwcmpOutlier)
-                flagged +=
-                    (flagged.empty() ? "" : ", ") + escapeHtml(s.observer) + " (" + fixed(s.pwcmpDistance, 2) + ")";
-        html << "<p>pwcmp's outlier analysis (dist_L &gt; 1.5): " << (flagged.empty() ? "no observer" : flagged)
-             << ".</p>\n";
-    }
+    observersHtml(html, analysis);
     html << "</section>\n";
     return html.str();
 }
@@ -392,9 +459,10 @@ void writeScaleOutputs(const Analysis& analysis, const std::filesystem::path& fo
     ensureDirectory(folder / "plots");
     std::string scores =
         "block,condition,jod,ci_low,ci_high,standard_error,interval_method,percentile_low,"
-        "percentile_high,bradley_terry_jod,bradley_terry_standard_error,fallback_reasons,bound,prior\n";
+        "percentile_high,bradley_terry_jod,bradley_terry_standard_error,fallback_reasons,bound,prior,prior_driven\n";
     std::string pairs = "block,condition_A,condition_B,difference_jod,ci_low,ci_high,standard_error,comparisons,"
-                        "p_value,p_adjusted,correction,significant,interval_method,fallback_reasons,bound\n";
+                        "p_value,p_adjusted,correction,significant,interval_method,fallback_reasons,bound,"
+                        "prior_driven\n";
     std::string counts = "block,condition_row,condition_column,count_row_chosen\n";
     std::string consistency = "block,observer,trials,held_out_loglik_per_trial,complete,circular_triads,zeta\n";
     for (size_t b = 0; b < analysis.blocks.size(); ++b) {
@@ -402,13 +470,16 @@ void writeScaleOutputs(const Analysis& analysis, const std::filesystem::path& fo
         const std::string name = csvField(block.name);
         for (size_t i = 0; i < block.conditions.size(); ++i) {
             const auto k = static_cast<Eigen::Index>(i);
-            scores += name + "," + csvField(block.conditions[i]) + "," + number(block.thurstone.scores[k], 8) + "," +
-                      number(block.low[k], 8) + "," + number(block.high[k], 8) + "," +
-                      number(block.standardError[k], 8) + "," + scoreMethod(block, i) + "," +
-                      number(block.percentileLow[k], 8) + "," + number(block.percentileHigh[k], 8) + "," +
-                      number(block.bradleyTerry.scores[k], 8) + "," + number(block.bradleyTerryStandardError[k], 8) +
-                      "," + csvField(joined(scoreReasons(block, i), ";")) + "," + scoreBound(block, i) + "," +
-                      priorName(analysis.options.fit.prior) + "\n";
+            const bool is = measured(block, i);
+            scores += name + "," + csvField(block.conditions[i]) + "," +
+                      measuredNumber(is, block.thurstone.scores[k], 8) + "," + measuredNumber(is, block.low[k], 8) +
+                      "," + measuredNumber(is, block.high[k], 8) + "," + measuredNumber(is, block.standardError[k], 8) +
+                      "," + scoreMethod(block, i) + "," + measuredNumber(is, block.percentileLow[k], 8) + "," +
+                      measuredNumber(is, block.percentileHigh[k], 8) + "," +
+                      measuredNumber(is, block.bradleyTerry.scores[k], 8) + "," +
+                      measuredNumber(is, block.bradleyTerryStandardError[k], 8) + "," +
+                      csvField(joined(scoreReasons(block, i), ";")) + "," + scoreBound(block, i) + "," +
+                      priorName(analysis.options.fit.prior) + "," + (scorePriorDriven(block, i) ? "1" : "0") + "\n";
             for (size_t j = 0; j < block.conditions.size(); ++j)
                 if (i != j)
                     counts += name + "," + csvField(block.conditions[i]) + "," + csvField(block.conditions[j]) + "," +
@@ -416,13 +487,14 @@ void writeScaleOutputs(const Analysis& analysis, const std::filesystem::path& fo
         }
         for (const PairTest& pair : block.pairs)
             pairs += name + "," + csvField(block.conditions[pair.test.first]) + "," +
-                     csvField(block.conditions[pair.test.second]) + "," + number(pair.test.difference, 8) + "," +
-                     number(pair.test.low, 8) + "," + number(pair.test.high, 8) + "," +
-                     number(pair.test.standardError, 8) + "," + number(pair.comparisons, 10) + "," +
-                     number(pair.test.pValue, 6) + "," + number(pair.adjustedPValue, 6) + "," +
-                     correctionName(analysis.options.correction) + "," + (pair.significant ? "1" : "0") + "," +
-                     pairMethod(block, pair) + "," + csvField(joined(pair.test.diagnosis.reasons, ";")) + "," +
-                     pair.test.diagnosis.bound + "\n";
+                     csvField(block.conditions[pair.test.second]) + "," +
+                     measuredNumber(measured(block, pair), pair.test.difference, 8) + "," + number(pair.test.low, 8) +
+                     "," + number(pair.test.high, 8) + "," + number(pair.test.standardError, 8) + "," +
+                     number(pair.comparisons, 10) + "," + number(pair.test.pValue, 6) + "," +
+                     number(pair.adjustedPValue, 6) + "," + correctionName(analysis.options.correction) + "," +
+                     (pair.significant ? "1" : "0") + "," + pairMethod(block, pair) + "," +
+                     csvField(joined(pair.test.diagnosis.reasons, ";")) + "," + pair.test.diagnosis.bound + "," +
+                     (pair.test.diagnosis.priorDriven ? "1" : "0") + "\n";
         for (size_t k = 0; k < block.observerStats.size(); ++k) {
             const ObserverInBlock& s = block.observerStats[k];
             consistency +=
@@ -436,13 +508,14 @@ void writeScaleOutputs(const Analysis& analysis, const std::filesystem::path& fo
         writeFileAtomic(folder / plotName(b, "matrix", block.name), encodePng(plotPreferenceMatrix(block)));
     }
     std::string observers = "observer,trials,held_out_loglik_per_trial,flagged,catch_trials,catch_failures,left_rate,"
-                            "pwcmp_dist_l,pwcmp_outlier\n";
+                            "pwcmp_dist_l,pwcmp_outlier,side_p_value,side_p_adjusted,side_biased\n";
     for (const ObserverSummary& s : analysis.observers)
         observers +=
             csvField(s.observer) + "," + number(s.trials, 10) + "," + number(s.heldOutPerTrial, 8) + "," +
             (s.flagged ? "1" : "0") + "," + std::to_string(s.catchTrials) + "," + std::to_string(s.catchFailures) +
             "," + (s.sideTrials > 0 ? number(s.leftChosen / s.sideTrials, 6) : "") + "," + number(s.pwcmpDistance, 6) +
-            "," + (std::isnan(s.pwcmpDistance) ? "" : (s.pwcmpOutlier ? "1" : "0")) + "\n";
+            "," + (std::isnan(s.pwcmpDistance) ? "" : (s.pwcmpOutlier ? "1" : "0")) + "," + number(s.sidePValue, 6) +
+            "," + number(s.sidePAdjusted, 6) + "," + (s.sideTrials > 0 ? (s.sideBiased ? "1" : "0") : "") + "\n";
     writeFileAtomic(folder / "scores.csv", scores);
     writeFileAtomic(folder / "pairs.csv", pairs);
     writeFileAtomic(folder / "counts.csv", counts);

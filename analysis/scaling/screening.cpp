@@ -18,7 +18,8 @@ HeldOutLikelihood heldOutLikelihood(const BlockData& block, const FitResult& ful
     Eigen::VectorXd weights = Eigen::VectorXd::Ones(n);
     for (int k = 0; k < n; ++k) {
         weights[k] = 0.0;
-        const FitResult without = fitScores(block.weightedCounts(weights), options, &full.scores);
+        const FitResult without = fitScores(block.weightedCounts(weights), options, &full.scores,
+                                            options.prior == Prior::Pwcmp ? &full.priorInformation : nullptr);
         weights[k] = 1.0;
         result.logLikelihood[k] = logLikelihood(options.model, block.pairs, block.winsFirst.row(k).transpose(),
                                                 block.winsSecond.row(k).transpose(), without.scores);

@@ -29,7 +29,13 @@ struct Tally {
     double randomObservers = 0, randomFlagged = 0, invertedObservers = 0, invertedFlagged = 0;
     double genuineObservers = 0, genuineFlagged = 0;
     double bootstrapCovered = 0, unionCovered = 0, unionWidth = 0;
+    // Pairs' intervals; intervals with one open end (scores, pairs) and how often their finite end held.
+    double pairIntervals = 0, pairCovered = 0, oneSided = 0, oneSidedCovered = 0, pairOneSided = 0,
+           pairOneSidedCovered = 0;
     void add(const Tally& o) {
+        pairIntervals += o.pairIntervals, pairCovered += o.pairCovered, oneSided += o.oneSided;
+        oneSidedCovered += o.oneSidedCovered, pairOneSided += o.pairOneSided;
+        pairOneSidedCovered += o.pairOneSidedCovered;
         bootstrapCovered += o.bootstrapCovered, unionCovered += o.unionCovered, unionWidth += o.unionWidth;
         intervals += o.intervals, covered += o.covered, width += o.width, percentileCovered += o.percentileCovered;
         fallbacks += o.fallbacks, maximumHalfWidth = std::max(maximumHalfWidth, o.maximumHalfWidth);
@@ -252,39 +258,50 @@ Tally runExperiment(const ValidationOptions& options, const std::string& scenari
         block = withoutObservers(block, flags); // the intervals below are those of the screened data
     }
 
-    const FitResult fit = fitScores(block.totalCounts(), fitOptions);
-    BootstrapOptions bootstrapOptions;
-    bootstrapOptions.samples = options.bootstrapSamples;
-    bootstrapOptions.seed = mixSeed(seed, 1);
-    bootstrapOptions.threads = 1; // experiments already run in parallel
-    const BootstrapResult bootstrap = bootstrapObservers(block, fit, fitOptions, bootstrapOptions);
+    // The intervals `analyze scale` reports: the studentized bootstrap (or its fallback), with the ends the data
+    // leave open open and the finite end of a one-sided interval at the one-sided profile bound.
+    AnalysisOptions analysisOptions;
+    analysisOptions.fit = fitOptions;
+    analysisOptions.intervals = IntervalMethod::bootstrap;
+    analysisOptions.bootstrap.samples = options.bootstrapSamples;
+    analysisOptions.bootstrap.seed = mixSeed(seed, 1);
+    analysisOptions.bootstrap.threads = 1; // experiments already run in parallel
+    analysisOptions.correction = options.correction;
+    analysisOptions.alpha = options.alpha;
+    const BlockAnalysis analysis = analyzeBlock(block, analysisOptions);
+    const Eigen::VectorXd& fit = analysis.thurstone.scores;
 
     Eigen::VectorXd truth = Eigen::Map<const Eigen::VectorXd>(design.trueScores.data(), m);
     truth.array() -= truth.mean();
     for (int i = 0; i < m; ++i) {
+        const double low = analysis.low[i], high = analysis.high[i];
         tally.intervals += 1;
-        tally.covered += bootstrap.low[i] <= truth[i] && truth[i] <= bootstrap.high[i];
-        tally.width += bootstrap.high[i] - bootstrap.low[i];
-        tally.fallbacks += bootstrap.scoreDiagnoses[i].fallback;
-        tally.maximumHalfWidth =
-            std::max({tally.maximumHalfWidth, fit.scores[i] - bootstrap.low[i], bootstrap.high[i] - fit.scores[i]});
-        tally.percentileCovered += bootstrap.percentileLow[i] <= truth[i] && truth[i] <= bootstrap.percentileHigh[i];
-        tally.percentileWidth += bootstrap.percentileHigh[i] - bootstrap.percentileLow[i];
-        tally.squaredError += (fit.scores[i] - truth[i]) * (fit.scores[i] - truth[i]);
+        const bool covered = low <= truth[i] && truth[i] <= high;
+        tally.covered += covered;
+        if (std::isfinite(low) != std::isfinite(high)) tally.oneSided += 1, tally.oneSidedCovered += covered;
+        if (std::isfinite(low) && std::isfinite(high)) tally.width += high - low;
+        tally.fallbacks += analysis.intervalFlags[i].fallback;
+        if (std::isfinite(low)) tally.maximumHalfWidth = std::max(tally.maximumHalfWidth, fit[i] - low);
+        if (std::isfinite(high)) tally.maximumHalfWidth = std::max(tally.maximumHalfWidth, high - fit[i]);
+        tally.percentileCovered += analysis.percentileLow[i] <= truth[i] && truth[i] <= analysis.percentileHigh[i];
+        tally.percentileWidth += analysis.percentileHigh[i] - analysis.percentileLow[i];
+        tally.squaredError += (fit[i] - truth[i]) * (fit[i] - truth[i]);
     }
-    const std::vector<double> estimatedRank = ranks(fit.scores), trueRank = ranks(truth);
+    const std::vector<double> estimatedRank = ranks(fit), trueRank = ranks(truth);
     double rankSquares = 0;
     for (int i = 0; i < m; ++i) rankSquares += (estimatedRank[i] - trueRank[i]) * (estimatedRank[i] - trueRank[i]);
     tally.rankCorrelation = 1.0 - 6.0 * rankSquares / (static_cast<double>(m) * (m * m - 1.0));
 
-    std::vector<double> pValues;
-    for (const DifferenceTest& test : bootstrap.differences) pValues.push_back(test.pValue);
-    const std::vector<double> adjusted = adjustPValues(pValues, options.correction);
-    for (size_t k = 0; k < bootstrap.differences.size(); ++k) {
-        const DifferenceTest& test = bootstrap.differences[k];
+    for (const PairTest& pair : analysis.pairs) {
+        const DifferenceTest& test = pair.test;
         const double trueDifference = truth[test.first] - truth[test.second];
+        const bool covered = test.low <= trueDifference && trueDifference <= test.high;
+        tally.pairIntervals += 1;
+        tally.pairCovered += covered;
+        if (std::isfinite(test.low) != std::isfinite(test.high))
+            tally.pairOneSided += 1, tally.pairOneSidedCovered += covered;
         tally.pairs += 1;
-        if (adjusted[k] >= options.alpha || trueDifference == 0.0) continue;
+        if (!pair.significant || trueDifference == 0.0) continue;
         if ((test.difference > 0) == (trueDifference > 0)) tally.significantCorrect += 1;
         else tally.significantReversed += 1;
     }
@@ -333,6 +350,10 @@ ValidationReport runValidation(const ValidationOptions& options) {
                 row.unionCoverage = total.unionCovered / total.intervals;
                 row.unionMeanWidth = total.unionWidth / total.intervals;
             }
+            row.pairCoverage = total.pairIntervals > 0 ? total.pairCovered / total.pairIntervals : -1.0;
+            row.oneSidedShare = total.oneSided / total.intervals;
+            row.oneSidedCoverage = total.oneSided > 0 ? total.oneSidedCovered / total.oneSided : -1.0;
+            row.pairOneSidedCoverage = total.pairOneSided > 0 ? total.pairOneSidedCovered / total.pairOneSided : -1.0;
             row.rmse = std::sqrt(total.squaredError / total.intervals);
             row.rankCorrelation = total.rankCorrelation / total.experiments;
             row.significantCorrect = total.significantCorrect / total.pairs;
@@ -383,11 +404,11 @@ std::string validationMarkdown(const ValidationReport& report) {
         bootstrapCoverages.c_str());
     out += line;
     out += std::string("Prior: ") + priorName(o.prior) + ".\n\n";
-    out += "| scenario | observers | coverage | mean width | fallback share | largest half-width | "
-           "coverage (percentile, pwcmp) | "
+    out += "| scenario | observers | coverage | pair coverage | one-sided share | one-sided coverage (scores, pairs) | "
+           "mean width | fallback share | largest half-width | coverage (percentile, pwcmp) | "
            "mean width | RMSE (JOD) | Spearman | significant & correct | significant & reversed | random caught | "
            "inverted caught | false alarms |\n";
-    out += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    out += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     auto rate = [](double value) {
         if (value < 0) return std::string("—");
         char buffer[32];
@@ -395,13 +416,15 @@ std::string validationMarkdown(const ValidationReport& report) {
         return std::string(buffer);
     };
     for (const ValidationRow& r : report.rows) {
-        std::snprintf(
-            line, sizeof line,
-            "| %s | %d | %.4f | %.3f | %.3f | %.2f | %.4f | %.3f | %.4f | %.4f | %.4f | %.4f | %s | %s | %s |\n",
-            r.scenario.c_str(), r.observers, r.coverage, r.meanWidth, r.fallbackShare, r.maximumHalfWidth,
-            r.percentileCoverage, r.percentileMeanWidth, r.rmse, r.rankCorrelation, r.significantCorrect,
-            r.significantReversed, rate(r.randomHitRate).c_str(), rate(r.invertedHitRate).c_str(),
-            rate(r.falseAlarmRate).c_str());
+        std::snprintf(line, sizeof line,
+                      "| %s | %d | %.4f | %s | %.3f | %s, %s | %.3f | %.3f | %.2f | %.4f | %.3f | %.4f | %.4f | %.4f | "
+                      "%.4f | %s | "
+                      "%s | %s |\n",
+                      r.scenario.c_str(), r.observers, r.coverage, rate(r.pairCoverage).c_str(), r.oneSidedShare,
+                      rate(r.oneSidedCoverage).c_str(), rate(r.pairOneSidedCoverage).c_str(), r.meanWidth,
+                      r.fallbackShare, r.maximumHalfWidth, r.percentileCoverage, r.percentileMeanWidth, r.rmse,
+                      r.rankCorrelation, r.significantCorrect, r.significantReversed, rate(r.randomHitRate).c_str(),
+                      rate(r.invertedHitRate).c_str(), rate(r.falseAlarmRate).c_str());
         out += line;
     }
     return out;
@@ -438,6 +461,7 @@ nlohmann::json validationJson(const ValidationReport& report) {
                               {"observers", r.observers},
                               {"experiments", r.experiments},
                               {"coverage", r.coverage},
+                              {"one_sided_share", r.oneSidedShare},
                               {"mean_width", r.meanWidth},
                               {"fallback_share", r.fallbackShare},
                               {"maximum_half_width", r.maximumHalfWidth},
@@ -452,6 +476,9 @@ nlohmann::json validationJson(const ValidationReport& report) {
         if (r.falseAlarmRate >= 0) row["false_alarm_rate"] = r.falseAlarmRate;
         if (r.bootstrapCoverage >= 0) row["bootstrap_coverage"] = r.bootstrapCoverage;
         if (r.unionCoverage >= 0) row["union_coverage"] = r.unionCoverage;
+        if (r.pairCoverage >= 0) row["pair_coverage"] = r.pairCoverage;
+        if (r.oneSidedCoverage >= 0) row["one_sided_coverage"] = r.oneSidedCoverage;
+        if (r.pairOneSidedCoverage >= 0) row["pair_one_sided_coverage"] = r.pairOneSidedCoverage;
         json["rows"].push_back(row);
     }
     return json;

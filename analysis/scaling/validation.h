@@ -70,11 +70,16 @@ struct ValidationRow {
     std::string scenario;
     int observers = 0;
     int experiments = 0;
-    double coverage = 0.0;           // the reported intervals (studentized, or the flagged fallback), 95 % nominal
-    double meanWidth = 0.0;          // JOD
-    double fallbackShare = 0.0;      // share of score intervals that fell back to percentile+profile
-    double maximumHalfWidth = 0.0;   // JOD, largest distance from a score to one of its bounds
-    double percentileCoverage = 0.0; // pwcmp's percentile bootstrap on the same resamples
+    double coverage = 0.0;      // the reported intervals (studentized, or the flagged fallback; an end the data leave
+                                // open is open, as `analyze scale` reports it), 95 % nominal
+    double pairCoverage = -1.0; // the same for every pair's difference (not "active")
+    double oneSidedShare = 0.0; // share of score intervals with one open end
+    double oneSidedCoverage = -1.0;     // how often the finite end of those held (−1: none)
+    double pairOneSidedCoverage = -1.0; // the same for the pairs' intervals
+    double meanWidth = 0.0;             // JOD
+    double fallbackShare = 0.0;         // share of score intervals that fell back to percentile+profile
+    double maximumHalfWidth = 0.0;      // JOD, largest distance from a score to one of its bounds
+    double percentileCoverage = 0.0;    // pwcmp's percentile bootstrap on the same resamples
     double percentileMeanWidth = 0.0;
     double bootstrapCoverage = -1.0; // "active" only: the studentized observer bootstrap on the same data
     double unionCoverage = -1.0;     // "active" only: the union of that bootstrap and the profile interval

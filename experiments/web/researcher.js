@@ -226,7 +226,9 @@ function renderScale(scale) {
     const body = element('tbody');
     for (const c of block.conditions) {
       const row = element('tr', { class: 'scale-row', 'data-condition': c.condition, 'data-jod': c.jod });
-      row.append(element('td', {}, c.condition), element('td', { class: 'number' }, fixed(c.jod, 2)),
+      if (c.measured === false) row.append(element('td', {}, c.condition),
+        element('td', { class: 'not-measured', colspan: '2' }, 'not measured (never compared)'));
+      else row.append(element('td', {}, c.condition), element('td', { class: 'number' }, fixed(c.jod, 2)),
         element('td', { class: 'number' }, `[${fixed(c.low, 2)}, ${fixed(c.high, 2)}]` + (c.interval_fallback ? ' *' : '')));
       body.append(row);
     }

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -150,6 +151,41 @@ TEST(CliScale, CountMatrixOracle) {
     EXPECT_EQ(json["blocks"][0]["interval_method"], "profile-likelihood");
 }
 
+TEST(CliScale, AConditionNeverComparedIsNotMeasuredInEveryOutput) {
+    // D has no comparison at all: it has no score (the prior alone puts it at 0) and no interval (the profile search
+    // stopped at ±200 JOD), so no output may print a number for it.
+    const fs::path input = scratch() / "unmeasured.csv";
+    std::ofstream(input) << "condition,A,B,C,D\nA,0,25,0,0\nB,75,0,25,0\nC,0,75,0,0\nD,0,0,0,0\n";
+    const fs::path output = scratch() / "unmeasured-out";
+    const CliRun result = run("analyze scale " + input.string() + " -o " + output.string());
+    ASSERT_EQ(result.exitCode, 0) << result.output;
+    EXPECT_NE(result.output.find("D                        not measured"), std::string::npos) << result.output;
+    std::ifstream stream(output / "scale.json");
+    const nlohmann::json json = nlohmann::json::parse(stream);
+    const auto& d = json["blocks"][0]["scores"][3];
+    EXPECT_EQ(d["condition"], "D");
+    EXPECT_EQ(d["measured"], false);
+    EXPECT_TRUE(d["jod"].is_null()) << d.dump();
+    EXPECT_TRUE(d["ci_low"].is_null() && d["ci_high"].is_null()) << d.dump();
+    EXPECT_EQ(d["bound"], "not-measured");
+    EXPECT_EQ(json["blocks"][0]["scores"][0]["measured"], true);
+    for (const auto& pair : json["blocks"][0]["pairs"])
+        if (pair["condition_B"] == "D") {
+            EXPECT_TRUE(pair["difference_jod"].is_null()) << pair.dump();
+            EXPECT_EQ(pair["bound"], "not-measured");
+        }
+    std::ifstream csvStream(output / "scores.csv");
+    std::string line, dLine;
+    while (std::getline(csvStream, line))
+        if (line.rfind("matrix,D,", 0) == 0 || line.find(",D,") != std::string::npos) dLine = line;
+    ASSERT_FALSE(dLine.empty());
+    EXPECT_NE(dLine.find(",D,,,,,"), std::string::npos) << dLine; // jod, ci_low, ci_high, standard_error empty
+    EXPECT_NE(dLine.find("not-measured"), std::string::npos) << dLine;
+    std::ifstream htmlStream(output / "report_section.html");
+    const std::string html((std::istreambuf_iterator<char>(htmlStream)), std::istreambuf_iterator<char>());
+    EXPECT_NE(html.find("<td>D</td><td colspan=\"4\">not measured"), std::string::npos);
+}
+
 TEST(CliScale, PwcmpsOwnExampleFileWithItsPriorAndOutlierAnalysis) {
     // pwcmp's examples/ex3_tmo_cmp_data.csv as it is (extra columns session_id and criterion).
     const std::string input = std::string(SKINLAB_SOURCE_DIR) + "/tests/data/pwcmp/ex3_tmo_cmp_data.csv";
@@ -172,8 +208,8 @@ TEST(CliScale, PwcmpsOwnExampleFileWithItsPriorAndOutlierAnalysis) {
         if (observer["pwcmp_outlier"] == true) flagged.push_back(observer["observer"]);
     EXPECT_EQ(flagged, (std::vector<std::string>{"M02", "bab"}));
     const std::string scores = (std::ostringstream() << std::ifstream(output / "scores.csv").rdbuf()).str();
-    EXPECT_NE(scores.find(",bound,prior\n"), std::string::npos);
-    EXPECT_NE(scores.find(",two-sided,pwcmp\n"), std::string::npos);
+    EXPECT_NE(scores.find(",bound,prior,prior_driven\n"), std::string::npos);
+    EXPECT_NE(scores.find(",two-sided,pwcmp,0\n"), std::string::npos);
     const std::string html = (std::ostringstream() << std::ifstream(output / "report_section.html").rdbuf()).str();
     EXPECT_NE(html.find("pwcmp's prior"), std::string::npos);
 }
@@ -209,6 +245,26 @@ TEST(CliValidate, DegenerateScenariosGiveFiniteIntervals) {
     const CliRun bad = run("analyze validate --scenarios sparse,unknown");
     EXPECT_EQ(bad.exitCode, 2);
     EXPECT_NE(bad.output.find("'unknown' is not one of"), std::string::npos) << bad.output;
+}
+
+TEST(CliValidate, NearUnanimousDesignsCoverScoresPairsAndOneSidedBounds) {
+    // 5 conditions 1.5 JOD apart, 10 observers, 1 trial per pair: most pairs unanimous. The reported intervals
+    // (open ends open, the finite end of a one-sided interval at the exact one-sided bound) must hold the truth
+    // ≥ 94.5 % of the time for scores and pairs, and so must the finite ends of the one-sided intervals. With the
+    // χ²₁ bound as the finite end, those one-sided intervals covered 0.75–0.85 (scores) and 0.54–0.93 (pairs).
+    const fs::path output = scratch() / "validate-near-unanimous";
+    const CliRun result = run("analyze validate --scores 0,1.5,3,4.5,6 --trials-per-pair 1 --observers 10 "
+                              "--experiments 150 --bootstrap 200 --scenarios thurstone --seed 3 -o " +
+                              output.string());
+    ASSERT_EQ(result.exitCode, 0) << result.output;
+    std::ifstream stream(output / "validation.json");
+    const nlohmann::json json = nlohmann::json::parse(stream);
+    const auto& row = json["rows"].at(0);
+    EXPECT_GE(row["coverage"].get<double>(), 0.945) << row.dump();
+    EXPECT_GE(row["pair_coverage"].get<double>(), 0.945) << row.dump();
+    EXPECT_GT(row["one_sided_share"].get<double>(), 0.2) << "the design is near-unanimous: " << row.dump();
+    EXPECT_GE(row["one_sided_coverage"].get<double>(), 0.945) << row.dump();
+    EXPECT_GE(row["pair_one_sided_coverage"].get<double>(), 0.945) << row.dump();
 }
 
 TEST(CliValidate, ActiveScenarioRunsWithProfileIntervals) {

@@ -159,6 +159,24 @@ TEST(DegenerateDesigns, UnanimousStudiesGetOneSidedBoundsInsteadOfPriorSetEnds) 
     EXPECT_EQ(json["settings"]["prior"], "gaussian");
 }
 
+TEST(DegenerateDesigns, AUnanimousPairsFiniteEndIsTheExactOneSidedBound) {
+    // 10 observers each chose c1 over c0 once: 10:0. The data bound c1 − c0 from below only. An exact
+    // (Clopper–Pearson) bound at 97.5 % is P ≥ 0.025^(1/10) = 0.6915, d ≥ 1.4826·Φ⁻¹(0.6915) = 0.742 JOD; a true
+    // difference of 1.0 JOD (P = 0.75) gives 10:0 in 5.6 % of studies, so a bound above it would miss that often.
+    // The χ²₁ profile bound sat at P ≥ 0.825 (1.38 JOD), above the true 1.0 of studies that answer 10:0.
+    std::vector<std::vector<Answers>> answers(10, std::vector<Answers>{{0, 1, 0, 1}});
+    const Analysis analysis = analyzeDataset(dataset(2, answers), quickOptions());
+    const BlockAnalysis& block = analysis.blocks.at(0);
+    const PairTest& pair = block.pairs.at(0);
+    EXPECT_EQ(pair.test.diagnosis.bound, "upper"); // q0 − q1 is at most a negative number
+    EXPECT_TRUE(pair.test.diagnosis.priorDriven);
+    EXPECT_TRUE(std::isinf(pair.test.low));
+    EXPECT_NEAR(pair.test.high, -0.742, 0.03);
+    EXPECT_EQ(block.intervalFlags[1].bound, "lower");
+    EXPECT_TRUE(block.intervalFlags[1].priorDriven);
+    EXPECT_NEAR(block.low[1], 0.371, 0.02); // half the difference: the score relative to the mean of two
+}
+
 TEST(DegenerateDesigns, DisconnectedComponentsAreScaledSeparately) {
     // A count matrix (profile intervals) with two components of three conditions: each score used to get ±7.3 JOD
     // (the prior's spread between the components). Each component is centred on its own mean, its scores get

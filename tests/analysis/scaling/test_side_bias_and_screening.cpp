@@ -1,10 +1,13 @@
 // Simulated observers with known side bias and known bad observers: the estimates must find them.
 #include "analysis/scaling/bootstrap.h"
 #include "analysis/scaling/consistency.h"
+#include "analysis/scaling/scale_analysis.h"
 #include "analysis/scaling/screening.h"
 #include "analysis/scaling/simulation.h"
 
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 namespace skinlab::analysis::scaling {
 namespace {
@@ -39,6 +42,86 @@ TEST(SideBias, DetectsAConstantBias) {
     EXPECT_NEAR(bias.bias, 0.7775, 1e-3);
     EXPECT_NEAR(bias.leftRate, 0.7, 1e-12);
     EXPECT_LT(bias.pValue, 1e-6);
+}
+
+// A block of `observers` observers who each chose the left image in every trial of a simulated 5-condition study
+// (1 trial per pair and observer, sides alternating; the answers follow the side, not the condition).
+BlockData allLeftPanel(int observers) {
+    SimulationDesign design;
+    design.trueScores = {0.0, 1.5, 3.0, 4.5, 6.0};
+    design.observers = observers;
+    design.trialsPerPair = 1;
+    BlockData block = simulateBlock(design, 3).block;
+    block.winsFirst.setZero();
+    block.winsSecond.setZero();
+    for (auto& side : block.sideCounts) side = {0, 0, 0, 0};
+    for (int k = 0; k < observers; ++k)
+        for (size_t p = 0; p < block.pairs.size(); ++p) {
+            const bool firstOnLeft = (k + static_cast<int>(p)) % 2 == 0; // the chosen image is the left one
+            (firstOnLeft ? block.winsFirst : block.winsSecond)(k, static_cast<Eigen::Index>(p)) += 1.0;
+            block.sideCounts[p][firstOnLeft ? 0 : 3] += 1.0;
+        }
+    block.sideTrials = Eigen::VectorXd::Constant(observers, static_cast<double>(block.pairs.size()));
+    block.leftChosen = block.sideTrials;
+    return block;
+}
+
+TEST(SideBias, AnAllLeftPanelIsFlaggedByTheExactTest) {
+    // Every answer on the left: the Wald test of b broke down here (b̂ → ∞, SE → ∞, p = 1). The exact binomial test
+    // of 100 left answers of 100 gives p = 2·2⁻¹⁰⁰.
+    const BlockData block = allLeftPanel(10);
+    const FitResult fit = fitScores(block.totalCounts(), FitOptions{});
+    const SideBias bias = estimateSideBias(block, fit.scores, Model::Thurstone);
+    ASSERT_TRUE(bias.available);
+    EXPECT_EQ(bias.leftRate, 1.0);
+    EXPECT_LT(bias.pValue, 1e-3);
+    EXPECT_NEAR(bias.pValue, 2.0 * std::pow(0.5, 100), 1e-40);
+    EXPECT_TRUE(std::isinf(bias.bias) && bias.bias > 0) << "no finite estimate exists: " << bias.bias;
+}
+
+TEST(SideBias, ExactBinomialPValues) {
+    // Hand values: n = 10, k = 0 → 2/1024; k = 2 → 2·(1 + 10 + 45)/1024 = 0.109375; k = 5 → 1; n = 0 → 1.
+    EXPECT_NEAR(binomialHalfPValue(0, 10), 2.0 / 1024.0, 1e-15);
+    EXPECT_NEAR(binomialHalfPValue(10, 10), 2.0 / 1024.0, 1e-15);
+    EXPECT_NEAR(binomialHalfPValue(2, 10), 0.109375, 1e-12);
+    EXPECT_NEAR(binomialHalfPValue(8, 10), 0.109375, 1e-12);
+    EXPECT_EQ(binomialHalfPValue(5, 10), 1.0);
+    EXPECT_EQ(binomialHalfPValue(0, 0), 1.0);
+    EXPECT_NEAR(binomialHalfPValue(0, 2000), 0.0, 1e-300); // no overflow or NaN at large n
+}
+
+TEST(Screening, FlagsEveryObserverOfAnAllLeftPanel) {
+    // Each observer: 10 of 10 on the left, exact p = 2/1024, Holm over 10 observers 0.0195 < 0.05.
+    Dataset dataset;
+    dataset.blocks.push_back(allLeftPanel(10));
+    AnalysisOptions options;
+    options.bootstrap.samples = 100;
+    const Analysis analysis = analyzeDataset(dataset, options);
+    ASSERT_EQ(analysis.observers.size(), 10u);
+    for (const ObserverSummary& observer : analysis.observers) {
+        EXPECT_NEAR(observer.sidePValue, 2.0 / 1024.0, 1e-12);
+        EXPECT_TRUE(observer.sideBiased) << observer.observer;
+    }
+    EXPECT_LT(analysis.blocks[0].sideBias.pValue, 1e-3);
+    int sideWarnings = 0;
+    for (const std::string& warning : analysis.warnings) sideWarnings += warning.find("side bias") != std::string::npos;
+    EXPECT_EQ(sideWarnings, 11); // the panel and each observer
+}
+
+TEST(Screening, UnbiasedObserversAreNotFlaggedForSide) {
+    SimulationDesign design;
+    design.trueScores = {0.0, 0.5, 1.0, 1.5};
+    design.observers = 20;
+    design.trialsPerPair = 4;
+    Dataset dataset;
+    dataset.blocks.push_back(simulateBlock(design, 17).block);
+    AnalysisOptions options;
+    options.bootstrap.samples = 100;
+    const Analysis analysis = analyzeDataset(dataset, options);
+    for (const ObserverSummary& observer : analysis.observers) {
+        EXPECT_FALSE(observer.sideBiased) << observer.observer;
+        EXPECT_GT(observer.sidePValue, 0.0);
+    }
 }
 
 TEST(Screening, FlagsRandomAndInvertedObservers) {
