@@ -165,9 +165,10 @@ std::string predictionSectionHtml(const std::vector<PredictionAgreement>& agreem
              << escapeHtml(a.anchor) << "</em>)</h3><div class=\"scatters\"><figure>"
              << scatterSvg(points, "predicted Δ JOD", options) << "</figure></div>"
              << "<p>Slope " << formatNumber(a.slope, 2) << ", RMSE " << formatNumber(a.rmse, 2)
-             << " JOD, Spearman ρ = " << formatNumber(a.spearman, 2) << " [" << formatNumber(a.spearmanLow, 2) << ", "
-             << formatNumber(a.spearmanHigh, 2) << "] over " << a.conditions.size() << " conditions"
-             << (static_cast<int>(a.conditions.size()) < agreement::kFewConditions
+             << " JOD, Spearman ρ = " << formatNumber(a.spearman, 2) << " "
+             << correlationIntervalText(a.spearmanLow, a.spearmanHigh, static_cast<int>(a.conditions.size()))
+             << " over " << a.conditions.size() << " conditions"
+             << (static_cast<int>(a.conditions.size()) < agreement::kFewConditions && std::isfinite(a.spearmanLow)
                      ? " (few conditions: a wide interval)"
                      : "")
              << ".</p>\n<table><thead><tr><th class=\"l\">condition</th><th>predicted Δ</th><th>measured Δ</th>"
