@@ -109,8 +109,8 @@ TEST_P(GoldenImages, BuiltinSceneMatchesItsGolden) {
 // The named variants halo-grey-backdrop and bleed-true-mask keep the goldens of the former halo and bleed defaults.
 INSTANTIATE_TEST_SUITE_P(Builtin, GoldenImages,
                          ::testing::Values("halo", "bleed", "ear", "head", "halo-grey-backdrop", "bleed-true-mask"),
-                         [](const ::testing::TestParamInfo<std::string>& info) {
-                             std::string name = info.param; // a test name holds letters, digits and '_' only
+                         [](const ::testing::TestParamInfo<std::string>& param) {
+                             std::string name = param.param; // a test name holds letters, digits and '_' only
                              std::replace(name.begin(), name.end(), '-', '_');
                              return name;
                          });

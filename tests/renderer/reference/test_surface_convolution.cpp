@@ -157,7 +157,7 @@ TEST_P(StepResponse, EqualsTheMarginalCdf) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Profiles, StepResponse, ::testing::Values("deon", "burley"),
-                         [](const auto& info) { return std::string(info.param); });
+                         [](const auto& param) { return std::string(param.param); });
 
 TEST(SurfaceConvolution, ConvergesAsSampleDensityGrows) {
     // builtin:halo's skin sphere (radius 40 mm) lit by a directional light: E = max(0, n · L), albedo of skin.

@@ -162,9 +162,9 @@ double partArea(const Model& model, std::uint32_t material) {
 // --- builtin:halo -------------------------------------------------------------------------------------------
 
 // A length parameter as a test name: 0.5f -> "0_5mm", 200.0f -> "200mm".
-std::string millimetresName(const ::testing::TestParamInfo<float>& info) {
+std::string millimetresName(const ::testing::TestParamInfo<float>& param) {
     char text[32];
-    std::snprintf(text, sizeof text, "%gmm", static_cast<double>(info.param));
+    std::snprintf(text, sizeof text, "%gmm", static_cast<double>(param.param));
     std::string name = text;
     for (char& c : name)
         if (c == '.') c = '_';
