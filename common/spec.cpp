@@ -363,7 +363,7 @@ std::string nearestKey(std::string_view unknown, const std::vector<std::string>&
     std::size_t bestDistance = 0;
     for (const std::string& candidate : known) {
         const std::size_t distance = editDistance(unknown, candidate);
-        // Close enough to be a slip of the keyboard: at most 2 edits, and fewer than a third of the key.
+        // Close enough to be a slip of the keyboard: at most 2 edits and a third of the key (1 below 6 letters).
         const std::size_t allowed = std::min<std::size_t>(2, std::max<std::size_t>(1, candidate.size() / 3));
         if (distance == 0 || distance > allowed || distance >= candidate.size()) continue;
         if (best.empty() || distance < bestDistance || (distance == bestDistance && candidate < best)) {

@@ -82,7 +82,7 @@ private:
 };
 
 // The entry of `known` a slip of the keyboard away from `unknown` (at most 2 edits — insert, delete, replace, swap
-// neighbours — and fewer than a third of its length), the closest first; empty when none is.
+// neighbours — and a third of its length, 1 below 6 letters), the closest; empty when none is.
 std::string nearestKey(std::string_view unknown, const std::vector<std::string>& known);
 
 // Describes a TOML node's type and value for messages: `string "wide"`, `integer 3`, `table`.

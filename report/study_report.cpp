@@ -849,8 +849,9 @@ void writeAgreement(std::ostringstream& html, const ReportData& r) {
                                       block.thurstone.scores[i], block.low[i], block.high[i]});
                 }
                 html << "<figure>" << scatterSvg(points, row->metric.label) << "<figcaption>" << h(row->metric.label)
-                     << ": r = " << num(row->pearson) << " [" << num(row->pearsonLow) << ", " << num(row->pearsonHigh)
-                     << "], ρ = " << num(row->spearman) << "</figcaption></figure>";
+                     << ": r = " << num(row->pearson) << " "
+                     << correlationIntervalText(row->pearsonLow, row->pearsonHigh, row->conditions)
+                     << ", ρ = " << num(row->spearman) << "</figcaption></figure>";
             }
             html << "</div>\n";
         }

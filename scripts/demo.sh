@@ -40,7 +40,7 @@ if [ -e "$out/stimuli/manifest.json" ] && ! grep -q "\"set\": *\"$set_name\"" "$
 fi
 echo "demo: rendering the stimulus set $stimuli_spec (every block, each with its reference; then each stimulus's" \
   "visibility against its block's reference, predicted by ColorVideoVDP)"
-"$skinlab" stimuli build "$stimuli_spec" -o "$out/stimuli"
+run_with_heartbeat demo "$skinlab" stimuli build "$stimuli_spec" -o "$out/stimuli"
 
 # A demo study is recreated on every run (a real study is never overwritten by `study create`).
 rm -f "$out/study.db" "$out/study.db-wal" "$out/study.db-shm"
