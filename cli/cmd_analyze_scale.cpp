@@ -1,4 +1,5 @@
 // `skinlab analyze scale RESPONSES -o DIR` and `skinlab analyze validate` (docs/analysis.md).
+#include "analysis/scaling/multiple_comparisons.h"
 #include "analysis/scaling/scale_analysis.h"
 #include "analysis/scaling/scale_report.h"
 #include "analysis/scaling/screening.h"
@@ -142,6 +143,10 @@ void runScale(const ScaleArguments& arguments) {
             std::printf("  %-24s %+7.3f JOD%s  %s%s\n", block.conditions[i].c_str(), block.thurstone.scores[k],
                         priorDriven ? " (value set by the prior)" : "", interval, note.c_str());
         }
+        const auto significant = std::count_if(block.pairs.begin(), block.pairs.end(),
+                                               [](const scaling::PairTest& pair) { return pair.significant; });
+        std::printf("  significant pairs: %td of %zu (correction over the block's pairs: %s)\n", significant,
+                    block.pairs.size(), scaling::correctionName(options.correction));
     }
     for (const scaling::ObserverSummary& observer : analysis.observers)
         if (arguments.pwcmpOutliers && !std::isnan(observer.pwcmpDistance))

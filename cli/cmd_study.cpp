@@ -72,6 +72,7 @@ void runCreate(const StudyOptions& o) {
         "%s: %zu block(s), %zu stimuli; per participant %d trials (%d practice, %d test, %d repeat, %d catch)\n",
         o.output.c_str(), d.blocks.size(), d.stimuli.size(), created.trialsPerParticipant, d.design.practiceTrials,
         d.testTrialCount(), d.repeatTrialCount(), d.catchTrialCount());
+    for (const std::string& block : created.blocksLeftOut) std::printf("not studied: block %s\n", block.c_str());
     std::printf("next: skinlab study serve %s\n", o.output.c_str());
 }
 

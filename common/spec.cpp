@@ -2,10 +2,12 @@
 
 #include "common/error.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <set>
 #include <sstream>
+#include <vector>
 
 namespace skinlab {
 
@@ -41,6 +43,7 @@ struct SpecReader::State {
     std::string file;
     std::set<std::string> read;   // key paths read as values or tables
     std::set<std::string> opaque; // key paths read raw: nothing below them is checked
+    std::set<std::string> asked;  // key paths looked up, present or not (the keys an unknown key may misspell)
 };
 
 toml::table parseTomlFile(const std::filesystem::path& path) {
@@ -183,9 +186,12 @@ std::string SpecReader::keyPath(std::string_view key) const {
     return prefix_.empty() ? std::string(key) : prefix_ + "." + std::string(key);
 }
 
-bool SpecReader::has(std::string_view key) const { return table_->get(key) != nullptr; }
+bool SpecReader::has(std::string_view key) const { return get(key) != nullptr; }
 
-const toml::node* SpecReader::get(std::string_view key) const { return table_->get(key); }
+const toml::node* SpecReader::get(std::string_view key) const {
+    state_->asked.insert(keyPath(key));
+    return table_->get(key);
+}
 
 void SpecReader::mark(std::string_view key, bool opaque) const {
     state_->read.insert(keyPath(key));
@@ -336,10 +342,53 @@ const toml::node* SpecReader::raw(std::string_view key) const {
     return n;
 }
 
+namespace {
+// Optimal string alignment distance: insertions, deletions, substitutions and swaps of neighbours ("fov_dge").
+std::size_t editDistance(std::string_view a, std::string_view b) {
+    std::vector<std::vector<std::size_t>> d(a.size() + 1, std::vector<std::size_t>(b.size() + 1));
+    for (std::size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
+    for (std::size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i)
+        for (std::size_t j = 1; j <= b.size(); ++j) {
+            d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
+            if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1])
+                d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+        }
+    return d[a.size()][b.size()];
+}
+} // namespace
+
+std::string nearestKey(std::string_view unknown, const std::vector<std::string>& known) {
+    std::string best;
+    std::size_t bestDistance = 0;
+    for (const std::string& candidate : known) {
+        const std::size_t distance = editDistance(unknown, candidate);
+        // Close enough to be a slip of the keyboard: at most 2 edits and a third of the key (1 below 6 letters).
+        const std::size_t allowed = std::min<std::size_t>(2, std::max<std::size_t>(1, candidate.size() / 3));
+        if (distance == 0 || distance > allowed || distance >= candidate.size()) continue;
+        if (best.empty() || distance < bestDistance || (distance == bestDistance && candidate < best)) {
+            best = candidate;
+            bestDistance = distance;
+        }
+    }
+    return best;
+}
+
 void SpecReader::checkUnread(const toml::table& table, const std::string& prefix) const {
     for (auto&& [k, v] : table) {
         std::string path = prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
-        if (!state_->read.count(path)) throwInput(state_->file, path, "unknown key");
+        if (!state_->read.count(path)) {
+            // The keys this table was asked for and does not have: "fov_dge" is likely "fov_deg".
+            std::vector<std::string> known;
+            const std::string parent = prefix.empty() ? "" : prefix + ".";
+            for (const std::string& asked : state_->asked) {
+                if (asked.size() <= parent.size() || asked.compare(0, parent.size(), parent) != 0) continue;
+                const std::string name = asked.substr(parent.size());
+                if (name.find_first_of(".[") == std::string::npos && !table.contains(name)) known.push_back(name);
+            }
+            const std::string hint = nearestKey(k.str(), known);
+            throwInput(state_->file, path, hint.empty() ? "unknown key" : "unknown key (did you mean " + hint + "?)");
+        }
         if (state_->opaque.count(path)) continue;
         if (auto* t = v.as_table()) checkUnread(*t, path);
         if (auto* a = v.as_array()) {

@@ -7,6 +7,7 @@
 //   scene.toml: camera.fov_deg: 200 is out of range [1, 179]
 //   scene.toml: camera.fov_deg: expected a number, got string "wide"
 //   scene.toml: camera.fvo: unknown key
+//   scene.toml: camera.fov_dge: unknown key (did you mean fov_deg?)   (a key the reader asked for, a slip away)
 #include <array>
 #include <cstdint>
 #include <filesystem>
@@ -79,6 +80,10 @@ private:
     std::string prefix_;
     std::shared_ptr<State> state_;
 };
+
+// The entry of `known` a slip of the keyboard away from `unknown` (at most 2 edits — insert, delete, replace, swap
+// neighbours — and a third of its length, 1 below 6 letters), the closest; empty when none is.
+std::string nearestKey(std::string_view unknown, const std::vector<std::string>& known);
 
 // Describes a TOML node's type and value for messages: `string "wide"`, `integer 3`, `table`.
 std::string describeNode(const toml::node& node);

@@ -11,6 +11,9 @@ namespace skinlab::experiments {
 struct CreatedStudy {
     StudyDefinition definition;
     int trialsPerParticipant = 0; // practice + test + repeat + catch
+    // The stimulus set's blocks the study leaves out, each with the reason: "mid (not among the design's blocks:
+    // close, explicit)", "far (it holds fewer than two of the design's conditions)".
+    std::vector<std::string> blocksLeftOut;
 };
 
 // Reads DIR/manifest.json and the design (with --set overrides), checks the images against their hashes, and

@@ -134,17 +134,36 @@ std::string planText(const StudyPlan& plan) {
             }
             out += "\n";
         }
+        // What a study of each size should find: the expected number of significant neighbouring pairs (the sum of
+        // their powers), so that an outcome can be read against the plan.
+        if (!block.neighbours.empty()) {
+            out += "  significant neighbouring pairs to expect (of " + std::to_string(block.neighbours.size()) + "):";
+            for (std::size_t k = 0; k < plan.options.observerCounts.size(); ++k) {
+                double expected = 0.0;
+                for (const PlannedPair& pair : block.neighbours)
+                    expected += k < pair.power.size() ? pair.power[k] : 0.0;
+                std::snprintf(line, sizeof line, " %.1f at %d%s", expected, plan.options.observerCounts[k],
+                              k + 1 < plan.options.observerCounts.size() ? "," : " observers\n");
+                out += line;
+            }
+        }
         if (block.observersNeeded > 0) {
             std::snprintf(line, sizeof line,
                           "  needs %d observers (%d trials in all) for every neighbouring pair to be resolved with "
                           "power >= %.2g\n",
                           block.observersNeeded, block.observersNeeded * plan.trialsPerObserver, plan.options.power);
             out += line;
-        } else {
+        } else if (!block.neighbours.empty()) {
+            // Not every pair: name the one that keeps the block from it (the closest); the others may well come out.
+            const PlannedPair& closest = *std::min_element(
+                block.neighbours.begin(), block.neighbours.end(),
+                [](const PlannedPair& a, const PlannedPair& b) { return a.difference < b.difference; });
             std::snprintf(line, sizeof line,
-                          "  not resolved with power >= %.2g by %d observers: the predicted differences are too small "
-                          "for this design\n",
-                          plan.options.power, plan.options.observerCounts.back());
+                          "  not every neighbouring pair reaches power >= %.2g by %d observers: the closest, %s > %s "
+                          "(%.3f JOD), is too small for this design; pairs further apart can still come out "
+                          "significant (above)\n",
+                          plan.options.power, plan.options.observerCounts.back(), closest.better.c_str(),
+                          closest.worse.c_str(), closest.difference);
             out += line;
         }
     }

@@ -597,8 +597,9 @@ DisplayFrame Renderer::renderDisplay(const RenderRequest& request, bool withLine
     out.mmPerUnit = spec.mmPerUnit;
     out.resolved = spec.resolved;
     out.timingsMs = impl.timer.json();
-    out.timingsMs["cpu"] = {{"load", loadMs}, {"upload", uploadMs}, {"readback", readbackMs}};
-    out.timingsMs["call_wall"] = millisecondsSince(start);
+    out.timingsMs["cpu"] = {
+        {"load", gl::roundMs(loadMs)}, {"upload", gl::roundMs(uploadMs)}, {"readback", gl::roundMs(readbackMs)}};
+    out.timingsMs["call_wall"] = gl::roundMs(millisecondsSince(start));
     return out;
 }
 
@@ -799,11 +800,16 @@ RenderResult Renderer::render(const RenderRequest& request) {
     result.glRenderer = impl.context.renderer();
     result.glVersion = impl.context.version();
     result.timingsMs = impl.timer.json();
-    result.timingsMs["cpu"] = {{"load", loadMs}, {"upload", uploadMs}, {"readback", readbackMs}, {"write", writeMs}};
-    if (referenceMethod) result.timingsMs["reference"] = impl.referenceMethod.lastRun(); // CPU parts of "sss"
+    result.timingsMs["cpu"] = {{"load", gl::roundMs(loadMs)},
+                               {"upload", gl::roundMs(uploadMs)},
+                               {"readback", gl::roundMs(readbackMs)},
+                               {"write", gl::roundMs(writeMs)}};
+    if (referenceMethod)
+        result.timingsMs["reference"] = gl::roundTimings(impl.referenceMethod.lastRun()); // CPU parts of "sss"
     if (cycles)
-        result.timingsMs[eevee ? "eevee" : "pathtraced"] = {{"render", cycles->renderSeconds * 1000.0},
-                                                            {"blender_wall", cycles->wallSeconds * 1000.0}};
+        result.timingsMs[eevee ? "eevee" : "pathtraced"] = {
+            {"render", gl::roundMs(cycles->renderSeconds * 1000.0)},
+            {"blender_wall", gl::roundMs(cycles->wallSeconds * 1000.0)}};
     result.timingsMs["width"] = width;
     result.timingsMs["height"] = height;
     result.timingsMs["gl_renderer"] = result.glRenderer;

@@ -276,10 +276,10 @@ std::string predictionSectionHtml(const std::vector<PredictionAgreement>& agreem
              << "<p>Slope " << formatNumber(a.slope, 2) << interval(a.slopeLow, a.slopeHigh) << ", RMSE "
              << formatNumber(a.rmse, 2) << " JOD" << interval(a.rmseLow, a.rmseHigh) << " ("
              << (a.overConditions ? "bootstrap over observers and conditions" : "bootstrap over observers") << ", "
-             << a.observers << " observers), Spearman ρ = " << formatNumber(a.spearman, 2) << " ["
-             << formatNumber(a.spearmanLow, 2) << ", " << formatNumber(a.spearmanHigh, 2)
-             << "], exact p = " << formatNumber(a.spearmanP, 3) << ", over " << a.conditions.size() << " conditions"
-             << (static_cast<int>(a.conditions.size()) < agreement::kFewConditions
+             << a.observers << " observers), Spearman ρ = " << formatNumber(a.spearman, 2) << " "
+             << correlationIntervalText(a.spearmanLow, a.spearmanHigh, static_cast<int>(a.conditions.size()))
+             << ", exact p = " << formatNumber(a.spearmanP, 3) << ", over " << a.conditions.size() << " conditions"
+             << (static_cast<int>(a.conditions.size()) < agreement::kFewConditions && std::isfinite(a.spearmanLow)
                      ? " (few conditions: a wide interval)"
                      : "")
              << ".</p>\n<table><thead><tr><th class=\"l\">condition</th><th>predicted Δ</th><th>measured</th>"

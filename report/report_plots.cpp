@@ -57,6 +57,12 @@ std::string tickLabel(double v) {
     return s;
 }
 
+// Characters of a UTF-8 label (continuation bytes do not count).
+std::size_t labelCharacters(const std::string& label) {
+    return static_cast<std::size_t>(std::count_if(
+        label.begin(), label.end(), [](char c) { return (static_cast<unsigned char>(c) & 0xC0) != 0x80; }));
+}
+
 } // namespace
 
 std::string formatNumber(double value, int digits) {
@@ -72,8 +78,20 @@ std::string formatNumber(double value, int digits) {
     return s;
 }
 
+std::string correlationIntervalText(double low, double high, int conditions) {
+    if (std::isfinite(low) && std::isfinite(high))
+        return "[" + formatNumber(low, 2) + ", " + formatNumber(high, 2) + "]";
+    if (conditions < 4) return "(no interval with " + std::to_string(conditions) + " conditions: Fisher z needs 4)";
+    return "(no interval)";
+}
+
 std::string scaleSvg(const std::vector<IntervalPoint>& points) {
-    const double left = 150.0, right = 620.0, rowHeight = 26.0, top = 20.0;
+    // The labels stand right-aligned left of the axis: the margin holds the longest one (12 px sans-serif, at most
+    // ~7 px a character), the axis keeps its 470 px.
+    std::size_t longest = 0;
+    for (const auto& p : points) longest = std::max(longest, labelCharacters(p.label));
+    const double left = std::max(150.0, kLabelCharacterPx * static_cast<double>(longest) + 16.0);
+    const double right = left + 470.0, rowHeight = 26.0, top = 20.0, width = right + 20.0;
     const double height = top + rowHeight * static_cast<double>(points.size()) + 36.0;
     std::vector<double> values;
     for (const auto& p : points) values.push_back(p.value);
@@ -81,8 +99,8 @@ std::string scaleSvg(const std::vector<IntervalPoint>& points) {
     Range range = rangeOf(values, 0.0, 1.0);
     range.low -= 1.5;
     range.high += 1.5;
-    std::string svg = "<svg class=\"plot\" xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"0 0 640 " + px(height) +
-                      "\" width=\"640\" height=\"" + px(height) + "\" role=\"img\">";
+    std::string svg = "<svg class=\"plot\" xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"0 0 " + px(width) + " " +
+                      px(height) + "\" width=\"" + px(width) + "\" height=\"" + px(height) + "\" role=\"img\">";
     const double axisY = top + rowHeight * static_cast<double>(points.size()) + 4.0;
     for (double t : ticks(range)) {
         double x = range.map(t, left, right);

@@ -12,7 +12,9 @@ struct IntervalPoint {
     double value = 0.0, low = 0.0, high = 0.0;
 };
 
-// One row per point, in the given order: a dot at `value` and a bar from `low` to `high` (JOD).
+// One row per point, in the given order: a dot at `value` and a bar from `low` to `high` (JOD); the label left of
+// the axis, in a margin as wide as the longest label needs (kLabelCharacterPx a character).
+inline constexpr double kLabelCharacterPx = 7.0;
 std::string scaleSvg(const std::vector<IntervalPoint>& points);
 
 struct ScatterPoint {
@@ -29,6 +31,10 @@ struct ScatterOptions {
 
 std::string scatterSvg(const std::vector<ScatterPoint>& points, const std::string& xLabel,
                        const ScatterOptions& options = {});
+
+// A correlation's interval for the page: "[0.12, 0.95]", or why there is none: "(no interval with 3 conditions: Fisher
+// z needs 4)" (its variance is 1/(n − 3)), or "(no interval)" when the correlation itself is undefined.
+std::string correlationIntervalText(double low, double high, int conditions);
 
 // A number for the page: `digits` after the point, "−" for minus, "—" for a non-finite value.
 std::string formatNumber(double value, int digits);

@@ -497,9 +497,10 @@ void writeMetricFinding(std::ostringstream& html, const ReportData& r, const sca
                           [&](const auto& row) { return row.block == block.name && std::isfinite(row.spearmanP); }));
         html << "<li>In <strong>" << h(block.name) << "</strong> the metric that agrees best with the scale is <em>"
              << h(bestMetric->metric.label) << "</em> (" << (bestMetric->metric.higherIsBetter ? "higher" : "lower")
-             << " is better): Spearman ρ = " << linked(a, num(bestMetric->spearman)) << " ["
-             << linked(a, num(bestMetric->spearmanLow)) << ", " << linked(a, num(bestMetric->spearmanHigh))
-             << "], p = " << num(bestMetric->spearmanP) << " (" << num(bestMetric->spearmanPHolm)
+             << " is better): Spearman ρ = " << linked(a, num(bestMetric->spearman)) << " "
+             << linked(a, correlationIntervalText(bestMetric->spearmanLow, bestMetric->spearmanHigh,
+                                                  bestMetric->conditions))
+             << ", p = " << num(bestMetric->spearmanP) << " (" << num(bestMetric->spearmanPHolm)
              << " after Holm's correction for choosing the best of " << compared
              << " metrics), Pearson r = " << linked(a, num(bestMetric->pearson)) << " over " << bestMetric->conditions
              << " conditions";
@@ -839,10 +840,11 @@ void writeAgreement(std::ostringstream& html, const ReportData& r) {
                 shown.push_back(&row);
                 html << "<tr><td class=\"l\">" << h(row.metric.label) << "</td><td>"
                      << (row.metric.higherIsBetter ? "higher" : "lower") << "</td><td>" << row.conditions << "</td><td>"
-                     << num(row.pearson) << "</td><td>[" << num(row.pearsonLow) << ", " << num(row.pearsonHigh)
-                     << "]</td><td>" << num(row.spearman) << "</td><td>[" << num(row.spearmanLow) << ", "
-                     << num(row.spearmanHigh) << "]</td><td>" << num(row.spearmanP) << "</td><td>"
-                     << num(row.spearmanPHolm) << "</td><td>"
+                     << num(row.pearson) << "</td><td>"
+                     << correlationIntervalText(row.pearsonLow, row.pearsonHigh, row.conditions) << "</td><td>"
+                     << num(row.spearman) << "</td><td>"
+                     << correlationIntervalText(row.spearmanLow, row.spearmanHigh, row.conditions) << "</td><td>"
+                     << num(row.spearmanP) << "</td><td>" << num(row.spearmanPHolm) << "</td><td>"
                      << (row.significantPairs
                              ? std::to_string(row.predictedPairs) + " / " + std::to_string(row.significantPairs)
                              : std::string("—"))
@@ -861,8 +863,9 @@ void writeAgreement(std::ostringstream& html, const ReportData& r) {
                                       block.thurstone.scores[i], block.low[i], block.high[i]});
                 }
                 html << "<figure>" << scatterSvg(points, row->metric.label) << "<figcaption>" << h(row->metric.label)
-                     << ": r = " << num(row->pearson) << " [" << num(row->pearsonLow) << ", " << num(row->pearsonHigh)
-                     << "], ρ = " << num(row->spearman) << "</figcaption></figure>";
+                     << ": r = " << num(row->pearson) << " "
+                     << correlationIntervalText(row->pearsonLow, row->pearsonHigh, row->conditions)
+                     << ", ρ = " << num(row->spearman) << "</figcaption></figure>";
             }
             html << "</div>\n";
         }

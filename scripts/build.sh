@@ -11,7 +11,10 @@ bash scripts/install-deps.sh "${SKINLAB_DEPS:-all}"
 export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=true
 # Warnings are errors (set SKINLAB_WERROR=OFF to build past them while developing), so e.g. a `switch` over
 # SssMethod that misses a method fails the build (-Wall includes -Wswitch).
+echo "build: configuring (CMake preset release, build/release)"
 cmake --preset release -DSKINLAB_WERROR="${SKINLAB_WERROR:-ON}" >/dev/null
 targets=()
 for t in "$@"; do targets+=(--target "$t"); done
+# ninja prints one "[done/total] Building …" line per step (its counter); nothing is left to build: "no work to do".
+echo "build: building ${*:-everything} with $(nproc) jobs"
 cmake --build --preset release -j "$(nproc)" "${targets[@]}"

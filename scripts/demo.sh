@@ -14,6 +14,7 @@
 # and prints where everything is, and the command for a session with a real participant.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source scripts/lib/progress.sh
 # Only what the main job uses: the packages of the "demo" profile and the `skinlab` executable.
 SKINLAB_DEPS=demo bash scripts/build.sh skinlab
 export SKINLAB_ASSETS="${SKINLAB_ASSETS:-$(cd .. && pwd)/shared/assets}"
@@ -37,13 +38,18 @@ set_name=$(sed -n 's/^name = "\(.*\)"$/\1/p' "$stimuli_spec" | head -n 1)  # [se
 if [ -e "$out/stimuli/manifest.json" ] && ! grep -q "\"set\": *\"$set_name\"" "$out/stimuli/manifest.json"; then
   rm -rf "$out/stimuli"
 fi
-"$skinlab" stimuli build "$stimuli_spec" -o "$out/stimuli"
+echo "demo: rendering the stimulus set $stimuli_spec (every block, each with its reference; then each stimulus's" \
+  "visibility against its block's reference, predicted by ColorVideoVDP)"
+run_with_heartbeat demo "$skinlab" stimuli build "$stimuli_spec" -o "$out/stimuli"
 
 # A demo study is recreated on every run (a real study is never overwritten by `study create`).
 rm -f "$out/study.db" "$out/study.db-wal" "$out/study.db-shm"
+echo "demo: a 2AFC study of every block ($design)"
 "$skinlab" study create --stimuli "$out/stimuli" --design "$design" -o "$out/study.db"
 # Before recruiting: which predicted differences would a study of this design resolve, with how many observers?
-"$skinlab" study plan "$out/study.db" --simulations 100 --observers 10,20,40,80,160
+echo "demo: study plan: how many observers this design needs for the predicted differences (100 simulated studies" \
+  "per observer count)"
+run_with_heartbeat demo "$skinlab" study plan "$out/study.db" --simulations 100 --observers 10,20,40,80,160
 
 "$skinlab" study serve "$out/study.db" --port 0 > "$out/serve.log" 2>&1 &
 server=$!
@@ -55,14 +61,25 @@ for _ in $(seq 1 100); do
   sleep 0.1
 done
 [ -n "$url" ] || { echo "demo: the study server did not start:" >&2; cat "$out/serve.log" >&2; exit 1; }
-"$skinlab" study simulate "$out/study.db" --observers 20 --truth predicted \
+echo "demo: 20 simulated observers answer through the real HTTP API, from the same predictions"
+run_with_heartbeat demo "$skinlab" study simulate "$out/study.db" --observers 20 --truth predicted \
   --seed 7 --label-prefix demo --url "$url"
 kill $server; wait $server 2>/dev/null || true
 trap - EXIT
 
 "$skinlab" study export "$out/study.db" --format csv -o "$out/responses.csv"
-"$skinlab" analyze scale "$out/study.db" -o "$out/scale"
-"$skinlab" report "$out/study.db" -o "$out/report"
+echo "demo: the answers scaled to JOD with intervals"
+run_with_heartbeat demo "$skinlab" analyze scale "$out/study.db" -o "$out/scale"
+cat <<TXT
+demo: reading the outcome against the plan: the plan's "significant neighbouring pairs to expect" at 20 observers is
+  what one study of 20 observers should find on average; "significant pairs" above counts every pair of a block (pairs
+  further apart than neighbours too) in one such study, so a count near the expectation, or above it by the
+  non-neighbouring pairs, agrees with the plan. A block the plan does not resolve has one neighbouring pair too
+  close to come out; its other pairs can. A pair of equal conditions comes out significant in under 5 % of studies
+  (Holm's correction over the block's pairs).
+TXT
+echo "demo: the study report (HTML, then the PDF through headless Chromium)"
+run_with_heartbeat demo "$skinlab" report "$out/study.db" -o "$out/report"
 
 cat <<TXT
 

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages skinlab needs (headless, no GPU required), quietly (apt's output goes to a log
-# that is shown only when the installation fails). Idempotent: only missing packages are installed. Needs root
-# (or sudo) and Debian's package registry.
+# Installs the Debian 12 packages skinlab needs (headless, no GPU required). apt's output goes to a log (its last
+# lines are shown when the installation fails); meanwhile a count is printed every few seconds ("install-deps: 12/85
+# packages unpacked"). Idempotent: only missing packages are installed. Needs root (or sudo) and Debian's package
+# registry (network access to a Debian mirror).
 #   scripts/install-deps.sh demo   what the main job needs: build, render, serve, analyse, report (HTML + PDF)
 #   scripts/install-deps.sh all    (default) and what the tests need besides: Node.js for the browser tests,
 #                                  clang-format, Blender (Cycles), Slurm and munge, nginx, curl and jq
@@ -59,12 +60,22 @@ fi
 
 SUDO=""
 if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
+source "$(dirname "$0")/lib/progress.sh"
 log="$(mktemp "${TMPDIR:-/tmp}/skinlab-install-deps.XXXXXX.log")"
 echo "install-deps: installing ${#missing[@]} packages for '$profile' (${missing[*]}); apt's log: $log"
 export DEBIAN_FRONTEND=noninteractive
-if ! { $SUDO apt-get update -qq && $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"; } >"$log" 2>&1; then
+fail() {
   tail -n 40 "$log" >&2
   echo "install-deps: apt-get failed (the last lines are above; the whole log: $log)" >&2
   exit 1
-fi
-echo "install-deps: done"
+}
+echo "install-deps: reading the package lists from Debian's package registry (apt-get update)"
+run_with_progress install-deps "$log" - $SUDO apt-get update -q || fail
+# How many packages the installation brings, dependencies included (a dry run), for the counts.
+total=$($SUDO apt-get install -s --no-install-recommends "${missing[@]}" 2>>"$log" | grep -c '^Inst ' || true)
+first=$(($(wc -l <"$log") + 1))
+install_status() { apt_status "$1" "$first" "$total"; }
+echo "install-deps: downloading and installing $total packages (dependencies included)"
+run_with_progress install-deps "$log" install_status \
+  $SUDO apt-get install -y -q --no-install-recommends -o Dpkg::Progress-Fancy=0 "${missing[@]}" || fail
+echo "install-deps: done ($total packages)"

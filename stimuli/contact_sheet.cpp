@@ -3,6 +3,7 @@
 #include "common/error.h"
 #include "common/html.h"
 #include "common/files.h"
+#include "stimuli/naming.h"
 
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
@@ -41,9 +42,11 @@ std::string valueText(const nlohmann::json& value) {
     return value.is_string() ? value.get<std::string>() : value.dump();
 }
 
-// The factor levels that tell the stimuli of one block apart (the caption of a thumbnail).
-std::vector<std::string> varyingFactors(const Block& block) {
+// The factor levels that tell the stimuli of one block apart (the caption of a thumbnail), in the spec's factor order
+// (the entries' own order is alphabetical).
+std::vector<std::string> varyingFactors(const Manifest& manifest, const Block& block) {
     std::vector<std::string> names;
+    for (const auto& f : manifest.factors) names.push_back(f.value("name", ""));
     for (const auto* s : block.stimuli)
         for (auto it = s->at("factors").begin(); it != s->at("factors").end(); ++it)
             if (std::find(names.begin(), names.end(), it.key()) == names.end()) names.push_back(it.key());
@@ -62,10 +65,11 @@ std::vector<std::string> varyingFactors(const Block& block) {
     return varying;
 }
 
-// A level as a caption word: words as they are ("separable", "burley"); numbers and booleans with their factor's
-// name, which they do not name themselves ("cbf=true", "lab_weight=0.09", "transmittance.enabled=true").
-// (Manifest factor values are the levels as text: "true", "0.09".)
-std::string levelText(const std::string& factor, const nlohmann::json& value) {
+// A level as a caption word: its label when the spec gave the factor words or paths ("bleed" for a scene file,
+// "separable"); numbers and booleans with their factor's name, which they do not name themselves ("cbf=true",
+// "lab_weight=0.09", "transmittance.enabled=true"); a scene that is no level of the factor (a block's reference
+// may render its own) by its short name ("bleed-true-mask"). (Manifest factor values are the levels as text.)
+std::string levelText(const Manifest& manifest, const std::string& factor, const nlohmann::json& value) {
     const std::string text = valueText(value);
     bool bare = text == "true" || text == "false" || value.is_number();
     if (!bare && !text.empty()) {
@@ -73,22 +77,36 @@ std::string levelText(const std::string& factor, const nlohmann::json& value) {
         std::strtod(text.c_str(), &end);
         bare = end && *end == '\0';
     }
-    if (!bare) return text;
-    const std::string name = factor.rfind("sss.", 0) == 0 ? factor.substr(4) : factor;
-    return name + "=" + text;
+    if (bare) {
+        const std::string name = factor.rfind("sss.", 0) == 0 ? factor.substr(4) : factor;
+        return name + "=" + text;
+    }
+    for (const auto& f : manifest.factors) {
+        if (f.value("name", "") != factor || !f.contains("levels")) continue;
+        for (const auto& level : f["levels"])
+            if (level.value("value", "") == text && !level.value("label", "").empty())
+                return level["label"].get<std::string>();
+    }
+    if (factor == "scene") {
+        const std::string label = sceneLabel(text);
+        if (!label.empty()) return label;
+    }
+    return text;
 }
 
-std::string caption(const nlohmann::json& stimulus, const std::vector<std::string>& varying) {
+std::string caption(const Manifest& manifest, const nlohmann::json& stimulus, const std::vector<std::string>& varying) {
     std::string text;
     const auto& f = stimulus.at("factors");
     for (const auto& name : varying)
-        if (f.contains(name)) text += (text.empty() ? "" : " ") + levelText(name, f[name]);
-    if (stimulus.at("reference").get<bool>()) text += text.empty() ? "reference" : " (ref)";
+        if (f.contains(name)) text += (text.empty() ? "" : " ") + levelText(manifest, name, f[name]);
+    const bool reference = stimulus.at("reference").get<bool>();
+    if (reference) text += text.empty() ? "reference" : " (ref)";
     if (text.empty()) text = stimulus.at("id").get<std::string>();
-    // The predicted visibility against the block's reference (ColorVideoVDP), when the build recorded it.
-    if (stimulus.contains("predicted") && stimulus["predicted"].contains("jod")) {
-        char jod[48];
-        std::snprintf(jod, sizeof jod, " - %.2f JOD", stimulus["predicted"]["jod"].get<double>());
+    // The visibility ColorVideoVDP predicts against the block's reference, when the build recorded it (not on the
+    // reference itself: 10 JOD by definition).
+    if (!reference && stimulus.contains("predicted") && stimulus["predicted"].contains("jod")) {
+        char jod[64];
+        std::snprintf(jod, sizeof jod, " - predicted %.2f JOD", stimulus["predicted"]["jod"].get<double>());
         text += jod;
     }
     return text;
@@ -250,7 +268,7 @@ void writePng(const fs::path& path, const Manifest& manifest, const std::vector<
               text);
         y += titleHeight;
         const int thumbHeight = thumbHeightOf(b);
-        std::vector<std::string> varying = varyingFactors(b);
+        std::vector<std::string> varying = varyingFactors(manifest, b);
         for (size_t i = 0; i < b.stimuli.size(); ++i) {
             const auto& s = *b.stimuli[i];
             int column = static_cast<int>(i % maxColumns);
@@ -259,7 +277,8 @@ void writePng(const fs::path& path, const Manifest& manifest, const std::vector<
             OIIO::ImageBuf thumb = thumbnail(dir / s.at("files").at("png").get<std::string>(), thumbWidth, thumbHeight);
             OIIO::ImageBufAlgo::paste(sheet, x, y, 0, 0, thumb);
             bool reference = s.at("reference").get<bool>();
-            const std::vector<std::string> lines = wrapCaption(caption(s, varying), thumbWidth, kCaptionLines, font);
+            const std::vector<std::string> lines =
+                wrapCaption(caption(manifest, s, varying), thumbWidth, kCaptionLines, font);
             for (size_t line = 0; line < lines.size(); ++line)
                 label(x, y + thumbHeight + 14 + static_cast<int>(line) * lineHeight, lines[line],
                       reference ? accent : text);
@@ -273,6 +292,15 @@ void writePng(const fs::path& path, const Manifest& manifest, const std::vector<
 }
 
 } // namespace
+
+std::vector<std::string> contactSheetCaptions(const Manifest& manifest) {
+    std::vector<std::string> captions;
+    for (const Block& block : groupByBlock(manifest)) {
+        const std::vector<std::string> varying = varyingFactors(manifest, block);
+        for (const auto* s : block.stimuli) captions.push_back(caption(manifest, *s, varying));
+    }
+    return captions;
+}
 
 ContactSheetFiles writeContactSheet(const fs::path& dir, const Manifest& manifest, int thumbnailWidth) {
     std::vector<Block> blocks = groupByBlock(manifest);

@@ -5,6 +5,8 @@
 #include "stimuli/manifest.h"
 
 #include <filesystem>
+#include <string>
+#include <vector>
 
 namespace skinlab::stimuli {
 
@@ -12,6 +14,11 @@ struct ContactSheetFiles {
     std::filesystem::path html;
     std::filesystem::path png;
 };
+
+// The captions of contact.png's thumbnails (before wrapping), block by block in manifest order: the levels that
+// vary inside the block, by label ("bleed separable cbf=true"), "(ref)" on the reference, and the predicted JOD
+// against the reference when the build recorded it ("... - predicted 8.17 JOD").
+std::vector<std::string> contactSheetCaptions(const Manifest& manifest);
 
 // Writes DIR/contact.html and DIR/contact.png atomically from the manifest and the PNGs it lists.
 ContactSheetFiles writeContactSheet(const std::filesystem::path& dir, const Manifest& manifest,

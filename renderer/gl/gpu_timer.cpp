@@ -2,7 +2,18 @@
 
 #include "common/error.h"
 
+#include <cmath>
+
 namespace skinlab::renderer::gl {
+
+double roundMs(double milliseconds) { return std::round(milliseconds * 1000.0) / 1000.0; }
+
+nlohmann::json roundTimings(nlohmann::json timings) {
+    if (timings.is_number_float()) return roundMs(timings.get<double>());
+    if (timings.is_structured())
+        for (auto& value : timings) value = roundTimings(std::move(value));
+    return timings;
+}
 
 PassTimer::PassTimer() {
     GLuint name = 0;
@@ -56,21 +67,22 @@ void PassTimer::end() {
 nlohmann::json PassTimer::json() const {
     nlohmann::json passes = nlohmann::json::object();
     nlohmann::json passesWall = nlohmann::json::object();
+    nlohmann::json fromWall = nlohmann::json::array();
     double gpuTotal = 0;
     double wallTotal = 0;
-    std::string replaced;
     for (const Record& record : records_) {
-        passes[record.pass] = record.gpuMs;
-        passesWall[record.pass] = record.wallMs;
+        passes[record.pass] = roundMs(record.gpuMs);
+        passesWall[record.pass] = roundMs(record.wallMs);
         gpuTotal += record.gpuMs;
         wallTotal += record.wallMs;
-        if (record.replaced) replaced += (replaced.empty() ? "" : ", ") + record.pass;
+        if (record.replaced) fromWall.push_back(record.pass);
     }
-    return {{"passes", passes},
-            {"passes_wall", passesWall},
-            {"gpu_total", gpuTotal},
-            {"wall_total", wallTotal},
-            {"timer_check", replaced.empty() ? "ok" : "gpu time above wall time, replaced: " + replaced}};
+    nlohmann::json out = {{"passes", passes},
+                          {"passes_wall", passesWall},
+                          {"gpu_total", roundMs(gpuTotal)},
+                          {"wall_total", roundMs(wallTotal)}};
+    if (!fromWall.empty()) out["gpu_from_wall"] = fromWall;
+    return out;
 }
 
 } // namespace skinlab::renderer::gl

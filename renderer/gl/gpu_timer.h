@@ -5,7 +5,7 @@
 // Why both: llvmpipe's first GL_TIME_ELAPSED query of a context can return garbage (hundreds of seconds; see
 // design.md), so the constructor issues one throw-away query; and a GPU time larger than the wall-clock time
 // of the same glFinish-bracketed pass is impossible, so such a value is replaced by the wall-clock time and
-// the pass is named in "timer_check". The glFinish brackets serialise the frame; that costs a little
+// the pass is listed in "gpu_from_wall" (absent when every GPU value is the timer's own). The glFinish brackets serialise the frame; that costs a little
 // throughput but makes every figure attributable to one pass.
 #include "renderer/gl/gl_resources.h"
 
@@ -15,6 +15,11 @@
 #include <vector>
 
 namespace skinlab::renderer::gl {
+
+// Milliseconds to the microsecond (3 decimals): timings are written as 0.02, not 1.9999999999999998e-05.
+double roundMs(double milliseconds);
+// A copy of a timings record with every floating-point value rounded by roundMs (integers and text as they are).
+nlohmann::json roundTimings(nlohmann::json timings);
 
 class PassTimer {
 public:
@@ -26,8 +31,8 @@ public:
     // so that one failed render does not break the next one on the same context.
     void reset();
 
-    // {"passes": {name: gpu ms}, "passes_wall": {name: wall ms}, "gpu_total": ms, "wall_total": ms,
-    //  "timer_check": "ok" | "gpu time above wall time, replaced: a, b"}
+    // {"passes": {name: gpu ms}, "passes_wall": {name: wall ms}, "gpu_total": ms, "wall_total": ms[,
+    //  "gpu_from_wall": [passes whose GPU time is their wall-clock time]]}, every figure to 1 µs (roundMs).
     nlohmann::json json() const;
 
     struct Record {

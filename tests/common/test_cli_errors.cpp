@@ -53,6 +53,26 @@ TEST(CliErrors, EverySubcommandExitsTwoWithOneLine) {
     }
 }
 
+// A misspelled option is named with the nearest option of its subcommand (or of a command above it), not as a list
+// of unexpected arguments ("300 --widht", CLI11's reversed order); a plain extra word keeps CLI11's message.
+TEST(CliErrors, MisspelledOptionNamesTheNearestOne) {
+    CliRun result = run("render --scene builtin:head -o never.exr --widht 300");
+    EXPECT_EQ(result.exitCode, 2);
+    EXPECT_EQ(result.output,
+              "skinlab: error: unknown option --widht (did you mean --width?); see skinlab render --help\n");
+    result = run("analyze scale r.csv -o out --prior-precison 2");
+    EXPECT_EQ(result.output, "skinlab: error: unknown option --prior-precison (did you mean --prior-precision?); see "
+                             "skinlab analyze scale --help\n");
+    result = run("methods --verbsoe");
+    EXPECT_EQ(result.output, "skinlab: error: unknown option --verbsoe (did you mean --verbose?); see skinlab methods "
+                             "--help\n");
+    result = run("methods --no-such-flag");
+    EXPECT_EQ(result.output, "skinlab: error: unknown option --no-such-flag; see skinlab methods --help\n");
+    result = run("methods extra");
+    EXPECT_EQ(result.exitCode, 2);
+    EXPECT_NE(result.output.find("extra"), std::string::npos) << result.output;
+}
+
 TEST(CliErrors, HelpAndVersionExitZero) {
     for (const std::string arguments : {"--help", "--version", "analyze scale --help", "study --help"}) {
         const CliRun result = run(arguments);

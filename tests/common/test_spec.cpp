@@ -57,6 +57,25 @@ TEST(Spec, ErrorsNameFileAndKeyWordForWord) {
     EXPECT_EQ(errorOf([] { skinlab::parseTomlString("a = = 1", "bad.toml"); }).rfind("bad.toml:1:", 0), 0u);
 }
 
+// An unknown key a slip away from a key the reader asked for names it; one far from every asked key does not.
+TEST(Spec, UnknownKeyNamesTheNearestKeyAsked) {
+    toml::table t =
+        skinlab::parseTomlString("[camera]\nfov_dge = 30\nview = \"close\"\n[render]\nwidht = 3\n", "scene.toml");
+    SpecReader r(t, "scene.toml");
+    r.table("camera").number("fov_deg", 40, 1, 179);
+    r.table("camera").string("view", "");
+    r.table("camera").number("near_mm", 1, 0, 10);
+    EXPECT_EQ(errorOf([&] { r.finish(); }), "scene.toml: camera.fov_dge: unknown key (did you mean fov_deg?)");
+    SpecReader far(t, "scene.toml");
+    far.table("camera").number("fov_dge", 40, 1, 179);
+    far.table("camera").string("view", "");
+    far.table("render").integer("height", 4, 1, 9);
+    EXPECT_EQ(errorOf([&] { far.finish(); }), "scene.toml: render.widht: unknown key");
+    EXPECT_EQ(skinlab::nearestKey("widht", {"width", "height"}), "width");
+    EXPECT_EQ(skinlab::nearestKey("x", {"y", "z"}), "");
+    EXPECT_EQ(skinlab::nearestKey("colour", {"color", "intensity"}), "color");
+}
+
 TEST(Spec, OverridesParseTomlValuesOrBareStrings) {
     toml::table t = skinlab::parseTomlString(kSpec, "scene.toml");
     skinlab::applyOverride(t, "camera.view=far");

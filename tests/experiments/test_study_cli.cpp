@@ -87,6 +87,17 @@ TEST(StudyCli, CreateStatusExportAndTheirErrors) {
     EXPECT_NE(created.out.find("per participant 27 trials (1 practice, 12 test, 12 repeat, 2 catch)"),
               std::string::npos)
         << created.out;
+    EXPECT_EQ(created.out.find("not studied"), std::string::npos) << created.out;
+    // A block of the set the design leaves out is named, with the reason.
+    const fs::path oneBlock = files.folder.path() / "one-block.db";
+    CommandResult partial =
+        runSkinlab({"study", "create", "--stimuli", files.stimuli.string(), "--design", files.design.string(), "-o",
+                    oneBlock.string(), "--set", "blocks=[\"scene:a/mid\"]"});
+    ASSERT_EQ(partial.exitCode, 0) << partial.err;
+    EXPECT_NE(partial.out.find(": 1 block(s),"), std::string::npos) << partial.out;
+    EXPECT_NE(partial.out.find("not studied: block scene:b/close (not among the design's blocks: scene:a/mid)\n"),
+              std::string::npos)
+        << partial.out;
 
     // Never overwrites a study; the existing file is untouched.
     const std::string before = skinlab::sha256File(files.database);

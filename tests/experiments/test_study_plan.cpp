@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include <gtest/gtest.h>
+#include <regex>
 
 using namespace skinlab::experiments;
 
@@ -50,6 +51,24 @@ TEST(StudyPlan, PowerFollowsThePredictedDifferences) {
     for (double p : block.neighbours[1].power) EXPECT_LE(p, 0.06);
     EXPECT_EQ(block.observersNeeded, -1) << "an equal pair can never reach power 0.8";
     EXPECT_EQ(plan.trialsPerObserver, 6);
+    // The text says which pair keeps the block from being resolved, and how many pairs a study of each size should
+    // still find significant (here the 3 JOD pair: about one), so that an outcome with significant pairs reads as
+    // the plan foresaw it rather than against it.
+    const std::string text = planText(plan);
+    EXPECT_NE(text.find("not every neighbouring pair reaches power >= 0.8 by 80 observers: the closest, "),
+              std::string::npos)
+        << text;
+    EXPECT_NE(text.find("(0.000 JOD), is too small for this design; pairs further apart can still come out"),
+              std::string::npos)
+        << text;
+    EXPECT_EQ(text.find("the predicted differences are too small"), std::string::npos) << text;
+    std::smatch expected;
+    ASSERT_TRUE(std::regex_search(text, expected,
+                                  std::regex("significant neighbouring pairs to expect \\(of 2\\): ([0-9.]+) at 5, "
+                                             "[0-9.]+ at 20, [0-9.]+ at 80 observers\n")))
+        << text;
+    EXPECT_GE(std::stod(expected[1].str()), 0.9);
+    EXPECT_LE(std::stod(expected[1].str()), 1.1);
 }
 
 TEST(StudyPlan, PowerGrowsWithObservers) {

@@ -184,7 +184,7 @@ TEST(TrialPlan, GroupedBlocksStayTogether) {
 
 TEST(TrialPlan, DesignErrorsNameFileKeyAndValue) {
     EXPECT_EQ(expectInputError("repetitions = 0\n"), "D.toml: repetitions: 0 is out of range [1, 100]");
-    EXPECT_EQ(expectInputError("repetitons = 2\n"), "D.toml: repetitons: unknown key");
+    EXPECT_EQ(expectInputError("repetitons = 2\n"), "D.toml: repetitons: unknown key (did you mean repetitions?)");
     EXPECT_EQ(expectInputError("block_order = \"random\"\n"),
               "D.toml: block_order: 'random' is not one of: interleaved, grouped");
     EXPECT_EQ(

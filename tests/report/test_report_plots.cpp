@@ -1,5 +1,6 @@
 // The report's SVG plots and number formatting: bounded output whatever the intervals (±1e9 JOD, infinite,
 // NaN), clipped bars marked, and no "nan"/"inf" text.
+#include "report/prediction_section.h"
 #include "report/report_plots.h"
 
 #include <gtest/gtest.h>
@@ -27,6 +28,44 @@ TEST(ReportPlots, HugeAndUndefinedIntervalsAreClippedAndMarked) {
     EXPECT_LE(count(svg, "class=\"grid\""), 12);
     EXPECT_EQ(svg.find("nan"), std::string::npos);
     EXPECT_EQ(svg.find("inf"), std::string::npos);
+}
+
+// A long condition label fits left of the axis: the margin grows with the longest label (the figure with it).
+TEST(ReportPlots, ScaleMarginHoldsTheLongestLabel) {
+    const std::string label = "halo-silhouette-separable-no-follow_surface-cbf";
+    const std::string svg = scaleSvg({{"none", 0.0, -0.5, 0.5}, {label, 1.0, 0.5, 1.5}});
+    const std::size_t text = svg.find(">" + label + "<");
+    ASSERT_NE(text, std::string::npos) << svg;
+    const std::size_t x = svg.rfind("<text x=\"", text);
+    ASSERT_NE(x, std::string::npos);
+    const double labelRight = std::stod(svg.substr(x + 9));
+    EXPECT_GE(labelRight, kLabelCharacterPx * static_cast<double>(label.size())) << svg.substr(x, 120);
+    const std::size_t viewBox = svg.find("viewBox=\"0 0 ");
+    ASSERT_NE(viewBox, std::string::npos);
+    EXPECT_GE(std::stod(svg.substr(viewBox + 13)), labelRight + 470.0);
+    // Short labels keep the former 150 px margin.
+    EXPECT_NE(scaleSvg({{"a", 0.0, -0.5, 0.5}}).find("viewBox=\"0 0 640.0 "), std::string::npos);
+}
+
+// A correlation without an interval says why (Fisher z needs 4 conditions) instead of "[—, —]".
+TEST(ReportPlots, CorrelationIntervalSaysWhyThereIsNone) {
+    EXPECT_EQ(correlationIntervalText(0.1, 0.9, 10), "[0.10, 0.90]");
+    EXPECT_EQ(correlationIntervalText(NAN, NAN, 3), "(no interval with 3 conditions: Fisher z needs 4)");
+    PredictionAgreement a;
+    a.block = "silhouette";
+    a.anchor = "separable";
+    a.conditions = {"separable", "no-follow", "cbf"};
+    a.predicted = {0.0, 0.4, 0.9};
+    a.measured = {0.0, 0.3, 1.1};
+    a.low = {NAN, 0.1, 0.8};
+    a.high = {NAN, 0.5, 1.4};
+    a.spearman = 1.0;
+    a.spearmanLow = a.spearmanHigh = NAN;
+    const std::string html = predictionSectionHtml({a}, "", {});
+    EXPECT_NE(html.find("Spearman ρ = 1.00 (no interval with 3 conditions: Fisher z needs 4) over 3 conditions."),
+              std::string::npos)
+        << html;
+    EXPECT_EQ(html.find("ρ = 1.00 [—, —]"), std::string::npos) << html;
 }
 
 TEST(ReportPlots, ScatterSkipsUndefinedPoints) {

@@ -2,6 +2,7 @@
 // shards, the manifest's JSON/CSV, and every spec-level bad-input message word for word. No GL.
 #include "common/error.h"
 #include "stimuli/build.h"
+#include "stimuli/contact_sheet.h"
 #include "stimuli/expansion.h"
 #include "stimuli/manifest.h"
 #include "stimuli/naming.h"
@@ -15,6 +16,7 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <set>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -369,6 +371,35 @@ TEST(StimulusManifest, JsonRoundTripAndCsv) {
               "m.json: format: not a skinlab stimulus manifest");
 }
 
+// contact.png's captions name a scene file by its factor label, a reference's own scene by its short name, and say
+// that the JOD is predicted (the reference has none: 10 by definition).
+TEST(ContactSheet, CaptionsUseLabelsAndSayPredicted) {
+    const std::string scene = "../../renderer/scenes/evaluation/bleed-coarse-mask.toml";
+    Manifest m;
+    m.set = "demo";
+    m.factors = nlohmann::json::array(
+        {{{"name", "scene"}, {"key", "scene"}, {"levels", {{{"value", scene}, {"label", "bleed"}}}}},
+         {{"name", "method"},
+          {"key", "sss.method"},
+          {"levels", {{{"value", "none"}, {"label", "none"}}, {{"value", "separable"}, {"label", "separable"}}}}},
+         {{"name", "sss.cbf"},
+          {"key", "sss.cbf"},
+          {"levels", {{{"value", "true"}, {"label", "cbf"}}, {{"value", "false"}, {"label", "no-cbf"}}}}}});
+    auto entry = [&](const std::string& id, nlohmann::json factors, bool reference, double jod) {
+        return nlohmann::json{{"id", id},
+                              {"block", "patches"},
+                              {"factors", factors},
+                              {"reference", reference},
+                              {"predicted", {{"jod", jod}}}};
+    };
+    m.stimuli = {entry("a", {{"scene", scene}, {"method", "separable"}, {"sss.cbf", "true"}}, false, 8.1666),
+                 entry("b", {{"scene", scene}, {"method", "none"}, {"sss.cbf", "false"}}, false, 9.5),
+                 entry("r", {{"scene", "builtin:bleed-true-mask"}, {"method", "reference"}}, true, 10.0)};
+    EXPECT_EQ(contactSheetCaptions(m), (std::vector<std::string>{"bleed separable cbf=true - predicted 8.17 JOD",
+                                                                 "bleed none cbf=false - predicted 9.50 JOD",
+                                                                 "bleed-true-mask reference (ref)"}));
+}
+
 TEST(StimulusOutputFolder, RefusesForeignFolders) {
     fs::path dir = fs::path(SKINLAB_BINARY_DIR) / "tests-tmp" / "stimuli-folder";
     fs::remove_all(dir);
@@ -471,6 +502,32 @@ TEST(ShippedSpecs, ExpandToTheDocumentedCounts) {
     std::map<std::string, int> references;
     for (const Stimulus& st : demo) references[st.block] += st.reference ? 1 : 0;
     EXPECT_EQ(references, (std::map<std::string, int>{{"explicit", 1}, {"mid", 1}}));
+}
+
+// The demo's study designs study every block their stimulus set builds (scripts/demo.sh renders them all), and each
+// condition is a stimulus id of the set.
+TEST(ShippedSpecs, DemoDesignsStudyEveryBlockTheSetBuilds) {
+    const fs::path specs = fs::path(SKINLAB_SOURCE_DIR) / "stimuli" / "specs";
+    const fs::path designs = fs::path(SKINLAB_SOURCE_DIR) / "experiments" / "designs";
+    for (const std::string file : {"demo.toml", "demo-scan.toml"}) {
+        std::vector<std::string> overrides;
+        const fs::path path = needsHead(file) ? withoutHead(specs / file, overrides) : specs / file;
+        const std::vector<Stimulus> all = expand(readSetSpec(path, overrides));
+        std::set<std::string> blocks, ids;
+        for (const Stimulus& st : all) {
+            blocks.insert(st.block);
+            ids.insert(st.id);
+        }
+        const toml::table design = toml::parse_file((designs / file).string());
+        std::set<std::string> studied;
+        for (const auto& b : *design["blocks"].as_array()) studied.insert(b.value<std::string>().value_or(""));
+        EXPECT_EQ(studied, blocks) << file;
+        for (const auto& c : *design["conditions"].as_array()) {
+            const std::string id = c.value<std::string>().value_or("");
+            EXPECT_TRUE(ids.count(id)) << file << ": " << id;
+        }
+    }
+    fs::remove_all(headlessFolder());
 }
 
 // Every stimulus of every shipped spec resolves against the renderer's scene reader (methods, extension switches

@@ -435,4 +435,8 @@ TEST(StimuliImport, ImportedSetThroughStudyAnalysisAndReport) {
     EXPECT_NE(text.find("b-ref"), std::string::npos);
     ASSERT_EQ(metrics.at("comparisons").size(), 6u);
     for (const auto& c : metrics.at("comparisons")) EXPECT_EQ(c.at("bands_measured"), c.at("block") == "a") << c.dump();
+    // Three conditions a block: the metrics' correlations have no interval, and the page says why (not "[—, —]").
+    const std::string page = skinlab::readFile(report / "index.html");
+    EXPECT_EQ(page.find("[—, —]"), std::string::npos);
+    EXPECT_NE(page.find("(no interval with 3 conditions: Fisher z needs 4)"), std::string::npos);
 }

@@ -95,6 +95,14 @@ TEST(CliScale, WritesEveryOutput) {
     EXPECT_EQ(html.rfind("<section class=\"skinlab-scaling\">", 0), 0u);
     EXPECT_NE(html.find("data:image/png;base64,"), std::string::npos);
     EXPECT_NE(result.output.find("builtin:head/close"), std::string::npos);
+    // Each block's count of significant pairs, as scale.json records them.
+    for (const auto& block : json["blocks"]) {
+        int significant = 0;
+        for (const auto& pair : block["pairs"]) significant += pair["significant"].get<bool>() ? 1 : 0;
+        const std::string line = "  significant pairs: " + std::to_string(significant) + " of " +
+                                 std::to_string(block["pairs"].size()) + " (correction over the block's pairs: holm)\n";
+        EXPECT_NE(result.output.find(line), std::string::npos) << line << result.output;
+    }
 }
 
 // --no-exclusion scales every observer, p3 with its two failed catch trials among them.

@@ -6,6 +6,7 @@
 #include "render_test_support.h"
 
 #include <OpenImageIO/imageio.h>
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 
@@ -107,7 +108,12 @@ TEST_P(GoldenImages, BuiltinSceneMatchesItsGolden) {
 
 // The named variants halo-grey-backdrop and bleed-true-mask keep the goldens of the former halo and bleed defaults.
 INSTANTIATE_TEST_SUITE_P(Builtin, GoldenImages,
-                         ::testing::Values("halo", "bleed", "ear", "head", "halo-grey-backdrop", "bleed-true-mask"));
+                         ::testing::Values("halo", "bleed", "ear", "head", "halo-grey-backdrop", "bleed-true-mask"),
+                         [](const ::testing::TestParamInfo<std::string>& param) {
+                             std::string name = param.param; // a test name holds letters, digits and '_' only
+                             std::replace(name.begin(), name.end(), '-', '_');
+                             return name;
+                         });
 
 } // namespace
 } // namespace skinlab::renderer

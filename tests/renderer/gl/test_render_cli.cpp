@@ -4,6 +4,7 @@
 
 #include <cstdlib>
 #include <fstream>
+#include <regex>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <sys/wait.h>
@@ -86,6 +87,11 @@ TEST_F(RenderCli, RendersExrPngAndTimings) {
     EXPECT_TRUE(timings["passes"].contains("main"));
     EXPECT_GT(timings["wall_total"].get<double>(), 0.0);
     EXPECT_EQ(timings["width"], 64);
+    // Milliseconds to the microsecond (no "1.9999999999999998e-05"), and no status line a user cannot act on.
+    const std::string text = test::readText(out / "t.json");
+    EXPECT_FALSE(std::regex_search(text, std::regex("[0-9]\\.[0-9]{4,}"))) << text;
+    EXPECT_FALSE(std::regex_search(text, std::regex("[0-9][eE][-+]?[0-9]"))) << text;
+    EXPECT_EQ(text.find("timer_check"), std::string::npos) << text;
 }
 
 TEST_F(RenderCli, UnknownBuiltinScene) {

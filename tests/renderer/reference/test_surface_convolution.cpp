@@ -156,7 +156,8 @@ TEST_P(StepResponse, EqualsTheMarginalCdf) {
     EXPECT_LT(worstErrors.back(), 0.015);
 }
 
-INSTANTIATE_TEST_SUITE_P(Profiles, StepResponse, ::testing::Values("deon", "burley"));
+INSTANTIATE_TEST_SUITE_P(Profiles, StepResponse, ::testing::Values("deon", "burley"),
+                         [](const auto& param) { return std::string(param.param); });
 
 TEST(SurfaceConvolution, ConvergesAsSampleDensityGrows) {
     // builtin:halo's skin sphere (radius 40 mm) lit by a directional light: E = max(0, n · L), albedo of skin.

@@ -161,6 +161,16 @@ double partArea(const Model& model, std::uint32_t material) {
 
 // --- builtin:halo -------------------------------------------------------------------------------------------
 
+// A length parameter as a test name: 0.5f -> "0_5mm", 200.0f -> "200mm".
+std::string millimetresName(const ::testing::TestParamInfo<float>& param) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%gmm", static_cast<double>(param.param));
+    std::string name = text;
+    for (char& c : name)
+        if (c == '.') c = '_';
+    return name;
+}
+
 class HaloDepthGap : public ::testing::TestWithParam<float> {};
 
 TEST_P(HaloDepthGap, BackdropSitsExactlyTheGapBehindTheSphere) {
@@ -188,7 +198,7 @@ TEST_P(HaloDepthGap, BackdropSitsExactlyTheGapBehindTheSphere) {
     EXPECT_NEAR(model.boundsMax.x - model.boundsMin.x, kHaloBackdropSizeMm, 1e-3f);
 }
 
-INSTANTIATE_TEST_SUITE_P(Gaps, HaloDepthGap, ::testing::Values(1.0f, 50.0f, 200.0f, 2000.0f));
+INSTANTIATE_TEST_SUITE_P(Gaps, HaloDepthGap, ::testing::Values(1.0f, 50.0f, 200.0f, 2000.0f), millimetresName);
 
 TEST(HaloScene, SphereIsClosedRoundAndSkinBackdropIsNot) {
     const Model model = makeHaloScene(200.0f);
@@ -316,7 +326,7 @@ TEST_P(EarThickness, SlabIsExactlyAsThickAsAsked) {
     EXPECT_GT(signedVolume(model, model.parts[0]), 0.0);
 }
 
-INSTANTIATE_TEST_SUITE_P(Thicknesses, EarThickness, ::testing::Values(0.5f, 2.5f, 6.0f));
+INSTANTIATE_TEST_SUITE_P(Thicknesses, EarThickness, ::testing::Values(0.5f, 2.5f, 6.0f), millimetresName);
 
 TEST(EarScene, ConcaveSideFacesTheViewer) {
     const Model model = makeEarScene(2.5f);

@@ -122,7 +122,7 @@ TEST(SceneSpec, LightsAreValidatedPerType) {
     EXPECT_EQ(errorOf("builtin:bleed", {"lights=[{direction = [0, 0, 0]}]"}),
               "builtin:bleed: lights[0].direction: must not be the zero vector");
     EXPECT_EQ(errorOf("builtin:bleed", {"lights=[{colour = [1, 1, 1]}]"}),
-              "builtin:bleed: lights[0].colour: unknown key");
+              "builtin:bleed: lights[0].colour: unknown key (did you mean color?)");
     EXPECT_EQ(errorOf("builtin:bleed", {"lights=[{}, {}, {}, {}, {}]"}),
               "builtin:bleed: lights: at most 4 lights, got 5");
     EXPECT_EQ(loadSceneSpec("builtin:bleed", {"lights=[]"}, {}).lights.size(), 0u);

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <sys/wait.h>
@@ -111,4 +112,26 @@ TEST(KernelCli, MethodsTableAndKeysOfAnotherMethod) {
     const CliRun profile = runCli("kernel --method artistic --profile burley");
     EXPECT_EQ(profile.exitCode, 2);
     EXPECT_NE(profile.out.find("sss.profile: not a parameter of method 'artistic'"), std::string::npos) << profile.out;
+}
+
+// The table as text: `none` reads no key of its own (the common keys are listed once, after the methods), and an
+// integer range reads "integer 3…101", not "3.0…101.0".
+TEST(KernelCli, MethodsTextListsCommonKeysOnceAndIntegersAsIntegers) {
+    const CliRun table = runCli("methods");
+    ASSERT_EQ(table.exitCode, 0) << table.out;
+    const std::size_t none = table.out.find("none\n");
+    const std::size_t next = table.out.find("gaussian-sum  (screen-space)\n");
+    ASSERT_NE(none, std::string::npos) << table.out;
+    ASSERT_NE(next, std::string::npos) << table.out;
+    const std::string noneBlock = table.out.substr(none, next - none);
+    EXPECT_NE(noneBlock.find("keys: only the common keys\n"), std::string::npos) << noneBlock;
+    EXPECT_EQ(noneBlock.find("width_mm"), std::string::npos) << noneBlock;
+    std::size_t widthLines = 0;
+    for (std::size_t at = table.out.find("      width_mm ("); at != std::string::npos;
+         at = table.out.find("      width_mm (", at + 1))
+        ++widthLines;
+    EXPECT_EQ(widthLines, 1u) << table.out;
+    EXPECT_NE(table.out.find("      samples (integer "), std::string::npos) << table.out;
+    EXPECT_EQ(table.out.find("integer 3.0"), std::string::npos) << table.out;
+    EXPECT_TRUE(std::regex_search(table.out, std::regex("samples \\(integer [0-9]+\xe2\x80\xa6[0-9]+,"))) << table.out;
 }

@@ -85,7 +85,7 @@ TEST(SssParams, ErrorsNameFileKeyAndValue) {
               "scene.toml: sss.profile: 'gauss' is not one of: deon, burley, file:PATH");
     EXPECT_EQ(sssError("[sss]\nmethod = \"separable\"\nprofile = \"file:/nonexistent/Skin1.bn\""),
               "scene.toml: sss.profile: /nonexistent/Skin1.bn: kernel file not found");
-    EXPECT_EQ(sssError("[sss]\nwidht_mm = 3"), "scene.toml: sss.widht_mm: unknown key");
+    EXPECT_EQ(sssError("[sss]\nwidht_mm = 3"), "scene.toml: sss.widht_mm: unknown key (did you mean width_mm?)");
     EXPECT_EQ(sssError("[sss]\nmethod = \"artistic\"\nartistic_strength = [0.5, 0.5, 2]"),
               "scene.toml: sss.artistic_strength: element 2: 2 is out of range [0, 1]");
 }
