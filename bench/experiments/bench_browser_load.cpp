@@ -8,14 +8,19 @@
 // addresses, 8 per address (like a lab behind one NAT), so the per-address connection cap is exercised as deployed.
 // Every request's latency is recorded; a request that gets no answer (server killed) is re-sent on a new
 // connection, as the page does. At the end every acknowledged answer is checked against study.db: stored once, as
-// acknowledged.
+// acknowledged. --export-every-s S: a researcher downloads the JSON export (GET /api/researcher/export) every S
+// seconds meanwhile, on its own connection; its requests are reported apart from the participants'. --prefill N: N
+// participants who already answered every trial are written into the study before it is served (the export then
+// starts at N × 24 answers).
 //
 // Usage: bench_experiments_browser_load [--participants N] [--think-ms MIN:MAX] [--ramp-s S] [--slow-headers N]
-//          [--chunked-floods N] [--kill-at F1,F2] [--image-kib K] [--folder DIR] [--server PATH]
+//          [--chunked-floods N] [--kill-at F1,F2] [--image-kib K] [--export-every-s S] [--prefill N]
+//          [--folder DIR] [--server PATH]
 // Prints a summary (Markdown rows for docs/benchmarks.md).
 #include "bench/bench_stats.h"
 #include "common/files.h"
 #include "bench_stimulus_set.h"
+#include "experiments/sqlite_database.h"
 #include "experiments/study_creation.h"
 #include "experiments/study_store.h"
 
@@ -64,6 +69,8 @@ struct Options {
     int chunkedFloods = 0;
     std::vector<double> killAt; // fractions of all answers
     int imageKiB = 1024;
+    double exportEverySeconds = 0; // 0 = no researcher export
+    int prefill = 0;
     fs::path folder = fs::temp_directory_path() / "skinlab-bench-browser-load";
     std::string server = SKINLAB_CLI;
 };
@@ -78,6 +85,8 @@ void writeSet(const fs::path& folder, int imageKiB) {
         return bytes;
     });
 }
+
+constexpr const char* kToken = "0123456789abcdef0123456789abcdef"; // the researcher's
 
 // The server process.
 struct Server {
@@ -94,7 +103,7 @@ struct Server {
             ::dup2(devNull, 2); // its log (one line per join) is not part of the measurement
             const std::string portText = std::to_string(wantedPort);
             ::execl(o.server.c_str(), o.server.c_str(), "study", "serve", db.c_str(), "--port", portText.c_str(),
-                    "--token", "bench-token", static_cast<char*>(nullptr));
+                    "--token", kToken, static_cast<char*>(nullptr));
             ::_exit(127);
         }
         ::close(pipeFds[1]);
@@ -432,6 +441,64 @@ void chunkedFlood(int& port, std::atomic<bool>& stop, std::atomic<long>& refused
     }
 }
 
+// The researcher: GET /api/researcher/export?format=json every `every` seconds (blocking, in its own thread), the
+// whole body read and dropped; each download's time and size are recorded.
+struct Exports {
+    std::vector<double> ms;
+    std::vector<double> megabytes;
+    int failed = 0;
+};
+
+void exportLoop(int& port, double every, std::atomic<bool>& stop, Exports& out) {
+    auto next = Clock::now();
+    while (!stop) {
+        next += std::chrono::microseconds(static_cast<long>(every * 1e6));
+        while (!stop && Clock::now() < next) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        if (stop) break;
+        const auto start = Clock::now();
+        try {
+            asio::io_context io;
+            beast::tcp_stream stream(io);
+            stream.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(port)));
+            http::request<http::empty_body> request{http::verb::get, "/api/researcher/export?format=json", 11};
+            request.set(http::field::host, "127.0.0.1:" + std::to_string(port));
+            request.set(http::field::authorization, std::string("Bearer ") + kToken);
+            http::write(stream, request);
+            beast::flat_buffer buffer;
+            http::response_parser<http::string_body> parser;
+            parser.body_limit(boost::none);
+            http::read(stream, buffer, parser);
+            if (parser.get().result_int() != 200)
+                throw std::runtime_error("status " + std::to_string(parser.get().result_int()));
+            out.ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+            out.megabytes.push_back(static_cast<double>(parser.get().body().size()) / 1e6);
+        } catch (const std::exception&) {
+            ++out.failed; // the server was killed meanwhile (--kill-at)
+        }
+    }
+}
+
+// N participants who answered every trial, written through the store (joins) and one transaction (sessions and
+// answers) before the server starts.
+void prefill(const fs::path& db, int participants) {
+    {
+        StudyStore store(db);
+        for (int i = 0; i < participants; ++i) store.join("", "prefill-" + std::to_string(i));
+    }
+    SqliteDatabase sql(db.string(), false);
+    SqliteTransaction tx(sql);
+    sql.execute("INSERT INTO sessions (participant_id, started_at, user_agent, viewport_width, viewport_height,"
+                " device_pixel_ratio) SELECT id, created_at, 'Mozilla/5.0 (bench) prefill', 1920, 1080, 1.0"
+                " FROM participants");
+    sql.execute("INSERT INTO responses (trial_id, participant_id, session_id, chosen, side, response_ms, client_time,"
+                " server_time, viewport_width, viewport_height, device_pixel_ratio, user_agent)"
+                " SELECT t.id, t.participant_id, s.id, CASE WHEN t.id % 2 = 0 THEN 'A' ELSE 'B' END,"
+                " CASE WHEN t.a_on_left = (t.id % 2 = 0) THEN 'left' ELSE 'right' END, 900.0,"
+                " '2026-12-01T00:00:00.000Z', '2026-12-01T00:00:00.000Z', 1920, 1080, 1.0,"
+                " 'Mozilla/5.0 (bench) prefill' FROM trials t JOIN sessions s ON s.participant_id = t.participant_id");
+    tx.commit();
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -451,6 +518,8 @@ int main(int argc, char** argv) {
             std::string item;
             while (std::getline(list, item, ',')) o.killAt.push_back(std::stod(item));
         } else if (key == "--image-kib") o.imageKiB = std::stoi(value);
+        else if (key == "--export-every-s") o.exportEverySeconds = std::stod(value);
+        else if (key == "--prefill") o.prefill = std::stoi(value);
         else if (key == "--folder") o.folder = value;
         else if (key == "--server") o.server = value;
         else {
@@ -464,6 +533,8 @@ int main(int argc, char** argv) {
     skinlab::writeFileAtomic(design, "title = \"Browser load\"\nseed = 3\nrepetitions = 2\n[catch]\nblank = 2\n");
     const fs::path db = o.folder / "study.db";
     createStudy(o.folder / "stimuli", design, {}, db);
+    if (o.prefill > 0) prefill(db, o.prefill);
+    const long prefilled = o.prefill > 0 ? StudyStore(db).responseCount() : 0;
 
     Server server;
     server.start(o, db, 0);
@@ -493,6 +564,10 @@ int main(int argc, char** argv) {
     std::atomic<long> floodsRefused{0};
     std::vector<std::thread> floods;
     for (int i = 0; i < o.chunkedFloods; ++i) floods.emplace_back([&] { chunkedFlood(port, stop, floodsRefused); });
+    Exports exports;
+    std::thread researcher;
+    if (o.exportEverySeconds > 0)
+        researcher = std::thread([&] { exportLoop(port, o.exportEverySeconds, stop, exports); });
 
     // Kill -9 and restart at the given fractions of all answers; sample the server's RSS meanwhile.
     const long total = 22L * o.participants;
@@ -531,6 +606,7 @@ int main(int argc, char** argv) {
     ioThread.join();
     supervisor.join();
     for (auto& t : floods) t.join();
+    if (researcher.joinable()) researcher.join();
     server.kill(SIGTERM);
 
     // Every acknowledged answer stored exactly once, as acknowledged.
@@ -547,7 +623,7 @@ int main(int argc, char** argv) {
             else if (it->second != (side == "left")) ++mismatched;
         }
     }
-    const long stored = store.responseCount();
+    const long stored = store.responseCount() - prefilled;
     std::printf(
         "%.1f s: %ld/%d participants completed; %ld answers acknowledged, %ld stored (%ld lost, %ld stored "
         "differently, %ld stored without acknowledgement); %d kills; %d HTTP errors, %d re-sent after no answer\n",
@@ -564,6 +640,12 @@ int main(int argc, char** argv) {
     std::printf("image requests: %zu, ms p50 %.1f p90 %.1f p99 %.1f max %.1f\n", stats.images.size(),
                 percentile(stats.images, 50), percentile(stats.images, 90), percentile(stats.images, 99),
                 percentile(stats.images, 100));
+    if (o.exportEverySeconds > 0)
+        std::printf("researcher exports (JSON, every %.1f s, %ld answers prefilled): %zu downloaded, %d failed; ms p50 "
+                    "%.0f max %.0f; MB first %.1f last %.1f\n",
+                    o.exportEverySeconds, prefilled, exports.ms.size(), exports.failed, percentile(exports.ms, 50),
+                    percentile(exports.ms, 100), exports.megabytes.empty() ? 0.0 : exports.megabytes.front(),
+                    exports.megabytes.empty() ? 0.0 : exports.megabytes.back());
     std::printf(
         "(participants | think ms | slow headers | floods | requests | p50 all ms | p99 all ms | p50 answer ms | "
         "p99 answer ms | max ms | answers/s | server peak RSS MiB)\n");
