@@ -130,7 +130,7 @@ struct HttpServer::State {
     int reserve() const {
         return limits.reserveConnections >= 0 ? limits.reserveConnections : std::max(8, limits.maxConnections / 20);
     }
-    // Closes the connection that has waited longest for a request; false when none waits.
+    // Closes a connection waiting for a request, one of those waiting longest (see there); false when none waits.
     bool closeLongestIdle();
     // Counts a new connection from `address` (its network); false when the client's network has its cap of
     // connections (nothing counted then).
@@ -174,6 +174,7 @@ class Connection : public std::enable_shared_from_this<Connection> {
 public:
     Connection(tcp::socket socket, HttpServer::State* state, std::string address)
         : stream_(std::move(socket)), state_(state), address_(std::move(address)),
+          network_(clientNetwork(address_, state_->limits.clientIpv6Prefix)),
           buffer_(state_->limits.headerBytes + 4096), timer_(stream_.get_executor()) {}
     ~Connection() {
         leaveIdle();
@@ -421,6 +422,7 @@ public:
         evicted_ = true;
         return weak_from_this().lock();
     }
+    const std::string& network() const { return network_; }
     void closeSoon() {
         asio::post(stream_.get_executor(), [self = shared_from_this()] { self->close(); });
     }
@@ -429,6 +431,7 @@ private:
     beast::tcp_stream stream_;
     HttpServer::State* state_; // outlives every connection (see State)
     std::string address_;
+    std::string network_; // clientNetwork(address_)
     beast::flat_buffer buffer_;
     std::optional<http::request_parser<http::string_body>> parser_;
     asio::steady_timer timer_;
@@ -444,17 +447,34 @@ private:
 } // namespace
 
 bool HttpServer::State::closeLongestIdle() {
-    std::shared_ptr<Connection> longest;
+    // Of the kCandidates connections idle longest, the one whose client network holds the most open connections
+    // (the longest idle of those): a network flooding idle connections loses its own first, and a participant's
+    // kept-alive connection is closed only when the candidates are all participants'.
+    constexpr int kCandidates = 32;
+    std::shared_ptr<Connection> chosen;
     {
         std::lock_guard lock(idleMutex);
-        while (!idle.empty() && !longest) {
-            Connection* connection = idle.front();
-            idle.pop_front();
-            longest = connection->takeForClosing();
+        while (!idle.empty() && !chosen) {
+            auto best = idle.begin();
+            {
+                std::lock_guard counts(perClientMutex);
+                int most = -1, k = 0;
+                for (auto it = idle.begin(); it != idle.end() && k < kCandidates; ++it, ++k) {
+                    const auto found = perClient.find((*it)->network());
+                    const int n = found == perClient.end() ? 0 : found->second;
+                    if (n > most) {
+                        best = it;
+                        most = n;
+                    }
+                }
+            }
+            Connection* connection = *best;
+            idle.erase(best);
+            chosen = connection->takeForClosing();
         }
     }
-    if (!longest) return false;
-    longest->closeSoon();
+    if (!chosen) return false;
+    chosen->closeSoon();
     return true;
 }
 

@@ -5,10 +5,11 @@
 // anything is buffered: header size, body size (chunked bodies included, counted as they arrive), the time a
 // request may take to arrive, and the number of open connections per client network (an IPv4 address, an IPv6 /64,
 // as joins are counted: experiments/join_limiter.h). Open connections in all are bounded; the last
-// `reserveConnections` slots are kept for newcomers: once they are in use, each new connection closes the
-// connection that has been idle longest (a kept-alive one waiting for its next request, or a new one that has sent
-// nothing yet), and when every slot holds a connection in the middle of a request, new ones wait in the listen
-// backlog until one closes. Why this design: docs/architecture.md ("Study server: threading model").
+// `reserveConnections` slots are kept for newcomers: once they are in use, each new connection closes an idle
+// connection (a kept-alive one waiting for its next request, or a new one that has sent nothing yet): of the 32 idle
+// longest, the one whose client network holds the most connections. When every slot holds a connection in the middle
+// of a request, new ones wait in the listen backlog until one closes. Why this design: docs/architecture.md ("Study
+// server: threading model").
 //
 // Requests that break a limit or are not HTTP are answered here (JSON {"error": ...}) and never reach the handler:
 // 400 malformed, 408 too slow, 413 body too large, 431 header too large, 429 too many connections from one client

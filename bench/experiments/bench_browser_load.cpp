@@ -11,10 +11,12 @@
 // acknowledged. --export-every-s S: a researcher downloads the JSON export (GET /api/researcher/export) every S
 // seconds meanwhile, on its own connection; its requests are reported apart from the participants'. --prefill N: N
 // participants who already answered every trial are written into the study before it is served (the export then
-// starts at N × 24 answers).
+// starts at N × 24 answers). --idle-connections N: N connections that never send a request, 60 per source address
+// (127.2.x.y), each reopened 100 ms after the server closes it; the participants start 10 s after them.
 //
 // Usage: bench_experiments_browser_load [--participants N] [--think-ms MIN:MAX] [--ramp-s S] [--slow-headers N]
 //          [--chunked-floods N] [--kill-at F1,F2] [--image-kib K] [--export-every-s S] [--prefill N]
+//          [--idle-connections N]
 //          [--folder DIR] [--server PATH]
 // Prints a summary (Markdown rows for docs/benchmarks.md).
 #include "bench/bench_stats.h"
@@ -45,6 +47,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <thread>
 #include <unistd.h>
@@ -71,6 +74,7 @@ struct Options {
     int imageKiB = 1024;
     double exportEverySeconds = 0; // 0 = no researcher export
     int prefill = 0;
+    int idleConnections = 0;
     fs::path folder = fs::temp_directory_path() / "skinlab-bench-browser-load";
     std::string server = SKINLAB_CLI;
 };
@@ -142,8 +146,9 @@ struct Server {
 
 struct Stats {
     std::vector<double> all, answers, slowSideNormal, images;
-    int errors = 0;  // HTTP answers other than 2xx/304
-    int retries = 0; // requests re-sent after no answer
+    int errors = 0;         // HTTP answers other than 2xx/304
+    int retries = 0;        // requests re-sent after no answer
+    int connectRetries = 0; // of which: no connection made (refused or timed out)
     std::map<int, int> statuses;
 };
 
@@ -273,7 +278,10 @@ private:
         stream_->expires_after(std::chrono::seconds(10));
         stream_->async_connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(port_)),
                                [self = shared_from_this()](beast::error_code e) {
-                                   if (e) return self->retry();
+                                   if (e) {
+                                       ++self->stats_.connectRetries;
+                                       return self->retry();
+                                   }
                                    self->write();
                                });
     }
@@ -419,6 +427,54 @@ private:
     char sink_[1024];
 };
 
+// A connection that never sends a request (an idle-connection flood), reopened 100 ms after the server closes it.
+class IdleHolder : public std::enable_shared_from_this<IdleHolder> {
+public:
+    IdleHolder(asio::io_context& io, int index, int& port, std::atomic<bool>& stop, std::atomic<long>& closed)
+        : io_(io), index_(index), port_(port), stop_(stop), closed_(closed) {}
+    void start(double delaySeconds) {
+        auto timer =
+            std::make_shared<asio::steady_timer>(io_, std::chrono::microseconds(static_cast<long>(delaySeconds * 1e6)));
+        timer->async_wait([self = shared_from_this(), timer](beast::error_code) { self->open(); });
+    }
+
+private:
+    void open() {
+        if (stop_) return;
+        socket_ = std::make_unique<tcp::socket>(io_);
+        beast::error_code ec;
+        socket_->open(tcp::v4(), ec);
+        const int address = index_ / 60;
+        const std::string source =
+            "127.2." + std::to_string(1 + address / 250) + "." + std::to_string(1 + address % 250);
+        socket_->bind(tcp::endpoint(asio::ip::make_address(source), 0), ec);
+        socket_->async_connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(port_)),
+                               [self = shared_from_this()](beast::error_code e) {
+                                   if (e) return self->later();
+                                   self->watch();
+                               });
+    }
+    void watch() {
+        socket_->async_read_some(asio::buffer(sink_), [self = shared_from_this()](beast::error_code ec, std::size_t) {
+            if (!ec) return self->watch();
+            ++self->closed_;
+            self->later();
+        });
+    }
+    void later() {
+        socket_.reset();
+        auto retry = std::make_shared<asio::steady_timer>(io_, std::chrono::milliseconds(100));
+        retry->async_wait([self = shared_from_this(), retry](beast::error_code) { self->open(); });
+    }
+    asio::io_context& io_;
+    int index_;
+    int& port_;
+    std::atomic<bool>& stop_;
+    std::atomic<long>& closed_;
+    std::unique_ptr<tcp::socket> socket_;
+    char sink_[512];
+};
+
 // A client that sends a 500 MiB chunked body, again and again (blocking, in its own thread).
 void chunkedFlood(int& port, std::atomic<bool>& stop, std::atomic<long>& refused) {
     const std::string chunk = "10000\r\n" + std::string(65536, ' ') + "\r\n";
@@ -520,12 +576,18 @@ int main(int argc, char** argv) {
         } else if (key == "--image-kib") o.imageKiB = std::stoi(value);
         else if (key == "--export-every-s") o.exportEverySeconds = std::stod(value);
         else if (key == "--prefill") o.prefill = std::stoi(value);
+        else if (key == "--idle-connections") o.idleConnections = std::stoi(value);
         else if (key == "--folder") o.folder = value;
         else if (key == "--server") o.server = value;
         else {
             std::fprintf(stderr, "unknown option %s\n", key.c_str());
             return 2;
         }
+    }
+    rlimit files{}; // every connection is a file descriptor here too
+    if (::getrlimit(RLIMIT_NOFILE, &files) == 0 && files.rlim_cur < files.rlim_max) {
+        files.rlim_cur = files.rlim_max;
+        ::setrlimit(RLIMIT_NOFILE, &files);
     }
     fs::remove_all(o.folder);
     writeSet(o.folder / "stimuli", o.imageKiB);
@@ -551,9 +613,17 @@ int main(int argc, char** argv) {
     std::atomic<bool> stop{false};
     std::atomic<int> slowCut{0};
     std::vector<std::shared_ptr<Participant>> participants;
+    // An idle-connection flood first (over 5 s), the participants 10 s later.
+    std::atomic<long> idleClosed{0};
+    std::vector<std::shared_ptr<IdleHolder>> idle;
+    for (int i = 0; i < o.idleConnections; ++i) {
+        idle.push_back(std::make_shared<IdleHolder>(io, i, port, stop, idleClosed));
+        idle.back()->start(5.0 * i / o.idleConnections);
+    }
+    const double lead = o.idleConnections > 0 ? 10 : 0;
     for (int i = 0; i < o.participants; ++i) {
         participants.push_back(std::make_shared<Participant>(io, o, i, port, stats, answered));
-        participants.back()->start(o.rampSeconds * i / std::max(1, o.participants));
+        participants.back()->start(lead + o.rampSeconds * i / std::max(1, o.participants));
     }
     std::vector<std::shared_ptr<SlowHeader>> slow;
     for (int i = 0; i < o.slowHeaders; ++i) {
@@ -626,13 +696,18 @@ int main(int argc, char** argv) {
     const long stored = store.responseCount() - prefilled;
     std::printf(
         "%.1f s: %ld/%d participants completed; %ld answers acknowledged, %ld stored (%ld lost, %ld stored "
-        "differently, %ld stored without acknowledgement); %d kills; %d HTTP errors, %d re-sent after no answer\n",
+        "differently, %ld stored without acknowledgement); %d kills; %d HTTP errors, %d re-sent after no answer (%d "
+        "of them: no connection)\n",
         seconds, completed, o.participants, acknowledged, stored, lost, mismatched, stored - acknowledged + lost, kills,
-        stats.errors, stats.retries);
+        stats.errors, stats.retries, stats.connectRetries);
     std::printf("statuses:");
     for (const auto& [status, n] : stats.statuses) std::printf(" %d×%d", status, n);
     std::printf("\nslow-header connections cut by the server: %d; chunked floods refused: %ld\n", slowCut.load(),
                 floodsRefused.load());
+    if (o.idleConnections > 0)
+        std::printf("idle connections: %d held open (reopened when closed), closed by the server %ld times; the "
+                    "participants started %.0f s after them\n",
+                    o.idleConnections, idleClosed.load(), lead);
     std::printf("| %d | %.0f–%.0f | %d | %d | %zu | %.1f | %.1f | %.1f | %.1f | %.1f | %.0f | %ld |\n", o.participants,
                 o.thinkMin, o.thinkMax, o.slowHeaders, o.chunkedFloods, stats.all.size(), percentile(stats.all, 50),
                 percentile(stats.all, 99), percentile(stats.answers, 50), percentile(stats.answers, 99),

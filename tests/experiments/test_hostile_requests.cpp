@@ -1068,7 +1068,7 @@ TEST(HostileRequests, ExportsStreamInBoundedChunksFromASnapshotWhileAnswersGoOn)
 }
 
 // Idle connections from many addresses, each under its cap, can fill every connection slot: a newcomer is still
-// served (the connection idle longest makes room), and when every slot is in the middle of a request the newcomer
+// served (a connection idle long, of the network holding the most, makes room), and when every slot is in the middle of a request the newcomer
 // waits in the listen backlog until one is free — never a 429 meant for a single flooding network.
 TEST(HostileRequests, IdleConnectionsFromManyAddressesNeverKeepANewcomerOut) {
     // A real HttpServer with few slots: 48 in all, 8 per address, the last 8 (or none) kept for newcomers.
@@ -1098,11 +1098,15 @@ TEST(HostileRequests, IdleConnectionsFromManyAddressesNeverKeepANewcomerOut) {
     };
     const std::string request = "GET / HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n";
     {
-        // Six addresses, 8 idle connections each: every slot (48) taken, none of them over its cap.
+        // A participant's kept-alive connection, then six addresses with 8 idle connections each (the last 7):
+        // every slot (48) taken, none of them over its cap.
         SmallServer small(8);
+        RawSocket participant(small.port, "127.0.5.1");
+        ASSERT_TRUE(participant.send(request));
+        ASSERT_EQ(statusOf(participant.readResponse(5s)), 200);
         std::vector<std::unique_ptr<RawSocket>> idle;
         for (int address = 1; address <= 6; ++address)
-            for (int k = 0; k < 8; ++k) {
+            for (int k = 0; k < (address < 6 ? 8 : 7); ++k) {
                 idle.push_back(std::make_unique<RawSocket>(small.port, ("127.0.1." + std::to_string(address)).c_str()));
                 ASSERT_TRUE(idle.back()->connected());
                 std::this_thread::sleep_for(5ms); // an order of age
@@ -1114,10 +1118,13 @@ TEST(HostileRequests, IdleConnectionsFromManyAddressesNeverKeepANewcomerOut) {
             ASSERT_TRUE(fresh.send(request));
             EXPECT_EQ(statusOf(fresh.readResponse(5s)), 200) << "newcomer " << newcomer;
         }
-        // The connections idle longest made room; the youngest are still open and served.
+        // The flooding networks' connections idle longest made room; the youngest are still open and served, and
+        // so is the participant's, although it waited longer than any: its network holds one connection.
         EXPECT_TRUE(idle.front()->closedByServer(2s));
         ASSERT_TRUE(idle.back()->send(request));
         EXPECT_EQ(statusOf(idle.back()->readResponse(5s)), 200);
+        ASSERT_TRUE(participant.send(request));
+        EXPECT_EQ(statusOf(participant.readResponse(5s)), 200);
     }
     {
         // Every slot in the middle of a request (headers begun, not finished): nothing idle to close. A newcomer's
