@@ -17,12 +17,14 @@
 #include <cstdlib>
 #include <cstring>
 #include <fcntl.h>
+#include <functional>
 #include <pthread.h>
 #include <algorithm>
 #include <regex>
 #include <sys/stat.h>
 #include <thread>
 #include <unistd.h>
+#include <utility>
 
 namespace skinlab::cli {
 namespace ex = skinlab::experiments;
@@ -62,6 +64,7 @@ struct StudyOptions {
     bool apiOnly = false;
     std::string format;
     bool overwrite = false;
+    bool includeSessionIds = false;
     ex::NginxSiteOptions site;
 };
 
@@ -76,20 +79,32 @@ void runCreate(const StudyOptions& o) {
     std::printf("next: skinlab study serve %s\n", o.output.c_str());
 }
 
-// writeFileAtomic(), the file readable by its owner only (the site file says where the TLS key lies).
-void writePrivateFileAtomic(const std::string& path, const std::string& text) {
+// writeFileAtomic(), the file readable by its owner only (the site file says where the TLS key lies; an export
+// holds personal data), written piece by piece as `next` produces them ("" = the end).
+void writePrivateFileAtomic(const std::string& path, const std::function<std::string()>& next) {
     AtomicOutput out(path);
     const int fd = ::open(out.tempPath().c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
     if (fd < 0) throw InputError(path + ": cannot write output (" + std::strerror(errno) + ")");
     bool written = ::fchmod(fd, 0600) == 0;
-    for (std::size_t at = 0; written && at < text.size();) {
-        const ssize_t n = ::write(fd, text.data() + at, text.size() - at);
-        written = n > 0;
-        at += written ? static_cast<std::size_t>(n) : 0;
+    try {
+        for (std::string text = next(); written && !text.empty(); text = next())
+            for (std::size_t at = 0; written && at < text.size();) {
+                const ssize_t n = ::write(fd, text.data() + at, text.size() - at);
+                written = n > 0;
+                at += written ? static_cast<std::size_t>(n) : 0;
+            }
+    } catch (...) {
+        ::close(fd);
+        throw;
     }
     ::close(fd);
     if (!written) throw InputError(path + ": write failed (" + std::strerror(errno) + ")");
     out.commit();
+}
+
+void writePrivateFileAtomic(const std::string& path, const std::string& text) {
+    bool given = false;
+    writePrivateFileAtomic(path, [&] { return std::exchange(given, true) ? std::string() : text; });
 }
 
 // The researcher token: --token (visible to every user in `ps`), --token-file, or SKINLAB_RESEARCHER_TOKEN; empty = a
@@ -242,9 +257,12 @@ void runDeployConfig(const StudyOptions& o) {
 
 void runExport(const StudyOptions& o) {
     ex::StudyStore store(o.study, ex::StudyAccess::readOnly); // also on a read-only mount
-    const std::string text = ex::exportResponses(store, o.format);
-    if (o.output.empty() || o.output == "-") std::fwrite(text.data(), 1, text.size(), stdout);
-    else writeFileAtomic(o.output, text);
+    // Streamed from a snapshot (experiments/study_export.h); a file is readable by its owner only.
+    ex::ResponseExport exporter(store, o.format, {o.includeSessionIds});
+    if (!o.output.empty() && o.output != "-") return writePrivateFileAtomic(o.output, [&] { return exporter.next(); });
+    for (std::string piece = exporter.next(); !piece.empty(); piece = exporter.next())
+        if (std::fwrite(piece.data(), 1, piece.size(), stdout) != piece.size())
+            throw InputError("standard output: write failed (" + std::string(std::strerror(errno)) + ")");
 }
 
 // `skinlab study create`: its options and what it runs.
@@ -272,7 +290,7 @@ void addServe(CLI::App& study, const std::shared_ptr<StudyOptions>& options) {
                       "Name the server is reached by (checked against the Host header; default: its address only)");
     serve
         ->add_option("--max-connections-per-client", options->connectionsPerClient,
-                     "Open connections allowed per client address")
+                     "Open connections allowed per client network (an IPv4 address, an IPv6 --join-ipv6-prefix)")
         ->capture_default_str()
         ->check(CLI::Range(1, 100000));
     serve
@@ -294,7 +312,7 @@ void addServe(CLI::App& study, const std::shared_ptr<StudyOptions>& options) {
         ->check(CLI::Range(1, 100000));
     serve
         ->add_option("--join-ipv6-prefix", options->joinIpv6Prefix,
-                     "IPv6 clients share the join allowance per this prefix length")
+                     "IPv6 clients share the join allowance and the connection cap per this prefix length")
         ->capture_default_str()
         ->check(CLI::Range(32, 128));
     serve->add_option("--stimuli", options->stimuli, "Stimulus folder, if it moved since `study create`");
@@ -398,7 +416,11 @@ void addExport(CLI::App& study, const std::shared_ptr<StudyOptions>& options) {
     exportCommand->add_option("--format", options->format, "csv, json or pwcmp")
         ->check(CLI::IsMember({"csv", "json", "pwcmp"}))
         ->default_val("csv");
-    exportCommand->add_option("-o,--output", options->output, "Output file (default: standard output)");
+    exportCommand->add_option("-o,--output", options->output,
+                              "Output file, readable by its owner only (default: standard output)");
+    exportCommand->add_flag("--include-session-ids", options->includeSessionIds,
+                            "Include the platform's session ids (SESSION_ID, assignmentId): they resume an unfinished "
+                            "participation");
     exportCommand->callback([options] { runExport(*options); });
 }
 

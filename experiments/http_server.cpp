@@ -1,6 +1,7 @@
 #include "experiments/http_server.h"
 
 #include "common/error.h"
+#include "experiments/join_limiter.h"
 
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/post.hpp>
@@ -15,6 +16,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <list>
 #include <mutex>
 #include <thread>
 #include <unordered_map>
@@ -96,14 +98,24 @@ std::optional<std::string> HttpRequest::queryParameter(std::string_view name) co
     return std::nullopt;
 }
 
+namespace {
+class Connection;
+} // namespace
+
 // Members in this order: destroying `io` destroys the connections still queued on it, which release their
 // per-client counts (declared before it); the worker pool is joined first.
 struct HttpServer::State {
     HttpHandler handler;
     HttpLimits limits;
     std::mutex perClientMutex;
-    std::unordered_map<std::string, int> perClient;
+    std::unordered_map<std::string, int> perClient; // by client network (clientNetwork())
     std::atomic<int> open{0};
+    bool acceptPaused = false; // every slot in use: new connections wait in the listen backlog (perClientMutex)
+    bool stopped = false;      // stop() was called: accepting never resumes (perClientMutex)
+    // Connections waiting for a request (kept-alive ones between requests, new ones before their first byte), the
+    // longest waiting first: the ones closed to keep the reserve free for newcomers.
+    std::mutex idleMutex;
+    std::list<Connection*> idle;
     std::atomic<bool> runningFlag{false};
     asio::io_context io;
     std::optional<asio::executor_work_guard<asio::io_context::executor_type>> work;
@@ -114,18 +126,25 @@ struct HttpServer::State {
         : handler(std::move(h)), limits(l), workers(static_cast<std::size_t>(std::max(1, l.workerThreads))) {}
 
     void accept();
-    // Counts a new connection from `address`; false when a limit is reached (nothing counted then).
+    void onAccept(tcp::socket socket);
+    int reserve() const {
+        return limits.reserveConnections >= 0 ? limits.reserveConnections : std::max(8, limits.maxConnections / 20);
+    }
+    // Closes a connection waiting for a request, one of those waiting longest (see there); false when none waits.
+    bool closeLongestIdle();
+    // Counts a new connection from `address` (its network); false when the client's network has its cap of
+    // connections (nothing counted then).
     bool admit(const std::string& address) {
         std::lock_guard lock(perClientMutex);
-        if (open.load() >= limits.maxConnections) return false;
         if (std::find(limits.uncappedClients.begin(), limits.uncappedClients.end(), address) !=
             limits.uncappedClients.end()) {
             ++open; // a trusted proxy carries many clients; they are counted per forwarded address by the handler
             return true;
         }
-        int& n = perClient[address];
+        const std::string network = clientNetwork(address, limits.clientIpv6Prefix);
+        int& n = perClient[network];
         if (n >= limits.connectionsPerClient) {
-            if (n == 0) perClient.erase(address);
+            if (n == 0) perClient.erase(network);
             return false;
         }
         ++n;
@@ -133,10 +152,19 @@ struct HttpServer::State {
         return true;
     }
     void release(const std::string& address) {
-        std::lock_guard lock(perClientMutex);
-        auto it = perClient.find(address);
-        if (it != perClient.end() && --it->second <= 0) perClient.erase(it);
-        --open;
+        bool resume = false;
+        {
+            std::lock_guard lock(perClientMutex);
+            if (std::find(limits.uncappedClients.begin(), limits.uncappedClients.end(), address) ==
+                limits.uncappedClients.end()) {
+                auto it = perClient.find(clientNetwork(address, limits.clientIpv6Prefix));
+                if (it != perClient.end() && --it->second <= 0) perClient.erase(it);
+            }
+            --open;
+            resume = acceptPaused && !stopped && open.load() < limits.maxConnections;
+            if (resume) acceptPaused = false;
+        }
+        if (resume) asio::post(acceptor.get_executor(), [this] { accept(); });
     }
 };
 
@@ -146,8 +174,12 @@ class Connection : public std::enable_shared_from_this<Connection> {
 public:
     Connection(tcp::socket socket, HttpServer::State* state, std::string address)
         : stream_(std::move(socket)), state_(state), address_(std::move(address)),
+          network_(clientNetwork(address_, state_->limits.clientIpv6Prefix)),
           buffer_(state_->limits.headerBytes + 4096), timer_(stream_.get_executor()) {}
-    ~Connection() { state_->release(address_); }
+    ~Connection() {
+        leaveIdle();
+        state_->release(address_);
+    }
 
     void start() {
         asio::dispatch(stream_.get_executor(), [self = shared_from_this()] { self->readRequest(); });
@@ -159,11 +191,14 @@ private:
         parser_->header_limit(static_cast<std::uint32_t>(state_->limits.headerBytes));
         parser_->body_limit(state_->limits.bodyBytes);
         if (buffer_.size() == 0) {
-            // Idle: wait for the first byte of the next request under the (long) keep-alive deadline.
+            // Idle: wait for the first byte of the next request under the (long) keep-alive deadline — or until a
+            // newcomer needs the slot (State::closeLongestIdle).
             stream_.expires_after(state_->limits.idleTimeout);
+            enterIdle();
             stream_.async_read_some(buffer_.prepare(1024),
                                     [self = shared_from_this()](beast::error_code ec, std::size_t n) {
-                                        if (ec) return self->close();
+                                        const bool evicted = !self->leaveIdle();
+                                        if (ec || evicted) return self->close();
                                         self->buffer_.commit(n);
                                         self->readRest();
                                     });
@@ -278,6 +313,7 @@ private:
     }
 
     void write(HttpResponse response, bool keepAlive, unsigned version, bool head) {
+        if (response.streamBody) return writeStreamed(std::move(response), keepAlive, version, head);
         // The body is written from a shared buffer: a stimulus image held in memory is never copied per request.
         std::shared_ptr<const std::string> bytes =
             response.sharedBody ? response.sharedBody : std::make_shared<const std::string>(std::move(response.body));
@@ -300,15 +336,102 @@ private:
                           });
     }
 
+    // A body produced piece by piece (HttpResponse::streamBody): the header, then one piece at a time — produced on
+    // a worker (it may read SQLite), written here, and only then the next — so one piece is held at a time.
+    using Pieces = std::shared_ptr<std::function<std::string()>>;
+    void writeStreamed(HttpResponse response, bool keepAlive, unsigned version, bool head) {
+        auto header =
+            std::make_shared<http::response<http::empty_body>>(static_cast<http::status>(response.status), version);
+        header->set(http::field::server, "skinlab");
+        if (!response.contentType.empty()) header->set(http::field::content_type, response.contentType);
+        for (const auto& [name, value] : response.headers) header->insert(name, value);
+        const bool chunked = version >= 11; // HTTP/1.0 has no chunks: the body ends with the connection
+        keepAlive = keepAlive && chunked;
+        header->keep_alive(keepAlive);
+        if (chunked) header->chunked(true);
+        auto serializer = std::make_shared<http::response_serializer<http::empty_body>>(*header);
+        auto pieces = std::make_shared<std::function<std::string()>>(std::move(response.streamBody));
+        stream_.expires_after(state_->limits.writeTimeout);
+        http::async_write_header(stream_, *serializer,
+                                 [self = shared_from_this(), header, serializer, pieces, keepAlive, chunked,
+                                  head](beast::error_code ec, std::size_t) {
+                                     if (ec || (head && !keepAlive)) return self->close();
+                                     if (head) return self->readRequest();
+                                     self->producePiece(pieces, keepAlive, chunked);
+                                 });
+    }
+    void producePiece(const Pieces& pieces, bool keepAlive, bool chunked) {
+        asio::post(state_->workers, [self = shared_from_this(), pieces, keepAlive, chunked] {
+            auto piece = std::make_shared<std::string>();
+            bool failed = false;
+            try {
+                *piece = (*pieces)();
+            } catch (const std::exception& e) {
+                spdlog::error("{}: a streamed answer failed: {}", self->address_, e.what());
+                failed = true;
+            }
+            asio::post(self->stream_.get_executor(), [self, pieces, piece, keepAlive, chunked, failed] {
+                self->writePiece(pieces, piece, keepAlive, chunked, failed);
+            });
+        });
+    }
+    void writePiece(const Pieces& pieces, const std::shared_ptr<std::string>& piece, bool keepAlive, bool chunked,
+                    bool failed) {
+        if (failed || (piece->empty() && !chunked)) return close();
+        stream_.expires_after(state_->limits.writeTimeout);
+        if (piece->empty()) {
+            return asio::async_write(stream_, http::make_chunk_last(),
+                                     [self = shared_from_this(), keepAlive](beast::error_code ec, std::size_t) {
+                                         if (ec || !keepAlive) return self->close();
+                                         self->readRequest();
+                                     });
+        }
+        auto next = [self = shared_from_this(), pieces, piece, keepAlive, chunked](beast::error_code ec, std::size_t) {
+            if (ec) return self->close();
+            self->producePiece(pieces, keepAlive, chunked);
+        };
+        if (chunked) asio::async_write(stream_, http::make_chunk(asio::buffer(*piece)), std::move(next));
+        else asio::async_write(stream_, asio::buffer(*piece), std::move(next));
+    }
+
     void close() {
         beast::error_code ignored;
         stream_.socket().shutdown(tcp::socket::shutdown_both, ignored);
         stream_.socket().close(ignored);
     }
 
+    // The idle list (State::idle): entered while waiting for a request, left when a byte arrives or the wait ends.
+    void enterIdle() {
+        std::lock_guard lock(state_->idleMutex);
+        idleEntry_ = state_->idle.insert(state_->idle.end(), this);
+        idle_ = true;
+    }
+    // False when the connection was chosen to be closed meanwhile.
+    bool leaveIdle() {
+        std::lock_guard lock(state_->idleMutex);
+        if (idle_) state_->idle.erase(idleEntry_);
+        idle_ = false;
+        return !evicted_;
+    }
+
+public:
+    // State::closeLongestIdle(), under idleMutex, with this connection taken off the idle list: marks it, and
+    // returns it when it is still alive (it may be in its destructor, waiting for the mutex).
+    std::shared_ptr<Connection> takeForClosing() {
+        idle_ = false;
+        evicted_ = true;
+        return weak_from_this().lock();
+    }
+    const std::string& network() const { return network_; }
+    void closeSoon() {
+        asio::post(stream_.get_executor(), [self = shared_from_this()] { self->close(); });
+    }
+
+private:
     beast::tcp_stream stream_;
     HttpServer::State* state_; // outlives every connection (see State)
     std::string address_;
+    std::string network_; // clientNetwork(address_)
     beast::flat_buffer buffer_;
     std::optional<http::request_parser<http::string_body>> parser_;
     asio::steady_timer timer_;
@@ -316,29 +439,55 @@ private:
     bool failing_ = false;
     std::unique_ptr<char[]> drainBuffer_;
     std::size_t drained_ = 0;
+    std::list<Connection*>::iterator idleEntry_; // in state_->idle while idle_ (idleMutex)
+    bool idle_ = false;
+    bool evicted_ = false;
 };
 
 } // namespace
+
+bool HttpServer::State::closeLongestIdle() {
+    // Of the kCandidates connections idle longest, the one whose client network holds the most open connections
+    // (the longest idle of those): a network flooding idle connections loses its own first, and a participant's
+    // kept-alive connection is closed only when the candidates are all participants'.
+    constexpr int kCandidates = 32;
+    std::shared_ptr<Connection> chosen;
+    {
+        std::lock_guard lock(idleMutex);
+        while (!idle.empty() && !chosen) {
+            auto best = idle.begin();
+            {
+                std::lock_guard counts(perClientMutex);
+                int most = -1, k = 0;
+                for (auto it = idle.begin(); it != idle.end() && k < kCandidates; ++it, ++k) {
+                    const auto found = perClient.find((*it)->network());
+                    const int n = found == perClient.end() ? 0 : found->second;
+                    if (n > most) {
+                        best = it;
+                        most = n;
+                    }
+                }
+            }
+            Connection* connection = *best;
+            idle.erase(best);
+            chosen = connection->takeForClosing();
+        }
+    }
+    if (!chosen) return false;
+    chosen->closeSoon();
+    return true;
+}
 
 void HttpServer::State::accept() {
     acceptor.async_accept(asio::make_strand(io), [self = this](beast::error_code ec, tcp::socket socket) {
         if (ec == asio::error::operation_aborted || !self->acceptor.is_open()) return;
         if (!ec) {
-            beast::error_code ignored;
-            const auto endpoint = socket.remote_endpoint(ignored);
-            std::string address = ignored ? std::string("?") : endpoint.address().to_string();
-            if (self->admit(address)) {
-                socket.set_option(tcp::no_delay(true), ignored);
-                std::make_shared<Connection>(std::move(socket), self, std::move(address))->start();
-            } else {
-                // Over the limit: a short answer, written without waiting, and the connection is closed.
-                static const std::string refused =
-                    "HTTP/1.1 429 Too Many Requests\r\nContent-Type: application/json\r\nConnection: close\r\n"
-                    "Retry-After: 5\r\nContent-Length: 42\r\n\r\n{\"error\":\"too many connections from here\"}";
-                socket.non_blocking(true, ignored);
-                socket.write_some(asio::buffer(refused), ignored);
-                socket.shutdown(tcp::socket::shutdown_both, ignored);
-                socket.close(ignored);
+            self->onAccept(std::move(socket));
+            std::lock_guard lock(self->perClientMutex);
+            // Every slot holds a connection: the next ones wait in the listen backlog until one is released.
+            if (self->open.load() >= self->limits.maxConnections && !self->stopped) {
+                self->acceptPaused = true;
+                return;
             }
         } else if (ec == asio::error::no_descriptors) {
             spdlog::warn("out of file descriptors; connections wait in the backlog");
@@ -346,6 +495,28 @@ void HttpServer::State::accept() {
         }
         self->accept();
     });
+}
+
+void HttpServer::State::onAccept(tcp::socket socket) {
+    beast::error_code ignored;
+    const auto endpoint = socket.remote_endpoint(ignored);
+    std::string address = ignored ? std::string("?") : endpoint.address().to_string();
+    if (!admit(address)) {
+        // Over the client network's cap: a short answer, written without waiting, and the connection is closed.
+        static const std::string refused =
+            "HTTP/1.1 429 Too Many Requests\r\nContent-Type: application/json\r\nConnection: close\r\n"
+            "Retry-After: 5\r\nContent-Length: 42\r\n\r\n{\"error\":\"too many connections from here\"}";
+        socket.non_blocking(true, ignored);
+        socket.write_some(asio::buffer(refused), ignored);
+        socket.shutdown(tcp::socket::shutdown_both, ignored);
+        socket.close(ignored);
+        return;
+    }
+    // In the reserve: the connection idle longest makes room (its client reconnects when it needs to, as a browser
+    // does after a keep-alive timeout), so idle connections cannot keep newcomers out.
+    if (open.load() > limits.maxConnections - reserve()) closeLongestIdle();
+    socket.set_option(tcp::no_delay(true), ignored);
+    std::make_shared<Connection>(std::move(socket), this, std::move(address))->start();
 }
 
 HttpServer::HttpServer(HttpHandler handler, HttpLimits limits)
@@ -399,6 +570,11 @@ void HttpServer::run() {
 
 void HttpServer::stop() {
     State& s = *state_;
+    {
+        std::lock_guard lock(s.perClientMutex);
+        s.stopped = true;
+        s.acceptPaused = false;
+    }
     asio::post(s.io, [state = state_.get()] {
         beast::error_code ignored;
         state->acceptor.close(ignored);

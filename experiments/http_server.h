@@ -3,12 +3,17 @@
 // (thousands of kept-alive browsers cost a socket and a few KiB each, not a thread), and a small pool of worker
 // threads runs the handlers, which may block on SQLite and its fsync. Limits are enforced while reading, before
 // anything is buffered: header size, body size (chunked bodies included, counted as they arrive), the time a
-// request may take to arrive, and the number of open connections per client address. Why this design:
-// docs/architecture.md ("Study server: threading model").
+// request may take to arrive, and the number of open connections per client network (an IPv4 address, an IPv6 /64,
+// as joins are counted: experiments/join_limiter.h). Open connections in all are bounded; the last
+// `reserveConnections` slots are kept for newcomers: once they are in use, each new connection closes an idle
+// connection (a kept-alive one waiting for its next request, or a new one that has sent nothing yet): of the 32 idle
+// longest, the one whose client network holds the most connections. When every slot holds a connection in the middle
+// of a request, new ones wait in the listen backlog until one closes. Why this design: docs/architecture.md ("Study
+// server: threading model").
 //
 // Requests that break a limit or are not HTTP are answered here (JSON {"error": ...}) and never reach the handler:
-// 400 malformed, 408 too slow, 413 body too large, 431 header too large, 429 too many connections from one address,
-// 501 a transfer coding other than chunked (the connection is closed).
+// 400 malformed, 408 too slow, 413 body too large, 431 header too large, 429 too many connections from one client
+// network, 501 a transfer coding other than chunked (the connection is closed).
 #include <chrono>
 #include <nlohmann/json_fwd.hpp>
 #include <cstddef>
@@ -45,6 +50,11 @@ struct HttpResponse {
     std::vector<std::pair<std::string, std::string>> headers;
     std::string body;
     std::shared_ptr<const std::string> sharedBody; // when set, sent instead of `body` (not copied)
+    // When set, the body is produced piece by piece instead (a large export): called on a worker thread, one call at
+    // a time, each once the previous piece is written to the socket, so one piece is held at a time; "" ends the
+    // body. Sent with chunked transfer coding (to an HTTP/1.0 client: until the connection closes). Should it throw,
+    // the connection is closed without the last chunk, so the client sees an incomplete answer, never a short one.
+    std::function<std::string()> streamBody;
 };
 
 // A JSON answer: `body` serialised (invalid UTF-8 replaced), Content-Type application/json, never cached. Every JSON
@@ -59,9 +69,11 @@ struct HttpLimits {
     std::chrono::milliseconds requestTimeout{10000}; // from the first byte... to the whole request read
     std::chrono::milliseconds idleTimeout{30000};    // a kept-alive connection with no request
     std::chrono::milliseconds writeTimeout{30000};
-    int connectionsPerClient = 64;            // open connections per client IP address
+    int connectionsPerClient = 64;            // open connections per client network (429 beyond)
+    int clientIpv6Prefix = 64;                // an IPv6 client network: this many leading bits
     std::vector<std::string> uncappedClients; // addresses exempt from connectionsPerClient (a trusted proxy)
     int maxConnections = 20000;               // in all (bounded by the open-file limit too)
+    int reserveConnections = -1;              // kept for newcomers (see above); -1 = 5 % of maxConnections, >= 8
     int ioThreads = 2;
     int workerThreads = 8; // run the handlers
 };

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 namespace skinlab::experiments {
@@ -28,6 +29,22 @@ inline constexpr const char* kViewingColumns =
     " v.pointer_fine, v.touch_points, v.mobile, v.pixels_per_mm, v.viewing_distance_mm, v.pixels_per_degree";
 std::optional<ViewingConditions> readViewing(const SqliteStatement& s, int first, double devicePixelRatio,
                                              int viewportWidth, int viewportHeight);
+
+// Every response joined with its trial, participant, stimuli, session, trial conditions, platform ids and the
+// session's viewing conditions, ordered by participant and position (the exports' and the store's read);
+// readResponseRow() reads one row of it.
+std::string responseRowsQuery();
+ResponseRow readResponseRow(const SqliteStatement& s);
+
+// Every session with its participant and viewing conditions, in order of starting; readSessionViewing() reads one.
+std::string sessionViewingsQuery();
+SessionViewing readSessionViewing(const SqliteStatement& s);
+
+// Every participant with its counts (trials, answers, test/repeat answers, catch answers and correct ones, last
+// answer) and platform ids, in joining order; readParticipantStatus() reads one row. `plannedTotal` > 0: the length
+// of an active design's participation (its trials are stored batch by batch), else the stored trials are counted.
+std::string participantStatusQuery();
+ParticipantStatus readParticipantStatus(const SqliteStatement& s, int plannedTotal);
 
 // Inserts a participant's planned trials at positions firstPosition, firstPosition + 1, ... (inside the caller's
 // transaction).

@@ -202,6 +202,7 @@ StudyServer::StudyServer(StudyStore& store, ServerOptions options) : store_(stor
     limits.bodyBytes = options_.maxBodyBytes;
     limits.headerBytes = options_.maxHeaderBytes;
     limits.connectionsPerClient = options_.connectionsPerClient;
+    limits.clientIpv6Prefix = options_.joinIpv6Prefix; // connections are capped per network as joins are
     limits.workerThreads = options_.threads;
     limits.ioThreads = options_.ioThreads;
     limits.requestTimeout = options_.requestTimeout;
@@ -496,10 +497,17 @@ HttpResponse StudyServer::getExport(const HttpRequest& req) {
     const std::string format = req.queryParameter("format").value_or("csv");
     if (format != "csv" && format != "json" && format != "pwcmp")
         throw RequestError(400, "format: \"" + validUtf8(format, 16) + "\" is not one of csv, json, pwcmp");
+    // The platform's session ids resume unfinished participations: only when asked for.
+    const std::string sessionIds = req.queryParameter("include_session_ids").value_or("0");
+    if (sessionIds != "0" && sessionIds != "1")
+        throw RequestError(400, "include_session_ids: \"" + validUtf8(sessionIds, 16) + "\" is not 0 or 1");
     HttpResponse res;
     res.contentType = format == "json" ? "application/json" : "text/csv";
     res.headers.emplace_back("Cache-Control", "no-store");
-    res.body = exportResponses(store_, format);
+    // Streamed from a snapshot, piece by piece (experiments/study_export.h): no lock of the store is held and
+    // the memory does not grow with the study.
+    auto exporter = std::make_shared<ResponseExport>(store_, format, ExportOptions{sessionIds == "1"});
+    res.streamBody = [exporter] { return exporter->next(); };
     return res;
 }
 

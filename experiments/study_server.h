@@ -32,7 +32,7 @@ struct ServerOptions {
     std::filesystem::path stimuliDir;      // empty = the folder recorded at `study create`
     std::size_t maxBodyBytes = 16 * 1024;  // larger request bodies are refused with 413 (chunked too)
     std::size_t maxHeaderBytes = 8 * 1024; // larger request headers are refused with 431
-    int connectionsPerClient = 64;         // open connections per client address (more: 429)
+    int connectionsPerClient = 64;         // open connections per client network (more: 429)
     std::string publicHost;                // a name the server is reached by (Host header); empty = its address only
     double joinsPerMinute = 60;            // new participants per client address: sustained rate...
     double joinBurst = 60;                 // ...and burst (more: 429 with Retry-After)

@@ -8,14 +8,21 @@
 // addresses, 8 per address (like a lab behind one NAT), so the per-address connection cap is exercised as deployed.
 // Every request's latency is recorded; a request that gets no answer (server killed) is re-sent on a new
 // connection, as the page does. At the end every acknowledged answer is checked against study.db: stored once, as
-// acknowledged.
+// acknowledged. --export-every-s S: a researcher downloads the JSON export (GET /api/researcher/export) every S
+// seconds meanwhile, on its own connection; its requests are reported apart from the participants'. --prefill N: N
+// participants who already answered every trial are written into the study before it is served (the export then
+// starts at N × 24 answers). --idle-connections N: N connections that never send a request, 60 per source address
+// (127.2.x.y), each reopened 100 ms after the server closes it; the participants start 10 s after them.
 //
 // Usage: bench_experiments_browser_load [--participants N] [--think-ms MIN:MAX] [--ramp-s S] [--slow-headers N]
-//          [--chunked-floods N] [--kill-at F1,F2] [--image-kib K] [--folder DIR] [--server PATH]
+//          [--chunked-floods N] [--kill-at F1,F2] [--image-kib K] [--export-every-s S] [--prefill N]
+//          [--idle-connections N]
+//          [--folder DIR] [--server PATH]
 // Prints a summary (Markdown rows for docs/benchmarks.md).
 #include "bench/bench_stats.h"
 #include "common/files.h"
 #include "bench_stimulus_set.h"
+#include "experiments/sqlite_database.h"
 #include "experiments/study_creation.h"
 #include "experiments/study_store.h"
 
@@ -40,6 +47,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <thread>
 #include <unistd.h>
@@ -64,6 +72,9 @@ struct Options {
     int chunkedFloods = 0;
     std::vector<double> killAt; // fractions of all answers
     int imageKiB = 1024;
+    double exportEverySeconds = 0; // 0 = no researcher export
+    int prefill = 0;
+    int idleConnections = 0;
     fs::path folder = fs::temp_directory_path() / "skinlab-bench-browser-load";
     std::string server = SKINLAB_CLI;
 };
@@ -78,6 +89,8 @@ void writeSet(const fs::path& folder, int imageKiB) {
         return bytes;
     });
 }
+
+constexpr const char* kToken = "0123456789abcdef0123456789abcdef"; // the researcher's
 
 // The server process.
 struct Server {
@@ -94,7 +107,7 @@ struct Server {
             ::dup2(devNull, 2); // its log (one line per join) is not part of the measurement
             const std::string portText = std::to_string(wantedPort);
             ::execl(o.server.c_str(), o.server.c_str(), "study", "serve", db.c_str(), "--port", portText.c_str(),
-                    "--token", "bench-researcher-token-0123", static_cast<char*>(nullptr));
+                    "--token", kToken, static_cast<char*>(nullptr));
             ::_exit(127);
         }
         ::close(pipeFds[1]);
@@ -133,8 +146,9 @@ struct Server {
 
 struct Stats {
     std::vector<double> all, answers, slowSideNormal, images;
-    int errors = 0;  // HTTP answers other than 2xx/304
-    int retries = 0; // requests re-sent after no answer
+    int errors = 0;         // HTTP answers other than 2xx/304
+    int retries = 0;        // requests re-sent after no answer
+    int connectRetries = 0; // of which: no connection made (refused or timed out)
     std::map<int, int> statuses;
 };
 
@@ -264,7 +278,10 @@ private:
         stream_->expires_after(std::chrono::seconds(10));
         stream_->async_connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(port_)),
                                [self = shared_from_this()](beast::error_code e) {
-                                   if (e) return self->retry();
+                                   if (e) {
+                                       ++self->stats_.connectRetries;
+                                       return self->retry();
+                                   }
                                    self->write();
                                });
     }
@@ -410,6 +427,54 @@ private:
     char sink_[1024];
 };
 
+// A connection that never sends a request (an idle-connection flood), reopened 100 ms after the server closes it.
+class IdleHolder : public std::enable_shared_from_this<IdleHolder> {
+public:
+    IdleHolder(asio::io_context& io, int index, int& port, std::atomic<bool>& stop, std::atomic<long>& closed)
+        : io_(io), index_(index), port_(port), stop_(stop), closed_(closed) {}
+    void start(double delaySeconds) {
+        auto timer =
+            std::make_shared<asio::steady_timer>(io_, std::chrono::microseconds(static_cast<long>(delaySeconds * 1e6)));
+        timer->async_wait([self = shared_from_this(), timer](beast::error_code) { self->open(); });
+    }
+
+private:
+    void open() {
+        if (stop_) return;
+        socket_ = std::make_unique<tcp::socket>(io_);
+        beast::error_code ec;
+        socket_->open(tcp::v4(), ec);
+        const int address = index_ / 60;
+        const std::string source =
+            "127.2." + std::to_string(1 + address / 250) + "." + std::to_string(1 + address % 250);
+        socket_->bind(tcp::endpoint(asio::ip::make_address(source), 0), ec);
+        socket_->async_connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(port_)),
+                               [self = shared_from_this()](beast::error_code e) {
+                                   if (e) return self->later();
+                                   self->watch();
+                               });
+    }
+    void watch() {
+        socket_->async_read_some(asio::buffer(sink_), [self = shared_from_this()](beast::error_code ec, std::size_t) {
+            if (!ec) return self->watch();
+            ++self->closed_;
+            self->later();
+        });
+    }
+    void later() {
+        socket_.reset();
+        auto retry = std::make_shared<asio::steady_timer>(io_, std::chrono::milliseconds(100));
+        retry->async_wait([self = shared_from_this(), retry](beast::error_code) { self->open(); });
+    }
+    asio::io_context& io_;
+    int index_;
+    int& port_;
+    std::atomic<bool>& stop_;
+    std::atomic<long>& closed_;
+    std::unique_ptr<tcp::socket> socket_;
+    char sink_[512];
+};
+
 // A client that sends a 500 MiB chunked body, again and again (blocking, in its own thread).
 void chunkedFlood(int& port, std::atomic<bool>& stop, std::atomic<long>& refused) {
     const std::string chunk = "10000\r\n" + std::string(65536, ' ') + "\r\n";
@@ -432,6 +497,64 @@ void chunkedFlood(int& port, std::atomic<bool>& stop, std::atomic<long>& refused
     }
 }
 
+// The researcher: GET /api/researcher/export?format=json every `every` seconds (blocking, in its own thread), the
+// whole body read and dropped; each download's time and size are recorded.
+struct Exports {
+    std::vector<double> ms;
+    std::vector<double> megabytes;
+    int failed = 0;
+};
+
+void exportLoop(int& port, double every, std::atomic<bool>& stop, Exports& out) {
+    auto next = Clock::now();
+    while (!stop) {
+        next += std::chrono::microseconds(static_cast<long>(every * 1e6));
+        while (!stop && Clock::now() < next) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        if (stop) break;
+        const auto start = Clock::now();
+        try {
+            asio::io_context io;
+            beast::tcp_stream stream(io);
+            stream.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(port)));
+            http::request<http::empty_body> request{http::verb::get, "/api/researcher/export?format=json", 11};
+            request.set(http::field::host, "127.0.0.1:" + std::to_string(port));
+            request.set(http::field::authorization, std::string("Bearer ") + kToken);
+            http::write(stream, request);
+            beast::flat_buffer buffer;
+            http::response_parser<http::string_body> parser;
+            parser.body_limit(boost::none);
+            http::read(stream, buffer, parser);
+            if (parser.get().result_int() != 200)
+                throw std::runtime_error("status " + std::to_string(parser.get().result_int()));
+            out.ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+            out.megabytes.push_back(static_cast<double>(parser.get().body().size()) / 1e6);
+        } catch (const std::exception&) {
+            ++out.failed; // the server was killed meanwhile (--kill-at)
+        }
+    }
+}
+
+// N participants who answered every trial, written through the store (joins) and one transaction (sessions and
+// answers) before the server starts.
+void prefill(const fs::path& db, int participants) {
+    {
+        StudyStore store(db);
+        for (int i = 0; i < participants; ++i) store.join("", "prefill-" + std::to_string(i));
+    }
+    SqliteDatabase sql(db.string(), false);
+    SqliteTransaction tx(sql);
+    sql.execute("INSERT INTO sessions (participant_id, started_at, user_agent, viewport_width, viewport_height,"
+                " device_pixel_ratio) SELECT id, created_at, 'Mozilla/5.0 (bench) prefill', 1920, 1080, 1.0"
+                " FROM participants");
+    sql.execute("INSERT INTO responses (trial_id, participant_id, session_id, chosen, side, response_ms, client_time,"
+                " server_time, viewport_width, viewport_height, device_pixel_ratio, user_agent)"
+                " SELECT t.id, t.participant_id, s.id, CASE WHEN t.id % 2 = 0 THEN 'A' ELSE 'B' END,"
+                " CASE WHEN t.a_on_left = (t.id % 2 = 0) THEN 'left' ELSE 'right' END, 900.0,"
+                " '2026-12-01T00:00:00.000Z', '2026-12-01T00:00:00.000Z', 1920, 1080, 1.0,"
+                " 'Mozilla/5.0 (bench) prefill' FROM trials t JOIN sessions s ON s.participant_id = t.participant_id");
+    tx.commit();
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -451,6 +574,9 @@ int main(int argc, char** argv) {
             std::string item;
             while (std::getline(list, item, ',')) o.killAt.push_back(std::stod(item));
         } else if (key == "--image-kib") o.imageKiB = std::stoi(value);
+        else if (key == "--export-every-s") o.exportEverySeconds = std::stod(value);
+        else if (key == "--prefill") o.prefill = std::stoi(value);
+        else if (key == "--idle-connections") o.idleConnections = std::stoi(value);
         else if (key == "--folder") o.folder = value;
         else if (key == "--server") o.server = value;
         else {
@@ -458,12 +584,19 @@ int main(int argc, char** argv) {
             return 2;
         }
     }
+    rlimit files{}; // every connection is a file descriptor here too
+    if (::getrlimit(RLIMIT_NOFILE, &files) == 0 && files.rlim_cur < files.rlim_max) {
+        files.rlim_cur = files.rlim_max;
+        ::setrlimit(RLIMIT_NOFILE, &files);
+    }
     fs::remove_all(o.folder);
     writeSet(o.folder / "stimuli", o.imageKiB);
     const fs::path design = o.folder / "design.toml";
     skinlab::writeFileAtomic(design, "title = \"Browser load\"\nseed = 3\nrepetitions = 2\n[catch]\nblank = 2\n");
     const fs::path db = o.folder / "study.db";
     createStudy(o.folder / "stimuli", design, {}, db);
+    if (o.prefill > 0) prefill(db, o.prefill);
+    const long prefilled = o.prefill > 0 ? StudyStore(db).responseCount() : 0;
 
     Server server;
     server.start(o, db, 0);
@@ -480,9 +613,17 @@ int main(int argc, char** argv) {
     std::atomic<bool> stop{false};
     std::atomic<int> slowCut{0};
     std::vector<std::shared_ptr<Participant>> participants;
+    // An idle-connection flood first (over 5 s), the participants 10 s later.
+    std::atomic<long> idleClosed{0};
+    std::vector<std::shared_ptr<IdleHolder>> idle;
+    for (int i = 0; i < o.idleConnections; ++i) {
+        idle.push_back(std::make_shared<IdleHolder>(io, i, port, stop, idleClosed));
+        idle.back()->start(5.0 * i / o.idleConnections);
+    }
+    const double lead = o.idleConnections > 0 ? 10 : 0;
     for (int i = 0; i < o.participants; ++i) {
         participants.push_back(std::make_shared<Participant>(io, o, i, port, stats, answered));
-        participants.back()->start(o.rampSeconds * i / std::max(1, o.participants));
+        participants.back()->start(lead + o.rampSeconds * i / std::max(1, o.participants));
     }
     std::vector<std::shared_ptr<SlowHeader>> slow;
     for (int i = 0; i < o.slowHeaders; ++i) {
@@ -493,6 +634,10 @@ int main(int argc, char** argv) {
     std::atomic<long> floodsRefused{0};
     std::vector<std::thread> floods;
     for (int i = 0; i < o.chunkedFloods; ++i) floods.emplace_back([&] { chunkedFlood(port, stop, floodsRefused); });
+    Exports exports;
+    std::thread researcher;
+    if (o.exportEverySeconds > 0)
+        researcher = std::thread([&] { exportLoop(port, o.exportEverySeconds, stop, exports); });
 
     // Kill -9 and restart at the given fractions of all answers; sample the server's RSS meanwhile.
     const long total = 22L * o.participants;
@@ -531,6 +676,7 @@ int main(int argc, char** argv) {
     ioThread.join();
     supervisor.join();
     for (auto& t : floods) t.join();
+    if (researcher.joinable()) researcher.join();
     server.kill(SIGTERM);
 
     // Every acknowledged answer stored exactly once, as acknowledged.
@@ -547,16 +693,21 @@ int main(int argc, char** argv) {
             else if (it->second != (side == "left")) ++mismatched;
         }
     }
-    const long stored = store.responseCount();
+    const long stored = store.responseCount() - prefilled;
     std::printf(
         "%.1f s: %ld/%d participants completed; %ld answers acknowledged, %ld stored (%ld lost, %ld stored "
-        "differently, %ld stored without acknowledgement); %d kills; %d HTTP errors, %d re-sent after no answer\n",
+        "differently, %ld stored without acknowledgement); %d kills; %d HTTP errors, %d re-sent after no answer (%d "
+        "of them: no connection)\n",
         seconds, completed, o.participants, acknowledged, stored, lost, mismatched, stored - acknowledged + lost, kills,
-        stats.errors, stats.retries);
+        stats.errors, stats.retries, stats.connectRetries);
     std::printf("statuses:");
     for (const auto& [status, n] : stats.statuses) std::printf(" %d×%d", status, n);
     std::printf("\nslow-header connections cut by the server: %d; chunked floods refused: %ld\n", slowCut.load(),
                 floodsRefused.load());
+    if (o.idleConnections > 0)
+        std::printf("idle connections: %d held open (reopened when closed), closed by the server %ld times; the "
+                    "participants started %.0f s after them\n",
+                    o.idleConnections, idleClosed.load(), lead);
     std::printf("| %d | %.0f–%.0f | %d | %d | %zu | %.1f | %.1f | %.1f | %.1f | %.1f | %.0f | %ld |\n", o.participants,
                 o.thinkMin, o.thinkMax, o.slowHeaders, o.chunkedFloods, stats.all.size(), percentile(stats.all, 50),
                 percentile(stats.all, 99), percentile(stats.answers, 50), percentile(stats.answers, 99),
@@ -564,6 +715,12 @@ int main(int argc, char** argv) {
     std::printf("image requests: %zu, ms p50 %.1f p90 %.1f p99 %.1f max %.1f\n", stats.images.size(),
                 percentile(stats.images, 50), percentile(stats.images, 90), percentile(stats.images, 99),
                 percentile(stats.images, 100));
+    if (o.exportEverySeconds > 0)
+        std::printf("researcher exports (JSON, every %.1f s, %ld answers prefilled): %zu downloaded, %d failed; ms p50 "
+                    "%.0f max %.0f; MB first %.1f last %.1f\n",
+                    o.exportEverySeconds, prefilled, exports.ms.size(), exports.failed, percentile(exports.ms, 50),
+                    percentile(exports.ms, 100), exports.megabytes.empty() ? 0.0 : exports.megabytes.front(),
+                    exports.megabytes.empty() ? 0.0 : exports.megabytes.back());
     std::printf(
         "(participants | think ms | slow headers | floods | requests | p50 all ms | p99 all ms | p50 answer ms | "
         "p99 answer ms | max ms | answers/s | server peak RSS MiB)\n");

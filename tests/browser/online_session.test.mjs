@@ -202,7 +202,8 @@ try {
   check(second.redirected && /\/complete\?cc=C1ABCDEF$/.test(second.url), `not redirected to the completion URL (${second.url})`);
   check(completions.length === 1 && completions[0] === `/complete?cc=${CODE}`, `platform saw ${JSON.stringify(completions)}`);
 
-  const exported = spawnSync(cli, ['study', 'export', database, '--format', 'json'], { encoding: 'utf8' });
+  const exported = spawnSync(cli, ['study', 'export', database, '--format', 'json', '--include-session-ids'],
+    { encoding: 'utf8' });
   check(exported.status === 0, 'export failed: ' + exported.stderr);
   const data = JSON.parse(exported.stdout);
   check(data.participants.length === 1, `${data.participants.length} participants, expected 1 (the same PROLIFIC_PID)`);

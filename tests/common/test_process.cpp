@@ -111,7 +111,7 @@ TEST(Process, ChildrenStartWithNoBlockedOrIgnoredSignals) {
 
     TempFolder folder;
     SpawnOptions options;
-    options.output = folder.path / "status.txt";
+    options.output = folder.path() / "status.txt";
     EXPECT_EQ(waitProcess(spawnProcess(findProgram("cat"), {"/proc/self/status"}, options)), 0);
     const std::string spawned = readAll(options.output);
     EXPECT_EQ(statusMask(spawned, "SigBlk"), 0u) << spawned;

@@ -14,6 +14,7 @@
 #include "experiments/study_backup.h"
 #include "experiments/study_export.h"
 #include "study_server_fixture.h"
+#include "store_answer.h"
 
 #include <arpa/inet.h>
 #include <atomic>
@@ -28,6 +29,7 @@
 #include <sys/stat.h>
 #include <thread>
 #include <unistd.h>
+#include <utility>
 
 using namespace skinlab::experiments;
 using namespace skinlab::experiments::test_support;
@@ -104,6 +106,43 @@ public:
             buffer_.append(chunk, static_cast<std::size_t>(n));
         }
     }
+    // Reads up to the end of a response's header (the bytes after it stay buffered); "" when none arrives in time.
+    std::string readHead(std::chrono::milliseconds timeout = 10s) {
+        const auto deadline = std::chrono::steady_clock::now() + timeout;
+        for (std::size_t end; (end = buffer_.find("\r\n\r\n")) == std::string::npos;)
+            if (!receive(deadline)) return "";
+        const std::size_t end = buffer_.find("\r\n\r\n") + 4;
+        std::string head = buffer_.substr(0, end);
+        buffer_.erase(0, end);
+        return head;
+    }
+    // A chunked body after readHead(): the size of each chunk in order, the body decoded; false when it does not
+    // arrive whole in time.
+    bool readChunks(std::vector<std::size_t>& sizes, std::string& body, std::chrono::milliseconds timeout = 20s) {
+        const auto deadline = std::chrono::steady_clock::now() + timeout;
+        while (true) {
+            std::size_t line;
+            while ((line = buffer_.find("\r\n")) == std::string::npos)
+                if (!receive(deadline)) return false;
+            const std::size_t size = std::stoul(buffer_.substr(0, line), nullptr, 16);
+            while (buffer_.size() < line + 2 + size + 2)
+                if (!receive(deadline)) return false;
+            if (size == 0) {
+                buffer_.erase(0, line + 4);
+                return true;
+            }
+            sizes.push_back(size);
+            body += buffer_.substr(line + 2, size);
+            buffer_.erase(0, line + 2 + size + 2);
+        }
+    }
+    // Everything until the server closes the connection (an HTTP/1.0 body without a length).
+    std::string readUntilClosed(std::chrono::milliseconds timeout = 20s) {
+        const auto deadline = std::chrono::steady_clock::now() + timeout;
+        while (receive(deadline)) {
+        }
+        return std::exchange(buffer_, std::string());
+    }
     // True when the server closed the connection (EOF or reset) within the timeout.
     bool closedByServer(std::chrono::milliseconds timeout) {
         pollfd p{fd_, POLLIN, 0};
@@ -113,6 +152,18 @@ public:
     }
 
 private:
+    bool receive(std::chrono::steady_clock::time_point deadline) {
+        const auto left =
+            std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+        pollfd p{fd_, POLLIN, 0};
+        if (left.count() <= 0 || ::poll(&p, 1, static_cast<int>(left.count())) <= 0) return false;
+        char chunk[65536];
+        const ssize_t n = ::recv(fd_, chunk, sizeof chunk, 0);
+        if (n <= 0) return false;
+        buffer_.append(chunk, static_cast<std::size_t>(n));
+        return true;
+    }
+
     int fd_ = -1;
     bool connected_ = false;
     std::string buffer_;
@@ -1024,4 +1075,166 @@ TEST(HostileRequests, FramingTransferCodingsSlowBodiesAndFormulaCells) {
     EXPECT_EQ(csvTextField("@SUM(1)"), "'@SUM(1)");
     EXPECT_EQ(csvTextField("+1"), "'+1");
     EXPECT_EQ(csvTextField("P001"), "P001");
+}
+
+// The researcher's export is streamed from a snapshot: chunks of bounded size, produced as the client reads them,
+// from a read transaction of its own, so answers go on while it is read (none of them in it), and memory holds one
+// piece whatever the study's size.
+TEST(HostileRequests, ExportsStreamInBoundedChunksFromASnapshotWhileAnswersGoOn) {
+    Hostile h;
+    StudyStore& store = h.study.store();
+    // Enough answers for several pieces of JSON.
+    for (int i = 0; i < 14; ++i) {
+        const ParticipantRecord p = store.join("", "bulk-" + std::to_string(i));
+        const std::int64_t session = store.startSession(p.id, "test", 1280, 800, 1.0);
+        while (const auto trial = store.nextTrial(p.id)) store.recordResponse(storeAnswer(p, session, *trial, "left"));
+    }
+    HttpClient client = h.study.client();
+    Participant late = joinAndStart(client);
+    const std::int64_t before = store.responseCount();
+    const std::string authorization = "Authorization: Bearer " + std::string(kResearcherToken) + "\r\n";
+    for (const std::string format : {"json", "csv"}) {
+        RawSocket reader(h.study.port());
+        ASSERT_TRUE(reader.send("GET /api/researcher/export?format=" + format + " HTTP/1.1\r\nHost: " + h.host +
+                                "\r\n" + authorization + "\r\n"));
+        const std::string head = reader.readHead();
+        ASSERT_EQ(statusOf(head), 200) << head;
+        EXPECT_NE(head.find("Transfer-Encoding: chunked"), std::string::npos) << head;
+        EXPECT_EQ(head.find("Content-Length"), std::string::npos) << head;
+        // The export has begun (its snapshot is taken): an answer now is acknowledged and stored, and not in it.
+        const JsonAnswer answered =
+            postJson(client, "/api/response", answerBody(late, late.state["trial"]["id"], "left"));
+        ASSERT_EQ(answered.status, 200) << answered.raw;
+        late.state = answered.body;
+        std::vector<std::size_t> sizes;
+        std::string body;
+        ASSERT_TRUE(reader.readChunks(sizes, body)) << format;
+        EXPECT_GE(sizes.size(), format == "json" ? 3u : 1u) << format << ": " << body.size() << " bytes in one piece";
+        for (const std::size_t size : sizes) EXPECT_LE(size, ResponseExport::kPieceBytes + 8192) << format;
+        const std::int64_t inSnapshot = store.responseCount() - 1;
+        if (format == "json") {
+            const json exported = json::parse(body);
+            EXPECT_EQ(static_cast<std::int64_t>(exported["responses"].size()), inSnapshot);
+        } else {
+            EXPECT_EQ(std::count(body.begin(), body.end(), '\n'), inSnapshot + 1) << "header and one line per answer";
+        }
+        // The connection stays usable after the last chunk (kept alive).
+        ASSERT_TRUE(reader.send("GET /api/study HTTP/1.1\r\nHost: " + h.host + "\r\n\r\n"));
+        EXPECT_EQ(statusOf(reader.readResponse()), 200);
+    }
+    EXPECT_EQ(store.responseCount(), before + 2);
+    // The stream as a whole is the export as a library call makes it, in every format.
+    for (const std::string format : {"json", "csv", "pwcmp"}) {
+        RawSocket reader(h.study.port());
+        ASSERT_TRUE(reader.send("GET /api/researcher/export?format=" + format + " HTTP/1.1\r\nHost: " + h.host +
+                                "\r\n" + authorization + "\r\n"));
+        ASSERT_EQ(statusOf(reader.readHead()), 200);
+        std::vector<std::size_t> sizes;
+        std::string body;
+        ASSERT_TRUE(reader.readChunks(sizes, body));
+        EXPECT_EQ(body, exportResponses(store, format)) << format;
+    }
+    // HTTP/1.0 has no chunks: the body ends with the connection. HEAD: the header alone.
+    {
+        RawSocket reader(h.study.port());
+        ASSERT_TRUE(reader.send("GET /api/researcher/export?format=csv HTTP/1.0\r\nHost: " + h.host + "\r\n" +
+                                authorization + "\r\n"));
+        const std::string response = reader.readUntilClosed();
+        EXPECT_EQ(statusOf(response), 200) << response.substr(0, 300);
+        EXPECT_EQ(response.find("chunked"), std::string::npos);
+        EXPECT_EQ(bodyOf(response), exportResponses(store, "csv"));
+    }
+    {
+        RawSocket reader(h.study.port());
+        ASSERT_TRUE(
+            reader.send("HEAD /api/researcher/export HTTP/1.1\r\nHost: " + h.host + "\r\n" + authorization + "\r\n"));
+        EXPECT_EQ(statusOf(reader.readHead()), 200);
+        ASSERT_TRUE(reader.send("GET /api/study HTTP/1.1\r\nHost: " + h.host + "\r\n\r\n"));
+        EXPECT_EQ(statusOf(reader.readResponse()), 200) << "the HEAD answer carried a body";
+    }
+    h.expectRejected("include_session_ids=yes", 400, [&] {
+        return h.request("GET", "/api/researcher/export?include_session_ids=yes", "", authorization);
+    });
+}
+
+// Idle connections from many addresses, each under its cap, can fill every connection slot: a newcomer is still
+// served (a connection idle long, of the network holding the most, makes room), and when every slot is in the middle of a request the newcomer
+// waits in the listen backlog until one is free — never a 429 meant for a single flooding network.
+TEST(HostileRequests, IdleConnectionsFromManyAddressesNeverKeepANewcomerOut) {
+    // A real HttpServer with few slots: 48 in all, 8 per address, the last 8 (or none) kept for newcomers.
+    struct SmallServer {
+        HttpServer server;
+        int port;
+        std::thread serving;
+        explicit SmallServer(int reserve)
+            : server([](const HttpRequest&) { return HttpResponse{200, "text/plain", {}, "ok", nullptr, {}}; },
+                     limits(reserve)),
+              port(server.bind("127.0.0.1", 0)), serving([this] { server.run(); }) {}
+        ~SmallServer() {
+            server.stop();
+            serving.join();
+        }
+        static HttpLimits limits(int reserve) {
+            HttpLimits l;
+            l.maxConnections = 48;
+            l.reserveConnections = reserve;
+            l.connectionsPerClient = 8;
+            l.requestTimeout = 30s;
+            return l;
+        }
+        void waitForOpen(int n) {
+            for (int i = 0; i < 500 && server.openConnections() != n; ++i) std::this_thread::sleep_for(10ms);
+        }
+    };
+    const std::string request = "GET / HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n";
+    {
+        // A participant's kept-alive connection, then six addresses with 8 idle connections each (the last 7):
+        // every slot (48) taken, none of them over its cap.
+        SmallServer small(8);
+        RawSocket participant(small.port, "127.0.5.1");
+        ASSERT_TRUE(participant.send(request));
+        ASSERT_EQ(statusOf(participant.readResponse(5s)), 200);
+        std::vector<std::unique_ptr<RawSocket>> idle;
+        for (int address = 1; address <= 6; ++address)
+            for (int k = 0; k < (address < 6 ? 8 : 7); ++k) {
+                idle.push_back(std::make_unique<RawSocket>(small.port, ("127.0.1." + std::to_string(address)).c_str()));
+                ASSERT_TRUE(idle.back()->connected());
+                std::this_thread::sleep_for(5ms); // an order of age
+            }
+        std::this_thread::sleep_for(300ms);
+        EXPECT_LE(small.server.openConnections(), 48);
+        for (int newcomer = 1; newcomer <= 3; ++newcomer) {
+            RawSocket fresh(small.port, ("127.0.2." + std::to_string(newcomer)).c_str());
+            ASSERT_TRUE(fresh.send(request));
+            EXPECT_EQ(statusOf(fresh.readResponse(5s)), 200) << "newcomer " << newcomer;
+        }
+        // The flooding networks' connections idle longest made room; the youngest are still open and served, and
+        // so is the participant's, although it waited longer than any: its network holds one connection.
+        EXPECT_TRUE(idle.front()->closedByServer(2s));
+        ASSERT_TRUE(idle.back()->send(request));
+        EXPECT_EQ(statusOf(idle.back()->readResponse(5s)), 200);
+        ASSERT_TRUE(participant.send(request));
+        EXPECT_EQ(statusOf(participant.readResponse(5s)), 200);
+    }
+    {
+        // Every slot in the middle of a request (headers begun, not finished): nothing idle to close. A newcomer's
+        // connection waits in the listen backlog, unanswered, and is served as soon as a slot is free.
+        SmallServer small(0);
+        std::vector<std::unique_ptr<RawSocket>> busy;
+        for (int address = 1; address <= 6; ++address)
+            for (int k = 0; k < 8; ++k) {
+                busy.push_back(std::make_unique<RawSocket>(small.port, ("127.0.3." + std::to_string(address)).c_str()));
+                ASSERT_TRUE(busy.back()->send("GET / HTTP/1.1\r\n"));
+            }
+        small.waitForOpen(48);
+        EXPECT_EQ(small.server.openConnections(), 48);
+        RawSocket waiting(small.port, "127.0.4.1");
+        ASSERT_TRUE(waiting.connected());
+        ASSERT_TRUE(waiting.send(request));
+        EXPECT_EQ(waiting.readResponse(1s), "") << "answered while every slot was busy";
+        ASSERT_TRUE(busy.front()->send("Host: 127.0.0.1\r\n\r\n"));
+        EXPECT_EQ(statusOf(busy.front()->readResponse(5s)), 200);
+        busy.erase(busy.begin()); // closes it: a slot is free
+        EXPECT_EQ(statusOf(waiting.readResponse(5s)), 200);
+    }
 }

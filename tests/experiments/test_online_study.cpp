@@ -174,8 +174,27 @@ TEST(OnlineStudy, ProlificIdsRoundTripResumeAndRedirect) {
     for (const std::string& id : {kPid, kStudyId, kSessionId})
         EXPECT_EQ(participantAnswers.find(id), std::string::npos) << "the participant API shows a platform id";
 
-    // Every export format carries the ids, the viewing conditions and the flags.
-    const std::vector<std::string> csv = csvLines(exportResponses(study.store(), "csv"));
+    // Every export format carries the ids, the viewing conditions and the flags — but the platform's session id (it
+    // resumes the participation) only when asked for.
+    for (const std::string format : {"csv", "pwcmp", "json"}) {
+        const std::string text = exportResponses(study.store(), format);
+        EXPECT_EQ(text.find(kSessionId), std::string::npos) << format << ": the session id is exported by default";
+        EXPECT_EQ(text.find("external_session_id"), std::string::npos) << format;
+        EXPECT_NE(text.find(kPid), std::string::npos) << format;
+    }
+    // The researcher's export over HTTP likewise: the session ids only with include_session_ids=1.
+    const HttpHeaders researcher{{"Authorization", "Bearer " + std::string(kResearcherToken)}};
+    for (const std::string format : {"csv", "pwcmp", "json"}) {
+        const JsonAnswer plain = get(client, "/api/researcher/export?format=" + format, researcher);
+        EXPECT_EQ(plain.status, 200) << plain.raw;
+        EXPECT_EQ(plain.raw.find(kSessionId), std::string::npos) << format << ": " << plain.raw;
+        EXPECT_NE(plain.raw.find(kPid), std::string::npos) << format;
+        const JsonAnswer asked =
+            get(client, "/api/researcher/export?format=" + format + "&include_session_ids=1", researcher);
+        EXPECT_EQ(asked.raw, exportResponses(study.store(), format, {.includeSessionIds = true})) << format;
+        EXPECT_NE(asked.raw.find(kSessionId), std::string::npos) << format;
+    }
+    const std::vector<std::string> csv = csvLines(exportResponses(study.store(), "csv", {.includeSessionIds = true}));
     ASSERT_EQ(csv.size(), 9u);
     EXPECT_EQ(csv[0].rfind(
                   "observer,scene,condition_A,condition_B,is_A_selected,A_on_left,trial_kind,correct,response_ms,", 0),
@@ -197,7 +216,7 @@ TEST(OnlineStudy, ProlificIdsRoundTripResumeAndRedirect) {
     ASSERT_GE(pwcmp.size(), 2u);
     EXPECT_EQ(pwcmp[0].rfind("observer,scene,condition_A,condition_B,is_A_selected,flagged,", 0), 0u);
     EXPECT_EQ(fieldOf(pwcmp[1], columnOf(pwcmp[0], "external_id")), kPid);
-    const json exported = json::parse(exportResponses(study.store(), "json"));
+    const json exported = json::parse(exportResponses(study.store(), "json", {.includeSessionIds = true}));
     EXPECT_EQ(exported["participants"][0]["recruitment"]["external_id"], kPid);
     EXPECT_EQ(exported["participants"][0]["recruitment"]["external_session_id"], kSessionId);
     ASSERT_EQ(exported["sessions"].size(), 2u);

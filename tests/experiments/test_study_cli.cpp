@@ -634,4 +634,42 @@ TEST(StudyCli, WeakResearcherTokensAreRefused) {
     EXPECT_TRUE(ok && first.rfind("serving ", 0) == 0) << first;
     server.kill(SIGTERM);
     server.wait();
+// Exports hold personal data and, unless asked for, never the platform's session id (Prolific SESSION_ID, MTurk
+// assignmentId): with it anyone who reads the file resumes an unfinished participation. Every format, written with
+// -o under the usual umask, is readable by its owner only; --include-session-ids adds the ids.
+TEST(StudyCli, ExportsArePrivateAndLeaveOutSessionIds) {
+    StudyFiles files;
+    skinlab::writeFileAtomic(files.design, std::string(kDesign) + "[recruitment]\nplatform = \"prolific\"\n");
+    ASSERT_EQ(files.create(), 0);
+    const std::string sessionId = "60bb1b2c3d4e5f6a7b8c9d22";
+    {
+        StudyStore store(files.database);
+        const ParticipantRecord p = store.join(
+            "", "key-1", ExternalIds{"prolific", "5f8a1b2c3d4e5f6a7b8c9d0e", "60aa1b2c3d4e5f6a7b8c9d11", sessionId});
+        const std::int64_t session = store.startSession(p.id, "test", 1280, 800, 1.0);
+        for (int i = 0; i < 3; ++i)
+            store.recordResponse(storeAnswer(p, session, *store.nextTrial(p.id), i % 2 ? "left" : "right"));
+    }
+    const mode_t previous = ::umask(022);
+    for (const std::string format : {"csv", "pwcmp", "json"}) {
+        for (const bool asked : {false, true}) {
+            const fs::path file = files.folder.path() / ("export-" + std::to_string(asked) + "." + format);
+            std::vector<std::string> arguments{"study", "export",     files.database.string(), "--format", format,
+                                               "-o",    file.string()};
+            if (asked) arguments.push_back("--include-session-ids");
+            const CommandResult exported = runSkinlab(arguments);
+            ASSERT_EQ(exported.exitCode, 0) << exported.err;
+            EXPECT_EQ(fs::status(file).permissions() & fs::perms::all, fs::perms::owner_read | fs::perms::owner_write)
+                << file;
+            const std::string text = skinlab::readFile(file);
+            EXPECT_NE(text.find("5f8a1b2c3d4e5f6a7b8c9d0e"), std::string::npos) << format << ": " << text;
+            if (format == "pwcmp") continue; // the three answers may all be practice or catch trials
+            EXPECT_EQ(text.find(sessionId) != std::string::npos, asked) << format << ": " << text;
+            EXPECT_EQ(text.find("external_session_id") != std::string::npos, asked) << format;
+        }
+    }
+    // Standard output carries the same (the researcher chooses where it goes).
+    const CommandResult printed = runSkinlab({"study", "export", files.database.string(), "--format", "csv"});
+    EXPECT_EQ(printed.out, skinlab::readFile(files.folder.path() / "export-0.csv"));
+    ::umask(previous);
 }
