@@ -72,7 +72,8 @@ void bootstrapAgreement(PredictionAgreement& a, const std::vector<int>& used, co
     a.overConditions = static_cast<int>(used.size()) >= agreement::kFewConditions;
     scaling::FitOptions fit = options.fit;
     fit.model = scaling::Model::Thurstone;
-    std::vector<double> slopes, rmses;
+    // `noise`: each resample's RMSE about the full data's scores (every condition once), what noise alone gives.
+    std::vector<double> slopes, rmses, noise;
     for (int b = 0; b < options.samples; ++b) {
         std::mt19937_64 random(scaling::mixSeed(options.seed, static_cast<std::uint64_t>(b)));
         std::uniform_int_distribution<int> pick(0, observers - 1);
@@ -90,12 +91,27 @@ void bootstrapAgreement(PredictionAgreement& a, const std::vector<int>& used, co
         const auto [slope, rmse] = slopeAndRmse(x, y);
         slopes.push_back(slope);
         rmses.push_back(rmse);
+        std::vector<double> full, resampled;
+        for (const int k : used) full.push_back(block.thurstone.scores[k]), resampled.push_back(scores[k]);
+        noise.push_back(slopeAndRmse(full, resampled).second);
     }
     std::tie(a.slopeLow, a.slopeHigh) = bootstrapInterval(a.slope, slopes, observers, options.level, false);
     // The RMSE includes the measurement noise, which inflates it: its bootstrap bias is removed; never below 0.
     std::tie(a.rmseLow, a.rmseHigh) = bootstrapInterval(a.rmse, rmses, observers, options.level, true);
     a.rmseLow = std::max(a.rmseLow, 0.0);
     a.rmseHigh = std::max(a.rmseHigh, 0.0);
+    // At its boundary (a true RMSE of 0) that interval alone starts above 0 too often: in 13–17 % of simulated
+    // 5-condition studies whose truth was the prediction (10 and 20 observers). A test of RMSE = 0 also decides the
+    // low end: where the RMSE stays below what noise alone reaches in `level` of the resamples (their RMSE about
+    // the full data's scores, scaled by √(n/(n − 1)) for n observers), the interval starts at 0.
+    std::erase_if(noise, [](double v) { return !std::isfinite(v); });
+    if (noise.size() >= 20 && std::isfinite(a.rmse)) {
+        std::sort(noise.begin(), noise.end());
+        const auto index = static_cast<std::size_t>(std::ceil(options.level * double(noise.size()))) - 1;
+        const double scale = std::sqrt(double(observers) / double(observers - 1));
+        if (a.rmse <= scale * noise[std::min(index, noise.size() - 1)]) a.rmseLow = 0.0;
+        a.rmseHigh = std::max(a.rmseHigh, a.rmseLow);
+    }
     a.bootstrapSamples = options.samples;
 }
 

@@ -31,7 +31,8 @@ struct PredictionAgreement {
     // Least squares of measured on predicted with an intercept (the measured scale's zero is arbitrary); RMSE of
     // measured − predicted about their mean difference (n − 1 degrees of freedom). Intervals: bootstrap over
     // observers (each resample re-fits the scale; ± t·sd with the small-sample factor, the RMSE's bias removed),
-    // and over conditions too from kFewConditions conditions (`overConditions`); NaN without two observers.
+    // and over conditions too from kFewConditions conditions (`overConditions`); the RMSE's starts at 0 where a
+    // bootstrap test of RMSE = 0 does not reject; NaN without two observers.
     double slope = 0.0, slopeLow = 0.0, slopeHigh = 0.0;
     double rmse = 0.0, rmseLow = 0.0, rmseHigh = 0.0;
     bool overConditions = false;

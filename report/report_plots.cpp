@@ -136,6 +136,49 @@ std::string scaleSvg(const std::vector<IntervalPoint>& points) {
     return svg + "</svg>";
 }
 
+namespace {
+
+// A point's label: anchored beside the point, on the side with room.
+struct PointLabel {
+    double x = 0.0, y = 0.0;
+    bool leftSide = false;
+    std::string text;
+};
+
+// Moves labels whose boxes would overlap an earlier one up or down in steps of a line (11 px), the nearest free
+// place first, within [top, bottom] (boxes: 10 px high, 6 px a character at the labels' 10 px font).
+void separateLabels(std::vector<PointLabel>& labels, double top, double bottom) {
+    auto extent = [](const PointLabel& l, double& from, double& to) {
+        std::size_t characters = 0;
+        for (unsigned char c : l.text) characters += (c & 0xC0) != 0x80; // UTF-8 code points
+        const double width = 6.0 * double(characters);
+        from = l.leftSide ? l.x - width : l.x;
+        to = l.leftSide ? l.x : l.x + width;
+    };
+    for (std::size_t i = 0; i < labels.size(); ++i) {
+        const double original = labels[i].y;
+        auto overlaps = [&](double y) {
+            double from = 0.0, to = 0.0;
+            extent(labels[i], from, to);
+            for (std::size_t j = 0; j < i; ++j) {
+                double otherFrom = 0.0, otherTo = 0.0;
+                extent(labels[j], otherFrom, otherTo);
+                if (to > otherFrom && otherTo > from && std::abs(y - labels[j].y) < 10.0) return true;
+            }
+            return false;
+        };
+        for (int step = 0; step <= 16; ++step) {
+            const double y = original + (step % 2 == 1 ? 1.0 : -1.0) * 11.0 * double((step + 1) / 2);
+            if (y >= top && y <= bottom && !overlaps(y)) {
+                labels[i].y = y;
+                break;
+            }
+        }
+    }
+}
+
+} // namespace
+
 std::string scatterSvg(const std::vector<ScatterPoint>& points, const std::string& xLabel,
                        const ScatterOptions& options) {
     const double left = 52.0, right = 330.0, top = 14.0, bottom = 212.0;
@@ -176,6 +219,7 @@ std::string scatterSvg(const std::vector<ScatterPoint>& points, const std::strin
     if (options.identity)
         svg += "<line x1=\"" + px(left) + "\" y1=\"" + px(bottom) + "\" x2=\"" + px(right) + "\" y2=\"" + px(top) +
                "\" class=\"identity\"><title>measured = predicted</title></line>";
+    std::vector<PointLabel> labels;
     for (const auto& p : points) {
         if (!std::isfinite(p.x) || !std::isfinite(p.y)) continue;
         double x = rx.map(p.x, left, right);
@@ -199,9 +243,13 @@ std::string scatterSvg(const std::vector<ScatterPoint>& points, const std::strin
         // Labels on the side with room: left of points in the right part of the plot, so none runs off the figure.
         const bool leftSide = x > left + 0.6 * (right - left);
         svg += "<circle cx=\"" + px(x) + "\" cy=\"" + px(y) + "\" r=\"4\" class=\"dot\"><title>" + escapeHtml(p.label) +
-               "</title></circle><text x=\"" + px(leftSide ? x - 6 : x + 6) + "\" y=\"" + px(std::max(y - 6, top + 8)) +
-               "\" class=\"point\"" + (leftSide ? " text-anchor=\"end\"" : "") + ">" + escapeHtml(p.label) + "</text>";
+               "</title></circle>";
+        labels.push_back({leftSide ? x - 6 : x + 6, std::max(y - 6, top + 8), leftSide, p.label});
     }
+    separateLabels(labels, top + 8, bottom);
+    for (const PointLabel& l : labels)
+        svg += "<text x=\"" + px(l.x) + "\" y=\"" + px(l.y) + "\" class=\"point\"" +
+               (l.leftSide ? " text-anchor=\"end\"" : "") + ">" + escapeHtml(l.text) + "</text>";
     return svg + "</svg>";
 }
 

@@ -821,8 +821,10 @@ void writeAgreement(std::ostringstream& html, const ReportData& r) {
             << num(100.0 * agreementOptions.level, 0)
             << " % Fisher z over the conditions (Spearman: Bonett–Wright), widened by the variance of a bootstrap "
                "over observers ("
-            << agreementOptions.samples
-            << " resamples, the scale re-fitted each time). p: no association, exact over every ordering of up to 8 "
+            << agreementOptions.samples << " resamples, the scale re-fitted each time); below "
+            << agreement::kFewConditions
+            << " conditions Spearman's interval also spans its exact interval, so that it excludes 0 only where the "
+               "exact p does. p: no association, exact over every ordering of up to 8 "
                "conditions; Holm: corrected over the block's metrics. Pairs: of the pairs the "
                "observers separated significantly, how many the metric orders the same way (ties count as not). "
                "Also in agreement.csv and agreement.json.</p>\n";

@@ -441,6 +441,11 @@ nlohmann::json agreementJson(const AgreementResult& result) {
                         {"predicted_pairs", row.predictedPairs},
                         {"predicted_share", jsonNumber(row.predictedShare)},
                         {"bootstrap_samples", row.bootstrapSamples}});
+    const char* interval =
+        "Fisher z over the conditions (Spearman: Bonett-Wright variance), widened by the variance of "
+        "atanh(r) over a bootstrap of the observers (Thurstone scale re-fitted per resample); "
+        "Spearman below 8 conditions: the hull of that and the exact interval (consistent with the "
+        "exact p)";
     return {{"format", "skinlab-agreement"},
             {"version", 1},
             {"skinlab_version", version()},
@@ -448,8 +453,7 @@ nlohmann::json agreementJson(const AgreementResult& result) {
              {{"bootstrap_samples", result.options.samples},
               {"seed", result.options.seed},
               {"level", result.options.level},
-              {"interval", "Fisher z over the conditions (Spearman: Bonett-Wright variance), widened by the variance "
-                           "of atanh(r) over a bootstrap of the observers (Thurstone scale re-fitted per resample)"},
+              {"interval", interval},
               {"p_value", "two-sided, no association: exact over all orderings of the conditions up to 8, else Fisher "
                           "z; spearman_p_holm: Holm over the block's metrics"},
               {"correlation_sign", "raw: metric against JOD (an error metric that agrees with observers correlates "

@@ -84,6 +84,11 @@ for (const file of ['scale.json', 'agreement.json', 'agreement.csv', 'metrics/me
 const agreement = JSON.parse(fs.readFileSync(path.join(reportDir, 'agreement.json'), 'utf8'));
 check(agreement.agreement.some((row) => row.metric === 'image.flip_mean' && row.conditions === 4),
   'agreement.json has FLIP over the 4 conditions');
+// Few conditions: Spearman's interval excludes 0 only where its exact p is below 0.05, and the settings say so.
+check(agreement.agreement.every((row) => row.spearman_low === null || row.spearman_p === null ||
+  row.spearman_p <= 0.05 || (row.spearman_low <= 0 && row.spearman_high >= 0)),
+  'agreement.json: a Spearman interval excludes 0 only with exact p <= 0.05');
+check(/exact interval/.test(agreement.settings.interval), 'agreement.json settings name the exact interval');
 // The same agreement tables without a report, from the report's metrics folder.
 run(['analyze', 'agreement', database, '--metrics', path.join(reportDir, 'metrics'), '-o', path.join(work, 'agreement'),
   '--bootstrap', '200']);
@@ -146,6 +151,12 @@ try {
     'findings name the best metric, with its p corrected for the choice');
   check(/Predicted and measured/.test(facts.text) && /anchor/.test(facts.text),
     'the predicted-and-measured section (the set records ColorVideoVDP predictions)');
+  check(/Slope [−\d.]+ \[[−\d.]+, [−\d.]+\], RMSE [\d.]+ JOD \[[\d.]+, [\d.]+\]/.test(facts.text),
+    'slope and RMSE of predicted against measured, each with its interval');
+  check(/exact p = [\d.]+, over 4 conditions/.test(facts.text), "Spearman's exact p over the block's 4 conditions");
+  check(/the agreement below is circular/.test(facts.text), 'simulated observers: the circularity is stated');
+  check(/Spearman's interval also spans its exact interval/.test(facts.text),
+    "the agreement section says how Spearman's interval is made at few conditions");
   check(/scale 0–/.test(facts.text), 'heat maps print their colour scale');
   check(/Simulated observers\./.test(facts.text), 'the banner says the observers were simulated');
   check(/Which face looks more like real skin\?/.test(facts.text), 'the question is shown');

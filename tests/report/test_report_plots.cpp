@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <limits>
+#include <regex>
 
 namespace skinlab::report {
 namespace {
@@ -86,6 +87,39 @@ TEST(ReportPlots, ScatterMarksClippedBarsAndKeepsLabelsInside) {
     EXPECT_NE(svg.find("interval continues to 200.00 JOD"), std::string::npos);
     EXPECT_NE(svg.find("text-anchor=\"end\">gaussian-sum</text>"), std::string::npos) << svg;
     EXPECT_NE(svg.find("class=\"point\">none</text>"), std::string::npos);
+}
+
+TEST(ReportPlots, ScatterLabelsDoNotOverlap) {
+    // The demo's patches block: gaussian-sum and separable 0.17 JOD apart on x and 0.02 on y. Each label's box (10 px
+    // high, at most 6 px a character at the labels' 10 px font) must not overlap another's.
+    std::vector<ScatterPoint> points = {{"bleed-patches-none", 0.0, -0.13, -0.42, 0.16},
+                                        {"bleed-patches-gaussian-sum", -1.07, -1.01, -1.29, -0.72},
+                                        {"bleed-patches-separable", -0.90, -0.99, -1.24, -0.74},
+                                        {"bleed-patches-artistic", -0.35, -0.35, -0.61, -0.09},
+                                        {"bleed-patches-pscbf", -1.83, -1.68, -1.97, -1.39}};
+    ScatterOptions options;
+    options.identity = true;
+    const std::string svg = scatterSvg(points, "predicted", options);
+    struct Box {
+        double left, right, y;
+    };
+    std::vector<Box> boxes;
+    const std::regex label(
+        R"re(<text x="([-0-9.]+)" y="([-0-9.]+)" class="point"( text-anchor="end")?>([^<]*)</text>)re");
+    for (auto it = std::sregex_iterator(svg.begin(), svg.end(), label); it != std::sregex_iterator(); ++it) {
+        const double x = std::stod((*it)[1]), width = 6.0 * double((*it)[4].length());
+        boxes.push_back({(*it)[3].matched ? x - width : x, (*it)[3].matched ? x : x + width, std::stod((*it)[2])});
+        EXPECT_GE(boxes.back().y, 14.0 + 8.0) << (*it)[4];
+        EXPECT_LE(boxes.back().y, 212.0) << (*it)[4];
+    }
+    ASSERT_EQ(boxes.size(), points.size()) << svg;
+    for (std::size_t i = 0; i < boxes.size(); ++i)
+        for (std::size_t j = i + 1; j < boxes.size(); ++j) {
+            const bool sideBySide = boxes[i].right <= boxes[j].left || boxes[j].right <= boxes[i].left;
+            EXPECT_TRUE(sideBySide || std::abs(boxes[i].y - boxes[j].y) >= 10.0)
+                << points[i].label << " and " << points[j].label << " overlap\n"
+                << svg;
+        }
 }
 
 TEST(ReportPlots, NumbersNeverShowNan) {
