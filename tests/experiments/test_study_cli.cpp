@@ -634,6 +634,8 @@ TEST(StudyCli, WeakResearcherTokensAreRefused) {
     EXPECT_TRUE(ok && first.rfind("serving ", 0) == 0) << first;
     server.kill(SIGTERM);
     server.wait();
+}
+
 // Exports hold personal data and, unless asked for, never the platform's session id (Prolific SESSION_ID, MTurk
 // assignmentId): with it anyone who reads the file resumes an unfinished participation. Every format, written with
 // -o under the usual umask, is readable by its owner only; --include-session-ids adds the ids.
