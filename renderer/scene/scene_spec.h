@@ -73,7 +73,7 @@ struct EnvironmentSpec {
 // render.ssaa_factor: its default (samples per pixel along each axis) and range; the internal size (image size ×
 // factor) stays within kMaxInternalSize, the texture size every GL 4.5 driver the project meets supports (Mesa
 // llvmpipe: 16384).
-inline constexpr int kDefaultSsaaFactor = 3;
+inline constexpr int kDefaultSsaaFactor = 2;
 inline constexpr int kMaxSsaaFactor = 8;
 inline constexpr int kMaxInternalSize = 16384;
 // EEVEE's pixel filter with render.antialiasing = "ssaa" (render.filter_size, px). EEVEE (Blender 2.8–4.1) jitters
