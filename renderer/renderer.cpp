@@ -784,10 +784,9 @@ RenderResult Renderer::render(const RenderRequest& request) {
     const auto writeStart = std::chrono::steady_clock::now();
     bool fractionalSkin = !spec.textures.skinMask.empty();
     for (const Vertex& v : frame.model->vertices) fractionalSkin = fractionalSkin || v.skin < 1.0f;
-    // Anti-aliasing: Blender's depth pass averages the box filter's samples (a silhouette pixel mixes the surface's
-    // depth with the background's 1e10) and its material index pass keeps the first hit, so the depth and mask
-    // of the rasterizer's resolve (same camera and triangles: nearest depth, skin coverage) replace them, and
-    // every method's AOVs mean the same.
+    // Anti-aliasing: Blender's depth and material-index passes do not follow its box filter's coverage (the index
+    // pass keeps the first hit), so the depth and mask of the rasterizer's resolve (same camera and triangles:
+    // nearest depth, skin coverage) replace them, and every method's AOVs mean the same.
     const bool rasterizerDepthAndMask = cycles && frame.ssaaFactor > 1;
     if (rasterizerDepthAndMask) {
         cycles->depth = readBack[aovIndex("depth")];
