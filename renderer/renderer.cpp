@@ -16,6 +16,7 @@
 #include "renderer/gl/gpu_timer.h"
 #include "renderer/gl/main_pass.h"
 #include "renderer/gl/reference_method.h"
+#include "renderer/gl/resolve_pass.h"
 #include "renderer/gl/shader_library.h"
 #include "renderer/gl/shadow_map_pass.h"
 #include "renderer/gl/sss_stage.h"
@@ -107,6 +108,12 @@ struct Frame {
     std::shared_ptr<const Model> model;
     std::vector<gl::GpuMaterial> partMaterials; // one per part of the model
     gl::GpuScene* scene = nullptr;
+    // The passes run at the internal size: the output size × the supersampling factor (1 without anti-aliasing);
+    // the camera's focal length in pixels is the internal one, so every mm → pixel conversion of the passes (SSS
+    // kernels, transmittance, the reference) follows the internal grid while the kernels stay the same in mm.
+    int width = 0;
+    int height = 0;
+    int ssaaFactor = 1;
     CameraPose camera;
     float exposure = 1.0f; // 2^exposure_ev
     glm::mat3 environmentFromWorld{1.0f};
@@ -136,7 +143,18 @@ struct Renderer::Impl {
     gl::SssStage sssStage{shaders};
     gl::ReferenceMethod referenceMethod{shaders}; // sss.method = "reference": replaces the SSS stage
     gl::AddSpecularPass addSpecularPass{shaders};
+    gl::ResolvePass resolvePass{shaders};
     gl::ToneMapPass toneMapPass{shaders};
+    // With anti-aliasing, the output-size layers the resolve pass writes (beauty, display and, for render() and
+    // renderDisplay's linear layers, the AOVs); without, `targets` is the output.
+    gl::FrameTargets resolvedTargets;
+    gl::FrameTargets& output(const Frame& frame) { return frame.ssaaFactor > 1 ? resolvedTargets : targets; }
+    // Resolves one layer of `targets` into the same layer of `resolvedTargets` (no-op without anti-aliasing).
+    void resolve(const Frame& frame, gl::Texture gl::FrameTargets::*layer, gl::ResolveMode mode) {
+        if (frame.ssaaFactor <= 1) return;
+        resolvePass.run(targets, (targets.*layer).get(), resolvedTargets, (resolvedTargets.*layer).get(),
+                        frame.ssaaFactor, mode);
+    }
 
     // renderDisplay's resident state: the uploaded scene and what the frame targets hold. render() uses its own
     // scene and overwrites the targets, so it clears `lightingKey`. Declared after the context: destroyed before it.
@@ -218,6 +236,13 @@ std::string Renderer::glVersion() const { return impl_->context.version(); }
 
 namespace {
 
+// The internal size the passes run at: the output size × render.ssaa_factor (× 1 without anti-aliasing).
+void setInternalSize(Frame& frame, const SceneSpec& spec) {
+    frame.ssaaFactor = spec.ssaaFactor;
+    frame.width = spec.width * spec.ssaaFactor;
+    frame.height = spec.height * spec.ssaaFactor;
+}
+
 // --- materials -----------------------------------------------------------------------------------------------
 // One GPU material per part of the model: the model's own materials with the scene's [[materials]] overrides.
 std::vector<gl::GpuMaterial> partMaterialsOf(const SceneSpec& spec, const Model& model) {
@@ -282,20 +307,23 @@ struct Aov {
     int textureChannels;                                 // 4: RGBA32F, 1: R32F
     std::vector<float> pathtraced::CyclesImage::*cycles; // nullptr: never from Cycles
     int cyclesChannels;                                  // components per pixel in the Cycles image
+    gl::ResolveMode resolve;                             // how anti-aliasing's samples combine (resolve.frag)
 };
 
+using gl::ResolveMode;
 const std::array<Aov, 11> kAovs{{
-    {"", "RGB", &gl::FrameTargets::beauty, 4, &pathtraced::CyclesImage::beauty, 3},
-    {"diffuse", "RGB", &gl::FrameTargets::scatteredDiffuse, 4, &pathtraced::CyclesImage::diffuse, 3},
-    {"specular", "RGB", &gl::FrameTargets::specular, 4, &pathtraced::CyclesImage::specular, 3},
-    {"albedo", "RGB", &gl::FrameTargets::albedo, 4, nullptr, 0},
-    {"depth", "Z", &gl::FrameTargets::linearDepth, 1, &pathtraced::CyclesImage::depth, 1},
-    {"normal", "XYZ", &gl::FrameTargets::normal, 4, nullptr, 0},
-    {"geonormal", "XYZ", &gl::FrameTargets::geometricNormal, 4, nullptr, 0},
-    {"mask", "Y", &gl::FrameTargets::mask, 1, &pathtraced::CyclesImage::mask, 1},
-    {"transmittance", "RGB", &gl::FrameTargets::transmittance, 4, nullptr, 0},
-    {"aux", "Y", &gl::FrameTargets::aux, 1, nullptr, 0},
-    {"curvature", "Y", &gl::FrameTargets::curvature, 1, nullptr, 0},
+    {"", "RGB", &gl::FrameTargets::beauty, 4, &pathtraced::CyclesImage::beauty, 3, ResolveMode::Average},
+    {"diffuse", "RGB", &gl::FrameTargets::scatteredDiffuse, 4, &pathtraced::CyclesImage::diffuse, 3,
+     ResolveMode::Average},
+    {"specular", "RGB", &gl::FrameTargets::specular, 4, &pathtraced::CyclesImage::specular, 3, ResolveMode::Average},
+    {"albedo", "RGB", &gl::FrameTargets::albedo, 4, nullptr, 0, ResolveMode::Average},
+    {"depth", "Z", &gl::FrameTargets::linearDepth, 1, &pathtraced::CyclesImage::depth, 1, ResolveMode::Nearest},
+    {"normal", "XYZ", &gl::FrameTargets::normal, 4, nullptr, 0, ResolveMode::CoveredDirection},
+    {"geonormal", "XYZ", &gl::FrameTargets::geometricNormal, 4, nullptr, 0, ResolveMode::CoveredDirection},
+    {"mask", "Y", &gl::FrameTargets::mask, 1, &pathtraced::CyclesImage::mask, 1, ResolveMode::Average},
+    {"transmittance", "RGB", &gl::FrameTargets::transmittance, 4, nullptr, 0, ResolveMode::Average},
+    {"aux", "Y", &gl::FrameTargets::aux, 1, nullptr, 0, ResolveMode::CoveredAverage},
+    {"curvature", "Y", &gl::FrameTargets::curvature, 1, nullptr, 0, ResolveMode::CoveredAverage},
 }};
 
 std::size_t aovIndex(std::string_view layer) {
@@ -426,8 +454,8 @@ float Renderer::Impl::runSssPasses(const Frame& frame, const gl::MainPassSetting
         sssInputs.geometricNormal = targets.geometricNormal.get();
         sssInputs.aux = targets.aux.get();
         sssInputs.curvature = targets.curvature.get();
-        sssInputs.width = spec.width;
-        sssInputs.height = spec.height;
+        sssInputs.width = frame.width;
+        sssInputs.height = frame.height;
         sssInputs.focalLengthPixels = frame.camera.focalLengthPixels;
         sssInputs.mmPerUnit = static_cast<float>(spec.mmPerUnit);
         sssInputs.view = frame.camera.view;
@@ -444,16 +472,25 @@ float Renderer::Impl::runSssPasses(const Frame& frame, const gl::MainPassSetting
     addSpecularPass.run(targets);
     passTimer.end();
 
+    // Anti-aliasing: the beauty at the output size, each pixel the box-filtered mean of its samples in linear
+    // light; the tone map below maps that resolved beauty (the EXR's), so the PNG is the EXR's beauty tone mapped.
+    if (frame.ssaaFactor > 1) {
+        passTimer.begin("resolve");
+        resolve(frame, &gl::FrameTargets::beauty, gl::ResolveMode::Average);
+        passTimer.end();
+    }
+
     passTimer.begin("tone_map");
+    gl::FrameTargets& display = output(frame);
     float reinhardScale = 1.0f;
     if (spec.toneMapper == "reinhard") {
         // Reinhard et al. 2002, Eq. 1: the log-average luminance of the beauty (read back once, on the CPU).
         std::vector<float> linear(static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height) * 4);
-        gl::readTexture(targets.beauty.get(), spec.width, spec.height, 4, linear.data());
+        gl::readTexture(display.beauty.get(), spec.width, spec.height, 4, linear.data());
         const double logAverage = reinhardLogAverage(linear.data(), linear.size() / 4, 4);
         reinhardScale = static_cast<float>(spec.reinhardKey / logAverage);
     }
-    toneMapPass.run(targets, spec.toneMapper, static_cast<float>(spec.exponentialK),
+    toneMapPass.run(display, spec.toneMapper, static_cast<float>(spec.exponentialK),
                     static_cast<float>(spec.filmicWhite), reinhardScale);
     passTimer.end();
     return supportRadiusMm;
@@ -545,8 +582,9 @@ DisplayFrame Renderer::renderDisplay(const RenderRequest& request, bool withLine
     if (shadows) scene.lights = gpuLightsOf(spec);
     glm::vec3 frameMin, frameMax;
     skinBounds(*frame.model, frame.partMaterials, frameMin, frameMax);
+    setInternalSize(frame, spec);
     frame.camera = frameCamera(spec.camera, frameMin, frameMax, frame.model->boundsMin, frame.model->boundsMax,
-                               spec.width, spec.height);
+                               frame.width, frame.height);
     frame.exposure = static_cast<float>(std::exp2(spec.exposureEv));
     frame.environmentFromWorld = glm::mat3(glm::rotate(
         glm::mat4(1.0f), static_cast<float>(-glm::radians(spec.environment.rotationDeg)), glm::vec3(0, 1, 0)));
@@ -559,7 +597,7 @@ DisplayFrame Renderer::renderDisplay(const RenderRequest& request, bool withLine
     if (impl.lightingKey != lightingKey) {
         impl.lightingKey.clear();
         impl.shadowKey.clear();
-        impl.targets.resize(spec.width, spec.height);
+        impl.targets.resize(frame.width, frame.height);
         impl.residentMainSettings = impl.runLightingPasses(frame, shadows);
         impl.shadowKey = shadowKey;
         impl.lightingKey = lightingKey;
@@ -568,32 +606,38 @@ DisplayFrame Renderer::renderDisplay(const RenderRequest& request, bool withLine
     }
     // The reference method draws into the frame targets itself: the lighting is not kept after it.
     if (referenceMethod) impl.lightingKey.clear();
+    if (frame.ssaaFactor > 1) impl.resolvedTargets.resize(spec.width, spec.height);
     out.supportRadiusMm = impl.runSssPasses(frame, impl.residentMainSettings);
     out.reran.push_back("sss");
+    if (withLinear) {
+        impl.resolve(frame, &gl::FrameTargets::linearDepth, gl::ResolveMode::Nearest);
+        impl.resolve(frame, &gl::FrameTargets::mask, gl::ResolveMode::Average);
+    }
 
     const auto readbackStart = std::chrono::steady_clock::now();
+    const gl::FrameTargets& targets = impl.output(frame);
     const std::size_t pixels = static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height);
     std::vector<float> rgba(pixels * 4);
-    gl::readTexture(impl.targets.display.get(), spec.width, spec.height, 4, rgba.data());
+    gl::readTexture(targets.display.get(), spec.width, spec.height, 4, rgba.data());
     std::vector<float> display(pixels * 3);
     for (std::size_t p = 0; p < pixels; ++p)
         for (std::size_t c = 0; c < 3; ++c) display[p * 3 + c] = rgba[p * 4 + c];
     out.srgb8 = encodeDisplaySrgb8(display);
     if (withLinear) {
-        gl::readTexture(impl.targets.beauty.get(), spec.width, spec.height, 4, rgba.data());
+        gl::readTexture(targets.beauty.get(), spec.width, spec.height, 4, rgba.data());
         out.beauty.resize(pixels * 3);
         for (std::size_t p = 0; p < pixels; ++p)
             for (std::size_t c = 0; c < 3; ++c) out.beauty[p * 3 + c] = rgba[p * 4 + c];
         out.depth.resize(pixels);
-        gl::readTexture(impl.targets.linearDepth.get(), spec.width, spec.height, 1, out.depth.data());
+        gl::readTexture(targets.linearDepth.get(), spec.width, spec.height, 1, out.depth.data());
         out.mask.resize(pixels);
-        gl::readTexture(impl.targets.mask.get(), spec.width, spec.height, 1, out.mask.data());
+        gl::readTexture(targets.mask.get(), spec.width, spec.height, 1, out.mask.data());
     }
     const double readbackMs = millisecondsSince(readbackStart);
 
     out.width = spec.width;
     out.height = spec.height;
-    out.focalLengthPixels = frame.camera.focalLengthPixels;
+    out.focalLengthPixels = frame.camera.focalLengthPixels / static_cast<float>(frame.ssaaFactor);
     out.mmPerUnit = spec.mmPerUnit;
     out.resolved = spec.resolved;
     out.timingsMs = impl.timer.json();
@@ -640,9 +684,11 @@ RenderResult Renderer::render(const RenderRequest& request) {
     scene.lights = gpuLightsOf(spec);
     glm::vec3 frameMin, frameMax;
     skinBounds(*frame.model, frame.partMaterials, frameMin, frameMax);
+    setInternalSize(frame, spec);
     frame.camera = frameCamera(spec.camera, frameMin, frameMax, frame.model->boundsMin, frame.model->boundsMax,
-                               spec.width, spec.height);
-    impl.targets.resize(spec.width, spec.height);
+                               frame.width, frame.height);
+    impl.targets.resize(frame.width, frame.height);
+    if (frame.ssaaFactor > 1) impl.resolvedTargets.resize(spec.width, spec.height);
     frame.exposure = static_cast<float>(std::exp2(spec.exposureEv));
     frame.environmentFromWorld = glm::mat3(glm::rotate(
         glm::mat4(1.0f), static_cast<float>(-glm::radians(spec.environment.rotationDeg)), glm::vec3(0, 1, 0)));
@@ -684,6 +730,14 @@ RenderResult Renderer::render(const RenderRequest& request) {
     impl.lightingKey.clear(); // the targets and shadow maps no longer hold renderDisplay's
     impl.shadowKey.clear();
     const float supportRadiusMm = impl.runPasses(frame);
+    // Anti-aliasing: every AOV at the output size (the beauty is resolved before the tone map already).
+    if (frame.ssaaFactor > 1) {
+        impl.timer.begin("resolve_aovs");
+        for (const Aov& aov : kAovs)
+            if (aov.texture != &gl::FrameTargets::beauty) impl.resolve(frame, aov.texture, aov.resolve);
+        impl.timer.end();
+    }
+    const gl::FrameTargets& output = impl.output(frame);
 
     // --- read back: every AOV of the table, and the display image -------------------------------------------
     const auto readbackStart = std::chrono::steady_clock::now();
@@ -697,7 +751,7 @@ RenderResult Renderer::render(const RenderRequest& request) {
         return data;
     };
     std::vector<std::vector<float>> readBack;
-    for (const Aov& aov : kAovs) readBack.push_back(read((impl.targets.*aov.texture).get(), aov.textureChannels));
+    for (const Aov& aov : kAovs) readBack.push_back(read((output.*aov.texture).get(), aov.textureChannels));
     const bool rasterizerSpecular =
         cycles && (eevee ? spec.eevee.specularSource : spec.pathtraced.specularSource) == "rasterizer";
     if (rasterizerSpecular) {
@@ -719,7 +773,7 @@ RenderResult Renderer::render(const RenderRequest& request) {
             display[i] = toneMap(cycles->beauty[i], spec.toneMapper, static_cast<float>(spec.exponentialK),
                                  static_cast<float>(spec.filmicWhite));
     } else if (!request.pngPath.empty()) {
-        const std::vector<float> displayRgba = read(impl.targets.display.get(), 4);
+        const std::vector<float> displayRgba = read(output.display.get(), 4);
         display.resize(pixels * 3);
         for (std::size_t p = 0; p < pixels; ++p)
             for (std::size_t c = 0; c < 3; ++c) display[p * 3 + c] = displayRgba[p * 4 + c];
@@ -730,7 +784,15 @@ RenderResult Renderer::render(const RenderRequest& request) {
     const auto writeStart = std::chrono::steady_clock::now();
     bool fractionalSkin = !spec.textures.skinMask.empty();
     for (const Vertex& v : frame.model->vertices) fractionalSkin = fractionalSkin || v.skin < 1.0f;
-    if (cycles && fractionalSkin) {
+    // Anti-aliasing: Blender's depth and material-index passes do not follow its box filter's coverage (the index
+    // pass keeps the first hit), so the depth and mask of the rasterizer's resolve (same camera and triangles:
+    // nearest depth, skin coverage) replace them, and every method's AOVs mean the same.
+    const bool rasterizerDepthAndMask = cycles && frame.ssaaFactor > 1;
+    if (rasterizerDepthAndMask) {
+        cycles->depth = readBack[aovIndex("depth")];
+        cycles->mask = readBack[aovIndex("mask")];
+        for (float& m : cycles->mask) m = std::clamp(m, 0.0f, 1.0f);
+    } else if (cycles && fractionalSkin) {
         // A skin-mask map or per-vertex skin below 1: Cycles' index pass only knows the material's flag, so the
         // rasterizer's mask (same camera, point-sampled) supplies the fraction.
         const std::vector<float>& mask = readBack[aovIndex("mask")];
@@ -752,7 +814,8 @@ RenderResult Renderer::render(const RenderRequest& request) {
     metadata.strings["skinlab:gl_renderer"] = impl.context.renderer();
     metadata.strings["skinlab:gl_version"] = impl.context.version();
     metadata.strings["skinlab:camera"] = cameraJson.dump();
-    metadata.floats["skinlab:f_px"] = camera.focalLengthPixels;
+    // The output image's focal length (the passes ran at ssaa_factor × it).
+    metadata.floats["skinlab:f_px"] = camera.focalLengthPixels / static_cast<float>(frame.ssaaFactor);
     metadata.floats["skinlab:mm_per_unit"] = static_cast<float>(spec.mmPerUnit);
     metadata.floats["skinlab:sss_radius_mm"] = supportRadiusMm;
     if (cycles && eevee) {
@@ -763,6 +826,12 @@ RenderResult Renderer::render(const RenderRequest& request) {
         record["channels_from_eevee"] =
             rasterizerSpecular ? nlohmann::json{"R, G, B: diffuse only", "diffuse.*", "depth.Z", "mask.Y"}
                                : nlohmann::json{"R", "G", "B", "diffuse.*", "specular.*", "depth.Z", "mask.Y"};
+        if (rasterizerDepthAndMask) {
+            nlohmann::json kept = nlohmann::json::array();
+            for (const auto& channel : record["channels_from_eevee"])
+                if (channel != "depth.Z" && channel != "mask.Y") kept.push_back(channel);
+            record["channels_from_eevee"] = kept;
+        }
         metadata.strings["skinlab:eevee"] = record.dump();
         metadata.strings["skinlab:blender_version"] = cycles->blenderVersion;
         metadata.floats["skinlab:render_seconds"] = static_cast<float>(cycles->renderSeconds);
@@ -776,16 +845,21 @@ RenderResult Renderer::render(const RenderRequest& request) {
                 for (const char c : letters) fromCycles.push_back(std::string(1, c));
             else fromCycles.push_back(layer + "." + (letters.size() == 1 ? letters : std::string("*")));
         }
-        metadata.strings["skinlab:pathtraced"] = nlohmann::json{
-            {"samples", params.at("samples")},
-            {"seed", params.at("seed")},
-            {"blender_version", cycles->blenderVersion},
-            {"render_seconds", cycles->renderSeconds},
-            {"wall_seconds", cycles->wallSeconds},
-            {"channels_from_cycles",
-             params.value("specular_source", "cycles") == "rasterizer"
-                 ? nlohmann::json{"R, G, B: diffuse only", "diffuse.*", "depth.Z", "mask.Y"}
-                 : fromCycles}}.dump();
+        nlohmann::json channelsFromCycles =
+            params.value("specular_source", "cycles") == "rasterizer"
+                ? nlohmann::json{"R, G, B: diffuse only", "diffuse.*", "depth.Z", "mask.Y"}
+                : fromCycles;
+        if (rasterizerDepthAndMask) {
+            nlohmann::json kept = nlohmann::json::array();
+            for (const auto& channel : channelsFromCycles)
+                if (channel != "depth.Z" && channel != "mask.Y") kept.push_back(channel);
+            channelsFromCycles = kept;
+        }
+        metadata.strings["skinlab:pathtraced"] =
+            nlohmann::json{{"samples", params.at("samples")},           {"seed", params.at("seed")},
+                           {"blender_version", cycles->blenderVersion}, {"render_seconds", cycles->renderSeconds},
+                           {"wall_seconds", cycles->wallSeconds},       {"channels_from_cycles", channelsFromCycles}}
+                .dump();
         metadata.strings["skinlab:blender_version"] = cycles->blenderVersion;
         metadata.floats["skinlab:pathtraced_samples"] = static_cast<float>(params.at("samples").get<int>());
         metadata.floats["skinlab:pathtraced_seed"] = static_cast<float>(params.at("seed").get<int>());

@@ -45,11 +45,12 @@ struct DisplayFrame {
     int width = 0;
     int height = 0;
     std::vector<std::uint8_t> srgb8; // RGB, top row first: the bytes `skinlab render --png` encodes
-    // Only with `withLinear`: R, G, B as the EXR's beauty; depth.Z; mask.Y (top row first).
+    // Only with `withLinear`: R, G, B as the EXR's beauty; depth.Z; mask.Y (top row first), resolved as the EXR's
+    // with anti-aliasing (render.antialiasing, docs/rendering.md): mask as coverage, depth the nearest sample's.
     std::vector<float> beauty;
     std::vector<float> depth;
     std::vector<float> mask;
-    float focalLengthPixels = 0.0f; // skinlab:f_px
+    float focalLengthPixels = 0.0f; // skinlab:f_px, of the output image (not of the supersampled passes)
     float supportRadiusMm = 0.0f;   // skinlab:sss_radius_mm
     double mmPerUnit = 1.0;
     nlohmann::json resolved;

@@ -171,7 +171,7 @@ const std::vector<ShaderVariant>& shaderVariants() {
     static const std::vector<ShaderVariant> variants = [] {
         std::vector<ShaderVariant> v;
         for (const char* fragment : {"add_specular.frag", "background.frag", "copy.frag", "surface_aovs.frag",
-                                     "curvature_smooth.frag", "tone_map.frag", "transmittance.frag"})
+                                     "curvature_smooth.frag", "resolve.frag", "tone_map.frag", "transmittance.frag"})
             v.push_back({"fullscreen.vert", fragment, {}});
         v.push_back({"main_pass.vert", "main_pass.frag", {}});
         v.push_back({"reference_bake.vert", "main_pass.frag", {}});

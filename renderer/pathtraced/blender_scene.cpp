@@ -142,6 +142,9 @@ nlohmann::json blenderSceneJson(const BlenderSceneInputs& inputs, std::string_vi
                          {"seed", p.seed},      {"max_bounces", p.maxBounces}, {"filter_width_px", p.filterWidthPx},
                          {"threads", p.threads}};
     scene["settings"]["engine"] = inputs.engine;
+    // render.antialiasing = "ssaa": Cycles' box filter of one pixel, the rasterizer's reconstruction (EEVEE has no
+    // box; its filter width is set by the scene spec, kEeveeBoxMatchedFilterPx). "none": a narrow Gaussian.
+    scene["settings"]["pixel_filter"] = spec.antialiasing == "ssaa" ? "box" : "gaussian";
     if (inputs.engine == "eevee") scene["settings"]["eevee"] = inputs.eeveeSettings;
     // One object per part (cycles_scene.py), each with its own vertices, in Model::parts order in the file.
     nlohmann::json parts = nlohmann::json::array();

@@ -7,6 +7,7 @@
 #include "renderer/sss/pathtraced_params.h"
 #include "renderer/sss/sss_params.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <glm/gtc/matrix_transform.hpp>
@@ -240,6 +241,26 @@ void readRender(const SpecReader& root, SceneSpec& spec, nlohmann::json& resolve
     spec.height = static_cast<int>(render.integer("height", 512, 16, 8192));
     spec.exposureEv = render.number("exposure_ev", 0.0, -30.0, 30.0);
     resolved["render"] = {{"width", spec.width}, {"height", spec.height}, {"exposure_ev", spec.exposureEv}};
+    // Anti-aliasing (docs/rendering.md, "Anti-aliasing"): supersampling at ssaa_factor × the size per axis,
+    // resolved by a box of one output pixel; "none" samples each pixel's centre once.
+    spec.antialiasing = render.choice("antialiasing", "ssaa", {"ssaa", "none"});
+    resolved["render"]["antialiasing"] = spec.antialiasing;
+    if (spec.antialiasing == "none") {
+        for (const char* key : {"ssaa_factor", "ssaa_filter"})
+            if (render.has(key)) render.fail(key, "only applies to render.antialiasing = \"ssaa\"");
+        spec.ssaaFactor = 1;
+        return;
+    }
+    spec.ssaaFactor = static_cast<int>(render.integer("ssaa_factor", kDefaultSsaaFactor, 2, kMaxSsaaFactor));
+    spec.ssaaFilter = render.choice("ssaa_filter", "box", {"box"});
+    const int largest = std::max(spec.width, spec.height);
+    if (largest * spec.ssaaFactor > kMaxInternalSize)
+        render.fail("ssaa_factor", std::to_string(spec.ssaaFactor) + " x " + std::to_string(largest) +
+                                       " px = " + std::to_string(largest * spec.ssaaFactor) +
+                                       " px exceeds the internal limit of " + std::to_string(kMaxInternalSize) +
+                                       " px (lower it or the image size)");
+    resolved["render"]["ssaa_factor"] = spec.ssaaFactor;
+    resolved["render"]["ssaa_filter"] = spec.ssaaFilter;
 }
 
 // [tone_map]: the display operator.
@@ -266,9 +287,20 @@ void readMethodTables(const SpecReader& root, SceneSpec& spec, nlohmann::json& r
     resolved["sss"] = spec.sss.toJson();
     resolved["transmittance"] = spec.transmittance.toJson();
     spec.pathtraced = pathtraced::readPathtracedParams(root);
+    spec.eevee = pathtraced::readEeveeParams(root);
+    if (spec.antialiasing == "ssaa") {
+        // The Blender conditions get the rasterizer's reconstruction (docs/rendering.md, "Anti-aliasing"): Cycles
+        // its box filter of one pixel, EEVEE the Blackman-Harris filter of the same variance (kEeveeBoxMatchedFilterPx);
+        // their own filter width is then not a choice.
+        for (const char* table : {"pathtraced", "eevee"})
+            if (const SpecReader t = root.table(table); t.has("filter_width_px"))
+                t.fail("filter_width_px", "only applies to render.antialiasing = \"none\" (with \"ssaa\" Blender "
+                                          "gets the same one-pixel box filter as the rasterizer)");
+        spec.pathtraced.filterWidthPx = 1.0;
+        spec.eevee.filterWidthPx = kEeveeBoxMatchedFilterPx;
+    }
     if (sss::methodInfo(spec.sss.method).execution == sss::Execution::Cycles)
         resolved["pathtraced"] = spec.pathtraced.toJson();
-    spec.eevee = pathtraced::readEeveeParams(root);
     if (sss::methodInfo(spec.sss.method).execution == sss::Execution::Eevee) resolved["eevee"] = spec.eevee.toJson();
 }
 

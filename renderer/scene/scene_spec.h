@@ -70,6 +70,18 @@ struct EnvironmentSpec {
     glm::vec3 backgroundColor{0, 0, 0};     // radiance when background = color
 };
 
+// render.ssaa_factor: its default (samples per pixel along each axis) and range; the internal size (image size ×
+// factor) stays within kMaxInternalSize, the texture size every GL 4.5 driver the project meets supports (Mesa
+// llvmpipe: 16384).
+inline constexpr int kDefaultSsaaFactor = 2;
+inline constexpr int kMaxSsaaFactor = 8;
+inline constexpr int kMaxInternalSize = 16384;
+// EEVEE's pixel filter with render.antialiasing = "ssaa" (render.filter_size, px). EEVEE (Blender 2.8–4.1) jitters
+// its temporal samples by a Blackman-Harris window of full width 2 × filter_size px (the inverse CDF of the window
+// on [−0.5, 0.5] scaled by 4, in NDC, i.e. ±filter_size px), whose standard deviation is 0.1385 × its full width;
+// it has no box filter. 1.042 px gives the standard deviation of a box of one pixel, 1/√12 px.
+inline constexpr double kEeveeBoxMatchedFilterPx = 1.042;
+
 struct SceneSpec {
     std::string source;        // spec path or builtin:NAME, as given
     std::string modelSource;   // "builtin:NAME" or the model file path (resolved)
@@ -87,7 +99,13 @@ struct SceneSpec {
     EnvironmentSpec environment;
     int width = 512;
     int height = 512;
-    double exposureEv = 0.0;                // beauty and AOVs are scaled by 2^exposure_ev
+    double exposureEv = 0.0; // beauty and AOVs are scaled by 2^exposure_ev
+    // render.antialiasing: "ssaa" renders every pass at ssaaFactor × (width, height) and resolves each layer to
+    // (width, height) with a box of one output pixel (renderer/gl/resolve_pass.h); "none" (ssaaFactor 1) samples
+    // each pixel's centre once.
+    std::string antialiasing = "ssaa";
+    int ssaaFactor = kDefaultSsaaFactor;    // samples per pixel along each axis; 1 when antialiasing = "none"
+    std::string ssaaFilter = "box";         // the reconstruction filter: box (one output pixel, as Cycles' box)
     std::string toneMapper = "filmic";      // linear | exponential | reinhard | reinhard-rgb | filmic
     double exponentialK = 1.0;              // exponential: 1 - exp(-k x)
     double filmicWhite = 11.2;              // filmic (Hable 2010): linear value mapped to display white

@@ -13,6 +13,7 @@ common_tail() {
 width = $size
 height = $size
 exposure_ev = 0.0
+antialiasing = "none"
 
 [tone_map]
 operator = "filmic"

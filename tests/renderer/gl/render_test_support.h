@@ -97,14 +97,18 @@ inline std::vector<unsigned char> readPng(const std::filesystem::path& path, int
 using skinlab::test_support::TempFolder;
 
 // Renders `scene` with `method` (and the `overrides`, as --set) at width × height into `exrPath`; the assets come
-// from $SKINLAB_ASSETS (the renderer's default).
+// from $SKINLAB_ASSETS (the renderer's default). Without anti-aliasing unless the overrides turn it on
+// ("render.antialiasing=ssaa"): the tests through here check per-pixel mechanics (kernels against their CPU
+// mirrors, Blender against the rasterizer pixel by pixel) on pixel-centre samples; anti-aliasing has its own
+// tests (test_antialiasing.cpp).
 inline RenderResult renderToExr(Renderer& renderer, const std::string& scene, const std::string& method,
                                 std::vector<std::string> overrides, int width, int height,
                                 const std::filesystem::path& exrPath) {
     RenderRequest request;
     request.scene = scene;
     request.method = method;
-    request.overrides = std::move(overrides);
+    request.overrides = {"render.antialiasing=none"};
+    for (std::string& override : overrides) request.overrides.push_back(std::move(override));
     request.width = width;
     request.height = height;
     request.exrPath = exrPath;

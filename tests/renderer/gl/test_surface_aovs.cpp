@@ -23,7 +23,9 @@ ExrImage renderScene(Renderer& renderer, const TempFolder& folder, const std::st
                      std::vector<std::string> overrides = {}) {
     RenderRequest request;
     request.scene = scene;
-    request.overrides = {"shadow.resolution=256"}; // shadows play no part here
+    // Pixel centres: the AOVs are checked per pixel against their C++ mirrors, which the resolve's averages of
+    // nonlinear quantities would not follow (anti-aliasing: test_antialiasing.cpp).
+    request.overrides = {"render.antialiasing=none", "shadow.resolution=256"}; // shadows play no part here
     for (auto& o : overrides) request.overrides.push_back(std::move(o));
     request.width = size;
     request.height = size;

@@ -24,7 +24,9 @@ ExrImage renderEar(Renderer& renderer, const TempFolder& folder, const std::stri
                    std::vector<std::string> overrides) {
     RenderRequest request;
     request.scene = "builtin:ear";
-    request.overrides = {"shadow.resolution=1024"};
+    // Pixel centres: the AOVs are checked per pixel against their C++ mirrors, which the resolve's averages of
+    // nonlinear quantities would not follow (anti-aliasing: test_antialiasing.cpp).
+    request.overrides = {"render.antialiasing=none", "shadow.resolution=1024"};
     for (auto& o : overrides) request.overrides.push_back(std::move(o));
     request.width = 96;
     request.height = 96;

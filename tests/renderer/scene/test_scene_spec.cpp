@@ -38,6 +38,43 @@ TEST(SceneSpec, EveryBuiltinSceneLoadsWithItsDefaults) {
     }
 }
 
+TEST(SceneSpec, AntialiasingIsSupersamplingByDefaultAndItsKeysAreStrict) {
+    const SceneSpec defaults = loadSceneSpec("builtin:halo", {}, {});
+    EXPECT_EQ(defaults.antialiasing, "ssaa");
+    EXPECT_EQ(defaults.ssaaFactor, kDefaultSsaaFactor);
+    EXPECT_EQ(defaults.resolved["render"]["antialiasing"], "ssaa");
+    EXPECT_EQ(defaults.resolved["render"]["ssaa_factor"], kDefaultSsaaFactor);
+    EXPECT_EQ(defaults.resolved["render"]["ssaa_filter"], "box");
+    // With "ssaa" the Blender conditions get the one-pixel box (Cycles) and its variance-matched filter (EEVEE).
+    EXPECT_EQ(defaults.pathtraced.filterWidthPx, 1.0);
+    EXPECT_EQ(defaults.eevee.filterWidthPx, kEeveeBoxMatchedFilterPx);
+
+    const SceneSpec off = loadSceneSpec("builtin:halo", {"render.antialiasing=none"}, {});
+    EXPECT_EQ(off.ssaaFactor, 1);
+    EXPECT_EQ(off.resolved["render"]["antialiasing"], "none");
+    EXPECT_FALSE(off.resolved["render"].contains("ssaa_factor"));
+    EXPECT_EQ(off.pathtraced.filterWidthPx, 0.01); // the narrow Gaussian: pixel centres, as the rasterizer then
+    EXPECT_EQ(loadSceneSpec("builtin:halo", {"render.ssaa_factor=4"}, {}).ssaaFactor, 4);
+
+    EXPECT_EQ(errorOf("builtin:halo", {"render.antialiasing=fxaa"}),
+              "builtin:halo: render.antialiasing: 'fxaa' is not one of: ssaa, none");
+    EXPECT_EQ(errorOf("builtin:halo", {"render.ssaa_factor=1"}),
+              "builtin:halo: render.ssaa_factor: 1 is out of range [2, 8]");
+    EXPECT_EQ(errorOf("builtin:halo", {"render.ssaa_factor=9"}),
+              "builtin:halo: render.ssaa_factor: 9 is out of range [2, 8]");
+    EXPECT_EQ(errorOf("builtin:halo", {"render.ssaa_filter=lanczos"}),
+              "builtin:halo: render.ssaa_filter: 'lanczos' is not one of: box");
+    EXPECT_EQ(errorOf("builtin:halo", {"render.antialiasing=none", "render.ssaa_factor=2"}),
+              "builtin:halo: render.ssaa_factor: only applies to render.antialiasing = \"ssaa\"");
+    EXPECT_EQ(errorOf("builtin:halo", {"render.width=4096", "render.ssaa_factor=8"}),
+              "builtin:halo: render.ssaa_factor: 8 x 4096 px = 32768 px exceeds the internal limit of 16384 px "
+              "(lower it or the image size)");
+    EXPECT_EQ(errorOf("builtin:halo", {"pathtraced.filter_width_px=0.5"}),
+              "builtin:halo: pathtraced.filter_width_px: only applies to render.antialiasing = \"none\" (with "
+              "\"ssaa\" Blender gets the same one-pixel box filter as the rasterizer)");
+    EXPECT_EQ(errorOf("builtin:halo", {"render.antialiasing=none", "eevee.filter_width_px=0.5"}), "");
+}
+
 TEST(SceneSpec, OverridesChangeValuesAndAreRecordedInTheResolvedParameters) {
     const SceneSpec spec = loadSceneSpec(
         "builtin:head",
