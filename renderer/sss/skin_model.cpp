@@ -1,8 +1,10 @@
 #include "renderer/sss/skin_model.h"
 
+#include "common/check.h"
 #include "common/error.h"
 #include "renderer/sss/burley_profile.h"
 #include "renderer/sss/materials.h"
+#include "renderer/sss/sss_params.h"
 
 #include <algorithm>
 #include <cmath>
@@ -238,10 +240,16 @@ std::vector<GaussianLobe> fitDeonLobesToBurley(const std::array<double, 3>& shap
         }
         std::vector<std::vector<double>> gram(n, std::vector<double>(n, 0.0));
         std::vector<double> rhs(n, 0.0);
+        // One more equation, weighted like kMomentWeight samples: the second moment Σ w_k v_k equals Burley's 7 d²
+        // (the width the Blender radii and the kernels' reach follow), so the tail lobes cannot run off.
+        constexpr double kMomentWeight = 50.0;
         for (std::size_t a = 0; a < n; ++a) {
             for (int s = 0; s < kSamples; ++s) rhs[a] += basis[a][s] * target[s];
-            for (std::size_t b = 0; b < n; ++b)
+            rhs[a] += kMomentWeight * deon[a].varianceMm2 / (7.0 * d * d);
+            for (std::size_t b = 0; b < n; ++b) {
                 for (int s = 0; s < kSamples; ++s) gram[a][b] += basis[a][s] * basis[b][s];
+                gram[a][b] += kMomentWeight * deon[a].varianceMm2 * deon[b].varianceMm2 / (49.0 * d * d * d * d);
+            }
         }
         std::vector<double> w(n, 0.0);
         for (int iteration = 0; iteration < 2000; ++iteration)
@@ -285,6 +293,57 @@ SkinOptics skinOptics(const SkinTone& tone, std::string_view where) {
     }
     optics.lobes = fitDeonLobesToBurley(optics.burleyShapeMm);
     return optics;
+}
+
+void applySkinTone(const SkinOptics& optics, SssParams& params) {
+    SKINLAB_CHECK_EQ(optics.lobes.size(), 6u);
+    std::array<std::array<double, 3>, 6> weights{};
+    for (std::size_t k = 0; k < 6; ++k) weights[k] = optics.lobes[k].weight;
+    params.skinLobeWeights = weights;
+    params.skinShapeMm = optics.burleyShapeMm;
+}
+
+std::vector<GaussianLobe> skinProfileLobes(const SssParams& params) {
+    std::vector<GaussianLobe> lobes = deonSkinLobes();
+    if (params.skinLobeWeights)
+        for (std::size_t k = 0; k < lobes.size(); ++k) lobes[k].weight = (*params.skinLobeWeights)[k];
+    return lobes;
+}
+
+std::array<double, 3> skinBurleyShapeMm(const SssParams& params) {
+    if (params.material == "skin" && params.skinShapeMm) return *params.skinShapeMm;
+    return burleyShapeMm(params.material);
+}
+
+std::array<double, 3> skinTransmittance(const SssParams& params, double thicknessMm) {
+    std::array<double, 3> t{};
+    for (const auto& lobe : skinProfileLobes(params))
+        for (int c = 0; c < 3; ++c) t[c] += lobe.weight[c] * std::exp(-thicknessMm * thicknessMm / lobe.varianceMm2);
+    return t;
+}
+
+std::array<double, 3> skinWidthRatio(const SssParams& params) {
+    if (!params.skinShapeMm) return {1.0, 1.0, 1.0};
+    const std::array<double, 3> deon = burleyShapeMm("skin"); // d'Eon's profile as Burley's d (same second moment)
+    std::array<double, 3> ratio{};
+    for (int c = 0; c < 3; ++c) ratio[c] = (*params.skinShapeMm)[c] / deon[c];
+    return ratio;
+}
+
+PscbfProfile skinPscbfProfile(const SssParams& params) {
+    PscbfProfile profile = mikkelsenSkinProfile(params.pscbfSigma);
+    if (!params.skinShapeMm) return profile;
+    const std::array<double, 3> ratio = skinWidthRatio(params);
+    for (int c = 0; c < 3; ++c) profile.varianceMm2[c] *= ratio[c] * ratio[c];
+    profile.maxRadiusMm *= std::max({ratio[0], ratio[1], ratio[2]});
+    return profile;
+}
+
+std::array<double, 3> skinArtisticFalloff(const SssParams& params) {
+    std::array<double, 3> falloff = params.artisticFalloff;
+    const std::array<double, 3> ratio = skinWidthRatio(params);
+    for (int c = 0; c < 3; ++c) falloff[c] *= ratio[c];
+    return falloff;
 }
 
 SkinToneTable::SkinToneTable(double melaninBlend, int melaninSteps, int haemoglobinSteps)

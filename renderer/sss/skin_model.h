@@ -30,6 +30,7 @@
 // new tone and the texel multiplied by albedo(C_m', C_h) / albedo(C_m, C_h), so what the model does not explain
 // (pores, stubble, shading baked into the map) is kept.
 #include "renderer/sss/gaussian_sum_profile.h"
+#include "renderer/sss/pscbf_kernel.h"
 
 #include <array>
 #include <optional>
@@ -125,8 +126,30 @@ SkinOptics skinOptics(const SkinTone& tone, std::string_view where = "");
 void validateSkinTone(const SkinTone& tone, std::string_view where = "");
 
 // Non-negative weights on d'Eon's six variances fitting a Burley profile of shape d (mm) per channel, each channel
-// normalised to sum 1 (least squares on the radial CDF, the energy within r, over 0…12 d).
+// normalised to sum 1 (least squares on the radial CDF, the energy within r, over 0…12 d, with Burley's second
+// moment 7 d² as one more, heavily weighted equation).
 std::vector<GaussianLobe> fitDeonLobesToBurley(const std::array<double, 3>& shapeMm);
+
+// --- what the methods read ----------------------------------------------------------------------------------------
+struct SssParams;
+// Writes the tone's refitted weights and Burley shape into the [sss] record (SssParams::skinLobeWeights, skinShapeMm).
+void applySkinTone(const SkinOptics& optics, SssParams& params);
+// The six lobes of material "skin": the tone's refit when the scene has [skin], else d'Eon's (deonSkinLobes()).
+std::vector<GaussianLobe> skinProfileLobes(const SssParams& params);
+// Burley's d (mm) for a material: the tone's for "skin" when the scene has [skin], else burleyShapeMm(material).
+std::array<double, 3> skinBurleyShapeMm(const SssParams& params);
+// Transmittance T(s) = Σ w_i exp(−s²/v_i) with the lobes of skinProfileLobes (T(0) = 1 per channel).
+std::array<double, 3> skinTransmittance(const SssParams& params, double thicknessMm);
+// Per-channel ratio of the tone's Burley d to d'Eon's profile as Burley's d (burleyShapeMm("skin"), the same second
+// moment); (1, 1, 1) without [skin]. The Blender radii (fitted to d'Eon's profile) scale by it.
+std::array<double, 3> skinWidthRatio(const SssParams& params);
+
+// pscbf's profile (Mikkelsen 2010, Table 1) with each channel's Gaussian widened by skinWidthRatio (variance × ratio²)
+// and the filter disc r_max by the largest ratio; Mikkelsen's own without [skin].
+PscbfProfile skinPscbfProfile(const SssParams& params);
+// The artistic kernel's per-channel falloff (a width multiplier of its profile) times skinWidthRatio; the key's own
+// value without [skin].
+std::array<double, 3> skinArtisticFalloff(const SssParams& params);
 
 // --- inversion and re-toning (Jimenez et al. 2010) ------------------------------------------------------------------
 struct ToneEstimate {

@@ -127,8 +127,9 @@ TEST(SkinModel, ProfileNarrowsWithMelaninAndRedReachesFarthest) {
         EXPECT_GT(o->burleyShapeMm[0], o->burleyShapeMm[1]);
         EXPECT_GT(o->burleyShapeMm[1], o->burleyShapeMm[2]);
         // The refitted six Gaussians: weights ≥ 0, each channel sums to 1, and their radial CDF follows Burley's
-        // at d, 3d and 6d: within 0.06 in red; green and blue are narrower than d'Eon's narrowest lobe (σ = 0.08 mm)
-        // resolves, so there the fit misses part of Burley's central peak (within 0.2; docs/skin-tones.md).
+        // at d, 3d and 6d: within 0.1 in red; green and blue are narrower than d'Eon's narrowest lobe (σ = 0.08 mm)
+        // resolves, so there the fit misses part of Burley's central peak (within 0.2; docs/skin-tones.md). The
+        // second moment is Burley's 7 d² (the fit's constraint), the width every method and Blender follow.
         const GaussianSumProfile gaussians(o->lobes, "refit");
         const BurleyProfile burley(o->burleyShapeMm, "burley");
         for (int c = 0; c < 3; ++c) {
@@ -138,11 +139,14 @@ TEST(SkinModel, ProfileNarrowsWithMelaninAndRedReachesFarthest) {
                 sum += lobe.weight[c];
             }
             EXPECT_NEAR(sum, 1.0, 1e-12);
+            double moment = 0.0;
+            for (const auto& lobe : o->lobes) moment += lobe.weight[c] * lobe.varianceMm2;
+            EXPECT_NEAR(std::sqrt(moment / 7.0) / o->burleyShapeMm[c], 1.0, 0.03) << "channel " << c;
             for (double k : {1.0, 3.0, 6.0}) {
                 const double r = k * o->burleyShapeMm[c];
                 double cdf = 0.0;
                 for (const auto& lobe : o->lobes) cdf += lobe.weight[c] * -std::expm1(-r * r / (2.0 * lobe.varianceMm2));
-                EXPECT_NEAR(cdf, burley.radialCumulative(c, r), c == 0 ? 0.06 : 0.2)
+                EXPECT_NEAR(cdf, burley.radialCumulative(c, r), c == 0 ? 0.1 : 0.2)
                     << "channel " << c << " r = " << k << " d";
             }
         }
