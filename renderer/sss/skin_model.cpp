@@ -359,6 +359,9 @@ SkinToneTable::SkinToneTable(double melaninBlend, int melaninSteps, int haemoglo
             table_[static_cast<std::size_t>(m * haemoglobinSteps_ + h)] =
                 reflectanceToLinearSrgb(skinReflectanceSpectrum(tone));
         }
+    logTable_.resize(table_.size());
+    for (std::size_t i = 0; i < table_.size(); ++i)
+        for (int c = 0; c < 3; ++c) logTable_[i][c] = std::log(std::max(table_[i][c], 1e-4));
 }
 
 namespace {
@@ -397,8 +400,11 @@ std::array<double, 3> SkinToneTable::albedo(double melanin, double haemoglobin) 
 ToneEstimate SkinToneTable::invert(const std::array<double, 3>& rgb) const {
     int best = 0;
     double bestDistance = std::numeric_limits<double>::infinity();
-    for (std::size_t i = 0; i < table_.size(); ++i) {
-        const double distance = logDistance(rgb, table_[i]);
+    std::array<double, 3> logRgb{};
+    for (int c = 0; c < 3; ++c) logRgb[c] = std::log(std::max(rgb[c], 1e-4));
+    for (std::size_t i = 0; i < logTable_.size(); ++i) {
+        double distance = 0.0;
+        for (int c = 0; c < 3; ++c) distance += (logRgb[c] - logTable_[i][c]) * (logRgb[c] - logTable_[i][c]);
         if (distance < bestDistance) bestDistance = distance, best = static_cast<int>(i);
     }
     // Pattern search on the continuous grid coordinates.

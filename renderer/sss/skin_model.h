@@ -169,7 +169,8 @@ public:
 private:
     double blend_;
     int melaninSteps_, haemoglobinSteps_;
-    std::vector<std::array<double, 3>> table_; // melanin-major
+    std::vector<std::array<double, 3>> table_;    // melanin-major
+    std::vector<std::array<double, 3>> logTable_; // its logarithms (the nearest-entry search)
 };
 
 // Relative error above which a colour counts as not skin (not invertible): 0.15 (15 % of the colour's magnitude).
