@@ -447,6 +447,7 @@ double retoneAlbedo(std::vector<float>& rgba, const SkinTone& tone, std::string_
     struct Entry {
         ToneEstimate estimate;
         std::size_t count = 0;
+        bool skin = false;
     };
     std::unordered_map<std::uint32_t, Entry> colours;
     const std::size_t texels = rgba.size() / 4;
@@ -457,15 +458,23 @@ double retoneAlbedo(std::vector<float>& rgba, const SkinTone& tone, std::string_
         return k;
     };
     const auto coloured = [](const float* p) { return p[0] > 0.0f || p[1] > 0.0f || p[2] > 0.0f; };
+    // Skin: the model's match within the tolerance and a skin hue (red at least 10 % above green, green not below
+    // blue), which keeps whites, greys and blue or green texels (eyes, background) out.
+    const auto isSkin = [](const float* p, const ToneEstimate& estimate) {
+        return estimate.error <= kToneInversionTolerance && p[0] >= 1.1f * p[1] && p[1] >= p[2];
+    };
     std::size_t colouredCount = 0, invertible = 0;
     for (std::size_t t = 0; t < texels; ++t) {
         const float* p = &rgba[t * 4];
         if (!coloured(p)) continue;
         ++colouredCount;
         auto [it, inserted] = colours.try_emplace(keyOf(p));
-        if (inserted) it->second.estimate = table.invert({p[0], p[1], p[2]});
+        if (inserted) {
+            it->second.estimate = table.invert({p[0], p[1], p[2]});
+            it->second.skin = isSkin(p, it->second.estimate);
+        }
         ++it->second.count;
-        if (it->second.estimate.error <= kToneInversionTolerance) ++invertible;
+        if (it->second.skin) ++invertible;
     }
     const double share = colouredCount > 0 ? static_cast<double>(invertible) / static_cast<double>(colouredCount) : 0.0;
     if (colouredCount == 0 || share < 0.5)
@@ -476,7 +485,7 @@ double retoneAlbedo(std::vector<float>& rgba, const SkinTone& tone, std::string_
     // target / median, so freckles and shading detail keep their melanin ratio to the rest of the skin.
     std::vector<std::pair<double, std::size_t>> melanins;
     for (const auto& [k, entry] : colours)
-        if (entry.estimate.error <= kToneInversionTolerance) melanins.emplace_back(entry.estimate.melanin, entry.count);
+        if (entry.skin) melanins.emplace_back(entry.estimate.melanin, entry.count);
     std::sort(melanins.begin(), melanins.end());
     std::size_t seen = 0;
     double median = melanins.front().first;
@@ -488,7 +497,7 @@ double retoneAlbedo(std::vector<float>& rgba, const SkinTone& tone, std::string_
     const double scale = tone.melanin / median;
     std::unordered_map<std::uint32_t, std::array<float, 3>> ratios;
     for (const auto& [k, entry] : colours) {
-        if (entry.estimate.error > kToneInversionTolerance) continue;
+        if (!entry.skin) continue;
         const double melanin = std::clamp(entry.estimate.melanin * scale, kMelaninMin, kMelaninMax);
         const auto from = table.albedo(entry.estimate.melanin, entry.estimate.haemoglobin);
         const auto to = table.albedo(melanin, entry.estimate.haemoglobin);

@@ -173,13 +173,15 @@ private:
     std::vector<std::array<double, 3>> logTable_; // its logarithms (the nearest-entry search)
 };
 
-// Relative error above which a colour counts as not skin (not invertible): 0.15 (15 % of the colour's magnitude).
-constexpr double kToneInversionTolerance = 0.15;
+// Relative error above which a colour counts as not skin (not invertible): 0.35 (35 % of the colour's magnitude).
+// Scanned skin is more saturated than the model reaches (the scanned head's typical texel is 5–20 % away); what the
+// model does not explain is kept by the re-toning's ratio.
+constexpr double kToneInversionTolerance = 0.35;
 
 // Re-tones a linear RGBA float image in place (4 floats per texel): per texel, estimate (C_m, C_h); scale C_m by
 // tone.melanin / (the median C_m of the map's invertible texels), so the map's typical skin lands on the tone and
-// freckles keep their melanin ratio; multiply the texel by albedo(C_m', C_h) / albedo(C_m, C_h). Texels the model
-// cannot invert (error above the tolerance, e.g. eyes or hair) are kept. Returns the share of texels re-toned; throws InputError naming
+// freckles keep their melanin ratio; multiply the texel by albedo(C_m', C_h) / albedo(C_m, C_h). Texels that are not
+// skin (error above the tolerance, or not a skin hue: red < 1.1 × green or green < blue; eyes, whites) are kept. Returns the share of texels re-toned; throws InputError naming
 // `where` and `key` when fewer than half of the texels with any colour can be inverted (the map is not skin).
 double retoneAlbedo(std::vector<float>& rgba, const SkinTone& tone, std::string_view where, std::string_view key);
 

@@ -179,7 +179,9 @@ TEST(SkinModel, InversionRecoversTheLevelsAndRejectsNonSkinColours) {
             const ToneEstimate estimate = table.invert(table.albedo(m, h));
             EXPECT_NEAR(estimate.melanin / m, 1.0, 0.02) << m << " " << h;
             // Haemoglobin shows through light skin only: under much melanin the dermis is barely seen.
-            if (m <= 0.03) EXPECT_NEAR(estimate.haemoglobin / h, 1.0, 0.05) << m << " " << h;
+            if (m <= 0.03) {
+                EXPECT_NEAR(estimate.haemoglobin / h, 1.0, 0.05) << m << " " << h;
+            }
             EXPECT_LT(estimate.error, 1e-3);
             // The table agrees with the model evaluated directly.
             const auto direct = skinOptics(tone(m, h)).albedo;
@@ -209,10 +211,10 @@ TEST(SkinModel, RetoningKeepsDetailAndMovesTheTone) {
     // Detail kept: darker texels stay darker and brighter ones brighter; their melanin ratio is kept, so on darker
     // skin the same ratio shows as more contrast (log contrast between 1× and 2.5× the original).
     for (int i : {0, 2}) {
-        const double before = std::log(factors[i]);
-        const double after = std::log(rgba[static_cast<std::size_t>(4 * i + 1)] / rgba[4 + 1]);
-        EXPECT_GE(after / before, 1.0) << i;
-        EXPECT_LE(after / before, 2.5) << i;
+        const double original = std::log(factors[i]);
+        const double retoned = std::log(rgba[static_cast<std::size_t>(4 * i + 1)] / rgba[4 + 1]);
+        EXPECT_GE(retoned / original, 1.0) << i;
+        EXPECT_LE(retoned / original, 2.5) << i;
     }
     // The blue texel is kept as it was.
     for (int c = 0; c < 4; ++c) EXPECT_EQ(rgba[16 + c], before[16 + c]);
