@@ -28,9 +28,10 @@ std::unique_ptr<Marginal> makeMarginal(const SssParams& params) {
         if (params.material != "skin")
             throwInput("", "sss.material",
                        "'" + params.material + "' has no d'Eon profile (only 'skin'); use sss.profile = \"burley\"");
-        return std::make_unique<GaussianSumProfile>(
-            skinProfileLobes(params), params.skinLobeWeights ? "six-Gaussian profile of the [skin] tone (d'Eon's variances)"
-                                                             : "d'Eon six-Gaussian skin profile");
+        return std::make_unique<GaussianSumProfile>(skinProfileLobes(params),
+                                                    params.skinLobeWeights
+                                                        ? "six-Gaussian profile of the [skin] tone (d'Eon's variances)"
+                                                        : "d'Eon six-Gaussian skin profile");
     }
     throwInput("", "sss.profile", "'" + params.profile + "' is not one of: deon, burley, file:PATH");
 }

@@ -41,13 +41,13 @@ constexpr SkinSpectrum kD65{82.7549, 91.4860, 93.4318, 86.6823, 104.865, 117.008
 // Molar extinction of oxy- and deoxy-haemoglobin (cm⁻¹/M), 400–700 nm every 10 nm: S. Prahl, "Optical Absorption
 // of Hemoglobin", Oregon Medical Laser Center, 1999 (compiled from W. B. Gratzer and N. Kollias),
 // https://omlc.org/spectra/hemoglobin/summary.html.
-constexpr SkinSpectrum kOxyExtinction{266232, 466840, 480360, 246072, 102580, 62816,  44480,  33209.2,
-                                      26629.2, 23684.4, 20932.8, 20035.2, 24202.4, 39956.8, 53236,  43016,
-                                      32613.2, 44496,  50104,  14400.8, 3200,   1506,   942,    610,
-                                      442,    368,    319.6,  294,    277.6,  276,    290};
-constexpr SkinSpectrum kDeoxyExtinction{223296, 303956, 407560,  528600,  413280,  103292,  23388.8, 16156.4,
-                                        14550,  16684,  20862,   25773.6, 31589.6, 39036.4, 46592,   53412,
-                                        53788,  45072,  37020,   28324.4, 14677.2, 9443.6,  6509.6,  5148.8,
+constexpr SkinSpectrum kOxyExtinction{266232,  466840,  480360,  246072,  102580,  62816,   44480, 33209.2,
+                                      26629.2, 23684.4, 20932.8, 20035.2, 24202.4, 39956.8, 53236, 43016,
+                                      32613.2, 44496,   50104,   14400.8, 3200,    1506,    942,   610,
+                                      442,     368,     319.6,   294,     277.6,   276,     290};
+constexpr SkinSpectrum kDeoxyExtinction{223296, 303956,  407560,  528600,  413280,  103292,  23388.8, 16156.4,
+                                        14550,  16684,   20862,   25773.6, 31589.6, 39036.4, 46592,   53412,
+                                        53788,  45072,   37020,   28324.4, 14677.2, 9443.6,  6509.6,  5148.8,
                                         4345.2, 3750.12, 3226.56, 2795.12, 2407.92, 2051.96, 1794.28};
 
 // XYZ → linear sRGB (IEC 61966-2-1).
@@ -57,7 +57,7 @@ constexpr std::array<std::array<double, 3>, 3> kXyzToSrgb{{
     {0.0557, -0.2040, 1.0570},
 }};
 
-constexpr double kOxygenSaturation = 0.75;       // γ, Donner & Jensen 2006
+constexpr double kOxygenSaturation = 0.75;         // γ, Donner & Jensen 2006
 constexpr double kHaemoglobinInBloodGPerL = 150.0; // Prahl 1999
 constexpr double kHaemoglobinMolarMass = 64500.0;  // g/mol, Prahl 1999
 
@@ -96,9 +96,7 @@ const std::array<SkinSpectrum, 3>& channelResponses() {
     return responses;
 }
 
-double diffuseFresnelReflectance(double eta) {
-    return -1.440 / (eta * eta) + 0.710 / eta + 0.668 + 0.0636 * eta;
-}
+double diffuseFresnelReflectance(double eta) { return -1.440 / (eta * eta) + 0.710 / eta + 0.668 + 0.0636 * eta; }
 
 double signedExp(double z, double sigmaTr) { return (z >= 0.0 ? 1.0 : -1.0) * std::exp(-sigmaTr * std::abs(z)); }
 
@@ -211,9 +209,7 @@ std::array<double, 3> reflectanceToLinearSrgb(const SkinSpectrum& reflectance) {
     return rgb;
 }
 
-double linearLuminance(const std::array<double, 3>& rgb) {
-    return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
-}
+double linearLuminance(const std::array<double, 3>& rgb) { return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]; }
 
 void validateSkinTone(const SkinTone& tone, std::string_view where) {
     checkRange(where, "skin.melanin", tone.melanin, kMelaninMin, kMelaninMax);
@@ -280,8 +276,7 @@ SkinOptics skinOptics(const SkinTone& tone, std::string_view where) {
         double total = 0.0;
         for (int i = 0; i < kSkinSpectralSamples; ++i) {
             const LayerCoefficients dermis = dermisCoefficients(tone, i);
-            const double sigmaTr =
-                std::sqrt(3.0 * dermis.absorption * (dermis.absorption + dermis.reducedScattering));
+            const double sigmaTr = std::sqrt(3.0 * dermis.absorption * (dermis.absorption + dermis.reducedScattering));
             const double weight = responses[c][i] * reflectance[i];
             weighted += weight / sigmaTr;
             total += weight;
@@ -382,10 +377,10 @@ double logDistance(const std::array<double, 3>& a, const std::array<double, 3>& 
 } // namespace
 
 std::array<double, 3> SkinToneTable::albedo(double melanin, double haemoglobin) const {
-    const double mc = std::clamp(gridCoordinate(melanin, kMelaninMin, kMelaninMax, melaninSteps_), 0.0,
-                                 double(melaninSteps_ - 1));
-    const double hc = std::clamp(gridCoordinate(haemoglobin, kHaemoglobinMin, kHaemoglobinMax, haemoglobinSteps_),
-                                 0.0, double(haemoglobinSteps_ - 1));
+    const double mc =
+        std::clamp(gridCoordinate(melanin, kMelaninMin, kMelaninMax, melaninSteps_), 0.0, double(melaninSteps_ - 1));
+    const double hc = std::clamp(gridCoordinate(haemoglobin, kHaemoglobinMin, kHaemoglobinMax, haemoglobinSteps_), 0.0,
+                                 double(haemoglobinSteps_ - 1));
     const int m0 = std::min(static_cast<int>(mc), melaninSteps_ - 2);
     const int h0 = std::min(static_cast<int>(hc), haemoglobinSteps_ - 2);
     const double fm = mc - m0, fh = hc - h0;

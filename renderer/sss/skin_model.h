@@ -56,10 +56,10 @@ constexpr double kHaemoglobinMin = 0.001;
 constexpr double kHaemoglobinMax = 0.1;
 
 struct SkinTone {
-    double melanin = 0.02;       // C_m, epidermal melanin volume fraction
-    double melaninBlend = 0.7;   // β_m, eumelanin share of the melanin (the rest pheomelanin)
-    double haemoglobin = 0.02;   // C_h, dermal blood volume fraction
-    std::string level;           // named level ("I" … "VI") it came from; empty when given by value
+    double melanin = 0.02;     // C_m, epidermal melanin volume fraction
+    double melaninBlend = 0.7; // β_m, eumelanin share of the melanin (the rest pheomelanin)
+    double haemoglobin = 0.02; // C_h, dermal blood volume fraction
+    std::string level;         // named level ("I" … "VI") it came from; empty when given by value
 };
 
 // Named levels spanning Fitzpatrick I–VI: melanin fractions placed in S. Jacques' published melanosome volume
@@ -113,11 +113,11 @@ double linearLuminance(const std::array<double, 3>& rgb);
 // Everything the renderer takes from a tone.
 struct SkinOptics {
     SkinTone tone;
-    std::array<double, 3> albedo{};           // linear sRGB diffuse albedo
-    double luminance = 0.0;                   // of the albedo
-    std::array<double, 3> meanFreePathMm{};   // ℓd per channel (dermis)
-    std::array<double, 3> burleyShapeMm{};    // d per channel
-    std::vector<GaussianLobe> lobes;          // d'Eon's variances, weights refitted to the Burley profile
+    std::array<double, 3> albedo{};         // linear sRGB diffuse albedo
+    double luminance = 0.0;                 // of the albedo
+    std::array<double, 3> meanFreePathMm{}; // ℓd per channel (dermis)
+    std::array<double, 3> burleyShapeMm{};  // d per channel
+    std::vector<GaussianLobe> lobes;        // d'Eon's variances, weights refitted to the Burley profile
 };
 // Throws InputError naming `where` and the key of a value out of range (skin.melanin, skin.haemoglobin,
 // skin.melanin_blend).

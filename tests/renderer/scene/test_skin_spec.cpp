@@ -25,7 +25,8 @@ std::string errorOf(const std::vector<std::string>& overrides) {
 double kernelSecondMoment(const sss::Kernel& kernel, int channel) {
     double moment = 0.0;
     for (const auto& stage : kernel.stages)
-        for (const auto& tap : stage.taps) moment += tap.weight[static_cast<std::size_t>(channel)] * tap.offsetMm * tap.offsetMm;
+        for (const auto& tap : stage.taps)
+            moment += tap.weight[static_cast<std::size_t>(channel)] * tap.offsetMm * tap.offsetMm;
     return moment;
 }
 
@@ -97,7 +98,8 @@ TEST(SkinSpec, BadValuesNameTheirKey) {
     EXPECT_EQ(errorOf({"skin.melanin=0.7"}), "builtin:head: skin.melanin: 0.7 is out of range [0.001, 0.5]");
     EXPECT_EQ(errorOf({"skin.melanin=0.1", "skin.haemoglobin=0.5"}),
               "builtin:head: skin.haemoglobin: 0.5 is out of range [0.001, 0.1]");
-    EXPECT_EQ(errorOf({"skin.tone=\"VII\""}).rfind("builtin:head: skin.tone: ", 0), 0u) << errorOf({"skin.tone=\"VII\""});
+    EXPECT_EQ(errorOf({"skin.tone=\"VII\""}).rfind("builtin:head: skin.tone: ", 0), 0u)
+        << errorOf({"skin.tone=\"VII\""});
     EXPECT_EQ(errorOf({"skin.tone=\"II\"", "skin.melanin=0.1"}),
               "builtin:head: skin.melanin: give skin.tone or skin.melanin, not both");
     EXPECT_EQ(errorOf({"skin.haemoglobin=0.05"}),

@@ -145,7 +145,8 @@ TEST(SkinModel, ProfileNarrowsWithMelaninAndRedReachesFarthest) {
             for (double k : {1.0, 3.0, 6.0}) {
                 const double r = k * o->burleyShapeMm[c];
                 double cdf = 0.0;
-                for (const auto& lobe : o->lobes) cdf += lobe.weight[c] * -std::expm1(-r * r / (2.0 * lobe.varianceMm2));
+                for (const auto& lobe : o->lobes)
+                    cdf += lobe.weight[c] * -std::expm1(-r * r / (2.0 * lobe.varianceMm2));
                 EXPECT_NEAR(cdf, burley.radialCumulative(c, r), c == 0 ? 0.1 : 0.2)
                     << "channel " << c << " r = " << k << " d";
             }
