@@ -48,8 +48,8 @@ using SkinSpectrum = std::array<double, kSkinSpectralSamples>;
 double skinWavelengthNm(int sample);
 
 // Ranges accepted for the model's parameters (inclusive). Melanin: 0.1 % (albinism-like) to 50 %, the upper end of
-// Jacques' darkly pigmented range (18–43 % melanosome volume fraction) with margin; haemoglobin: 0.1 % to 10 %,
-// Donner & Jensen's 2006 range; blend: a share in [0, 1].
+// Jacques' darkly pigmented range (18–43 % melanosome volume fraction) with margin; haemoglobin: 0.1 % to 10 % of
+// the dermis' volume (this project's range, pale to flushed skin); blend: a share in [0, 1].
 constexpr double kMelaninMin = 0.001;
 constexpr double kMelaninMax = 0.5;
 constexpr double kHaemoglobinMin = 0.001;
