@@ -208,6 +208,25 @@ struct Renderer::Impl {
         return shared;
     }
 
+    // The albedo map the scene shows: the spec's file, re-toned through the skin model under [skin]
+    // (sss::retoneAlbedo), or the model's own map (builtin:head's procedural detail, which the tone's material
+    // albedo multiplies).
+    std::shared_ptr<const Image> albedoMapOf(const SceneSpec& spec, const Model& model) {
+        if (spec.textures.albedo.empty()) return model.albedoMap;
+        const auto loaded = image(spec.textures.albedo, ColorEncoding::sRGB);
+        if (!spec.skin) return loaded;
+        const sss::SkinTone& tone = spec.skin->tone;
+        const std::string key = spec.textures.albedo.string() + "|retone|" + std::to_string(tone.melanin) + "|" +
+                                std::to_string(tone.melaninBlend);
+        if (auto found = images.find(key); found != images.end()) return found->second;
+        Image retoned = *loaded;
+        sss::retoneAlbedo(retoned.pixels, tone, spec.source, tone.level.empty() ? "skin.melanin" : "skin.tone");
+        auto shared = std::make_shared<const Image>(std::move(retoned));
+        if (images.size() > 16) images.clear();
+        images[key] = shared;
+        return shared;
+    }
+
     const CachedEnvironment& environment(const EnvironmentSpec& spec) {
         std::string key = spec.file.string();
         if (spec.file.empty())
@@ -249,6 +268,7 @@ std::vector<gl::GpuMaterial> partMaterialsOf(const SceneSpec& spec, const Model&
     std::vector<gl::GpuMaterial> byMaterial;
     for (const MeshMaterial& m : model.materials)
         byMaterial.push_back({m.albedo, m.skin ? 1.0f : 0.0f, m.glossiness, m.specularIntensity});
+    std::vector<bool> explicitAlbedo(model.materials.size(), false);
     for (std::size_t i = 0; i < spec.materials.size(); ++i) {
         const MaterialSpec& override = spec.materials[i];
         bool matched = false;
@@ -256,7 +276,7 @@ std::vector<gl::GpuMaterial> partMaterialsOf(const SceneSpec& spec, const Model&
             if (override.name != "*" && override.name != model.materials[m].name) continue;
             matched = true;
             gl::GpuMaterial& target = byMaterial[m];
-            if (override.albedo) target.albedo = *override.albedo;
+            if (override.albedo) target.albedo = *override.albedo, explicitAlbedo[m] = true;
             if (override.skin) target.skin = *override.skin ? 1.0f : 0.0f;
             if (override.glossiness) target.glossiness = static_cast<float>(*override.glossiness);
             if (override.specularIntensity) target.specularIntensity = static_cast<float>(*override.specularIntensity);
@@ -268,6 +288,16 @@ std::vector<gl::GpuMaterial> partMaterialsOf(const SceneSpec& spec, const Model&
                        "no material '" + override.name + "' in the model (it has: " + names + "; \"*\" means all)");
         }
     }
+    // [skin] without an albedo map of the spec: skin materials take the tone's albedo (builtin:head's procedural map
+    // multiplies it, so its detail stays); a spec's albedo map is re-toned instead (albedoMapOf). [[materials]]
+    // albedo overrides win.
+    if (spec.skin && spec.textures.albedo.empty())
+        for (std::size_t m = 0; m < byMaterial.size(); ++m)
+            if (byMaterial[m].skin > 0.0f && !explicitAlbedo[m]) {
+                const auto& a = spec.skin->albedo;
+                byMaterial[m].albedo =
+                    glm::vec3(static_cast<float>(a[0]), static_cast<float>(a[1]), static_cast<float>(a[2]));
+            }
     std::vector<gl::GpuMaterial> parts;
     for (const SubMesh& part : model.parts) parts.push_back(byMaterial.at(part.material));
     return parts;
@@ -389,6 +419,14 @@ gl::MainPassSettings Renderer::Impl::runLightingPasses(const Frame& frame, bool 
         spec.transmittance.curvature && spec.transmittance.curvatureForm == "thesis";
     mainSettings.curvatureReferenceMm = static_cast<float>(spec.sss.curvatureReferenceMm);
     mainSettings.mmPerUnit = static_cast<float>(spec.mmPerUnit);
+    if (spec.sss.skinLobeWeights) {
+        std::array<glm::vec3, 6> weights{};
+        for (std::size_t k = 0; k < 6; ++k) {
+            const auto& w = (*spec.sss.skinLobeWeights)[k];
+            weights[k] = glm::vec3(static_cast<float>(w[0]), static_cast<float>(w[1]), static_cast<float>(w[2]));
+        }
+        mainSettings.transmittanceWeights = weights;
+    }
     mainPass.run(targets, *frame.scene, shadowMapPass.shadowMaps(), mainSettings);
     passTimer.end();
 
@@ -513,6 +551,7 @@ std::string residentSceneKeyOf(const SceneSpec& spec) {
                           {"model", r.value("model", nlohmann::json())},
                           {"textures", r.value("textures", nlohmann::json())},
                           {"materials", r.value("materials", nlohmann::json())},
+                          {"skin", r.value("skin", nlohmann::json())},
                           {"environment", r.value("environment", nlohmann::json())}}
         .dump();
 }
@@ -552,8 +591,7 @@ DisplayFrame Renderer::renderDisplay(const RenderRequest& request, bool withLine
         impl.residentSceneKey.clear();
         impl.shadowKey.clear();
         impl.lightingKey.clear();
-        const auto albedoMap = spec.textures.albedo.empty() ? frame.model->albedoMap
-                                                            : impl.image(spec.textures.albedo, ColorEncoding::sRGB);
+        const auto albedoMap = impl.albedoMapOf(spec, *frame.model);
         const auto normalMap = spec.textures.normal.empty() ? frame.model->normalMap
                                                             : impl.image(spec.textures.normal, ColorEncoding::Data);
         const auto specularMap = impl.image(spec.textures.specular, ColorEncoding::Data);
@@ -661,8 +699,7 @@ RenderResult Renderer::render(const RenderRequest& request) {
     frame.model = impl.model(spec);
     frame.partMaterials = partMaterialsOf(spec, *frame.model);
     // A spec's maps replace the ones the model brings (builtin:head's procedural skin detail).
-    const auto albedoMap =
-        spec.textures.albedo.empty() ? frame.model->albedoMap : impl.image(spec.textures.albedo, ColorEncoding::sRGB);
+    const auto albedoMap = impl.albedoMapOf(spec, *frame.model);
     const auto normalMap =
         spec.textures.normal.empty() ? frame.model->normalMap : impl.image(spec.textures.normal, ColorEncoding::Data);
     const auto specularMap = impl.image(spec.textures.specular, ColorEncoding::Data);
@@ -711,6 +748,7 @@ RenderResult Renderer::render(const RenderRequest& request) {
             cyclesInputs.partMaterials.push_back({m.albedo, m.skin, m.glossiness, m.specularIntensity});
         cyclesInputs.camera = frame.camera;
         cyclesInputs.sssWidthMm = spec.sss.widthMm;
+        if (spec.skin && !spec.textures.albedo.empty()) cyclesInputs.retonedAlbedoMap = albedoMap.get();
         if (eevee) {
             cyclesInputs.params = spec.eevee.sceneParams();
             cyclesInputs.eeveeSettings = spec.eevee.toJson();

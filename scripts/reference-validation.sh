@@ -27,7 +27,8 @@
 # REFERENCE_CONVEXITY_MM (sss.reference_convexity_mm: default [0.88, 0.32, 0.28], the path tracer's level on convex
 # skin; [0, 0, 0] is the evaluation table's), HEAD_SKIN_DETAIL (builtin:head's model.skin_detail, default true;
 # false gives the smooth head), EAR_KEY_LIGHT (builtin:ear's key light: back, the default, shows the through-light;
-# front does not), SKINLAB_ASSETS (without the scanned head its case is
+# front does not), SKIN_TONE (a [skin] tone level "I" … "VI" for every case; builtin:head's skin then takes the
+# tone's albedo, the scan's map is re-toned; docs/skin-tones.md), SKINLAB_ASSETS (without the scanned head its case is
 # skipped with a message), CASES (a space-separated subset of: halo-5 halo-200 bleed ear head scan).
 # Every scene key that matters is written out below (model, materials, camera, lights, environment, SSS width,
 # the path tracer's settings), so the numbers do not move with the built-in scenes' defaults. Rerunning resumes:
@@ -164,6 +165,9 @@ EOF
 }
 
 head_scene() {
+  # With SKIN_TONE the skin material takes the tone's albedo (no albedo of its own) and [skin] is written.
+  local albedo_line='albedo = [0.60, 0.42, 0.34]'
+  [ -n "${SKIN_TONE:-}" ] && albedo_line='# albedo: the [skin] tone'"'"'s'
   cat <<EOF
 mm_per_unit = 1.0
 
@@ -173,7 +177,7 @@ skin_detail = ${head_detail}
 
 [[materials]]
 name = "skin"
-albedo = [0.60, 0.42, 0.34]
+$albedo_line
 skin = true
 glossiness = 0.5
 specular_intensity = 1.0

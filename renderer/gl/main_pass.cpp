@@ -49,6 +49,11 @@ void MainPass::bindShading(GLuint program, const GpuScene& scene, GLuint shadowM
     setUniform(program, "transmittanceThesisCurvature", settings.transmittanceThesisCurvature ? 1 : 0);
     setUniform(program, "transmittanceCurvatureScale",
                settings.camera.focalLengthPixels / 8.0f * settings.curvatureReferenceMm / settings.mmPerUnit);
+    setUniform(program, "transmittanceToneWeights", settings.transmittanceWeights ? 1 : 0);
+    for (int k = 0; k < 6; ++k)
+        setUniform(program, ("transmittanceWeight" + std::to_string(k)).c_str(),
+                   settings.transmittanceWeights ? (*settings.transmittanceWeights)[static_cast<std::size_t>(k)]
+                                                 : glm::vec3(0.0f));
     setUniform(program, "transmittanceScale",
                static_cast<float>(sss::transmittanceScalePerUnit(
                    settings.translucency, std::max(settings.sssWidthMm, 1e-6f), settings.mmPerUnit)));

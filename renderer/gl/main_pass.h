@@ -6,6 +6,9 @@
 #include "renderer/gl/shader_library.h"
 #include "renderer/scene/scene_spec.h"
 
+#include <array>
+#include <optional>
+
 namespace skinlab::renderer::gl {
 
 // Transmittance (Jimenez et al., IEEE CG&A 2010): the shaded point is moved this far inside the surface along its
@@ -31,6 +34,8 @@ struct MainPassSettings {
     // unit: × f_px / 8, as in surface_aovs.frag).
     bool transmittanceThesisCurvature = false;
     float curvatureReferenceMm = 20.0f;
+    // The [skin] tone's weights on d'Eon's six variances (sss::skinProfileLobes); empty: d'Eon's own table.
+    std::optional<std::array<glm::vec3, 6>> transmittanceWeights;
 };
 
 class MainPass {

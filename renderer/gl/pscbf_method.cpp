@@ -5,6 +5,7 @@
 #include "renderer/gl/sss_blur_pass.h"
 #include "renderer/gl/sss_extension_settings.h"
 #include "renderer/sss/pscbf_kernel.h"
+#include "renderer/sss/skin_model.h"
 
 #include <cmath>
 #include <vector>
@@ -24,7 +25,7 @@ constexpr int kMaxTaps = 101; // PSCBF_MAX_TAPS of the shader (sss.samples ≤ 1
 PscbfMethod::PscbfMethod(ShaderLibrary& shaders) : shaders_(shaders) {}
 
 glm::dvec3 PscbfMethod::depthSigmaMm(const sss::SssParams& params) {
-    const auto& variance = sss::mikkelsenSkinProfile(params.pscbfSigma).varianceMm2;
+    const auto variance = sss::skinPscbfProfile(params).varianceMm2;
     const double scale = sss::profileScale(params.widthMm);
     return {std::sqrt(variance[0]) * scale, std::sqrt(variance[1]) * scale, std::sqrt(variance[2]) * scale};
 }

@@ -1,6 +1,7 @@
 #include "renderer/pathtraced/blender_scene.h"
 #include "renderer/output/exr_writer.h"
 #include "renderer/scene/texture.h"
+#include "renderer/sss/skin_model.h"
 #include "renderer/sss/sss_params.h"
 
 #include "common/error.h"
@@ -80,6 +81,8 @@ std::vector<ModelMapFile> modelMapFiles(const BlenderSceneInputs& inputs) {
     std::vector<ModelMapFile> files;
     if (inputs.spec->textures.albedo.empty() && inputs.model->albedoMap)
         files.push_back({"albedo", "model-albedo.exr", inputs.model->albedoMap.get()});
+    if (!inputs.spec->textures.albedo.empty() && inputs.retonedAlbedoMap)
+        files.push_back({"albedo", "retoned-albedo.exr", inputs.retonedAlbedoMap});
     if (inputs.spec->textures.normal.empty() && inputs.model->normalMap)
         files.push_back({"normal", "model-normal.exr", inputs.model->normalMap.get()});
     return files;
@@ -95,6 +98,9 @@ nlohmann::json materialsJson(const BlenderSceneInputs& inputs) {
     const SceneSpec& spec = *inputs.spec;
     const PathtracedParams& p = inputs.params;
     const double radiusScale = sss::profileScale(inputs.sssWidthMm) / spec.mmPerUnit;
+    // A [skin] tone: the radii (fitted to d'Eon's profile) scale by the tone's profile width over d'Eon's, per
+    // channel (sss::skinWidthRatio; (1, 1, 1) without [skin]).
+    const std::array<double, 3> tone = sss::skinWidthRatio(spec.sss);
     nlohmann::json materials = nlohmann::json::array();
     for (std::size_t i = 0; i < inputs.partMaterials.size(); ++i) {
         const PartMaterial& m = inputs.partMaterials[i];
@@ -104,7 +110,9 @@ nlohmann::json materialsJson(const BlenderSceneInputs& inputs) {
              {"skin", m.skin},
              {"sss", p.sss},
              {"diffuse", p.diffuse},
-             {"radius", {p.radiusMm[0] * radiusScale, p.radiusMm[1] * radiusScale, p.radiusMm[2] * radiusScale}},
+             {"radius",
+              {p.radiusMm[0] * radiusScale * tone[0], p.radiusMm[1] * radiusScale * tone[1],
+               p.radiusMm[2] * radiusScale * tone[2]}},
              {"roughness", principledRoughness(m.glossiness)},
              {"specular",
               p.specular && p.specularSource == "cycles" ? principledSpecular(kSkinF0) * m.specularIntensity : 0.0}});
@@ -117,7 +125,8 @@ nlohmann::json materialsJson(const BlenderSceneInputs& inputs) {
         nlohmann::json radius = nlohmann::json::array();
         for (int c = 0; c < 3; ++c) {
             nlohmann::json channel = nlohmann::json::array();
-            for (const double a : table.albedo) channel.push_back(radiusAtAlbedoMm(p, c, a) * radiusScale);
+            for (const double a : table.albedo)
+                channel.push_back(radiusAtAlbedoMm(p, c, a) * radiusScale * tone[static_cast<std::size_t>(c)]);
             radius.push_back(channel);
         }
         const nlohmann::json radiusTable = {{"albedo", table.albedo}, {"radius", radius}};

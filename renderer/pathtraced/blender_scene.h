@@ -29,6 +29,8 @@ struct BlenderSceneInputs {
     CameraPose camera;
     PathtracedParams params;
     double sssWidthMm = 3.0; // sss.width_mm: radii scale by width_mm / 3
+    // [skin] with a spec albedo map: the map re-toned through the skin model, written beside the scene in its place.
+    const Image* retonedAlbedoMap = nullptr;
     // "cycles" (sss.method = "pathtraced") or "eevee" (sss.method = "eevee"): the same scene, another engine.
     std::string engine = "cycles";
     // engine "eevee": EEVEE's own settings (keys of scene.json's settings.eevee, cycles_scene.py configure_eevee).

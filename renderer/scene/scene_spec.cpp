@@ -3,6 +3,7 @@
 #include "common/error.h"
 #include "common/spec.h"
 #include "renderer/scene/builtin_scenes.h"
+#include "renderer/scene/skin_spec.h"
 #include "renderer/sss/eevee_params.h"
 #include "renderer/sss/pathtraced_params.h"
 #include "renderer/sss/sss_params.h"
@@ -360,6 +361,8 @@ SceneSpec loadSceneSpec(const std::string& scene, const std::vector<std::string>
     readRender(root, spec, resolved);
     readToneMap(root, spec, resolved);
     readMethodTables(root, spec, resolved);
+    spec.skin = readSkinTable(root, resolved);
+    if (spec.skin) sss::applySkinTone(*spec.skin, spec.sss);
     root.finish();
     spec.resolved = resolved;
     return spec;

@@ -8,6 +8,7 @@
 // relative path is relative to the spec file's folder.
 #include "renderer/sss/eevee_params.h"
 #include "renderer/sss/pathtraced_params.h"
+#include "renderer/sss/skin_model.h"
 #include "renderer/sss/sss_params.h"
 
 #include <array>
@@ -117,6 +118,9 @@ struct SceneSpec {
     pathtraced::PathtracedParams pathtraced;
     // [eevee], typed (renderer/sss/eevee_params.h); recorded in `resolved` only when sss.method = "eevee".
     pathtraced::EeveeParams eevee;
+    // [skin] (renderer/scene/skin_spec.h, docs/skin-tones.md): the tone and what the model derives from it; its
+    // profile is also written into `sss` (SssParams::skinLobeWeights, skinShapeMm). Absent: the scene's own skin.
+    std::optional<sss::SkinOptics> skin;
 
     nlohmann::json resolved; // every parameter after defaults and overrides
 };

@@ -72,6 +72,13 @@ uniform float transmittanceShrink;  // world units: the point is moved this far 
 uniform float transmittanceScale;   // scaled thickness s (mm) per world unit of thickness
 uniform int transmittanceThesisCurvature;   // transmittance.curvature_form = "thesis": s / (1 + 2c)
 uniform float transmittanceCurvatureScale;  // c per unit of the thesis' raw measure: f_px / 8 · reference mm / mm_per_unit
+uniform int transmittanceToneWeights;       // 1: the [skin] tone's weights below instead of d'Eon's table
+uniform vec3 transmittanceWeight0;          // the tone's weights of d'Eon's lobes 0 … 5 (renderer/sss/skin_model.h)
+uniform vec3 transmittanceWeight1;
+uniform vec3 transmittanceWeight2;
+uniform vec3 transmittanceWeight3;
+uniform vec3 transmittanceWeight4;
+uniform vec3 transmittanceWeight5;
 
 uniform vec3 irradianceSH[9];        // A_l * L_lm (renderer/scene/environment.h), environment frame
 uniform mat3 environmentFromWorld;   // inverse of the environment's rotation about +Y
@@ -195,7 +202,14 @@ void main() {
         float facing = clamp(0.3 + dot(toLight, -geometricNormal), 0.0, 1.0);
         if (transmittanceEnabled != 0 && lightShadowLayer[i] >= 0 && mask > 0.0 && facing > 0.0) {
             float thickness = thicknessToLight(i, worldPosition, geometricNormal);
-            if (thickness >= 0.0) transmittedSum += radiance * deonTransmittance(thickness * transmittanceScale / transmittanceWidening) * facing;
+            if (thickness >= 0.0) {
+                float s = thickness * transmittanceScale / transmittanceWidening;
+                vec3 t = transmittanceToneWeights != 0
+                             ? toneTransmittance(s, transmittanceWeight0, transmittanceWeight1, transmittanceWeight2,
+                                                 transmittanceWeight3, transmittanceWeight4, transmittanceWeight5)
+                             : deonTransmittance(s);
+                transmittedSum += radiance * t * facing;
+            }
         }
     }
     vec3 ambient = max(irradiance(environmentFromWorld * normal), vec3(0.0)) / 3.14159265358979 * occlusion;

@@ -13,3 +13,11 @@ vec3 deonTransmittance(float thicknessMm) {
            vec3(0.358, 0.004, 0.0) * exp(-s2 / 1.99) +
            vec3(0.078, 0.0, 0.0) * exp(-s2 / 7.41);
 }
+
+// The same form with the weights of a [skin] tone on d'Eon's six variances (renderer/sss/skin_model.h,
+// skinTransmittance()); each channel's weights sum to 1, so T(0) = 1 per channel.
+vec3 toneTransmittance(float thicknessMm, vec3 w0, vec3 w1, vec3 w2, vec3 w3, vec3 w4, vec3 w5) {
+    float s2 = thicknessMm * thicknessMm;
+    return w0 * exp(-s2 / 0.0064) + w1 * exp(-s2 / 0.0484) + w2 * exp(-s2 / 0.187) + w3 * exp(-s2 / 0.567) +
+           w4 * exp(-s2 / 1.99) + w5 * exp(-s2 / 7.41);
+}

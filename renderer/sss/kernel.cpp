@@ -5,6 +5,7 @@
 #include "renderer/sss/gaussian_sum_profile.h"
 #include "renderer/sss/materials.h"
 #include "renderer/sss/method.h"
+#include "renderer/sss/skin_model.h"
 #include "renderer/sss/tabulated_kernel.h"
 
 #include <algorithm>
@@ -21,13 +22,16 @@ std::unique_ptr<Marginal> makeMarginal(const SssParams& params) {
     if (params.profile.rfind("file:", 0) == 0)
         return std::make_unique<TabulatedMarginal>(TabulatedMarginal::fromFile(params.profile.substr(5)));
     if (params.profile == "burley")
-        return std::make_unique<BurleyProfile>(burleyShapeMm(params.material),
+        return std::make_unique<BurleyProfile>(skinBurleyShapeMm(params),
                                                "Burley normalized diffusion, material " + params.material);
     if (params.profile == "deon") {
         if (params.material != "skin")
             throwInput("", "sss.material",
                        "'" + params.material + "' has no d'Eon profile (only 'skin'); use sss.profile = \"burley\"");
-        return std::make_unique<GaussianSumProfile>(deonSkinLobes(), "d'Eon six-Gaussian skin profile");
+        return std::make_unique<GaussianSumProfile>(skinProfileLobes(params),
+                                                    params.skinLobeWeights
+                                                        ? "six-Gaussian profile of the [skin] tone (d'Eon's variances)"
+                                                        : "d'Eon six-Gaussian skin profile");
     }
     throwInput("", "sss.profile", "'" + params.profile + "' is not one of: deon, burley, file:PATH");
 }

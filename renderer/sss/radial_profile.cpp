@@ -4,6 +4,7 @@
 #include "renderer/sss/burley_profile.h"
 #include "renderer/sss/gaussian_sum_profile.h"
 #include "renderer/sss/materials.h"
+#include "renderer/sss/skin_model.h"
 
 #include <algorithm>
 #include <cmath>
@@ -14,8 +15,8 @@ namespace {
 // d'Eon's sum of Gaussians: the radial CDF of G(v, ·) is 1 − exp(−r²/(2v)).
 class GaussianSumRadial final : public RadialProfile {
 public:
-    explicit GaussianSumRadial(double scale)
-        : profile_(deonSkinLobes(), "d'Eon six-Gaussian skin profile"), scale_(scale) {
+    GaussianSumRadial(std::vector<GaussianLobe> lobes, double scale)
+        : profile_(std::move(lobes), "d'Eon six-Gaussian skin profile"), scale_(scale) {
         for (const auto& lobe : profile_.lobes())
             for (int c = 0; c < 3; ++c) totals_[c] += lobe.weight[c];
     }
@@ -39,8 +40,8 @@ private:
 
 class BurleyRadial final : public RadialProfile {
 public:
-    BurleyRadial(const std::string& material, double scale)
-        : profile_(burleyShapeMm(material), "Burley normalized diffusion, material " + material), scale_(scale) {}
+    BurleyRadial(const std::array<double, 3>& shapeMm, const std::string& material, double scale)
+        : profile_(shapeMm, "Burley normalized diffusion, material " + material), scale_(scale) {}
     std::string description() const override { return profile_.description(); }
     double radial(int channel, double rMm) const override {
         return scale_ * scale_ * profile_.radial(channel, scale_ * rMm);
@@ -76,8 +77,9 @@ std::unique_ptr<RadialProfile> makeRadialProfile(const SssParams& params) {
     if (!(params.widthMm > 0.0)) throwInput("", "sss.width_mm", "must be positive");
     // Surface distance d (mm) ↔ profile distance d / profileScale(width_mm) (renderer/sss/sss_params.h).
     const double scale = kProfileWidthMm / params.widthMm; // 1 / profileScale, as one division
-    if (params.profile == "deon") return std::make_unique<GaussianSumRadial>(scale);
-    if (params.profile == "burley") return std::make_unique<BurleyRadial>(params.material, scale);
+    if (params.profile == "deon") return std::make_unique<GaussianSumRadial>(skinProfileLobes(params), scale);
+    if (params.profile == "burley")
+        return std::make_unique<BurleyRadial>(skinBurleyShapeMm(params), params.material, scale);
     throwInput("", "sss.profile",
                "'" + params.profile + "' has no radial form for the reference method (use deon or burley)");
 }

@@ -5,6 +5,7 @@
 #include <array>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
@@ -165,6 +166,12 @@ struct SssParams {
     // Values of the keys a method declares in its own row (MethodInfo::ownKeys), by key; absent: the declared
     // default. The built-in methods' keys are the typed fields above.
     nlohmann::json own = nlohmann::json::object();
+    // The scene's skin tone ([skin], renderer/sss/skin_model.h), set by the scene reader, not an [sss] key: the
+    // six-Gaussian weights refitted to the tone (by lobe, d'Eon's variances) and its Burley shape d (mm per channel),
+    // which every profile of material "skin" reads instead of d'Eon's light-skin table (skinProfileLobes,
+    // skinBurleyShapeMm in skin_model.h). Empty: d'Eon's.
+    std::optional<std::array<std::array<double, 3>, 6>> skinLobeWeights;
+    std::optional<std::array<double, 3>> skinShapeMm;
 
     // The resolved record: the method and the keys it reads (its row of the method table), nothing else.
     nlohmann::json toJson() const;

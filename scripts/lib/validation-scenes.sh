@@ -20,6 +20,7 @@ operator = "filmic"
 
 [sss]
 width_mm = 3.0
+$(if [ -n "${SKIN_TONE:-}" ]; then printf '\n[skin]\ntone = "%s"\n' "$SKIN_TONE"; fi)
 
 [pathtraced]
 samples = $samples

@@ -2,6 +2,7 @@
 // artistic_kernel.h), one stage run as a horizontal and a vertical pass.
 #include "renderer/sss/artistic_kernel.h"
 #include "renderer/sss/method.h"
+#include "renderer/sss/skin_model.h"
 
 namespace skinlab::renderer::sss {
 
@@ -10,7 +11,8 @@ class ArtisticMethod final : public Method {
 public:
     Kernel kernel(const SssParams& params) const override {
         KernelStage stage;
-        stage.taps = artisticTaps(params.samples, params.artisticStrength, params.artisticFalloff);
+        // A [skin] tone widens each channel's falloff by its profile width over d'Eon's (skinArtisticFalloff).
+        stage.taps = artisticTaps(params.samples, params.artisticStrength, skinArtisticFalloff(params));
         scaleOffsets(stage.taps, profileScale(params.widthMm));
         stage.accumulate = {1.0, 1.0, 1.0};
         Kernel kernel;

@@ -4,6 +4,7 @@
 #include "renderer/sss/discretisation.h"
 #include "renderer/sss/gaussian_sum_profile.h"
 #include "renderer/sss/method.h"
+#include "renderer/sss/skin_model.h"
 
 namespace skinlab::renderer::sss {
 
@@ -14,7 +15,7 @@ public:
         const double scale = profileScale(params.widthMm);
         Kernel kernel;
         double previous = 0.0;
-        for (const auto& lobe : deonSkinLobes()) {
+        for (const auto& lobe : skinProfileLobes(params)) {
             const double variance = lobe.varianceMm2 * scale * scale;
             KernelStage stage;
             stage.varianceMm2 = variance - previous;

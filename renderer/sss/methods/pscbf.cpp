@@ -3,6 +3,7 @@
 // renderer/gl/pscbf_method.h). Offsets scale with width_mm / 3 like every profile.
 #include "renderer/sss/method.h"
 #include "renderer/sss/pscbf_kernel.h"
+#include "renderer/sss/skin_model.h"
 
 namespace skinlab::renderer::sss {
 
@@ -11,7 +12,7 @@ class PscbfMethod final : public Method {
 public:
     Kernel kernel(const SssParams& params) const override {
         const double scale = profileScale(params.widthMm);
-        const PscbfProfile& profile = mikkelsenSkinProfile(params.pscbfSigma);
+        const PscbfProfile profile = skinPscbfProfile(params); // Mikkelsen's, widened by a [skin] tone
         KernelStage stage = makePscbfKernel(profile, params.samples).broadStage();
         scaleOffsets(stage.taps, scale);
         Kernel kernel;
