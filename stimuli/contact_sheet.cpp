@@ -186,7 +186,7 @@ std::string visibilityTableHtml(const nlohmann::json& visibility, const std::str
         if (distance.is_array()) out << "<br>" << cell(distance[k].get<double>(), "%.2f") << " m";
         out << "</th>";
     }
-    out << "<th>visible (≤ " << cell(visibility.value("visible_below_jod", 9.0), "%g") << " JOD) up to</th></tr></thead><tbody>";
+    out << "<th>visible (below " << cell(visibility.value("visible_below_jod", 9.0), "%g") << " JOD) up to</th></tr></thead><tbody>";
     for (const nlohmann::json& row : visibility.at("rows")) {
         if (row.at("block") != block) continue;
         out << "<tr><td class=\"id\">" << escapeHtml(row.at("stimulus").get<std::string>()) << "</td>";
@@ -226,7 +226,7 @@ std::string html(const Manifest& manifest, const std::vector<Block>& blocks,
         << "figcaption{font-size:12px;margin-top:4px}\n.id{font-family:monospace;color:#aaa}\n"
         << "table{border-collapse:collapse}td{padding:0 .6em 0 0;vertical-align:top}\n"
         << "table.visibility{margin:.5em 0 1em}table.visibility th,table.visibility td{padding:2px 8px;"
-           "text-align:right;border-bottom:1px solid #444;font-size:13px}table.visibility td.visible{color:#fc6}\n"
+           "text-align:right;border-bottom:1px solid #444;font-size:13px}table.visibility td.id{text-align:left}table.visibility td.visible{color:#fc6}\n"
         << ".plot{background:#fff;max-width:100%}\n"
         << "</style>\n</head>\n<body>\n<h1>Stimulus set " << escapeHtml(manifest.set) << "</h1>\n";
     if (!manifest.description.empty()) out << "<p>" << escapeHtml(manifest.description) << "</p>\n";

@@ -106,6 +106,25 @@ VisibilityTable computeVisibility(const fs::path& dir, const Manifest& manifest,
         table.pngSha256[found->second->at("id").get<std::string>()] = pngSha(*found->second);
     }
 
+    // Rows block by block (blocks in order of their first stimulus), stimuli in manifest order inside a block.
+    {
+        std::vector<std::string> order;
+        for (const VisibilityRow& row : table.rows)
+            if (std::find(order.begin(), order.end(), row.block) == order.end()) order.push_back(row.block);
+        const auto rank = [&](const std::string& block) { return std::find(order.begin(), order.end(), block); };
+        std::vector<size_t> index(table.rows.size());
+        for (size_t i = 0; i < index.size(); ++i) index[i] = i;
+        std::stable_sort(index.begin(), index.end(),
+                         [&](size_t a, size_t b) { return rank(table.rows[a].block) < rank(table.rows[b].block); });
+        std::vector<VisibilityRow> rows;
+        std::vector<std::pair<const nlohmann::json*, const nlohmann::json*>> sortedPairs;
+        for (size_t i : index) {
+            rows.push_back(table.rows[i]);
+            sortedPairs.push_back(pairs[i]);
+        }
+        table.rows = std::move(rows);
+        pairs = std::move(sortedPairs);
+    }
     // Each image decoded once; every (row, ppd) a task.
     std::map<std::string, cv::Mat> images; // stimulus id → linear display RGB
     for (const auto& [test, reference] : pairs)
@@ -204,7 +223,7 @@ std::string visibilitySvg(const VisibilityTable& table) {
     std::vector<std::string> blocks;
     for (const VisibilityRow& row : table.rows)
         if (std::find(blocks.begin(), blocks.end(), row.block) == blocks.end()) blocks.push_back(row.block);
-    const double panelWidth = 760, plotLeft = 60, plotWidth = 400, plotTop = 46, plotHeight = 220, panelHeight = 320;
+    const double panelWidth = 960, plotLeft = 60, plotWidth = 420, plotTop = 58, plotHeight = 220, panelHeight = 336;
     const double lo = std::log(table.pixelsPerDegree.front()), hi = std::log(table.pixelsPerDegree.back());
     const auto xOf = [&](double ppd) {
         return plotLeft + (hi > lo ? (std::log(ppd) - lo) / (hi - lo) : 0.5) * plotWidth;
@@ -245,7 +264,7 @@ std::string visibilitySvg(const VisibilityTable& table) {
         svg << "<text x=\"" << plotLeft + plotWidth / 2 << "\" y=\"" << top + plotTop + plotHeight + 30
             << "\" text-anchor=\"middle\">pixels per degree (log scale)</text>\n";
         if (!table.distanceMetres.empty())
-            svg << "<text x=\"" << plotLeft + plotWidth / 2 << "\" y=\"" << top + 32
+            svg << "<text x=\"" << plotLeft + plotWidth / 2 << "\" y=\"" << top + 34
                 << "\" text-anchor=\"middle\" fill=\"#666\">viewing distance in m on " << escapeHtml(table.display.name)
                 << "</text>\n";
         svg << "<text transform=\"translate(" << 16 << "," << top + plotTop + plotHeight / 2
