@@ -163,12 +163,12 @@ void runAnalyzeMetrics(const AnalyzeMetricsArguments& arguments) {
         throwInput("--exposure", "",
                    std::to_string(arguments.exposure) +
                        " cannot be combined with --stimuli (the presented images are scored as observers see them)");
-    spdlog::info("metrics: viewing geometry {} ({}), for FLIP and ColorVideoVDP; display-referred scores on {}",
-                 metrics::describeCvvdpDisplay(display), displaySource,
-                 arguments.stimulusFolder.empty() ? "the renders" : "the presented PNGs");
+    const bool presented = !plan.jobs.empty() && !plan.jobs.front().referencePresented.empty();
     auto records = metrics::runMetrics(plan, options, arguments.outputFolder);
-    spdlog::info("metrics: {} comparison(s) written to {}/metrics.csv and metrics.json", records.size(),
-                 arguments.outputFolder);
+    spdlog::info("metrics: {} comparison(s) written to {}/metrics.csv and metrics.json; viewing geometry {} ({}) for "
+                 "FLIP and ColorVideoVDP; display-referred scores on {}",
+                 records.size(), arguments.outputFolder, metrics::describeCvvdpDisplay(display), displaySource,
+                 presented ? "the presented PNGs" : "the renders");
 }
 
 std::string displayNameList() {

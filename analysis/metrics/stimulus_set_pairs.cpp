@@ -4,6 +4,7 @@
 #include "common/files.h"
 #include "common/hash.h"
 
+#include <algorithm>
 #include <map>
 #include <set>
 
@@ -83,7 +84,7 @@ ComparisonPlan planStimulusSetComparisons(const fs::path& stimulusFolder,
         const nlohmann::json& files = member(stimulus, "files", file, where);
         std::string exr = stringMember(files, "exr", file, where + "files.");
         entry.exr = stimulusFolder / exr;
-        entry.png = stimulusFolder / stringMember(files, "png", file, where + "files.");
+        if (files.contains("png")) entry.png = stimulusFolder / stringMember(files, "png", file, where + "files.");
         if (stimulus.contains("reference")) {
             if (!stimulus["reference"].is_boolean()) throwInput(file, where + "reference", "must be true or false");
             entry.reference = stimulus["reference"].get<bool>();
@@ -91,7 +92,7 @@ ComparisonPlan planStimulusSetComparisons(const fs::path& stimulusFolder,
         entry.factors = stimulus.contains("factors") ? stimulus["factors"] : nlohmann::json::object();
         // The content hash ties the metrics to the set as built; a changed file is not silently measured.
         for (const auto& [kind, path] : {std::pair<std::string, fs::path>{"exr", entry.exr}, {"png", entry.png}}) {
-            if (!stimulus.contains("sha256") || !stimulus["sha256"].contains(kind)) continue;
+            if (path.empty() || !stimulus.contains("sha256") || !stimulus["sha256"].contains(kind)) continue;
             const nlohmann::json& expected = stimulus["sha256"][kind];
             if (!expected.is_string()) throwInput(file, where + "sha256." + kind, "must be a string");
             if (fs::is_regular_file(path, ec) && sha256File(path) != expected.get<std::string>())
@@ -140,6 +141,9 @@ ComparisonPlan planStimulusSetComparisons(const fs::path& stimulusFolder,
 
     ComparisonPlan plan;
     plan.display = display;
+    // The presented images, when every stimulus lists one (a set built or imported by skinlab does).
+    const bool presented =
+        std::all_of(entries.begin(), entries.end(), [](const StimulusEntry& e) { return !e.png.empty(); });
     for (const std::string& block : blockOrder) {
         auto found = references.find(block);
         if (found == references.end()) {
@@ -150,7 +154,7 @@ ComparisonPlan planStimulusSetComparisons(const fs::path& stimulusFolder,
         for (const StimulusEntry* test : members[block])
             if (test != reference)
                 plan.jobs.push_back({reference->id, reference->exr, test->id, test->exr, block, test->factors,
-                                     reference->png, test->png});
+                                     presented ? reference->png : fs::path(), presented ? test->png : fs::path()});
     }
     return plan;
 }

@@ -18,7 +18,8 @@ struct ComparisonJob {
     std::string block;                                 // the stimulus block ("" for files)
     nlohmann::json factors = nlohmann::json::object(); // the test stimulus's factor levels ({} for files)
     // Stimulus sets: the presented PNGs (files.png, what observers see) of the reference and the test; the
-    // display-referred metrics run on them (docs/metrics.md, "Stimulus sets"). Empty for files.
+    // display-referred metrics run on them (docs/metrics.md, "Stimulus sets"). Empty for files, and for a set in
+    // which some stimulus lists no PNG (then every score runs on the EXRs).
     std::filesystem::path referencePresented;
     std::filesystem::path testPresented;
 };
