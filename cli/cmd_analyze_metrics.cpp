@@ -227,7 +227,8 @@ void registerAnalyzeMetrics(CLI::App& analyze) {
                         "the file says linear), srgb, linear");
     command->add_option("--display", arguments->display,
                         "Display model, the viewing geometry of FLIP and ColorVideoVDP (default: with --stimuli the "
-                        "display of the set's predictions, else standard_fhd): " + displayNameList());
+                        "display of the set's predictions, else standard_fhd): " +
+                            displayNameList());
     command->add_option("--display-ppd", arguments->displayPpd,
                         "Custom display: pixels per degree (overrides the geometry)");
     command->add_option("--display-resolution", arguments->displayResolution,

@@ -159,7 +159,8 @@ void runVisibility(const StimuliOptions& o) {
     const stimuli::ContactSheetFiles files = stimuli::writeContactSheet(o.output, *manifest);
     std::printf("visibility: %zu stimuli x %zu pixels per degree on %s (%s) in %.1f s\n", table.rows.size(),
                 table.pixelsPerDegree.size(), table.display.name.c_str(), table.displaySource.c_str(), table.seconds);
-    std::printf("visibility: %s, %s, %s; contact sheet: %s\n", (std::filesystem::path(o.output) / "visibility.json").c_str(),
+    std::printf("visibility: %s, %s, %s; contact sheet: %s\n",
+                (std::filesystem::path(o.output) / "visibility.json").c_str(),
                 (std::filesystem::path(o.output) / "visibility.csv").c_str(),
                 (std::filesystem::path(o.output) / "visibility.svg").c_str(), files.html.c_str());
 }

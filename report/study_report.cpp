@@ -340,8 +340,8 @@ Metrics readMetrics(const ReportOptions& options, const fs::path& stimuliFolder,
             overrides.pixelsPerDegree = options.pixelsPerDegree;
             metricOptions.metric.display =
                 metrics::applyCvvdpOverrides(metrics::cvvdpDisplay(plan.display.value_or("standard_fhd")), overrides);
-            metricOptions.displaySource = plan.display ? "the set's predictions (manifest.json predicted.display)"
-                                                       : "default";
+            metricOptions.displaySource =
+                plan.display ? "the set's predictions (manifest.json predicted.display)" : "default";
             if (options.pixelsPerDegree) metricOptions.displaySource += " with --ppd";
             spdlog::info("report: image metrics of {} stimuli against their block's reference", plan.jobs.size());
             metrics::runMetrics(plan, metricOptions, metricsFolder);
@@ -762,12 +762,12 @@ std::string viewingGeometry(const nlohmann::json& metricsJson) {
              << num(v.value("pixels_per_degree", NAN), 1) << " pixels per degree (FLIP and ColorVideoVDP alike; from "
              << h(v.value("source", std::string("?"))) << ")";
         const nlohmann::json referred = settings.value("display_referred", nlohmann::json::object());
-        if (referred.contains("input")) text << "; display-referred scores on " << h(referred["input"].get<std::string>());
+        if (referred.contains("input"))
+            text << "; display-referred scores on " << h(referred["input"].get<std::string>());
         text << ".";
     } else {
         // metrics.json of an earlier skinlab: FLIP and ColorVideoVDP had their own geometries.
-        text << "FLIP at "
-             << num(settings.contains("flip") ? settings["flip"].value("pixels_per_degree", NAN) : NAN, 1)
+        text << "FLIP at " << num(settings.contains("flip") ? settings["flip"].value("pixels_per_degree", NAN) : NAN, 1)
              << " pixels per degree, ColorVideoVDP at "
              << num(settings.contains("cvvdp") ? settings["cvvdp"].value("pixels_per_degree", NAN) : NAN, 1) << ".";
     }

@@ -186,7 +186,8 @@ std::string visibilityTableHtml(const nlohmann::json& visibility, const std::str
         if (distance.is_array()) out << "<br>" << cell(distance[k].get<double>(), "%.2f") << " m";
         out << "</th>";
     }
-    out << "<th>visible (below " << cell(visibility.value("visible_below_jod", 9.0), "%g") << " JOD) up to</th></tr></thead><tbody>";
+    out << "<th>visible (below " << cell(visibility.value("visible_below_jod", 9.0), "%g")
+        << " JOD) up to</th></tr></thead><tbody>";
     for (const nlohmann::json& row : visibility.at("rows")) {
         if (row.at("block") != block) continue;
         out << "<tr><td class=\"id\">" << escapeHtml(row.at("stimulus").get<std::string>()) << "</td>";
@@ -196,8 +197,7 @@ std::string visibilityTableHtml(const nlohmann::json& visibility, const std::str
                 << cell(v, "%.2f") << "</td>";
         }
         std::string limit;
-        if (row.value("visible_everywhere", false))
-            limit = "beyond " + cell(ppd.back().get<double>(), "%g") + " ppd";
+        if (row.value("visible_everywhere", false)) limit = "beyond " + cell(ppd.back().get<double>(), "%g") + " ppd";
         else if (row.value("invisible_everywhere", false))
             limit = "not visible at " + cell(ppd.front().get<double>(), "%g") + " ppd";
         else if (row.at("one_jod_limit").is_object()) {
@@ -226,7 +226,8 @@ std::string html(const Manifest& manifest, const std::vector<Block>& blocks,
         << "figcaption{font-size:12px;margin-top:4px}\n.id{font-family:monospace;color:#aaa}\n"
         << "table{border-collapse:collapse}td{padding:0 .6em 0 0;vertical-align:top}\n"
         << "table.visibility{margin:.5em 0 1em}table.visibility th,table.visibility td{padding:2px 8px;"
-           "text-align:right;border-bottom:1px solid #444;font-size:13px}table.visibility td.id{text-align:left}table.visibility td.visible{color:#fc6}\n"
+           "text-align:right;border-bottom:1px solid #444;font-size:13px}table.visibility "
+           "td.id{text-align:left}table.visibility td.visible{color:#fc6}\n"
         << ".plot{background:#fff;max-width:100%}\n"
         << "</style>\n</head>\n<body>\n<h1>Stimulus set " << escapeHtml(manifest.set) << "</h1>\n";
     if (!manifest.description.empty()) out << "<p>" << escapeHtml(manifest.description) << "</p>\n";
@@ -242,8 +243,8 @@ std::string html(const Manifest& manifest, const std::vector<Block>& blocks,
         out << "<h2>Visibility against viewing distance</h2>\n<p>ColorVideoVDP of every condition against its block's "
                "reference on the presented images, at each pixels per degree (display "
             << escapeHtml(d.value("name", std::string())) << "'s photometry"
-            << (visibility->at("distance_m").is_array() ? "; distances on its screen size" : "")
-            << "). Below " << visibility->value("visible_below_jod", 9.0)
+            << (visibility->at("distance_m").is_array() ? "; distances on its screen size" : "") << "). Below "
+            << visibility->value("visible_below_jod", 9.0)
             << " JOD (highlighted) 75 % of observers tell the condition from the reference. Tables per block below; "
                "<code>visibility.csv</code>, <code>visibility.json</code>.</p>\n"
             << "<img class=\"plot\" src=\"visibility.svg\" alt=\"JOD against pixels per degree, per block\">\n";

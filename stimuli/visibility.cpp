@@ -210,7 +210,8 @@ std::string visibilityCsv(const VisibilityTable& table) {
         std::string ppd, distance;
         if (row.limitPixelsPerDegree) {
             ppd = number(*row.limitPixelsPerDegree, "%.2f");
-            if (const auto d = viewingDistanceAt(table.display, *row.limitPixelsPerDegree)) distance = number(*d, "%.3f");
+            if (const auto d = viewingDistanceAt(table.display, *row.limitPixelsPerDegree))
+                distance = number(*d, "%.3f");
         }
         out += "," + ppd + "," + distance + "," + (row.visibleEverywhere ? "1" : "0") + "," +
                (row.invisibleEverywhere ? "1" : "0") + "\n";

@@ -28,15 +28,15 @@ inline const std::vector<double> kVisibilityPixelsPerDegree = {20.0, 30.0, 40.0,
 inline constexpr double kVisibleBelowJod = 9.0;
 
 struct VisibilityOptions {
-    std::string display;                                             // empty: the set's predictions', else standard_fhd
+    std::string display; // empty: the set's predictions', else standard_fhd
     std::vector<double> pixelsPerDegree = kVisibilityPixelsPerDegree; // ascending, each > 0
     int jobs = 2;                                                     // threads (ColorVideoVDP is thread-safe)
 };
 
 struct VisibilityRow {
     std::string block;
-    std::string reference; // stimulus id
-    std::string stimulus;  // stimulus id
+    std::string reference;   // stimulus id
+    std::string stimulus;    // stimulus id
     std::vector<double> jod; // per pixels per degree
     // Where the row's JOD reaches kVisibleBelowJod (linear in log ppd between the two neighbouring ppds): nullopt
     // when it never does in the range; `visibleEverywhere` / `invisibleEverywhere` tell the cases apart.
@@ -52,7 +52,7 @@ struct VisibilityTable {
     std::vector<double> distanceMetres; // viewing distance on the display model at each ppd; empty without geometry
     std::vector<VisibilityRow> rows;    // blocks in manifest order, stimuli in manifest order
     nlohmann::json pngSha256 = nlohmann::json::object(); // stimulus id → sha256 of the PNG compared
-    double seconds = 0.0;                                 // wall time of the computation
+    double seconds = 0.0;                                // wall time of the computation
 };
 
 // Viewing distance in metres at which `display` (with resolution and diagonal) has `pixelsPerDegree` at the centre;

@@ -46,7 +46,8 @@ std::vector<ComparisonRecord> runMetrics(const ComparisonPlan& plan, const Metri
         if (!job.referencePresented.empty()) {
             const MetricRender shownReference =
                 inspectMetricRender(job.referencePresented, RenderRole::test, ImageEncoding::srgb);
-            const MetricRender shownTest = inspectMetricRender(job.testPresented, RenderRole::test, ImageEncoding::srgb);
+            const MetricRender shownTest =
+                inspectMetricRender(job.testPresented, RenderRole::test, ImageEncoding::srgb);
             if (shownTest.width != shownReference.width || shownTest.height != shownReference.height)
                 throwInput(job.testPresented.string(), "",
                            "size " + std::to_string(shownTest.width) + "x" + std::to_string(shownTest.height) +
@@ -80,7 +81,8 @@ std::vector<ComparisonRecord> runMetrics(const ComparisonPlan& plan, const Metri
         const PreparedReference& reference = *found->second;
         spdlog::info("metrics: {} vs {}", job.testName, job.referenceName);
         std::optional<MetricRender> shown;
-        if (!job.testPresented.empty()) shown = loadMetricRender(job.testPresented, RenderRole::test, ImageEncoding::srgb);
+        if (!job.testPresented.empty())
+            shown = loadMetricRender(job.testPresented, RenderRole::test, ImageEncoding::srgb);
         ComparisonResult result =
             compareWithReference(reference, loadMetricRender(job.testPath, RenderRole::test, options.metric.encoding),
                                  options.metric, shown ? &*shown : nullptr);
@@ -117,8 +119,9 @@ std::vector<ComparisonRecord> runMetrics(const ComparisonPlan& plan, const Metri
     // 3. Tables last.
     writeFileAtomic(outputFolder / "metrics.csv", metricsCsv(records));
     const bool presented = !plan.jobs.empty() && !plan.jobs.front().referencePresented.empty();
-    ReportSettings settings{options.metric.exposure, options.heatmapMax, options.metric.flipPixelsPerDegree(),
-                            options.metric.encoding, options.metric.display, presented, options.displaySource};
+    ReportSettings settings{options.metric.exposure, options.heatmapMax,     options.metric.flipPixelsPerDegree(),
+                            options.metric.encoding, options.metric.display, presented,
+                            options.displaySource};
     writeFileAtomic(outputFolder / "metrics.json",
                     metricsJson(records, settings, plan.blocksWithoutReference).dump(2) + "\n");
     return records;

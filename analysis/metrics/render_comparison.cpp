@@ -238,9 +238,8 @@ ComparisonResult compareWithReference(const PreparedReference& reference, const 
     result.flip = flipErrorMap(referenceShown, testShown, options.flipPixelsPerDegree(), exposure);
     {
         const bool scaled = exposure != 1.0;
-        const CvvdpResult visibility =
-            cvvdp(scaled ? cv::Mat(referenceShown * exposure) : referenceShown,
-                  scaled ? cv::Mat(testShown * exposure) : testShown, options.display, true);
+        const CvvdpResult visibility = cvvdp(scaled ? cv::Mat(referenceShown * exposure) : referenceShown,
+                                             scaled ? cv::Mat(testShown * exposure) : testShown, options.display, true);
         result.cvvdpJod = visibility.jod;
         result.cvvdpMap = visibility.map;
     }
