@@ -5,9 +5,11 @@
 #include "common/error.h"
 
 #include <array>
+#include <cmath>
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -27,9 +29,9 @@ struct AnalyzeMetricsArguments {
     std::optional<double> sssRadiusMillimetres;
     double heatmapMax = 0.0;
     bool noHeatmaps = false;
-    double pixelsPerDegree = metrics::flipDefaultPixelsPerDegree;
+    std::optional<double> pixelsPerDegree;
     std::string encoding = "auto";
-    std::string display = "standard_fhd";
+    std::optional<std::string> display;
     std::optional<double> displayPpd;
     std::optional<std::string> displayResolution;
     std::optional<double> displayDiagonal;
@@ -39,6 +41,12 @@ struct AnalyzeMetricsArguments {
     std::optional<double> displayAmbient;
     std::optional<double> displayReflectivity;
 };
+
+std::string formatNumber(double value) {
+    std::ostringstream out;
+    out << value;
+    return out.str();
+}
 
 // "WIDTHxHEIGHT" → {width, height}; InputError naming --display-resolution otherwise.
 std::array<int, 2> parseResolution(const std::string& text) {
@@ -62,9 +70,19 @@ std::array<int, 2> parseResolution(const std::string& text) {
     return size;
 }
 
-metrics::CvvdpDisplay displayOf(const AnalyzeMetricsArguments& arguments) {
+// The one viewing geometry of the run: --display, else the display of the set's predictions (`setDisplay`), else
+// standard_fhd; changed by --display-* and --ppd (FLIP and ColorVideoVDP both use its pixels per degree).
+metrics::CvvdpDisplay displayOf(const AnalyzeMetricsArguments& arguments,
+                                const std::optional<std::string>& setDisplay = std::nullopt) {
     metrics::CvvdpDisplayOverrides overrides;
     overrides.pixelsPerDegree = arguments.displayPpd;
+    if (arguments.pixelsPerDegree) {
+        if (!(*arguments.pixelsPerDegree > 0.0) || !std::isfinite(*arguments.pixelsPerDegree))
+            throwInput("--ppd", "", formatNumber(*arguments.pixelsPerDegree) + " must be a positive number");
+        if (arguments.displayPpd && *arguments.displayPpd != *arguments.pixelsPerDegree)
+            throwInput("--ppd", "", "differs from --display-ppd (one viewing geometry: give one of them)");
+        overrides.pixelsPerDegree = arguments.pixelsPerDegree;
+    }
     if (arguments.displayResolution) overrides.resolution = parseResolution(*arguments.displayResolution);
     overrides.diagonalInches = arguments.displayDiagonal;
     overrides.viewingDistanceMetres = arguments.displayDistance;
@@ -72,7 +90,13 @@ metrics::CvvdpDisplay displayOf(const AnalyzeMetricsArguments& arguments) {
     overrides.contrast = arguments.displayContrast;
     overrides.ambientIlluminance = arguments.displayAmbient;
     overrides.reflectivity = arguments.displayReflectivity;
-    return metrics::applyCvvdpOverrides(metrics::cvvdpDisplay(arguments.display), overrides);
+    const std::string name = arguments.display.value_or(setDisplay.value_or("standard_fhd"));
+    return metrics::applyCvvdpOverrides(metrics::cvvdpDisplay(name), overrides);
+}
+
+bool overridesGiven(const AnalyzeMetricsArguments& a) {
+    return a.pixelsPerDegree || a.displayPpd || a.displayResolution || a.displayDiagonal || a.displayDistance ||
+           a.displayPeak || a.displayContrast || a.displayAmbient || a.displayReflectivity;
 }
 
 // --reference-seeds: every test against the path-traced truth without its noise (docs/metrics.md).
@@ -99,7 +123,8 @@ void runDebiased(const AnalyzeMetricsArguments& arguments) {
 void runAnalyzeMetrics(const AnalyzeMetricsArguments& arguments) {
     if (!arguments.referenceSeeds.empty()) return runDebiased(arguments);
     if (!arguments.compareReference.empty()) throwInput("--compare-reference", "", "only with --reference-seeds");
-    const metrics::CvvdpDisplay display = displayOf(arguments); // option errors before any file is read
+    metrics::CvvdpDisplay display = displayOf(arguments); // option errors before any file is read
+    std::string displaySource = arguments.display ? "--display" : "default";
     metrics::ComparisonPlan plan;
     if (!arguments.stimulusFolder.empty()) {
         if (!arguments.tests.empty())
@@ -108,6 +133,15 @@ void runAnalyzeMetrics(const AnalyzeMetricsArguments& arguments) {
         std::optional<std::string> referenceId;
         if (!arguments.reference.empty()) referenceId = arguments.reference;
         plan = metrics::planStimulusSetComparisons(arguments.stimulusFolder, referenceId);
+        // The set's viewing geometry: the display its predictions were made for, unless --display says otherwise.
+        if (plan.display && !arguments.display) {
+            display = displayOf(arguments, plan.display);
+            displaySource = "the set's predictions (manifest.json predicted.display)";
+        } else if (plan.display && *arguments.display != *plan.display) {
+            spdlog::warn("metrics: the set's predictions are on {}, these metrics on --display {}: their "
+                         "ColorVideoVDP will differ from the manifest's predicted JOD",
+                         *plan.display, *arguments.display);
+        }
     } else {
         if (arguments.reference.empty())
             throwInput("--reference", "", "required: the reference EXR (or use --stimuli DIR)");
@@ -119,14 +153,22 @@ void runAnalyzeMetrics(const AnalyzeMetricsArguments& arguments) {
     metrics::MetricsRunOptions options;
     options.metric.exposure = arguments.exposure;
     options.metric.sssRadiusMillimetres = arguments.sssRadiusMillimetres;
-    options.metric.pixelsPerDegree = arguments.pixelsPerDegree;
     options.metric.encoding = metrics::parseImageEncoding(arguments.encoding);
     options.metric.display = display;
     options.heatmapMax = arguments.heatmapMax;
     options.heatmaps = !arguments.noHeatmaps;
+    if (overridesGiven(arguments)) displaySource += " with --display-*/--ppd changes";
+    options.displaySource = displaySource;
+    if (!arguments.stimulusFolder.empty() && arguments.exposure != 1.0)
+        throwInput("--exposure", "",
+                   std::to_string(arguments.exposure) +
+                       " cannot be combined with --stimuli (the presented images are scored as observers see them)");
+    const bool presented = !plan.jobs.empty() && !plan.jobs.front().referencePresented.empty();
     auto records = metrics::runMetrics(plan, options, arguments.outputFolder);
-    spdlog::info("metrics: {} comparison(s) written to {}/metrics.csv and metrics.json (ColorVideoVDP on {})",
-                 records.size(), arguments.outputFolder, metrics::describeCvvdpDisplay(display));
+    spdlog::info("metrics: {} comparison(s) written to {}/metrics.csv and metrics.json; viewing geometry {} ({}) for "
+                 "FLIP and ColorVideoVDP; display-referred scores on {}",
+                 records.size(), arguments.outputFolder, metrics::describeCvvdpDisplay(display), displaySource,
+                 presented ? "the presented PNGs" : "the renders");
 }
 
 std::string displayNameList() {
@@ -178,13 +220,15 @@ void registerAnalyzeMetrics(CLI::App& analyze) {
                         "data, the 99th percentile rounded up; FLIP and ColorVideoVDP maps always so)");
     command->add_flag("--no-heatmaps", arguments->noHeatmaps, "Write only metrics.csv and metrics.json");
     command->add_option("--ppd", arguments->pixelsPerDegree,
-                        "FLIP's pixels per degree of visual angle (default 67.0206: 0.7 m from a 0.7 m wide 3840-pixel "
-                        "monitor)");
+                        "Pixels per degree of visual angle of the viewing geometry, for FLIP and ColorVideoVDP alike "
+                        "(the same as --display-ppd; default: the display's)");
     command->add_option("--encoding", arguments->encoding,
                         "How pixel values map to linear light: auto (default: float files linear, 8/16-bit sRGB unless "
                         "the file says linear), srgb, linear");
     command->add_option("--display", arguments->display,
-                        "ColorVideoVDP display model (default standard_fhd): " + displayNameList());
+                        "Display model, the viewing geometry of FLIP and ColorVideoVDP (default: with --stimuli the "
+                        "display of the set's predictions, else standard_fhd): " +
+                            displayNameList());
     command->add_option("--display-ppd", arguments->displayPpd,
                         "Custom display: pixels per degree (overrides the geometry)");
     command->add_option("--display-resolution", arguments->displayResolution,

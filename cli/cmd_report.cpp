@@ -30,7 +30,8 @@ void registerReport(CLI::App& app) {
         ->check(CLI::Range(100, 100000));
     command->add_option("--seed", arguments->options.seed, "Bootstrap seed (default 1)");
     command->add_option("--ppd", arguments->options.pixelsPerDegree,
-                        "FLIP's pixels per degree when the metrics are computed here (default 67.0206)");
+                        "Pixels per degree of the viewing geometry when the metrics are computed here, for FLIP and "
+                        "ColorVideoVDP alike (default: the display of the set's predictions)");
     command->add_option("--chromium", arguments->options.chromium,
                         "Chromium executable for the PDF (default chromium)");
     command->add_flag("--no-pdf", arguments->noPdf, "Write only the HTML page");

@@ -1,4 +1,4 @@
-// `skinlab stimuli build|list|merge|contact|slurm|status|calibrate`: stimulus sets (docs/stimuli.md). `import`: in
+// `skinlab stimuli build|list|merge|contact|visibility|slurm|status|calibrate`: stimulus sets (docs/stimuli.md). `import`: in
 // cmd_stimuli_import.cpp.
 #include "analysis/metrics/cvvdp.h"
 #include "cli/commands.h"
@@ -10,6 +10,7 @@
 #include "stimuli/merge.h"
 #include "stimuli/output_folder.h"
 #include "stimuli/slurm.h"
+#include "stimuli/visibility.h"
 
 #include <cmath>
 #include <cstdio>
@@ -48,6 +49,10 @@ struct StimuliOptions {
     std::optional<double> referenceLevel;
     double tolerance = 0.05;
     int maxProbes = 24;
+    // visibility
+    std::optional<std::string> visibilityDisplay;
+    std::vector<double> visibilityPpd = stimuli::kVisibilityPixelsPerDegree;
+    int visibilityJobs = 2;
 };
 
 // The submission as one command line (absolute paths, without --only-shard and --dry-run), recorded so that
@@ -140,6 +145,24 @@ void runContact(const StimuliOptions& o) {
     if (!manifest) throwInput(o.output, "", "holds no stimulus set (no manifest.json)");
     stimuli::ContactSheetFiles files = stimuli::writeContactSheet(o.output, *manifest);
     std::printf("contact sheet: %s\n", files.html.string().c_str());
+}
+
+void runVisibility(const StimuliOptions& o) {
+    std::optional<stimuli::Manifest> manifest = stimuli::readManifest(o.output);
+    if (!manifest) throwInput(o.output, "", "holds no stimulus set (no manifest.json)");
+    stimuli::VisibilityOptions options;
+    options.display = o.visibilityDisplay.value_or("");
+    options.pixelsPerDegree = o.visibilityPpd;
+    options.jobs = o.visibilityJobs;
+    const stimuli::VisibilityTable table = stimuli::computeVisibility(o.output, *manifest, options);
+    stimuli::writeVisibility(o.output, table);
+    const stimuli::ContactSheetFiles files = stimuli::writeContactSheet(o.output, *manifest);
+    std::printf("visibility: %zu stimuli x %zu pixels per degree on %s (%s) in %.1f s\n", table.rows.size(),
+                table.pixelsPerDegree.size(), table.display.name.c_str(), table.displaySource.c_str(), table.seconds);
+    std::printf("visibility: %s, %s, %s; contact sheet: %s\n",
+                (std::filesystem::path(o.output) / "visibility.json").c_str(),
+                (std::filesystem::path(o.output) / "visibility.csv").c_str(),
+                (std::filesystem::path(o.output) / "visibility.svg").c_str(), files.html.c_str());
 }
 
 void runSlurm(const StimuliOptions& o) {
@@ -332,6 +355,19 @@ void registerStimuli(CLI::App& app) {
     CLI::App* contact = stimuli->add_subcommand("contact", "Rewrite the contact sheet of a set folder");
     contact->add_option("dir", options->output, "Set folder")->required();
     contact->callback([options] { runContact(*options); });
+
+    CLI::App* visibility = stimuli->add_subcommand(
+        "visibility", "Predicted JOD of every condition against its block's reference at a range of pixels per degree "
+                      "(viewing distances): visibility.json, .csv, .svg and the contact sheet (docs/stimuli.md)");
+    visibility->add_option("dir", options->output, "Set folder (built, with a reference in its blocks)")->required();
+    visibility->add_option("--display", options->visibilityDisplay,
+                           "Display model whose photometry is used (default: the display of the set's predictions)");
+    visibility
+        ->add_option("--ppd", options->visibilityPpd,
+                     "Pixels per degree to predict at, ascending, comma-separated (default 20,30,40,60,80,120)")
+        ->delimiter(',');
+    visibility->add_option("--jobs", options->visibilityJobs, "Threads (default 2)");
+    visibility->callback([options] { runVisibility(*options); });
 
     CLI::App* slurm = stimuli->add_subcommand(
         "slurm", "Build a set on a Slurm cluster: a job array (one task per shard) and a merge job (afterok)");

@@ -335,7 +335,14 @@ Metrics readMetrics(const ReportOptions& options, const fs::path& stimuliFolder,
         if (!plan.jobs.empty()) {
             metricsFolder = out / "metrics";
             metrics::MetricsRunOptions metricOptions;
-            metricOptions.metric.pixelsPerDegree = options.pixelsPerDegree;
+            // One viewing geometry: the display the set's predictions were made for (docs/metrics.md).
+            metrics::CvvdpDisplayOverrides overrides;
+            overrides.pixelsPerDegree = options.pixelsPerDegree;
+            metricOptions.metric.display =
+                metrics::applyCvvdpOverrides(metrics::cvvdpDisplay(plan.display.value_or("standard_fhd")), overrides);
+            metricOptions.displaySource =
+                plan.display ? "the set's predictions (manifest.json predicted.display)" : "default";
+            if (options.pixelsPerDegree) metricOptions.displaySource += " with --ppd";
             spdlog::info("report: image metrics of {} stimuli against their block's reference", plan.jobs.size());
             metrics::runMetrics(plan, metricOptions, metricsFolder);
             // The references, for the stimulus section.
@@ -745,6 +752,28 @@ void writePredictions(std::ostringstream& html, const ReportData& r) {
                                   static_cast<int>(r.simulated.size()));
 }
 
+// One sentence naming the one viewing geometry of the metrics and what they were computed on.
+std::string viewingGeometry(const nlohmann::json& metricsJson) {
+    const nlohmann::json settings = metricsJson.value("settings", nlohmann::json::object());
+    std::ostringstream text;
+    if (settings.contains("viewing")) {
+        const nlohmann::json& v = settings["viewing"];
+        text << "Viewing geometry: display " << h(v.value("display", std::string("?"))) << ", "
+             << num(v.value("pixels_per_degree", NAN), 1) << " pixels per degree (FLIP and ColorVideoVDP alike; from "
+             << h(v.value("source", std::string("?"))) << ")";
+        const nlohmann::json referred = settings.value("display_referred", nlohmann::json::object());
+        if (referred.contains("input"))
+            text << "; display-referred scores on " << h(referred["input"].get<std::string>());
+        text << ".";
+    } else {
+        // metrics.json of an earlier skinlab: FLIP and ColorVideoVDP had their own geometries.
+        text << "FLIP at " << num(settings.contains("flip") ? settings["flip"].value("pixels_per_degree", NAN) : NAN, 1)
+             << " pixels per degree, ColorVideoVDP at "
+             << num(settings.contains("cvvdp") ? settings["cvvdp"].value("pixels_per_degree", NAN) : NAN, 1) << ".";
+    }
+    return text.str();
+}
+
 void writeObjectiveErrors(std::ostringstream& html, const ReportData& r) {
     const Metrics& m = r.metrics;
     const std::vector<agreement::ConditionMetrics>& conditionMetrics = m.conditions;
@@ -763,12 +792,8 @@ void writeObjectiveErrors(std::ostringstream& html, const ReportData& r) {
         }
         html << ". ΔE00 and FLIP: lower is better; PSNR, SSIM and ColorVideoVDP (10 = indistinguishable): higher is "
                 "better. Heat maps: each on its own colour scale (printed under it). Bands: mean ΔE00 in the halo, "
-                "bleed, spill and interior bands (docs/metrics.md). FLIP at "
-             << num(m.json.contains("settings") && m.json["settings"].contains("flip")
-                        ? m.json["settings"]["flip"].value("pixels_per_degree", NAN)
-                        : NAN,
-                    1)
-             << " pixels per degree.</p>\n";
+                "bleed, spill and interior bands (docs/metrics.md). "
+             << viewingGeometry(m.json) << "</p>\n";
         for (const experiments::StudyBlock& block : r.definition.blocks) {
             html << "<h3 id=\"metrics-" << slug(block.name) << "\">" << h(block.name) << "</h3><table><thead><tr>"
                  << "<th class=\"l\">condition</th><th>PSNR (dB)</th><th>SSIM</th><th>mean ΔE00</th><th>p95 ΔE00</th>"

@@ -5,6 +5,7 @@
 // agreement.json/csv, metrics/ when it computed them).
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 
 namespace skinlab::report {
@@ -17,7 +18,9 @@ struct ReportOptions {
     int bootstrapSamples = 1000;   // scale intervals and correlation intervals
     std::uint64_t seed = 1;
     int threads = 2;
-    double pixelsPerDegree = 67.02064327658226; // FLIP, when the metrics are computed here
+    // The viewing geometry of the metrics computed here: the display of the set's predictions (standard_fhd when it
+    // has none), its pixels per degree replaced by this when set; FLIP and ColorVideoVDP use the same.
+    std::optional<double> pixelsPerDegree;
     bool pdf = true;
     std::string chromium = "chromium"; // executable for the PDF
 };

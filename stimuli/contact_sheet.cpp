@@ -4,6 +4,7 @@
 #include "common/html.h"
 #include "common/files.h"
 #include "stimuli/naming.h"
+#include "stimuli/visibility.h"
 
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
@@ -11,6 +12,7 @@
 #include <cstdlib>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <sstream>
 
 namespace skinlab::stimuli {
@@ -165,7 +167,52 @@ std::string presentationText(const Block& block, bool ascii = false) {
     return text;
 }
 
-std::string html(const Manifest& manifest, const std::vector<Block>& blocks) {
+// The block's rows of visibility.json as a table: JOD at each ppd, and where the comparison stops being visible.
+std::string visibilityTableHtml(const nlohmann::json& visibility, const std::string& block) {
+    std::ostringstream out;
+    const nlohmann::json& ppd = visibility.at("pixels_per_degree");
+    const nlohmann::json& distance = visibility.at("distance_m");
+    bool any = false;
+    for (const nlohmann::json& row : visibility.at("rows")) any = any || row.at("block") == block;
+    if (!any) return "";
+    const auto cell = [](double value, const char* format) {
+        char text[32];
+        std::snprintf(text, sizeof text, format, value);
+        return std::string(text);
+    };
+    out << "<table class=\"visibility\"><thead><tr><th>condition</th>";
+    for (size_t k = 0; k < ppd.size(); ++k) {
+        out << "<th>" << cell(ppd[k].get<double>(), "%g") << " ppd";
+        if (distance.is_array()) out << "<br>" << cell(distance[k].get<double>(), "%.2f") << " m";
+        out << "</th>";
+    }
+    out << "<th>visible (below " << cell(visibility.value("visible_below_jod", 9.0), "%g")
+        << " JOD) up to</th></tr></thead><tbody>";
+    for (const nlohmann::json& row : visibility.at("rows")) {
+        if (row.at("block") != block) continue;
+        out << "<tr><td class=\"id\">" << escapeHtml(row.at("stimulus").get<std::string>()) << "</td>";
+        for (const nlohmann::json& jod : row.at("jod")) {
+            const double v = jod.get<double>();
+            out << "<td" << (v < visibility.value("visible_below_jod", 9.0) ? " class=\"visible\"" : "") << ">"
+                << cell(v, "%.2f") << "</td>";
+        }
+        std::string limit;
+        if (row.value("visible_everywhere", false)) limit = "beyond " + cell(ppd.back().get<double>(), "%g") + " ppd";
+        else if (row.value("invisible_everywhere", false))
+            limit = "not visible at " + cell(ppd.front().get<double>(), "%g") + " ppd";
+        else if (row.at("one_jod_limit").is_object()) {
+            const nlohmann::json& l = row["one_jod_limit"];
+            limit = cell(l.at("pixels_per_degree").get<double>(), "%.0f") + " ppd";
+            if (l.contains("distance_m")) limit += " (" + cell(l["distance_m"].get<double>(), "%.2f") + " m)";
+        }
+        out << "<td>" << escapeHtml(limit) << "</td></tr>";
+    }
+    out << "</tbody></table>\n";
+    return out.str();
+}
+
+std::string html(const Manifest& manifest, const std::vector<Block>& blocks,
+                 const std::optional<nlohmann::json>& visibility) {
     std::ostringstream out;
     out << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>" << escapeHtml(manifest.set)
         << " — skinlab stimulus set</title>\n<style>\n"
@@ -178,6 +225,10 @@ std::string html(const Manifest& manifest, const std::vector<Block>& blocks) {
         << ".presentation{color:#aaa;font-size:13px}\n"
         << "figcaption{font-size:12px;margin-top:4px}\n.id{font-family:monospace;color:#aaa}\n"
         << "table{border-collapse:collapse}td{padding:0 .6em 0 0;vertical-align:top}\n"
+        << "table.visibility{margin:.5em 0 1em}table.visibility th,table.visibility td{padding:2px 8px;"
+           "text-align:right;border-bottom:1px solid #444;font-size:13px}table.visibility "
+           "td.id{text-align:left}table.visibility td.visible{color:#fc6}\n"
+        << ".plot{background:#fff;max-width:100%}\n"
         << "</style>\n</head>\n<body>\n<h1>Stimulus set " << escapeHtml(manifest.set) << "</h1>\n";
     if (!manifest.description.empty()) out << "<p>" << escapeHtml(manifest.description) << "</p>\n";
     out << "<p>" << manifest.stimuli.size() << " stimuli in " << blocks.size()
@@ -187,10 +238,22 @@ std::string html(const Manifest& manifest, const std::vector<Block>& blocks) {
     for (auto it = manifest.fixed.begin(); it != manifest.fixed.end(); ++it)
         fixed += (fixed.empty() ? "" : ", ") + it.key() + " = " + valueText(it.value());
     out << escapeHtml(fixed.empty() ? "(scene defaults)" : fixed) << ".</p>\n";
+    if (visibility) {
+        const nlohmann::json& d = visibility->at("display");
+        out << "<h2>Visibility against viewing distance</h2>\n<p>ColorVideoVDP of every condition against its block's "
+               "reference on the presented images, at each pixels per degree (display "
+            << escapeHtml(d.value("name", std::string())) << "'s photometry"
+            << (visibility->at("distance_m").is_array() ? "; distances on its screen size" : "") << "). Below "
+            << visibility->value("visible_below_jod", 9.0)
+            << " JOD (highlighted) 75 % of observers tell the condition from the reference. Tables per block below; "
+               "<code>visibility.csv</code>, <code>visibility.json</code>.</p>\n"
+            << "<img class=\"plot\" src=\"visibility.svg\" alt=\"JOD against pixels per degree, per block\">\n";
+    }
     for (const auto& block : blocks) {
         const std::string presented = presentationText(block);
         out << "<h2>" << escapeHtml(block.name.empty() ? "(all)" : block.name) << "</h2>\n";
         if (!presented.empty()) out << "<p class=\"presentation\">Presented: " << escapeHtml(presented) << "</p>\n";
+        if (visibility) out << visibilityTableHtml(*visibility, block.name);
         out << "<div class=\"grid\">\n";
         for (const auto* s : block.stimuli) {
             bool reference = s->at("reference").get<bool>();
@@ -305,7 +368,7 @@ std::vector<std::string> contactSheetCaptions(const Manifest& manifest) {
 ContactSheetFiles writeContactSheet(const fs::path& dir, const Manifest& manifest, int thumbnailWidth) {
     std::vector<Block> blocks = groupByBlock(manifest);
     ContactSheetFiles files{dir / "contact.html", dir / "contact.png"};
-    writeFileAtomic(files.html, html(manifest, blocks));
+    writeFileAtomic(files.html, html(manifest, blocks, currentVisibility(dir, manifest)));
     if (manifest.stimuli.empty()) {
         files.png.clear();
         return files;

@@ -116,11 +116,21 @@ nlohmann::json metricsJson(const std::vector<ComparisonRecord>& records, const R
                                                                       {"cvvdp", record.cvvdpHeatmapMax}}},
         });
     }
+    const char* shown = settings.presented ? "the presented PNGs (files.png: what observers see), sRGB-decoded"
+                                           : "the renders x exposure";
     return {{"format", "skinlab-metrics"},
             {"version", 1},
             {"skinlab_version", version()},
             {"settings",
              {{"exposure", settings.exposure},
+              {"viewing",
+               {{"display", settings.display.name},
+                {"pixels_per_degree", settings.display.pixelsPerDegree},
+                {"source", settings.displaySource},
+                {"note", "one viewing geometry: FLIP and ColorVideoVDP at these pixels per degree"}}},
+              {"display_referred",
+               {{"scores", "delta_e00, psnr_db, ssim, flip_mean, cvvdp_jod, cvvdp_map_mean"}, {"input", shown}}},
+              {"linear", {{"scores", "leak_energy"}, {"input", "the linear EXR renders x exposure, unclipped"}}},
               {"display_encoding", displayEncodingDescription},
               {"skin_mask_threshold", 0.5},
               {"percentile", "p95 with linear interpolation between order statistics"},
@@ -129,7 +139,8 @@ nlohmann::json metricsJson(const std::vector<ComparisonRecord>& records, const R
               {"flip",
                {{"variant", "LDR-FLIP (Andersson et al. 2020)"},
                 {"pixels_per_degree", settings.pixelsPerDegree},
-                {"input", "linear RGB x exposure, clamped to [0,1]"}}},
+                {"input", settings.presented ? "the presented PNGs, sRGB-decoded to linear [0,1]"
+                                             : "linear RGB x exposure, clamped to [0,1]"}}},
               {"cvvdp",
                {{"variant", "ColorVideoVDP v0.5.6 parameters (Mantiuk et al. 2024), still image"},
                 {"display", settings.display.name},
@@ -139,7 +150,9 @@ nlohmann::json metricsJson(const std::vector<ComparisonRecord>& records, const R
                 {"black_level", settings.display.blackLevel()},
                 {"reflected_level", settings.display.reflectedLevel()},
                 {"eotf", settings.display.eotf},
-                {"input", "linear Rec.709 RGB x exposure as the display's relative value (1 = peak)"},
+                {"input", settings.presented
+                              ? "the presented PNGs, sRGB-decoded, as the display's relative value (1 = peak)"
+                              : "linear Rec.709 RGB x exposure as the display's relative value (1 = peak)"},
                 {"map", "per-pixel JOD loss, 10 - JOD"}}},
               {"encoding", imageEncodingName(settings.encoding)}}},
             {"blocks_without_reference", blocksWithoutReference},

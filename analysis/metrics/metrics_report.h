@@ -37,6 +37,8 @@ struct ReportSettings {
     double pixelsPerDegree = flipDefaultPixelsPerDegree;
     ImageEncoding encoding = ImageEncoding::automatic;
     CvvdpDisplay display = cvvdpDisplay("standard_fhd");
+    bool presented = false;                  // display-referred scores on the presented PNGs of a stimulus set
+    std::string displaySource = "--display"; // where the display (the viewing geometry) came from
 };
 
 // CSV with a header row; NaN (undefined: empty band, no skin) is an empty cell, +inf (PSNR of identical

@@ -8,6 +8,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 
 #include <spdlog/spdlog.h>
 
@@ -39,6 +40,21 @@ std::vector<ComparisonRecord> runMetrics(const ComparisonPlan& plan, const Metri
             throwInput(job.referencePath.string(), "skinlab:sss_radius_mm",
                        "metadata attribute is missing (or give --sss-radius-mm)");
         checkComparable(reference, inspectMetricRender(job.testPath, RenderRole::test, options.metric.encoding));
+        // A stimulus set: the presented PNGs, as observers see them, of one size per block.
+        if (job.referencePresented.empty() != job.testPresented.empty())
+            throw std::logic_error("runMetrics(): a presented image for one of reference and test only");
+        if (!job.referencePresented.empty()) {
+            const MetricRender shownReference =
+                inspectMetricRender(job.referencePresented, RenderRole::test, ImageEncoding::srgb);
+            const MetricRender shownTest =
+                inspectMetricRender(job.testPresented, RenderRole::test, ImageEncoding::srgb);
+            if (shownTest.width != shownReference.width || shownTest.height != shownReference.height)
+                throwInput(job.testPresented.string(), "",
+                           "size " + std::to_string(shownTest.width) + "x" + std::to_string(shownTest.height) +
+                               " differs from the reference's presented image " + job.referencePresented.string() +
+                               " (" + std::to_string(shownReference.width) + "x" +
+                               std::to_string(shownReference.height) + ")");
+        }
     }
     for (const auto& [path, reference] : referenceHeaders)
         if (reference.plain)
@@ -54,19 +70,27 @@ std::vector<ComparisonRecord> runMetrics(const ComparisonPlan& plan, const Metri
         auto found = prepared.find(job.referencePath);
         if (found == prepared.end()) {
             prepared.clear(); // jobs are grouped by reference; keep one in memory at a time
-            auto reference = std::make_shared<const PreparedReference>(prepareReference(
-                loadMetricRender(job.referencePath, RenderRole::reference, options.metric.encoding), options.metric));
+            std::optional<MetricRender> shown;
+            if (!job.referencePresented.empty())
+                shown = loadMetricRender(job.referencePresented, RenderRole::test, ImageEncoding::srgb);
+            auto reference = std::make_shared<const PreparedReference>(
+                prepareReference(loadMetricRender(job.referencePath, RenderRole::reference, options.metric.encoding),
+                                 options.metric, shown ? &*shown : nullptr));
             found = prepared.emplace(job.referencePath, reference).first;
         }
         const PreparedReference& reference = *found->second;
         spdlog::info("metrics: {} vs {}", job.testName, job.referenceName);
-        ComparisonResult result = compareWithReference(
-            reference, loadMetricRender(job.testPath, RenderRole::test, options.metric.encoding), options.metric);
+        std::optional<MetricRender> shown;
+        if (!job.testPresented.empty())
+            shown = loadMetricRender(job.testPresented, RenderRole::test, ImageEncoding::srgb);
+        ComparisonResult result =
+            compareWithReference(reference, loadMetricRender(job.testPath, RenderRole::test, options.metric.encoding),
+                                 options.metric, shown ? &*shown : nullptr);
 
         ComparisonRecord record;
         record.job = job;
-        record.width = reference.render.width;
-        record.height = reference.render.height;
+        record.width = reference.displayWidth();
+        record.height = reference.displayHeight();
         record.sssRadiusMillimetres = reference.sssRadiusMillimetres;
         record.millimetresPerUnit = reference.render.millimetresPerUnit.value_or(notANumber);
         record.bandsMeasured = result.bandsMeasured;
@@ -82,7 +106,8 @@ std::vector<ComparisonRecord> runMetrics(const ComparisonPlan& plan, const Metri
             record.flipHeatmapMax = std::min(1.0, automaticScaleMax(result.flip, 0.001));
             record.cvvdpHeatmapMax = automaticScaleMax(result.cvvdpMap, 0.001);
             record.heatmap = "heatmaps/" + job.testName + ".png";
-            writeErrorHeatmap(outputFolder / record.heatmap, result.deltaE00, reference.bands, record.heatmapMax);
+            writeErrorHeatmap(outputFolder / record.heatmap, result.deltaE00, reference.displayBands,
+                              record.heatmapMax);
             record.flipHeatmap = "heatmaps/" + job.testName + ".flip.png";
             writeFlipHeatmap(outputFolder / record.flipHeatmap, result.flip, record.flipHeatmapMax);
             record.cvvdpHeatmap = "heatmaps/" + job.testName + ".cvvdp.png";
@@ -93,8 +118,10 @@ std::vector<ComparisonRecord> runMetrics(const ComparisonPlan& plan, const Metri
 
     // 3. Tables last.
     writeFileAtomic(outputFolder / "metrics.csv", metricsCsv(records));
-    ReportSettings settings{options.metric.exposure, options.heatmapMax, options.metric.pixelsPerDegree,
-                            options.metric.encoding, options.metric.display};
+    const bool presented = !plan.jobs.empty() && !plan.jobs.front().referencePresented.empty();
+    ReportSettings settings{options.metric.exposure, options.heatmapMax,     options.metric.flipPixelsPerDegree(),
+                            options.metric.encoding, options.metric.display, presented,
+                            options.displaySource};
     writeFileAtomic(outputFolder / "metrics.json",
                     metricsJson(records, settings, plan.blocksWithoutReference).dump(2) + "\n");
     return records;

@@ -15,6 +15,8 @@ struct MetricsRunOptions {
     MetricOptions metric;
     double heatmapMax = 0.0; // ΔE00 at the top of the heat map's colour scale; 0 = from each map's data
     bool heatmaps = true;
+    // Where metric.display came from, for metrics.json ("the set's predictions", "--display", ...).
+    std::string displaySource = "--display";
 };
 
 // Inputs are checked (files, channels, metadata, sizes) before anything is written. Returns the records written.

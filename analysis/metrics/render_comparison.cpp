@@ -5,6 +5,8 @@
 #include "analysis/metrics/image_quality.h"
 #include "common/error.h"
 
+#include <opencv2/imgproc.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -26,32 +28,53 @@ std::string formatNumber(double value) {
 std::string sizeText(int width, int height) { return std::to_string(width) + "x" + std::to_string(height); }
 
 struct EncodedImage {
-    cv::Mat lab;       // CV_64FC3
-    cv::Mat luminance; // CV_64FC1
-    cv::Mat display;   // CV_64FC3 on 0–255
+    cv::Mat lab;     // CV_64FC3
+    cv::Mat display; // CV_64FC3 on 0–255
 };
 
 EncodedImage encode(const cv::Mat& beauty, double exposure) {
     EncodedImage encoded;
     encoded.lab.create(beauty.size(), CV_64FC3);
-    encoded.luminance.create(beauty.size(), CV_64FC1);
     encoded.display.create(beauty.size(), CV_64FC3);
     for (int y = 0; y < beauty.rows; ++y) {
         const auto* in = beauty.ptr<cv::Vec3f>(y);
         auto* lab = encoded.lab.ptr<cv::Vec3d>(y);
-        auto* luminance = encoded.luminance.ptr<double>(y);
         auto* display = encoded.display.ptr<cv::Vec3d>(y);
         for (int x = 0; x < beauty.cols; ++x) {
             double r = in[x][0], g = in[x][1], b = in[x][2];
             Lab value = displayLab(r, g, b, exposure);
             lab[x] = {value.lightness, value.a, value.b};
-            double y709 = luminanceRec709(r, g, b) * exposure;
-            luminance[x] = std::isfinite(y709) ? y709 : 0.0;
             display[x] = {255.0 * encodeSrgb(r * exposure), 255.0 * encodeSrgb(g * exposure),
                           255.0 * encodeSrgb(b * exposure)};
         }
     }
     return encoded;
+}
+
+// Linear Y × exposure of a render, unclipped (non-finite values count as 0).
+cv::Mat linearLuminance(const cv::Mat& beauty, double exposure) {
+    cv::Mat luminance(beauty.size(), CV_64FC1);
+    for (int y = 0; y < beauty.rows; ++y) {
+        const auto* in = beauty.ptr<cv::Vec3f>(y);
+        auto* out = luminance.ptr<double>(y);
+        for (int x = 0; x < beauty.cols; ++x) {
+            const double value = luminanceRec709(in[x][0], in[x][1], in[x][2]) * exposure;
+            out[x] = std::isfinite(value) ? value : 0.0;
+        }
+    }
+    return luminance;
+}
+
+// The bands on an image of `width` × `height` showing the render (a magnified crop: each shown pixel in the band
+// of the render pixel it shows).
+ErrorBands bandsAtSize(const ErrorBands& bands, int width, int height) {
+    if (bands.skin.cols == width && bands.skin.rows == height) return bands;
+    ErrorBands scaled;
+    const cv::Size size(width, height);
+    for (size_t i = 0; i < bands.masks.size(); ++i)
+        cv::resize(bands.masks[i], scaled.masks[i], size, 0.0, 0.0, cv::INTER_NEAREST);
+    cv::resize(bands.skin, scaled.skin, size, 0.0, 0.0, cv::INTER_NEAREST);
+    return scaled;
 }
 
 // ΔE00 values where `mask` is set (all pixels when empty).
@@ -107,21 +130,39 @@ void validateMetricOptions(const MetricOptions& options) {
     if (options.sssRadiusMillimetres &&
         (!(*options.sssRadiusMillimetres > 0.0) || !std::isfinite(*options.sssRadiusMillimetres)))
         throwInput("--sss-radius-mm", "", formatNumber(*options.sssRadiusMillimetres) + " must be a positive number");
-    if (!(options.pixelsPerDegree > 0.0) || !std::isfinite(options.pixelsPerDegree))
+    if (options.pixelsPerDegree < 0.0 || !std::isfinite(options.pixelsPerDegree) ||
+        !(options.flipPixelsPerDegree() > 0.0))
         throwInput("--ppd", "", formatNumber(options.pixelsPerDegree) + " must be a positive number");
 }
 
-PreparedReference prepareReference(MetricRender reference, const MetricOptions& options) {
+namespace {
+
+// The display-referred encodings (of the presented image when there is one, else of the render × exposure), the
+// render's linear luminance and the bands at the display-referred size.
+void encodeReference(PreparedReference& prepared, const MetricRender& reference, const MetricRender* presented,
+                     const MetricOptions& options) {
+    EncodedImage encoded = encode(presented ? presented->beauty : reference.beauty, presented ? 1.0 : options.exposure);
+    prepared.lab = std::move(encoded.lab);
+    prepared.display = std::move(encoded.display);
+    prepared.luminance = linearLuminance(reference.beauty, options.exposure);
+    if (presented) prepared.presented = presented->beauty;
+    prepared.displayBands = bandsAtSize(prepared.bands, prepared.lab.cols, prepared.lab.rows);
+}
+
+} // namespace
+
+PreparedReference prepareReference(MetricRender reference, const MetricOptions& options,
+                                   const MetricRender* presented) {
     const std::string file = reference.path.string();
     validateMetricOptions(options);
+    if (presented && options.exposure != 1.0)
+        throwInput("--exposure", "",
+                   formatNumber(options.exposure) + ": the presented images are scored as shown (exposure 1)");
     if (reference.plain) {
         PreparedReference prepared;
         for (cv::Mat& mask : prepared.bands.masks) mask = cv::Mat::zeros(reference.height, reference.width, CV_8UC1);
         prepared.bands.skin = cv::Mat::zeros(reference.height, reference.width, CV_8UC1);
-        EncodedImage encoded = encode(reference.beauty, options.exposure);
-        prepared.lab = std::move(encoded.lab);
-        prepared.luminance = std::move(encoded.luminance);
-        prepared.display = std::move(encoded.display);
+        encodeReference(prepared, reference, presented, options);
         prepared.render = std::move(reference);
         return prepared;
     }
@@ -139,10 +180,7 @@ PreparedReference prepareReference(MetricRender reference, const MetricOptions& 
     prepared.geometry.supportRadiusWorld = prepared.sssRadiusMillimetres / *reference.millimetresPerUnit;
     prepared.geometry.focalLengthPixels = *reference.focalLengthPixels;
     prepared.bands = buildErrorBands(reference.depth, reference.mask, prepared.geometry);
-    EncodedImage encoded = encode(reference.beauty, options.exposure);
-    prepared.lab = std::move(encoded.lab);
-    prepared.luminance = std::move(encoded.luminance);
-    prepared.display = std::move(encoded.display);
+    encodeReference(prepared, reference, presented, options);
     prepared.skinLuminanceSum = maskedSum(prepared.luminance, prepared.bands.skin);
     prepared.render = std::move(reference);
     return prepared;
@@ -164,40 +202,49 @@ void checkComparable(const MetricRender& ref, const MetricRender& test) {
 }
 
 ComparisonResult compareWithReference(const PreparedReference& reference, const MetricRender& test,
-                                      const MetricOptions& options) {
+                                      const MetricOptions& options, const MetricRender* presented) {
     const MetricRender& ref = reference.render;
     checkComparable(ref, test);
+    if (reference.presented.empty() != (presented == nullptr))
+        throw std::logic_error("compareWithReference(): a presented image for one of reference and test only");
+    if (presented && (presented->width != reference.presented.cols || presented->height != reference.presented.rows))
+        throwInput(presented->path.string(), "",
+                   "size " + sizeText(presented->width, presented->height) +
+                       " differs from the reference's presented image (" +
+                       sizeText(reference.presented.cols, reference.presented.rows) + ")");
 
-    EncodedImage encoded = encode(test.beauty, options.exposure);
+    // Display-referred: the presented images as shown, or the renders × exposure on the display.
+    const double exposure = presented ? 1.0 : options.exposure;
+    const cv::Mat& referenceShown = presented ? reference.presented : ref.beauty;
+    const cv::Mat& testShown = presented ? presented->beauty : test.beauty;
+    const int width = referenceShown.cols, height = referenceShown.rows;
+    EncodedImage encoded = encode(testShown, exposure);
     ComparisonResult result;
-    result.deltaE00.create(ref.height, ref.width, CV_32FC1);
-    cv::Mat absoluteLuminance(ref.height, ref.width, CV_64FC1);
-    for (int y = 0; y < ref.height; ++y) {
+    result.deltaE00.create(height, width, CV_32FC1);
+    for (int y = 0; y < height; ++y) {
         const auto* labReference = reference.lab.ptr<cv::Vec3d>(y);
         const auto* labTest = encoded.lab.ptr<cv::Vec3d>(y);
-        const auto* yReference = reference.luminance.ptr<double>(y);
-        const auto* yTest = encoded.luminance.ptr<double>(y);
         auto* deltaE = result.deltaE00.ptr<float>(y);
-        auto* leak = absoluteLuminance.ptr<double>(y);
-        for (int x = 0; x < ref.width; ++x) {
+        for (int x = 0; x < width; ++x)
             deltaE[x] = static_cast<float>(ciede2000({labReference[x][0], labReference[x][1], labReference[x][2]},
                                                      {labTest[x][0], labTest[x][1], labTest[x][2]}));
-            leak[x] = std::fabs(yTest[x] - yReference[x]);
-        }
     }
+    // Linear: the renders' luminance, unclipped.
+    const cv::Mat testLuminance = linearLuminance(test.beauty, options.exposure);
+    cv::Mat absoluteLuminance;
+    cv::absdiff(testLuminance, reference.luminance, absoluteLuminance);
 
     cv::Mat ssimMap = structuralSimilarityMap(reference.display, encoded.display);
-    result.flip = flipErrorMap(ref.beauty, test.beauty, options.pixelsPerDegree, options.exposure);
+    result.flip = flipErrorMap(referenceShown, testShown, options.flipPixelsPerDegree(), exposure);
     {
-        const bool scaled = options.exposure != 1.0;
-        const CvvdpResult visibility =
-            cvvdp(scaled ? cv::Mat(ref.beauty * options.exposure) : ref.beauty,
-                  scaled ? cv::Mat(test.beauty * options.exposure) : test.beauty, options.display, true);
+        const bool scaled = exposure != 1.0;
+        const CvvdpResult visibility = cvvdp(scaled ? cv::Mat(referenceShown * exposure) : referenceShown,
+                                             scaled ? cv::Mat(testShown * exposure) : testShown, options.display, true);
         result.cvvdpJod = visibility.jod;
         result.cvvdpMap = visibility.map;
     }
-    const cv::Mat& skin = reference.bands.skin;
-    const auto totalPixels = static_cast<std::size_t>(ref.width) * static_cast<std::size_t>(ref.height);
+    const cv::Mat& skin = reference.displayBands.skin;
+    const auto totalPixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
     const auto skinPixels = static_cast<std::size_t>(cv::countNonZero(skin));
 
     auto regionScores = [&](const cv::Mat& mask) {
@@ -225,7 +272,7 @@ ComparisonResult compareWithReference(const PreparedReference& reference, const 
     result.skin = regionScores(skin);
 
     for (Band band : allBands) {
-        const cv::Mat& mask = reference.bands.mask(band);
+        const cv::Mat& mask = reference.displayBands.mask(band);
         BandScores& scores = result.bands[static_cast<std::size_t>(band)];
         std::vector<double> values = collect(result.deltaE00, mask);
         scores.pixels = values.size();
@@ -236,7 +283,7 @@ ComparisonResult compareWithReference(const PreparedReference& reference, const 
         scores.deltaE00P95 = percentile95(std::move(values));
         scores.flipMean = flipMean(result.flip, mask);
         scores.cvvdpMapMean = cvvdpMapMean(result.cvvdpMap, mask);
-        double leakSum = maskedSum(absoluteLuminance, mask);
+        double leakSum = maskedSum(absoluteLuminance, reference.bands.mask(band));
         scores.leakEnergy = reference.skinLuminanceSum > 0.0 ? leakSum / reference.skinLuminanceSum : notANumber;
     }
     double interiorMean = result.band(Band::interior).deltaE00Mean;

@@ -4,6 +4,7 @@
 #include "common/files.h"
 #include "common/hash.h"
 
+#include <algorithm>
 #include <map>
 #include <set>
 
@@ -30,6 +31,7 @@ struct StimulusEntry {
     std::string id;
     std::string block;
     fs::path exr;
+    fs::path png;
     bool reference = false;
     nlohmann::json factors;
 };
@@ -71,6 +73,7 @@ ComparisonPlan planStimulusSetComparisons(const fs::path& stimulusFolder,
 
     std::vector<StimulusEntry> entries;
     std::set<std::string> ids;
+    std::optional<std::string> display;
     for (size_t i = 0; i < stimuli.size(); ++i) {
         const nlohmann::json& stimulus = stimuli[i];
         const std::string where = "stimuli[" + std::to_string(i) + "].";
@@ -81,18 +84,31 @@ ComparisonPlan planStimulusSetComparisons(const fs::path& stimulusFolder,
         const nlohmann::json& files = member(stimulus, "files", file, where);
         std::string exr = stringMember(files, "exr", file, where + "files.");
         entry.exr = stimulusFolder / exr;
+        if (files.contains("png")) entry.png = stimulusFolder / stringMember(files, "png", file, where + "files.");
         if (stimulus.contains("reference")) {
             if (!stimulus["reference"].is_boolean()) throwInput(file, where + "reference", "must be true or false");
             entry.reference = stimulus["reference"].get<bool>();
         }
         entry.factors = stimulus.contains("factors") ? stimulus["factors"] : nlohmann::json::object();
         // The content hash ties the metrics to the set as built; a changed file is not silently measured.
-        if (stimulus.contains("sha256") && stimulus["sha256"].contains("exr")) {
-            const nlohmann::json& expected = stimulus["sha256"]["exr"];
-            if (!expected.is_string()) throwInput(file, where + "sha256.exr", "must be a string");
-            if (fs::is_regular_file(entry.exr, ec) && sha256File(entry.exr) != expected.get<std::string>())
-                throwInput(entry.exr.string(), "",
+        for (const auto& [kind, path] : {std::pair<std::string, fs::path>{"exr", entry.exr}, {"png", entry.png}}) {
+            if (path.empty() || !stimulus.contains("sha256") || !stimulus["sha256"].contains(kind)) continue;
+            const nlohmann::json& expected = stimulus["sha256"][kind];
+            if (!expected.is_string()) throwInput(file, where + "sha256." + kind, "must be a string");
+            if (fs::is_regular_file(path, ec) && sha256File(path) != expected.get<std::string>())
+                throwInput(path.string(), "",
                            "sha256 does not match " + file + " (the file changed after the set was built)");
+        }
+        // The display the set's predictions were made for: one viewing geometry per set.
+        if (stimulus.contains("predicted") && stimulus["predicted"].is_object() &&
+            stimulus["predicted"].contains("display")) {
+            const nlohmann::json& named = stimulus["predicted"]["display"];
+            if (!named.is_string()) throwInput(file, where + "predicted.display", "must be a string");
+            if (display && *display != named.get<std::string>())
+                throwInput(file, where + "predicted.display",
+                           "\"" + named.get<std::string>() + "\" differs from \"" + *display +
+                               "\" of an earlier stimulus (predict the set again on one display)");
+            display = named.get<std::string>();
         }
         entries.push_back(std::move(entry));
     }
@@ -124,6 +140,10 @@ ComparisonPlan planStimulusSetComparisons(const fs::path& stimulusFolder,
     }
 
     ComparisonPlan plan;
+    plan.display = display;
+    // The presented images, when every stimulus lists one (a set built or imported by skinlab does).
+    const bool presented =
+        std::all_of(entries.begin(), entries.end(), [](const StimulusEntry& e) { return !e.png.empty(); });
     for (const std::string& block : blockOrder) {
         auto found = references.find(block);
         if (found == references.end()) {
@@ -133,7 +153,8 @@ ComparisonPlan planStimulusSetComparisons(const fs::path& stimulusFolder,
         const StimulusEntry* reference = found->second;
         for (const StimulusEntry* test : members[block])
             if (test != reference)
-                plan.jobs.push_back({reference->id, reference->exr, test->id, test->exr, block, test->factors});
+                plan.jobs.push_back({reference->id, reference->exr, test->id, test->exr, block, test->factors,
+                                     presented ? reference->png : fs::path(), presented ? test->png : fs::path()});
     }
     return plan;
 }

@@ -1,11 +1,15 @@
 // Stimulus-set throughput: builds a set spec (default stimuli/specs/demo.toml) into a fresh folder
 // and reports stimuli per minute, then rebuilds it unchanged (nothing rendered: the cost of the resume check,
-// which re-hashes every file). Prints a table and writes bench_stimuli.csv into the output folder.
+// which re-hashes every file), then the visibility against viewing distance of the built set (`stimuli
+// visibility`, when it has references). Prints a table and writes bench_stimuli.csv (and bench_visibility.csv) into
+// the output folder.
 //   bench_stimuli [--spec SPEC] [--jobs N] [-o DIR] [--assets DIR] [--set key=value ...]
 #include "common/files.h"
 #include "renderer/renderer.h"
 #include "stimuli/build.h"
+#include "stimuli/visibility.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -68,6 +72,20 @@ int main(int argc, char** argv) {
                "," + std::to_string(warm.wallSeconds) + "\n";
         skinlab::writeFileAtomic(out / "bench_stimuli.csv", csv);
         std::printf("written         %s\n", (out / "bench_stimuli.csv").string().c_str());
+        // Visibility against viewing distance (`stimuli visibility`): every condition at 6 pixels per degree.
+        const std::optional<skinlab::stimuli::Manifest> manifest = skinlab::stimuli::readManifest(setDir);
+        if (manifest && std::any_of(manifest->stimuli.begin(), manifest->stimuli.end(),
+                                    [](const nlohmann::json& s) { return s.value("reference", false); })) {
+            const skinlab::stimuli::VisibilityTable table =
+                skinlab::stimuli::computeVisibility(setDir, *manifest, skinlab::stimuli::VisibilityOptions{});
+            std::printf("visibility      %.1f s  (%zu conditions x %zu pixels per degree, 2 threads)\n", table.seconds,
+                        table.rows.size(), table.pixelsPerDegree.size());
+            skinlab::writeFileAtomic(out / "bench_visibility.csv",
+                                     "spec,conditions,pixels_per_degree,threads,visibility_s\n\"" +
+                                         options.spec.filename().string() + "\"," + std::to_string(table.rows.size()) +
+                                         "," + std::to_string(table.pixelsPerDegree.size()) + ",2," +
+                                         std::to_string(table.seconds) + "\n");
+        }
     } catch (const std::exception& e) {
         std::fprintf(stderr, "bench_stimuli: %s\n", e.what());
         return 1;

@@ -555,6 +555,99 @@ TEST_F(StimuliBuild, CropAndMagnificationAreAppliedRecordedAndPredictedOn) {
     EXPECT_EQ(manifestOf(shown)["stimuli"][3]["presentation"]["crop"]["x"], 48);
 }
 
+// The metrics of a set run on what observers see: `analyze metrics --stimuli` scores the presented PNGs (cropped,
+// magnified, tone-mapped) on the display of the set's predictions, so its ColorVideoVDP reproduces each stimulus's
+// predicted JOD (within 0.05 JOD; the same computation), FLIP runs at the same pixels per degree, and the heat maps
+// have the presented size. `stimuli visibility` tabulates every condition at 20–120 pixels per degree: its JOD at the
+// display's own pixels per degree is the prediction, the table is in visibility.csv/json, the plot in visibility.svg
+// and both in the contact sheet. Fails before the metrics were moved onto the presented images (the EXR crops gave
+// other JOD) and before the visibility command existed.
+TEST_F(StimuliBuild, SetMetricsReproduceThePredictionsAndVisibilitySpansViewingDistances) {
+    const fs::path shown = gRoot / "presented", metrics = gRoot / "metrics";
+    // With SSS, so that the reference carries its scattering radius for the bands.
+    std::string spec = presentedSpec("presented", true);
+    spec.replace(spec.find("method = \"none\""), 15, "method = \"separable\"");
+    CliRun run = runCli({"stimuli", "build", writeSpec("presented.toml", spec).string(), "-o", shown.string()});
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    run = runCli({"analyze", "metrics", "--stimuli", shown.string(), "-o", metrics.string()});
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    const nlohmann::json m = manifestOf(shown);
+    std::ifstream metricsFile(metrics / "metrics.json");
+    const nlohmann::json scores = nlohmann::json::parse(metricsFile);
+    const skinlab::metrics::CvvdpDisplay display = skinlab::metrics::cvvdpDisplay("standard_fhd");
+    // One viewing geometry, from the set's predictions, stated once and used by FLIP and ColorVideoVDP.
+    EXPECT_EQ(scores["settings"]["viewing"]["display"], "standard_fhd");
+    EXPECT_NEAR(scores["settings"]["viewing"]["pixels_per_degree"].get<double>(), display.pixelsPerDegree, 1e-9);
+    EXPECT_NEAR(scores["settings"]["flip"]["pixels_per_degree"].get<double>(), display.pixelsPerDegree, 1e-9);
+    EXPECT_NE(scores["settings"]["viewing"]["source"].get<std::string>().find("predictions"), std::string::npos);
+    std::map<std::string, double> predicted;
+    std::map<std::string, int> presentedWidth;
+    for (const auto& s : m["stimuli"]) {
+        presentedWidth[s["id"]] = s["width"].get<int>();
+        if (!s["reference"].get<bool>()) predicted[s["id"]] = s["predicted"]["jod"].get<double>();
+    }
+    ASSERT_EQ(scores["comparisons"].size(), predicted.size());
+    for (const auto& c : scores["comparisons"]) {
+        const std::string id = c["test"]["name"];
+        EXPECT_NEAR(c["cvvdp_jod"].get<double>(), predicted.at(id), 0.05) << id;
+        EXPECT_EQ(c["width"].get<int>(), presentedWidth.at(id)) << id; // the presented size, not the crop's
+        EXPECT_LT(c["cvvdp_jod"].get<double>(), 10.0) << id;
+        // The map has the presented size (plus the 170-pixel legend panel).
+        EXPECT_EQ(readPixels(metrics / c["cvvdp_heatmap"].get<std::string>()).width, presentedWidth.at(id) + 170) << id;
+    }
+    // Another display on the command line is another geometry: the JOD move off the predictions.
+    run = runCli({"analyze", "metrics", "--stimuli", shown.string(), "--display", "standard_4k", "--no-heatmaps", "-o",
+                  (gRoot / "metrics-4k").string()});
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    EXPECT_NE(run.output.find("will differ from the manifest's predicted JOD"), std::string::npos) << run.output;
+    // --exposure has no meaning for images scored as shown.
+    run = runCli({"analyze", "metrics", "--stimuli", shown.string(), "--exposure", "2", "-o",
+                  (gRoot / "metrics-exposed").string()});
+    EXPECT_EQ(run.exitCode, 2) << run.output;
+    EXPECT_NE(run.output.find("--exposure: 2"), std::string::npos) << run.output;
+
+    // Visibility at 20–120 pixels per degree, plus the display's own: there it is the prediction.
+    char ownPpd[32];
+    std::snprintf(ownPpd, sizeof ownPpd, "%.17g", display.pixelsPerDegree);
+    run = runCli({"stimuli", "visibility", shown.string(), "--ppd", std::string("20,30,") + ownPpd + ",60,80,120"});
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    std::ifstream visibilityFile(shown / "visibility.json");
+    const nlohmann::json visibility = nlohmann::json::parse(visibilityFile);
+    EXPECT_EQ(visibility["display"]["name"], "standard_fhd");
+    ASSERT_EQ(visibility["pixels_per_degree"].size(), 6u);
+    ASSERT_EQ(visibility["rows"].size(), predicted.size());
+    // 24-inch 1920×1080 at 0.6 m is the model's 37.8 ppd: the distance axis says 0.6 m there.
+    EXPECT_NEAR(visibility["distance_m"][2].get<double>(), 0.6, 1e-6);
+    for (const auto& row : visibility["rows"]) {
+        const std::string id = row["stimulus"];
+        EXPECT_NEAR(row["jod"][2].get<double>(), predicted.at(id), 1e-9) << id;
+        // The summary agrees with the row: visible everywhere exactly when below 9 JOD at every ppd.
+        bool everywhere = true, nowhere = true;
+        for (const auto& jod : row["jod"]) {
+            EXPECT_LE(jod.get<double>(), 10.0) << id;
+            everywhere = everywhere && jod.get<double>() < 9.0;
+            nowhere = nowhere && jod.get<double>() >= 9.0;
+        }
+        EXPECT_EQ(row["visible_everywhere"].get<bool>(), everywhere) << id;
+        EXPECT_EQ(row["invisible_everywhere"].get<bool>(), nowhere) << id;
+    }
+    std::ifstream csv(shown / "visibility.csv");
+    std::string header;
+    std::getline(csv, header);
+    EXPECT_EQ(header.rfind("block,reference,stimulus,jod_ppd_20,jod_ppd_30,", 0), 0u) << header;
+    std::stringstream svg, html;
+    svg << std::ifstream(shown / "visibility.svg").rdbuf();
+    EXPECT_NE(svg.str().find("<polyline"), std::string::npos);
+    html << std::ifstream(shown / "contact.html").rdbuf();
+    EXPECT_NE(html.str().find("Visibility against viewing distance"), std::string::npos);
+    EXPECT_NE(html.str().find("src=\"visibility.svg\""), std::string::npos);
+    EXPECT_NE(html.str().find("<table class=\"visibility\">"), std::string::npos);
+    // Unordered values are refused with the option named.
+    run = runCli({"stimuli", "visibility", shown.string(), "--ppd", "40,20"});
+    EXPECT_EQ(run.exitCode, 2) << run.output;
+    EXPECT_NE(run.output.find("--ppd: 20 is not larger than the value before it"), std::string::npos) << run.output;
+}
+
 namespace {
 
 // Every image file of a built set (exr/, png/, contact.png) → the sha256 of its bytes.
