@@ -429,6 +429,7 @@ float Renderer::Impl::runSssPasses(const Frame& frame, const gl::MainPassSetting
         sssInputs.width = spec.width;
         sssInputs.height = spec.height;
         sssInputs.focalLengthPixels = frame.camera.focalLengthPixels;
+        sssInputs.principalPoint = frame.camera.principalPoint;
         sssInputs.mmPerUnit = static_cast<float>(spec.mmPerUnit);
         sssInputs.view = frame.camera.view;
         sssInputs.projection = frame.camera.projection;
@@ -546,7 +547,7 @@ DisplayFrame Renderer::renderDisplay(const RenderRequest& request, bool withLine
     glm::vec3 frameMin, frameMax;
     skinBounds(*frame.model, frame.partMaterials, frameMin, frameMax);
     frame.camera = frameCamera(spec.camera, frameMin, frameMax, frame.model->boundsMin, frame.model->boundsMax,
-                               spec.width, spec.height);
+                               spec.frameWidth, spec.frameHeight, spec.window);
     frame.exposure = static_cast<float>(std::exp2(spec.exposureEv));
     frame.environmentFromWorld = glm::mat3(glm::rotate(
         glm::mat4(1.0f), static_cast<float>(-glm::radians(spec.environment.rotationDeg)), glm::vec3(0, 1, 0)));
@@ -641,7 +642,7 @@ RenderResult Renderer::render(const RenderRequest& request) {
     glm::vec3 frameMin, frameMax;
     skinBounds(*frame.model, frame.partMaterials, frameMin, frameMax);
     frame.camera = frameCamera(spec.camera, frameMin, frameMax, frame.model->boundsMin, frame.model->boundsMax,
-                               spec.width, spec.height);
+                               spec.frameWidth, spec.frameHeight, spec.window);
     impl.targets.resize(spec.width, spec.height);
     frame.exposure = static_cast<float>(std::exp2(spec.exposureEv));
     frame.environmentFromWorld = glm::mat3(glm::rotate(
@@ -753,6 +754,10 @@ RenderResult Renderer::render(const RenderRequest& request) {
     metadata.strings["skinlab:gl_version"] = impl.context.version();
     metadata.strings["skinlab:camera"] = cameraJson.dump();
     metadata.floats["skinlab:f_px"] = camera.focalLengthPixels;
+    if (spec.window) // the part of the render.width × render.height frame this image is (x y width height, y from the top)
+        metadata.strings["skinlab:window"] = std::to_string(spec.window->x) + " " + std::to_string(spec.window->y) +
+                                             " " + std::to_string(spec.window->width) + " " +
+                                             std::to_string(spec.window->height);
     metadata.floats["skinlab:mm_per_unit"] = static_cast<float>(spec.mmPerUnit);
     metadata.floats["skinlab:sss_radius_mm"] = supportRadiusMm;
     if (cycles && eevee) {
