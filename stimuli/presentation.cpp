@@ -66,8 +66,10 @@ void checkPresentation(const Presentation& presentation, int renderWidth, int re
                        std::to_string(presentation.magnification) + " cannot be rendered natively: the presented " +
                            std::to_string(presentedWidth) + " × " + std::to_string(presentedHeight) +
                            " pixels (at most 8192 each way) of a " + std::to_string(frameWidth) + " × " +
-                           std::to_string(frameHeight) + " frame (at most 65536); lower it, or set presentation = "
-                           "\"replicate\"" + stimulus);
+                           std::to_string(frameHeight) +
+                           " frame (at most 65536); lower it, or set presentation = "
+                           "\"replicate\"" +
+                           stimulus);
     }
 }
 

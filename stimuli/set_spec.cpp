@@ -179,8 +179,9 @@ private:
         if (value->get() == "native") return PresentationMethod::native;
         if (value->get() == "replicate") return PresentationMethod::replicate;
         throwInput(fileName_, field,
-                   "'" + value->get() + "' is not a presentation (native: the crop rendered at the presented size; "
-                                        "replicate: nearest-neighbour magnification)");
+                   "'" + value->get() +
+                       "' is not a presentation (native: the crop rendered at the presented size; "
+                       "replicate: nearest-neighbour magnification)");
     }
 
     CropRect readCrop(const toml::node& node, const std::string& field) {

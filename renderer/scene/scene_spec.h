@@ -95,11 +95,11 @@ struct SceneSpec {
     int shadowResolution = 2048; // texels, square
     int shadowPcfRadius = 1;     // PCF taps: (2r+1)^2
     EnvironmentSpec environment;
-    int width = 512;  // the image rendered: the window's size with render.window, else the frame's
+    int width = 512; // the image rendered: the window's size with render.window, else the frame's
     int height = 512;
     int frameWidth = 512; // render.width, render.height: the camera's whole frame (f_px, aspect)
     int frameHeight = 512;
-    std::optional<RenderWindow> window; // render.window
+    std::optional<RenderWindow> window;     // render.window
     double exposureEv = 0.0;                // beauty and AOVs are scaled by 2^exposure_ev
     std::string toneMapper = "filmic";      // linear | exponential | reinhard | reinhard-rgb | filmic
     double exponentialK = 1.0;              // exponential: 1 - exp(-k x)

@@ -582,8 +582,9 @@ TEST(ShippedSpecs, EveryMagnifiedCropRendersNatively) {
             const int m = s.presentation.magnification;
             const CropRect c = effectiveCrop(s.presentation, entryJson["presentation"]["render"]["width"],
                                              entryJson["presentation"]["render"]["height"]);
-            EXPECT_EQ(plan.resolved[i]["render"]["window"],
-                      (nlohmann::json{{"x", c.x * m}, {"y", c.y * m}, {"width", c.width * m}, {"height", c.height * m}}))
+            EXPECT_EQ(
+                plan.resolved[i]["render"]["window"],
+                (nlohmann::json{{"x", c.x * m}, {"y", c.y * m}, {"width", c.width * m}, {"height", c.height * m}}))
                 << where;
         }
     }

@@ -502,12 +502,11 @@ TEST_F(StimuliBuild, ReplicatedCropAndMagnificationAreAppliedRecordedAndPredicte
     CliRun run = runCli({"stimuli", "build", writeSpec("whole.toml", presentedSpec("whole", false)).string(), "-o",
                          full.string(), "--no-predict"});
     ASSERT_EQ(run.exitCode, 0) << run.output;
-    run = runCli({"stimuli", "build",
-                  writeSpec("presented.toml", presentedSpec("presented", true, "replicate")).string(), "-o",
-                  shown.string()});
+    run =
+        runCli({"stimuli", "build", writeSpec("presented.toml", presentedSpec("presented", true, "replicate")).string(),
+                "-o", shown.string()});
     ASSERT_EQ(run.exitCode, 0) << run.output;
-    EXPECT_NE(run.output.find("fixed.presentation: \"replicate\" magnifies 3× by nearest neighbour"),
-              std::string::npos)
+    EXPECT_NE(run.output.find("fixed.presentation: \"replicate\" magnifies 3× by nearest neighbour"), std::string::npos)
         << run.output;
     const nlohmann::json m = manifestOf(shown);
     ASSERT_EQ(m["stimuli"].size(), 6u);
@@ -551,12 +550,10 @@ TEST_F(StimuliBuild, ReplicatedCropAndMagnificationAreAppliedRecordedAndPredicte
     std::ifstream html(shown / "contact.html");
     std::stringstream text;
     text << html.rdbuf();
-    EXPECT_NE(
-        text.str().find("Presented: crop 20,8 40×30 of 96×64, ×3 → 120×90 px (nearest-neighbour replication)"),
-        std::string::npos);
-    EXPECT_NE(
-        text.str().find("Presented: crop 50,0 46×64 of 96×64, ×2 → 92×128 px (nearest-neighbour replication)"),
-        std::string::npos);
+    EXPECT_NE(text.str().find("Presented: crop 20,8 40×30 of 96×64, ×3 → 120×90 px (nearest-neighbour replication)"),
+              std::string::npos);
+    EXPECT_NE(text.str().find("Presented: crop 50,0 46×64 of 96×64, ×2 → 92×128 px (nearest-neighbour replication)"),
+              std::string::npos);
     // A rebuild keeps everything; a changed crop re-renders its block only.
     run = runCli({"stimuli", "build", (gRoot / "presented.toml").string(), "-o", shown.string()});
     ASSERT_EQ(run.exitCode, 0) << run.output;
@@ -593,8 +590,8 @@ double shareDiffering(const Pixels& shown, const Pixels& full, int x, int y, int
 // the whole frame rendered at magnification × the size; nothing is a nearest-neighbour upsample.
 TEST_F(StimuliBuild, NativeCropEqualsTheRegionOfAMagnifiedWholeRender) {
     const fs::path shown = gRoot / "native";
-    CliRun run = runCli({"stimuli", "build", writeSpec("native.toml", presentedSpec("native", true)).string(), "-o",
-                         shown.string()});
+    CliRun run = runCli(
+        {"stimuli", "build", writeSpec("native.toml", presentedSpec("native", true)).string(), "-o", shown.string()});
     ASSERT_EQ(run.exitCode, 0) << run.output;
     EXPECT_EQ(run.output.find("nearest neighbour"), std::string::npos) << run.output;
     // The whole frame at 3× (the close block's magnification) and 2× (the mid block's).
