@@ -460,7 +460,7 @@ fs::path withoutHead(const fs::path& spec, std::vector<std::string>& overrides) 
 // swapped for builtin:head with a --set override so this runs without the scanned head.
 TEST(ShippedSpecs, ExpandToTheDocumentedCounts) {
     const fs::path dir = fs::path(SKINLAB_SOURCE_DIR) / "stimuli" / "specs";
-    const std::vector<std::pair<std::string, size_t>> expected = {{"demo.toml", 22},
+    const std::vector<std::pair<std::string, size_t>> expected = {{"demo.toml", 28},
                                                                   {"demo-scan.toml", 28},
                                                                   {"thesis-fig5.2-methods.toml", 18},
                                                                   {"thesis-fig3.16-halos.toml", 7},
@@ -497,12 +497,12 @@ TEST(ShippedSpecs, ExpandToTheDocumentedCounts) {
     }
     std::vector<Stimulus> demo = expand(readSetSpec(dir / "demo.toml"));
     fs::remove_all(headlessFolder());
-    EXPECT_EQ(demo.front().id, "halo-silhouette-none");
+    EXPECT_EQ(demo.front().id, "head-face-none");
     EXPECT_EQ(demo.back().id, "bleed-true-mask-patches-reference"); // the references come last
-    // Two blocks (the silhouette and the patches), each with one reference and its own presentation.
+    // Three blocks (the face, the silhouette and the patches), each with one reference and its own presentation.
     std::map<std::string, int> references;
     for (const Stimulus& st : demo) references[st.block] += st.reference ? 1 : 0;
-    EXPECT_EQ(references, (std::map<std::string, int>{{"explicit", 1}, {"mid", 1}}));
+    EXPECT_EQ(references, (std::map<std::string, int>{{"close", 1}, {"explicit", 1}, {"mid", 1}}));
 }
 
 // The demo's study designs study every block their stimulus set builds (scripts/demo.sh renders them all), and each
