@@ -127,6 +127,8 @@ void runList(const StimuliOptions& o) {
                          "x" + std::to_string(c->height);
         if (s.presentation.magnification != 1)
             overrides += " magnification=" + std::to_string(s.presentation.magnification);
+        if (s.presentation.method == stimuli::PresentationMethod::replicate && s.presentation.magnification != 1)
+            overrides += " presentation=replicate";
         std::printf("%s\t%s\t%s\tscene=%s%s\n", s.id.c_str(), s.block.c_str(), s.reference ? "reference" : "-",
                     s.factors.front().second.value.c_str(), overrides.c_str());
     }

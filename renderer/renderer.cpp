@@ -262,6 +262,13 @@ void setInternalSize(Frame& frame, const SceneSpec& spec) {
     frame.height = spec.height * spec.ssaaFactor;
 }
 
+// The render.window in pixels of the internal (supersampled) frame: every pass runs at ssaa_factor × the frame.
+std::optional<RenderWindow> internalWindow(const SceneSpec& spec) {
+    if (!spec.window) return std::nullopt;
+    const int f = spec.ssaaFactor;
+    return RenderWindow{spec.window->x * f, spec.window->y * f, spec.window->width * f, spec.window->height * f};
+}
+
 // --- materials -----------------------------------------------------------------------------------------------
 // One GPU material per part of the model: the model's own materials with the scene's [[materials]] overrides.
 std::vector<gl::GpuMaterial> partMaterialsOf(const SceneSpec& spec, const Model& model) {
@@ -495,6 +502,7 @@ float Renderer::Impl::runSssPasses(const Frame& frame, const gl::MainPassSetting
         sssInputs.width = frame.width;
         sssInputs.height = frame.height;
         sssInputs.focalLengthPixels = frame.camera.focalLengthPixels;
+        sssInputs.principalPoint = frame.camera.principalPoint;
         sssInputs.mmPerUnit = static_cast<float>(spec.mmPerUnit);
         sssInputs.view = frame.camera.view;
         sssInputs.projection = frame.camera.projection;
@@ -622,7 +630,8 @@ DisplayFrame Renderer::renderDisplay(const RenderRequest& request, bool withLine
     skinBounds(*frame.model, frame.partMaterials, frameMin, frameMax);
     setInternalSize(frame, spec);
     frame.camera = frameCamera(spec.camera, frameMin, frameMax, frame.model->boundsMin, frame.model->boundsMax,
-                               frame.width, frame.height);
+                               spec.frameWidth * frame.ssaaFactor, spec.frameHeight * frame.ssaaFactor,
+                               internalWindow(spec));
     frame.exposure = static_cast<float>(std::exp2(spec.exposureEv));
     frame.environmentFromWorld = glm::mat3(glm::rotate(
         glm::mat4(1.0f), static_cast<float>(-glm::radians(spec.environment.rotationDeg)), glm::vec3(0, 1, 0)));
@@ -723,7 +732,8 @@ RenderResult Renderer::render(const RenderRequest& request) {
     skinBounds(*frame.model, frame.partMaterials, frameMin, frameMax);
     setInternalSize(frame, spec);
     frame.camera = frameCamera(spec.camera, frameMin, frameMax, frame.model->boundsMin, frame.model->boundsMax,
-                               frame.width, frame.height);
+                               spec.frameWidth * frame.ssaaFactor, spec.frameHeight * frame.ssaaFactor,
+                               internalWindow(spec));
     impl.targets.resize(frame.width, frame.height);
     if (frame.ssaaFactor > 1) impl.resolvedTargets.resize(spec.width, spec.height);
     frame.exposure = static_cast<float>(std::exp2(spec.exposureEv));
@@ -854,6 +864,10 @@ RenderResult Renderer::render(const RenderRequest& request) {
     metadata.strings["skinlab:camera"] = cameraJson.dump();
     // The output image's focal length (the passes ran at ssaa_factor × it).
     metadata.floats["skinlab:f_px"] = camera.focalLengthPixels / static_cast<float>(frame.ssaaFactor);
+    if (spec.window) // the part of the render.width × render.height frame this image is (x y width height, y from the top)
+        metadata.strings["skinlab:window"] = std::to_string(spec.window->x) + " " + std::to_string(spec.window->y) +
+                                             " " + std::to_string(spec.window->width) + " " +
+                                             std::to_string(spec.window->height);
     metadata.floats["skinlab:mm_per_unit"] = static_cast<float>(spec.mmPerUnit);
     metadata.floats["skinlab:sss_radius_mm"] = supportRadiusMm;
     if (cycles && eevee) {

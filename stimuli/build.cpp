@@ -110,8 +110,20 @@ std::pair<int, int> renderSize(const nlohmann::json& resolved) {
     return {width->get<int>(), height->get<int>()};
 }
 
-nlohmann::json presentationOf(const Stimulus& stimulus, const nlohmann::json& resolved) {
+} // namespace
+
+std::pair<int, int> presentationFrame(const Stimulus& stimulus, const nlohmann::json& resolved) {
     auto [width, height] = renderSize(resolved);
+    const Presentation& p = stimulus.presentation;
+    if (p.method == PresentationMethod::native && presents(p) && findDotted(resolved, "render.window"))
+        return {width / p.magnification, height / p.magnification};
+    return {width, height};
+}
+
+namespace {
+
+nlohmann::json presentationOf(const Stimulus& stimulus, const nlohmann::json& resolved) {
+    auto [width, height] = presentationFrame(stimulus, resolved);
     return presentationJson(stimulus.presentation, width, height);
 }
 
@@ -124,12 +136,13 @@ std::pair<int, int> imageSize(const fs::path& path) {
 }
 
 // Renders one stimulus into temporary files and renames them into place; returns its complete manifest entry.
-nlohmann::json renderStimulus(renderer::Renderer& renderer, const Stimulus& stimulus, const nlohmann::json& resolved,
+nlohmann::json renderStimulus(renderer::Renderer& renderer, const Stimulus& stimulus,
+                              const std::vector<std::string>& overrides, const nlohmann::json& resolved,
                               const fs::path& dir, const fs::path& assets) {
     auto start = std::chrono::steady_clock::now();
     AtomicOutput exr(dir / exrRelativePath(stimulus.id));
     AtomicOutput png(dir / pngRelativePath(stimulus.id));
-    RenderRequest request = requestFor(stimulus.scene, stimulus.overrides, assets);
+    RenderRequest request = requestFor(stimulus.scene, overrides, assets);
     request.exrPath = exr.tempPath();
     request.pngPath = png.tempPath();
     renderer::RenderResult result = renderer.render(request);
@@ -199,18 +212,52 @@ BuildPlan planBuild(const fs::path& specPath, const std::vector<std::string>& sp
     plan.selected = shard ? selectShard(plan.all, *shard) : plan.all;
     validateLevels(plan.spec, plan.all, assetsDir);
     for (const auto& stimulus : plan.selected) {
+        nlohmann::json resolved;
         try {
-            plan.resolved.push_back(renderer::resolveScene(requestFor(stimulus.scene, stimulus.overrides, assetsDir)));
+            resolved = renderer::resolveScene(requestFor(stimulus.scene, stimulus.overrides, assetsDir));
         } catch (const InputError& e) {
             throw InputError(plan.spec.fileName + ": stimulus '" + stimulus.id + "': " + e.what());
         }
-        auto [width, height] = renderSize(plan.resolved.back());
+        auto [width, height] = renderSize(resolved);
         checkPresentation(stimulus.presentation, width, height, plan.spec.fileName, stimulus.id);
+        // A native presentation renders the crop's window of a magnified frame (presentation.h).
+        std::vector<std::string> overrides = stimulus.overrides;
+        const std::vector<std::string> native = nativeRenderOverrides(stimulus.presentation, width, height);
+        if (!native.empty()) {
+            if (findDotted(resolved, "render.window"))
+                throwInput(plan.spec.fileName, stimulus.presentation.methodWhere,
+                           "native presentation of stimulus '" + stimulus.id +
+                               "', whose scene sets its own render.window: remove it, or set presentation = "
+                               "\"replicate\"");
+            overrides.insert(overrides.end(), native.begin(), native.end());
+            try {
+                resolved = renderer::resolveScene(requestFor(stimulus.scene, overrides, assetsDir));
+            } catch (const InputError& e) {
+                throw InputError(plan.spec.fileName + ": stimulus '" + stimulus.id + "': " + e.what());
+            }
+        }
+        plan.resolved.push_back(std::move(resolved));
+        plan.renderOverrides.push_back(std::move(overrides));
     }
     return plan;
 }
 
 namespace {
+
+// One warning per spec key that asks for nearest-neighbour magnification: its blocks of pixels are an artefact
+// observers see (and the predicted JOD includes), not a property of any condition.
+void warnReplicated(const BuildPlan& plan) {
+    std::vector<std::string> warned;
+    for (const auto& s : plan.selected) {
+        const Presentation& p = s.presentation;
+        if (p.method != PresentationMethod::replicate || p.magnification == 1) continue;
+        if (std::find(warned.begin(), warned.end(), p.methodWhere) != warned.end()) continue;
+        warned.push_back(p.methodWhere);
+        spdlog::warn("stimuli: {}: {}: \"replicate\" magnifies {}× by nearest neighbour (blocks of {}×{} pixels in "
+                     "every stimulus); presentation = \"native\" renders the crop at the presented size",
+                     plan.spec.fileName, p.methodWhere, p.magnification, p.magnification, p.magnification);
+    }
+}
 
 // The entries of an earlier build of this version that are still valid, by id (the earlier renderer into
 // manifest.renderer).
@@ -286,7 +333,8 @@ size_t renderStimuli(const BuildOptions& options, const BuildPlan& plan, Manifes
                 auto t0 = std::chrono::steady_clock::now();
                 nlohmann::json entry;
                 try {
-                    entry = renderStimulus(*renderer, plan.selected[i], plan.resolved[i], dir, options.assetsDir);
+                    entry = renderStimulus(*renderer, plan.selected[i], plan.renderOverrides[i], plan.resolved[i], dir,
+                                           options.assetsDir);
                 } catch (const InputError& e) {
                     throw InputError(plan.spec.fileName + ": stimulus '" + plan.selected[i].id + "': " + e.what());
                 } catch (const RuntimeError& e) {
@@ -341,6 +389,7 @@ BuildSummary buildSet(const BuildOptions& options) {
     tidyOutputFolder(dir, selectedIds);
     spdlog::info("stimuli: set '{}': {} stimuli, {} unchanged, {} to render", plan.spec.name, plan.selected.size(),
                  entries.size(), toRender.size());
+    warnReplicated(plan);
 
     BuildSummary summary;
     summary.stimuli = plan.selected.size();

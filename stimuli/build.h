@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace skinlab::stimuli {
@@ -32,7 +33,10 @@ struct BuildPlan {
     SetSpec spec;
     std::vector<Stimulus> all;            // the whole set
     std::vector<Stimulus> selected;       // this shard's slice (all of it without --shard)
-    std::vector<nlohmann::json> resolved; // per selected stimulus: resolveScene()'s JSON
+    std::vector<nlohmann::json> resolved; // per selected stimulus: resolveScene()'s JSON of what is rendered
+    // Per selected stimulus: the scene overrides rendered, its own and those of a native presentation
+    // (presentation.h: render.width/height × magnification, render.window).
+    std::vector<std::vector<std::string>> renderOverrides;
 };
 
 // Reads the spec, expands it and resolves every selected stimulus (no GL). Throws InputError for bad input:
@@ -52,6 +56,10 @@ struct BuildSummary {
 };
 
 BuildSummary buildSet(const BuildOptions& options);
+
+// The render size the stimulus' crop is given in (the set's render size): the resolved render's, or for a native
+// presentation (rendered as a render.window of a frame magnification × that size) the frame's / magnification.
+std::pair<int, int> presentationFrame(const Stimulus& stimulus, const nlohmann::json& resolved);
 
 // The manifest entry of a stimulus (everything but the render-derived fields: sha256, width, height, timings).
 nlohmann::json stimulusEntry(const Stimulus& stimulus, const nlohmann::json& resolved);

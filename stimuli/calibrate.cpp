@@ -404,14 +404,18 @@ CalibrationReport calibrateLevels(const CalibrateOptions& options) {
     TemporaryFolder folder;
     renderer::Renderer renderer;
     int renders = 0;
-    auto render = [&](const Stimulus& stimulus, const std::vector<std::string>& overrides) {
+    const auto [frameWidth, frameHeight] = presentationFrame(*base, plan.resolved[baseIndex]);
+    auto render = [&](const Stimulus& stimulus, std::vector<std::string> overrides) {
+        // Presented like the set presents it: a native presentation renders the crop's window (presentation.h).
+        const std::vector<std::string> native = nativeRenderOverrides(stimulus.presentation, frameWidth, frameHeight);
+        overrides.insert(overrides.end(), native.begin(), native.end());
         renderer::RenderRequest request = requestOf(stimulus, overrides, options.assetsDir);
         const std::string name = "render-" + std::to_string(renders + 1);
         request.exrPath = folder.path() / (name + ".exr");
         request.pngPath = folder.path() / (name + ".png");
         renderer.render(request);
         ++renders;
-        // Presented like the set presents it (crop, magnification): the prediction is on what an observer sees.
+        // A replicated presentation is cropped and magnified here: the prediction is on what an observer sees.
         applyPresentation(request.exrPath, request.pngPath, stimulus.presentation);
         cv::Mat image =
             metrics::loadMetricRender(request.pngPath, metrics::RenderRole::test, metrics::ImageEncoding::srgb).beauty;

@@ -147,7 +147,7 @@ std::vector<std::string> wrapCaption(const std::string& caption, int width, int 
 }
 
 // How a block is presented, from its first stimulus' manifest entry: "crop 120,40 320×180 of 896×504, ×3 →
-// 960×540 px" (empty for a whole frame at magnification 1, or an entry without a presentation).
+// 960×540 px (rendered natively)" (empty for a whole frame at magnification 1, or an entry without a presentation).
 std::string presentationText(const Block& block, bool ascii = false) {
     const std::string times = ascii ? "x" : "×", arrow = ascii ? "->" : "→";
     if (block.stimuli.empty() || !block.stimuli.front()->contains("presentation")) return "";
@@ -164,6 +164,8 @@ std::string presentationText(const Block& block, bool ascii = false) {
                                    valueText(r.at("width")) + times + valueText(r.at("height"));
     text += ", " + times + std::to_string(m) + " " + arrow + " " + valueText(p.at("presented").at("width")) + times +
             valueText(p.at("presented").at("height")) + " px";
+    if (m > 1 && p.contains("method"))
+        text += p.at("method") == "native" ? " (rendered natively)" : " (nearest-neighbour replication)";
     return text;
 }
 

@@ -181,6 +181,10 @@ private:
                 s.presentation.magnification = *rule.magnification;
                 s.presentation.magnificationWhere = rule.selection.where + ".magnification";
             }
+            if (rule.method) {
+                s.presentation.method = *rule.method;
+                s.presentation.methodWhere = rule.selection.where + ".presentation";
+            }
             break;
         }
         const renderer::sss::MethodInfo* method = methodOf(combination);

@@ -15,6 +15,17 @@ CropRect effectiveCrop(const Presentation& presentation, int renderWidth, int re
     return presentation.crop ? *presentation.crop : CropRect{0, 0, renderWidth, renderHeight};
 }
 
+bool presents(const Presentation& presentation) { return presentation.crop || presentation.magnification != 1; }
+
+std::vector<std::string> nativeRenderOverrides(const Presentation& presentation, int renderWidth, int renderHeight) {
+    if (presentation.method != PresentationMethod::native || !presents(presentation)) return {};
+    const CropRect c = effectiveCrop(presentation, renderWidth, renderHeight);
+    const int m = presentation.magnification;
+    return {"render.width=" + std::to_string(renderWidth * m), "render.height=" + std::to_string(renderHeight * m),
+            "render.window={ x = " + std::to_string(c.x * m) + ", y = " + std::to_string(c.y * m) +
+                ", width = " + std::to_string(c.width * m) + ", height = " + std::to_string(c.height * m) + " }"};
+}
+
 void checkPresentation(const Presentation& presentation, int renderWidth, int renderHeight, const std::string& specName,
                        const std::string& stimulusId) {
     const std::string stimulus = " (stimulus '" + stimulusId + "')";
@@ -46,6 +57,20 @@ void checkPresentation(const Presentation& presentation, int renderWidth, int re
                    std::to_string(presentation.magnification) + " makes the presented image " +
                        std::to_string(presentedWidth) + " × " + std::to_string(presentedHeight) +
                        " pixels (at most 16384 each way)" + stimulus);
+    if (presentation.method == PresentationMethod::native && presents(presentation)) {
+        // The renderer's limits (renderer/scene/scene_spec.cpp): the window at most 8192, the frame at most 65536.
+        const long long frameWidth = static_cast<long long>(renderWidth) * presentation.magnification;
+        const long long frameHeight = static_cast<long long>(renderHeight) * presentation.magnification;
+        if (presentedWidth > 8192 || presentedHeight > 8192 || frameWidth > 65536 || frameHeight > 65536)
+            throwInput(specName, presentation.magnificationWhere,
+                       std::to_string(presentation.magnification) + " cannot be rendered natively: the presented " +
+                           std::to_string(presentedWidth) + " × " + std::to_string(presentedHeight) +
+                           " pixels (at most 8192 each way) of a " + std::to_string(frameWidth) + " × " +
+                           std::to_string(frameHeight) +
+                           " frame (at most 65536); lower it, or set presentation = "
+                           "\"replicate\"" +
+                           stimulus);
+    }
 }
 
 nlohmann::json presentationJson(const Presentation& presentation, int renderWidth, int renderHeight) {
@@ -54,7 +79,8 @@ nlohmann::json presentationJson(const Presentation& presentation, int renderWidt
     return {{"render", {{"width", renderWidth}, {"height", renderHeight}}},
             {"crop", {{"x", c.x}, {"y", c.y}, {"width", c.width}, {"height", c.height}}},
             {"magnification", m},
-            {"presented", {{"width", c.width * m}, {"height", c.height * m}}}};
+            {"presented", {{"width", c.width * m}, {"height", c.height * m}}},
+            {"method", presentation.method == PresentationMethod::native ? "native" : "replicate"}};
 }
 
 namespace {
@@ -91,7 +117,7 @@ std::string cropText(const CropRect& c) {
 } // namespace
 
 void applyPresentation(const fs::path& exr, const fs::path& png, const Presentation& presentation) {
-    if (!presentation.crop && presentation.magnification == 1) return;
+    if (presentation.method == PresentationMethod::native || !presents(presentation)) return;
     {
         OIIO::ImageBuf source = readWhole(exr);
         const OIIO::ImageSpec& spec = source.spec();

@@ -173,6 +173,17 @@ private:
 
     // crop = { x, y, width, height }: pixels of the render; whether it lies inside the frame is checked against
     // the resolved render size (build.cpp), since the size may come from the scene.
+    PresentationMethod presentationMethod(const toml::node& node, const std::string& field) {
+        auto* value = node.as_string();
+        if (!value) throwInput(fileName_, field, "expected \"native\" or \"replicate\", got " + describeNode(node));
+        if (value->get() == "native") return PresentationMethod::native;
+        if (value->get() == "replicate") return PresentationMethod::replicate;
+        throwInput(fileName_, field,
+                   "'" + value->get() +
+                       "' is not a presentation (native: the crop rendered at the presented size; "
+                       "replicate: nearest-neighbour magnification)");
+    }
+
     CropRect readCrop(const toml::node& node, const std::string& field) {
         auto* table = node.as_table();
         if (!table) throwInput(fileName_, field, "expected a table { x, y, width, height }, got " + describeNode(node));
@@ -203,8 +214,11 @@ private:
         if (const toml::node* m = scene.get("magnification"))
             spec.presentation.magnification =
                 static_cast<int>(presentationInteger(*m, "fixed.magnification", 1, kMaxMagnification));
+        if (const toml::node* method = scene.get("presentation"))
+            spec.presentation.method = presentationMethod(*method, "fixed.presentation");
         scene.erase("crop");
         scene.erase("magnification");
+        scene.erase("presentation");
         std::vector<std::pair<std::string, const toml::node*>> leaves;
         flatten(scene, "", leaves);
         for (auto& [key, node] : leaves) {
@@ -376,6 +390,10 @@ private:
                     rule.magnification = static_cast<int>(presentationInteger(v, field, 1, kMaxMagnification));
                     continue;
                 }
+                if (name == "presentation") {
+                    rule.method = presentationMethod(v, field);
+                    continue;
+                }
                 const Factor* factor = nullptr;
                 for (const auto& f : spec.factors)
                     if (f.name == name || (!f.key.empty() && f.key == sceneKeyOf(name))) factor = &f;
@@ -399,8 +417,9 @@ private:
                     levels.push_back(selectionLevel(*value, factor, name, reader, true));
                 rule.selection.levels.emplace_back(factor->name, std::move(levels));
             }
-            if (!rule.crop && !rule.magnification)
-                throwInput(fileName_, where, "gives neither crop = { x, y, width, height } nor magnification");
+            if (!rule.crop && !rule.magnification && !rule.method)
+                throwInput(fileName_, where,
+                           "gives none of crop = { x, y, width, height }, magnification, presentation");
             spec.crops.push_back(std::move(rule));
         }
     }

@@ -52,14 +52,22 @@ struct CropRect {
     bool operator==(const CropRect&) const = default;
 };
 
-// How the stimuli are presented: the part of the render shown and its integer nearest-neighbour magnification
-// (each render pixel becomes magnification × magnification display pixels at one image pixel per device pixel).
-// `where` names the spec key each value came from, for messages ("fixed.crop", "crop[1]").
+// How a magnified crop is made (key `presentation`): native renders the crop's part of the camera's frustum at
+// magnification × the pixels (render.window of a frame magnification × the render size: an off-axis projection of the
+// same camera, the SSS kernel in millimetres); replicate crops the render and repeats each pixel as a
+// magnification × magnification square (nearest neighbour), which the build warns about.
+enum class PresentationMethod { native, replicate };
+
+// How the stimuli are presented: the part of the render shown and its integer magnification (the presented image
+// has magnification × the crop's pixels, shown at one image pixel per device pixel). `where` names the spec key
+// each value came from, for messages ("fixed.crop", "crop[1]").
 struct Presentation {
     std::optional<CropRect> crop; // none: the whole frame
     int magnification = 1;
+    PresentationMethod method = PresentationMethod::native;
     std::string cropWhere = "fixed.crop";
     std::string magnificationWhere = "fixed.magnification";
+    std::string methodWhere = "fixed.presentation";
 };
 
 // A [[crop]] entry: the crop (and optionally the magnification) of the stimuli whose block-factor levels match.
@@ -67,6 +75,7 @@ struct CropRule {
     Selection selection; // block factors only, so that every stimulus of a block is presented alike
     std::optional<CropRect> crop;
     std::optional<int> magnification;
+    std::optional<PresentationMethod> method; // presentation = "native" | "replicate"
 };
 
 struct SetSpec {
@@ -78,7 +87,7 @@ struct SetSpec {
     std::string idTemplate;           // set.id: "{scene}-{view}-{method}"; empty: every factor's label joined by '-'
     std::vector<std::string> blockFactors; // set.block: factors naming a block (default scene, view)
     std::vector<FixedParameter> fixed;     // [fixed], flattened to dotted keys (sorted), without crop/magnification
-    Presentation presentation;             // fixed.crop and fixed.magnification (applied after rendering)
+    Presentation presentation;             // fixed.crop, fixed.magnification and fixed.presentation
     std::vector<CropRule> crops;           // [[crop]]: per block (view, scene, ...) crops; the first match wins
     std::vector<Factor> factors;           // "scene" first, then [[factor]] in the order written
     std::vector<Selection> excludes;       // [[exclude]]

@@ -67,7 +67,9 @@ void PscbfMethod::run(const SssStageInputs& inputs, const sss::SssParams& params
         setUniform(program, "horizontal", horizontal ? 1 : 0);
         setUniform(program, "focalLengthPixels", inputs.focalLengthPixels);
         setUniform(program, "mmPerUnit", inputs.mmPerUnit);
-        setUniform(program, "principalPoint", glm::vec2(0.5f * inputs.width, 0.5f * inputs.height));
+        setUniform(program, "principalPoint",
+                   std::isnan(inputs.principalPoint.x) ? glm::vec2(0.5f * inputs.width, 0.5f * inputs.height)
+                                                       : inputs.principalPoint);
         setUniform(program, "worldToView", glm::mat3(inputs.view));
         setUniform(program, "hasGeometricNormal", inputs.geometricNormal != 0 ? 1 : 0);
         setUniform(program, "depthWeight", params.followSurface ? 1 : 0);

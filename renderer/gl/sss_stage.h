@@ -17,6 +17,7 @@
 
 #include <epoxy/gl.h>
 #include <glm/glm.hpp>
+#include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -37,9 +38,12 @@ struct SssStageInputs {
     GLuint curvature = 0;       // GL_R32F: smoothed curvature, 1/world unit, ≥ 0 (sss.curvature)
     int width = 0;              // pixels
     int height = 0;             // pixels
-    float focalLengthPixels = 0;    // f_px = (height/2) / tan(fovY/2); a kernel offset of o mm at depth z covers
-                                    // o / mmPerUnit * f_px / z pixels (docs/methods.md, same scale on both axes)
-    float mmPerUnit = 1;            // millimetres per world unit of the scene
+    float focalLengthPixels = 0; // f_px = (height/2) / tan(fovY/2); a kernel offset of o mm at depth z covers
+                                 // o / mmPerUnit * f_px / z pixels (docs/methods.md, same scale on both axes)
+    float mmPerUnit = 1;         // millimetres per world unit of the scene
+    // Where the view axis meets the image, pixels (row 0 at the bottom); NaN: the image centre (W/2, H/2). Off the
+    // centre for a render.window (an off-axis projection).
+    glm::vec2 principalPoint{std::numeric_limits<float>::quiet_NaN()};
     glm::mat4 view{1.0f};           // world → view (camera looks down -Z)
     glm::mat4 projection{1.0f};     // view → clip (OpenGL convention)
     glm::vec3 cameraPosition{0.0f}; // world units

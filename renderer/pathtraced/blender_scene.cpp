@@ -248,6 +248,16 @@ nlohmann::json blenderSceneJson(const BlenderSceneInputs& inputs, std::string_vi
                        {"fov_y_rad", inputs.camera.fovYRadians},
                        {"near", inputs.camera.nearPlane * 0.5f},
                        {"far", inputs.camera.farPlane * 2.0f}};
+    if (spec.window) {
+        // render.window: Blender renders the window's pixels (settings.width/height) with the same focal length in
+        // pixels, so the vertical field of view is the window's, and the lens shift moves the image off the view
+        // axis. With a vertical sensor fit Blender measures the shift in units of the image height.
+        const auto h = static_cast<float>(spec.height), w = static_cast<float>(spec.width);
+        const float f = inputs.camera.focalLengthPixels;
+        scene["camera"]["fov_y_rad"] = 2.0f * std::atan(0.5f * h / f);
+        scene["camera"]["shift_x"] = (0.5f * w - inputs.camera.principalPoint.x) / h;
+        scene["camera"]["shift_y"] = (0.5f * h - inputs.camera.principalPoint.y) / h;
+    }
     return scene;
 }
 

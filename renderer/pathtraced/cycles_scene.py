@@ -549,6 +549,9 @@ def build_camera(scene, description):
     data.sensor_fit = "VERTICAL"
     data.sensor_height = 24.0
     data.lens = 12.0 / math.tan(0.5 * float(description["fov_y_rad"]))
+    # render.window: the window's part of the frame, off the view axis (units of the image height, vertical fit).
+    data.shift_x = float(description.get("shift_x", 0.0))
+    data.shift_y = float(description.get("shift_y", 0.0))
     data.clip_start = float(description["near"])
     data.clip_end = float(description["far"])
     obj = bpy.data.objects.new("skinlab_camera", data)

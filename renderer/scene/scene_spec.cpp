@@ -24,6 +24,8 @@ glm::vec3 toVec3(const std::array<double, 3>& v) {
 nlohmann::json jsonVec3(const glm::vec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); }
 
 constexpr double kHuge = 1e30;
+constexpr std::int64_t kMaxImage = 8192;          // render.width/height, render.window.width/height
+constexpr std::int64_t kMaxWindowedFrame = 65536; // render.width/height with a render.window
 
 // Resolves a path of the spec: "assets:REL" under the assets folder, else relative to the spec's folder.
 // Checks that the file exists (a missing file is bad input, named with its key).
@@ -238,10 +240,35 @@ void readEnvironment(const SpecReader& root, const PathResolver& paths, SceneSpe
 // [render]: image size and exposure.
 void readRender(const SpecReader& root, SceneSpec& spec, nlohmann::json& resolved) {
     const SpecReader render = root.table("render");
-    spec.width = static_cast<int>(render.integer("width", 512, 16, 8192));
-    spec.height = static_cast<int>(render.integer("height", 512, 16, 8192));
+    // The frame may exceed the largest image only when a window renders a part of it.
+    const bool windowed = render.has("window");
+    const std::int64_t largest = windowed ? kMaxWindowedFrame : kMaxImage;
+    spec.frameWidth = static_cast<int>(render.integer("width", 512, 16, largest));
+    spec.frameHeight = static_cast<int>(render.integer("height", 512, 16, largest));
+    spec.width = spec.frameWidth;
+    spec.height = spec.frameHeight;
     spec.exposureEv = render.number("exposure_ev", 0.0, -30.0, 30.0);
     resolved["render"] = {{"width", spec.width}, {"height", spec.height}, {"exposure_ev", spec.exposureEv}};
+    if (windowed) {
+        const SpecReader window = render.table("window");
+        RenderWindow w;
+        for (const char* key : {"x", "y", "width", "height"})
+            if (!window.has(key)) window.fail(key, "missing (a window has x, y, width, height in pixels of the frame)");
+        w.x = static_cast<int>(window.integer("x", 0, 0, spec.frameWidth - 1));
+        w.y = static_cast<int>(window.integer("y", 0, 0, spec.frameHeight - 1));
+        w.width = static_cast<int>(window.integer("width", 1, 1, kMaxImage));
+        w.height = static_cast<int>(window.integer("height", 1, 1, kMaxImage));
+        if (w.x + w.width > spec.frameWidth)
+            window.fail("width", "x + width = " + std::to_string(w.x + w.width) + " exceeds render.width " +
+                                     std::to_string(spec.frameWidth));
+        if (w.y + w.height > spec.frameHeight)
+            window.fail("height", "y + height = " + std::to_string(w.y + w.height) + " exceeds render.height " +
+                                      std::to_string(spec.frameHeight));
+        spec.window = w;
+        spec.width = w.width;
+        spec.height = w.height;
+        resolved["render"]["window"] = {{"x", w.x}, {"y", w.y}, {"width", w.width}, {"height", w.height}};
+    }
     // Anti-aliasing (docs/rendering.md, "Anti-aliasing"): supersampling at ssaa_factor × the size per axis,
     // resolved by a box of one output pixel; "none" samples each pixel's centre once.
     spec.antialiasing = render.choice("antialiasing", "ssaa", {"ssaa", "none"});
@@ -254,10 +281,10 @@ void readRender(const SpecReader& root, SceneSpec& spec, nlohmann::json& resolve
     }
     spec.ssaaFactor = static_cast<int>(render.integer("ssaa_factor", kDefaultSsaaFactor, 2, kMaxSsaaFactor));
     spec.ssaaFilter = render.choice("ssaa_filter", "box", {"box"});
-    const int largest = std::max(spec.width, spec.height);
-    if (largest * spec.ssaaFactor > kMaxInternalSize)
-        render.fail("ssaa_factor", std::to_string(spec.ssaaFactor) + " x " + std::to_string(largest) +
-                                       " px = " + std::to_string(largest * spec.ssaaFactor) +
+    const int largestSide = std::max(spec.width, spec.height);
+    if (largestSide * spec.ssaaFactor > kMaxInternalSize)
+        render.fail("ssaa_factor", std::to_string(spec.ssaaFactor) + " x " + std::to_string(largestSide) +
+                                       " px = " + std::to_string(largestSide * spec.ssaaFactor) +
                                        " px exceeds the internal limit of " + std::to_string(kMaxInternalSize) +
                                        " px (lower it or the image size)");
     resolved["render"]["ssaa_factor"] = spec.ssaaFactor;
@@ -369,7 +396,8 @@ SceneSpec loadSceneSpec(const std::string& scene, const std::vector<std::string>
 }
 
 CameraPose frameCamera(const CameraSpec& camera, const glm::vec3& frameMin, const glm::vec3& frameMax,
-                       const glm::vec3& sceneMin, const glm::vec3& sceneMax, int width, int height) {
+                       const glm::vec3& sceneMin, const glm::vec3& sceneMax, int width, int height,
+                       const std::optional<RenderWindow>& window) {
     CameraPose pose;
     pose.fovYRadians = static_cast<float>(glm::radians(camera.fovDeg));
     const float tanHalf = std::tan(pose.fovYRadians * 0.5f);
@@ -402,6 +430,22 @@ CameraPose frameCamera(const CameraSpec& camera, const glm::vec3& frameMin, cons
     const float aspect = static_cast<float>(width) / static_cast<float>(height);
     pose.projection = glm::perspective(pose.fovYRadians, aspect, pose.nearPlane, pose.farPlane);
     pose.focalLengthPixels = 0.5f * static_cast<float>(height) / tanHalf;
+    pose.principalPoint = {0.5f * static_cast<float>(width), 0.5f * static_cast<float>(height)};
+    if (window) {
+        // Frame NDC → window NDC: x_w = (W/w) x_f + (W − 2x − w)/w; y counted from the bottom (GL), the window's
+        // bottom row is H − y − h of the frame, so y_w = (H/h) y_f + (2y + h − H)/h. Applied in clip space (the
+        // offsets scale with w_clip), it is the off-axis frustum through the window's edges.
+        const auto W = static_cast<float>(width), H = static_cast<float>(height);
+        const auto x = static_cast<float>(window->x), y = static_cast<float>(window->y);
+        const auto w = static_cast<float>(window->width), h = static_cast<float>(window->height);
+        glm::mat4 toWindow(1.0f);
+        toWindow[0][0] = W / w;
+        toWindow[1][1] = H / h;
+        toWindow[3][0] = (W - 2.0f * x - w) / w;
+        toWindow[3][1] = (2.0f * y + h - H) / h;
+        pose.projection = toWindow * pose.projection;
+        pose.principalPoint = {0.5f * W - x, y + h - 0.5f * H};
+    }
     return pose;
 }
 

@@ -82,6 +82,15 @@ inline constexpr int kMaxInternalSize = 16384;
 // on [−0.5, 0.5] scaled by 4, in NDC, i.e. ±filter_size px), whose standard deviation is 0.1385 × its full width;
 // it has no box filter. 1.042 px gives the standard deviation of a box of one pixel, 1/√12 px.
 inline constexpr double kEeveeBoxMatchedFilterPx = 1.042;
+// A window of the camera's frame (render.window): pixels of the render.width × render.height frame, x from the
+// left, y from the top row. Only the window is rendered, at the frame's pixel scale (an off-axis projection of the
+// same camera): the image is the frame's pixels inside the window, not a resampling.
+struct RenderWindow {
+    int x = 0;
+    int y = 0;
+    int width = 0;
+    int height = 0;
+};
 
 struct SceneSpec {
     std::string source;        // spec path or builtin:NAME, as given
@@ -98,8 +107,11 @@ struct SceneSpec {
     int shadowResolution = 2048; // texels, square
     int shadowPcfRadius = 1;     // PCF taps: (2r+1)^2
     EnvironmentSpec environment;
-    int width = 512;
+    int width = 512; // the image rendered: the window's size with render.window, else the frame's
     int height = 512;
+    int frameWidth = 512; // render.width, render.height: the camera's whole frame (f_px, aspect)
+    int frameHeight = 512;
+    std::optional<RenderWindow> window;     // render.window
     double exposureEv = 0.0; // beauty and AOVs are scaled by 2^exposure_ev
     // render.antialiasing: "ssaa" renders every pass at ssaaFactor × (width, height) and resolves each layer to
     // (width, height) with a box of one output pixel (renderer/gl/resolve_pass.h); "none" (ssaaFactor 1) samples
@@ -140,14 +152,20 @@ struct CameraPose {
     float farPlane = 100.0f; // world units
     glm::mat4 view{1.0f};
     glm::mat4 projection{1.0f};
-    float focalLengthPixels = 1.0f; // (height / 2) / tan(fovY / 2)
+    float focalLengthPixels = 1.0f; // (frame height / 2) / tan(fovY / 2)
+    // Where the view axis meets the image, in pixels of the rendered image (row 0 at the bottom): its centre, or
+    // off it for a render.window.
+    glm::vec2 principalPoint{0.0f};
 };
 
 // Named views look at the bounding sphere of the `frame` bounds (the skin parts of the model; all of it when
 // it has no skin) from +Z, orbited by yaw/pitch: the sphere's silhouette fills 40 % of the image height for
 // far, 90 % for mid and 180 % for close (the face fills the frame). Near/far planes enclose the bounding
 // sphere of the whole scene's bounds.
+// `width` × `height` is the whole frame; with a `window`, the projection is the off-axis one that maps exactly the
+// window's pixels of that frame to the rendered image (focal length in pixels unchanged).
 CameraPose frameCamera(const CameraSpec& camera, const glm::vec3& frameMin, const glm::vec3& frameMax,
-                       const glm::vec3& sceneMin, const glm::vec3& sceneMax, int width, int height);
+                       const glm::vec3& sceneMin, const glm::vec3& sceneMax, int width, int height,
+                       const std::optional<RenderWindow>& window = std::nullopt);
 
 } // namespace skinlab::renderer

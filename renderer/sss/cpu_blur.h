@@ -32,6 +32,7 @@
 #include "renderer/sss/sss_params.h"
 
 #include <array>
+#include <optional>
 #include <vector>
 
 namespace skinlab::renderer::sss {
@@ -44,6 +45,8 @@ struct SurfaceBuffers {
     std::vector<float> depth; // linear view depth, world units, +inf on background; row-major, row 0 at the bottom
     std::vector<float> mask;  // skin mask 0…1
     float focalLengthPixels = 0.0f; // f_px = (H/2) / tan(fovY/2)
+    // Where the view axis meets the image, pixels (row 0 at the bottom): the centre unless given (a render.window).
+    std::optional<std::array<float, 2>> principalPoint;
     float mmPerUnit = 1.0f;
     // Extension inputs, read only while the matching switch of BlurSettings is on (may stay empty otherwise):
     std::vector<Rgb> albedo;      // linear albedo (sss.lab_weight; the albedo AOV)

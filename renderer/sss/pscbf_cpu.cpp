@@ -26,6 +26,8 @@ std::vector<Rgb> pscbfPass(const PscbfCpuInputs& inputs, const std::vector<Rgb>&
     const bool horizontal = axis == BlurAxis::Horizontal;
     const bool hasNormal = !inputs.viewNormal.empty();
     const float f = surface.focalLengthPixels;
+    const std::array<float, 2> principal =
+        surface.principalPoint.value_or(std::array<float, 2>{0.5f * float(width), 0.5f * float(height)});
     std::vector<Rgb> output(input.size());
     for (int y = 0; y < height; ++y)
         for (int x = 0; x < width; ++x) {
@@ -37,7 +39,7 @@ std::vector<Rgb> pscbfPass(const PscbfCpuInputs& inputs, const std::vector<Rgb>&
                 continue;
             }
             const float centreDepth = surface.depth[index];
-            const glm::vec3 w((0.5f * width - (float(x) + 0.5f)) / f, (0.5f * height - (float(y) + 0.5f)) / f, 1.0f);
+            const glm::vec3 w((principal[0] - (float(x) + 0.5f)) / f, (principal[1] - (float(y) + 0.5f)) / f, 1.0f);
             glm::vec3 n(0.0f, 0.0f, 1.0f);
             if (hasNormal) {
                 const glm::vec3 normal = toVec3(inputs.viewNormal[index]);

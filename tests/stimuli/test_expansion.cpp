@@ -7,6 +7,7 @@
 #include "stimuli/manifest.h"
 #include "stimuli/naming.h"
 #include "stimuli/output_folder.h"
+#include "stimuli/presentation.h"
 #include "stimuli/set_spec.h"
 
 #include <algorithm>
@@ -459,8 +460,8 @@ fs::path withoutHead(const fs::path& spec, std::vector<std::string>& overrides) 
 // swapped for builtin:head with a --set override so this runs without the scanned head.
 TEST(ShippedSpecs, ExpandToTheDocumentedCounts) {
     const fs::path dir = fs::path(SKINLAB_SOURCE_DIR) / "stimuli" / "specs";
-    const std::vector<std::pair<std::string, size_t>> expected = {{"demo.toml", 22},
-                                                                  {"demo-scan.toml", 28},
+    const std::vector<std::pair<std::string, size_t>> expected = {{"demo.toml", 26},
+                                                                  {"demo-scan.toml", 26},
                                                                   {"thesis-fig5.2-methods.toml", 18},
                                                                   {"thesis-fig3.16-halos.toml", 7},
                                                                   {"thesis-fig3.17-bleeding.toml", 7},
@@ -497,12 +498,12 @@ TEST(ShippedSpecs, ExpandToTheDocumentedCounts) {
     }
     std::vector<Stimulus> demo = expand(readSetSpec(dir / "demo.toml"));
     fs::remove_all(headlessFolder());
-    EXPECT_EQ(demo.front().id, "halo-silhouette-none");
+    EXPECT_EQ(demo.front().id, "head-face-none");
     EXPECT_EQ(demo.back().id, "bleed-true-mask-patches-reference"); // the references come last
-    // Two blocks (the silhouette and the patches), each with one reference and its own presentation.
+    // Three blocks (the face, the silhouette and the patches), each with one reference and its own presentation.
     std::map<std::string, int> references;
     for (const Stimulus& st : demo) references[st.block] += st.reference ? 1 : 0;
-    EXPECT_EQ(references, (std::map<std::string, int>{{"explicit", 1}, {"mid", 1}}));
+    EXPECT_EQ(references, (std::map<std::string, int>{{"close", 1}, {"explicit", 1}, {"mid", 1}}));
 }
 
 // The demo's study designs study every block their stimulus set builds (scripts/demo.sh renders them all), and each
@@ -554,6 +555,42 @@ TEST(ShippedSpecs, EveryStimulusResolves) {
     }
     fs::remove_all(headlessFolder());
     EXPECT_GT(resolved, 80u);
+}
+
+// No presented PNG of a shipped spec is a nearest-neighbour upsample: every crop or magnification resolves to a
+// native presentation, a render.window of the magnified frame (the renderer draws it; nothing renders here).
+TEST(ShippedSpecs, EveryMagnifiedCropRendersNatively) {
+    const fs::path dir = fs::path(SKINLAB_SOURCE_DIR) / "stimuli" / "specs";
+    const char* assets = std::getenv("SKINLAB_ASSETS");
+    const bool haveHead = assets && *assets && fs::exists(fs::path(assets) / "LeePerrySmith");
+    size_t magnified = 0;
+    for (const auto& entry : fs::directory_iterator(dir)) {
+        if (entry.path().extension() != ".toml") continue;
+        std::vector<std::string> overrides;
+        const fs::path path = !haveHead && needsHead(entry.path().filename().string())
+                                  ? withoutHead(entry.path(), overrides)
+                                  : entry.path();
+        BuildPlan plan;
+        ASSERT_NO_THROW(plan = planBuild(path, overrides, std::nullopt, haveHead ? fs::path(assets) : fs::path()))
+            << entry.path().filename();
+        for (size_t i = 0; i < plan.selected.size(); ++i) {
+            const Stimulus& s = plan.selected[i];
+            const std::string where = entry.path().filename().string() + ": " + s.id;
+            const nlohmann::json entryJson = stimulusEntry(s, plan.resolved[i]);
+            EXPECT_EQ(entryJson["presentation"]["method"], "native") << where;
+            if (!presents(s.presentation)) continue;
+            ++magnified;
+            const int m = s.presentation.magnification;
+            const CropRect c = effectiveCrop(s.presentation, entryJson["presentation"]["render"]["width"],
+                                             entryJson["presentation"]["render"]["height"]);
+            EXPECT_EQ(
+                plan.resolved[i]["render"]["window"],
+                (nlohmann::json{{"x", c.x * m}, {"y", c.y * m}, {"width", c.width * m}, {"height", c.height * m}}))
+                << where;
+        }
+    }
+    fs::remove_all(headlessFolder());
+    EXPECT_GT(magnified, 40u);
 }
 
 // Presentation: [fixed] crop and magnification, [[crop]] per block (first match), every bad value refused naming
@@ -628,7 +665,7 @@ TEST(StimulusPresentation, BadCropsAndMagnificationsAreRefusedNamingTheKey) {
         errorOf([&] { spec(kBase + "[[crop]]\nview = \"far\"\ncrop = { x = 0, y = 0, width = 8, height = 8 }\n"); }),
         "set.toml: crop[0].view: 'far' is not a level of factor 'view'");
     EXPECT_EQ(errorOf([&] { spec(kBase + "[[crop]]\nview = \"mid\"\n"); }),
-              "set.toml: crop[0]: gives neither crop = { x, y, width, height } nor magnification");
+              "set.toml: crop[0]: gives none of crop = { x, y, width, height }, magnification, presentation");
     EXPECT_EQ(errorOf([&] { spec(kBase + "[[crop]]\nview = \"mid\"\nmagnification = 99\n"); }),
               "set.toml: crop[0].magnification: 99 is out of range [1, 16]");
 }

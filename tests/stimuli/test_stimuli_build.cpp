@@ -19,6 +19,7 @@
 #include <OpenImageIO/imageio.h>
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <csignal>
 #include <cstdio>
@@ -478,11 +479,14 @@ Pixels readPixels(const fs::path& path) {
     return ::testing::AssertionSuccess();
 }
 
-std::string presentedSpec(const std::string& name, bool crop) {
+// `method`: the presentation key's value ("" for the default, native).
+std::string presentedSpec(const std::string& name, bool crop, const std::string& method = "",
+                          const std::string& render = "width = 96, height = 64") {
     std::ostringstream s;
     s << "[set]\nname = \"" << name << "\"\nscene = \"builtin:head\"\n\n"
-      << "[fixed]\nrender = { width = 96, height = 64 }\nshadow = { resolution = 256 }\nsss = { method = \"none\" }\n";
+      << "[fixed]\nrender = { " << render << " }\nshadow = { resolution = 256 }\nsss = { method = \"none\" }\n";
     if (crop) s << "crop = { x = 20, y = 8, width = 40, height = 30 }\nmagnification = 3\n";
+    if (!method.empty()) s << "presentation = \"" << method << "\"\n";
     s << "\n[[factor]]\nname = \"view\"\nlevels = [\"close\", \"mid\"]\n\n"
       << "[[factor]]\nname = \"camera.yaw_deg\"\nlevels = [0.0, 30.0]\nlabels = [\"front\", \"side\"]\n\n";
     if (crop) s << "[[crop]]\nview = \"mid\"\ncrop = { x = 50, y = 0, width = 46, height = 64 }\nmagnification = 2\n\n";
@@ -492,14 +496,18 @@ std::string presentedSpec(const std::string& name, bool crop) {
 
 } // namespace
 
-TEST_F(StimuliBuild, CropAndMagnificationAreAppliedRecordedAndPredictedOn) {
+// presentation = "replicate": the render cropped and magnified by nearest neighbour, bit for bit, with a warning.
+TEST_F(StimuliBuild, ReplicatedCropAndMagnificationAreAppliedRecordedAndPredictedOn) {
     const fs::path full = gRoot / "whole", shown = gRoot / "presented";
     CliRun run = runCli({"stimuli", "build", writeSpec("whole.toml", presentedSpec("whole", false)).string(), "-o",
                          full.string(), "--no-predict"});
     ASSERT_EQ(run.exitCode, 0) << run.output;
-    run = runCli({"stimuli", "build", writeSpec("presented.toml", presentedSpec("presented", true)).string(), "-o",
-                  shown.string()});
+    run =
+        runCli({"stimuli", "build", writeSpec("presented.toml", presentedSpec("presented", true, "replicate")).string(),
+                "-o", shown.string()});
     ASSERT_EQ(run.exitCode, 0) << run.output;
+    EXPECT_NE(run.output.find("fixed.presentation: \"replicate\" magnifies 3× by nearest neighbour"), std::string::npos)
+        << run.output;
     const nlohmann::json m = manifestOf(shown);
     ASSERT_EQ(m["stimuli"].size(), 6u);
     const skinlab::metrics::CvvdpDisplay display = skinlab::metrics::cvvdpDisplay("standard_fhd");
@@ -513,7 +521,8 @@ TEST_F(StimuliBuild, CropAndMagnificationAreAppliedRecordedAndPredictedOn) {
         const nlohmann::json expected = {{"render", {{"width", 96}, {"height", 64}}},
                                          {"crop", {{"x", x}, {"y", y}, {"width", w}, {"height", h}}},
                                          {"magnification", mag},
-                                         {"presented", {{"width", w * mag}, {"height", h * mag}}}};
+                                         {"presented", {{"width", w * mag}, {"height", h * mag}}},
+                                         {"method", "replicate"}};
         EXPECT_EQ(s["presentation"], expected) << id;
         EXPECT_EQ(s["width"], w * mag) << id;
         EXPECT_EQ(s["height"], h * mag) << id;
@@ -541,13 +550,15 @@ TEST_F(StimuliBuild, CropAndMagnificationAreAppliedRecordedAndPredictedOn) {
     std::ifstream html(shown / "contact.html");
     std::stringstream text;
     text << html.rdbuf();
-    EXPECT_NE(text.str().find("Presented: crop 20,8 40×30 of 96×64, ×3 → 120×90 px"), std::string::npos);
-    EXPECT_NE(text.str().find("Presented: crop 50,0 46×64 of 96×64, ×2 → 92×128 px"), std::string::npos);
+    EXPECT_NE(text.str().find("Presented: crop 20,8 40×30 of 96×64, ×3 → 120×90 px (nearest-neighbour replication)"),
+              std::string::npos);
+    EXPECT_NE(text.str().find("Presented: crop 50,0 46×64 of 96×64, ×2 → 92×128 px (nearest-neighbour replication)"),
+              std::string::npos);
     // A rebuild keeps everything; a changed crop re-renders its block only.
     run = runCli({"stimuli", "build", (gRoot / "presented.toml").string(), "-o", shown.string()});
     ASSERT_EQ(run.exitCode, 0) << run.output;
     EXPECT_NE(run.output.find("(0 rendered, 6 unchanged)"), std::string::npos) << run.output;
-    std::string moved = presentedSpec("presented", true);
+    std::string moved = presentedSpec("presented", true, "replicate");
     moved.replace(moved.find("x = 50"), 6, "x = 48");
     run = runCli({"stimuli", "build", writeSpec("presented.toml", moved).string(), "-o", shown.string()});
     ASSERT_EQ(run.exitCode, 0) << run.output;
@@ -650,6 +661,90 @@ TEST_F(StimuliBuild, SetMetricsReproduceThePredictionsAndVisibilitySpansViewingD
 
 namespace {
 
+// Share of the pixels of `shown` whose channels differ from the crop (x, y, w, h) of `full` (same pixel scale) by
+// more than `tolerance`; 1 when the sizes differ.
+double shareDiffering(const Pixels& shown, const Pixels& full, int x, int y, int w, int h, float tolerance) {
+    if (shown.width != w || shown.height != h || shown.channels != full.channels) return 1.0;
+    size_t differing = 0;
+    for (int j = 0; j < h; ++j)
+        for (int i = 0; i < w; ++i)
+            for (int c = 0; c < shown.channels; ++c)
+                if (std::fabs(shown.at(i, j, c) - full.at(x + i, y + j, c)) > tolerance) {
+                    ++differing;
+                    break;
+                }
+    return static_cast<double>(differing) / (static_cast<double>(w) * h);
+}
+
+} // namespace
+
+// The default presentation renders each crop natively: the presented image is the crop's part of the camera's
+// frustum at magnification × the pixels, the same (within rasterisation round-off at silhouettes) as that region of
+// the whole frame rendered at magnification × the size; nothing is a nearest-neighbour upsample.
+TEST_F(StimuliBuild, NativeCropEqualsTheRegionOfAMagnifiedWholeRender) {
+    const fs::path shown = gRoot / "native";
+    CliRun run = runCli(
+        {"stimuli", "build", writeSpec("native.toml", presentedSpec("native", true)).string(), "-o", shown.string()});
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    EXPECT_EQ(run.output.find("nearest neighbour"), std::string::npos) << run.output;
+    // The whole frame at 3× (the close block's magnification) and 2× (the mid block's).
+    std::map<int, fs::path> whole;
+    for (const auto& [mag, render] :
+         std::vector<std::pair<int, std::string>>{{3, "width = 288, height = 192"}, {2, "width = 192, height = 128"}}) {
+        const std::string name = "whole" + std::to_string(mag);
+        whole[mag] = gRoot / name;
+        run = runCli({"stimuli", "build", writeSpec(name + ".toml", presentedSpec(name, false, "", render)).string(),
+                      "-o", whole[mag].string(), "--no-predict", "--no-contact-sheet"});
+        ASSERT_EQ(run.exitCode, 0) << run.output;
+    }
+    const nlohmann::json m = manifestOf(shown);
+    ASSERT_EQ(m["stimuli"].size(), 6u);
+    for (const auto& s : m["stimuli"]) {
+        const std::string id = s["id"];
+        const bool mid = s["block"] == "builtin:head/mid";
+        const int x = mid ? 50 : 20, y = mid ? 0 : 8, w = mid ? 46 : 40, h = mid ? 64 : 30, mag = mid ? 2 : 3;
+        EXPECT_EQ(s["presentation"]["method"], "native") << id;
+        EXPECT_EQ(s["presentation"]["render"], (nlohmann::json{{"width", 96}, {"height", 64}})) << id;
+        EXPECT_EQ(s["resolved"]["render"]["window"],
+                  (nlohmann::json{{"x", x * mag}, {"y", y * mag}, {"width", w * mag}, {"height", h * mag}}))
+            << id;
+        EXPECT_EQ(s["width"], w * mag) << id;
+        EXPECT_EQ(s["height"], h * mag) << id;
+        const Pixels png = readPixels(shown / "png" / (id + ".png"));
+        const Pixels wholePng = readPixels(whole[mag] / "png" / (id + ".png"));
+        EXPECT_LT(shareDiffering(png, wholePng, x * mag, y * mag, w * mag, h * mag, 2.5f / 255.0f), 0.005) << id;
+        // Not a nearest-neighbour upsample: some m × m block of the presented image is not uniform.
+        bool blocky = true;
+        for (int j = 0; j + mag <= png.height && blocky; j += mag)
+            for (int i = 0; i + mag <= png.width && blocky; i += mag)
+                for (int k = 0; k < mag * mag && blocky; ++k)
+                    blocky = png.at(i + k % mag, j + k / mag, 0) == png.at(i, j, 0);
+        EXPECT_FALSE(blocky) << id;
+        // The EXR is the native render, every AOV (the beauty compared in linear light).
+        const Pixels exr = readPixels(shown / "exr" / (id + ".exr"));
+        const Pixels wholeExr = readPixels(whole[mag] / "exr" / (id + ".exr"));
+        EXPECT_EQ(exr.channels, wholeExr.channels) << id;
+        EXPECT_EQ(exr.width, w * mag) << id;
+        Pixels beauty{exr.width, exr.height, 3, {}}, wholeBeauty{wholeExr.width, wholeExr.height, 3, {}};
+        for (size_t p = 0; p < exr.data.size() / static_cast<size_t>(exr.channels); ++p)
+            for (int c = 0; c < 3; ++c) beauty.data.push_back(exr.data[p * static_cast<size_t>(exr.channels) + c]);
+        for (size_t p = 0; p < wholeExr.data.size() / static_cast<size_t>(wholeExr.channels); ++p)
+            for (int c = 0; c < 3; ++c)
+                wholeBeauty.data.push_back(wholeExr.data[p * static_cast<size_t>(wholeExr.channels) + c]);
+        EXPECT_LT(shareDiffering(beauty, wholeBeauty, x * mag, y * mag, w * mag, h * mag, 0.01f), 0.005) << id;
+        if (!s["reference"].get<bool>()) {
+            EXPECT_TRUE(s.contains("predicted")) << id;
+        }
+    }
+    std::ifstream html(shown / "contact.html");
+    std::stringstream text;
+    text << html.rdbuf();
+    EXPECT_NE(text.str().find("Presented: crop 20,8 40×30 of 96×64, ×3 → 120×90 px (rendered natively)"),
+              std::string::npos);
+}
+
+namespace {
+
 // Every image file of a built set (exr/, png/, contact.png) → the sha256 of its bytes.
 std::map<std::string, std::string> imageFileHashes(const fs::path& dir) {
     std::map<std::string, std::string> out;
@@ -721,6 +816,24 @@ TEST_F(StimuliBuild, CropOutsideTheFrameIsRefusedBeforeRendering) {
                   ": crop[0].crop.x: 96 lies outside the 96 × 64 render (stimulus 'head-mid-front')\n");
     EXPECT_EQ(refused("magnification = 3", "magnification = 0"),
               "skinlab: error: " + spec + ": fixed.magnification: 0 is out of range [1, 16]\n");
+    // A crop that cannot be rendered natively (the presented image over 8192 pixels) names the key and the way out.
+    std::string large = presentedSpec("bad", true, "", "width = 960, height = 640");
+    const std::string crop = "width = 40, height = 30 }\nmagnification = 3";
+    large.replace(large.find(crop), crop.size(), "width = 600, height = 30 }\nmagnification = 16");
+    CliRun run = runCli({"stimuli", "build", writeSpec("bad.toml", large).string(), "-o", out.string()});
+    EXPECT_EQ(run.exitCode, 2);
+    EXPECT_FALSE(fs::exists(out));
+    EXPECT_EQ(run.output, "skinlab: error: " + spec +
+                              ": fixed.magnification: 16 cannot be rendered natively: the presented 9600 × 480 pixels "
+                              "(at most 8192 each way) of a 15360 × 10240 frame (at most 65536); lower it, or set "
+                              "presentation = \"replicate\" (stimulus 'head-close-front')\n");
+    // An unknown presentation names its key.
+    std::string unknown = presentedSpec("bad", true, "bicubic");
+    run = runCli({"stimuli", "build", writeSpec("bad.toml", unknown).string(), "-o", out.string()});
+    EXPECT_EQ(run.exitCode, 2);
+    EXPECT_EQ(run.output, "skinlab: error: " + spec +
+                              ": fixed.presentation: 'bicubic' is not a presentation (native: the crop rendered at "
+                              "the presented size; replicate: nearest-neighbour magnification)\n");
 }
 
 // `stimuli slurm --dry-run` prints the two sbatch scripts (a job array, one task per shard, and a merge job) and

@@ -7,6 +7,7 @@
 #include "renderer/shading/specular_brdf.h"
 #include "renderer/shading/tone_mappers.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <glm/glm.hpp>
@@ -137,6 +138,34 @@ TEST(RenderPipeline, ExposureScalesBeautyAndAovsByPowersOfTwo) {
         ASSERT_NEAR(b.channels.at("R")[p], 0.25f * a.channels.at("R")[p], 1e-6f);
         ASSERT_NEAR(b.channels.at("specular.R")[p], 0.25f * a.channels.at("specular.R")[p], 1e-6f);
     }
+}
+
+// render.window renders the window's pixels of the whole frame: with pscbf (view rays from the shifted principal
+// point, kernels in millimetres at the frame's focal length) every pixel a kernel's reach inside the window equals
+// the frame's; only near the window's edges, where the blur lacks the light from outside, may they differ.
+TEST(RenderPipeline, WindowEqualsTheFramesPixelsAwayFromItsEdges) {
+    SKINLAB_REQUIRE_RENDERER(renderer);
+    TempFolder folder("window");
+    const std::vector<std::string> common = {"camera.view=\"close\"", "shadow.resolution=512"};
+    test::renderToExr(*renderer, "builtin:head", "pscbf", common, 192, 192, folder / "whole.exr");
+    std::vector<std::string> windowed = common;
+    windowed.push_back("render.window={ x = 60, y = 70, width = 64, height = 48 }");
+    test::renderToExr(*renderer, "builtin:head", "pscbf", windowed, 192, 192, folder / "window.exr");
+    const ExrImage whole = readExr(folder / "whole.exr");
+    const ExrImage part = readExr(folder / "window.exr");
+    ASSERT_EQ(part.width, 64);
+    ASSERT_EQ(part.height, 48);
+    EXPECT_EQ(part.strings.at("skinlab:window"), "60 70 64 48");
+    EXPECT_EQ(part.floats.at("skinlab:f_px"), whole.floats.at("skinlab:f_px"));
+    const int margin = 12;
+    double largest = 0.0;
+    for (int y = margin; y < part.height - margin; ++y)
+        for (int x = margin; x < part.width - margin; ++x)
+            for (const char* channel : {"R", "G", "B", "diffuse.R", "diffuse.G", "diffuse.B", "depth.Z", "mask.Y"}) {
+                const double a = part.at(channel, x, y), b = whole.at(channel, 60 + x, 70 + y);
+                largest = std::max(largest, std::fabs(a - b) / std::max(1e-3, std::fabs(b)));
+            }
+    EXPECT_LT(largest, 2e-3);
 }
 
 TEST(RenderPipeline, ShadowsDarkenTheBackdropBehindTheSphere) {

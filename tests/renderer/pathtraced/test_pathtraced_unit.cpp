@@ -62,7 +62,7 @@ Exported exportScene(const std::string& scene, std::vector<std::string> override
         e.spec.modelSource == "builtin:halo" ? makeHaloScene(static_cast<float>(e.spec.depthGapMm)) : makeBleedScene();
     BlenderSceneInputs inputs = inputsFor(e.spec, e.model);
     inputs.camera = frameCamera(e.spec.camera, e.model.boundsMin, e.model.boundsMax, e.model.boundsMin,
-                                e.model.boundsMax, e.spec.width, e.spec.height);
+                                e.model.boundsMax, e.spec.frameWidth, e.spec.frameHeight, e.spec.window);
     inputs.sssWidthMm = e.spec.sss.widthMm;
     e.json = blenderSceneJson(inputs, "mesh.bin", "cycles.exr", "cycles.json");
     return e;
@@ -145,6 +145,23 @@ TEST(BlenderScene, LightsInBlenderUnits) {
     EXPECT_FALSE(sun.at("shadow").get<bool>());
     EXPECT_NEAR(principledRoughness(0.5), std::pow(2.0 / (8192.0 * std::pow(0.5, 5.0) + 2.0), 0.25), 1e-12);
     EXPECT_NEAR(principledSpecular(0.028), 0.35, 1e-12);
+}
+
+// render.window: Blender renders the window's pixels with the frame's focal length in pixels (the window's vertical
+// field of view) and the lens shift that moves the image off the view axis (units of the image height, vertical fit).
+TEST(BlenderScene, WindowIsTheFieldOfViewAndLensShiftOfTheSameCamera) {
+    const Exported whole = exportScene("builtin:halo", {"render.width=256", "render.height=256"});
+    EXPECT_FALSE(whole.json.at("camera").contains("shift_x"));
+    const Exported part = exportScene("builtin:halo", {"render.width=256", "render.height=256",
+                                                       "render.window={ x = 64, y = 32, width = 96, height = 64 }"});
+    EXPECT_EQ(part.json.at("settings").at("width"), 96);
+    EXPECT_EQ(part.json.at("settings").at("height"), 64);
+    const double f = 128.0 / std::tan(15.0 * kPi / 180.0); // the frame's f_px (fov_deg 30)
+    EXPECT_NEAR(part.json.at("camera").at("fov_y_rad").get<double>(), 2.0 * std::atan(32.0 / f), 1e-6);
+    // The window's centre lies 16 px left of and 64 px above the frame's: shifts −16/64 and 64/64.
+    EXPECT_NEAR(part.json.at("camera").at("shift_x").get<double>(), -0.25, 1e-6);
+    EXPECT_NEAR(part.json.at("camera").at("shift_y").get<double>(), 1.0, 1e-6);
+    EXPECT_EQ(part.json.at("camera").at("view_to_world"), whole.json.at("camera").at("view_to_world"));
 }
 
 TEST(BlenderScene, EnvironmentLookupMatchesSkinlabConvention) {

@@ -222,5 +222,63 @@ TEST(CameraFraming, FocalLengthAndNamedViewDistances) {
     EXPECT_GT(side.position.x, radius);
 }
 
+// render.window: the off-axis projection puts every point at the pixel it has in the whole frame, shifted by the
+// window's corner (y counted from the top), with the frame's focal length and the principal point moved with it.
+TEST(CameraFraming, WindowProjectsEveryPointWhereTheWholeFrameDoes) {
+    CameraSpec camera;
+    const glm::vec3 lo{-1, -1, -1}, hi{1, 1, 1};
+    const int W = 640, H = 480;
+    const RenderWindow window{100, 60, 200, 150};
+    const CameraPose whole = frameCamera(camera, lo, hi, lo, hi, W, H);
+    const CameraPose part = frameCamera(camera, lo, hi, lo, hi, W, H, window);
+    EXPECT_EQ(part.focalLengthPixels, whole.focalLengthPixels);
+    EXPECT_EQ(part.view, whole.view);
+    // Pixel coordinates (x from the left, y from the top) of a world point in an image of w × h.
+    auto pixel = [](const CameraPose& pose, const glm::vec3& p, float w, float h) {
+        const glm::vec4 clip = pose.projection * pose.view * glm::vec4(p, 1.0f);
+        return glm::vec2((clip.x / clip.w * 0.5f + 0.5f) * w, (0.5f - clip.y / clip.w * 0.5f) * h);
+    };
+    for (const glm::vec3& p :
+         {glm::vec3{0.1f, 0.2f, 0.3f}, glm::vec3{-0.5f, 0.4f, -0.2f}, glm::vec3{0.7f, -0.6f, 0.0f}}) {
+        const glm::vec2 inWhole = pixel(whole, p, W, H), inPart = pixel(part, p, 200.0f, 150.0f);
+        EXPECT_NEAR(inPart.x, inWhole.x - 100.0f, 1e-3f);
+        EXPECT_NEAR(inPart.y, inWhole.y - 60.0f, 1e-3f);
+    }
+    // The view axis meets the frame at its centre: (320, 240) from the top, (320, 240) from the bottom; in the
+    // window (rows from the bottom, its bottom row 480 − 60 − 150 = 270 of the frame) at (220, −30).
+    EXPECT_EQ(whole.principalPoint, glm::vec2(320.0f, 240.0f));
+    EXPECT_EQ(part.principalPoint, glm::vec2(220.0f, -30.0f));
+}
+
+TEST(SceneSpec, WindowIsReadRecordedAndCheckedAgainstTheFrame) {
+    const SceneSpec spec = loadSceneSpec(
+        "builtin:head",
+        {"render.width=512", "render.height=256", "render.window={ x = 10, y = 20, width = 100, height = 50 }"}, {});
+    EXPECT_EQ(spec.width, 100);
+    EXPECT_EQ(spec.height, 50);
+    EXPECT_EQ(spec.frameWidth, 512);
+    EXPECT_EQ(spec.frameHeight, 256);
+    EXPECT_EQ(spec.resolved["render"]["width"], 512);
+    EXPECT_EQ(spec.resolved["render"]["window"],
+              (nlohmann::json{{"x", 10}, {"y", 20}, {"width", 100}, {"height", 50}}));
+    EXPECT_FALSE(loadSceneSpec("builtin:head", {}, {}).resolved["render"].contains("window"));
+    // A frame over 8192 only with a window.
+    EXPECT_EQ(errorOf("builtin:head", {"render.width=9000"}),
+              "builtin:head: render.width: 9000 is out of range [16, 8192]");
+    EXPECT_EQ(errorOf("builtin:head", {"render.width=9000", "render.window={ x = 8000, y = 0, width = 1000, "
+                                                            "height = 100 }"}),
+              "");
+    EXPECT_EQ(errorOf("builtin:head", {"render.window={ x = 500, y = 0, width = 100, height = 100 }"}),
+              "builtin:head: render.window.width: x + width = 600 exceeds render.width 512");
+    EXPECT_EQ(errorOf("builtin:head", {"render.window={ x = 0, y = 500, width = 100, height = 100 }"}),
+              "builtin:head: render.window.height: y + height = 600 exceeds render.height 512");
+    EXPECT_EQ(errorOf("builtin:head", {"render.window={ x = 0, y = 0, width = 100 }"}),
+              "builtin:head: render.window.height: missing (a window has x, y, width, height in pixels of the frame)");
+    EXPECT_EQ(errorOf("builtin:head", {"render.window={ x = 0, y = 0, width = 100, height = 100, z = 1 }"}),
+              "builtin:head: render.window.z: unknown key");
+    EXPECT_EQ(errorOf("builtin:head", {"render.window=3"}),
+              "builtin:head: render.window: expected a table, got integer 3");
+}
+
 } // namespace
 } // namespace skinlab::renderer
