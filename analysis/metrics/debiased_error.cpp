@@ -144,7 +144,9 @@ DebiasedScores scoreDebiased(const SeededTruth& truth, const cv::Mat& testLumina
 namespace {
 
 // The index of the pair i < j among S seeds, in the order (0,1), (0,2) … (S−2,S−1).
-std::size_t pairIndex(std::size_t i, std::size_t j, std::size_t seeds) { return i * (2 * seeds - i - 1) / 2 + (j - i - 1); }
+std::size_t pairIndex(std::size_t i, std::size_t j, std::size_t seeds) {
+    return i * (2 * seeds - i - 1) / 2 + (j - i - 1);
+}
 
 // The pair terms of one quantity in one region, and the plain squared error against the first seed.
 template <int Channels>
@@ -185,9 +187,9 @@ DebiasedScores scoreDebiased(const SeededTruth& truth, const DebiasedImages& tes
     std::vector<std::size_t> allSeeds(seeds);
     for (std::size_t k = 0; k < seeds; ++k) allSeeds[k] = k;
     for (std::size_t quantity = 0; quantity < debiasedQuantityCount; ++quantity) {
-        const bool scored = !test[quantity].empty() &&
-                            std::all_of(truth.images.begin(), truth.images.end(),
-                                        [&](const DebiasedImages& seed) { return !seed[quantity].empty(); });
+        const bool scored =
+            !test[quantity].empty() && std::all_of(truth.images.begin(), truth.images.end(),
+                                                   [&](const DebiasedImages& seed) { return !seed[quantity].empty(); });
         for (std::size_t region = 0; region < debiasedRegionCount; ++region) {
             JackknifeEstimate& estimate = scores.quantityMse[quantity][region];
             estimate.value = estimate.standardError = notANumber;
@@ -198,8 +200,7 @@ DebiasedScores scoreDebiased(const SeededTruth& truth, const DebiasedImages& tes
             std::size_t pixels = 0;
             if (test[quantity].channels() == 3)
                 accumulatePairs<3>(truth, quantity, test[quantity], truth.regions[region], pairSums, plainSum, pixels);
-            else
-                accumulatePairs<1>(truth, quantity, test[quantity], truth.regions[region], pairSums, plainSum, pixels);
+            else accumulatePairs<1>(truth, quantity, test[quantity], truth.regions[region], pairSums, plainSum, pixels);
             if (quantity == 0) scores.pixels[region] = pixels;
             if (pixels == 0) continue;
             const double n = static_cast<double>(pixels);
@@ -324,8 +325,8 @@ RankingAgreement rankingAgreement(const std::vector<DebiasedScores>& scores, con
     agreement.conditions = members.size();
     agreement.jackknifeInterval = agreement.bootstrapInterval = {notANumber, notANumber};
     const std::size_t seeds = scores.empty() ? 0 : scores.front().seeds;
-    agreement.tQuantile = seeds >= 3 ? studentTQuantile(0.5 * (1.0 + options.level), static_cast<double>(seeds - 1))
-                                     : notANumber;
+    agreement.tQuantile =
+        seeds >= 3 ? studentTQuantile(0.5 * (1.0 + options.level), static_cast<double>(seeds - 1)) : notANumber;
     std::vector<JackknifeEstimate> estimates;
     std::vector<double> other;
     for (std::size_t member : members) {
@@ -485,7 +486,7 @@ nlohmann::json estimateJson(const JackknifeEstimate& estimate) {
 
 nlohmann::json intervalJson(const std::array<double, 2>& interval) {
     return std::isfinite(interval[0]) && std::isfinite(interval[1]) ? nlohmann::json{interval[0], interval[1]}
-                                                                     : nlohmann::json();
+                                                                    : nlohmann::json();
 }
 
 // One subset's agreement; `tau_b_interval_95` is the jackknife interval with the t quantile.
@@ -548,8 +549,9 @@ std::vector<double> tableScoreValues(const nlohmann::json& metrics, const std::f
     for (const DebiasedScores& test : tests) {
         const auto found = byPath.find(std::filesystem::weakly_canonical(test.test));
         if (found == byPath.end())
-            throwInput(file.string(), "", "has no comparison of " + test.test.string() +
-                                              " (score the same test renders with analyze metrics --reference)");
+            throwInput(file.string(), "",
+                       "has no comparison of " + test.test.string() +
+                           " (score the same test renders with analyze metrics --reference)");
         const nlohmann::json& comparison = *found->second;
         const nlohmann::json* entry = nullptr;
         if (score.region == "skin") {
@@ -651,7 +653,8 @@ DebiasedRun runDebiasedMetrics(const std::vector<std::filesystem::path>& seeds,
                 const JackknifeEstimate& q = scores.quantityMse[quantity][region];
                 const double qAgainst = comparedMse ? (*comparedMse)[quantity][region] : notANumber;
                 csv += "," + number(q.value) + "," + number(q.standardError) + "," + number(qAgainst);
-                nlohmann::json item{{"mse", estimateJson(q)}, {"plain_mse_one_seed", scores.quantityPlainMse[quantity][region]}};
+                nlohmann::json item{{"mse", estimateJson(q)},
+                                    {"plain_mse_one_seed", scores.quantityPlainMse[quantity][region]}};
                 if (comparedMse) item["mse_against_compared"] = qAgainst;
                 colour[std::string(debiasedQuantityName(quantity))] = item;
             }

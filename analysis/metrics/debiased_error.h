@@ -117,19 +117,19 @@ struct TruthScore {
 double truthScore(const DebiasedScores& scores, const TruthScore& truth, const std::vector<std::size_t>* draw);
 
 struct AgreementOptions {
-    double level = 0.95;                 // of every interval
+    double level = 0.95; // of every interval
     std::size_t bootstrapReplicates = 2000;
-    std::uint64_t bootstrapSeed = 41;    // the bootstrap's draws are reproducible
-    std::size_t competitiveCount = 16;   // the competitive conditions: this many closest to the truth
+    std::uint64_t bootstrapSeed = 41;  // the bootstrap's draws are reproducible
+    std::size_t competitiveCount = 16; // the competitive conditions: this many closest to the truth
 };
 
 // How a ranking of the tests by another score (e.g. the MSE against the object-space reference) agrees with the
 // ranking by the truth score against the path-traced truth, over a subset of the tests.
 struct RankingAgreement {
-    std::size_t conditions = 0;       // in the subset
-    std::vector<std::size_t> members; // the subset's indices into the tests
-    JackknifeEstimate tau;            // τ_b over all pairs of the subset; leave-one-seed-out jackknife
-    double tQuantile = 0.0;           // t_{(1+level)/2} with S − 1 degrees of freedom (NaN with two seeds)
+    std::size_t conditions = 0;                // in the subset
+    std::vector<std::size_t> members;          // the subset's indices into the tests
+    JackknifeEstimate tau;                     // τ_b over all pairs of the subset; leave-one-seed-out jackknife
+    double tQuantile = 0.0;                    // t_{(1+level)/2} with S − 1 degrees of freedom (NaN with two seeds)
     std::array<double, 2> jackknifeInterval{}; // τ_b ± t·SE, clipped to [−1, 1]
     // Percentile interval of τ_b over bootstrap replicates that resample the subset's conditions and the seeds
     // (each with replacement; NaN with fewer than three conditions).
@@ -186,7 +186,7 @@ struct DebiasedRunOptions {
 struct DebiasedRun {
     SeededTruth truth;
     std::vector<DebiasedScores> tests;
-    std::optional<DebiasedScores> compared;                           // the compared reference's own scores
+    std::optional<DebiasedScores> compared; // the compared reference's own scores
     // Per test, quantity and region: the plain MSE against the compared reference.
     std::vector<std::array<std::array<double, debiasedRegionCount>, debiasedQuantityCount>> comparedMse;
     std::array<std::array<AgreementSubsets, debiasedRegionCount>, debiasedQuantityCount> agreement{};

@@ -61,7 +61,8 @@ double studentTCdf(double t, double degreesOfFreedom) {
     if (!(degreesOfFreedom > 0.0) || std::isnan(t)) return notANumber;
     if (std::isinf(t)) return t > 0.0 ? 1.0 : 0.0;
     // P(|T| > |t|) = I_{ν/(ν+t²)}(ν/2, 1/2).
-    const double tail = 0.5 * regularizedBeta(0.5 * degreesOfFreedom, 0.5, degreesOfFreedom / (degreesOfFreedom + t * t));
+    const double tail =
+        0.5 * regularizedBeta(0.5 * degreesOfFreedom, 0.5, degreesOfFreedom / (degreesOfFreedom + t * t));
     return t >= 0.0 ? 1.0 - tail : tail;
 }
 
@@ -107,7 +108,8 @@ std::vector<std::size_t> smallestIndices(const std::vector<double>& values, std:
     std::vector<std::size_t> indices;
     for (std::size_t i = 0; i < values.size(); ++i)
         if (std::isfinite(values[i])) indices.push_back(i);
-    std::stable_sort(indices.begin(), indices.end(), [&](std::size_t a, std::size_t b) { return values[a] < values[b]; });
+    std::stable_sort(indices.begin(), indices.end(),
+                     [&](std::size_t a, std::size_t b) { return values[a] < values[b]; });
     if (indices.size() > count) indices.resize(count);
     return indices;
 }

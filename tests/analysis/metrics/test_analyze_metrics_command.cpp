@@ -226,18 +226,19 @@ TEST_F(AnalyzeMetricsCommand, RanksTheTableScoresAgainstTheSeededTruth) {
     testing::writeSyntheticExr(path("exr/reference.exr"), reference);
     testing::writeSyntheticExr(path("exr/halo.exr"), blurred);
     const std::string tests = path("exr/halo.exr") + " " + path("exr/reference.exr");
-    ASSERT_EQ(runSkinlab("analyze metrics --reference " + path("exr/reference.exr") + " " + tests + " -o " +
-                         path("table")).exitCode,
-              0);
-    CommandResult run = runSkinlab("analyze metrics --reference-seeds " + seeds + " --compare-reference " +
-                                   path("exr/reference.exr") + " --compare-metrics " + path("table/metrics.json") +
-                                   " " + tests + " -o " + path("seeded"));
+    ASSERT_EQ(
+        runSkinlab("analyze metrics --reference " + path("exr/reference.exr") + " " + tests + " -o " + path("table"))
+            .exitCode,
+        0);
+    CommandResult run =
+        runSkinlab("analyze metrics --reference-seeds " + seeds + " --compare-reference " + path("exr/reference.exr") +
+                   " --compare-metrics " + path("table/metrics.json") + " " + tests + " -o " + path("seeded"));
     ASSERT_EQ(run.exitCode, 0) << run.output;
     const auto json = nlohmann::json::parse(readFile(path("seeded/debiased.json")));
     const auto& halo = json["table_score_agreement"]["halo_leak_energy"];
     EXPECT_EQ(halo["truth"]["quantity"], "Y");
     EXPECT_EQ(halo["conditions"], 2u);
-    EXPECT_EQ(halo["tau_b"]["value"], 1.0); // the halo render is worse under both
+    EXPECT_EQ(halo["tau_b"]["value"], 1.0);                               // the halo render is worse under both
     EXPECT_NEAR(halo["jackknife_t_quantile"].get<double>(), 4.303, 1e-3); // three seeds: t(0.975, 2)
     EXPECT_EQ(json["table_score_agreement"]["halo_excess"]["truth"]["quantity"], "Lab");
     EXPECT_TRUE(json["ranking_agreement_by_quantity"]["R"]["halo"].contains("competitive"));
@@ -246,9 +247,8 @@ TEST_F(AnalyzeMetricsCommand, RanksTheTableScoresAgainstTheSeededTruth) {
     EXPECT_NE(csv.find("halo_leak_energy,halo,Y,mse,competitive,2,1,"), std::string::npos) << csv;
 
     CommandResult missing = runSkinlab("analyze metrics --reference-seeds " + seeds + " --compare-reference " +
-                                       path("exr/reference.exr") + " --compare-metrics " +
-                                       path("table/metrics.json") + " " + path("exr/seed0.exr") + " -o " +
-                                       path("missing"));
+                                       path("exr/reference.exr") + " --compare-metrics " + path("table/metrics.json") +
+                                       " " + path("exr/seed0.exr") + " -o " + path("missing"));
     EXPECT_EQ(missing.exitCode, 2) << missing.output;
     EXPECT_NE(missing.output.find("metrics.json: has no comparison of"), std::string::npos) << missing.output;
     EXPECT_FALSE(fs::exists(path("missing/debiased.json")));

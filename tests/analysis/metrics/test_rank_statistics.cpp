@@ -54,8 +54,8 @@ TEST(RankStatistics, PairTermsResampleWithoutTheSquaresOfOneSeed) {
     // Three seeds: P_01 = 1, P_02 = 2, P_12 = 3.
     const std::vector<double> terms{1, 2, 3};
     EXPECT_DOUBLE_EQ(pairTermMean(terms, 3, {0, 1, 2}), 2.0);
-    EXPECT_DOUBLE_EQ(pairTermMean(terms, 3, {0, 1}), 1.0);  // leave seed 2 out
-    EXPECT_DOUBLE_EQ(pairTermMean(terms, 3, {2, 1}), 3.0);  // order does not matter
+    EXPECT_DOUBLE_EQ(pairTermMean(terms, 3, {0, 1}), 1.0);    // leave seed 2 out
+    EXPECT_DOUBLE_EQ(pairTermMean(terms, 3, {2, 1}), 3.0);    // order does not matter
     EXPECT_DOUBLE_EQ(pairTermMean(terms, 3, {0, 0, 1}), 1.0); // the pair (0, 0) is no pair of independent seeds
     EXPECT_DOUBLE_EQ(pairTermMean(terms, 3, {0, 2, 2}), 2.0);
     EXPECT_TRUE(std::isnan(pairTermMean(terms, 3, {1, 1})));
@@ -137,7 +137,8 @@ TEST(RankStatistics, CompetitiveSubsetsAreTheClosestAndWithoutTheClearlyWorse) {
     const Synthetic synthetic = synthesize(scale, other, 6, 0.001, random);
     AgreementOptions options;
     options.competitiveCount = 8;
-    const AgreementSubsets subsets = agreementSubsets(synthetic.scores, synthetic.other, {4, 0, TruthKind::mse}, options);
+    const AgreementSubsets subsets =
+        agreementSubsets(synthetic.scores, synthetic.other, {4, 0, TruthKind::mse}, options);
     EXPECT_EQ(subsets.all.conditions, 10u);
     EXPECT_LT(subsets.all.tau.value, 0.5);
     EXPECT_EQ(subsets.competitive.members, (std::vector<std::size_t>{0, 1, 2, 3, 4, 5, 6, 7}));
