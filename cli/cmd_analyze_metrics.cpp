@@ -22,6 +22,9 @@ struct AnalyzeMetricsArguments {
     std::string reference;
     std::vector<std::string> referenceSeeds;
     std::string compareReference;
+    std::string compareMetrics;
+    int competitive = 16;
+    int bootstrapReplicates = 2000;
     std::vector<std::string> tests;
     std::string stimulusFolder;
     std::string outputFolder;
@@ -115,6 +118,13 @@ void runDebiased(const AnalyzeMetricsArguments& arguments) {
         options.sssRadiusMillimetres = *arguments.sssRadiusMillimetres;
     }
     options.compareReference = arguments.compareReference;
+    options.compareMetrics = arguments.compareMetrics;
+    if (arguments.competitive < 2)
+        throwInput("--competitive", "", std::to_string(arguments.competitive) + " must be at least 2");
+    if (arguments.bootstrapReplicates < 0)
+        throwInput("--bootstrap", "", std::to_string(arguments.bootstrapReplicates) + " must be 0 or more");
+    options.agreement.competitiveCount = static_cast<std::size_t>(arguments.competitive);
+    options.agreement.bootstrapReplicates = static_cast<std::size_t>(arguments.bootstrapReplicates);
     const auto run = metrics::runDebiasedMetrics(seeds, tests, options, arguments.outputFolder);
     spdlog::info("metrics: {} render(s) scored against {} path-traced seeds; {}/debiased.csv and debiased.json",
                  run.tests.size(), seeds.size(), arguments.outputFolder);
@@ -123,6 +133,7 @@ void runDebiased(const AnalyzeMetricsArguments& arguments) {
 void runAnalyzeMetrics(const AnalyzeMetricsArguments& arguments) {
     if (!arguments.referenceSeeds.empty()) return runDebiased(arguments);
     if (!arguments.compareReference.empty()) throwInput("--compare-reference", "", "only with --reference-seeds");
+    if (!arguments.compareMetrics.empty()) throwInput("--compare-metrics", "", "only with --reference-seeds");
     metrics::CvvdpDisplay display = displayOf(arguments); // option errors before any file is read
     std::string displaySource = arguments.display ? "--display" : "default";
     metrics::ComparisonPlan plan;
@@ -204,6 +215,15 @@ void registerAnalyzeMetrics(CLI::App& analyze) {
                         "With --reference-seeds: another ground truth of the same scene (e.g. the object-space "
                         "reference render): each test's paired difference from it, and the agreement of the tests' "
                         "rankings under the two truths (Kendall's tau with its interval)");
+    command->add_option("--compare-metrics", arguments->compareMetrics,
+                        "With --compare-reference: metrics.json of analyze metrics --reference on the same test "
+                        "files; the agreement of each of its band scores (leak energies, dE00 means and excesses) "
+                        "with the truth's ranking (table_score_agreement)");
+    command->add_option("--competitive", arguments->competitive,
+                        "With --compare-reference: the competitive conditions, this many closest to the truth "
+                        "(default 16)");
+    command->add_option("--bootstrap", arguments->bootstrapReplicates,
+                        "With --compare-reference: bootstrap replicates of the tau intervals (default 2000; 0: none)");
     command->add_option("--stimuli", arguments->stimulusFolder,
                         "Stimulus set folder (manifest.json): compare every stimulus with its block's reference");
     command

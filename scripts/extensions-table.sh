@@ -16,7 +16,10 @@
 #   */pathtraced/, */metrics-pathtraced/   each reference stimulus rendered by `pathtraced` (seed 0, and ID-seedK.exr
 #                          for the other seeds), and the block's scores against seed 0
 #   */metrics-debiased/    the block's squared errors against the noise-free path-traced image (`analyze metrics
-#                          --reference-seeds`, jackknife over the seeds) and their ranking against `reference`'s
+#                          --reference-seeds`, jackknife over the seeds), their ranking against `reference`'s, and
+#                          how each score of the table ranks the conditions against Cycles (`--compare-metrics`):
+#                          a score whose τ_b over the 16 conditions closest to Cycles is below 0.8 is withdrawn
+#                          from the block's tables, with the reason printed
 #   */eevee/, */metrics-eevee/, */metrics-eevee-pathtraced/   each block's scene rendered by `eevee`
 #                          (Blender EEVEE, its own screen-space SSS), scored against the block's reference and
 #                          against the path-traced one: the table's `eevee` row
@@ -87,7 +90,7 @@ import json, sys
 m = json.load(open(sys.argv[1]))
 print(next(s["files"]["exr"] for s in m["stimuli"] if s["id"] == sys.argv[2]))' "$dir/manifest.json" "$id")"
     "$skinlab" analyze metrics --reference-seeds "$seed_files" --compare-reference "$reference" "${tests[@]}" \
-      -o "$dir/metrics-debiased/$id" > /dev/null
+      --compare-metrics "$dir/metrics/metrics.json" -o "$dir/metrics-debiased/$id" > /dev/null
   done < <(python3 -c '
 import json, os, sys
 m = json.load(open(sys.argv[1]))
@@ -235,10 +238,37 @@ for name in sets:
                  [(band, "excess", f"{band} mean ΔE00 excess") for band in ["halo", "bleed"]]
         # The same halo/bleed leak energies against the path-traced reference (its bands: from its own depth and mask).
         pivots += [(band, "leak_energy", f"{band} leak energy against `pathtraced`", "pathtraced") for band in ["halo", "bleed"]]
+        # The table's scores ranked against Cycles (debiased, --compare-metrics): a score whose τ_b over the 16
+        # conditions closest to Cycles is below 0.8 does not rank the conditions as the path tracer does and is
+        # withdrawn from this block's tables.
+        withdrawn = {}
+        agreement = (debiased.get(block) or {}).get("table_score_agreement", {})
+        if agreement:
+            lines += ["Scores against `reference` ranked against Cycles (τ_b [seed jackknife, t] [bootstrap over conditions "
+                      "and seeds], 95 %; 16 closest: the conditions with the smallest debiased error against Cycles in the "
+                      "score's band; withdrawn below 0.8 there; docs/pathtraced.md, \"Reading the agreement\"):", "",
+                      "| score | τ_b all | τ_b 16 closest | kept |", "|---|---|---|---|"]
+            def tau_text(a):
+                if a["tau_b"]["value"] is None: return "–"
+                jack, boot = a.get("tau_b_interval_95"), a.get("tau_b_bootstrap_interval_95")
+                return (f"{a['tau_b']['value']:+.2f}" + (f" [{jack[0]:+.2f}, {jack[1]:+.2f}]" if jack else " [–]")
+                        + (f" [{boot[0]:+.2f}, {boot[1]:+.2f}]" if boot else " [–]"))
+            for score, a in agreement.items():
+                tau = a["competitive"]["tau_b"]["value"]
+                if tau is None: continue
+                if tau < 0.8:
+                    withdrawn[score] = f"τ_b {tau:+.2f} over the 16 conditions closest to Cycles"
+                lines.append(f"| {score} | {tau_text(a)} | {tau_text(a['competitive'])} | "
+                             + ("**withdrawn**" if tau < 0.8 else "yes") + " |")
+            lines.append("")
         for band, score, caption, *against in pivots:
             pick = (lambda c: c.get("pathtraced")) if against else (lambda c: c)
             cells = [pick(c) for k, c in table.items() if k[0] == block]
             if not any(c is not None and c["bands"][band]["pixels"] > 0 for c in cells): continue
+            if not against and f"{band}_{score}" in withdrawn:
+                lines += [f"{caption}: withdrawn ({withdrawn[f'{band}_{score}']}, below 0.8: it does not rank the "
+                          "conditions as the path tracer does).", ""]
+                continue
             lines += [f"{caption}:", "", "| method | " + " | ".join(extension_sets) + " |",
                       "|---|" + "---|" * len(extension_sets)]
             for method in methods + ["eevee"]:
@@ -276,10 +306,11 @@ for name in sets:
                 c = table.get((block, method, extension))
                 if c is None: continue
                 b = c["bands"]
-                lines.append(f"| {method} | {extension} | {number(b['halo']['leak_energy'])} | "
-                             f"{number(b['bleed']['leak_energy'])} | {number(b['spill']['leak_energy'])} | "
-                             f"{number(b['halo']['excess'])} | {number(b['bleed']['excess'])} | "
-                             f"{number(c['skin']['delta_e00_mean'])} | "
+                kept = lambda name, value: "withdrawn" if name in withdrawn else number(value)
+                lines.append(f"| {method} | {extension} | {kept('halo_leak_energy', b['halo']['leak_energy'])} | "
+                             f"{kept('bleed_leak_energy', b['bleed']['leak_energy'])} | {kept('spill_leak_energy', b['spill']['leak_energy'])} | "
+                             f"{kept('halo_excess', b['halo']['excess'])} | {kept('bleed_excess', b['bleed']['excess'])} | "
+                             f"{kept('skin_delta_e00_mean', c['skin']['delta_e00_mean'])} | "
                              f"{'–' if c['pathtraced'] is None else number(c['pathtraced']['bands']['halo']['leak_energy'])} | "
                              f"{'–' if c['pathtraced'] is None else number(c['pathtraced']['bands']['bleed']['leak_energy'])} |")
         lines.append("")

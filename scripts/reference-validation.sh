@@ -14,7 +14,9 @@
 #   - every condition against `reference` and against `pathtraced`;
 #   - `reference` against `pathtraced` (the per-band disagreement), and `pathtraced` seed 1 against seed 0 (noise);
 #   - every condition against the noise-free path-traced image (`--reference-seeds`, pairs of seeds, jackknife
-#     errors) and its ranking against `reference`'s (`--compare-reference`: Kendall's τ_b with its interval).
+#     errors) and its ranking against `reference`'s (`--compare-reference`: Kendall's τ_b with its t jackknife and
+#     bootstrap intervals, over all conditions, the 16 closest to Cycles and all but the clearly worse; in Y, R, G, B
+#     and CIELAB), and the evaluation table's scores against `reference` ranked against Cycles' (`--compare-metrics`).
 # The table: per case and band, the leak energy and mean ΔE00 of `reference` against `pathtraced` next to the
 # path tracer's own; and per case and score, Kendall's τ_b between the rankings of the 24 conditions under the
 # two references.
@@ -352,7 +354,7 @@ for name in $cases; do
   seed_files="$dir/pathtraced.exr"
   for seed in $(seq 1 $((seeds - 1))); do seed_files+=",$dir/pathtraced-seed$seed.exr"; done
   "$skinlab" analyze metrics --reference-seeds "$seed_files" --compare-reference "$dir/set/$ref_exr" "${tests[@]}" \
-    -o "$dir/metrics-debiased" > /dev/null
+    --compare-metrics "$dir/metrics-reference/metrics.json" -o "$dir/metrics-debiased" > /dev/null
   ran+=("$name")
 done
 
@@ -465,15 +467,39 @@ for name in cases:
         per_condition.append(f"| {name} | {k} | {number(band(a, 'halo', 'leak_energy'))} / {number(band(p, 'halo', 'leak_energy'))} | "
                              f"{number(band(a, 'bleed', 'leak_energy'))} / {number(band(p, 'bleed', 'leak_energy'))} | "
                              f"{number(a['skin']['delta_e00_mean'])} / {number(p['skin']['delta_e00_mean'])} |")
-# Debiased: every condition's squared luminance error against the noise-free path-traced image (pairs of seeds,
-# `analyze metrics --reference-seeds`), the reference's own, and the rankings' agreement with the jackknife interval.
-debiased = ["", f"## Debiased rankings against `pathtraced` ({seeds} seeds): Kendall's τ_b with its 95 % jackknife interval", "",
+# Debiased: every condition's squared error against the noise-free path-traced image (pairs of seeds,
+# `analyze metrics --reference-seeds`), the reference's own, and the rankings' agreement: τ_b with the seed
+# jackknife's interval (t quantile, S − 1 degrees of freedom) and the bootstrap's over conditions and seeds, over
+# all 24 conditions, the 16 closest to Cycles ("competitive") and all but the clearly worse (debiased MSE above
+# Q3 + 1.5 IQR of the 24); the same competitive τ_b per channel and in CIELAB; the evaluation table's scores.
+def tau_text(a):
+    tau = a["tau_b"]["value"]
+    if tau is None: return "–"
+    text = f"{tau:+.2f}"
+    jack, boot = a.get("tau_b_interval_95"), a.get("tau_b_bootstrap_interval_95")
+    text += f" [{jack[0]:+.2f}, {jack[1]:+.2f}]" if jack else " [–]"
+    text += f" [{boot[0]:+.2f}, {boot[1]:+.2f}]" if boot else " [–]"
+    return text
+debiased = ["", f"## Debiased rankings against `pathtraced` ({seeds} seeds): Kendall's τ_b", "",
             "MSE of Y over the band against the noise-free path-traced image (mean over pairs of seeds of "
-            "(a − r_i)(a − r_j)); `reference`'s own MSE ± its standard error; τ_b between the 24 conditions' MSE against "
-            "`reference` and their debiased MSE against `pathtraced`; pairs Cycles separates (|D| > 1.96 SE) and "
-            "the share of them ranked the same way by `reference`; conditions scoring better than `reference` itself.", "",
-            "| case | band | `reference` MSE ± SE | conditions' MSE min / median / max | τ_b [95 % interval] | separated pairs: same order | better than `reference` |",
-            "|---|---|---|---|---|---|---|"]
+            "(a − r_i)(a − r_j)); `reference`'s own MSE ± its standard error; τ_b between the conditions' MSE against "
+            "`reference` and their debiased MSE against `pathtraced`, each as τ_b [seed jackknife, t quantile] "
+            "[bootstrap over conditions and seeds], 95 %: over all 24 conditions, the 16 closest to `pathtraced` and all "
+            "but the clearly worse (debiased MSE above Q3 + 1.5 IQR; their count in brackets); pairs Cycles separates "
+            "(|D| > t·SE) and the share of them ranked the same way by `reference`; conditions scoring better than "
+            "`reference` itself.", "",
+            "| case | band | `reference` MSE ± SE | conditions' MSE min / median / max | τ_b all | τ_b 16 closest | τ_b without clearly worse | separated pairs: same order | better than `reference` |",
+            "|---|---|---|---|---|---|---|---|---|"]
+colour = ["", "## Competitive rankings per channel and in CIELAB", "",
+          "τ_b over the 16 conditions closest to `pathtraced` in each quantity (squared error of linear R, G, B × "
+          "exposure, and ΔE*ab² of the display encoding), with the bootstrap interval; Y for comparison.", "",
+          "| case | band | Y | R | G | B | CIELAB |", "|---|---|---|---|---|---|---|"]
+table_scores = ["", "## The evaluation table's scores against `reference`, ranked against Cycles", "",
+                "Each score of the conditions against `reference` (metrics-reference/metrics.json) against the "
+                "debiased ranking of Cycles in the same band: leak energies against the MSE of Y, ΔE00 means against "
+                "the MSE in CIELAB, ΔE00 excesses against √MSE(band) − √MSE(interior) in CIELAB. τ_b [t jackknife] "
+                "[bootstrap], 95 %; agrees: τ_b ≥ 0.8 over the 16 closest.", "",
+                "| case | score | τ_b all | τ_b 16 closest | τ_b without clearly worse | agrees |", "|---|---|---|---|---|---|"]
 for name in cases:
     path_json = os.path.join(out, name, "metrics-debiased", "debiased.json")
     if not os.path.exists(path_json): continue
@@ -483,15 +509,31 @@ for name in cases:
         if not ref["pixels"]: continue
         values = sorted(t["regions"][b]["mse"]["value"] for t in d["tests"])
         agree = d["ranking_agreement"][b]
-        tau = agree["tau_b"]["value"]
-        interval = agree["tau_b_interval_95"]
+        worse = agree["without_clearly_worse"]
+        t_quantile = agree.get("jackknife_t_quantile") or 1.96
         better = sum(1 for t in d["tests"] if t["regions"][b]["difference_from_compared"]["value"] is not None
-                     and t["regions"][b]["difference_from_compared"]["value"] + 1.96 * (t["regions"][b]["difference_from_compared"]["standard_error"] or 0) < 0)
+                     and t["regions"][b]["difference_from_compared"]["value"] + t_quantile * (t["regions"][b]["difference_from_compared"]["standard_error"] or 0) < 0)
         sep, same = agree["separated_pairs"], agree["concordant_separated_pairs"]
         debiased.append(f"| {name} | {b} | {number(ref['mse']['value'])} ± {number(ref['mse']['standard_error'])} | "
                         f"{number(values[0])} / {number(values[len(values) // 2])} / {number(values[-1])} | "
-                        + ("–" if tau is None else f"{tau:+.2f}") + ("" if not interval else f" [{interval[0]:+.2f}, {interval[1]:+.2f}]")
-                        + f" | {same}/{sep} | {better} |")
+                        f"{tau_text(agree)} | {tau_text(agree['competitive'])} | {tau_text(worse)} ({worse['conditions']}) | "
+                        f"{same}/{sep} | {better} |")
+        by_quantity = d.get("ranking_agreement_by_quantity", {})
+        if by_quantity:
+            cells = []
+            for q in ["Y", "R", "G", "B", "Lab"]:
+                a = by_quantity[q][b]["competitive"]
+                boot = a.get("tau_b_bootstrap_interval_95")
+                cells.append("–" if a["tau_b"]["value"] is None else f"{a['tau_b']['value']:+.2f}"
+                             + (f" [{boot[0]:+.2f}, {boot[1]:+.2f}]" if boot else ""))
+            colour.append(f"| {name} | {b} | " + " | ".join(cells) + " |")
+    for score, a in d.get("table_score_agreement", {}).items():
+        if a["tau_b"]["value"] is None and a["competitive"]["tau_b"]["value"] is None: continue
+        tau = a["competitive"]["tau_b"]["value"]
+        worse = a["without_clearly_worse"]
+        table_scores.append(f"| {name} | {score} | {tau_text(a)} | {tau_text(a['competitive'])} | "
+                            f"{tau_text(worse)} ({worse['conditions']}) | " + ("–" if tau is None else "yes" if tau >= 0.8 else "**no**") + " |")
+debiased += colour + table_scores
 lines += debiased
 path = os.path.join(out, "reference-validation.md")
 with open(path + ".tmp", "w") as f:

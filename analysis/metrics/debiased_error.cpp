@@ -1,6 +1,7 @@
 #include "analysis/metrics/debiased_error.h"
 
 #include "analysis/metrics/colour_space.h"
+#include "analysis/metrics/rank_statistics.h"
 #include "analysis/metrics/render_comparison.h"
 #include "common/csv.h"
 #include "common/error.h"
@@ -10,6 +11,8 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
+#include <random>
 
 #include <nlohmann/json.hpp>
 
@@ -36,6 +39,31 @@ std::string_view debiasedRegionName(std::size_t region) {
     static constexpr std::array<std::string_view, debiasedRegionCount> names{"halo",     "bleed", "spill",
                                                                              "interior", "skin",  "image"};
     return region < names.size() ? names[region] : std::string_view{"?"};
+}
+
+std::string_view debiasedQuantityName(std::size_t quantity) {
+    static constexpr std::array<std::string_view, debiasedQuantityCount> names{"Y", "R", "G", "B", "Lab"};
+    return quantity < names.size() ? names[quantity] : std::string_view{"?"};
+}
+
+DebiasedImages renderQuantities(const MetricRender& render, double exposure) {
+    DebiasedImages images;
+    images[0] = renderLuminance(render, exposure);
+    for (std::size_t channel = 0; channel < 3; ++channel) images[1 + channel] = cv::Mat(render.beauty.size(), CV_64FC1);
+    images[4] = cv::Mat(render.beauty.size(), CV_64FC3);
+    for (int y = 0; y < render.beauty.rows; ++y) {
+        const auto* rgb = render.beauty.ptr<cv::Vec3f>(y);
+        auto* lab = images[4].ptr<cv::Vec3d>(y);
+        for (int x = 0; x < render.beauty.cols; ++x) {
+            for (int channel = 0; channel < 3; ++channel) {
+                const double value = static_cast<double>(rgb[x][channel]) * exposure;
+                images[1 + static_cast<std::size_t>(channel)].ptr<double>(y)[x] = std::isfinite(value) ? value : 0.0;
+            }
+            const Lab colour = displayLab(rgb[x][0], rgb[x][1], rgb[x][2], exposure);
+            lab[x] = cv::Vec3d(colour.lightness, colour.a, colour.b);
+        }
+    }
+    return images;
 }
 
 cv::Mat renderLuminance(const MetricRender& render, double exposure) {
@@ -70,7 +98,8 @@ SeededTruth loadSeededTruth(const std::vector<std::filesystem::path>& seeds, dou
                    "a seeded truth needs skinlab's depth.Z, mask.Y and camera metadata (a skinlab render)");
     const int width = first.width;
     const int height = first.height;
-    truth.luminance.push_back(renderLuminance(first, exposure));
+    truth.images.push_back(renderQuantities(first, exposure));
+    truth.luminance.push_back(truth.images.back()[0]);
     PreparedReference prepared = prepareReference(std::move(first), options);
     truth.bands = prepared.bands;
     for (std::size_t band = 0; band < allBands.size(); ++band) truth.regions[band] = truth.bands.masks[band];
@@ -86,7 +115,8 @@ SeededTruth loadSeededTruth(const std::vector<std::filesystem::path>& seeds, dou
             throwInput(seeds[seed].string(), "",
                        std::to_string(render.width) + "x" + std::to_string(render.height) + " differs from " +
                            seeds.front().string() + " (" + std::to_string(width) + "x" + std::to_string(height) + ")");
-        truth.luminance.push_back(renderLuminance(render, exposure));
+        truth.images.push_back(renderQuantities(render, exposure));
+        truth.luminance.push_back(truth.images.back()[0]);
     }
     double skinSum = 0.0;
     std::size_t skinPixels = 0;
@@ -106,65 +136,105 @@ SeededTruth loadSeededTruth(const std::vector<std::filesystem::path>& seeds, dou
 
 DebiasedScores scoreDebiased(const SeededTruth& truth, const cv::Mat& testLuminance,
                              const std::filesystem::path& testPath) {
-    const std::size_t seeds = truth.luminance.size();
-    if (testLuminance.size() != truth.luminance.front().size())
+    DebiasedImages images;
+    images[0] = testLuminance;
+    return scoreDebiased(truth, images, testPath);
+}
+
+namespace {
+
+// The index of the pair i < j among S seeds, in the order (0,1), (0,2) … (S−2,S−1).
+std::size_t pairIndex(std::size_t i, std::size_t j, std::size_t seeds) {
+    return i * (2 * seeds - i - 1) / 2 + (j - i - 1);
+}
+
+// The pair terms of one quantity in one region, and the plain squared error against the first seed.
+template <int Channels>
+void accumulatePairs(const SeededTruth& truth, std::size_t quantity, const cv::Mat& test, const cv::Mat& inside,
+                     std::vector<double>& pairSums, double& plainSum, std::size_t& pixels) {
+    using Pixel = cv::Vec<double, Channels>;
+    const std::size_t seeds = truth.images.size();
+    std::vector<Pixel> residual(seeds);
+    for (int y = 0; y < inside.rows; ++y) {
+        const auto* in = inside.ptr<unsigned char>(y);
+        const auto* value = test.ptr<Pixel>(y);
+        for (int x = 0; x < inside.cols; ++x) {
+            if (!in[x]) continue;
+            ++pixels;
+            for (std::size_t k = 0; k < seeds; ++k) residual[k] = value[x] - truth.images[k][quantity].ptr<Pixel>(y)[x];
+            plainSum += residual[0].dot(residual[0]);
+            std::size_t pair = 0;
+            for (std::size_t i = 0; i < seeds; ++i)
+                for (std::size_t j = i + 1; j < seeds; ++j) pairSums[pair++] += residual[i].dot(residual[j]);
+        }
+    }
+}
+
+} // namespace
+
+DebiasedScores scoreDebiased(const SeededTruth& truth, const DebiasedImages& test,
+                             const std::filesystem::path& testPath) {
+    const std::size_t seeds = truth.images.size();
+    if (test[0].empty() || test[0].size() != truth.luminance.front().size())
         throwInput(testPath.string(), "",
-                   std::to_string(testLuminance.cols) + "x" + std::to_string(testLuminance.rows) +
+                   std::to_string(test[0].cols) + "x" + std::to_string(test[0].rows) +
                        " differs from the path-traced truth " + truth.paths.front().string() + " (" +
                        std::to_string(truth.luminance.front().cols) + "x" +
                        std::to_string(truth.luminance.front().rows) + ")");
     DebiasedScores scores;
     scores.test = testPath;
-    const double pairs = static_cast<double>(seeds * (seeds - 1)) / 2.0;
-    const double pairsWithoutOne = static_cast<double>((seeds - 1) * (seeds - 2)) / 2.0;
-    std::vector<double> residual(seeds);
-    for (std::size_t region = 0; region < debiasedRegionCount; ++region) {
-        const cv::Mat& inside = truth.regions[region];
-        std::size_t pixels = 0;
-        double pairSum = 0.0;
-        double plainSum = 0.0;
-        std::vector<double> withoutSeed(seeds, 0.0);
-        for (int y = 0; y < inside.rows; ++y) {
-            const auto* in = inside.ptr<unsigned char>(y);
-            const auto* test = testLuminance.ptr<double>(y);
-            for (int x = 0; x < inside.cols; ++x) {
-                if (!in[x]) continue;
-                ++pixels;
-                double total = 0.0;
-                double squares = 0.0;
+    scores.seeds = seeds;
+    std::vector<std::size_t> allSeeds(seeds);
+    for (std::size_t k = 0; k < seeds; ++k) allSeeds[k] = k;
+    for (std::size_t quantity = 0; quantity < debiasedQuantityCount; ++quantity) {
+        const bool scored =
+            !test[quantity].empty() && std::all_of(truth.images.begin(), truth.images.end(),
+                                                   [&](const DebiasedImages& seed) { return !seed[quantity].empty(); });
+        for (std::size_t region = 0; region < debiasedRegionCount; ++region) {
+            JackknifeEstimate& estimate = scores.quantityMse[quantity][region];
+            estimate.value = estimate.standardError = notANumber;
+            scores.quantityPlainMse[quantity][region] = notANumber;
+            if (!scored) continue;
+            std::vector<double> pairSums(seeds * (seeds - 1) / 2, 0.0);
+            double plainSum = 0.0;
+            std::size_t pixels = 0;
+            if (test[quantity].channels() == 3)
+                accumulatePairs<3>(truth, quantity, test[quantity], truth.regions[region], pairSums, plainSum, pixels);
+            else accumulatePairs<1>(truth, quantity, test[quantity], truth.regions[region], pairSums, plainSum, pixels);
+            if (quantity == 0) scores.pixels[region] = pixels;
+            if (pixels == 0) continue;
+            const double n = static_cast<double>(pixels);
+            for (double& sum : pairSums) sum /= n;
+            scores.pairTerms[quantity][region] = pairSums;
+            scores.quantityPlainMse[quantity][region] = plainSum / n;
+            estimate.value = pairTermMean(pairSums, seeds, allSeeds);
+            if (seeds >= 3) {
                 for (std::size_t k = 0; k < seeds; ++k) {
-                    residual[k] = test[x] - truth.luminance[k].ptr<double>(y)[x];
-                    total += residual[k];
-                    squares += residual[k] * residual[k];
+                    std::vector<std::size_t> without;
+                    for (std::size_t other = 0; other < seeds; ++other)
+                        if (other != k) without.push_back(other);
+                    estimate.leaveOneOut.push_back(pairTermMean(pairSums, seeds, without));
                 }
-                plainSum += residual[0] * residual[0];
-                // Σ_{i<j} e_i e_j = ((Σ e)² − Σ e²) / 2, and the same without seed k.
-                pairSum += 0.5 * (total * total - squares);
-                for (std::size_t k = 0; k < seeds; ++k) {
-                    const double t = total - residual[k];
-                    withoutSeed[k] += 0.5 * (t * t - (squares - residual[k] * residual[k]));
-                }
+                estimate.standardError = jackknifeStandardError(estimate.leaveOneOut);
             }
         }
-        scores.pixels[region] = pixels;
-        JackknifeEstimate& estimate = scores.mse[region];
-        if (pixels == 0) {
-            estimate.value = estimate.standardError = notANumber;
-            scores.plainMse[region] = notANumber;
-            continue;
-        }
-        const double n = static_cast<double>(pixels);
-        estimate.value = pairSum / (n * pairs);
-        scores.plainMse[region] = plainSum / n;
-        if (seeds >= 3) {
-            for (std::size_t k = 0; k < seeds; ++k)
-                estimate.leaveOneOut.push_back(withoutSeed[k] / (n * pairsWithoutOne));
-            estimate.standardError = jackknifeStandardError(estimate.leaveOneOut);
-        } else {
-            estimate.standardError = notANumber;
-        }
     }
+    scores.mse = scores.quantityMse[0];
+    scores.plainMse = scores.quantityPlainMse[0];
     return scores;
+}
+
+double pairTermMean(const std::vector<double>& pairTerms, std::size_t seeds, const std::vector<std::size_t>& draw) {
+    if (pairTerms.size() != seeds * (seeds - 1) / 2) return notANumber;
+    double sum = 0.0;
+    std::size_t count = 0;
+    for (std::size_t a = 0; a < draw.size(); ++a)
+        for (std::size_t b = a + 1; b < draw.size(); ++b) {
+            if (draw[a] == draw[b] || draw[a] >= seeds || draw[b] >= seeds) continue;
+            sum += pairTerms[pairIndex(std::min(draw[a], draw[b]), std::max(draw[a], draw[b]), seeds)];
+            ++count;
+        }
+    return count > 0 ? sum / static_cast<double>(count) : notANumber;
 }
 
 JackknifeEstimate debiasedDifference(const DebiasedScores& a, const DebiasedScores& b, std::size_t region) {
@@ -202,39 +272,176 @@ double kendallTauB(const std::vector<double>& x, const std::vector<double>& y) {
     return denominator > 0.0 ? (concordant - discordant) / denominator : notANumber;
 }
 
+double truthScore(const DebiasedScores& scores, const TruthScore& truth, const std::vector<std::size_t>* draw) {
+    if (truth.quantity >= debiasedQuantityCount || truth.region >= debiasedRegionCount) return notANumber;
+    std::vector<std::size_t> all;
+    if (!draw) {
+        for (std::size_t k = 0; k < scores.seeds; ++k) all.push_back(k);
+        draw = &all;
+    }
+    const auto mse = [&](std::size_t region) {
+        const auto& terms = scores.pairTerms[truth.quantity][region];
+        return terms.empty() ? notANumber : pairTermMean(terms, scores.seeds, *draw);
+    };
+    if (truth.kind == TruthKind::mse) return mse(truth.region);
+    constexpr std::size_t interior = 3;
+    return std::sqrt(std::max(mse(truth.region), 0.0)) - std::sqrt(std::max(mse(interior), 0.0));
+}
+
+namespace {
+
+// The truth score of a test with its leave-one-seed-out values.
+JackknifeEstimate truthEstimate(const DebiasedScores& scores, const TruthScore& truth) {
+    JackknifeEstimate estimate;
+    estimate.value = truthScore(scores, truth, nullptr);
+    if (scores.seeds >= 3) {
+        for (std::size_t k = 0; k < scores.seeds; ++k) {
+            std::vector<std::size_t> without;
+            for (std::size_t other = 0; other < scores.seeds; ++other)
+                if (other != k) without.push_back(other);
+            estimate.leaveOneOut.push_back(truthScore(scores, truth, &without));
+        }
+        estimate.standardError = jackknifeStandardError(estimate.leaveOneOut);
+    } else {
+        estimate.standardError = notANumber;
+    }
+    return estimate;
+}
+
+} // namespace
+
 RankingAgreement rankingAgreement(const std::vector<DebiasedScores>& scores, const std::vector<double>& otherScore,
                                   std::size_t region) {
+    std::vector<std::size_t> all(scores.size());
+    for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+    return rankingAgreement(scores, otherScore, TruthScore{region, 0, TruthKind::mse}, all, AgreementOptions{});
+}
+
+RankingAgreement rankingAgreement(const std::vector<DebiasedScores>& scores, const std::vector<double>& otherScore,
+                                  const TruthScore& truth, const std::vector<std::size_t>& members,
+                                  const AgreementOptions& options) {
     RankingAgreement agreement;
-    agreement.conditions = scores.size();
-    std::vector<double> debiased;
-    for (const DebiasedScores& score : scores) debiased.push_back(score.mse[region].value);
-    agreement.tau.value = kendallTauB(otherScore, debiased);
-    const std::size_t seeds = scores.empty() ? 0 : scores.front().mse[region].leaveOneOut.size();
-    for (std::size_t k = 0; k < seeds; ++k) {
+    agreement.members = members;
+    agreement.conditions = members.size();
+    agreement.jackknifeInterval = agreement.bootstrapInterval = {notANumber, notANumber};
+    const std::size_t seeds = scores.empty() ? 0 : scores.front().seeds;
+    agreement.tQuantile =
+        seeds >= 3 ? studentTQuantile(0.5 * (1.0 + options.level), static_cast<double>(seeds - 1)) : notANumber;
+    std::vector<JackknifeEstimate> estimates;
+    std::vector<double> other;
+    for (std::size_t member : members) {
+        estimates.push_back(truthEstimate(scores.at(member), truth));
+        other.push_back(otherScore.at(member));
+    }
+    std::vector<double> values;
+    for (const JackknifeEstimate& estimate : estimates) values.push_back(estimate.value);
+    agreement.tau.value = kendallTauB(other, values);
+    const std::size_t leaveOut = estimates.empty() ? 0 : estimates.front().leaveOneOut.size();
+    for (std::size_t k = 0; k < leaveOut; ++k) {
         std::vector<double> without;
-        for (const DebiasedScores& score : scores) without.push_back(score.mse[region].leaveOneOut[k]);
-        agreement.tau.leaveOneOut.push_back(kendallTauB(otherScore, without));
+        for (const JackknifeEstimate& estimate : estimates) without.push_back(estimate.leaveOneOut[k]);
+        agreement.tau.leaveOneOut.push_back(kendallTauB(other, without));
     }
     agreement.tau.standardError = jackknifeStandardError(agreement.tau.leaveOneOut);
+    if (std::isfinite(agreement.tau.standardError) && std::isfinite(agreement.tQuantile))
+        agreement.jackknifeInterval = {
+            std::max(-1.0, agreement.tau.value - agreement.tQuantile * agreement.tau.standardError),
+            std::min(1.0, agreement.tau.value + agreement.tQuantile * agreement.tau.standardError)};
+
+    // Pairs the truth separates: |difference| > t·SE with the jackknife over the seeds both share.
     double concordant = 0.0;
     double discordant = 0.0;
-    for (std::size_t i = 0; i < scores.size(); ++i)
-        for (std::size_t j = i + 1; j < scores.size(); ++j) {
-            const JackknifeEstimate difference = debiasedDifference(scores[i], scores[j], region);
-            if (!(std::abs(difference.value) > 1.96 * difference.standardError)) continue;
+    for (std::size_t i = 0; i < estimates.size(); ++i)
+        for (std::size_t j = i + 1; j < estimates.size(); ++j) {
+            const double difference = estimates[i].value - estimates[j].value;
+            std::vector<double> differences;
+            for (std::size_t k = 0; k < leaveOut; ++k)
+                differences.push_back(estimates[i].leaveOneOut[k] - estimates[j].leaveOneOut[k]);
+            const double error = jackknifeStandardError(differences);
+            if (!(std::abs(difference) > agreement.tQuantile * error)) continue;
             ++agreement.separatedPairs;
-            const double other = otherScore[i] - otherScore[j];
-            if (other != 0.0 && (other > 0.0) == (difference.value > 0.0)) {
+            const double otherDifference = other[i] - other[j];
+            if (otherDifference != 0.0 && (otherDifference > 0.0) == (difference > 0.0)) {
                 concordant += 1.0;
                 ++agreement.concordantSeparated;
-            } else if (other != 0.0) {
+            } else if (otherDifference != 0.0) {
                 discordant += 1.0;
             }
         }
     agreement.tauSeparated = agreement.separatedPairs > 0
                                  ? (concordant - discordant) / static_cast<double>(agreement.separatedPairs)
                                  : notANumber;
+
+    // Bootstrap: each replicate draws the subset's conditions and the seeds with replacement (a draw of seeds
+    // with fewer than two distinct seeds is drawn again) and ranks the drawn conditions by their truth scores from
+    // the drawn seeds.
+    const std::size_t count = members.size();
+    if (count >= 3 && options.bootstrapReplicates > 0 && seeds >= 2) {
+        std::mt19937_64 random(options.bootstrapSeed);
+        std::uniform_int_distribution<std::size_t> pickCondition(0, count - 1);
+        std::uniform_int_distribution<std::size_t> pickSeed(0, seeds - 1);
+        std::vector<double> replicates;
+        replicates.reserve(options.bootstrapReplicates);
+        std::vector<std::size_t> conditionDraw(count);
+        std::vector<std::size_t> seedDraw(seeds);
+        std::vector<double> x(count);
+        std::vector<double> y(count);
+        std::vector<double> cache(count);
+        std::vector<char> cached(count);
+        for (std::size_t replicate = 0; replicate < options.bootstrapReplicates; ++replicate) {
+            for (std::size_t& c : conditionDraw) c = pickCondition(random);
+            do {
+                for (std::size_t& k : seedDraw) k = pickSeed(random);
+            } while (std::all_of(seedDraw.begin(), seedDraw.end(), [&](std::size_t k) { return k == seedDraw[0]; }));
+            std::fill(cached.begin(), cached.end(), 0);
+            for (std::size_t i = 0; i < count; ++i) {
+                const std::size_t c = conditionDraw[i];
+                if (!cached[c]) {
+                    cache[c] = truthScore(scores[members[c]], truth, &seedDraw);
+                    cached[c] = 1;
+                }
+                x[i] = other[c];
+                y[i] = cache[c];
+            }
+            replicates.push_back(kendallTauB(x, y));
+        }
+        agreement.bootstrapInterval = percentileInterval(std::move(replicates), options.level);
+    }
     return agreement;
+}
+
+AgreementSubsets agreementSubsets(const std::vector<DebiasedScores>& scores, const std::vector<double>& otherScore,
+                                  const TruthScore& truth, const AgreementOptions& options) {
+    AgreementSubsets subsets;
+    std::vector<double> values;
+    std::vector<std::size_t> all;
+    for (std::size_t i = 0; i < scores.size(); ++i) {
+        values.push_back(truthScore(scores[i], truth, nullptr));
+        all.push_back(i);
+    }
+    subsets.all = rankingAgreement(scores, otherScore, truth, all, options);
+    subsets.competitive =
+        rankingAgreement(scores, otherScore, truth, smallestIndices(values, options.competitiveCount), options);
+    subsets.clearlyWorseFence = upperTukeyFence(values);
+    std::vector<std::size_t> kept;
+    for (std::size_t i = 0; i < values.size(); ++i)
+        if (!(values[i] > subsets.clearlyWorseFence)) kept.push_back(i); // a NaN fence keeps all
+    subsets.withoutClearlyWorse = rankingAgreement(scores, otherScore, truth, kept, options);
+    return subsets;
+}
+
+const std::vector<TableScore>& tableScores() {
+    static const std::vector<TableScore> scores{
+        {"halo_leak_energy", "halo", "leak_energy", {0, 0, TruthKind::mse}},
+        {"bleed_leak_energy", "bleed", "leak_energy", {1, 0, TruthKind::mse}},
+        {"spill_leak_energy", "spill", "leak_energy", {2, 0, TruthKind::mse}},
+        {"halo_delta_e00_mean", "halo", "delta_e00_mean", {0, 4, TruthKind::mse}},
+        {"bleed_delta_e00_mean", "bleed", "delta_e00_mean", {1, 4, TruthKind::mse}},
+        {"halo_excess", "halo", "excess", {0, 4, TruthKind::rmsExcess}},
+        {"bleed_excess", "bleed", "excess", {1, 4, TruthKind::rmsExcess}},
+        {"skin_delta_e00_mean", "skin", "delta_e00_mean", {4, 4, TruthKind::mse}},
+    };
+    return scores;
 }
 
 } // namespace skinlab::metrics
@@ -242,26 +449,34 @@ RankingAgreement rankingAgreement(const std::vector<DebiasedScores>& scores, con
 namespace skinlab::metrics {
 namespace {
 
+// The plain squared error between two images of one quantity over a region (dot product for CIELAB).
 double meanSquaredDifference(const cv::Mat& a, const cv::Mat& b, const cv::Mat& inside) {
+    if (a.empty() || b.empty()) return notANumber;
     double sum = 0.0;
     std::size_t pixels = 0;
+    const int channels = a.channels();
     for (int y = 0; y < inside.rows; ++y) {
         const auto* in = inside.ptr<unsigned char>(y);
         const auto* left = a.ptr<double>(y);
         const auto* right = b.ptr<double>(y);
         for (int x = 0; x < inside.cols; ++x)
             if (in[x]) {
-                sum += (left[x] - right[x]) * (left[x] - right[x]);
+                for (int c = 0; c < channels; ++c) {
+                    const double d = left[x * channels + c] - right[x * channels + c];
+                    sum += d * d;
+                }
                 ++pixels;
             }
     }
     return pixels > 0 ? sum / static_cast<double>(pixels) : notANumber;
 }
 
-cv::Mat loadTestLuminance(const std::filesystem::path& path, const SeededTruth& truth) {
+DebiasedImages loadTestImages(const std::filesystem::path& path, const SeededTruth& truth) {
     const MetricRender render = loadMetricRender(path, RenderRole::test);
-    return renderLuminance(render, truth.exposure);
+    return renderQuantities(render, truth.exposure);
 }
+
+nlohmann::json finiteOrNull(double value) { return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(); }
 
 nlohmann::json estimateJson(const JackknifeEstimate& estimate) {
     return {{"value", estimate.value},
@@ -269,11 +484,86 @@ nlohmann::json estimateJson(const JackknifeEstimate& estimate) {
             {"leave_one_seed_out", estimate.leaveOneOut}};
 }
 
+nlohmann::json intervalJson(const std::array<double, 2>& interval) {
+    return std::isfinite(interval[0]) && std::isfinite(interval[1]) ? nlohmann::json{interval[0], interval[1]}
+                                                                    : nlohmann::json();
+}
+
+// One subset's agreement; `tau_b_interval_95` is the jackknife interval with the t quantile.
+nlohmann::json agreementJson(const RankingAgreement& a) {
+    return {{"conditions", a.conditions},
+            {"members", a.members},
+            {"tau_b", estimateJson(a.tau)},
+            {"jackknife_t_quantile", finiteOrNull(a.tQuantile)},
+            {"tau_b_interval_95", intervalJson(a.jackknifeInterval)},
+            {"tau_b_bootstrap_interval_95", intervalJson(a.bootstrapInterval)},
+            {"separated_pairs", a.separatedPairs},
+            {"concordant_separated_pairs", a.concordantSeparated},
+            {"tau_separated", a.tauSeparated}};
+}
+
+// The whole subset (its keys at the top, as before) with the competitive subsets beside it.
+nlohmann::json subsetsJson(const AgreementSubsets& subsets, const TruthScore& truth) {
+    nlohmann::json json = agreementJson(subsets.all);
+    json["truth"] = {{"region", std::string(debiasedRegionName(truth.region))},
+                     {"quantity", std::string(debiasedQuantityName(truth.quantity))},
+                     {"kind", truth.kind == TruthKind::mse ? "mse" : "rms_excess"}};
+    json["competitive"] = agreementJson(subsets.competitive);
+    json["without_clearly_worse"] = agreementJson(subsets.withoutClearlyWorse);
+    json["without_clearly_worse"]["fence"] = finiteOrNull(subsets.clearlyWorseFence);
+    return json;
+}
+
 std::string number(double value) {
     if (!std::isfinite(value)) return "";
     char text[64];
     std::snprintf(text, sizeof text, "%.9g", value);
     return text;
+}
+
+// Rows of agreement.csv: one per subset.
+std::string agreementRows(const std::string& score, const TruthScore& truth, const AgreementSubsets& subsets) {
+    std::string rows;
+    const std::string head = csvField(score) + "," + std::string(debiasedRegionName(truth.region)) + "," +
+                             std::string(debiasedQuantityName(truth.quantity)) + "," +
+                             (truth.kind == TruthKind::mse ? "mse" : "rms_excess");
+    for (const auto& [name, a] : {std::pair<const char*, const RankingAgreement*>{"all", &subsets.all},
+                                  {"competitive", &subsets.competitive},
+                                  {"without_clearly_worse", &subsets.withoutClearlyWorse}})
+        rows += head + "," + name + "," + std::to_string(a->conditions) + "," + number(a->tau.value) + "," +
+                number(a->tau.standardError) + "," + number(a->tQuantile) + "," + number(a->jackknifeInterval[0]) +
+                "," + number(a->jackknifeInterval[1]) + "," + number(a->bootstrapInterval[0]) + "," +
+                number(a->bootstrapInterval[1]) + "," + std::to_string(a->separatedPairs) + "," +
+                std::to_string(a->concordantSeparated) + "," +
+                (a == &subsets.withoutClearlyWorse ? number(subsets.clearlyWorseFence) : std::string()) + "\n";
+    return rows;
+}
+
+// A table score per test from metrics.json of `analyze metrics --reference`, matched by the test's path.
+std::vector<double> tableScoreValues(const nlohmann::json& metrics, const std::filesystem::path& file,
+                                     const std::vector<DebiasedScores>& tests, const TableScore& score) {
+    std::map<std::filesystem::path, const nlohmann::json*> byPath;
+    for (const auto& comparison : metrics.at("comparisons"))
+        byPath[std::filesystem::weakly_canonical(comparison.at("test").at("path").get<std::string>())] = &comparison;
+    std::vector<double> values;
+    for (const DebiasedScores& test : tests) {
+        const auto found = byPath.find(std::filesystem::weakly_canonical(test.test));
+        if (found == byPath.end())
+            throwInput(file.string(), "",
+                       "has no comparison of " + test.test.string() +
+                           " (score the same test renders with analyze metrics --reference)");
+        const nlohmann::json& comparison = *found->second;
+        const nlohmann::json* entry = nullptr;
+        if (score.region == "skin") {
+            if (comparison.contains("skin") && comparison["skin"].is_object()) entry = &comparison["skin"];
+        } else if (comparison.contains("bands") && comparison["bands"].is_object() &&
+                   comparison["bands"].contains(score.region)) {
+            entry = &comparison["bands"][score.region];
+        }
+        const bool present = entry && entry->contains(score.key) && (*entry)[score.key].is_number();
+        values.push_back(present ? (*entry)[score.key].get<double>() : notANumber);
+    }
+    return values;
 }
 
 } // namespace
@@ -284,34 +574,63 @@ DebiasedRun runDebiasedMetrics(const std::vector<std::filesystem::path>& seeds,
     if (tests.empty()) throwInput("TEST.exr", "", "required: at least one render to score against the seeds");
     if (!(options.exposure > 0.0) || !std::isfinite(options.exposure))
         throwInput("--exposure", "", number(options.exposure) + " must be a positive number");
+    if (!options.compareMetrics.empty() && options.compareReference.empty())
+        throwInput("--compare-metrics", options.compareMetrics.string(), "only with --compare-reference");
+    nlohmann::json tableMetrics;
+    if (!options.compareMetrics.empty()) {
+        try {
+            tableMetrics = nlohmann::json::parse(readFile(options.compareMetrics));
+            if (!tableMetrics.contains("comparisons") || !tableMetrics["comparisons"].is_array())
+                throwInput(options.compareMetrics.string(), "comparisons",
+                           "missing: not a metrics.json of skinlab analyze metrics");
+        } catch (const nlohmann::json::exception& e) {
+            throwInput(options.compareMetrics.string(), "", std::string("not valid JSON: ") + e.what());
+        }
+    }
     DebiasedRun run;
     run.truth = loadSeededTruth(seeds, options.exposure, options.sssRadiusMillimetres);
-    std::vector<cv::Mat> luminances;
+    std::vector<DebiasedImages> images;
     for (const auto& test : tests) {
-        luminances.push_back(loadTestLuminance(test, run.truth));
-        run.tests.push_back(scoreDebiased(run.truth, luminances.back(), test));
+        images.push_back(loadTestImages(test, run.truth));
+        run.tests.push_back(scoreDebiased(run.truth, images.back(), test));
     }
     if (!options.compareReference.empty()) {
-        const cv::Mat compared = loadTestLuminance(options.compareReference, run.truth);
+        const DebiasedImages compared = loadTestImages(options.compareReference, run.truth);
         run.compared = scoreDebiased(run.truth, compared, options.compareReference);
-        for (const cv::Mat& luminance : luminances) {
-            std::array<double, debiasedRegionCount> mse{};
-            for (std::size_t region = 0; region < debiasedRegionCount; ++region)
-                mse[region] = meanSquaredDifference(luminance, compared, run.truth.regions[region]);
+        for (const DebiasedImages& image : images) {
+            std::array<std::array<double, debiasedRegionCount>, debiasedQuantityCount> mse{};
+            for (std::size_t quantity = 0; quantity < debiasedQuantityCount; ++quantity)
+                for (std::size_t region = 0; region < debiasedRegionCount; ++region)
+                    mse[quantity][region] =
+                        meanSquaredDifference(image[quantity], compared[quantity], run.truth.regions[region]);
             run.comparedMse.push_back(mse);
         }
-        for (std::size_t region = 0; region < debiasedRegionCount; ++region) {
-            std::vector<double> other;
-            for (const auto& mse : run.comparedMse) other.push_back(mse[region]);
-            run.agreement[region] = rankingAgreement(run.tests, other, region);
-        }
+        for (std::size_t quantity = 0; quantity < debiasedQuantityCount; ++quantity)
+            for (std::size_t region = 0; region < debiasedRegionCount; ++region) {
+                std::vector<double> other;
+                for (const auto& mse : run.comparedMse) other.push_back(mse[quantity][region]);
+                run.agreement[quantity][region] =
+                    agreementSubsets(run.tests, other, TruthScore{region, quantity, TruthKind::mse}, options.agreement);
+            }
+        if (!options.compareMetrics.empty())
+            for (const TableScore& score : tableScores()) {
+                const std::vector<double> values =
+                    tableScoreValues(tableMetrics, options.compareMetrics, run.tests, score);
+                run.tableAgreement.emplace_back(score,
+                                                agreementSubsets(run.tests, values, score.truth, options.agreement));
+            }
     }
 
     const double skin = run.truth.meanSkinLuminance;
     std::string csv = "test,region,pixels,mse,mse_se,relative_rmse,plain_mse_one_seed,mse_against_compared,"
-                      "difference_from_compared,difference_se\n";
+                      "difference_from_compared,difference_se";
+    for (std::size_t quantity = 1; quantity < debiasedQuantityCount; ++quantity) {
+        const std::string name(debiasedQuantityName(quantity));
+        csv += ",mse_" + name + ",mse_" + name + "_se,mse_" + name + "_against_compared";
+    }
+    csv += "\n";
     nlohmann::json testsJson = nlohmann::json::array();
-    const auto addRows = [&](const DebiasedScores& scores, const std::array<double, debiasedRegionCount>* comparedMse) {
+    const auto addRows = [&](const DebiasedScores& scores, const auto* comparedMse) {
         nlohmann::json regions = nlohmann::json::object();
         for (std::size_t region = 0; region < debiasedRegionCount; ++region) {
             const JackknifeEstimate& mse = scores.mse[region];
@@ -320,15 +639,27 @@ DebiasedRun runDebiasedMetrics(const std::vector<std::filesystem::path>& seeds,
             JackknifeEstimate difference;
             difference.value = difference.standardError = notANumber;
             if (run.compared && comparedMse) difference = debiasedDifference(scores, *run.compared, region);
-            const double against = comparedMse ? (*comparedMse)[region] : notANumber;
+            const double against = comparedMse ? (*comparedMse)[0][region] : notANumber;
             csv += csvField(scores.test.string()) + "," + std::string(debiasedRegionName(region)) + "," +
                    std::to_string(scores.pixels[region]) + "," + number(mse.value) + "," + number(mse.standardError) +
                    "," + number(relative) + "," + number(scores.plainMse[region]) + "," + number(against) + "," +
-                   number(difference.value) + "," + number(difference.standardError) + "\n";
+                   number(difference.value) + "," + number(difference.standardError);
             nlohmann::json entry{{"pixels", scores.pixels[region]},
                                  {"mse", estimateJson(mse)},
                                  {"relative_rmse", relative},
                                  {"plain_mse_one_seed", scores.plainMse[region]}};
+            nlohmann::json colour = nlohmann::json::object();
+            for (std::size_t quantity = 1; quantity < debiasedQuantityCount; ++quantity) {
+                const JackknifeEstimate& q = scores.quantityMse[quantity][region];
+                const double qAgainst = comparedMse ? (*comparedMse)[quantity][region] : notANumber;
+                csv += "," + number(q.value) + "," + number(q.standardError) + "," + number(qAgainst);
+                nlohmann::json item{{"mse", estimateJson(q)},
+                                    {"plain_mse_one_seed", scores.quantityPlainMse[quantity][region]}};
+                if (comparedMse) item["mse_against_compared"] = qAgainst;
+                colour[std::string(debiasedQuantityName(quantity))] = item;
+            }
+            csv += "\n";
+            entry["by_quantity"] = colour;
             if (comparedMse) {
                 entry["mse_against_compared"] = against;
                 entry["difference_from_compared"] = estimateJson(difference);
@@ -337,6 +668,7 @@ DebiasedRun runDebiasedMetrics(const std::vector<std::filesystem::path>& seeds,
         }
         return nlohmann::json{{"test", scores.test.string()}, {"regions", regions}};
     };
+    using ComparedMse = std::array<std::array<double, debiasedRegionCount>, debiasedQuantityCount>;
     for (std::size_t i = 0; i < run.tests.size(); ++i)
         testsJson.push_back(addRows(run.tests[i], run.compared ? &run.comparedMse[i] : nullptr));
     nlohmann::json json{{"format", "skinlab-debiased-metrics"},
@@ -344,28 +676,48 @@ DebiasedRun runDebiasedMetrics(const std::vector<std::filesystem::path>& seeds,
                         {"exposure", options.exposure},
                         {"mean_skin_luminance", skin},
                         {"quantity", "linear luminance Y (Rec. 709) x exposure"},
+                        {"quantities",
+                         "Y, R, G, B: linear x exposure; Lab: CIELAB of the display encoding (squared error = "
+                         "dE*ab^2, debiased to first order)"},
                         {"tests", testsJson}};
     for (const auto& seed : seeds) json["seeds"].push_back(seed.string());
+    std::string agreementCsv;
     if (run.compared) {
-        json["compared_reference"] = addRows(*run.compared, nullptr);
+        json["compared_reference"] = addRows(*run.compared, static_cast<const ComparedMse*>(nullptr));
+        json["agreement_settings"] = {{"level", options.agreement.level},
+                                      {"bootstrap_replicates", options.agreement.bootstrapReplicates},
+                                      {"bootstrap_seed", options.agreement.bootstrapSeed},
+                                      {"competitive_count", options.agreement.competitiveCount},
+                                      {"clearly_worse", "truth score above Q3 + 1.5 IQR of all conditions'"}};
+        agreementCsv = "score,region,quantity,truth,subset,conditions,tau_b,tau_b_se,t_quantile,jackknife_low,"
+                       "jackknife_high,bootstrap_low,bootstrap_high,separated_pairs,concordant_separated_pairs,"
+                       "clearly_worse_fence\n";
         nlohmann::json agreement = nlohmann::json::object();
-        for (std::size_t region = 0; region < debiasedRegionCount; ++region) {
-            const RankingAgreement& a = run.agreement[region];
-            const double low = std::max(-1.0, a.tau.value - 1.96 * a.tau.standardError);
-            const double high = std::min(1.0, a.tau.value + 1.96 * a.tau.standardError);
-            agreement[std::string(debiasedRegionName(region))] = {
-                {"conditions", a.conditions},
-                {"tau_b", estimateJson(a.tau)},
-                {"tau_b_interval_95",
-                 std::isfinite(a.tau.standardError) ? nlohmann::json{low, high} : nlohmann::json()},
-                {"separated_pairs", a.separatedPairs},
-                {"concordant_separated_pairs", a.concordantSeparated},
-                {"tau_separated", a.tauSeparated}};
+        nlohmann::json byQuantity = nlohmann::json::object();
+        for (std::size_t quantity = 0; quantity < debiasedQuantityCount; ++quantity) {
+            nlohmann::json regions = nlohmann::json::object();
+            for (std::size_t region = 0; region < debiasedRegionCount; ++region) {
+                const TruthScore truth{region, quantity, TruthKind::mse};
+                regions[std::string(debiasedRegionName(region))] = subsetsJson(run.agreement[quantity][region], truth);
+                agreementCsv += agreementRows("mse_against_compared", truth, run.agreement[quantity][region]);
+            }
+            if (quantity == 0) agreement = regions;
+            byQuantity[std::string(debiasedQuantityName(quantity))] = regions;
         }
         json["ranking_agreement"] = agreement;
+        json["ranking_agreement_by_quantity"] = byQuantity;
+        if (!run.tableAgreement.empty()) {
+            nlohmann::json table = nlohmann::json::object();
+            for (const auto& [score, subsets] : run.tableAgreement) {
+                table[score.name] = subsetsJson(subsets, score.truth);
+                agreementCsv += agreementRows(score.name, score.truth, subsets);
+            }
+            json["table_score_agreement"] = table;
+        }
     }
     ensureDirectory(outputFolder);
     writeFileAtomic(outputFolder / "debiased.csv", csv);
+    if (!agreementCsv.empty()) writeFileAtomic(outputFolder / "agreement.csv", agreementCsv);
     writeFileAtomic(outputFolder / "debiased.json", json.dump(2) + "\n");
     return run;
 }

@@ -208,6 +208,52 @@ TEST_F(AnalyzeMetricsCommand, ScoresAgainstSeededTruthsAndComparesRankings) {
         << compareOnly.output;
 }
 
+// --compare-metrics: the scores of `analyze metrics --reference` on the same files, each ranked against the seeded
+// truth (table_score_agreement), and agreement.csv with every subset; a metrics.json without a test fails.
+TEST_F(AnalyzeMetricsCommand, RanksTheTableScoresAgainstTheSeededTruth) {
+    std::string seeds;
+    for (int seed = 0; seed < 3; ++seed) {
+        testing::SyntheticRender noisy = reference;
+        noisy.beauty = reference.beauty.clone();
+        cv::Mat noise(noisy.beauty.size(), CV_32FC3);
+        cv::theRNG().state = 91 + seed;
+        cv::randn(noise, 0.0, 0.01);
+        noisy.beauty += noise;
+        const std::string name = "exr/seed" + std::to_string(seed) + ".exr";
+        testing::writeSyntheticExr(path(name), noisy);
+        seeds += (seed ? "," : "") + path(name);
+    }
+    testing::writeSyntheticExr(path("exr/reference.exr"), reference);
+    testing::writeSyntheticExr(path("exr/halo.exr"), blurred);
+    const std::string tests = path("exr/halo.exr") + " " + path("exr/reference.exr");
+    ASSERT_EQ(
+        runSkinlab("analyze metrics --reference " + path("exr/reference.exr") + " " + tests + " -o " + path("table"))
+            .exitCode,
+        0);
+    CommandResult run =
+        runSkinlab("analyze metrics --reference-seeds " + seeds + " --compare-reference " + path("exr/reference.exr") +
+                   " --compare-metrics " + path("table/metrics.json") + " " + tests + " -o " + path("seeded"));
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    const auto json = nlohmann::json::parse(readFile(path("seeded/debiased.json")));
+    const auto& halo = json["table_score_agreement"]["halo_leak_energy"];
+    EXPECT_EQ(halo["truth"]["quantity"], "Y");
+    EXPECT_EQ(halo["conditions"], 2u);
+    EXPECT_EQ(halo["tau_b"]["value"], 1.0);                               // the halo render is worse under both
+    EXPECT_NEAR(halo["jackknife_t_quantile"].get<double>(), 4.303, 1e-3); // three seeds: t(0.975, 2)
+    EXPECT_EQ(json["table_score_agreement"]["halo_excess"]["truth"]["quantity"], "Lab");
+    EXPECT_TRUE(json["ranking_agreement_by_quantity"]["R"]["halo"].contains("competitive"));
+    EXPECT_TRUE(json["tests"][0]["regions"]["halo"]["by_quantity"].contains("Lab"));
+    const std::string csv = readFile(path("seeded/agreement.csv"));
+    EXPECT_NE(csv.find("halo_leak_energy,halo,Y,mse,competitive,2,1,"), std::string::npos) << csv;
+
+    CommandResult missing = runSkinlab("analyze metrics --reference-seeds " + seeds + " --compare-reference " +
+                                       path("exr/reference.exr") + " --compare-metrics " + path("table/metrics.json") +
+                                       " " + path("exr/seed0.exr") + " -o " + path("missing"));
+    EXPECT_EQ(missing.exitCode, 2) << missing.output;
+    EXPECT_NE(missing.output.find("metrics.json: has no comparison of"), std::string::npos) << missing.output;
+    EXPECT_FALSE(fs::exists(path("missing/debiased.json")));
+}
+
 TEST_F(AnalyzeMetricsCommand, BadInputsFailWithOneLineNamingFileAndChannel) {
     testing::writeSyntheticExr(path("exr/reference.exr"), reference);
     testing::writeSyntheticExr(path("exr/no-depth.exr"), reference, {{"depth.Z"}, {}});

@@ -116,6 +116,34 @@ TEST_F(DebiasedError, PairedDifferencesAndRankingsFollowTheNoiseFreeImage) {
     EXPECT_DOUBLE_EQ(rankingAgreement(scores, reversed, skin).tau.value, -1.0);
 }
 
+// Colour beside luminance: an error in red alone is a fifth of itself in Y (Rec. 709: 0.2126), the whole of itself
+// in R, nothing in G and B, and a CIELAB difference; every channel debiased as Y is.
+TEST_F(DebiasedError, ScoresEachChannelAndCielabBesideLuminance) {
+    std::vector<fs::path> seeds;
+    for (int seed = 0; seed < 4; ++seed) seeds.push_back(writeSeed(seed, 0.03));
+    const SeededTruth seeded = loadSeededTruth(seeds, 1.0, 0.0);
+    const double offset = 0.05;
+    MetricRender render;
+    render.beauty = truth.beauty.clone();
+    for (int y = 0; y < truth.height; ++y)
+        for (int x = 0; x < truth.width; ++x)
+            if (truth.mask.at<float>(y, x) >= 0.5f) render.beauty.at<cv::Vec3f>(y, x)[0] += float(offset);
+    const DebiasedScores scores = scoreDebiased(seeded, renderQuantities(render, 1.0), "red.exr");
+    const auto& y = scores.quantityMse[0][skin];
+    const auto& red = scores.quantityMse[1][skin];
+    const auto& green = scores.quantityMse[2][skin];
+    const auto& lab = scores.quantityMse[4][skin];
+    EXPECT_DOUBLE_EQ(y.value, scores.mse[skin].value);
+    EXPECT_NEAR(y.value, 0.2126 * 0.2126 * offset * offset, 3.0 * y.standardError + 1e-7);
+    EXPECT_NEAR(red.value, offset * offset, 3.0 * red.standardError + 1e-6);
+    EXPECT_NEAR(green.value, 0.0, 3.0 * green.standardError + 1e-7);
+    EXPECT_GT(red.value, 10.0 * y.value);
+    EXPECT_GT(lab.value, 5.0 * lab.standardError);
+    // One noisy seed alone adds the noise variance, 0.03², to the red channel's error.
+    EXPECT_GT(scores.quantityPlainMse[1][skin], offset * offset + 0.5 * 0.03 * 0.03);
+    EXPECT_EQ(scores.pairTerms[1][skin].size(), 6u);
+}
+
 TEST(KendallTau, TiesAndKnownValues) {
     EXPECT_DOUBLE_EQ(kendallTauB({1, 2, 3, 4}, {1, 2, 3, 4}), 1.0);
     EXPECT_DOUBLE_EQ(kendallTauB({1, 2, 3, 4}, {4, 3, 2, 1}), -1.0);
