@@ -4,7 +4,7 @@
 #include "child_process.h"
 #include "common/files.h"
 #include "common/hash.h"
-#include "experiments/http_client.h"
+#include "net/http_client.h"
 #include "experiments/simulated_observers.h"
 #include "experiments/sqlite_database.h"
 #include "experiments/study_store.h"
@@ -23,6 +23,8 @@
 
 using namespace skinlab::experiments;
 using namespace skinlab::experiments::test_support;
+using namespace skinlab::net;
+using namespace skinlab::net;
 namespace fs = std::filesystem;
 
 namespace {
@@ -634,6 +636,8 @@ TEST(StudyCli, WeakResearcherTokensAreRefused) {
     EXPECT_TRUE(ok && first.rfind("serving ", 0) == 0) << first;
     server.kill(SIGTERM);
     server.wait();
+}
+
 // Exports hold personal data and, unless asked for, never the platform's session id (Prolific SESSION_ID, MTurk
 // assignmentId): with it anyone who reads the file resumes an unfinished participation. Every format, written with
 // -o under the usual umask, is readable by its owner only; --include-session-ids adds the ids.
