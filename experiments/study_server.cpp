@@ -30,8 +30,11 @@ std::optional<std::string_view> embeddedFile(std::string_view name);
 } // namespace web
 
 namespace fs = std::filesystem;
+using net::HttpLimits;
 using net::HttpRequest;
 using net::HttpResponse;
+using net::HttpServer;
+using net::JoinLimiter;
 using net::jsonResponse;
 using net::RequestError;
 using nlohmann::json;
