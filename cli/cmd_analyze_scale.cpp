@@ -7,7 +7,6 @@
 #include "cli/commands.h"
 #include "common/error.h"
 #include "common/files.h"
-#include "experiments/active_sampling.h"
 
 #include <spdlog/spdlog.h>
 
@@ -209,15 +208,6 @@ void runValidate(ValidateArguments& arguments) {
     for (int observers : arguments.options.observerCounts)
         if (observers < 2 + arguments.options.randomObservers + arguments.options.invertedObservers)
             throwInput("--observers", "", std::to_string(observers) + " is too few (at least 2 genuine observers)");
-    // The "active" scenario plans with the study server's planner (experiments/active_sampling.h): the posterior of
-    // every earlier answer, one batch = the spanning tree over 1/(expected variance reduction).
-    arguments.options.activePlanner = [](int conditions, const std::vector<scaling::PlannerAnswer>& answers,
-                                         std::uint64_t seed) {
-        std::vector<experiments::active::Comparison> comparisons;
-        comparisons.reserve(answers.size());
-        for (const scaling::PlannerAnswer& a : answers) comparisons.push_back({a.winner, a.loser});
-        return experiments::active::spanningTreeBatch(experiments::active::fitPosterior(conditions, comparisons), seed);
-    };
     const scaling::ValidationReport report = scaling::runValidation(arguments.options);
     const std::string markdown = scaling::validationMarkdown(report);
     std::printf("%s", markdown.c_str());

@@ -7,7 +7,7 @@
 // generation of each block's answers) is read under the lock, the batch is planned without it, and the lock is
 // taken again to re-check that nothing was stored for the participant meanwhile before the batch is stored (one
 // transaction).
-#include "experiments/active_sampling.h"
+#include "analysis/scaling/active_sampling.h"
 #include "experiments/study_records.h"
 
 #include <cstddef>
@@ -19,6 +19,9 @@
 #include <vector>
 
 namespace skinlab::experiments {
+
+// Active sampling (the posterior, the batches) is the analysis library's.
+namespace active = analysis::scaling::active;
 
 struct StudyConnection;
 

@@ -15,7 +15,7 @@
 // and participants starting together begin in different blocks. Sides: test trial k of participant n shows A on
 // the left iff k + n is even (exact balance within a participant); which condition is A is a seeded coin.
 // Within a batch, pairs come in decreasing order of gain; a batch never starts with the pair just shown.
-#include "experiments/active_sampling.h"
+#include "analysis/scaling/active_sampling.h"
 #include "experiments/study_definition.h"
 #include "experiments/trial_plan.h"
 
@@ -24,6 +24,9 @@
 #include <vector>
 
 namespace skinlab::experiments {
+
+// Active sampling (the posterior, the batches) is the analysis library's.
+namespace active = analysis::scaling::active;
 
 // The trials to store next for a participant of an active design. `stored` = the participant's stored trials in
 // position order (their positions are 0 … stored.size() − 1); `posteriorOf(b)` = the current posterior of

@@ -5,13 +5,13 @@
 
 #include "common/error.h"
 #include "common/files.h"
-#include "experiments/seeded_random.h"
+#include "common/seeded_random.h"
 
 #include <algorithm>
 #include <cctype>
 #include <chrono>
 #include <cmath>
-#include "experiments/http_client.h"
+#include "net/http_client.h"
 #include "common/hash.h"
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -21,6 +21,10 @@
 namespace skinlab::experiments {
 
 using nlohmann::json;
+
+using net::HttpAnswer;
+using net::HttpClient;
+using net::HttpHeaders;
 
 namespace {
 

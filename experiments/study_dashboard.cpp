@@ -6,6 +6,7 @@
 #include "analysis/scaling/screening.h"
 #include "common/error.h"
 #include "experiments/sqlite_database.h"
+#include "experiments/study_rows.h"
 #include "experiments/study_store.h"
 
 #include <algorithm>
@@ -144,8 +145,9 @@ json StudyDashboard::counts() {
             " (SELECT COUNT(*) FROM responses r WHERE r.participant_id = p.id),"
             " (SELECT COUNT(*) FROM responses r JOIN trials t ON t.id = r.trial_id WHERE r.participant_id = p.id AND "
             "t.kind = 'catch'),"
-            " (SELECT COUNT(*) FROM responses r JOIN trials t ON t.id = r.trial_id WHERE r.participant_id = p.id AND "
-            "t.kind = 'catch' AND r.chosen = t.expected),"
+            " (SELECT COUNT(*) FROM responses r JOIN trials t ON t.id = r.trial_id WHERE r.participant_id = p.id AND " +
+            std::string(kCorrectSql) +
+            " = 1),"
             " (SELECT COALESCE(MAX(server_time), '') FROM responses r WHERE r.participant_id = p.id),"
             " (SELECT COUNT(*) FROM participant_visits v WHERE v.participant_id = p.id AND v.outcome = 'resumed'),"
             " (SELECT COUNT(*) FROM participant_visits v WHERE v.participant_id = p.id AND v.outcome = 'refused')"

@@ -62,7 +62,7 @@ struct StudyDesign {
     bool allPairs = true;
     std::vector<std::pair<std::string, std::string>> pairs; // when !allPairs: condition pairs to compare
     // pairs = "active": each participant's test trials are planned batch by batch from the answers so far
-    // (experiments/active_sampling.h); `trialsPerParticipant` of them, no repetitions. allPairs stays true
+    // (analysis/scaling/active_sampling.h); `trialsPerParticipant` of them, no repetitions. allPairs stays true
     // (every pair of a block is a candidate).
     bool activePairs = false;
     int trialsPerParticipant = 0;
@@ -70,7 +70,7 @@ struct StudyDesign {
     // of a block, m − 1 trials. Small batches adapt sooner but need the answers of the batch before (one
     // participant at a time, as in a lab); with many participants at once they compare the same pairs.
     int activeBatch = 0;
-    // active_prior_sd: the sd (JOD) of the planner's prior on every score (experiments/active_sampling.h,
+    // active_prior_sd: the sd (JOD) of the planner's prior on every score (analysis/scaling/active_sampling.h,
     // PosteriorOptions). 1 suits scores within a few JOD of each other; scores spread wider are planned better
     // with a wider prior (docs/benchmarks.md, "Active sampling").
     double activePriorSd = 1.0;

@@ -1,5 +1,6 @@
 #include "experiments/study_export.h"
 
+#include "common/csv.h"
 #include "common/error.h"
 #include "experiments/sqlite_database.h"
 #include "experiments/study_rows.h"
@@ -9,19 +10,6 @@
 #include <string_view>
 
 namespace skinlab::experiments {
-
-std::string csvField(const std::string& value) {
-    // Quoted also when it starts or ends with a blank, which readers trim from unquoted fields.
-    const bool blankEdge = !value.empty() && (value.front() == ' ' || value.front() == '\t' || value.back() == ' ' ||
-                                              value.back() == '\t');
-    if (!blankEdge && value.find_first_of(",\"\r\n") == std::string::npos) return value;
-    std::string out = "\"";
-    for (char c : value) {
-        if (c == '"') out += '"';
-        out += c;
-    }
-    return out + "\"";
-}
 
 std::string csvTextField(const std::string& value) {
     // A spreadsheet reads a cell starting with = + - @ (or a tab or carriage return before one) as a formula
@@ -60,7 +48,7 @@ std::string onlineFields(const ResponseRow& r, bool includeSessionIds) {
     std::string out;
     auto add = [&](const std::string& field) { out += ',' + field; };
     if (r.conditions) {
-        add(flag(r.conditions->flagged()));
+        add(flag(r.flagged.value_or(false)));
         add(flag(r.conditions->pageHidden));
         add(flag(r.conditions->focusLost));
         add(flag(r.conditions->fullscreen));
@@ -181,7 +169,7 @@ nlohmann::json responseJson(const ResponseRow& r, bool includeSessionIds) {
                           {"viewport_height", r.viewportHeight},
                           {"device_pixel_ratio", r.devicePixelRatio},
                           {"user_agent", r.userAgent}};
-    row["flagged"] = r.conditions ? nlohmann::json(r.flagged() ? 1 : 0) : nlohmann::json();
+    row["flagged"] = r.flagged ? nlohmann::json(*r.flagged ? 1 : 0) : nlohmann::json();
     row["page_hidden"] = r.conditions ? nlohmann::json(r.conditions->pageHidden) : nlohmann::json();
     row["focus_lost"] = r.conditions ? nlohmann::json(r.conditions->focusLost) : nlohmann::json();
     row["fullscreen"] = r.conditions ? nlohmann::json(r.conditions->fullscreen) : nlohmann::json();

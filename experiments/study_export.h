@@ -73,9 +73,7 @@ nlohmann::json statusJson(StudyStore& store);
 // Human-readable table: one line per participant (progress, catch accuracy), then totals.
 std::string statusText(StudyStore& store);
 
-// CSV field quoting (RFC 4180): quoted when it holds a comma, quote or line break.
-std::string csvField(const std::string& value);
-// csvField() of text that came from a client or a platform: a leading = + - @ (a spreadsheet formula) is kept as text
+// csvField() (common/csv.h) of text that came from a client or a platform: a leading = + - @ (a spreadsheet formula) is kept as text
 // by an apostrophe before it.
 std::string csvTextField(const std::string& value);
 

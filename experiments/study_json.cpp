@@ -1,6 +1,6 @@
 #include "experiments/study_json.h"
 
-#include "experiments/request_error.h"
+#include "net/request_error.h"
 #include "experiments/study_text.h"
 #include "experiments/viewing_conditions.h"
 
@@ -10,6 +10,9 @@
 namespace skinlab::experiments {
 
 using nlohmann::json;
+
+using net::HttpRequest;
+using net::RequestError;
 
 json parseJsonBody(const HttpRequest& req) {
     const std::string type = req.header("Content-Type");

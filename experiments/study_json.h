@@ -2,7 +2,7 @@
 // The JSON of the study server's participant API (docs/experiments.md, "HTTP API"): reading request bodies, each
 // malformed field a RequestError 400 naming it, and the projections of the study's records into answers (the study,
 // a trial as the participant sees it, the participant's state).
-#include "experiments/http_server.h"
+#include "net/http_server.h"
 #include "experiments/study_definition.h"
 #include "experiments/study_records.h"
 
@@ -22,7 +22,7 @@ namespace skinlab::experiments {
 inline constexpr std::size_t kMaxTokenLength = 64;
 
 // The body as a JSON object: 415 unless Content-Type is application/json, 400 for anything but one JSON object.
-nlohmann::json parseJsonBody(const HttpRequest& request);
+nlohmann::json parseJsonBody(const net::HttpRequest& request);
 // Field readers: 400 naming the field when it is missing (and required), of another type or out of range.
 std::string stringField(const nlohmann::json& body, const char* name, std::size_t maxLength, bool required = true);
 std::int64_t integerField(const nlohmann::json& body, const char* name, std::int64_t min, std::int64_t max);

@@ -70,7 +70,7 @@ std::vector<ResponseRow> StudyReadModels::responses() {
 
 std::vector<ResponseRow> StudyReadModels::flaggedTrials() {
     std::vector<ResponseRow> rows = responses();
-    std::erase_if(rows, [](const ResponseRow& r) { return !r.flagged(); });
+    std::erase_if(rows, [](const ResponseRow& r) { return !r.flagged.value_or(false); });
     return rows;
 }
 

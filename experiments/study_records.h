@@ -47,7 +47,6 @@ struct TrialConditions {
     bool pageHidden = false; // document hidden at any moment (another tab, minimised window)
     bool focusLost = false;  // the window lost the focus at any moment
     bool fullscreen = false; // full screen when answered
-    bool flagged() const { return pageHidden || focusLost; }
 };
 
 struct TrialRecord {
@@ -103,7 +102,7 @@ struct ResponseRow {
     std::string stimulusB;
     bool aOnLeft = true;
     bool aSelected = true;
-    std::optional<bool> correct; // catch trials only
+    std::optional<bool> correct; // catch trials only (kCorrectSql, experiments/study_rows.h)
     double responseMs = 0;
     std::string clientTime;
     std::string serverTime;
@@ -116,7 +115,7 @@ struct ResponseRow {
     double sessionDevicePixelRatio = 1;        // at the session's start (a change = browser zoom)
     std::optional<ViewingConditions> viewing;  // the session's; absent = not reported
     std::optional<ExternalIds> external;       // the participant's platform ids
-    bool flagged() const { return conditions && conditions->flagged(); }
+    std::optional<bool> flagged;               // hidden or unfocused while shown (kFlaggedSql); absent = not recorded
 };
 
 // The viewing conditions of one session, with whose it is.

@@ -86,7 +86,7 @@ std::string responseRowsQuery() {
                " c.page_hidden, c.focus_lost, c.fullscreen, ses.device_pixel_ratio, ses.viewport_width,"
                " ses.viewport_height, rec.platform, rec.external_id, rec.external_study_id, "
                "rec.external_session_id, ") +
-           kViewingColumns +
+           kViewingColumns + ", " + kCorrectSql + ", " + kFlaggedSql +
            " FROM responses r JOIN trials t ON t.id = r.trial_id JOIN participants p ON p.id = t.participant_id"
            " JOIN stimuli sa ON sa.id = t.stimulus_a LEFT JOIN stimuli sb ON sb.id = t.stimulus_b"
            " JOIN sessions ses ON ses.id = r.session_id LEFT JOIN trial_conditions c ON c.trial_id = r.trial_id"
@@ -111,7 +111,6 @@ ResponseRow readResponseRow(const SqliteStatement& s) {
     r.stimulusB = s.text(9);
     r.aOnLeft = s.integer(10) != 0;
     r.aSelected = s.text(11) == "A";
-    if (r.kind == TrialKind::catchTrial) r.correct = s.text(11) == s.text(12);
     r.responseMs = s.real(13);
     r.clientTime = s.text(14);
     r.serverTime = s.text(15);
@@ -125,6 +124,8 @@ ResponseRow readResponseRow(const SqliteStatement& s) {
     r.viewing =
         readViewing(s, 31, r.sessionDevicePixelRatio, static_cast<int>(s.integer(25)), static_cast<int>(s.integer(26)));
     if (!s.isNull(27)) r.external = ExternalIds{s.text(27), s.text(28), s.text(29), s.text(30)};
+    if (!s.isNull(43)) r.correct = s.integer(43) != 0;
+    if (!s.isNull(44)) r.flagged = s.integer(44) != 0;
     return r;
 }
 
@@ -159,7 +160,8 @@ std::string participantStatusQuery() {
            ", (SELECT COUNT(*) FROM responses r JOIN trials t ON t.id = r.trial_id WHERE r.participant_id = "
            "p.id AND t.kind = 'catch')"
            ", (SELECT COUNT(*) FROM responses r JOIN trials t ON t.id = r.trial_id WHERE r.participant_id = "
-           "p.id AND t.kind = 'catch' AND r.chosen = t.expected)"
+           "p.id AND " +
+           kCorrectSql + " = 1)" +
            ", (SELECT COALESCE(MAX(server_time), '') FROM responses r WHERE r.participant_id = p.id)"
            ", rec.platform, rec.external_id, rec.external_study_id, rec.external_session_id"
            " FROM participants p LEFT JOIN recruitment rec ON rec.participant_id = p.id ORDER BY p.id";

@@ -11,6 +11,15 @@
 
 namespace skinlab::experiments {
 
+// The two judgements of an answer, defined once, in SQL over `responses r`, `trials t` and (LEFT JOIN)
+// `trial_conditions c`: the view responses_long, the store's response rows and its catch counts all read them.
+// correct: 1 when a catch trial's answer is the expected one, 0 when it is not; NULL for other trials.
+inline constexpr const char* kCorrectSql =
+    "CASE WHEN t.kind = 'catch' THEN (CASE WHEN r.chosen = t.expected THEN 1 ELSE 0 END) ELSE NULL END";
+// flagged: 1 when the page was hidden or lost the focus while the trial was shown, 0 when not; NULL = not recorded.
+inline constexpr const char* kFlaggedSql =
+    "CASE WHEN c.trial_id IS NULL THEN NULL WHEN c.page_hidden OR c.focus_lost THEN 1 ELSE 0 END";
+
 // Table trials: these columns, in this order, are what readTrial() reads.
 inline constexpr const char* kTrialColumns =
     "id, participant_id, position, kind, block, condition_a, condition_b, stimulus_a, stimulus_b, a_on_left,"

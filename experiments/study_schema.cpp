@@ -5,6 +5,7 @@
 #include "common/time.h"
 #include "common/version.h"
 #include "experiments/sqlite_database.h"
+#include "experiments/study_rows.h"
 
 #include <cerrno>
 #include <cstring>
@@ -114,15 +115,15 @@ CREATE TABLE IF NOT EXISTS trial_conditions (
 
 // Contract 3 (read by analysis/scaling), and `flagged` (1 = page hidden or focus lost while shown; NULL = not
 // recorded) after it.
-constexpr const char* kResponsesView = R"SQL(
+const std::string kResponsesView = std::string(R"SQL(
 DROP VIEW IF EXISTS responses_long;
 CREATE VIEW responses_long AS
   SELECT p.label AS observer, t.block AS scene, t.condition_a AS condition_A, t.condition_b AS condition_B,
          CASE r.chosen WHEN 'A' THEN 1 ELSE 0 END AS is_A_selected, t.a_on_left AS A_on_left,
          t.kind AS trial_kind,
-         CASE WHEN t.kind = 'catch' THEN (CASE WHEN r.chosen = t.expected THEN 1 ELSE 0 END) ELSE NULL END AS correct,
+         )SQL") + kCorrectSql + R"SQL( AS correct,
          r.response_ms AS response_ms,
-         CASE WHEN c.trial_id IS NULL THEN NULL WHEN c.page_hidden OR c.focus_lost THEN 1 ELSE 0 END AS flagged
+         )SQL" + kFlaggedSql + R"SQL( AS flagged
   FROM responses r JOIN trials t ON t.id = r.trial_id JOIN participants p ON p.id = t.participant_id
   LEFT JOIN trial_conditions c ON c.trial_id = r.trial_id
   ORDER BY p.id, t.position;

@@ -4,12 +4,14 @@
 #include "common/files.h"
 #include "common/hash.h"
 #include "experiments/recruitment.h"
-#include "experiments/request_error.h"
 #include "experiments/study_dashboard.h"
 #include "experiments/study_errors.h"
 #include "experiments/study_export.h"
 #include "experiments/study_json.h"
 #include "experiments/viewing_conditions.h"
+#include "net/request_checks.h"
+#include "net/request_error.h"
+#include "net/route_table.h"
 
 #include <boost/asio/ip/address.hpp>
 #include <algorithm>
@@ -28,6 +30,13 @@ std::optional<std::string_view> embeddedFile(std::string_view name);
 } // namespace web
 
 namespace fs = std::filesystem;
+using net::HttpLimits;
+using net::HttpRequest;
+using net::HttpResponse;
+using net::HttpServer;
+using net::JoinLimiter;
+using net::jsonResponse;
+using net::RequestError;
 using nlohmann::json;
 
 namespace {
@@ -39,18 +48,6 @@ HttpResponse errorResponse(int status, const std::string& message) {
 }
 
 std::string userAgentOf(const HttpRequest& req) { return validUtf8(req.header("User-Agent"), kMaxTextLength); }
-
-bool constantTimeEqual(const std::string& a, const std::string& b) {
-    if (a.size() != b.size()) return false;
-    unsigned char diff = 0;
-    for (std::size_t i = 0; i < a.size(); ++i) diff |= static_cast<unsigned char>(a[i] ^ b[i]);
-    return diff == 0;
-}
-
-std::string lowerCase(std::string s) {
-    for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return s;
-}
 
 // "/stimuli/<digits>.png" (1 to 6 digits) → the number.
 std::optional<std::size_t> stimulusNumber(const std::string& path) {
@@ -113,21 +110,6 @@ HttpResponse webFile(const std::string& name, const char* type) {
 constexpr const char* kHtml = "text/html; charset=utf-8";
 constexpr const char* kJavaScript = "text/javascript; charset=utf-8";
 constexpr const char* kCss = "text/css; charset=utf-8";
-
-// One endpoint: its method and path (a trailing '*' makes the path a prefix), whether it needs the researcher
-// token, and the handler that answers it.
-struct Route {
-    std::string_view method;
-    std::string_view path;
-    bool researcher;
-    HttpResponse (*handle)(StudyServer& server, const HttpRequest& request);
-
-    bool matches(const HttpRequest& req) const {
-        if (req.method != method) return false;
-        if (path.ends_with('*')) return std::string_view(req.path).starts_with(path.substr(0, path.size() - 1));
-        return req.path == path;
-    }
-};
 
 // The participant's state (experiments/study_json.h) from what the store holds now. The trials are read before
 // nextTrial(), which may store an active design's next batch.
@@ -232,29 +214,7 @@ void StudyServer::stop() {
 bool StudyServer::running() const { return http_ && http_->running(); }
 
 bool StudyServer::hostAllowed(const std::string& hostHeader) const {
-    // Host = name-or-address [":" port]. A browser sends the name it resolved; a DNS-rebinding page sends its own
-    // name, so only the bound address, a loopback name for a loopback server, or --public-host NAME are accepted.
-    std::string name = lowerCase(hostHeader), portText;
-    if (!name.empty() && name.front() == '[') {
-        const std::size_t close = name.find(']');
-        if (close == std::string::npos) return false;
-        portText = close + 1 < name.size() && name[close + 1] == ':' ? name.substr(close + 2) : "";
-        if (close + 1 < name.size() && name[close + 1] != ':') return false;
-        name = name.substr(1, close - 1);
-    } else if (const std::size_t colon = name.rfind(':'); colon != std::string::npos) {
-        portText = name.substr(colon + 1);
-        name = name.substr(0, colon);
-    }
-    if (name.empty()) return false;
-    if (!options_.publicHost.empty() && name == lowerCase(options_.publicHost)) return true; // any port (a proxy)
-    if (portText != std::to_string(port_)) return false;
-    boost::system::error_code ec;
-    const auto bound = boost::asio::ip::make_address(options_.host, ec);
-    if (ec) return false;
-    if (name == "localhost") return bound.is_loopback() || bound.is_unspecified();
-    const auto address = boost::asio::ip::make_address(name, ec);
-    if (ec) return false; // any other name
-    return bound.is_unspecified() || address == bound;
+    return net::HostRule{options_.host, port_, options_.publicHost}.allows(hostHeader);
 }
 
 bool StudyServer::trustedProxy(const std::string& peer) const {
@@ -339,7 +299,7 @@ HttpResponse StudyServer::route(const HttpRequest& req) {
     // Every endpoint (docs/experiments.md, "HTTP API"); the first that matches answers, none: 404.
     using S = StudyServer;
     using R = const HttpRequest&;
-    static const Route routes[] = {
+    static const net::RouteTable<StudyServer> routes{
         {"GET", "/", false, [](S&, R) { return webFile("index.html", kHtml); }},
         {"GET", "/index.html", false, [](S&, R) { return webFile("index.html", kHtml); }},
         {"GET", "/app.js", false, [](S&, R) { return webFile("app.js", kJavaScript); }},
@@ -362,18 +322,13 @@ HttpResponse StudyServer::route(const HttpRequest& req) {
         // Any other researcher path: the token is checked first, so no path answers differently without it.
         {"GET", "/api/researcher/*", true, [](S&, R) -> HttpResponse { throw RequestError(404, "not found"); }},
     };
-    for (const Route& r : routes)
-        if (r.matches(req)) {
-            if (r.researcher) authorizeResearcher(req);
-            return r.handle(*this, req);
-        }
-    throw RequestError(404, "not found");
+    return routes.answer(*this, req, [this](R r) { authorizeResearcher(r); });
 }
 
 void StudyServer::authorizeResearcher(const HttpRequest& req) {
     // The token travels in a header only: a URL ends up in logs, proxies and the browser's history.
-    const std::string authorization = req.header("Authorization");
-    if (authorization.rfind("Bearer ", 0) != 0) {
+    const std::optional<std::string> token = net::bearerToken(req);
+    if (!token) {
         if (req.queryParameter("token"))
             throw RequestError(401, "researcher token: send it as Authorization: Bearer TOKEN, never in the URL");
         throw RequestError(401, "researcher token required (Authorization: Bearer TOKEN)");
@@ -386,7 +341,7 @@ void StudyServer::authorizeResearcher(const HttpRequest& req) {
         throw RequestError(429, "too many wrong researcher tokens from this network; retry later",
                            static_cast<int>(std::ceil(retryAfter)));
     }
-    if (!constantTimeEqual(authorization.substr(7), options_.researcherToken)) {
+    if (!net::constantTimeEqual(*token, options_.researcherToken)) {
         wrongTokens_->allow(req.clientAddress, retryAfter);
         spdlog::warn("researcher token: wrong token from {} ({} {})", validUtf8(req.clientAddress, 64), req.method,
                      validUtf8(req.path, 128));

@@ -9,8 +9,8 @@
 // experiments/study_json.h.
 // Only the stimuli listed in the study are served, by number (/stimuli/<n>.png), from the bytes verified against
 // their sha256 when the server started (held in memory); no request path is ever mapped onto the file system.
-#include "experiments/http_server.h"
-#include "experiments/join_limiter.h"
+#include "net/http_server.h"
+#include "net/join_limiter.h"
 #include "experiments/study_store.h"
 
 #include <chrono>
@@ -84,31 +84,31 @@ private:
         std::shared_ptr<const std::string> bytes; // verified at start; served from memory
         std::string etag;                         // "\"<sha256>\""
     };
-    HttpResponse handle(const HttpRequest& request); // answer() with the headers every response carries
-    HttpResponse answer(const HttpRequest& request);
+    net::HttpResponse handle(const net::HttpRequest& request); // answer() with the headers every response carries
+    net::HttpResponse answer(const net::HttpRequest& request);
     // The table of endpoints (method and path → handler); each handler below answers one of them.
-    HttpResponse route(const HttpRequest& request);
+    net::HttpResponse route(const net::HttpRequest& request);
     // 401 without the researcher token in Authorization: Bearer (or with it in the URL), 403 with a wrong one (logged
     // with the client's address, never the token), 429 once the client's network sent too many wrong ones.
-    void authorizeResearcher(const HttpRequest& request);
-    HttpResponse getStimulus(const HttpRequest& request) const;
-    HttpResponse postJoin(const HttpRequest& request);
-    HttpResponse postSession(const HttpRequest& request);
-    HttpResponse getState(const HttpRequest& request);
-    HttpResponse postResponse(const HttpRequest& request);
-    HttpResponse getExport(const HttpRequest& request);
+    void authorizeResearcher(const net::HttpRequest& request);
+    net::HttpResponse getStimulus(const net::HttpRequest& request) const;
+    net::HttpResponse postJoin(const net::HttpRequest& request);
+    net::HttpResponse postSession(const net::HttpRequest& request);
+    net::HttpResponse getState(const net::HttpRequest& request);
+    net::HttpResponse postResponse(const net::HttpRequest& request);
+    net::HttpResponse getExport(const net::HttpRequest& request);
     bool hostAllowed(const std::string& host) const;
     // The client's address: the peer's, or the one a trusted proxy forwards (X-Forwarded-For, rightmost entry).
-    std::string clientAddress(const HttpRequest& request) const;
+    std::string clientAddress(const net::HttpRequest& request) const;
     bool trustedProxy(const std::string& peer) const;
 
     StudyStore& store_;
     ServerOptions options_;
     std::vector<Stimulus> stimuli_;
-    std::unique_ptr<HttpServer> http_;
+    std::unique_ptr<net::HttpServer> http_;
     int port_ = 0;
-    std::unique_ptr<JoinLimiter> joinLimiter_;
-    std::unique_ptr<JoinLimiter> wrongTokens_; // wrong researcher tokens per client network
+    std::unique_ptr<net::JoinLimiter> joinLimiter_;
+    std::unique_ptr<net::JoinLimiter> wrongTokens_; // wrong researcher tokens per client network
     // Requests in progress per forwarded client address (behind a proxy every connection is the proxy's).
     std::mutex inFlightMutex_;
     std::map<std::string, int> inFlight_;

@@ -13,7 +13,7 @@
 // design's counts and plan extension (active_design_state.h) and the read models (study_read_models.h); they share
 // one connection and its mutex (study_connection.h). A refused request throws a StudyRefusal
 // (experiments/study_errors.h: NotFound, Conflict, LimitReached, InvalidValue), never an HTTP status.
-#include "experiments/active_sampling.h"
+#include "analysis/scaling/active_sampling.h"
 #include "experiments/recruitment.h"
 #include "experiments/study_definition.h"
 #include "experiments/study_errors.h"

@@ -1,7 +1,7 @@
 #include "experiments/trial_plan.h"
 
 #include "common/error.h"
-#include "experiments/seeded_random.h"
+#include "common/seeded_random.h"
 
 #include <algorithm>
 

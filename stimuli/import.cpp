@@ -1,6 +1,6 @@
 #include "stimuli/import.h"
 
-#include "analysis/scaling/csv_reader.h"
+#include "common/csv.h"
 #include "common/error.h"
 #include "common/files.h"
 #include "common/hash.h"
@@ -112,7 +112,7 @@ void checkFactorName(const Table& table, int line, const std::string& column, co
 }
 
 void readCsvTable(Table& table) {
-    const auto records = analysis::scaling::parseCsv(table.text, table.where);
+    const auto records = parseCsv(table.text, table.where);
     if (records.empty()) throwInput(table.where, "", "empty table (a header row, then one row per image)");
     const auto& header = records.front();
     std::vector<std::string> columns; // per field: a reserved column or "factor:NAME"

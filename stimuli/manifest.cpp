@@ -1,5 +1,6 @@
 #include "stimuli/manifest.h"
 
+#include "common/csv.h"
 #include "common/error.h"
 #include "common/files.h"
 
@@ -94,15 +95,6 @@ void writeManifest(const fs::path& dir, const Manifest& manifest) {
 }
 
 namespace {
-std::string csvField(const std::string& text) {
-    if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
-    std::string out = "\"";
-    for (char c : text) {
-        if (c == '"') out += '"';
-        out += c;
-    }
-    return out + "\"";
-}
 
 std::string jsonText(const nlohmann::json& j) {
     if (j.is_null()) return "";

@@ -6,7 +6,9 @@
 #include "common/files.h"
 #include "common/hash.h"
 #include "common/spec.h"
-#include "experiments/request_error.h"
+#include "net/request_checks.h"
+#include "net/request_error.h"
+#include "net/route_table.h"
 #include "renderer/scene/builtin_scenes.h"
 #include "renderer/sss/sss_params.h"
 #include "tune/tune_export.h"
@@ -36,10 +38,10 @@ std::optional<std::string_view> embeddedFile(std::string_view relativePath);
 
 namespace {
 
-using experiments::HttpRequest;
-using experiments::HttpResponse;
-using experiments::jsonResponse;
-using experiments::RequestError;
+using net::HttpRequest;
+using net::HttpResponse;
+using net::jsonResponse;
+using net::RequestError;
 using json = nlohmann::json;
 namespace sss = renderer::sss;
 
@@ -55,13 +57,6 @@ bool loopbackHost(const std::string& host) {
     boost::system::error_code ec;
     const auto address = boost::asio::ip::make_address(host, ec);
     return !ec && address.is_loopback();
-}
-
-bool constantTimeEqual(const std::string& a, const std::string& b) {
-    if (a.size() != b.size()) return false;
-    unsigned char difference = 0;
-    for (std::size_t i = 0; i < a.size(); ++i) difference |= static_cast<unsigned char>(a[i] ^ b[i]);
-    return difference == 0;
 }
 
 std::string base64(const std::vector<unsigned char>& bytes) {
@@ -247,9 +242,9 @@ TuneServer::TuneServer(TuneOptions options) : options_(std::move(options)) {
     queue_ = std::make_unique<RenderQueue>(options_.assetsDir);
     jobs_ = std::make_unique<JobRunner>(options_.executable, options_.workDir / "jobs", options_.assetsDir);
     references_ = std::make_unique<PreparedReferences>();
-    experiments::HttpLimits limits;
+    net::HttpLimits limits;
     limits.workerThreads = 8;
-    http_ = std::make_unique<experiments::HttpServer>([this](const HttpRequest& r) { return handle(r); }, limits);
+    http_ = std::make_unique<net::HttpServer>([this](const HttpRequest& r) { return handle(r); }, limits);
 }
 
 TuneServer::~TuneServer() {
@@ -270,30 +265,6 @@ std::string TuneServer::url() const {
     const std::string host = options_.host == "0.0.0.0" ? "127.0.0.1" : options_.host;
     return "http://" + (host.find(':') != std::string::npos ? "[" + host + "]" : host) + ":" + std::to_string(port_) +
            "/";
-}
-
-bool TuneServer::hostAllowed(const std::string& hostHeader) const {
-    // Host = name-or-address [":" port]; a DNS-rebinding page sends its own name, so only the bound address or a
-    // loopback name for a loopback server are accepted.
-    std::string name = lowerCase(hostHeader), portText;
-    if (!name.empty() && name.front() == '[') {
-        const std::size_t close = name.find(']');
-        if (close == std::string::npos) return false;
-        if (close + 1 < name.size() && name[close + 1] != ':') return false;
-        portText = close + 1 < name.size() ? name.substr(close + 2) : "";
-        name = name.substr(1, close - 1);
-    } else if (const std::size_t colon = name.rfind(':'); colon != std::string::npos) {
-        portText = name.substr(colon + 1);
-        name = name.substr(0, colon);
-    }
-    if (name.empty() || portText != std::to_string(port_)) return false;
-    boost::system::error_code ec;
-    const auto bound = boost::asio::ip::make_address(options_.host, ec);
-    if (ec) return false;
-    if (name == "localhost") return bound.is_loopback() || bound.is_unspecified();
-    const auto address = boost::asio::ip::make_address(name, ec);
-    if (ec) return false;
-    return bound.is_unspecified() || address == bound;
 }
 
 HttpResponse TuneServer::handle(const HttpRequest& request) {
@@ -480,22 +451,6 @@ HttpResponse TuneServer::page(const std::string& path) const {
     return res;
 }
 
-void TuneServer::checkSameOrigin(const HttpRequest& request) const {
-    // A browser says where a request comes from: Sec-Fetch-Site (every current browser) and Origin (every POST, and
-    // cross-origin GETs). Either, when present, must name this page; a client that sends neither is not a browser.
-    if (request.headerCount("Sec-Fetch-Site") > 1 || request.headerCount("Origin") > 1)
-        throw RequestError(400, "Origin, Sec-Fetch-Site: at most one of each");
-    const std::string site = lowerCase(request.header("Sec-Fetch-Site"));
-    if (!site.empty() && site != "same-origin" && site != "none")
-        throw RequestError(403, "Sec-Fetch-Site: \"" + site.substr(0, 32) + "\": only this page's own requests");
-    if (request.headerCount("Origin") == 0) return;
-    const std::string origin = lowerCase(request.header("Origin"));
-    const std::string own = "http://" + lowerCase(request.header("Host"));
-    const bool defaultPort = port_ == 80 && own.ends_with(":80") && origin == own.substr(0, own.size() - 3);
-    if (origin != own && !defaultPort)
-        throw RequestError(403, "Origin: \"" + origin.substr(0, 64) + "\" is not this page's origin (" + own + ")");
-}
-
 void TuneServer::checkPageRequest(const HttpRequest& request) const {
     std::string type = lowerCase(request.header("Content-Type"));
     type = type.substr(0, type.find(';'));
@@ -503,7 +458,7 @@ void TuneServer::checkPageRequest(const HttpRequest& request) const {
     if (type != "application/json")
         throw RequestError(415, "Content-Type: \"" + type.substr(0, 64) + "\" is not application/json");
     if (request.headerCount("X-Skinlab-Token") != 1 ||
-        !constantTimeEqual(request.header("X-Skinlab-Token"), pageToken_))
+        !net::constantTimeEqual(request.header("X-Skinlab-Token"), pageToken_))
         throw RequestError(403, "X-Skinlab-Token: missing or not this start's (reload the page)");
 }
 
@@ -631,35 +586,43 @@ HttpResponse TuneServer::open(const HttpRequest& request) const {
 
 HttpResponse TuneServer::answer(const HttpRequest& request) {
     if (request.headerCount("Host") != 1) throw RequestError(400, "Host: exactly one Host header is required");
-    if (!hostAllowed(request.header("Host")))
+    if (!net::HostRule{options_.host, port_}.allows(request.header("Host")))
         throw RequestError(421, "Host: \"" + request.header("Host").substr(0, 64) + "\" is not this server");
-    const std::string& path = request.path;
-    const bool get = request.method == "GET";
-    const bool post = request.method == "POST";
+    // Every route (docs/tuning.md); the page's files need no check, every /api/ route (an unknown one too) is
+    // guarded: the page's own origin, the token when one is set, and for a POST a JSON body with the page's token.
+    using S = TuneServer;
+    using R = const HttpRequest&;
+    static const net::RouteTable<TuneServer> routes{
+        {"GET", "/", false, [](S& s, R r) { return s.page(r.path); }},
+        {"GET", "/index.html", false, [](S& s, R r) { return s.page(r.path); }},
+        {"GET", "/app.js", false, [](S& s, R r) { return s.page(r.path); }},
+        {"GET", "/style.css", false, [](S& s, R r) { return s.page(r.path); }},
+        {"GET", "/api/schema", true, [](S& s, R) { return jsonResponse(200, s.schema()); }},
+        {"POST", "/api/render", true, [](S& s, R r) { return s.render(parseBody(r)); }},
+        {"POST", "/api/kernel", true,
+         [](S& s, R r) { return jsonResponse(200, kernelCurves(s.requestConfig(parseBody(r)))); }},
+        {"POST", "/api/reference", true, [](S& s, R r) { return s.reference(parseBody(r)); }},
+        {"GET", "/api/job", true, [](S& s, R r) { return s.job(r); }},
+        {"GET", "/api/job/image", true, [](S& s, R r) { return s.job(r); }},
+        {"POST", "/api/job/cancel", true,
+         [](S& s, R r) {
+             return jsonResponse(200, {{"cancelled", s.jobs_->cancel(stringField(parseBody(r), "id"))}});
+         }},
+        {"POST", "/api/export", true, [](S& s, R r) { return s.exportFiles(parseBody(r)); }},
+        {"GET", "/api/open", true, [](S& s, R r) { return s.open(r); }},
+        {"*", "/api/*", true, [](S&, R) -> HttpResponse { throw RequestError(404, "not found"); }},
+    };
+    return routes.answer(*this, request, [this](R r) { guardApi(r); });
+}
 
-    if (get && (path == "/" || path == "/index.html" || path == "/app.js" || path == "/style.css")) return page(path);
-    if (path.rfind("/api/", 0) != 0) throw RequestError(404, "not found");
-    checkSameOrigin(request);
+void TuneServer::guardApi(const HttpRequest& request) const {
+    net::checkSameOrigin(request, port_);
     if (!options_.token.empty()) {
-        const std::string authorization = request.header("Authorization");
-        if (authorization.rfind("Bearer ", 0) != 0)
-            throw RequestError(401, "token required (Authorization: Bearer TOKEN)");
-        if (!constantTimeEqual(authorization.substr(7), options_.token)) throw RequestError(403, "wrong token");
+        const std::optional<std::string> token = net::bearerToken(request);
+        if (!token) throw RequestError(401, "token required (Authorization: Bearer TOKEN)");
+        if (!net::constantTimeEqual(*token, options_.token)) throw RequestError(403, "wrong token");
     }
-    if (post) checkPageRequest(request);
-
-    if (get && path == "/api/schema") return jsonResponse(200, schema());
-    if (post && path == "/api/render") return render(parseBody(request));
-    if (post && path == "/api/kernel") return jsonResponse(200, kernelCurves(requestConfig(parseBody(request))));
-    if (post && path == "/api/reference") return reference(parseBody(request));
-    if (get && (path == "/api/job" || path == "/api/job/image")) return job(request);
-    if (post && path == "/api/job/cancel") {
-        const std::string id = stringField(parseBody(request), "id");
-        return jsonResponse(200, {{"cancelled", jobs_->cancel(id)}});
-    }
-    if (post && path == "/api/export") return exportFiles(parseBody(request));
-    if (get && path == "/api/open") return open(request);
-    throw RequestError(404, "not found");
+    if (request.method == "POST") checkPageRequest(request);
 }
 
 } // namespace skinlab::tune

@@ -1,11 +1,11 @@
 #pragma once
-// `skinlab tune`: the live-tuning page and its JSON API on the project's HTTP server (experiments/http_server.h).
+// `skinlab tune`: the live-tuning page and its JSON API on the project's HTTP server (net/http_server.h).
 // Loopback by default; bound to any other address only with a token (Authorization: Bearer TOKEN on every /api/
 // request). Requests from other sites are refused: every /api/ request must come from the page's own origin
 // (Origin, Sec-Fetch-Site), and every POST must be JSON and carry the page's token, random per start (embedded in
 // the page it serves). Paths the page sends are read only inside the offered scenes' folders, the assets folder and
 // the stimulus sets. Routes and limits: docs/tuning.md.
-#include "experiments/http_server.h"
+#include "net/http_server.h"
 #include "tune/tune_engine.h"
 
 #include <filesystem>
@@ -45,25 +45,25 @@ public:
     std::string url() const;
 
     // The request handler (public for tests that call it without a socket).
-    experiments::HttpResponse handle(const experiments::HttpRequest& request);
+    net::HttpResponse handle(const net::HttpRequest& request);
 
     // The folders the page's path-valued keys may name (canonical).
     const std::vector<std::filesystem::path>& readableFolders() const { return readable_; }
 
 private:
-    experiments::HttpResponse answer(const experiments::HttpRequest& request);
-    experiments::HttpResponse page(const std::string& path) const;
-    bool hostAllowed(const std::string& hostHeader) const;
-    void checkSameOrigin(const experiments::HttpRequest& request) const;
-    void checkPageRequest(const experiments::HttpRequest& request) const;
+    net::HttpResponse answer(const net::HttpRequest& request);
+    net::HttpResponse page(const std::string& path) const;
+    // Every /api/ request: the page's own origin, the token when one is set, and for a POST checkPageRequest().
+    void guardApi(const net::HttpRequest& request) const;
+    void checkPageRequest(const net::HttpRequest& request) const;
     TuneConfig requestConfig(const nlohmann::json& body) const;
     void checkPathKeys(const TuneConfig& config) const;
-    experiments::HttpResponse reference(const nlohmann::json& body);
-    experiments::HttpResponse exportFiles(const nlohmann::json& body);
-    experiments::HttpResponse job(const experiments::HttpRequest& request) const;
-    experiments::HttpResponse open(const experiments::HttpRequest& request) const;
+    net::HttpResponse reference(const nlohmann::json& body);
+    net::HttpResponse exportFiles(const nlohmann::json& body);
+    net::HttpResponse job(const net::HttpRequest& request) const;
+    net::HttpResponse open(const net::HttpRequest& request) const;
     nlohmann::json schema() const;
-    experiments::HttpResponse render(const nlohmann::json& body);
+    net::HttpResponse render(const nlohmann::json& body);
     nlohmann::json compare(const nlohmann::json& request, const TuneFrame& frame);
     nlohmann::json stimulusList() const;
     nlohmann::json openStimulus(const std::string& id) const;
@@ -75,7 +75,7 @@ private:
     int port_ = 0;
     std::unique_ptr<RenderQueue> queue_;
     std::unique_ptr<JobRunner> jobs_;
-    std::unique_ptr<experiments::HttpServer> http_;
+    std::unique_ptr<net::HttpServer> http_;
     struct PreparedReferences;
     std::unique_ptr<PreparedReferences> references_;
 };

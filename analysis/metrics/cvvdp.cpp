@@ -503,7 +503,269 @@ double cvvdpMapMean(const cv::Mat& map, const cv::Mat& mask) {
     return count ? sum / static_cast<double>(count) : std::numeric_limits<double>::quiet_NaN();
 }
 
-// Long by design: one model pipeline, stage by stage as in the reference implementation, sharing its band pyramids.
+namespace {
+
+// One channel's planes of both images: [channel][0 = test, 1 = reference].
+using ImagePlanes = std::array<std::array<cv::Mat, 2>, 3>;
+
+// 1. Display model and DKL.
+ImagePlanes displayPlanes(const cv::Mat& referenceLinear, const cv::Mat& testLinear, const CvvdpDisplay& display) {
+    const int width = referenceLinear.cols, height = referenceLinear.rows;
+    static const std::array<double, 9> toDkl = rgbToDkl();
+    const double blackLevel = display.blackLevel();
+    const double reflected = display.reflectedLevel();
+    const bool linearDisplay = display.eotf == "linear";
+    auto luminance = [&](float v) -> float {
+        if (!std::isfinite(v)) v = v > 0.0f ? 1.0f : 0.0f;
+        if (linearDisplay)
+            return static_cast<float>(
+                std::clamp(double(v) * display.peakLuminance, std::max(0.005, blackLevel), display.peakLuminance) +
+                reflected);
+        return static_cast<float>((display.peakLuminance - blackLevel) * std::clamp(double(v), 0.0, 1.0) + blackLevel +
+                                  reflected);
+    };
+    ImagePlanes planes;
+    for (int img = 0; img < 2; ++img) {
+        const cv::Mat& source = img == 0 ? testLinear : referenceLinear;
+        for (int c = 0; c < 3; ++c) planes[c][img].create(height, width, CV_32FC1);
+        forRows(height, [&](int y) {
+            const auto* in = source.ptr<cv::Vec3f>(y);
+            float* out[3] = {planes[0][img].ptr<float>(y), planes[1][img].ptr<float>(y), planes[2][img].ptr<float>(y)};
+            for (int x = 0; x < width; ++x) {
+                const float r = luminance(in[x][0]), g = luminance(in[x][1]), b = luminance(in[x][2]);
+                for (int c = 0; c < 3; ++c)
+                    out[c][x] = static_cast<float>(toDkl[3 * c] * r + toDkl[3 * c + 1] * g + toDkl[3 * c + 2] * b);
+            }
+        });
+    }
+    return planes;
+}
+
+// The model's constants as the per-pixel loops use them (single precision), from the released parameters.
+struct BandConstants {
+    float channelGain[3] = {1.0f, 1.45f, 1.0f};
+    float maskGain, maxDifference, epsilon, maskP, epsilonPowerP;
+    float maskQ[3], epsilonPowerQ[3], crossMasking[3][3];
+    cv::Mat blurKernel;
+    int blurPad;
+    // The pooling exponents of the released parameters are β = 2 and β_tch = 4: those powers are products.
+    bool squarePooling, fourthPowerChannels;
+    double betaTchRoot, epsilonPowerBeta, epsilonPowerTch;
+
+    explicit BandConstants(const Parameters& p)
+        : maskGain(static_cast<float>(std::pow(10.0, p.maskC))),
+          maxDifference(static_cast<float>(std::pow(10.0, p.dMax))), epsilon(static_cast<float>(safeEpsilon)),
+          maskP(static_cast<float>(p.maskP)), epsilonPowerP(std::pow(epsilon, maskP)),
+          blurKernel(gaussianKernel(p.puDilate)), blurPad(static_cast<int>(p.puDilate * 2)),
+          squarePooling(p.beta == 2.0), fourthPowerChannels(p.betaTch == 4.0),
+          betaTchRoot(std::pow(safeEpsilon, 1.0 / p.betaTch)), epsilonPowerBeta(std::pow(safeEpsilon, p.beta)),
+          epsilonPowerTch(std::pow(safeEpsilon, p.betaTch)) {
+        for (int c = 0; c < 3; ++c) {
+            maskQ[c] = static_cast<float>(p.maskQ[c]);
+            epsilonPowerQ[c] = std::pow(epsilon, maskQ[c]);
+            for (int to = 0; to < 3; ++to) crossMasking[c][to] = static_cast<float>(p.crossMasking[c][to]);
+        }
+    }
+};
+
+// The baseband: contrast against the image-mean luminance (each image its own), CSF at 0.1 cpd, no masking.
+void basebandDifference(const ImagePlanes& level, std::array<cv::Mat, 3>& difference, CvvdpStageTimes& t) {
+    auto start = Clock::now();
+    const int h = level[0][0].rows, w = level[0][0].cols;
+    const std::size_t pixels = static_cast<std::size_t>(h) * static_cast<std::size_t>(w);
+    double meanTest = 0.0, meanReference = 0.0;
+    for (int y = 0; y < h; ++y) {
+        const float* a = level[0][0].ptr<float>(y);
+        const float* b = level[0][1].ptr<float>(y);
+        for (int x = 0; x < w; ++x) {
+            meanTest += std::max(a[x], 0.01f);
+            meanReference += std::max(b[x], 0.01f);
+        }
+    }
+    const float backgroundTest = static_cast<float>(meanTest / double(pixels));
+    const float backgroundReference = static_cast<float>(meanReference / double(pixels));
+    t.pyramid += secondsSince(start);
+    start = Clock::now();
+    float sensitivity[3];
+    for (int c = 0; c < 3; ++c) sensitivity[c] = csfRow(c, 0.1)(std::log10(backgroundReference));
+    t.csf += secondsSince(start);
+    start = Clock::now();
+    for (int c = 0; c < 3; ++c)
+        for (int y = 0; y < h; ++y) {
+            const float* a = level[c][0].ptr<float>(y);
+            const float* b = level[c][1].ptr<float>(y);
+            float* d = difference[c].ptr<float>(y);
+            for (int x = 0; x < w; ++x) {
+                const float test = std::min(a[x] / backgroundTest, 1000.0f);
+                const float reference = std::min(b[x] / backgroundReference, 1000.0f);
+                d[x] = std::fabs(test - reference) * sensitivity[c];
+            }
+        }
+    t.masking += secondsSince(start);
+}
+
+// Per row of a Laplacian band (level − expanded next level): Weber contrast against the expanded next level's
+// achromatic value of the same image, CSF-weighted (sensitivity from the reference's background) into `contrast`,
+// and the masker min(|T|, |R|) per channel into `minimum`.
+void bandContrast(const ImagePlanes& level, const ImagePlanes& expanded, double frequency, float bandMultiplier,
+                  const BandConstants& k, ImagePlanes& contrast, std::array<cv::Mat, 3>& minimum) {
+    const int h = level[0][0].rows, w = level[0][0].cols;
+    const std::array<CsfRow, 3> rows = {csfRow(0, frequency), csfRow(1, frequency), csfRow(2, frequency)};
+    for (int c = 0; c < 3; ++c) {
+        minimum[c].create(h, w, CV_32FC1);
+        for (int img = 0; img < 2; ++img) contrast[c][img].create(h, w, CV_32FC1);
+    }
+    forRows(h, [&](int y) {
+        const float* backgroundTest = expanded[0][0].ptr<float>(y);
+        const float* backgroundReference = expanded[0][1].ptr<float>(y);
+        const float *fine[3][2], *coarse[3][2];
+        float *weighted[3][2], *masker[3];
+        for (int c = 0; c < 3; ++c) {
+            masker[c] = minimum[c].ptr<float>(y);
+            for (int img = 0; img < 2; ++img) {
+                fine[c][img] = level[c][img].ptr<float>(y);
+                coarse[c][img] = expanded[c][img].ptr<float>(y);
+                weighted[c][img] = contrast[c][img].ptr<float>(y);
+            }
+        }
+        for (int x = 0; x < w; ++x) {
+            const float bgTest = std::max(backgroundTest[x], 0.01f);
+            const float bgReference = std::max(backgroundReference[x], 0.01f);
+            const float logBackground = std::log10(bgReference);
+            for (int c = 0; c < 3; ++c) {
+                const float test = std::min((fine[c][0][x] - coarse[c][0][x]) / bgTest, 1000.0f) * bandMultiplier;
+                const float reference =
+                    std::min((fine[c][1][x] - coarse[c][1][x]) / bgReference, 1000.0f) * bandMultiplier;
+                const float s = rows[c](logBackground) * k.channelGain[c];
+                weighted[c][0][x] = test * s;
+                weighted[c][1][x] = reference * s;
+                masker[c][x] = std::min(std::fabs(test * s), std::fabs(reference * s));
+            }
+        }
+    });
+}
+
+// Mutual masking: the smaller of the two contrasts, blurred (phase uncertainty), raised to q, pooled across channels
+// with the cross-masking weights; the difference raised to p, divided by 1 + mask, softly clamped at 10^d_max.
+void maskedDifference(const ImagePlanes& contrast, std::array<cv::Mat, 3>& minimum, const BandConstants& k,
+                      std::array<cv::Mat, 3>& difference) {
+    const int h = contrast[0][0].rows, w = contrast[0][0].cols;
+    if (h > k.blurPad && w > k.blurPad)
+        for (int c = 0; c < 3; ++c)
+            cv::sepFilter2D(minimum[c], minimum[c], CV_32F, k.blurKernel, k.blurKernel, {-1, -1}, 0.0,
+                            cv::BORDER_REFLECT_101);
+    forRows(h, [&](int y) {
+        const float* mn[3] = {minimum[0].ptr<float>(y), minimum[1].ptr<float>(y), minimum[2].ptr<float>(y)};
+        const float *test[3], *reference[3];
+        float* d[3];
+        for (int c = 0; c < 3; ++c) {
+            test[c] = contrast[c][0].ptr<float>(y);
+            reference[c] = contrast[c][1].ptr<float>(y);
+            d[c] = difference[c].ptr<float>(y);
+        }
+        for (int x = 0; x < w; ++x) {
+            float masker[3];
+            for (int q = 0; q < 3; ++q)
+                masker[q] = std::pow(mn[q][x] * k.maskGain + k.epsilon, k.maskQ[q]) - k.epsilonPowerQ[q];
+            for (int c = 0; c < 3; ++c) {
+                const float m = k.crossMasking[0][c] * masker[0] + k.crossMasking[1][c] * masker[1] +
+                                k.crossMasking[2][c] * masker[2];
+                const float delta = std::fabs(test[c][x] - reference[c][x]);
+                const float u = (std::pow(delta + k.epsilon, k.maskP) - k.epsilonPowerP) / (1.0f + m);
+                d[c][x] = k.maxDifference * u / (k.maxDifference + u);
+            }
+        }
+    });
+}
+
+// Spatial pooling of one band (p-norm, β = 2, normalised by the pixel count; row sums added in order) into
+// result.bandQuality[c][band].
+void poolBand(const std::array<cv::Mat, 3>& difference, int band, const Parameters& p, const BandConstants& k,
+              CvvdpResult& result) {
+    const int h = difference[0].rows, w = difference[0].cols;
+    const std::size_t pixels = static_cast<std::size_t>(h) * static_cast<std::size_t>(w);
+    std::array<std::vector<double>, 3> rowSums;
+    for (auto& r : rowSums) r.assign(h, 0.0);
+    forRows(h, [&](int y) {
+        for (int c = 0; c < 3; ++c) {
+            const float* d = difference[c].ptr<float>(y);
+            double sum = 0.0;
+            if (k.squarePooling)
+                for (int x = 0; x < w; ++x) {
+                    const double v = double(d[x]) + safeEpsilon;
+                    sum += v * v;
+                }
+            else
+                for (int x = 0; x < w; ++x) sum += std::pow(double(d[x]) + safeEpsilon, p.beta);
+            rowSums[c][y] = sum;
+        }
+    });
+    for (int c = 0; c < 3; ++c) {
+        double sum = 0.0;
+        for (double r : rowSums[c]) sum += r;
+        sum -= static_cast<double>(pixels) * k.epsilonPowerBeta;
+        result.bandQuality[c][band] = safePow(sum / static_cast<double>(pixels), 1.0 / p.beta);
+    }
+}
+
+// The heat-map band: the channels' β_tch-norm, weighted as in the pooling.
+cv::Mat heatBand(const std::array<cv::Mat, 3>& difference, bool baseband, float bandMultiplier, const Parameters& p,
+                 const BandConstants& k) {
+    const int h = difference[0].rows, w = difference[0].cols;
+    double weight[3];
+    for (int c = 0; c < 3; ++c)
+        weight[c] = p.channelWeight[c] * p.imageIntegration * (baseband ? p.basebandWeight[c] : 1.0);
+    cv::Mat heat(h, w, CV_32FC1);
+    forRows(h, [&](int y) {
+        const float* d[3] = {difference[0].ptr<float>(y), difference[1].ptr<float>(y), difference[2].ptr<float>(y)};
+        float* out = heat.ptr<float>(y);
+        for (int x = 0; x < w; ++x) {
+            double sum = 0.0;
+            for (int c = 0; c < 3; ++c) {
+                const double v = d[c][x] * weight[c] + safeEpsilon;
+                sum += (k.fourthPowerChannels ? (v * v) * (v * v) : std::pow(v, p.betaTch)) - k.epsilonPowerTch;
+            }
+            const double norm = k.fourthPowerChannels ? std::sqrt(std::sqrt(sum + safeEpsilon))
+                                                      : std::pow(sum + safeEpsilon, 1.0 / p.betaTch);
+            out[x] = static_cast<float>((norm - k.betaTchRoot) / bandMultiplier);
+        }
+    });
+    return heat;
+}
+
+// 3. Pooling over bands (β_sch, baseband weighted) and channels (β_tch), the image integration factor, JOD.
+void poolBands(const Parameters& p, int bandCount, CvvdpResult& result) {
+    double channelSum = 0.0;
+    for (int c = 0; c < 3; ++c) {
+        double bandSum = 0.0;
+        for (int band = 0; band < bandCount; ++band) {
+            const double weight = p.channelWeight[c] * (band == bandCount - 1 ? p.basebandWeight[c] : 1.0);
+            bandSum += safePow(result.bandQuality[c][band] * weight, p.betaSch);
+        }
+        channelSum += safePow(safePow(bandSum, 1.0 / p.betaSch), p.betaTch);
+    }
+    result.quality = safePow(channelSum, 1.0 / p.betaTch) * p.imageIntegration;
+    result.jod = qualityToJod(result.quality);
+}
+
+// The per-pixel map: the heat bands collapsed as a Laplacian pyramid, in JOD below 10.
+cv::Mat assembleMap(const std::vector<cv::Mat>& heatBands, int width, int height) {
+    cv::Mat image = heatBands.back();
+    for (int band = static_cast<int>(heatBands.size()) - 2; band >= 0; --band)
+        image = expand(image, heatBands[band].rows, heatBands[band].cols) + heatBands[band];
+    cv::Mat map(height, width, CV_32FC1);
+    for (int y = 0; y < height; ++y) {
+        const float* in = image.ptr<float>(y);
+        float* out = map.ptr<float>(y);
+        for (int x = 0; x < width; ++x) out[x] = static_cast<float>(10.0 - qualityToJod(in[x]));
+    }
+    return map;
+}
+
+} // namespace
+
+// One model pipeline, stage by stage as in the reference implementation, sharing its band pyramids; each stage is
+// a helper above.
 CvvdpResult cvvdp(const cv::Mat& referenceLinear, const cv::Mat& testLinear, const CvvdpDisplay& display,
                   bool computeMap, CvvdpStageTimes* times) {
     if (referenceLinear.empty() || testLinear.empty()) throw std::invalid_argument("cvvdp(): empty image");
@@ -518,43 +780,16 @@ CvvdpResult cvvdp(const cv::Mat& referenceLinear, const cv::Mat& testLinear, con
     t = {};
     const int width = referenceLinear.cols, height = referenceLinear.rows;
 
-    // 1. Display model and DKL: planes[channel][0 = test, 1 = reference].
+    // 1. Display model and DKL.
     auto start = Clock::now();
-    static const std::array<double, 9> toDkl = rgbToDkl();
-    const double blackLevel = display.blackLevel();
-    const double reflected = display.reflectedLevel();
-    const bool linearDisplay = display.eotf == "linear";
-    auto luminance = [&](float v) -> float {
-        if (!std::isfinite(v)) v = v > 0.0f ? 1.0f : 0.0f;
-        if (linearDisplay)
-            return static_cast<float>(
-                std::clamp(double(v) * display.peakLuminance, std::max(0.005, blackLevel), display.peakLuminance) +
-                reflected);
-        return static_cast<float>((display.peakLuminance - blackLevel) * std::clamp(double(v), 0.0, 1.0) + blackLevel +
-                                  reflected);
-    };
-    std::array<std::array<cv::Mat, 2>, 3> planes;
-    for (int img = 0; img < 2; ++img) {
-        const cv::Mat& source = img == 0 ? testLinear : referenceLinear;
-        for (int c = 0; c < 3; ++c) planes[c][img].create(height, width, CV_32FC1);
-        forRows(height, [&](int y) {
-            const auto* in = source.ptr<cv::Vec3f>(y);
-            float* out[3] = {planes[0][img].ptr<float>(y), planes[1][img].ptr<float>(y), planes[2][img].ptr<float>(y)};
-            for (int x = 0; x < width; ++x) {
-                const float r = luminance(in[x][0]), g = luminance(in[x][1]), b = luminance(in[x][2]);
-                for (int c = 0; c < 3; ++c)
-                    out[c][x] = static_cast<float>(toDkl[3 * c] * r + toDkl[3 * c + 1] * g + toDkl[3 * c + 2] * b);
-            }
-        });
-    }
+    const ImagePlanes planes = displayPlanes(referenceLinear, testLinear, display);
     t.colour += secondsSince(start);
 
-    // 2. Gaussian pyramids.
+    // 2. Gaussian pyramids: gaussian[level][channel][image].
     start = Clock::now();
     const PyramidLayout layout = pyramidLayout(width, height, display.pixelsPerDegree);
     const int bandCount = layout.levels + 1;
-    // gaussian[level][channel][image]
-    std::vector<std::array<std::array<cv::Mat, 2>, 3>> gaussian(bandCount);
+    std::vector<ImagePlanes> gaussian(bandCount);
     gaussian[0] = planes;
     for (int level = 1; level < bandCount; ++level)
         for (int c = 0; c < 3; ++c)
@@ -565,232 +800,48 @@ CvvdpResult cvvdp(const cv::Mat& referenceLinear, const cv::Mat& testLinear, con
     result.bandFrequencies = layout.frequencies;
     result.bandFrequencies.back() = 0.1; // the baseband's CSF frequency
     for (auto& q : result.bandQuality) q.assign(bandCount, 0.0);
-
-    const float channelGain[3] = {1.0f, 1.45f, 1.0f};
-    const float maskGain = static_cast<float>(std::pow(10.0, p.maskC));
-    const float maxDifference = static_cast<float>(std::pow(10.0, p.dMax));
-    const float epsilon = static_cast<float>(safeEpsilon);
-    const float maskP = static_cast<float>(p.maskP);
-    const float epsilonPowerP = std::pow(epsilon, maskP);
-    float maskQ[3], epsilonPowerQ[3], crossMasking[3][3];
-    for (int c = 0; c < 3; ++c) {
-        maskQ[c] = static_cast<float>(p.maskQ[c]);
-        epsilonPowerQ[c] = std::pow(epsilon, maskQ[c]);
-        for (int to = 0; to < 3; ++to) crossMasking[c][to] = static_cast<float>(p.crossMasking[c][to]);
-    }
-    const cv::Mat blurKernel = gaussianKernel(p.puDilate);
-    const int blurPad = static_cast<int>(p.puDilate * 2);
+    const BandConstants k(p);
     std::vector<cv::Mat> heatBands(computeMap ? bandCount : 0);
-    // The pooling exponents of the released parameters are β = 2 and β_tch = 4: those powers are products.
-    const bool squarePooling = p.beta == 2.0;
-    const bool fourthPowerChannels = p.betaTch == 4.0;
-    const double betaTchRoot = std::pow(safeEpsilon, 1.0 / p.betaTch);
-    const double epsilonPowerBeta = std::pow(safeEpsilon, p.beta);
-    const double epsilonPowerTch = std::pow(safeEpsilon, p.betaTch);
 
     for (int band = 0; band < bandCount; ++band) {
         const bool baseband = band == bandCount - 1;
         const float bandMultiplier = (band == 0 || baseband) ? 1.0f : 2.0f;
         const int h = gaussian[band][0][0].rows, w = gaussian[band][0][0].cols;
-        const std::size_t pixels = static_cast<std::size_t>(h) * static_cast<std::size_t>(w);
         std::array<cv::Mat, 3> difference; // D per channel
         for (auto& d : difference) d.create(h, w, CV_32FC1);
-
         if (baseband) {
-            // Contrast against the image-mean luminance (each image its own), CSF at 0.1 cpd, no masking.
-            start = Clock::now();
-            double meanTest = 0.0, meanReference = 0.0;
-            for (int y = 0; y < h; ++y) {
-                const float* a = gaussian[band][0][0].ptr<float>(y);
-                const float* b = gaussian[band][0][1].ptr<float>(y);
-                for (int x = 0; x < w; ++x) {
-                    meanTest += std::max(a[x], 0.01f);
-                    meanReference += std::max(b[x], 0.01f);
-                }
-            }
-            const float backgroundTest = static_cast<float>(meanTest / double(pixels));
-            const float backgroundReference = static_cast<float>(meanReference / double(pixels));
-            t.pyramid += secondsSince(start);
-            start = Clock::now();
-            float sensitivity[3];
-            for (int c = 0; c < 3; ++c) sensitivity[c] = csfRow(c, 0.1)(std::log10(backgroundReference));
-            t.csf += secondsSince(start);
-            start = Clock::now();
-            for (int c = 0; c < 3; ++c)
-                for (int y = 0; y < h; ++y) {
-                    const float* a = gaussian[band][c][0].ptr<float>(y);
-                    const float* b = gaussian[band][c][1].ptr<float>(y);
-                    float* d = difference[c].ptr<float>(y);
-                    for (int x = 0; x < w; ++x) {
-                        const float test = std::min(a[x] / backgroundTest, 1000.0f);
-                        const float reference = std::min(b[x] / backgroundReference, 1000.0f);
-                        d[x] = std::fabs(test - reference) * sensitivity[c];
-                    }
-                }
-            t.masking += secondsSince(start);
+            basebandDifference(gaussian[band], difference, t);
         } else {
-            // Laplacian band = level − expanded next level; Weber contrast against the expanded next level's
-            // achromatic value of the same image.
             start = Clock::now();
-            std::array<std::array<cv::Mat, 2>, 3> expanded;
+            ImagePlanes expanded;
             for (int c = 0; c < 3; ++c)
                 for (int img = 0; img < 2; ++img) expanded[c][img] = expand(gaussian[band + 1][c][img], h, w);
             t.pyramid += secondsSince(start);
-
-            // Per row: contrast, CSF-weighted contrast (sensitivity from the reference's background), the masker
-            // min(|T|, |R|) per channel. Then the phase-uncertainty blur of the masker.
             start = Clock::now();
-            const std::array<CsfRow, 3> rows = {csfRow(0, layout.frequencies[band]),
-                                                csfRow(1, layout.frequencies[band]),
-                                                csfRow(2, layout.frequencies[band])};
-            std::array<std::array<cv::Mat, 2>, 3> contrast;
+            ImagePlanes contrast;
             std::array<cv::Mat, 3> minimum;
-            for (int c = 0; c < 3; ++c) {
-                minimum[c].create(h, w, CV_32FC1);
-                for (int img = 0; img < 2; ++img) contrast[c][img].create(h, w, CV_32FC1);
-            }
-            forRows(h, [&](int y) {
-                const float* backgroundTest = expanded[0][0].ptr<float>(y);
-                const float* backgroundReference = expanded[0][1].ptr<float>(y);
-                const float *level[3][2], *coarse[3][2];
-                float *weighted[3][2], *masker[3];
-                for (int c = 0; c < 3; ++c) {
-                    masker[c] = minimum[c].ptr<float>(y);
-                    for (int img = 0; img < 2; ++img) {
-                        level[c][img] = gaussian[band][c][img].ptr<float>(y);
-                        coarse[c][img] = expanded[c][img].ptr<float>(y);
-                        weighted[c][img] = contrast[c][img].ptr<float>(y);
-                    }
-                }
-                for (int x = 0; x < w; ++x) {
-                    const float bgTest = std::max(backgroundTest[x], 0.01f);
-                    const float bgReference = std::max(backgroundReference[x], 0.01f);
-                    const float logBackground = std::log10(bgReference);
-                    for (int c = 0; c < 3; ++c) {
-                        const float test =
-                            std::min((level[c][0][x] - coarse[c][0][x]) / bgTest, 1000.0f) * bandMultiplier;
-                        const float reference =
-                            std::min((level[c][1][x] - coarse[c][1][x]) / bgReference, 1000.0f) * bandMultiplier;
-                        const float s = rows[c](logBackground) * channelGain[c];
-                        weighted[c][0][x] = test * s;
-                        weighted[c][1][x] = reference * s;
-                        masker[c][x] = std::min(std::fabs(test * s), std::fabs(reference * s));
-                    }
-                }
-            });
+            bandContrast(gaussian[band], expanded, layout.frequencies[band], bandMultiplier, k, contrast, minimum);
             t.csf += secondsSince(start);
-
-            // Mutual masking: the smaller of the two contrasts, blurred (phase uncertainty), raised to q, pooled
-            // across channels with the cross-masking weights; the difference raised to p, divided by 1 + mask,
-            // softly clamped at 10^d_max.
             start = Clock::now();
-            if (h > blurPad && w > blurPad)
-                for (int c = 0; c < 3; ++c)
-                    cv::sepFilter2D(minimum[c], minimum[c], CV_32F, blurKernel, blurKernel, {-1, -1}, 0.0,
-                                    cv::BORDER_REFLECT_101);
-            forRows(h, [&](int y) {
-                const float* mn[3] = {minimum[0].ptr<float>(y), minimum[1].ptr<float>(y), minimum[2].ptr<float>(y)};
-                const float *test[3], *reference[3];
-                float* d[3];
-                for (int c = 0; c < 3; ++c) {
-                    test[c] = contrast[c][0].ptr<float>(y);
-                    reference[c] = contrast[c][1].ptr<float>(y);
-                    d[c] = difference[c].ptr<float>(y);
-                }
-                for (int x = 0; x < w; ++x) {
-                    float masker[3];
-                    for (int k = 0; k < 3; ++k)
-                        masker[k] = std::pow(mn[k][x] * maskGain + epsilon, maskQ[k]) - epsilonPowerQ[k];
-                    for (int c = 0; c < 3; ++c) {
-                        const float m = crossMasking[0][c] * masker[0] + crossMasking[1][c] * masker[1] +
-                                        crossMasking[2][c] * masker[2];
-                        const float delta = std::fabs(test[c][x] - reference[c][x]);
-                        const float u = (std::pow(delta + epsilon, maskP) - epsilonPowerP) / (1.0f + m);
-                        d[c][x] = maxDifference * u / (maxDifference + u);
-                    }
-                }
-            });
+            maskedDifference(contrast, minimum, k, difference);
             t.masking += secondsSince(start);
         }
-
-        // Spatial pooling (p-norm, β = 2, normalised by the pixel count; row sums added in order) and the
-        // heat-map band (the channels' β_tch-norm, weighted as in the pooling).
         start = Clock::now();
-        std::array<std::vector<double>, 3> rowSums;
-        for (auto& r : rowSums) r.assign(h, 0.0);
-        forRows(h, [&](int y) {
-            for (int c = 0; c < 3; ++c) {
-                const float* d = difference[c].ptr<float>(y);
-                double sum = 0.0;
-                if (squarePooling)
-                    for (int x = 0; x < w; ++x) {
-                        const double v = double(d[x]) + safeEpsilon;
-                        sum += v * v;
-                    }
-                else
-                    for (int x = 0; x < w; ++x) sum += std::pow(double(d[x]) + safeEpsilon, p.beta);
-                rowSums[c][y] = sum;
-            }
-        });
-        for (int c = 0; c < 3; ++c) {
-            double sum = 0.0;
-            for (double r : rowSums[c]) sum += r;
-            sum -= static_cast<double>(pixels) * epsilonPowerBeta;
-            result.bandQuality[c][band] = safePow(sum / static_cast<double>(pixels), 1.0 / p.beta);
-        }
+        poolBand(difference, band, p, k, result);
         t.pooling += secondsSince(start);
         if (computeMap) {
             start = Clock::now();
-            double weight[3];
-            for (int c = 0; c < 3; ++c)
-                weight[c] = p.channelWeight[c] * p.imageIntegration * (baseband ? p.basebandWeight[c] : 1.0);
-            cv::Mat& heat = heatBands[band];
-            heat.create(h, w, CV_32FC1);
-            forRows(h, [&](int y) {
-                const float* d[3] = {difference[0].ptr<float>(y), difference[1].ptr<float>(y),
-                                     difference[2].ptr<float>(y)};
-                float* out = heat.ptr<float>(y);
-                for (int x = 0; x < w; ++x) {
-                    double sum = 0.0;
-                    for (int c = 0; c < 3; ++c) {
-                        const double v = d[c][x] * weight[c] + safeEpsilon;
-                        sum += (fourthPowerChannels ? (v * v) * (v * v) : std::pow(v, p.betaTch)) - epsilonPowerTch;
-                    }
-                    const double norm = fourthPowerChannels ? std::sqrt(std::sqrt(sum + safeEpsilon))
-                                                            : std::pow(sum + safeEpsilon, 1.0 / p.betaTch);
-                    out[x] = static_cast<float>((norm - betaTchRoot) / bandMultiplier);
-                }
-            });
+            heatBands[band] = heatBand(difference, baseband, bandMultiplier, p, k);
             t.heatmap += secondsSince(start);
         }
     }
 
-    // 3. Pooling over bands (β_sch, baseband weighted) and channels (β_tch), the image integration factor, JOD.
     start = Clock::now();
-    double channelSum = 0.0;
-    for (int c = 0; c < 3; ++c) {
-        double bandSum = 0.0;
-        for (int band = 0; band < bandCount; ++band) {
-            const double weight = p.channelWeight[c] * (band == bandCount - 1 ? p.basebandWeight[c] : 1.0);
-            bandSum += safePow(result.bandQuality[c][band] * weight, p.betaSch);
-        }
-        channelSum += safePow(safePow(bandSum, 1.0 / p.betaSch), p.betaTch);
-    }
-    result.quality = safePow(channelSum, 1.0 / p.betaTch) * p.imageIntegration;
-    result.jod = qualityToJod(result.quality);
+    poolBands(p, bandCount, result);
     t.pooling += secondsSince(start);
-
     if (computeMap) {
         start = Clock::now();
-        cv::Mat image = heatBands.back();
-        for (int band = bandCount - 2; band >= 0; --band)
-            image = expand(image, heatBands[band].rows, heatBands[band].cols) + heatBands[band];
-        result.map.create(height, width, CV_32FC1);
-        for (int y = 0; y < height; ++y) {
-            const float* in = image.ptr<float>(y);
-            float* out = result.map.ptr<float>(y);
-            for (int x = 0; x < width; ++x) out[x] = static_cast<float>(10.0 - qualityToJod(in[x]));
-        }
+        result.map = assembleMap(heatBands, width, height);
         t.heatmap += secondsSince(start);
     }
     return result;

@@ -1,6 +1,6 @@
 #include "analysis/scaling/responses.h"
 
-#include "analysis/scaling/csv_reader.h"
+#include "common/csv.h"
 #include "common/error.h"
 #include "common/files.h"
 #include "common/sqlite_read.h"

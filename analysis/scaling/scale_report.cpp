@@ -2,7 +2,7 @@
 
 #include "common/html.h"
 
-#include "analysis/scaling/csv_reader.h"
+#include "common/csv.h"
 #include "analysis/scaling/plots.h"
 #include "common/files.h"
 #include "common/version.h"

@@ -2,6 +2,7 @@
 
 #include "common/error.h"
 
+#include "analysis/scaling/active_sampling.h"
 #include "analysis/scaling/bootstrap.h"
 #include "analysis/scaling/scale_analysis.h"
 #include "analysis/scaling/screening.h"
@@ -91,19 +92,21 @@ BlockData simulateActive(const ValidationOptions& options, const std::vector<dou
         bool firstChosen, firstOnLeft;
     };
     std::vector<Trial> trials;
-    std::vector<PlannerAnswer> answers;
+    std::vector<active::Comparison> answers;
     for (int k = 0; k < observers; ++k) {
         int done = 0;
         for (std::uint64_t batch = 0; done < perObserver; ++batch) {
-            const auto pairs =
-                options.activePlanner(m, answers, mixSeed(seed, static_cast<std::uint64_t>(k) * 100000 + batch));
+            // The study server's planner: the posterior of every earlier answer, one batch = the spanning tree over
+            // 1/(expected variance reduction).
+            const auto pairs = active::spanningTreeBatch(active::fitPosterior(m, answers),
+                                                         mixSeed(seed, static_cast<std::uint64_t>(k) * 100000 + batch));
             if (pairs.empty()) throw RuntimeError("validate: the active planner returned no pairs");
             for (auto [i, j] : pairs) {
                 if (done == perObserver) break;
                 if (i > j) std::swap(i, j);
                 const bool chosen = truth[i] + noise(random) > truth[j] + noise(random);
                 trials.push_back({k, i, j, chosen, done % 2 == 0});
-                answers.push_back(chosen ? PlannerAnswer{i, j} : PlannerAnswer{j, i});
+                answers.push_back(chosen ? active::Comparison{i, j} : active::Comparison{j, i});
                 ++done;
             }
         }

@@ -8,14 +8,12 @@
 //  - "sparse": Case V observers who each judge only a random share of the pairs;
 //  - "disconnected": Case V observers, the conditions in groups never compared with each other;
 //  - "near-unanimous": Case V observers on a scale stretched so far pairs are (nearly) always unanimous;
-//  - "active": Case V observers, one after another, each judging pairs an active planner chose from every earlier
-//    answer (pairs = "active" in a study); the coverage columns are those of the profile-likelihood intervals and
+//  - "active": Case V observers, one after another, each judging pairs the study server's active planner chose from every
+//    earlier answer (pairs = "active" in a study); the coverage columns are those of the profile-likelihood intervals and
 //    score tests, and the coverage of the studentized observer bootstrap (what `analyze scale` uses for an active
 //    study) and of the union of both intervals are reported alongside.
 #include "analysis/scaling/multiple_comparisons.h"
 #include "analysis/scaling/pairwise_model.h"
-
-#include <functional>
 
 #include <nlohmann/json.hpp>
 
@@ -24,15 +22,6 @@
 #include <vector>
 
 namespace skinlab::analysis::scaling {
-
-// One answer of the "active" scenario: `winner` chosen over `loser` (condition indices).
-struct PlannerAnswer {
-    int winner = 0, loser = 0;
-};
-// The next batch of pairs (i, j) given every answer so far: the study server's planner, supplied by the caller
-// (the analysis does not link the server; `skinlab analyze validate` passes experiments/active_sampling's).
-using ActivePlanner = std::function<std::vector<std::pair<int, int>>(
-    int conditions, const std::vector<PlannerAnswer>& answers, std::uint64_t seed)>;
 
 struct ValidationOptions {
     std::vector<double> trueScores = {0.0, 0.3, 0.9, 1.0, 1.8, 2.5}; // JOD
@@ -57,10 +46,10 @@ struct ValidationOptions {
     double nearUnanimousStretch = 3.0; // "near-unanimous": true scores multiplied by this
     std::vector<std::string> scenarios = {"thurstone", "lapses+side-bias", "screening",
                                           "sparse",    "disconnected",     "near-unanimous"};
-    // "active": trials per observer (0: as many as the full design, trialsPerPair per pair), and the planner.
+    // "active": trials per observer (0: as many as the full design, trialsPerPair per pair), planned as the study
+    // server plans them (analysis/scaling/active_sampling.h).
     int activeTrials = 0;
     double activeStretch = 1.0; // "active": true scores multiplied by this
-    ActivePlanner activePlanner;
 };
 
 // Every scenario runValidation knows.

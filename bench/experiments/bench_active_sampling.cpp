@@ -5,7 +5,7 @@
 //  - random: each comparison a uniformly random pair (an incomplete random design);
 //  - active: batches of m − 1 pairs, each the minimum spanning tree over 1/(expected reduction of the summed
 //            variance of the centred scores) of the posterior built from every answer so far
-//            (experiments/active_sampling.h, as the study server plans them; --selection picks another).
+//            (analysis/scaling/active_sampling.h, as the study server plans them; --selection picks another).
 // Each observer answers m − 1 consecutive comparisons (one active batch). The scale is fitted exactly as
 // `analyze scale` fits it (Thurstone Case V MAP, analysis/scaling) and its RMSE against the truth (both
 // mean-zero) recorded.
@@ -43,7 +43,7 @@
 #include "analysis/scaling/design_efficiency.h"
 #include "analysis/scaling/pairwise_model.h"
 #include "analysis/scaling/profile_likelihood.h"
-#include "experiments/active_sampling.h"
+#include "analysis/scaling/active_sampling.h"
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -65,7 +65,7 @@
 
 using namespace skinlab;
 namespace sc = skinlab::analysis::scaling;
-namespace ac = skinlab::experiments::active;
+namespace ac = skinlab::analysis::scaling::active;
 
 namespace {
 

@@ -6,7 +6,7 @@
 // the shadow maps stay) and N that move a light's intensity (shadow maps and main passes re-run). Each figure is the whole round trip the page waits for: request, render, read-back, sRGB encoding, PNG,
 // base64 and answer. Prints p50 and p95 per method and kind of change.
 #include "bench/bench_stats.h"
-#include "experiments/http_client.h"
+#include "net/http_client.h"
 #include "renderer/sss/sss_params.h"
 #include "tune/tune_server.h"
 
@@ -56,7 +56,7 @@ int main(int argc, char** argv) {
         skinlab::tune::TuneServer server(options);
         const int port = server.bind();
         std::thread serving([&] { server.run(); });
-        skinlab::experiments::HttpClient client("127.0.0.1", port);
+        skinlab::net::HttpClient client("127.0.0.1", port);
         client.setTimeout(std::chrono::seconds(300));
         // This start's token, from the page (as the page's script sends it with every POST).
         const std::string page = client.get("/").body;
@@ -66,7 +66,7 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "bench_tune: the page holds no token\n");
             std::exit(1);
         }
-        const skinlab::experiments::HttpHeaders token{{"X-Skinlab-Token", page.substr(at + marker.size(), 64)}};
+        const skinlab::net::HttpHeaders token{{"X-Skinlab-Token", page.substr(at + marker.size(), 64)}};
         const std::string size = "render.width=" + std::to_string(width);
         const std::string sizeH = "render.height=" + std::to_string(height);
         std::printf("scene %s at %dx%d, %d changes per kind; milliseconds from request to image (HTTP round trip)\n",

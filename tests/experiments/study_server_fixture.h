@@ -4,7 +4,7 @@
 #include "experiments/study_store.h"
 #include "stimulus_set_fixture.h"
 
-#include "experiments/http_client.h"
+#include "net/http_client.h"
 #include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -12,6 +12,9 @@
 #include <thread>
 
 namespace skinlab::experiments::test_support {
+
+// The HTTP client and requests (net/) by their plain names in the tests.
+using namespace skinlab::net;
 
 inline const char* kResearcherToken = "researcher-secret-0123456789";
 

@@ -1,12 +1,12 @@
-// Unit tests of active sampling (experiments/active_sampling.h, experiments/active_plan.h): the EP posterior
+// Unit tests of active sampling (analysis/scaling/active_sampling.h, experiments/active_plan.h): the EP posterior
 // recovers known scores from simulated answers and does not depend on the answers' order; the information gain
 // prefers close, uncertain pairs; a batch is a spanning tree (connected, m − 1 pairs) and reproducible from its
 // seed; the `pairs = "active"` design keys are checked strictly; an active plan keeps practice and catch trials
 // in place and fills its open slots batch by batch.
 #include "common/error.h"
+#include "analysis/scaling/active_sampling.h"
 #include "experiments/active_plan.h"
-#include "experiments/active_sampling.h"
-#include "experiments/seeded_random.h"
+#include "common/seeded_random.h"
 #include "experiments/study_definition.h"
 #include "stimulus_set_fixture.h"
 
@@ -20,7 +20,9 @@
 #include <set>
 
 using namespace skinlab::experiments;
-using namespace skinlab::experiments::active;
+using namespace skinlab::analysis::scaling::active;
+using skinlab::combineSeed;
+using skinlab::SeededRandom;
 using skinlab::experiments::test_support::TemporaryFolder;
 
 namespace {

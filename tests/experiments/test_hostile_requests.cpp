@@ -8,7 +8,7 @@
 // records the attempt.
 #include "common/error.h"
 #include "common/files.h"
-#include "experiments/join_limiter.h"
+#include "net/join_limiter.h"
 #include "experiments/recruitment.h"
 #include "experiments/sqlite_database.h"
 #include "experiments/study_backup.h"

@@ -4,7 +4,7 @@
 #include "child_process.h"
 #include "common/files.h"
 #include "common/hash.h"
-#include "experiments/http_client.h"
+#include "net/http_client.h"
 #include "experiments/simulated_observers.h"
 #include "experiments/sqlite_database.h"
 #include "experiments/study_store.h"
@@ -23,6 +23,8 @@
 
 using namespace skinlab::experiments;
 using namespace skinlab::experiments::test_support;
+using namespace skinlab::net;
+using namespace skinlab::net;
 namespace fs = std::filesystem;
 
 namespace {

@@ -2,7 +2,7 @@
 // references, and the round trip of every export format through `analyze scale`'s reader.
 #include "analysis/scaling/responses.h"
 #include "common/files.h"
-#include "experiments/seeded_random.h"
+#include "common/seeded_random.h"
 #include "experiments/sqlite_database.h"
 #include "experiments/study_creation.h"
 #include "experiments/study_errors.h"
@@ -21,6 +21,7 @@
 
 using namespace skinlab::experiments;
 using namespace skinlab::experiments::test_support;
+using skinlab::SeededRandom;
 namespace fs = std::filesystem;
 namespace scaling = skinlab::analysis::scaling;
 

@@ -2,7 +2,7 @@
 // client), real EGL rendering, and the real `skinlab` executable for the CLI's errors and the export round trip.
 #include "common/error.h"
 #include "common/process.h"
-#include "experiments/http_client.h"
+#include "net/http_client.h"
 #include "renderer/renderer.h"
 #include "renderer/scene/builtin_scenes.h"
 #include "renderer/sss/sss_params.h"
@@ -29,8 +29,8 @@
 namespace skinlab::tune {
 namespace {
 
-using experiments::HttpAnswer;
-using experiments::HttpClient;
+using net::HttpAnswer;
+using net::HttpClient;
 using json = nlohmann::json;
 
 std::string& eglFailure() {
@@ -172,8 +172,8 @@ protected:
         return pageToken_;
     }
     // The headers of the page's own POSTs.
-    experiments::HttpHeaders pageHeaders() {
-        experiments::HttpHeaders headers{{"X-Skinlab-Token", pageToken()}};
+    net::HttpHeaders pageHeaders() {
+        net::HttpHeaders headers{{"X-Skinlab-Token", pageToken()}};
         if (!token_.empty()) headers.emplace_back("Authorization", "Bearer " + token_);
         return headers;
     }
@@ -568,7 +568,7 @@ TEST_F(TuneServerTest, OtherSitesRequestsAreRefused) {
     const json body = {{"scene", "builtin:head"}, {"overrides", kSmall}, {"name", "pwned"}};
     struct Attempt {
         const char* what;
-        experiments::HttpHeaders headers;
+        net::HttpHeaders headers;
         std::string contentType;
         int status;
     };
@@ -621,7 +621,7 @@ TEST_F(TuneServerTest, OtherSitesRequestsAreRefused) {
     options.workDir = work_ / "other";
     options.executable = SKINLAB_CLI;
     TuneServer second(options);
-    experiments::HttpRequest request;
+    net::HttpRequest request;
     request.method = "GET";
     request.path = "/";
     request.target = "/";

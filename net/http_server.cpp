@@ -1,7 +1,7 @@
-#include "experiments/http_server.h"
+#include "net/http_server.h"
 
 #include "common/error.h"
-#include "experiments/join_limiter.h"
+#include "net/join_limiter.h"
 
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/post.hpp>
@@ -21,7 +21,7 @@
 #include <thread>
 #include <unordered_map>
 
-namespace skinlab::experiments {
+namespace skinlab::net {
 
 namespace asio = boost::asio;
 namespace beast = boost::beast;
@@ -586,4 +586,4 @@ void HttpServer::stop() {
 bool HttpServer::running() const { return state_->runningFlag; }
 int HttpServer::openConnections() const { return state_->open.load(); }
 
-} // namespace skinlab::experiments
+} // namespace skinlab::net

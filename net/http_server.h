@@ -4,7 +4,7 @@
 // threads runs the handlers, which may block on SQLite and its fsync. Limits are enforced while reading, before
 // anything is buffered: header size, body size (chunked bodies included, counted as they arrive), the time a
 // request may take to arrive, and the number of open connections per client network (an IPv4 address, an IPv6 /64,
-// as joins are counted: experiments/join_limiter.h). Open connections in all are bounded; the last
+// as joins are counted: net/join_limiter.h). Open connections in all are bounded; the last
 // `reserveConnections` slots are kept for newcomers: once they are in use, each new connection closes an idle
 // connection (a kept-alive one waiting for its next request, or a new one that has sent nothing yet): of the 32 idle
 // longest, the one whose client network holds the most connections. When every slot holds a connection in the middle
@@ -25,7 +25,7 @@
 #include <utility>
 #include <vector>
 
-namespace skinlab::experiments {
+namespace skinlab::net {
 
 struct HttpRequest {
     std::string method; // "GET", "POST", ... ("HEAD" is handed over as "GET"; the body is dropped)
@@ -104,4 +104,4 @@ private:
 // Percent-decoding of a URL component ('+' stays '+'); nullopt when an escape is malformed.
 std::optional<std::string> percentDecode(std::string_view text);
 
-} // namespace skinlab::experiments
+} // namespace skinlab::net

@@ -27,7 +27,7 @@
 #include <utility>
 #include <vector>
 
-namespace skinlab::experiments::active {
+namespace skinlab::analysis::scaling::active {
 
 inline constexpr double kThurstoneSigma = 1.4826;
 
@@ -127,4 +127,4 @@ std::vector<std::pair<int, int>> greedyBatch(const ScorePosterior& posterior, in
 // condition, the values recomputed after each edge under the covariance its answer will leave (as greedyBatch).
 std::vector<std::pair<int, int>> sequentialTreeBatch(const ScorePosterior& posterior, std::uint64_t tieSeed);
 
-} // namespace skinlab::experiments::active
+} // namespace skinlab::analysis::scaling::active

@@ -1,7 +1,7 @@
-#include "experiments/active_sampling.h"
+#include "analysis/scaling/active_sampling.h"
 
 #include "common/error.h"
-#include "experiments/seeded_random.h"
+#include "common/seeded_random.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 #include <map>
 #include <string>
 
-namespace skinlab::experiments::active {
+namespace skinlab::analysis::scaling::active {
 
 namespace {
 
@@ -493,4 +493,4 @@ std::vector<std::pair<int, int>> sequentialTreeBatch(const ScorePosterior& poste
     return out;
 }
 
-} // namespace skinlab::experiments::active
+} // namespace skinlab::analysis::scaling::active

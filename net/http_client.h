@@ -7,7 +7,7 @@
 #include <utility>
 #include <vector>
 
-namespace skinlab::experiments {
+namespace skinlab::net {
 
 using HttpHeaders = std::vector<std::pair<std::string, std::string>>;
 
@@ -59,4 +59,4 @@ private:
     Connection* connection_ = nullptr;
 };
 
-} // namespace skinlab::experiments
+} // namespace skinlab::net

@@ -1,4 +1,4 @@
-#include "experiments/http_client.h"
+#include "net/http_client.h"
 
 #include <boost/asio/connect.hpp>
 #include <boost/asio/ip/tcp.hpp>
@@ -7,7 +7,7 @@
 #include <sys/socket.h>
 #include <sys/time.h>
 
-namespace skinlab::experiments {
+namespace skinlab::net {
 
 namespace asio = boost::asio;
 namespace beast = boost::beast;
@@ -114,4 +114,4 @@ HttpAnswer HttpClient::attempt(const std::string& method, const std::string& tar
     return answer;
 }
 
-} // namespace skinlab::experiments
+} // namespace skinlab::net

@@ -1,9 +1,10 @@
 #pragma once
-// A rejected request: bad input from a client of the study server. Carries the HTTP status (4xx) the server
-// answers with, as JSON {"error": message}. It is an InputError, so the CLI reports it the same way.
+// A rejected request: bad input from a client of one of skinlab's servers (the study server, `skinlab tune`).
+// Carries the HTTP status (4xx) the server answers with, as JSON {"error": message}. It is an InputError, so the
+// CLI reports it the same way.
 #include "common/error.h"
 
-namespace skinlab::experiments {
+namespace skinlab::net {
 
 class RequestError : public InputError {
 public:
@@ -18,4 +19,4 @@ private:
     int retryAfter_;
 };
 
-} // namespace skinlab::experiments
+} // namespace skinlab::net

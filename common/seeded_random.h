@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-namespace skinlab::experiments {
+namespace skinlab {
 
 // SplitMix64 finaliser (Steele, Lea & Flood 2014): mixes a 64-bit value into a well-distributed one. Used to
 // derive independent seeds (per participant, per pair) from the design seed.
@@ -49,4 +49,4 @@ private:
     std::mt19937_64 engine_;
 };
 
-} // namespace skinlab::experiments
+} // namespace skinlab

@@ -10,7 +10,7 @@
 #include <mutex>
 #include <string>
 
-namespace skinlab::experiments {
+namespace skinlab::net {
 
 // The bucket key of an address: IPv4 (or IPv4-mapped IPv6) as it is, IPv6 cut to its first `ipv6PrefixBits` bits
 // ("2001:db8:1:2::/64"). Anything that is not an IP address is its own key.
@@ -43,4 +43,4 @@ private:
     std::multimap<Clock::time_point, std::string> refilledAt_;
 };
 
-} // namespace skinlab::experiments
+} // namespace skinlab::net

@@ -1,9 +1,9 @@
-#include "experiments/join_limiter.h"
+#include "net/join_limiter.h"
 
 #include <algorithm>
 #include <boost/asio/ip/address.hpp>
 
-namespace skinlab::experiments {
+namespace skinlab::net {
 
 std::string clientNetwork(const std::string& address, int ipv6PrefixBits) {
     boost::system::error_code ec;
@@ -74,4 +74,4 @@ bool JoinLimiter::allow(const std::string& address, double& retryAfterSeconds, C
     return allowed;
 }
 
-} // namespace skinlab::experiments
+} // namespace skinlab::net
