@@ -1,6 +1,7 @@
 #include "stimuli/visibility.h"
 
 #include "analysis/metrics/metric_render.h"
+#include "common/csv.h"
 #include "common/error.h"
 #include "common/files.h"
 #include "common/html.h"
@@ -205,7 +206,7 @@ std::string visibilityCsv(const VisibilityTable& table) {
     for (double p : table.pixelsPerDegree) out += ",jod_ppd_" + number(p, "%g");
     out += ",one_jod_ppd,one_jod_distance_m,visible_everywhere,invisible_everywhere\n";
     for (const VisibilityRow& row : table.rows) {
-        out += row.block + "," + row.reference + "," + row.stimulus;
+        out += csvField(row.block) + "," + csvField(row.reference) + "," + csvField(row.stimulus);
         for (double jod : row.jod) out += "," + number(jod, "%.4f");
         std::string ppd, distance;
         if (row.limitPixelsPerDegree) {
