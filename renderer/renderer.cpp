@@ -629,9 +629,9 @@ DisplayFrame Renderer::renderDisplay(const RenderRequest& request, bool withLine
     glm::vec3 frameMin, frameMax;
     skinBounds(*frame.model, frame.partMaterials, frameMin, frameMax);
     setInternalSize(frame, spec);
-    frame.camera = frameCamera(spec.camera, frameMin, frameMax, frame.model->boundsMin, frame.model->boundsMax,
-                               spec.frameWidth * frame.ssaaFactor, spec.frameHeight * frame.ssaaFactor,
-                               internalWindow(spec));
+    frame.camera =
+        frameCamera(spec.camera, frameMin, frameMax, frame.model->boundsMin, frame.model->boundsMax,
+                    spec.frameWidth * frame.ssaaFactor, spec.frameHeight * frame.ssaaFactor, internalWindow(spec));
     frame.exposure = static_cast<float>(std::exp2(spec.exposureEv));
     frame.environmentFromWorld = glm::mat3(glm::rotate(
         glm::mat4(1.0f), static_cast<float>(-glm::radians(spec.environment.rotationDeg)), glm::vec3(0, 1, 0)));
@@ -731,9 +731,9 @@ RenderResult Renderer::render(const RenderRequest& request) {
     glm::vec3 frameMin, frameMax;
     skinBounds(*frame.model, frame.partMaterials, frameMin, frameMax);
     setInternalSize(frame, spec);
-    frame.camera = frameCamera(spec.camera, frameMin, frameMax, frame.model->boundsMin, frame.model->boundsMax,
-                               spec.frameWidth * frame.ssaaFactor, spec.frameHeight * frame.ssaaFactor,
-                               internalWindow(spec));
+    frame.camera =
+        frameCamera(spec.camera, frameMin, frameMax, frame.model->boundsMin, frame.model->boundsMax,
+                    spec.frameWidth * frame.ssaaFactor, spec.frameHeight * frame.ssaaFactor, internalWindow(spec));
     impl.targets.resize(frame.width, frame.height);
     if (frame.ssaaFactor > 1) impl.resolvedTargets.resize(spec.width, spec.height);
     frame.exposure = static_cast<float>(std::exp2(spec.exposureEv));

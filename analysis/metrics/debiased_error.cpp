@@ -568,14 +568,10 @@ std::vector<double> tableScoreValues(const nlohmann::json& metrics, const std::f
 
 } // namespace
 
-DebiasedRun runDebiasedMetrics(const std::vector<std::filesystem::path>& seeds,
-                               const std::vector<std::filesystem::path>& tests, const DebiasedRunOptions& options,
-                               const std::filesystem::path& outputFolder) {
-    if (tests.empty()) throwInput("TEST.exr", "", "required: at least one render to score against the seeds");
-    if (!(options.exposure > 0.0) || !std::isfinite(options.exposure))
-        throwInput("--exposure", "", number(options.exposure) + " must be a positive number");
-    if (!options.compareMetrics.empty() && options.compareReference.empty())
-        throwInput("--compare-metrics", options.compareMetrics.string(), "only with --compare-reference");
+namespace {
+
+// The table scores of --compare-metrics (a metrics.json of `analyze metrics`), or null without it.
+nlohmann::json readTableMetrics(const DebiasedRunOptions& options) {
     nlohmann::json tableMetrics;
     if (!options.compareMetrics.empty()) {
         try {
@@ -587,40 +583,39 @@ DebiasedRun runDebiasedMetrics(const std::vector<std::filesystem::path>& seeds,
             throwInput(options.compareMetrics.string(), "", std::string("not valid JSON: ") + e.what());
         }
     }
-    DebiasedRun run;
-    run.truth = loadSeededTruth(seeds, options.exposure, options.sssRadiusMillimetres);
-    std::vector<DebiasedImages> images;
-    for (const auto& test : tests) {
-        images.push_back(loadTestImages(test, run.truth));
-        run.tests.push_back(scoreDebiased(run.truth, images.back(), test));
-    }
-    if (!options.compareReference.empty()) {
-        const DebiasedImages compared = loadTestImages(options.compareReference, run.truth);
-        run.compared = scoreDebiased(run.truth, compared, options.compareReference);
-        for (const DebiasedImages& image : images) {
-            std::array<std::array<double, debiasedRegionCount>, debiasedQuantityCount> mse{};
-            for (std::size_t quantity = 0; quantity < debiasedQuantityCount; ++quantity)
-                for (std::size_t region = 0; region < debiasedRegionCount; ++region)
-                    mse[quantity][region] =
-                        meanSquaredDifference(image[quantity], compared[quantity], run.truth.regions[region]);
-            run.comparedMse.push_back(mse);
-        }
-        for (std::size_t quantity = 0; quantity < debiasedQuantityCount; ++quantity)
-            for (std::size_t region = 0; region < debiasedRegionCount; ++region) {
-                std::vector<double> other;
-                for (const auto& mse : run.comparedMse) other.push_back(mse[quantity][region]);
-                run.agreement[quantity][region] =
-                    agreementSubsets(run.tests, other, TruthScore{region, quantity, TruthKind::mse}, options.agreement);
-            }
-        if (!options.compareMetrics.empty())
-            for (const TableScore& score : tableScores()) {
-                const std::vector<double> values =
-                    tableScoreValues(tableMetrics, options.compareMetrics, run.tests, score);
-                run.tableAgreement.emplace_back(score,
-                                                agreementSubsets(run.tests, values, score.truth, options.agreement));
-            }
-    }
+    return tableMetrics;
+}
 
+// --compare-reference: every test against the compared reference, and how the two truths rank the tests.
+void compareWithReference(DebiasedRun& run, const std::vector<DebiasedImages>& images,
+                          const DebiasedRunOptions& options, const nlohmann::json& tableMetrics) {
+    const DebiasedImages compared = loadTestImages(options.compareReference, run.truth);
+    run.compared = scoreDebiased(run.truth, compared, options.compareReference);
+    for (const DebiasedImages& image : images) {
+        std::array<std::array<double, debiasedRegionCount>, debiasedQuantityCount> mse{};
+        for (std::size_t quantity = 0; quantity < debiasedQuantityCount; ++quantity)
+            for (std::size_t region = 0; region < debiasedRegionCount; ++region)
+                mse[quantity][region] =
+                    meanSquaredDifference(image[quantity], compared[quantity], run.truth.regions[region]);
+        run.comparedMse.push_back(mse);
+    }
+    for (std::size_t quantity = 0; quantity < debiasedQuantityCount; ++quantity)
+        for (std::size_t region = 0; region < debiasedRegionCount; ++region) {
+            std::vector<double> other;
+            for (const auto& mse : run.comparedMse) other.push_back(mse[quantity][region]);
+            run.agreement[quantity][region] =
+                agreementSubsets(run.tests, other, TruthScore{region, quantity, TruthKind::mse}, options.agreement);
+        }
+    if (!options.compareMetrics.empty())
+        for (const TableScore& score : tableScores()) {
+            const std::vector<double> values = tableScoreValues(tableMetrics, options.compareMetrics, run.tests, score);
+            run.tableAgreement.emplace_back(score, agreementSubsets(run.tests, values, score.truth, options.agreement));
+        }
+}
+
+// debiased.csv, debiased.json and, with a compared reference, agreement.csv.
+void writeDebiasedOutputs(const DebiasedRun& run, const std::vector<std::filesystem::path>& seeds,
+                          const DebiasedRunOptions& options, const std::filesystem::path& outputFolder) {
     const double skin = run.truth.meanSkinLuminance;
     std::string csv = "test,region,pixels,mse,mse_se,relative_rmse,plain_mse_one_seed,mse_against_compared,"
                       "difference_from_compared,difference_se";
@@ -719,6 +714,28 @@ DebiasedRun runDebiasedMetrics(const std::vector<std::filesystem::path>& seeds,
     writeFileAtomic(outputFolder / "debiased.csv", csv);
     if (!agreementCsv.empty()) writeFileAtomic(outputFolder / "agreement.csv", agreementCsv);
     writeFileAtomic(outputFolder / "debiased.json", json.dump(2) + "\n");
+}
+
+} // namespace
+
+DebiasedRun runDebiasedMetrics(const std::vector<std::filesystem::path>& seeds,
+                               const std::vector<std::filesystem::path>& tests, const DebiasedRunOptions& options,
+                               const std::filesystem::path& outputFolder) {
+    if (tests.empty()) throwInput("TEST.exr", "", "required: at least one render to score against the seeds");
+    if (!(options.exposure > 0.0) || !std::isfinite(options.exposure))
+        throwInput("--exposure", "", number(options.exposure) + " must be a positive number");
+    if (!options.compareMetrics.empty() && options.compareReference.empty())
+        throwInput("--compare-metrics", options.compareMetrics.string(), "only with --compare-reference");
+    const nlohmann::json tableMetrics = readTableMetrics(options);
+    DebiasedRun run;
+    run.truth = loadSeededTruth(seeds, options.exposure, options.sssRadiusMillimetres);
+    std::vector<DebiasedImages> images;
+    for (const auto& test : tests) {
+        images.push_back(loadTestImages(test, run.truth));
+        run.tests.push_back(scoreDebiased(run.truth, images.back(), test));
+    }
+    if (!options.compareReference.empty()) compareWithReference(run, images, options, tableMetrics);
+    writeDebiasedOutputs(run, seeds, options, outputFolder);
     return run;
 }
 

@@ -111,8 +111,8 @@ struct SceneSpec {
     int height = 512;
     int frameWidth = 512; // render.width, render.height: the camera's whole frame (f_px, aspect)
     int frameHeight = 512;
-    std::optional<RenderWindow> window;     // render.window
-    double exposureEv = 0.0; // beauty and AOVs are scaled by 2^exposure_ev
+    std::optional<RenderWindow> window; // render.window
+    double exposureEv = 0.0;            // beauty and AOVs are scaled by 2^exposure_ev
     // render.antialiasing: "ssaa" renders every pass at ssaaFactor × (width, height) and resolves each layer to
     // (width, height) with a box of one output pixel (renderer/gl/resolve_pass.h); "none" (ssaaFactor 1) samples
     // each pixel's centre once.

@@ -20,6 +20,8 @@ ExrImage renderTone(const std::string& scene, const std::string& tone, const std
     request.scene = scene;
     request.overrides = std::move(overrides);
     request.overrides.push_back("camera.view=\"close\"");
+    // Per-pixel checks (albedo ratios, the mask's pixels): one sample per pixel, no edge pixel mixing skin and eye.
+    request.overrides.push_back("render.antialiasing=\"none\"");
     if (!tone.empty()) request.overrides.push_back("skin.tone=\"" + tone + "\"");
     request.width = 64;
     request.height = 64;
