@@ -168,6 +168,7 @@ std::string JobRunner::start(const TuneConfig& config, const std::string& method
     const std::string key = configKey(config);
     for (const auto& [id, job] : jobs_)
         if (job->key == key && (job->status.state == "running" || job->status.state == "done")) return id;
+    collectEnded(); // a render that ended since the reaper's last pass (e.g. just cancelled) no longer counts
     for (const auto& [id, job] : jobs_)
         if (job->pid > 0 && job->status.method == method) throw JobBusy(method, id);
 
@@ -235,36 +236,43 @@ bool JobRunner::cancel(const std::string& id) {
     return true;
 }
 
+// One pass over the jobs (mutex_ held): collects every render that has ended, and ends a cancelled one that
+// outlived its grace period. Returns whether a render is still running.
+bool JobRunner::collectEnded() {
+    bool running = false;
+    for (auto& [id, job] : jobs_) {
+        if (job->pid <= 0) continue;
+        int status = 0;
+        const pid_t done = waitpid(job->pid, &status, WNOHANG);
+        if (done != job->pid) {
+            running = true;
+            if (job->status.state == "cancelled" || stopping_) job->end(); // SIGKILL after the grace period
+            continue;
+        }
+        job->pid = -1;
+        if (job->status.state == "cancelled") continue; // its time stopped at the cancel
+        job->finished = std::chrono::steady_clock::now();
+        if (stopping_) {
+            job->status.state = "cancelled";
+        } else if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {
+            job->status.state = "done";
+            lastSeconds_[job->sizeKey] = millisecondsBetween(job->started, job->finished) / 1000.0;
+        } else {
+            job->status.state = "failed";
+            std::ifstream log(job->log);
+            std::string line, last;
+            while (std::getline(log, line))
+                if (!line.empty()) last = line;
+            job->status.error = last.empty() ? "the render exited with status " + std::to_string(status) : last;
+        }
+    }
+    return running;
+}
+
 void JobRunner::reap() {
     std::unique_lock lock(mutex_);
     for (;;) {
-        bool running = false;
-        for (auto& [id, job] : jobs_) {
-            if (job->pid <= 0) continue;
-            int status = 0;
-            const pid_t done = waitpid(job->pid, &status, WNOHANG);
-            if (done != job->pid) {
-                running = true;
-                if (job->status.state == "cancelled" || stopping_) job->end(); // SIGKILL after the grace period
-                continue;
-            }
-            job->pid = -1;
-            if (job->status.state == "cancelled") continue; // its time stopped at the cancel
-            job->finished = std::chrono::steady_clock::now();
-            if (stopping_) {
-                job->status.state = "cancelled";
-            } else if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {
-                job->status.state = "done";
-                lastSeconds_[job->sizeKey] = millisecondsBetween(job->started, job->finished) / 1000.0;
-            } else {
-                job->status.state = "failed";
-                std::ifstream log(job->log);
-                std::string line, last;
-                while (std::getline(log, line))
-                    if (!line.empty()) last = line;
-                job->status.error = last.empty() ? "the render exited with status " + std::to_string(status) : last;
-            }
-        }
+        const bool running = collectEnded();
         if (stopping_ && !running) break;
         wake_.wait_for(lock, std::chrono::milliseconds(50));
     }

@@ -120,6 +120,7 @@ public:
 private:
     struct Job;
     void reap();
+    bool collectEnded();
 
     std::filesystem::path executable_, folder_, assetsDir_;
     mutable std::mutex mutex_;
