@@ -279,16 +279,30 @@ void ReferenceMethod::run(const ReferenceInputs& inputs, const sss::SssParams& p
         convolution.convexityMm[c] = params.referenceConvexityMm[c] * scale; // a length: scales with the profile
     }
     convolution.convexityRadiusMinMm = 20.0 * scale; // 20 mm at width 3 mm: the nose tip, the ear's rim
+    convolution.nearFieldMm = 0.5 * edgeMm;          // a seam's twin, a fan's small triangles: near field
     convolution.nonSkin =
         params.referenceNonSkin == "returns" ? reference::NonSkin::Returns : reference::NonSkin::Absorbs;
     reference::ConvolutionReport report;
-    const std::vector<glm::vec3> convolved =
-        reference::convolveSurface(samples, radiance, *profile, convolution, nullptr, &report);
+    // sss.reference_near_field = "pixel": the near field split off (surface_convolution.h, ownShare); the draw
+    // multiplies each vertex's own share by the main pass's E·α at every pixel, so detail finer than the
+    // tessellation keeps its sharpness.
+    // With "vertex" every share is 0 and the far field holds the whole sum.
+    const bool nearAtPixels = params.referenceNearField == "pixel";
+    std::vector<glm::vec3> ownShare;
+    const std::vector<glm::vec3> convolved = reference::convolveSurface(samples, radiance, *profile, convolution,
+                                                                        nullptr, &report,
+                                                                        nearAtPixels ? &ownShare : nullptr);
+    if (!nearAtPixels) ownShare.assign(vertexCount, glm::vec3(0.0f));
     const double convolveMs = millisecondsSince(convolveStart);
 
-    // --- 4. draw the tessellated skin with the convolved radiance over the main pass's diffuse ---
-    std::vector<glm::vec4> packed(std::max<std::size_t>(vertexCount, 1), glm::vec4(0.0f));
-    for (std::size_t i = 0; i < vertexCount; ++i) packed[i] = glm::vec4(convolved[i], 1.0f);
+    // --- 4. draw the tessellated skin with the convolved radiance (far field + own share × the pixel's E·α) over
+    // the main pass's diffuse ---
+    // Per vertex: the far field (rgb) and the own share (rgb), reference_draw.vert's layout.
+    std::vector<glm::vec4> packed(2 * std::max<std::size_t>(vertexCount, 1), glm::vec4(0.0f));
+    for (std::size_t i = 0; i < vertexCount; ++i) {
+        packed[2 * i] = glm::vec4(convolved[i], 1.0f);
+        packed[2 * i + 1] = glm::vec4(ownShare[i], 0.0f);
+    }
     if (packed.size() > impl.convolvedCapacity || !impl.convolvedBuffer.get()) {
         GLuint name = 0;
         glCreateBuffers(1, &name);

@@ -69,14 +69,18 @@ struct Convolution {
         return true;
     }
 
-    // The convolved E·α at receiver p (its own E·α when nothing weighs), and the number of sources summed.
-    glm::vec3 at(std::uint32_t p, glm::vec3 own, std::size_t& sourceCount) const {
+    // The convolved E·α at receiver p (its own E·α when nothing weighs), and the number of sources summed. With
+    // `share`, the receiver's own term is left out of the result and its weight (after normalising and the gain)
+    // written there (convolveSurface's ownShare).
+    glm::vec3 at(std::uint32_t p, glm::vec3 own, std::size_t& sourceCount, glm::vec3* share = nullptr) const {
         const glm::vec3 centre = samples.positionMm[p];
         const glm::vec3 normal = samples.normal[p];
         std::array<double, 3> weighted{0.0, 0.0, 0.0};
         std::array<double, 3> weightSum{0.0, 0.0, 0.0};
         double curvatureSum = 0.0, curvatureWeight = 0.0; // the kernel-weighted curvature at p (convexityMm)
         double farWeight = 0.0;                           // the kernel weight of a thin part's far side
+        std::array<double, 3> self{0.0, 0.0, 0.0};       // Σ_near K_c(p, q) · E_c α_c: the near field (ownShare)
+        std::array<double, 3> selfWeight{0.0, 0.0, 0.0}; // Σ_near K_c(p, q)
         std::size_t count = 0;
         sources.forEachWithin(centre, static_cast<float>(cutoff), [&](std::uint32_t q) {
             bool facing = true;
@@ -101,6 +105,11 @@ struct Convolution {
                 weighted[c] += k[c] * value[c];
                 if (facing) weightSum[c] += k[c];
             }
+            if (share && facing && (q == p || distance < settings.nearFieldMm))
+                for (int c = 0; c < 3; ++c) {
+                    self[c] += k[c] * value[c];
+                    selfWeight[c] += k[c];
+                }
             if (!facing) farWeight += (k[0] + k[1] + k[2]) / 3.0;
             if (facing && q != p && distance > 0.0f) {
                 const double mean = (k[0] + k[1] + k[2]) / 3.0;
@@ -134,10 +143,20 @@ struct Convolution {
                                                              std::max(0.0, 1.0 - 20.0 * farShare)
                                                        : 0.0;
         glm::vec3 result = own; // no weight at all (an isolated sample): keep E·α
+        if (share) {
+            *share = glm::vec3(1.0f);
+            result = glm::vec3(0.0f);
+        }
         for (int c = 0; c < 3; ++c)
-            if (weightSum[c] > 0.0)
-                result[c] = static_cast<float>(weighted[c] / weightSum[c] *
-                                               std::max(0.0, 1.0 + settings.convexityMm[c] * curvature));
+            if (weightSum[c] > 0.0) {
+                const double gain = std::max(0.0, 1.0 + settings.convexityMm[c] * curvature) / weightSum[c];
+                if (share) {
+                    result[c] = static_cast<float>((weighted[c] - self[c]) * gain);
+                    (*share)[c] = static_cast<float>(selfWeight[c] * gain);
+                } else {
+                    result[c] = static_cast<float>(weighted[c] * gain);
+                }
+            }
         return result;
     }
 };
@@ -153,11 +172,17 @@ std::vector<std::uint32_t> samplesWhere(const SurfaceSamples& samples, bool skin
 
 std::vector<glm::vec3> convolveSurface(const SurfaceSamples& samples, const std::vector<glm::vec3>& irradiance,
                                        const sss::RadialProfile& profile, const ConvolutionSettings& settings,
-                                       const std::vector<std::uint32_t>* receivers, ConvolutionReport* report) {
+                                       const std::vector<std::uint32_t>* receivers, ConvolutionReport* report,
+                                       std::vector<glm::vec3>* ownShare) {
     SKINLAB_CHECK_EQ(irradiance.size(), samples.size());
     const std::size_t count = samples.size();
     std::vector<glm::vec3> output(count);
-    for (std::size_t i = 0; i < count; ++i) output[i] = irradiance[i] * samples.albedo[i];
+    if (ownShare) {
+        ownShare->assign(count, glm::vec3(1.0f)); // not convolved: all of E·α is the sample's own
+        std::fill(output.begin(), output.end(), glm::vec3(0.0f));
+    } else {
+        for (std::size_t i = 0; i < count; ++i) output[i] = irradiance[i] * samples.albedo[i];
+    }
 
     std::vector<std::uint32_t> targets;
     if (receivers) {
@@ -188,7 +213,9 @@ std::vector<glm::vec3> convolveSurface(const SurfaceSamples& samples, const std:
         constexpr std::size_t chunk = 256;
         for (std::size_t begin = next.fetch_add(chunk); begin < targets.size(); begin = next.fetch_add(chunk))
             for (std::size_t t = begin; t < std::min(begin + chunk, targets.size()); ++t)
-                output[targets[t]] = convolution.at(targets[t], output[targets[t]], sourceCounts[t]);
+                output[targets[t]] =
+                    convolution.at(targets[t], irradiance[targets[t]] * samples.albedo[targets[t]], sourceCounts[t],
+                                   ownShare ? &(*ownShare)[targets[t]] : nullptr);
     };
     std::vector<std::thread> pool;
     for (unsigned i = 1; i < threads; ++i) pool.emplace_back(worker);

@@ -75,6 +75,10 @@ struct ConvolutionSettings {
     std::array<double, 3> convexityMm{0.0, 0.0, 0.0};
     // The tightest radius (mm) the convexity gain follows: |κ| is clamped to 1 / convexityRadiusMinMm.
     double convexityRadiusMinMm = 20.0;
+    // With convolveSurface's ownShare: sources closer than this (mm) to the receiver belong to its near field with
+    // its own term (a coincident twin across a seam, the small triangles of a fan); 0: the own term only. The
+    // reference passes half its edge length.
+    double nearFieldMm = 0.0;
     unsigned threads = 0; // worker threads; 0: std::thread::hardware_concurrency()
 };
 
@@ -87,9 +91,20 @@ struct ConvolutionReport {
 
 // irradiance: per sample, linear RGB (same size as samples). receivers: indices of the samples to convolve (all
 // samples when null); skin samples not listed keep E·α. Returns the diffuse radiance E·α after SSS per sample.
+//
+// ownShare (optional, resized to the samples): the near field split off. The receiver's own term K_c(p, p) — the
+// profile's mass over its own disc, the narrow lobes of a skin profile (d'Eon's σ = 80 µm and 0.22 mm) nearly
+// whole — and the sources closer than settings.nearFieldMm are then left out of the returned sum and reported as
+// their share s_c(p) = Σ_near K_c(p, q) · g_c / Σ_q K_c(p, q) (g_c the convex-surface gain), so that
+// out_c(p) ≈ returned_c(p) + s_c(p) · E_c(p) α_c(p) (exact with nearFieldMm = 0). A renderer that has
+// E·α at a finer resolution than the samples (the main pass's pixels) multiplies the share by that instead: light
+// and colour detail finer than the sample spacing (a shadow's or a light's edge, pores) keeps the sharpness the
+// narrow lobes give it, where interpolating the samples' sums would draw it as a staircase of the tessellation.
+// Samples that are not convolved get share 1 and return 0.
 std::vector<glm::vec3> convolveSurface(const SurfaceSamples& samples, const std::vector<glm::vec3>& irradiance,
                                        const sss::RadialProfile& profile, const ConvolutionSettings& settings = {},
                                        const std::vector<std::uint32_t>* receivers = nullptr,
-                                       ConvolutionReport* report = nullptr);
+                                       ConvolutionReport* report = nullptr,
+                                       std::vector<glm::vec3>* ownShare = nullptr);
 
 } // namespace skinlab::renderer::reference

@@ -5,9 +5,11 @@
 // fragments (the front and back faces meeting at a silhouette) the closest match wins: it is written as the
 // fragment depth and tested LESS against a depth buffer of the draw's own. Where nothing matches (a non-skin
 // occluder, the background) the output keeps the main pass's diffuse.
-// Output = mask · convolved + (1 − mask) · main-pass diffuse, so partly skin pixels blend like the screen-space
-// methods' output; alpha keeps the diffuse buffer's (the mask).
-in vec3 scatteredDiffuse;
+// Convolved = far field + own share × the main pass's diffuse E·α at this pixel (the near field at the pixel's
+// resolution, not the tessellation's). Output = mask · convolved + (1 − mask) · main-pass diffuse, so partly skin
+// pixels blend like the screen-space methods' output; alpha keeps the diffuse buffer's (the mask).
+in vec3 scatteredFar;
+in vec3 ownShare;
 in float viewDepth;
 
 layout(location = 0) out vec4 outColor;
@@ -26,5 +28,6 @@ void main() {
     gl_FragDepth = mismatch / allowed * 0.5;  // in [0, 0.5]: the buffer is cleared to 1
     vec4 base = texelFetch(diffuse, pixel, 0);
     float m = clamp(texelFetch(mask, pixel, 0).r, 0.0, 1.0);
+    vec3 scatteredDiffuse = scatteredFar + ownShare * base.rgb;
     outColor = vec4(mix(base.rgb, scatteredDiffuse, m), base.a);
 }

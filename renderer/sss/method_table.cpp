@@ -74,7 +74,7 @@ std::vector<MethodInfo> builtInRows() {
          Execution::ObjectSpace,
          "object-space SSS on the tessellated surface (the ground truth of the metrics)",
          {"profile", "material", "reference_edge_mm", "reference_through_gain", "reference_through_growth_per_mm2",
-          "reference_non_skin", "reference_convexity_mm"},
+          "reference_non_skin", "reference_convexity_mm", "reference_near_field"},
          {},
          {},
          makeReferenceMethod()},

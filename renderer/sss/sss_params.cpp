@@ -216,6 +216,14 @@ std::vector<SssKey>& sharedSssKeys() {
                   "mm",
                   "reference: per-channel length L of the convex-surface gain 1 + L κ, L at width_mm 3"},
                  &SssParams::referenceConvexityMm),
+        boundKey({"reference_near_field",
+                  KeyType::Choice,
+                  0,
+                  0,
+                  {"vertex", "pixel"},
+                  "",
+                  "reference: the near field summed at the vertices or drawn at the pixels (sharp light edges)"},
+                 &SssParams::referenceNearField),
     };
     return table;
 }

@@ -163,6 +163,12 @@ struct SssParams {
     // default): a level-neutral reference, as every screen-space method is; the fit to the path tracer's level on a
     // sphere is in docs/pathtraced.md, "A convex body's level".
     std::array<double, 3> referenceConvexityMm{0.0, 0.0, 0.0};
+    // reference method: where the near field is drawn: "vertex" (every source's light, the receiver's own included,
+    // summed at the vertices and interpolated across the triangles: detail finer than the edge length is lost) or
+    // "pixel" (the receiver's own term and sources closer than half the edge length, the profile's narrow lobes,
+    // multiply the main pass's E·α at every pixel: a sharp light edge or pore keeps the sharpness those lobes give
+    // it instead of a staircase of the tessellation). renderer/reference/surface_convolution.h, ownShare.
+    std::string referenceNearField = "vertex";
     // Values of the keys a method declares in its own row (MethodInfo::ownKeys), by key; absent: the declared
     // default. The built-in methods' keys are the typed fields above.
     nlohmann::json own = nlohmann::json::object();

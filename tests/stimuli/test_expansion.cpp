@@ -499,7 +499,7 @@ TEST(ShippedSpecs, ExpandToTheDocumentedCounts) {
     std::vector<Stimulus> demo = expand(readSetSpec(dir / "demo.toml"));
     fs::remove_all(headlessFolder());
     EXPECT_EQ(demo.front().id, "head-face-none");
-    EXPECT_EQ(demo.back().id, "bleed-true-mask-patches-reference"); // the references come last
+    EXPECT_EQ(demo.back().id, "bleed-true-mask-edge-patches-reference"); // the references come last
     // Three blocks (the face, the silhouette and the patches), each with one reference and its own presentation.
     std::map<std::string, int> references;
     for (const Stimulus& st : demo) references[st.block] += st.reference ? 1 : 0;

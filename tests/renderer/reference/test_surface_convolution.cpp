@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -190,6 +191,52 @@ TEST(SurfaceConvolution, ConvergesAsSampleDensityGrows) {
     }
     for (std::size_t k = 1; k < rms.size(); ++k) EXPECT_LT(rms[k], rms[k - 1]) << k;
     EXPECT_LT(worst.back(), 0.01); // radiance ≤ albedo < 1: 1 mm is within 1 % of white of 0.5 mm
+}
+
+TEST(SurfaceConvolution, TheOwnShareSplitsOffTheNearFieldExactly) {
+    // builtin:halo's sphere at 1 mm edges under a light with a step (a spot's hard edge) and the convex-surface
+    // gain: with the own term alone, far + share · E·α equals the whole sum at every receiver; with the near field
+    // of half the edge length (as the reference draws), each share lies in [0, 1 + L_c / R] and holds at least the weight of
+    // d'Eon's σ = 80 µm lobe (0.233 in red, 0.455 green, 0.649 blue), also at the poles' small triangles and along
+    // the seam's twin vertices. Samples that are not convolved return 0 with share 1.
+    const Model halo = tessellateSkin(makeHaloScene(200.0f), 1.0f, 1.0f);
+    const SurfaceSamples samples = gatherSurfaceSamples(halo, 1.0f);
+    const auto profile = makeRadialProfile(profileParams("deon"));
+    std::vector<std::uint32_t> receivers;
+    for (std::uint32_t i = 0; i < samples.size(); i += 5)
+        if (samples.skin[i] && glm::length(samples.positionMm[i]) < kHaloSphereRadiusMm + 0.5f) receivers.push_back(i);
+    ASSERT_GT(receivers.size(), 100u);
+    std::vector<glm::vec3> irradiance(samples.size());
+    for (std::size_t i = 0; i < samples.size(); ++i)
+        irradiance[i] = samples.positionMm[i].x > 3.0f ? glm::vec3(1.0f, 0.9f, 0.8f) : glm::vec3(0.05f);
+    ConvolutionSettings settings;
+    settings.convexityMm = {0.88, 0.32, 0.28};
+    const auto whole = convolveSurface(samples, irradiance, *profile, settings, &receivers);
+    std::vector<glm::vec3> share;
+    const auto far = convolveSurface(samples, irradiance, *profile, settings, &receivers, nullptr, &share);
+    ASSERT_EQ(share.size(), samples.size());
+    const glm::vec3 narrowLobe(0.233f, 0.455f, 0.649f);
+    double worst = 0.0;
+    for (const std::uint32_t i : receivers)
+        for (int c = 0; c < 3; ++c) {
+            const double recombined = far[i][c] + share[i][c] * irradiance[i][c] * samples.albedo[i][c];
+            worst = std::max(worst, std::abs(recombined - whole[i][c]));
+        }
+    EXPECT_LT(worst, 1e-6);
+    settings.nearFieldMm = 0.5;
+    std::vector<glm::vec3> nearShare;
+    convolveSurface(samples, irradiance, *profile, settings, &receivers, nullptr, &nearShare);
+    for (const std::uint32_t i : receivers)
+        for (int c = 0; c < 3; ++c) {
+            EXPECT_GE(nearShare[i][c], narrowLobe[c]) << i << " " << c;
+            // at most all of the weight, times the convex-surface gain 1 + L_c / R
+            EXPECT_LE(nearShare[i][c], 1.0 + settings.convexityMm[static_cast<std::size_t>(c)] / kHaloSphereRadiusMm + 1e-3)
+                << i << " " << c;
+        }
+    std::uint32_t untouched = 0;
+    while (std::find(receivers.begin(), receivers.end(), untouched) != receivers.end()) ++untouched;
+    EXPECT_EQ(far[untouched], glm::vec3(0.0f));
+    EXPECT_EQ(share[untouched], glm::vec3(1.0f));
 }
 
 TEST(SurfaceConvolution, OnlySkinScattersAndReceives) {
