@@ -289,9 +289,8 @@ void ReferenceMethod::run(const ReferenceInputs& inputs, const sss::SssParams& p
     // With "vertex" every share is 0 and the far field holds the whole sum.
     const bool nearAtPixels = params.referenceNearField == "pixel";
     std::vector<glm::vec3> ownShare;
-    const std::vector<glm::vec3> convolved = reference::convolveSurface(samples, radiance, *profile, convolution,
-                                                                        nullptr, &report,
-                                                                        nearAtPixels ? &ownShare : nullptr);
+    const std::vector<glm::vec3> convolved = reference::convolveSurface(
+        samples, radiance, *profile, convolution, nullptr, &report, nearAtPixels ? &ownShare : nullptr);
     if (!nearAtPixels) ownShare.assign(vertexCount, glm::vec3(0.0f));
     const double convolveMs = millisecondsSince(convolveStart);
 

@@ -79,8 +79,8 @@ struct Convolution {
         std::array<double, 3> weightSum{0.0, 0.0, 0.0};
         double curvatureSum = 0.0, curvatureWeight = 0.0; // the kernel-weighted curvature at p (convexityMm)
         double farWeight = 0.0;                           // the kernel weight of a thin part's far side
-        std::array<double, 3> self{0.0, 0.0, 0.0};       // Σ_near K_c(p, q) · E_c α_c: the near field (ownShare)
-        std::array<double, 3> selfWeight{0.0, 0.0, 0.0}; // Σ_near K_c(p, q)
+        std::array<double, 3> self{0.0, 0.0, 0.0};        // Σ_near K_c(p, q) · E_c α_c: the near field (ownShare)
+        std::array<double, 3> selfWeight{0.0, 0.0, 0.0};  // Σ_near K_c(p, q)
         std::size_t count = 0;
         sources.forEachWithin(centre, static_cast<float>(cutoff), [&](std::uint32_t q) {
             bool facing = true;
@@ -213,9 +213,8 @@ std::vector<glm::vec3> convolveSurface(const SurfaceSamples& samples, const std:
         constexpr std::size_t chunk = 256;
         for (std::size_t begin = next.fetch_add(chunk); begin < targets.size(); begin = next.fetch_add(chunk))
             for (std::size_t t = begin; t < std::min(begin + chunk, targets.size()); ++t)
-                output[targets[t]] =
-                    convolution.at(targets[t], irradiance[targets[t]] * samples.albedo[targets[t]], sourceCounts[t],
-                                   ownShare ? &(*ownShare)[targets[t]] : nullptr);
+                output[targets[t]] = convolution.at(targets[t], irradiance[targets[t]] * samples.albedo[targets[t]],
+                                                    sourceCounts[t], ownShare ? &(*ownShare)[targets[t]] : nullptr);
     };
     std::vector<std::thread> pool;
     for (unsigned i = 1; i < threads; ++i) pool.emplace_back(worker);

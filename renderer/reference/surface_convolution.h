@@ -104,7 +104,6 @@ struct ConvolutionReport {
 std::vector<glm::vec3> convolveSurface(const SurfaceSamples& samples, const std::vector<glm::vec3>& irradiance,
                                        const sss::RadialProfile& profile, const ConvolutionSettings& settings = {},
                                        const std::vector<std::uint32_t>* receivers = nullptr,
-                                       ConvolutionReport* report = nullptr,
-                                       std::vector<glm::vec3>* ownShare = nullptr);
+                                       ConvolutionReport* report = nullptr, std::vector<glm::vec3>* ownShare = nullptr);
 
 } // namespace skinlab::renderer::reference

@@ -230,7 +230,8 @@ TEST(SurfaceConvolution, TheOwnShareSplitsOffTheNearFieldExactly) {
         for (int c = 0; c < 3; ++c) {
             EXPECT_GE(nearShare[i][c], narrowLobe[c]) << i << " " << c;
             // at most all of the weight, times the convex-surface gain 1 + L_c / R
-            EXPECT_LE(nearShare[i][c], 1.0 + settings.convexityMm[static_cast<std::size_t>(c)] / kHaloSphereRadiusMm + 1e-3)
+            EXPECT_LE(nearShare[i][c],
+                      1.0 + settings.convexityMm[static_cast<std::size_t>(c)] / kHaloSphereRadiusMm + 1e-3)
                 << i << " " << c;
         }
     std::uint32_t untouched = 0;
