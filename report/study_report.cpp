@@ -336,13 +336,17 @@ Metrics readMetrics(const ReportOptions& options, const fs::path& stimuliFolder,
             metricsFolder = out / "metrics";
             metrics::MetricsRunOptions metricOptions;
             // One viewing geometry: the display the set's predictions were made for (docs/metrics.md).
-            metrics::CvvdpDisplayOverrides overrides;
-            overrides.pixelsPerDegree = options.pixelsPerDegree;
-            metricOptions.metric.display =
-                metrics::applyCvvdpOverrides(metrics::cvvdpDisplay(plan.display.value_or("standard_fhd")), overrides);
-            metricOptions.displaySource =
-                plan.display ? "the set's predictions (manifest.json predicted.display)" : "default";
-            if (options.pixelsPerDegree) metricOptions.displaySource += " with --ppd";
+            // --display names another model; --ppd and --display-* change it.
+            metricOptions.metric.display = metrics::applyCvvdpOverrides(
+                metrics::cvvdpDisplay(options.display.value_or(plan.display.value_or("standard_fhd"))),
+                options.displayChanges);
+            metricOptions.displaySource = options.display ? "--display"
+                                          : plan.display  ? "the set's predictions (manifest.json predicted.display)"
+                                                          : "default";
+            metrics::CvvdpDisplayOverrides beyondPpd = options.displayChanges;
+            beyondPpd.pixelsPerDegree.reset();
+            if (options.displayChanges.any())
+                metricOptions.displaySource += beyondPpd.any() ? " with --display-*/--ppd changes" : " with --ppd";
             spdlog::info("report: image metrics of {} stimuli against their block's reference", plan.jobs.size());
             metrics::runMetrics(plan, metricOptions, metricsFolder);
             // The references, for the stimulus section.
