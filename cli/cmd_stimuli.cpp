@@ -113,7 +113,7 @@ void runList(const StimuliOptions& o) {
     if (o.format == "json") {
         nlohmann::json out = nlohmann::json::array();
         for (size_t i = 0; i < plan.selected.size(); ++i)
-            out.push_back(stimuli::stimulusEntry(plan.selected[i], plan.resolved[i]));
+            out.push_back(stimuli::plannedEntryJson(plan.selected[i], plan.resolved[i]));
         std::cout << out.dump(2) << "\n";
         return;
     }

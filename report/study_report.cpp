@@ -11,6 +11,7 @@
 #include "common/html.h"
 #include "common/version.h"
 #include "experiments/study_store.h"
+#include "formats/stimulus_manifest.h"
 #include "report/prediction_section.h"
 #include "report/report_plots.h"
 
@@ -285,18 +286,13 @@ StimulusImages copyStimuli(const experiments::StudyDefinition& definition, const
         }
         cropOfBlock[block.name] = cropWhereTheyDiffer(images, names, out, slug(block.name));
     }
-    try {
-        const nlohmann::json manifest = nlohmann::json::parse(readFile(stimuliFolder / "manifest.json"));
-        for (const nlohmann::json& s : manifest.value("stimuli", nlohmann::json::array())) {
-            if (!s.value("reference", false) || !s.contains("files") || !s["files"].contains("png")) continue;
-            std::string block = s.value("block", ""), id = s.value("id", "");
-            if (!imagesOfBlock.count(block) || referenceOfBlock.count(block)) continue;
-            std::string file = "stimuli/" + slug(id) + ".png";
-            copyFileAtomic(stimuliFolder / s["files"]["png"].get<std::string>(), out / file);
-            referenceOfBlock[block] = {"reference", id, file};
-        }
-    } catch (const nlohmann::json::exception& e) {
-        throwInput((stimuliFolder / "manifest.json").string(), "", std::string("not valid JSON (") + e.what() + ")");
+    // The set's manifest, by the one strict reader of contract 2 (formats/stimulus_manifest.h).
+    for (const formats::ManifestEntry& s : formats::readStimulusManifest(stimuliFolder).stimuli) {
+        if (!s.reference || s.files.png.empty()) continue;
+        if (!imagesOfBlock.count(s.block) || referenceOfBlock.count(s.block)) continue;
+        std::string file = "stimuli/" + slug(s.id) + ".png";
+        copyFileAtomic(stimuliFolder / s.files.png, out / file);
+        referenceOfBlock[s.block] = {"reference", s.id, file};
     }
     return stimuli;
 }
@@ -979,9 +975,8 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
         predictionAgreement(definition, storedManifest, scale.analysis, &scale.dataset,
                             {options.bootstrapSamples, options.seed, scale.options.bootstrap.level, scale.options.fit});
     std::string predictionDisplay;
-    for (const nlohmann::json& s : storedManifest.value("stimuli", nlohmann::json::array()))
-        if (s.contains("predicted") && s["predicted"].contains("display"))
-            predictionDisplay = s["predicted"]["display"].get<std::string>();
+    for (const formats::ManifestEntry& s : storedManifestEntries(storedManifest))
+        if (s.predicted) predictionDisplay = s.predicted->display;
 
     const ReportData data{options,         store,          definition,  simulated,        stimuliFolder,
                           participants,    scale,          stimuli,     metrics,          agreementOptions,
