@@ -2,6 +2,7 @@
 
 #include "analysis/agreement/metric_agreement.h"
 #include "analysis/metrics/metrics_run.h"
+#include "analysis/scaling/responses.h"
 #include "analysis/scaling/screening.h"
 #include "analysis/scaling/scale_analysis.h"
 #include "analysis/scaling/scale_report.h"
@@ -179,30 +180,21 @@ Participants readParticipants(experiments::StudyStore& store, const ReportOption
         p.index[o.label] = p.observers.size();
         p.observers.push_back(o);
     }
-    const std::vector<experiments::ResponseRow> rows = store.responses();
-    p.table.file = options.study.string();
-    p.table.format = scaling::ResponseFormat::StudyDatabase;
-    p.table.adaptiveDesign = store.definition().design.activePairs;
-    // Conditions in design order, as `analyze scale` and the dashboard list them.
-    for (const experiments::StudyBlock& block : store.definition().blocks)
-        p.table.designConditionOrder[block.name] = block.conditions;
-    int line = 0;
-    for (const experiments::ResponseRow& row : rows) {
-        ++line;
+    // The browsers' viewports and pixel ratios, from the store's rows.
+    for (const experiments::ResponseRow& row : store.responses()) {
         p.viewports.insert({row.viewportWidth, row.viewportHeight});
         p.pixelRatios.insert(row.devicePixelRatio);
-        scaling::Response r;
-        r.observer = row.observer;
-        r.block = row.scene;
-        r.conditionA = row.conditionA;
-        r.conditionB = row.conditionB;
-        r.aSelected = row.aSelected;
-        r.aOnLeft = row.aOnLeft;
-        r.correct = row.correct;
-        r.responseMs = row.responseMs;
-        r.line = line;
-        r.kind = row.kind; // experiments' trial kinds are the analysis' (experiments/trial_plan.h)
-        p.table.responses.push_back(r);
+    }
+    // The responses by the one reader of a study file's rows (analysis/scaling/responses.h: the view
+    // responses_long), as `analyze scale` and the dashboard read them.
+    if (store.responseCount() > 0) {
+        p.table = scaling::readResponses(options.study);
+    } else {
+        p.table.file = options.study.string();
+        p.table.format = scaling::ResponseFormat::StudyDatabase;
+        p.table.adaptiveDesign = store.definition().design.activePairs;
+        for (const experiments::StudyBlock& block : store.definition().blocks)
+            p.table.designConditionOrder[block.name] = block.conditions;
     }
     std::set<std::string> answering;
     for (const scaling::Response& r : p.table.responses) answering.insert(r.observer);
