@@ -146,14 +146,15 @@ ManifestEntry manifestEntryFromJson(const nlohmann::json& json, const std::strin
     if (auto predicted = m.optionalObject("predicted")) {
         const Members p(*predicted, file, m.key("predicted"));
         Prediction prediction;
-        prediction.metric = p.string("metric");
-        prediction.display = p.string("display");
-        prediction.reference = p.string("reference");
         const nlohmann::json& jod = p.required("jod");
         if (!jod.is_number()) throwInput(file, p.key("jod"), "expected a number, not " + jod.dump());
         prediction.jod = jod.get<double>();
-        prediction.referencePngSha256 = p.string("reference_png_sha256");
-        prediction.pngSha256 = p.string("png_sha256");
+        // `stimuli build` writes them all; a prediction written by other tools may carry only its JOD.
+        prediction.metric = p.optionalString("metric");
+        prediction.display = p.optionalString("display");
+        prediction.reference = p.optionalString("reference");
+        prediction.referencePngSha256 = p.optionalString("reference_png_sha256");
+        prediction.pngSha256 = p.optionalString("png_sha256");
         e.predicted = prediction;
     }
     return e;

@@ -23,7 +23,8 @@ struct StimulusFiles {
     bool operator==(const StimulusFiles&) const = default;
 };
 
-// "predicted": ColorVideoVDP of the presented PNG against its block's reference (stimuli/prediction.h).
+// "predicted": ColorVideoVDP of the presented PNG against its block's reference (stimuli/prediction.h). Only the
+// JOD is required; the strings are "" when absent.
 struct Prediction {
     std::string metric;  // "ColorVideoVDP v0.5.6"
     std::string display; // display model

@@ -208,7 +208,8 @@ std::vector<ParticipantPrediction> participantPredictions(const nlohmann::json& 
     for (const formats::ManifestEntry& s : entries)
         if (s.predicted && pngOf.count(s.predicted->reference))
             predicted.push_back(
-                {s.block, s.files.png, pngOf[s.predicted->reference], s.predicted->display, s.predicted->jod});
+                {s.block, s.files.png, pngOf[s.predicted->reference],
+                 s.predicted->display.empty() ? std::string("standard_fhd") : s.predicted->display, s.predicted->jod});
     if (predicted.empty()) return out;
     std::map<std::string, metrics::MetricRender> images;
     auto image = [&](const std::string& png) -> const cv::Mat& {

@@ -968,7 +968,7 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
                             {options.bootstrapSamples, options.seed, scale.options.bootstrap.level, scale.options.fit});
     std::string predictionDisplay;
     for (const formats::ManifestEntry& s : storedManifestEntries(storedManifest))
-        if (s.predicted) predictionDisplay = s.predicted->display;
+        if (s.predicted && !s.predicted->display.empty()) predictionDisplay = s.predicted->display;
 
     const ReportData data{options,         store,          definition,  simulated,        stimuliFolder,
                           participants,    scale,          stimuli,     metrics,          agreementOptions,

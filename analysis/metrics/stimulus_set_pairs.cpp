@@ -65,7 +65,7 @@ ComparisonPlan planStimulusSetComparisons(const fs::path& stimulusFolder,
                 throwInput(path.string(), "",
                            "sha256 does not match " + file + " (the file changed after the set was built)");
         // The display the set's predictions were made for: one viewing geometry per set.
-        if (stimulus.predicted) {
+        if (stimulus.predicted && !stimulus.predicted->display.empty()) {
             const std::string& named = stimulus.predicted->display;
             if (display && *display != named)
                 throwInput(file, where + "predicted.display",
