@@ -334,8 +334,9 @@ void addSimulate(CLI::App& study) {
     CLI::App* simulate = study.add_subcommand("simulate", "Run simulated Thurstone observers through the server");
     simulate->add_option("study", a->study, "study.db (the one the server serves)")->required();
     // Required, checked in the callback so that the old spelling `--observers N` gets its own one-line error.
-    CLI::Option* count = simulate->add_option("--observer-count", o.observers, "Number of simultaneous observers")
-                             ->check(CLI::Range(1, 5000));
+    CLI::Option* count =
+        simulate->add_option("--observer-count", o.observers, "Number of simultaneous observers (required)")
+            ->check(CLI::Range(1, 5000));
     simulate->add_option("--observers", a->observersList)->group(""); // hidden: the old spelling, an error
     addTruthOptions(*simulate, a->truth,
                     "True scores in JOD: \"predicted\" (each stimulus's predicted JOD in the manifest), or a JSON "
