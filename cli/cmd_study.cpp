@@ -234,8 +234,7 @@ void runSimulate(const SimulateArguments& o) {
     else
         std::printf("response latency: p50 %.2f ms, p99 %.2f ms\n", report.latencyPercentile(50),
                     report.latencyPercentile(99));
-    if (report.completed() != options.observers)
-        throw RuntimeError("not every simulated observer completed the study");
+    if (report.completed() != options.observers) throw RuntimeError("not every simulated observer completed the study");
 }
 
 void runStatus(const StudyFileArguments& o) {
@@ -367,7 +366,8 @@ void addPlan(CLI::App& study) {
     CLI::App* plan = study.add_subcommand(
         "plan", "Observers needed for the predicted differences to come out significant (power by simulation)");
     plan->add_option("study", a->study, "study.db")->required();
-    addTruthOptions(*plan, a->truth, "True scores: \"predicted\" (default: the manifest's predicted JODs) or a JSON file");
+    addTruthOptions(*plan, a->truth,
+                    "True scores: \"predicted\" (default: the manifest's predicted JODs) or a JSON file");
     plan->add_option("--observers", a->plan.observerCounts, "Observer counts to simulate, e.g. 10,20,40")
         ->delimiter(',')
         ->check(CLI::Range(2, 10000));
@@ -383,7 +383,9 @@ void addStatus(CLI::App& study) {
     auto a = std::make_shared<StudyFileArguments>();
     CLI::App* status = study.add_subcommand("status", "Per-participant progress and catch-trial accuracy");
     status->add_option("study", a->study, "study.db")->required();
-    status->add_option("--format", a->format, "text or json")->check(CLI::IsMember({"text", "json"}))->default_val("text");
+    status->add_option("--format", a->format, "text or json")
+        ->check(CLI::IsMember({"text", "json"}))
+        ->default_val("text");
     status->callback([a] { runStatus(*a); });
 }
 

@@ -8,7 +8,6 @@
 
 namespace skinlab::cli {
 
-
 CLI::Option* addAssetsOption(CLI::App& command, std::string& assets) {
     return command.add_option("--assets", assets,
                               "Folder of the shared assets that assets: paths name (default $SKINLAB_ASSETS)");
@@ -85,7 +84,8 @@ void addDisplayOptions(CLI::App& command, DisplayArguments& display, const std::
                        "Pixels per degree of visual angle of the viewing geometry, for FLIP and ColorVideoVDP alike "
                        "(the same as --display-ppd; default: the display's)");
     metrics::CvvdpDisplayOverrides& o = display.overrides;
-    command.add_option("--display-ppd", o.pixelsPerDegree, "Custom display: pixels per degree (overrides the geometry)");
+    command.add_option("--display-ppd", o.pixelsPerDegree,
+                       "Custom display: pixels per degree (overrides the geometry)");
     command.add_option("--display-resolution", display.resolution,
                        "Custom display: resolution WIDTHxHEIGHT in pixels (with the diagonal and distance: ppd)");
     command.add_option("--display-diagonal-in", o.diagonalInches, "Custom display: diagonal in inches");

@@ -20,10 +20,10 @@ CLI::Option* addOverridesOption(CLI::App& command, std::vector<std::string>& ove
 // The viewing geometry of display-referred metrics (FLIP, ColorVideoVDP): a named display model, changed by
 // --display-* (a custom display) and --ppd. `overrides` is the metrics library's own struct.
 struct DisplayArguments {
-    std::optional<std::string> name;            // --display
+    std::optional<std::string> name;                   // --display
     skinlab::metrics::CvvdpDisplayOverrides overrides; // --display-ppd, --display-diagonal-in, ...
-    std::optional<std::string> resolution;      // --display-resolution WIDTHxHEIGHT
-    std::optional<double> pixelsPerDegree;      // --ppd (the same as --display-ppd)
+    std::optional<std::string> resolution;             // --display-resolution WIDTHxHEIGHT
+    std::optional<double> pixelsPerDegree;             // --ppd (the same as --display-ppd)
 
     // True when --ppd or any --display-* changes the display model.
     bool changed() const;

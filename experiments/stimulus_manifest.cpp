@@ -35,7 +35,8 @@ StimulusManifest readStimulusManifest(const fs::path& folder) {
         s.reference = entry.reference;
         s.width = entry.width;
         s.height = entry.height;
-        for (auto it = entry.factors.begin(); it != entry.factors.end(); ++it) s.factors[it.key()] = entry.factorText(it.key());
+        for (auto it = entry.factors.begin(); it != entry.factors.end(); ++it)
+            s.factors[it.key()] = entry.factorText(it.key());
         manifest.stimuli.push_back(std::move(s));
     }
     return manifest;

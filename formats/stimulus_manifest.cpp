@@ -89,9 +89,12 @@ std::string ManifestEntry::factorText(const std::string& name) const {
 }
 
 nlohmann::json toJson(const Prediction& p) {
-    return {{"metric", p.metric},   {"display", p.display},
-            {"reference", p.reference}, {"jod", p.jod},
-            {"reference_png_sha256", p.referencePngSha256}, {"png_sha256", p.pngSha256}};
+    return {{"metric", p.metric},
+            {"display", p.display},
+            {"reference", p.reference},
+            {"jod", p.jod},
+            {"reference_png_sha256", p.referencePngSha256},
+            {"png_sha256", p.pngSha256}};
 }
 
 nlohmann::json toJson(const ManifestEntry& e) {

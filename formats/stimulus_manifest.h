@@ -45,9 +45,9 @@ struct ManifestEntry {
     bool reference = false;
     int width = 0; // the presented size (the PNG's), in [1, 16384]; required with a PNG
     int height = 0;
-    std::string scene;                                  // the `scene` factor's level ("" when none)
-    std::vector<std::string> overrides;                 // the scene overrides of the stimulus
-    nlohmann::json resolved = nlohmann::json::object(); // every resolved scene parameter ({} for imported images)
+    std::string scene;                                   // the `scene` factor's level ("" when none)
+    std::vector<std::string> overrides;                  // the scene overrides of the stimulus
+    nlohmann::json resolved = nlohmann::json::object();  // every resolved scene parameter ({} for imported images)
     nlohmann::json timingsMs = nlohmann::json::object(); // the renderer's per-pass timings, stimulus_wall
     std::optional<nlohmann::json> presentation;          // rendered sets: the crop and magnification shown
     std::optional<Prediction> predicted;

@@ -207,9 +207,9 @@ std::vector<ParticipantPrediction> participantPredictions(const nlohmann::json& 
     std::vector<Predicted> predicted;
     for (const formats::ManifestEntry& s : entries)
         if (s.predicted && pngOf.count(s.predicted->reference))
-            predicted.push_back(
-                {s.block, s.files.png, pngOf[s.predicted->reference],
-                 s.predicted->display.empty() ? std::string("standard_fhd") : s.predicted->display, s.predicted->jod});
+            predicted.push_back({s.block, s.files.png, pngOf[s.predicted->reference],
+                                 s.predicted->display.empty() ? std::string("standard_fhd") : s.predicted->display,
+                                 s.predicted->jod});
     if (predicted.empty()) return out;
     std::map<std::string, metrics::MetricRender> images;
     auto image = [&](const std::string& png) -> const cv::Mat& {

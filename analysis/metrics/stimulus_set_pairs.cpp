@@ -59,8 +59,8 @@ ComparisonPlan planStimulusSetComparisons(const fs::path& stimulusFolder,
         entry.reference = stimulus.reference;
         entry.factors = stimulus.factors;
         // The content hash ties the metrics to the set as built; a changed file is not silently measured.
-        for (const auto& [path, expected] : {std::pair<fs::path, std::string>{entry.exr, stimulus.sha256.exr},
-                                             {entry.png, stimulus.sha256.png}})
+        for (const auto& [path, expected] :
+             {std::pair<fs::path, std::string>{entry.exr, stimulus.sha256.exr}, {entry.png, stimulus.sha256.png}})
             if (!path.empty() && fs::is_regular_file(path, ec) && sha256File(path) != expected)
                 throwInput(path.string(), "",
                            "sha256 does not match " + file + " (the file changed after the set was built)");

@@ -265,9 +265,9 @@ TEST(StudyCli, KillNineDuringASessionLosesAndDuplicatesNothing) {
     EXPECT_EQ(check.text(0), "ok");
 
     // The CLI's own simulate, status and export work against the restarted server.
-    CommandResult simulated = runSkinlab({"study", "simulate", files.database.string(), "--observer-count", "2", "--url",
-                                          "http://127.0.0.1:" + std::to_string(port), "--truth-factor", "quality",
-                                          "--lapse", "0.1", "--label-prefix", "cli"});
+    CommandResult simulated = runSkinlab({"study", "simulate", files.database.string(), "--observer-count", "2",
+                                          "--url", "http://127.0.0.1:" + std::to_string(port), "--truth-factor",
+                                          "quality", "--lapse", "0.1", "--label-prefix", "cli"});
     EXPECT_EQ(simulated.exitCode, 0) << simulated.out << simulated.err;
     EXPECT_NE(simulated.out.find("2/2 observers completed, 54 responses acknowledged, 0 rejected"), std::string::npos)
         << simulated.out;

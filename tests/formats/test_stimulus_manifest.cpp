@@ -77,12 +77,8 @@ TEST(StimulusManifestEntry, ErrorsNameFileKeyAndValue) {
     EXPECT_EQ(failure([](nlohmann::json& e) { e["sha256"].erase("png"); }),
               "set/manifest.json: stimuli[3].sha256.png: missing");
     // A hand-made set of renders without presented images is read; its entries have no PNG.
-    const ManifestEntry renders =
-        manifestEntryFromJson({{"id", "a"},
-                               {"files", {{"exr", "exr/a.exr"}}},
-                               {"sha256", {{"exr", "aa"}}},
-                               {"block", "b"}},
-                              "m.json", 0);
+    const ManifestEntry renders = manifestEntryFromJson(
+        {{"id", "a"}, {"files", {{"exr", "exr/a.exr"}}}, {"sha256", {{"exr", "aa"}}}, {"block", "b"}}, "m.json", 0);
     EXPECT_EQ(renders.files.png, "");
 }
 

@@ -66,8 +66,8 @@ TEST(PredictionSection, ParticipantsOwnPixelsPerDegreeMovesThePredictions) {
         entry->height = 96;
     }
     reference.reference = true;
-    test.predicted = skinlab::formats::Prediction{"ColorVideoVDP v0.5.6", "standard_fhd", "ref", predicted,
-                                                  std::string(64, '0'), std::string(64, '0')};
+    test.predicted = skinlab::formats::Prediction{"ColorVideoVDP v0.5.6", "standard_fhd",      "ref", predicted,
+                                                  std::string(64, '0'),   std::string(64, '0')};
     const nlohmann::json manifest = {
         {"stimuli", {skinlab::formats::toJson(reference), skinlab::formats::toJson(test)}}};
     const auto rows = skinlab::report::participantPredictions(

@@ -535,17 +535,17 @@ protected:
     void configure(TuneOptions& options) override {
         const auto set = work_ / "set";
         std::filesystem::create_directories(set);
-        const json manifest = {{"format", "skinlab-stimuli"},
-                               {"version", 1},
-                               {"set", "demo"},
-                               {"stimuli",
-                                {manifestEntry("head-mid-separable",
-                                               {{"scene", "builtin:head"},
-                                                {"factors", {{"method", "separable"}}},
-                                                {"reference", false},
-                                                {"overrides",
-                                                 {"render.width=160", "render.height=90", "camera.view=\"mid\"",
-                                                  "sss.method=\"separable\"", "sss.width_mm=2.5"}}})}}};
+        const json manifest = {
+            {"format", "skinlab-stimuli"},
+            {"version", 1},
+            {"set", "demo"},
+            {"stimuli",
+             {manifestEntry("head-mid-separable", {{"scene", "builtin:head"},
+                                                   {"factors", {{"method", "separable"}}},
+                                                   {"reference", false},
+                                                   {"overrides",
+                                                    {"render.width=160", "render.height=90", "camera.view=\"mid\"",
+                                                     "sss.method=\"separable\"", "sss.width_mm=2.5"}}})}}};
         std::ofstream(set / "manifest.json") << manifest.dump(1);
         options.stimulusSets = {set};
     }
