@@ -122,9 +122,13 @@ ManifestEntry manifestEntryFromJson(const nlohmann::json& json, const std::strin
     e.id = m.string("id");
     const Members files(m.required("files"), file, m.key("files"));
     const Members sha256(m.required("sha256"), file, m.key("sha256"));
-    e.files.exr = files.relativePath("exr");
-    e.sha256.exr = sha256.string("exr");
-    // The presented image: every set skinlab builds or imports has one; a hand-made set of renders may not.
+    // Every set skinlab builds or imports has both files; a hand-made set may list only its renders (what image
+    // metrics read) or only its presented images (what a study shows). Each reader asks for the one it needs.
+    if (!files.find("exr") && !files.find("png")) throwInput(file, m.key("files"), "expected an exr or a png path");
+    if (files.find("exr")) {
+        e.files.exr = files.relativePath("exr");
+        e.sha256.exr = sha256.string("exr");
+    }
     if (files.find("png")) {
         e.files.png = files.relativePath("png");
         e.sha256.png = sha256.string("png");

@@ -37,8 +37,8 @@ struct Prediction {
 
 struct ManifestEntry {
     std::string id;
-    StimulusFiles files;  // relative paths, checked to stay inside the set's folder; png "" when the entry has
-                          // no presented image (a hand-made set of renders; skinlab's sets always have one)
+    StimulusFiles files;  // relative paths, checked to stay inside the set's folder; "" when a hand-made set
+                          // lists no render (exr) or no presented image (png); skinlab's sets have both
     StimulusFiles sha256; // of each file
     nlohmann::json factors = nlohmann::json::object(); // factor name → level (a string or number, as in the spec)
     std::string block;                                 // comparisons only happen within a block

@@ -54,6 +54,8 @@ ComparisonPlan planStimulusSetComparisons(const fs::path& stimulusFolder,
         StimulusEntry entry;
         entry.id = stimulus.id;
         entry.block = stimulus.block;
+        if (stimulus.files.exr.empty())
+            throwInput(file, where + "files.exr", "missing (image metrics read the renders)");
         entry.exr = stimulusFolder / stimulus.files.exr;
         if (!stimulus.files.png.empty()) entry.png = stimulusFolder / stimulus.files.png;
         entry.reference = stimulus.reference;

@@ -80,6 +80,17 @@ TEST(StimulusManifestEntry, ErrorsNameFileKeyAndValue) {
     const ManifestEntry renders = manifestEntryFromJson(
         {{"id", "a"}, {"files", {{"exr", "exr/a.exr"}}}, {"sha256", {{"exr", "aa"}}}, {"block", "b"}}, "m.json", 0);
     EXPECT_EQ(renders.files.png, "");
+    // ... and one of presented images alone (a study shows only those).
+    const ManifestEntry presented = manifestEntryFromJson({{"id", "a"},
+                                                           {"files", {{"png", "png/a.png"}}},
+                                                           {"sha256", {{"png", "bb"}}},
+                                                           {"block", "b"},
+                                                           {"width", 8},
+                                                           {"height", 8}},
+                                                          "m.json", 0);
+    EXPECT_EQ(presented.files.exr, "");
+    EXPECT_EQ(failure([](nlohmann::json& e) { e["files"] = nlohmann::json::object(); }),
+              "set/manifest.json: stimuli[3].files: expected an exr or a png path");
 }
 
 TEST(StimulusManifestFile, ReadsTheFolderStrictly) {

@@ -100,7 +100,7 @@ TEST_F(StimulusSetPairs, ErrorsNameTheManifestAndTheKey) {
                                   "'disc-gaussian'); pick one with --reference ID");
     manifest["stimuli"][2]["reference"] = false;
     manifest["stimuli"][3]["files"].erase("exr");
-    EXPECT_EQ(failureOf(), file + ": stimuli[3].files.exr: missing");
+    EXPECT_EQ(failureOf(), file + ": stimuli[3].files.exr: missing (image metrics read the renders)");
     manifest["format"] = "something-else";
     EXPECT_EQ(failureOf(), file + ": format: expected \"skinlab-stimuli\"");
     fs::remove(folder / "manifest.json");
