@@ -2,14 +2,13 @@
 #include "analysis/metrics/debiased_error.h"
 #include "analysis/metrics/metrics_run.h"
 #include "cli/commands.h"
+#include "cli/options.h"
 #include "common/error.h"
 
-#include <array>
 #include <cmath>
 #include <filesystem>
 #include <memory>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -32,75 +31,9 @@ struct AnalyzeMetricsArguments {
     std::optional<double> sssRadiusMillimetres;
     double heatmapMax = 0.0;
     bool noHeatmaps = false;
-    std::optional<double> pixelsPerDegree;
     std::string encoding = "auto";
-    std::optional<std::string> display;
-    std::optional<double> displayPpd;
-    std::optional<std::string> displayResolution;
-    std::optional<double> displayDiagonal;
-    std::optional<double> displayDistance;
-    std::optional<double> displayPeak;
-    std::optional<double> displayContrast;
-    std::optional<double> displayAmbient;
-    std::optional<double> displayReflectivity;
+    DisplayArguments display; // --display, --ppd, --display-* (cli/options.h)
 };
-
-std::string formatNumber(double value) {
-    std::ostringstream out;
-    out << value;
-    return out.str();
-}
-
-// "WIDTHxHEIGHT" → {width, height}; InputError naming --display-resolution otherwise.
-std::array<int, 2> parseResolution(const std::string& text) {
-    const auto separator = text.find('x');
-    std::array<int, 2> size{0, 0};
-    bool ok = separator != std::string::npos && separator > 0 && separator + 1 < text.size();
-    if (ok) {
-        try {
-            std::size_t used = 0;
-            size[0] = std::stoi(text.substr(0, separator), &used);
-            ok = used == separator;
-            const std::string rest = text.substr(separator + 1);
-            size[1] = std::stoi(rest, &used);
-            ok = ok && used == rest.size();
-        } catch (const std::exception&) {
-            ok = false;
-        }
-    }
-    if (!ok || size[0] <= 0 || size[1] <= 0)
-        throwInput("--display-resolution", "", "\"" + text + "\" must be WIDTHxHEIGHT in pixels, e.g. 1920x1080");
-    return size;
-}
-
-// The one viewing geometry of the run: --display, else the display of the set's predictions (`setDisplay`), else
-// standard_fhd; changed by --display-* and --ppd (FLIP and ColorVideoVDP both use its pixels per degree).
-metrics::CvvdpDisplay displayOf(const AnalyzeMetricsArguments& arguments,
-                                const std::optional<std::string>& setDisplay = std::nullopt) {
-    metrics::CvvdpDisplayOverrides overrides;
-    overrides.pixelsPerDegree = arguments.displayPpd;
-    if (arguments.pixelsPerDegree) {
-        if (!(*arguments.pixelsPerDegree > 0.0) || !std::isfinite(*arguments.pixelsPerDegree))
-            throwInput("--ppd", "", formatNumber(*arguments.pixelsPerDegree) + " must be a positive number");
-        if (arguments.displayPpd && *arguments.displayPpd != *arguments.pixelsPerDegree)
-            throwInput("--ppd", "", "differs from --display-ppd (one viewing geometry: give one of them)");
-        overrides.pixelsPerDegree = arguments.pixelsPerDegree;
-    }
-    if (arguments.displayResolution) overrides.resolution = parseResolution(*arguments.displayResolution);
-    overrides.diagonalInches = arguments.displayDiagonal;
-    overrides.viewingDistanceMetres = arguments.displayDistance;
-    overrides.peakLuminance = arguments.displayPeak;
-    overrides.contrast = arguments.displayContrast;
-    overrides.ambientIlluminance = arguments.displayAmbient;
-    overrides.reflectivity = arguments.displayReflectivity;
-    const std::string name = arguments.display.value_or(setDisplay.value_or("standard_fhd"));
-    return metrics::applyCvvdpOverrides(metrics::cvvdpDisplay(name), overrides);
-}
-
-bool overridesGiven(const AnalyzeMetricsArguments& a) {
-    return a.pixelsPerDegree || a.displayPpd || a.displayResolution || a.displayDiagonal || a.displayDistance ||
-           a.displayPeak || a.displayContrast || a.displayAmbient || a.displayReflectivity;
-}
 
 // --reference-seeds: every test against the path-traced truth without its noise (docs/metrics.md).
 void runDebiased(const AnalyzeMetricsArguments& arguments) {
@@ -134,8 +67,8 @@ void runAnalyzeMetrics(const AnalyzeMetricsArguments& arguments) {
     if (!arguments.referenceSeeds.empty()) return runDebiased(arguments);
     if (!arguments.compareReference.empty()) throwInput("--compare-reference", "", "only with --reference-seeds");
     if (!arguments.compareMetrics.empty()) throwInput("--compare-metrics", "", "only with --reference-seeds");
-    metrics::CvvdpDisplay display = displayOf(arguments); // option errors before any file is read
-    std::string displaySource = arguments.display ? "--display" : "default";
+    metrics::CvvdpDisplay display = arguments.display.resolve(); // option errors before any file is read
+    std::string displaySource = arguments.display.name ? "--display" : "default";
     metrics::ComparisonPlan plan;
     if (!arguments.stimulusFolder.empty()) {
         if (!arguments.tests.empty())
@@ -145,13 +78,13 @@ void runAnalyzeMetrics(const AnalyzeMetricsArguments& arguments) {
         if (!arguments.reference.empty()) referenceId = arguments.reference;
         plan = metrics::planStimulusSetComparisons(arguments.stimulusFolder, referenceId);
         // The set's viewing geometry: the display its predictions were made for, unless --display says otherwise.
-        if (plan.display && !arguments.display) {
-            display = displayOf(arguments, plan.display);
+        if (plan.display && !arguments.display.name) {
+            display = arguments.display.resolve(plan.display);
             displaySource = "the set's predictions (manifest.json predicted.display)";
-        } else if (plan.display && *arguments.display != *plan.display) {
+        } else if (plan.display && *arguments.display.name != *plan.display) {
             spdlog::warn("metrics: the set's predictions are on {}, these metrics on --display {}: their "
                          "ColorVideoVDP will differ from the manifest's predicted JOD",
-                         *plan.display, *arguments.display);
+                         *plan.display, *arguments.display.name);
         }
     } else {
         if (arguments.reference.empty())
@@ -168,7 +101,7 @@ void runAnalyzeMetrics(const AnalyzeMetricsArguments& arguments) {
     options.metric.display = display;
     options.heatmapMax = arguments.heatmapMax;
     options.heatmaps = !arguments.noHeatmaps;
-    if (overridesGiven(arguments)) displaySource += " with --display-*/--ppd changes";
+    if (arguments.display.changed()) displaySource += " with --display-*/--ppd changes";
     options.displaySource = displaySource;
     if (!arguments.stimulusFolder.empty() && arguments.exposure != 1.0)
         throwInput("--exposure", "",
@@ -180,12 +113,6 @@ void runAnalyzeMetrics(const AnalyzeMetricsArguments& arguments) {
                  "FLIP and ColorVideoVDP; display-referred scores on {}",
                  records.size(), arguments.outputFolder, metrics::describeCvvdpDisplay(display), displaySource,
                  presented ? "the presented PNGs" : "the renders");
-}
-
-std::string displayNameList() {
-    std::string list;
-    for (const std::string& name : metrics::cvvdpDisplayNames()) list += (list.empty() ? "" : ", ") + name;
-    return list;
 }
 
 } // namespace
@@ -239,29 +166,12 @@ void registerAnalyzeMetrics(CLI::App& analyze) {
                         "dE00 at the top of the heat map's colour scale (default 0: each map's scale from its own "
                         "data, the 99th percentile rounded up; FLIP and ColorVideoVDP maps always so)");
     command->add_flag("--no-heatmaps", arguments->noHeatmaps, "Write only metrics.csv and metrics.json");
-    command->add_option("--ppd", arguments->pixelsPerDegree,
-                        "Pixels per degree of visual angle of the viewing geometry, for FLIP and ColorVideoVDP alike "
-                        "(the same as --display-ppd; default: the display's)");
     command->add_option("--encoding", arguments->encoding,
                         "How pixel values map to linear light: auto (default: float files linear, 8/16-bit sRGB unless "
                         "the file says linear), srgb, linear");
-    command->add_option("--display", arguments->display,
-                        "Display model, the viewing geometry of FLIP and ColorVideoVDP (default: with --stimuli the "
-                        "display of the set's predictions, else standard_fhd): " +
-                            displayNameList());
-    command->add_option("--display-ppd", arguments->displayPpd,
-                        "Custom display: pixels per degree (overrides the geometry)");
-    command->add_option("--display-resolution", arguments->displayResolution,
-                        "Custom display: resolution WIDTHxHEIGHT in pixels (with the diagonal and distance: ppd)");
-    command->add_option("--display-diagonal-in", arguments->displayDiagonal, "Custom display: diagonal in inches");
-    command->add_option("--display-distance-m", arguments->displayDistance,
-                        "Custom display: viewing distance in metres");
-    command->add_option("--display-peak", arguments->displayPeak, "Custom display: peak luminance in cd/m2");
-    command->add_option("--display-contrast", arguments->displayContrast,
-                        "Custom display: contrast ratio (peak / black level)");
-    command->add_option("--display-ambient", arguments->displayAmbient, "Custom display: ambient light in lux");
-    command->add_option("--display-reflectivity", arguments->displayReflectivity,
-                        "Custom display: reflectivity of the screen (0-1, default 0.005)");
+    addDisplayOptions(*command, arguments->display,
+                      "Display model, the viewing geometry of FLIP and ColorVideoVDP (default: with --stimuli the "
+                      "display of the set's predictions, else standard_fhd)");
     command->callback([arguments] { runAnalyzeMetrics(*arguments); });
 }
 

@@ -1,5 +1,6 @@
 // `skinlab render`: one scene → linear EXR with AOVs (+ display PNG, + timings JSON). docs/rendering.md.
 #include "cli/commands.h"
+#include "cli/options.h"
 #include "common/error.h"
 #include "common/files.h"
 #include "renderer/renderer.h"
@@ -66,15 +67,12 @@ void registerRender(CLI::App& app) {
         "render", "Render one scene to a linear EXR (beauty + AOVs, metadata) and optionally a display PNG");
     render->add_option("--scene", options->scene, "Scene spec (TOML file) or builtin:halo|bleed|ear|head")->required();
     render->add_option("--method", options->method, "SSS method (shorthand for --set sss.method=M)");
-    render->add_option("--set", options->overrides, "Override a spec value: key=value (repeatable)")
-        ->type_name("KEY=VALUE")
-        ->take_all();
+    addOverridesOption(*render, options->overrides, "spec value");
     render->add_option("--width", options->width, "Image width in pixels (shorthand for --set render.width=W)")
         ->check(CLI::Range(16, 8192));
     render->add_option("--height", options->height, "Image height in pixels (shorthand for --set render.height=H)")
         ->check(CLI::Range(16, 8192));
-    render->add_option("--assets", options->assets,
-                       "Folder of the shared assets for assets: paths (default $SKINLAB_ASSETS)");
+    addAssetsOption(*render, options->assets);
     render->add_option("-o,--output", options->exr, "Output EXR (float32, linear, AOV channels)")->required();
     render->add_option("--png", options->png, "Also write a display PNG (tone mapped, sRGB)");
     render->add_option("--timings", options->timings, "Write per-pass milliseconds (JSON)");

@@ -1,5 +1,6 @@
 // `skinlab report STUDY.db -o REPORT/`: the study report, HTML and PDF (docs/report.md).
 #include "cli/commands.h"
+#include "cli/options.h"
 #include "report/study_report.h"
 
 #include <spdlog/spdlog.h>
@@ -14,6 +15,7 @@ void registerReport(CLI::App& app) {
         std::string study, stimuli, metrics, output;
         report::ReportOptions options;
         bool noPdf = false;
+        DisplayArguments display; // --display, --ppd, --display-* (cli/options.h)
     };
     auto arguments = std::make_shared<Arguments>();
     CLI::App* command = app.add_subcommand(
@@ -29,9 +31,9 @@ void registerReport(CLI::App& app) {
     command->add_option("--bootstrap", arguments->options.bootstrapSamples, "Bootstrap resamples (default 1000)")
         ->check(CLI::Range(100, 100000));
     command->add_option("--seed", arguments->options.seed, "Bootstrap seed (default 1)");
-    command->add_option("--ppd", arguments->options.pixelsPerDegree,
-                        "Pixels per degree of the viewing geometry when the metrics are computed here, for FLIP and "
-                        "ColorVideoVDP alike (default: the display of the set's predictions)");
+    addDisplayOptions(*command, arguments->display,
+                      "Display model of the metrics computed here, the viewing geometry of FLIP and ColorVideoVDP "
+                      "(default: the display of the set's predictions, else standard_fhd)");
     command->add_option("--chromium", arguments->options.chromium,
                         "Chromium executable for the PDF (default chromium)");
     command->add_flag("--no-pdf", arguments->noPdf, "Write only the HTML page");
@@ -42,6 +44,9 @@ void registerReport(CLI::App& app) {
         options.metrics = arguments->metrics;
         options.output = arguments->output;
         options.pdf = !arguments->noPdf;
+        (void)arguments->display.resolve(); // option errors before any file is read
+        options.display = arguments->display.name;
+        options.displayChanges = arguments->display.changes();
         report::ReportSummary summary = report::writeStudyReport(options);
         std::printf("wrote %s%s%s\n", summary.html.c_str(), summary.pdf.empty() ? "" : " and ",
                     summary.pdf.empty() ? "" : summary.pdf.c_str());

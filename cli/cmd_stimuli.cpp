@@ -2,6 +2,7 @@
 // cmd_stimuli_import.cpp.
 #include "analysis/metrics/cvvdp.h"
 #include "cli/commands.h"
+#include "cli/options.h"
 #include "common/error.h"
 #include "common/files.h"
 #include "stimuli/build.h"
@@ -112,7 +113,7 @@ void runList(const StimuliOptions& o) {
     if (o.format == "json") {
         nlohmann::json out = nlohmann::json::array();
         for (size_t i = 0; i < plan.selected.size(); ++i)
-            out.push_back(stimuli::stimulusEntry(plan.selected[i], plan.resolved[i]));
+            out.push_back(stimuli::plannedEntryJson(plan.selected[i], plan.resolved[i]));
         std::cout << out.dump(2) << "\n";
         return;
     }
@@ -323,8 +324,8 @@ void registerStimuli(CLI::App& app) {
     auto specOptions = [&](CLI::App* cmd, bool shard = true) {
         cmd->add_option("spec", options->spec, "Stimulus-set spec (TOML), e.g. stimuli/specs/demo.toml")->required();
         if (shard) cmd->add_option("--shard", options->shard, "Only slice i of n (1-based), e.g. 2/8");
-        cmd->add_option("--assets", options->assets, "Folder of shared assets (default: $SKINLAB_ASSETS)");
-        cmd->add_option("--set", options->overrides, "Override a spec value: key=value (repeatable)");
+        addAssetsOption(*cmd, options->assets);
+        addOverridesOption(*cmd, options->overrides, "spec value");
     };
 
     CLI::App* build = stimuli->add_subcommand("build", "Render a stimulus set (resumable) into a folder");
@@ -411,8 +412,8 @@ void registerStimuli(CLI::App& app) {
         "calibrate", "Levels of a numeric parameter whose predicted difference (ColorVideoVDP) from the reference "
                      "is a given number of JOD");
     calibrate->add_option("spec", options->spec, "Stimulus-set spec (TOML)")->required();
-    calibrate->add_option("--assets", options->assets, "Folder of shared assets (default: $SKINLAB_ASSETS)");
-    calibrate->add_option("--set", options->overrides, "Override a spec value: key=value (repeatable)");
+    addAssetsOption(*calibrate, options->assets);
+    addOverridesOption(*calibrate, options->overrides, "spec value");
     calibrate->add_option("--factor", options->factor, "Numeric scene key to calibrate, e.g. sss.width_mm")->required();
     calibrate
         ->add_option("--target-jod", options->targetJod,

@@ -2,6 +2,7 @@
 // method reads, the image re-rendered as they move, a difference view against the object-space reference, the
 // kernel as curves, export to a scene spec and a stimulus-set snippet.
 #include "cli/commands.h"
+#include "cli/options.h"
 #include "common/error.h"
 #include "common/files.h"
 #include "renderer/renderer.h"
@@ -146,7 +147,7 @@ void registerTune(CLI::App& app) {
     tune->add_option("--token-file", options->tokenFile,
                      "File holding the token the page and API need (or SKINLAB_TUNE_TOKEN; beyond loopback a random "
                      "one is printed when none is given)");
-    tune->add_option("--assets", options->assets, "Folder of the shared assets (default $SKINLAB_ASSETS)");
+    addAssetsOption(*tune, options->assets);
     tune->add_option("--export-dir", options->exportDir, "Where the page's export writes (default: here)")
         ->capture_default_str();
     tune->add_option("--stimuli", options->stimuli,

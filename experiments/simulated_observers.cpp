@@ -2,6 +2,7 @@
 
 #include "common/time.h"
 #include "experiments/recruitment.h"
+#include "formats/stimulus_manifest.h"
 
 #include "common/error.h"
 #include "common/files.h"
@@ -303,9 +304,11 @@ namespace {
 // Calls f(stimulus, its manifest entry) for every stimulus of the study that shows a condition (not a reference).
 template <typename F>
 void forEachConditionEntry(StudyStore& store, F f) {
-    const json manifest = json::parse(store.meta("manifest_json"));
-    std::map<std::string, const json*> byId;
-    for (const json& s : manifest["stimuli"]) byId[s["id"].get<std::string>()] = &s;
+    // The manifest stored in the study, by the one strict reader of contract 2 (formats/stimulus_manifest.h).
+    const formats::StimulusManifest manifest =
+        formats::parseStimulusManifest(store.meta("manifest_json"), "the study's stored manifest.json");
+    std::map<std::string, const formats::ManifestEntry*> byId;
+    for (const formats::ManifestEntry& s : manifest.stimuli) byId[s.id] = &s;
     for (const StudyStimulus& s : store.definition().stimuli)
         if (!s.condition.empty()) f(s, *byId.at(s.id));
 }
@@ -315,19 +318,17 @@ void forEachConditionEntry(StudyStore& store, F f) {
 SimulationTruth truthFromPredictions(StudyStore& store) {
     SimulationTruth truth;
     truth.source = "--truth predicted";
-    forEachConditionEntry(store, [&](const StudyStimulus& s, const json& entry) {
+    forEachConditionEntry(store, [&](const StudyStimulus& s, const formats::ManifestEntry& entry) {
         // A block's reference shown as a condition is, by definition, indistinguishable from itself.
-        if (entry.value("reference", false)) {
+        if (entry.reference) {
             truth.byBlock[s.block][s.condition] = 10.0;
             return;
         }
-        const auto predicted = entry.find("predicted");
-        if (predicted == entry.end() || !predicted->is_object() || !predicted->contains("jod") ||
-            !(*predicted)["jod"].is_number())
+        if (!entry.predicted)
             throw InputError("--truth predicted: stimulus \"" + s.id +
                              "\" has no predicted JOD in the manifest (build the set with a [[reference]] so that "
                              "`stimuli build` predicts each stimulus against it)");
-        truth.byBlock[s.block][s.condition] = (*predicted)["jod"].get<double>();
+        truth.byBlock[s.block][s.condition] = entry.predicted->jod;
     });
     return truth;
 }
@@ -335,10 +336,10 @@ SimulationTruth truthFromPredictions(StudyStore& store) {
 SimulationTruth truthFromFactor(StudyStore& store, const std::string& factor) {
     SimulationTruth truth;
     truth.source = "--truth-factor " + factor;
-    forEachConditionEntry(store, [&](const StudyStimulus& s, const json& entry) {
-        if (!entry.contains("factors") || !entry["factors"].contains(factor))
+    forEachConditionEntry(store, [&](const StudyStimulus& s, const formats::ManifestEntry& entry) {
+        if (!entry.factors.contains(factor))
             throw InputError("--truth-factor: stimulus \"" + s.id + "\" has no factor \"" + factor + "\"");
-        const json& value = entry["factors"][factor];
+        const json& value = entry.factors.at(factor);
         double q = 0;
         if (value.is_number()) {
             q = value.get<double>();

@@ -3,6 +3,7 @@
 #include "common/error.h"
 #include "common/files.h"
 #include "common/hash.h"
+#include "formats/stimulus_manifest.h"
 
 namespace skinlab::experiments {
 namespace fs = std::filesystem;
@@ -13,84 +14,29 @@ const ManifestStimulus* StimulusManifest::find(const std::string& id) const {
     return nullptr;
 }
 
-namespace {
-
-// A manifest path must be relative and stay inside the set's folder: the server later serves exactly these
-// files, so a manifest must not be able to point it at /etc/passwd.
-bool staysInside(const std::string& relative) {
-    if (relative.empty()) return false;
-    fs::path p(relative);
-    if (p.is_absolute() || p.has_root_name() || p.has_root_directory()) return false;
-    for (const fs::path& part : p)
-        if (part == "..") return false;
-    return true;
-}
-
-std::string factorText(const nlohmann::json& value) {
-    if (value.is_string()) return value.get<std::string>();
-    return value.dump();
-}
-
-} // namespace
-
+// The one strict reader (formats/stimulus_manifest.h), then what a study needs of each entry.
 StimulusManifest readStimulusManifest(const fs::path& folder) {
+    const formats::StimulusManifest read = formats::readStimulusManifest(folder);
+    if (read.stimuli.empty()) throwInput(read.file, "stimuli", "expected a non-empty array");
     StimulusManifest manifest;
-    std::error_code ec;
-    manifest.folder = fs::absolute(folder, ec);
-    const fs::path file = manifest.folder / "manifest.json";
-    const std::string where = (folder / "manifest.json").string();
-    if (!fs::is_regular_file(file)) throwInput(where, "", "no manifest.json in the stimulus folder");
-    manifest.text = readFile(file);
-    manifest.sha256 = sha256Hex(manifest.text);
-    nlohmann::json root;
-    try {
-        root = nlohmann::json::parse(manifest.text);
-    } catch (const nlohmann::json::parse_error& e) {
-        throwInput(where, "", std::string("not valid JSON: ") + e.what());
-    }
-    if (!root.is_object()) throwInput(where, "", "expected a JSON object");
-    if (root.value("format", std::string()) != "skinlab-stimuli")
-        throwInput(where, "format", "expected \"skinlab-stimuli\"");
-    if (!root.contains("version") || !root["version"].is_number_integer() || root["version"].get<int>() != 1)
-        throwInput(where, "version", "expected 1 (the only manifest version this build reads)");
-    manifest.set = root.value("set", std::string());
-    if (!root.contains("stimuli") || !root["stimuli"].is_array() || root["stimuli"].empty())
-        throwInput(where, "stimuli", "expected a non-empty array");
-    std::size_t index = 0;
-    for (const nlohmann::json& entry : root["stimuli"]) {
-        const std::string key = "stimuli[" + std::to_string(index++) + "]";
-        if (!entry.is_object()) throwInput(where, key, "expected an object");
+    manifest.folder = read.folder;
+    manifest.set = read.set;
+    manifest.text = read.text;
+    manifest.sha256 = read.sha256;
+    for (std::size_t i = 0; i < read.stimuli.size(); ++i) {
+        const formats::ManifestEntry& entry = read.stimuli[i];
+        if (entry.files.png.empty())
+            throwInput(read.file, "stimuli[" + std::to_string(i) + "].files.png", "missing (a study shows the PNGs)");
         ManifestStimulus s;
-        auto requireString = [&](const nlohmann::json& obj, const char* name, const std::string& path) {
-            if (!obj.contains(name) || !obj[name].is_string() || obj[name].get<std::string>().empty())
-                throwInput(where, path, "expected a non-empty string");
-            return obj[name].get<std::string>();
-        };
-        s.id = requireString(entry, "id", key + ".id");
-        if (manifest.find(s.id)) throwInput(where, key + ".id", "duplicate stimulus id \"" + s.id + "\"");
-        if (!entry.contains("files") || !entry["files"].is_object())
-            throwInput(where, key + ".files", "expected an object with a \"png\" path");
-        s.pngPath = requireString(entry["files"], "png", key + ".files.png");
-        if (!staysInside(s.pngPath))
-            throwInput(where, key + ".files.png", "path leaves the stimulus folder: " + s.pngPath);
-        if (entry.contains("sha256") && entry["sha256"].is_object() && entry["sha256"].contains("png") &&
-            entry["sha256"]["png"].is_string())
-            s.pngSha256 = entry["sha256"]["png"].get<std::string>();
-        else throwInput(where, key + ".sha256.png", "expected the PNG's sha256 (hex)");
-        s.block = requireString(entry, "block", key + ".block");
-        s.reference = entry.value("reference", false);
-        for (const char* dim : {"width", "height"}) {
-            if (!entry.contains(dim) || !entry[dim].is_number_integer() || entry[dim].get<int>() < 1 ||
-                entry[dim].get<int>() > 16384)
-                throwInput(where, key + "." + dim, "expected an integer in [1, 16384]");
-        }
-        s.width = entry["width"].get<int>();
-        s.height = entry["height"].get<int>();
-        if (entry.contains("factors")) {
-            if (!entry["factors"].is_object()) throwInput(where, key + ".factors", "expected an object");
-            for (auto it = entry["factors"].begin(); it != entry["factors"].end(); ++it)
-                s.factors[it.key()] = factorText(it.value());
-        }
+        s.id = entry.id;
+        s.pngPath = entry.files.png;
+        s.pngSha256 = entry.sha256.png;
+        s.block = entry.block;
+        s.reference = entry.reference;
+        s.width = entry.width;
+        s.height = entry.height;
+        for (auto it = entry.factors.begin(); it != entry.factors.end(); ++it)
+            s.factors[it.key()] = entry.factorText(it.key());
         manifest.stimuli.push_back(std::move(s));
     }
     return manifest;

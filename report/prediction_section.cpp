@@ -159,16 +159,18 @@ std::optional<PredictionAgreement> blockPredictionAgreement(const scaling::Block
     return a;
 }
 
+std::vector<formats::ManifestEntry> storedManifestEntries(const nlohmann::json& manifest) {
+    if (!manifest.is_object() || !manifest.contains("stimuli")) return {};
+    return formats::manifestEntriesFromJson(manifest["stimuli"], "the study's stored manifest.json");
+}
+
 std::vector<PredictionAgreement> predictionAgreement(const experiments::StudyDefinition& definition,
                                                      const nlohmann::json& manifest, const scaling::Analysis& analysis,
                                                      const scaling::Dataset* dataset,
                                                      const PredictionOptions& options) {
     std::map<std::string, double> predictedOfStimulus;
-    if (manifest.contains("stimuli"))
-        for (const nlohmann::json& s : manifest["stimuli"])
-            if (s.contains("predicted") && s["predicted"].is_object() && s["predicted"].contains("jod") &&
-                s["predicted"]["jod"].is_number())
-                predictedOfStimulus[s["id"].get<std::string>()] = s["predicted"]["jod"].get<double>();
+    for (const formats::ManifestEntry& s : storedManifestEntries(manifest))
+        if (s.predicted) predictedOfStimulus[s.id] = s.predicted->jod;
     std::vector<PredictionAgreement> out;
     for (const scaling::BlockAnalysis& block : analysis.blocks) {
         // Predicted JOD of each of the block's conditions (through the stimulus showing it).
@@ -193,23 +195,21 @@ std::vector<ParticipantPrediction> participantPredictions(const nlohmann::json& 
                                                           const std::filesystem::path& stimuliFolder,
                                                           const std::vector<std::pair<std::string, double>>& viewing) {
     std::vector<ParticipantPrediction> out;
-    if (viewing.empty() || !manifest.contains("stimuli")) return out;
+    if (viewing.empty()) return out;
+    const std::vector<formats::ManifestEntry> entries = storedManifestEntries(manifest);
     // The predicted stimuli and their references, by block.
     struct Predicted {
         std::string block, png, referencePng, display;
         double jod = 0.0;
     };
     std::map<std::string, std::string> pngOf;
-    for (const nlohmann::json& s : manifest["stimuli"])
-        pngOf[s["id"].get<std::string>()] = s["files"]["png"].get<std::string>();
+    for (const formats::ManifestEntry& s : entries) pngOf[s.id] = s.files.png;
     std::vector<Predicted> predicted;
-    for (const nlohmann::json& s : manifest["stimuli"])
-        if (s.contains("predicted") && s["predicted"].contains("jod") &&
-            pngOf.count(s["predicted"].value("reference", "")))
-            predicted.push_back({s["block"].get<std::string>(), s["files"]["png"].get<std::string>(),
-                                 pngOf[s["predicted"]["reference"].get<std::string>()],
-                                 s["predicted"].value("display", std::string("standard_fhd")),
-                                 s["predicted"]["jod"].get<double>()});
+    for (const formats::ManifestEntry& s : entries)
+        if (s.predicted && pngOf.count(s.predicted->reference))
+            predicted.push_back({s.block, s.files.png, pngOf[s.predicted->reference],
+                                 s.predicted->display.empty() ? std::string("standard_fhd") : s.predicted->display,
+                                 s.predicted->jod});
     if (predicted.empty()) return out;
     std::map<std::string, metrics::MetricRender> images;
     auto image = [&](const std::string& png) -> const cv::Mat& {

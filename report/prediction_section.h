@@ -6,6 +6,7 @@
 // least-squares slope and RMSE with bootstrap intervals, Spearman's ρ with its exact p and interval.
 #include "analysis/scaling/scale_analysis.h"
 #include "experiments/study_definition.h"
+#include "formats/stimulus_manifest.h"
 
 #include <nlohmann/json.hpp>
 
@@ -55,6 +56,10 @@ std::optional<PredictionAgreement> blockPredictionAgreement(const skinlab::analy
                                                             const std::vector<double>& predicted,
                                                             const skinlab::analysis::scaling::BlockData* data,
                                                             const PredictionOptions& options);
+
+// The entries of a manifest stored in a study file (meta manifest_json), by the one strict reader of contract 2
+// (formats/stimulus_manifest.h); none when it has no "stimuli".
+std::vector<formats::ManifestEntry> storedManifestEntries(const nlohmann::json& manifest);
 
 // The blocks of `analysis` whose conditions carry predictions in `manifest` (at least 3 conditions). `dataset`: the
 // answers `analysis` was computed from (for the bootstrap; nullptr: none).

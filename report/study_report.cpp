@@ -2,6 +2,7 @@
 
 #include "analysis/agreement/metric_agreement.h"
 #include "analysis/metrics/metrics_run.h"
+#include "analysis/scaling/responses.h"
 #include "analysis/scaling/screening.h"
 #include "analysis/scaling/scale_analysis.h"
 #include "analysis/scaling/scale_report.h"
@@ -11,6 +12,7 @@
 #include "common/html.h"
 #include "common/version.h"
 #include "experiments/study_store.h"
+#include "formats/stimulus_manifest.h"
 #include "report/prediction_section.h"
 #include "report/report_plots.h"
 
@@ -178,30 +180,21 @@ Participants readParticipants(experiments::StudyStore& store, const ReportOption
         p.index[o.label] = p.observers.size();
         p.observers.push_back(o);
     }
-    const std::vector<experiments::ResponseRow> rows = store.responses();
-    p.table.file = options.study.string();
-    p.table.format = scaling::ResponseFormat::StudyDatabase;
-    p.table.adaptiveDesign = store.definition().design.activePairs;
-    // Conditions in design order, as `analyze scale` and the dashboard list them.
-    for (const experiments::StudyBlock& block : store.definition().blocks)
-        p.table.designConditionOrder[block.name] = block.conditions;
-    int line = 0;
-    for (const experiments::ResponseRow& row : rows) {
-        ++line;
+    // The browsers' viewports and pixel ratios, from the store's rows.
+    for (const experiments::ResponseRow& row : store.responses()) {
         p.viewports.insert({row.viewportWidth, row.viewportHeight});
         p.pixelRatios.insert(row.devicePixelRatio);
-        scaling::Response r;
-        r.observer = row.observer;
-        r.block = row.scene;
-        r.conditionA = row.conditionA;
-        r.conditionB = row.conditionB;
-        r.aSelected = row.aSelected;
-        r.aOnLeft = row.aOnLeft;
-        r.correct = row.correct;
-        r.responseMs = row.responseMs;
-        r.line = line;
-        r.kind = row.kind; // experiments' trial kinds are the analysis' (experiments/trial_plan.h)
-        p.table.responses.push_back(r);
+    }
+    // The responses by the one reader of a study file's rows (analysis/scaling/responses.h: the view
+    // responses_long), as `analyze scale` and the dashboard read them.
+    if (store.responseCount() > 0) {
+        p.table = scaling::readResponses(options.study);
+    } else {
+        p.table.file = options.study.string();
+        p.table.format = scaling::ResponseFormat::StudyDatabase;
+        p.table.adaptiveDesign = store.definition().design.activePairs;
+        for (const experiments::StudyBlock& block : store.definition().blocks)
+            p.table.designConditionOrder[block.name] = block.conditions;
     }
     std::set<std::string> answering;
     for (const scaling::Response& r : p.table.responses) answering.insert(r.observer);
@@ -285,18 +278,13 @@ StimulusImages copyStimuli(const experiments::StudyDefinition& definition, const
         }
         cropOfBlock[block.name] = cropWhereTheyDiffer(images, names, out, slug(block.name));
     }
-    try {
-        const nlohmann::json manifest = nlohmann::json::parse(readFile(stimuliFolder / "manifest.json"));
-        for (const nlohmann::json& s : manifest.value("stimuli", nlohmann::json::array())) {
-            if (!s.value("reference", false) || !s.contains("files") || !s["files"].contains("png")) continue;
-            std::string block = s.value("block", ""), id = s.value("id", "");
-            if (!imagesOfBlock.count(block) || referenceOfBlock.count(block)) continue;
-            std::string file = "stimuli/" + slug(id) + ".png";
-            copyFileAtomic(stimuliFolder / s["files"]["png"].get<std::string>(), out / file);
-            referenceOfBlock[block] = {"reference", id, file};
-        }
-    } catch (const nlohmann::json::exception& e) {
-        throwInput((stimuliFolder / "manifest.json").string(), "", std::string("not valid JSON (") + e.what() + ")");
+    // The set's manifest, by the one strict reader of contract 2 (formats/stimulus_manifest.h).
+    for (const formats::ManifestEntry& s : formats::readStimulusManifest(stimuliFolder).stimuli) {
+        if (!s.reference || s.files.png.empty()) continue;
+        if (!imagesOfBlock.count(s.block) || referenceOfBlock.count(s.block)) continue;
+        std::string file = "stimuli/" + slug(s.id) + ".png";
+        copyFileAtomic(stimuliFolder / s.files.png, out / file);
+        referenceOfBlock[s.block] = {"reference", s.id, file};
     }
     return stimuli;
 }
@@ -336,13 +324,17 @@ Metrics readMetrics(const ReportOptions& options, const fs::path& stimuliFolder,
             metricsFolder = out / "metrics";
             metrics::MetricsRunOptions metricOptions;
             // One viewing geometry: the display the set's predictions were made for (docs/metrics.md).
-            metrics::CvvdpDisplayOverrides overrides;
-            overrides.pixelsPerDegree = options.pixelsPerDegree;
-            metricOptions.metric.display =
-                metrics::applyCvvdpOverrides(metrics::cvvdpDisplay(plan.display.value_or("standard_fhd")), overrides);
-            metricOptions.displaySource =
-                plan.display ? "the set's predictions (manifest.json predicted.display)" : "default";
-            if (options.pixelsPerDegree) metricOptions.displaySource += " with --ppd";
+            // --display names another model; --ppd and --display-* change it.
+            metricOptions.metric.display = metrics::applyCvvdpOverrides(
+                metrics::cvvdpDisplay(options.display.value_or(plan.display.value_or("standard_fhd"))),
+                options.displayChanges);
+            metricOptions.displaySource = options.display ? "--display"
+                                          : plan.display  ? "the set's predictions (manifest.json predicted.display)"
+                                                          : "default";
+            metrics::CvvdpDisplayOverrides beyondPpd = options.displayChanges;
+            beyondPpd.pixelsPerDegree.reset();
+            if (options.displayChanges.any())
+                metricOptions.displaySource += beyondPpd.any() ? " with --display-*/--ppd changes" : " with --ppd";
             spdlog::info("report: image metrics of {} stimuli against their block's reference", plan.jobs.size());
             metrics::runMetrics(plan, metricOptions, metricsFolder);
             // The references, for the stimulus section.
@@ -975,9 +967,8 @@ ReportSummary writeStudyReport(const ReportOptions& options) {
         predictionAgreement(definition, storedManifest, scale.analysis, &scale.dataset,
                             {options.bootstrapSamples, options.seed, scale.options.bootstrap.level, scale.options.fit});
     std::string predictionDisplay;
-    for (const nlohmann::json& s : storedManifest.value("stimuli", nlohmann::json::array()))
-        if (s.contains("predicted") && s["predicted"].contains("display"))
-            predictionDisplay = s["predicted"]["display"].get<std::string>();
+    for (const formats::ManifestEntry& s : storedManifestEntries(storedManifest))
+        if (s.predicted && !s.predicted->display.empty()) predictionDisplay = s.predicted->display;
 
     const ReportData data{options,         store,          definition,  simulated,        stimuliFolder,
                           participants,    scale,          stimuli,     metrics,          agreementOptions,

@@ -3,6 +3,8 @@
 // and image metrics against the set's references) it writes REPORT/index.html with every image copied beside it
 // (relative links), REPORT/report.pdf through headless Chromium, and the tables behind the page (scale.json,
 // agreement.json/csv, metrics/ when it computed them).
+#include "analysis/metrics/cvvdp.h"
+
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -18,9 +20,11 @@ struct ReportOptions {
     int bootstrapSamples = 1000;   // scale intervals and correlation intervals
     std::uint64_t seed = 1;
     int threads = 2;
-    // The viewing geometry of the metrics computed here: the display of the set's predictions (standard_fhd when it
-    // has none), its pixels per degree replaced by this when set; FLIP and ColorVideoVDP use the same.
-    std::optional<double> pixelsPerDegree;
+    // The viewing geometry of the metrics computed here: the display model `display`, else the display of the set's
+    // predictions, else standard_fhd; changed by `displayChanges` (pixels per degree, a custom display's
+    // resolution, size, distance, photometry); FLIP and ColorVideoVDP use the same.
+    std::optional<std::string> display;
+    metrics::CvvdpDisplayOverrides displayChanges;
     bool pdf = true;
     std::string chromium = "chromium"; // executable for the PDF
 };

@@ -62,7 +62,7 @@ for _ in $(seq 1 100); do
 done
 [ -n "$url" ] || { echo "demo: the study server did not start:" >&2; cat "$out/serve.log" >&2; exit 1; }
 echo "demo: 20 simulated observers answer through the real HTTP API, from the same predictions"
-run_with_heartbeat demo "$skinlab" study simulate "$out/study.db" --observers 20 --truth predicted \
+run_with_heartbeat demo "$skinlab" study simulate "$out/study.db" --observer-count 20 --truth predicted \
   --seed 7 --label-prefix demo --url "$url"
 kill $server; wait $server 2>/dev/null || true
 trap - EXIT

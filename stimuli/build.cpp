@@ -20,6 +20,7 @@
 #include <mutex>
 #include <spdlog/spdlog.h>
 #include <thread>
+#include <tuple>
 
 namespace skinlab::stimuli {
 
@@ -154,17 +155,15 @@ nlohmann::json renderStimulus(renderer::Renderer& renderer, const Stimulus& stim
                      "re-render it",
                      stimulus.id);
 
-    nlohmann::json entry = stimulusEntry(stimulus, resolved);
-    entry["sha256"] = {{"exr", sha256File(exr.finalPath())}, {"png", sha256File(png.finalPath())}};
+    formats::ManifestEntry entry = stimulusEntry(stimulus, resolved);
+    entry.sha256 = {sha256File(exr.finalPath()), sha256File(png.finalPath())};
     // The presented size (what a participant sees at one image pixel per device pixel): the PNG's.
-    auto [width, height] = imageSize(png.finalPath());
-    entry["width"] = width;
-    entry["height"] = height;
+    std::tie(entry.width, entry.height) = imageSize(png.finalPath());
     nlohmann::json timings =
         result.timingsMs.is_object() ? result.timingsMs : nlohmann::json{{"render", result.timingsMs}};
     timings["stimulus_wall"] = secondsSince(start) * 1000.0; // render + write + hash, ms
-    entry["timings_ms"] = timings;
-    return entry;
+    entry.timingsMs = timings;
+    return formats::toJson(entry);
 }
 
 // An earlier entry is still valid when its resolved parameters are identical and both files are intact.
@@ -186,22 +185,26 @@ bool entryStillValid(const nlohmann::json& entry, const nlohmann::json& resolved
 
 } // namespace
 
-nlohmann::json stimulusEntry(const Stimulus& stimulus, const nlohmann::json& resolved) {
-    nlohmann::json factors = nlohmann::json::object();
-    std::string sceneValue;
+formats::ManifestEntry stimulusEntry(const Stimulus& stimulus, const nlohmann::json& resolved) {
+    formats::ManifestEntry entry;
+    entry.id = stimulus.id;
+    entry.files = {exrRelativePath(stimulus.id), pngRelativePath(stimulus.id)};
     for (const auto& [name, level] : stimulus.factors) {
-        factors[name] = level.value;
-        if (name == "scene") sceneValue = level.value;
+        entry.factors[name] = level.value;
+        if (name == "scene") entry.scene = level.value;
     }
-    return {{"id", stimulus.id},
-            {"files", {{"exr", exrRelativePath(stimulus.id)}, {"png", pngRelativePath(stimulus.id)}}},
-            {"factors", factors},
-            {"block", stimulus.block},
-            {"reference", stimulus.reference},
-            {"scene", sceneValue},
-            {"overrides", stimulus.overrides},
-            {"resolved", resolved},
-            {"presentation", presentationOf(stimulus, resolved)}};
+    entry.block = stimulus.block;
+    entry.reference = stimulus.reference;
+    entry.overrides = stimulus.overrides;
+    entry.resolved = resolved;
+    entry.presentation = presentationOf(stimulus, resolved);
+    return entry;
+}
+
+nlohmann::json plannedEntryJson(const Stimulus& stimulus, const nlohmann::json& resolved) {
+    nlohmann::json json = formats::toJson(stimulusEntry(stimulus, resolved));
+    for (const char* key : {"sha256", "width", "height", "timings_ms"}) json.erase(key);
+    return json;
 }
 
 BuildPlan planBuild(const fs::path& specPath, const std::vector<std::string>& specOverrides,
@@ -268,13 +271,20 @@ std::map<std::string, nlohmann::json> keptEntries(const BuildPlan& plan, const s
         manifest.renderer = existing->renderer;
         for (size_t i = 0; i < plan.selected.size(); ++i) {
             const Stimulus& s = plan.selected[i];
-            for (const auto& old : existing->stimuli) {
+            for (std::size_t k = 0; k < existing->stimuli.size(); ++k) {
+                const nlohmann::json& old = existing->stimuli[k];
                 if (old.value("id", "") != s.id ||
                     !entryStillValid(old, plan.resolved[i], presentationOf(s, plan.resolved[i]), dir))
                     continue;
-                nlohmann::json entry = stimulusEntry(s, plan.resolved[i]);
-                for (const char* field : {"sha256", "width", "height", "timings_ms"}) entry[field] = old[field];
-                entries[s.id] = std::move(entry);
+                // The earlier entry passed the strict reader when the manifest was read.
+                const formats::ManifestEntry kept =
+                    formats::manifestEntryFromJson(old, (dir / kManifestFile).string(), k);
+                formats::ManifestEntry entry = stimulusEntry(s, plan.resolved[i]);
+                entry.sha256 = kept.sha256;
+                entry.width = kept.width;
+                entry.height = kept.height;
+                entry.timingsMs = kept.timingsMs;
+                entries[s.id] = formats::toJson(entry);
             }
         }
     }

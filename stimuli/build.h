@@ -62,6 +62,8 @@ BuildSummary buildSet(const BuildOptions& options);
 std::pair<int, int> presentationFrame(const Stimulus& stimulus, const nlohmann::json& resolved);
 
 // The manifest entry of a stimulus (everything but the render-derived fields: sha256, width, height, timings).
-nlohmann::json stimulusEntry(const Stimulus& stimulus, const nlohmann::json& resolved);
+formats::ManifestEntry stimulusEntry(const Stimulus& stimulus, const nlohmann::json& resolved);
+// Its JSON before rendering (`stimuli list --format json`): the entry without the render-derived keys.
+nlohmann::json plannedEntryJson(const Stimulus& stimulus, const nlohmann::json& resolved);
 
 } // namespace skinlab::stimuli

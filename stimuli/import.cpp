@@ -549,20 +549,18 @@ nlohmann::json stimulusEntry(const fs::path& dir, const Table& table, const Mani
         provenance["mask_sha256"] = sha256File(c.mask);
         for (const auto& [key, value] : c.row->camera) provenance[key] = value;
     }
-    return {{"id", c.id},
-            {"files", {{"exr", exrRelativePath(c.id)}, {"png", pngRelativePath(c.id)}}},
-            {"sha256",
-             {{"exr", sha256File(dir / exrRelativePath(c.id))}, {"png", sha256File(dir / pngRelativePath(c.id))}}},
-            {"factors", factors},
-            {"block", c.block},
-            {"reference", c.row->reference},
-            {"width", c.width},
-            {"height", c.height},
-            {"scene", factors.value("scene", "")},
-            {"overrides", nlohmann::json::array()},
-            {"resolved", nlohmann::json::object()},
-            {"timings_ms", nlohmann::json::object()},
-            {"provenance", provenance}};
+    formats::ManifestEntry entry;
+    entry.id = c.id;
+    entry.files = {exrRelativePath(c.id), pngRelativePath(c.id)};
+    entry.sha256 = {sha256File(dir / entry.files.exr), sha256File(dir / entry.files.png)};
+    entry.factors = factors;
+    entry.block = c.block;
+    entry.reference = c.row->reference;
+    entry.width = c.width;
+    entry.height = c.height;
+    entry.scene = factors.value("scene", "");
+    entry.provenance = provenance;
+    return formats::toJson(entry);
 }
 
 } // namespace

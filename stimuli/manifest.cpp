@@ -51,10 +51,7 @@ nlohmann::json toJson(const Manifest& m) {
 }
 
 Manifest manifestFromJson(const nlohmann::json& j, const std::string& source) {
-    if (!j.is_object() || j.value("format", "") != kManifestFormat)
-        throwInput(source, "format", "not a skinlab stimulus manifest");
-    if (j.value("version", 0) != kManifestVersion)
-        throwInput(source, "version", "unsupported manifest version " + j.value("version", nlohmann::json()).dump());
+    formats::checkManifestFormat(j, source);
     try {
         Manifest m;
         m.set = j.at("set").get<std::string>();
@@ -70,6 +67,7 @@ Manifest manifestFromJson(const nlohmann::json& j, const std::string& source) {
         if (j.contains("shard")) m.shard = Shard{j["shard"].at("index").get<int>(), j["shard"].at("count").get<int>()};
         m.setIds = j.at("set_ids").get<std::vector<std::string>>();
         m.complete = j.value("complete", false);
+        formats::manifestEntriesFromJson(j.at("stimuli"), source); // the one strict reader of the entries
         for (const auto& s : j.at("stimuli")) m.stimuli.push_back(s);
         return m;
     } catch (const nlohmann::json::exception& e) {

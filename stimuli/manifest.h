@@ -2,6 +2,7 @@
 // The stimulus manifest (contract 2, docs/stimuli.md): manifest.json in the set's folder, describing every image
 // completely (factor levels, fully resolved scene parameters, renderer, sha256 of each file, timings), plus a
 // CSV view (manifest.csv, one row per stimulus). Both are rewritten atomically after every stimulus.
+#include "formats/stimulus_manifest.h"
 #include "stimuli/expansion.h"
 
 #include <filesystem>
@@ -12,9 +13,9 @@
 
 namespace skinlab::stimuli {
 
-inline constexpr const char* kManifestFormat = "skinlab-stimuli";
-inline constexpr int kManifestVersion = 1;
-inline constexpr const char* kManifestFile = "manifest.json";
+using formats::kManifestFile;
+using formats::kManifestFormat;
+using formats::kManifestVersion;
 inline constexpr const char* kManifestCsvFile = "manifest.csv";
 
 struct RendererInfo {
@@ -35,7 +36,8 @@ struct Manifest {
     nlohmann::json factors = nlohmann::json::array(); // [{name, key, levels: [{value, label}]}]
     std::optional<Shard> shard;                       // present in a shard's folder
     std::vector<std::string> setIds;                  // every id of the whole set, in expansion order (for merge)
-    std::vector<nlohmann::json> stimuli;              // entries (contract 2), in expansion order
+    std::vector<nlohmann::json> stimuli; // entries (contract 2: formats::toJson of a formats::ManifestEntry, checked
+                                         // by formats::manifestEntryFromJson when read), in expansion order
     // True when `stimuli` holds every stimulus of this folder's selection (the set, or the shard's slice).
     bool complete = false;
 };

@@ -46,12 +46,8 @@ PredictionSummary predictStimuli(const fs::path& dir, Manifest& manifest, const 
                     metrics::loadMetricRender(dir / entry.at("files").at("png").get<std::string>(),
                                               metrics::RenderRole::test, metrics::ImageEncoding::srgb);
                 const metrics::CvvdpResult r = metrics::cvvdp(referenceImage.beauty, test.beauty, display, false);
-                entry["predicted"] = {{"metric", kMetric},
-                                      {"display", options.display},
-                                      {"reference", result.reference},
-                                      {"jod", r.jod},
-                                      {"reference_png_sha256", pngSha(*reference)},
-                                      {"png_sha256", pngSha(entry)}};
+                entry["predicted"] = formats::toJson(formats::Prediction{kMetric, options.display, result.reference,
+                                                                         r.jod, pngSha(*reference), pngSha(entry)});
                 ++summary.predicted;
             }
             const double jod = entry["predicted"]["jod"].get<double>();

@@ -3,6 +3,7 @@
 #include "common/error.h"
 #include "common/files.h"
 #include "common/spec.h"
+#include "formats/stimulus_manifest.h"
 #include "renderer/renderer.h"
 #include "renderer/scene/builtin_scenes.h"
 #include "renderer/sss/burley_profile.h"
@@ -173,64 +174,41 @@ ExportedFiles exportConfig(const TuneConfig& config, const std::filesystem::path
     return files;
 }
 
-namespace {
-nlohmann::json readManifest(const std::filesystem::path& setFolder) {
-    const std::filesystem::path path = setFolder / "manifest.json";
-    std::ifstream in(path);
-    if (!in) throw InputError(path.string() + ": cannot read the stimulus manifest");
-    nlohmann::json manifest;
-    try {
-        manifest = nlohmann::json::parse(in);
-    } catch (const nlohmann::json::exception& e) {
-        throw InputError(path.string() + ": not JSON (" + e.what() + ")");
-    }
-    if (!manifest.is_object() || manifest.value("format", "") != "skinlab-stimuli" || !manifest.contains("stimuli") ||
-        !manifest["stimuli"].is_array())
-        throw InputError(path.string() + ": format: not a skinlab stimulus manifest");
-    return manifest;
-}
-} // namespace
-
+// Both read the set's manifest with the one strict reader of contract 2 (formats/stimulus_manifest.h).
 nlohmann::json stimulusEntries(const std::filesystem::path& setFolder) {
-    const nlohmann::json manifest = readManifest(setFolder);
+    const formats::StimulusManifest manifest = formats::readStimulusManifest(setFolder);
     nlohmann::json out = nlohmann::json::array();
-    for (const auto& s : manifest["stimuli"])
-        out.push_back({{"id", s.value("id", "")},
-                       {"scene", s.value("scene", "")},
-                       {"factors", s.value("factors", nlohmann::json::object())},
-                       {"reference", s.value("reference", false)},
-                       {"set", manifest.value("set", "")}});
+    for (const formats::ManifestEntry& s : manifest.stimuli)
+        out.push_back({{"id", s.id},
+                       {"scene", s.scene},
+                       {"factors", s.factors},
+                       {"reference", s.reference},
+                       {"set", manifest.set}});
     return out;
 }
 
 TuneConfig stimulusConfig(const std::filesystem::path& setFolder, const std::string& id) {
-    const nlohmann::json manifest = readManifest(setFolder);
-    const std::string where = (setFolder / "manifest.json").string();
-    for (const auto& s : manifest["stimuli"]) {
-        if (s.value("id", "") != id) continue;
-        TuneConfig config;
-        config.scene = s.value("scene", "");
-        if (config.scene.empty()) throw InputError(where + ": stimuli[" + id + "].scene: missing");
-        // A relative scene file: taken from the manifest's folder when it is there, else the file the build
-        // rendered (the manifest's resolved scene, absolute; the spec named it relative to the spec's folder).
-        if (config.scene.rfind("builtin:", 0) != 0 && !std::filesystem::path(config.scene).is_absolute()) {
-            const std::filesystem::path beside =
-                (std::filesystem::absolute(setFolder) / config.scene).lexically_normal();
-            const std::filesystem::path rendered =
-                s.contains("resolved") && s["resolved"].is_object() ? s["resolved"].value("scene", "") : "";
-            std::error_code error;
-            const bool besideExists = std::filesystem::is_regular_file(beside, error);
-            if (!besideExists && rendered.is_absolute() && std::filesystem::is_regular_file(rendered, error))
-                config.scene = rendered.lexically_normal().string();
-            else config.scene = beside.string();
-        }
-        for (const auto& o : s.value("overrides", nlohmann::json::array())) {
-            if (!o.is_string()) throw InputError(where + ": stimuli[" + id + "].overrides: not a list of strings");
-            config.overrides.push_back(o.get<std::string>());
-        }
-        return config;
+    const formats::StimulusManifest manifest = formats::readStimulusManifest(setFolder);
+    const formats::ManifestEntry* s = manifest.find(id);
+    if (!s) throw InputError(manifest.file + ": id: no stimulus '" + id + "' in the set");
+    TuneConfig config;
+    config.scene = s->scene;
+    if (config.scene.empty()) throw InputError(manifest.file + ": stimuli[" + id + "].scene: missing");
+    // A relative scene file: taken from the manifest's folder when it is there, else the file the build
+    // rendered (the manifest's resolved scene, absolute; the spec named it relative to the spec's folder).
+    if (config.scene.rfind("builtin:", 0) != 0 && !std::filesystem::path(config.scene).is_absolute()) {
+        const std::filesystem::path beside = (std::filesystem::absolute(setFolder) / config.scene).lexically_normal();
+        const nlohmann::json* resolvedScene = s->resolved.contains("scene") ? &s->resolved["scene"] : nullptr;
+        const std::filesystem::path rendered =
+            resolvedScene && resolvedScene->is_string() ? resolvedScene->get<std::string>() : "";
+        std::error_code error;
+        const bool besideExists = std::filesystem::is_regular_file(beside, error);
+        if (!besideExists && rendered.is_absolute() && std::filesystem::is_regular_file(rendered, error))
+            config.scene = rendered.lexically_normal().string();
+        else config.scene = beside.string();
     }
-    throw InputError(where + ": id: no stimulus '" + id + "' in the set");
+    config.overrides = s->overrides;
+    return config;
 }
 
 nlohmann::json kernelCurves(const TuneConfig& config) {

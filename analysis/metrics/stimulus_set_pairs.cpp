@@ -3,6 +3,7 @@
 #include "common/error.h"
 #include "common/files.h"
 #include "common/hash.h"
+#include "formats/stimulus_manifest.h"
 
 #include <algorithm>
 #include <map>
@@ -36,79 +37,43 @@ struct StimulusEntry {
     nlohmann::json factors;
 };
 
-const nlohmann::json& member(const nlohmann::json& object, const std::string& key, const std::string& file,
-                             const std::string& where) {
-    if (!object.is_object() || !object.contains(key)) throwInput(file, where + key, "missing");
-    return object.at(key);
-}
-
-std::string stringMember(const nlohmann::json& object, const std::string& key, const std::string& file,
-                         const std::string& where) {
-    const nlohmann::json& value = member(object, key, file, where);
-    if (!value.is_string()) throwInput(file, where + key, "must be a string");
-    return value.get<std::string>();
-}
-
 } // namespace
 
 ComparisonPlan planStimulusSetComparisons(const fs::path& stimulusFolder,
                                           const std::optional<std::string>& referenceId) {
-    const fs::path manifestPath = stimulusFolder / "manifest.json";
-    const std::string file = manifestPath.string();
+    // The one strict reader of contract 2 (formats/stimulus_manifest.h).
+    const formats::StimulusManifest manifest = formats::readStimulusManifest(stimulusFolder);
+    const std::string& file = manifest.file;
     std::error_code ec;
-    if (!fs::is_regular_file(manifestPath, ec)) throwInput(file, "", "file not found (is this a stimulus set folder?)");
-    nlohmann::json manifest;
-    try {
-        manifest = nlohmann::json::parse(readFile(manifestPath));
-    } catch (const nlohmann::json::parse_error& e) {
-        throwInput(file, "", std::string("not valid JSON (") + e.what() + ")");
-    }
-    if (stringMember(manifest, "format", file, "") != "skinlab-stimuli")
-        throwInput(file, "format", "expected \"skinlab-stimuli\"");
-    const nlohmann::json& version = member(manifest, "version", file, "");
-    if (!version.is_number_integer() || version.get<int>() != 1)
-        throwInput(file, "version", version.dump() + " is not supported (this skinlab reads version 1)");
-    const nlohmann::json& stimuli = member(manifest, "stimuli", file, "");
-    if (!stimuli.is_array()) throwInput(file, "stimuli", "must be an array");
 
     std::vector<StimulusEntry> entries;
-    std::set<std::string> ids;
     std::optional<std::string> display;
-    for (size_t i = 0; i < stimuli.size(); ++i) {
-        const nlohmann::json& stimulus = stimuli[i];
+    for (size_t i = 0; i < manifest.stimuli.size(); ++i) {
+        const formats::ManifestEntry& stimulus = manifest.stimuli[i];
         const std::string where = "stimuli[" + std::to_string(i) + "].";
         StimulusEntry entry;
-        entry.id = stringMember(stimulus, "id", file, where);
-        if (!ids.insert(entry.id).second) throwInput(file, where + "id", "'" + entry.id + "' repeats");
-        entry.block = stringMember(stimulus, "block", file, where);
-        const nlohmann::json& files = member(stimulus, "files", file, where);
-        std::string exr = stringMember(files, "exr", file, where + "files.");
-        entry.exr = stimulusFolder / exr;
-        if (files.contains("png")) entry.png = stimulusFolder / stringMember(files, "png", file, where + "files.");
-        if (stimulus.contains("reference")) {
-            if (!stimulus["reference"].is_boolean()) throwInput(file, where + "reference", "must be true or false");
-            entry.reference = stimulus["reference"].get<bool>();
-        }
-        entry.factors = stimulus.contains("factors") ? stimulus["factors"] : nlohmann::json::object();
+        entry.id = stimulus.id;
+        entry.block = stimulus.block;
+        if (stimulus.files.exr.empty())
+            throwInput(file, where + "files.exr", "missing (image metrics read the renders)");
+        entry.exr = stimulusFolder / stimulus.files.exr;
+        if (!stimulus.files.png.empty()) entry.png = stimulusFolder / stimulus.files.png;
+        entry.reference = stimulus.reference;
+        entry.factors = stimulus.factors;
         // The content hash ties the metrics to the set as built; a changed file is not silently measured.
-        for (const auto& [kind, path] : {std::pair<std::string, fs::path>{"exr", entry.exr}, {"png", entry.png}}) {
-            if (path.empty() || !stimulus.contains("sha256") || !stimulus["sha256"].contains(kind)) continue;
-            const nlohmann::json& expected = stimulus["sha256"][kind];
-            if (!expected.is_string()) throwInput(file, where + "sha256." + kind, "must be a string");
-            if (fs::is_regular_file(path, ec) && sha256File(path) != expected.get<std::string>())
+        for (const auto& [path, expected] :
+             {std::pair<fs::path, std::string>{entry.exr, stimulus.sha256.exr}, {entry.png, stimulus.sha256.png}})
+            if (!path.empty() && fs::is_regular_file(path, ec) && sha256File(path) != expected)
                 throwInput(path.string(), "",
                            "sha256 does not match " + file + " (the file changed after the set was built)");
-        }
         // The display the set's predictions were made for: one viewing geometry per set.
-        if (stimulus.contains("predicted") && stimulus["predicted"].is_object() &&
-            stimulus["predicted"].contains("display")) {
-            const nlohmann::json& named = stimulus["predicted"]["display"];
-            if (!named.is_string()) throwInput(file, where + "predicted.display", "must be a string");
-            if (display && *display != named.get<std::string>())
+        if (stimulus.predicted && !stimulus.predicted->display.empty()) {
+            const std::string& named = stimulus.predicted->display;
+            if (display && *display != named)
                 throwInput(file, where + "predicted.display",
-                           "\"" + named.get<std::string>() + "\" differs from \"" + *display +
+                           "\"" + named + "\" differs from \"" + *display +
                                "\" of an earlier stimulus (predict the set again on one display)");
-            display = named.get<std::string>();
+            display = named;
         }
         entries.push_back(std::move(entry));
     }

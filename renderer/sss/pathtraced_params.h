@@ -36,9 +36,10 @@ const AlbedoRadiusTable& albedoRadiusTable();
 double tableRadiusMm(const AlbedoRadiusTable& table, int channel, double albedo);
 
 // Cycles' fixed-radius random walk reflects a little more than its colour asks: a flat, uniformly lit skin surface of
-// colour a returns k(a)·a (k ≈ 1.012 at a = 0.1, 1.006 at 0.9; the same in every channel, the walk being scale-free).
-// With pathtraced.diffuse = "lambert" the walk is given a / k(a) per channel, so that flat skin reflects exactly its
-// colour, as the rasterizer's Lambertian does. Piecewise linear in a, constant beyond the ends. Values and their
+// colour a returns k(a)·a (k ≈ 1.09 at a = 0.02, 1.012 at 0.05 … 0.1, 1.006 at 0.9; the same in every channel, the
+// walk being scale-free). With pathtraced.diffuse = "lambert" the walk is given a / g(a) per channel, g ≈ k, so that
+// flat skin reflects exactly its colour, as the rasterizer's Lambertian does. Piecewise linear in a, constant beyond
+// the ends. Values and their
 // measurement: pathtraced_params.cpp; docs/pathtraced.md, "Flat skin reflects its colour".
 struct WalkReflectanceTable {
     std::vector<double> albedo; // knots, ascending

@@ -66,7 +66,7 @@ const url = await new Promise((resolve, reject) => {
   });
 });
 try {
-  run(['study', 'simulate', database, '--observers', '8', '--truth', path.join(work, 'truth.json'), '--seed', '3',
+  run(['study', 'simulate', database, '--observer-count', '8', '--truth', path.join(work, 'truth.json'), '--seed', '3',
     '--random', '1', '--url', url]);
 } finally {
   server.kill();

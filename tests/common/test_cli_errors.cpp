@@ -36,6 +36,9 @@ TEST(CliErrors, EverySubcommandExitsTwoWithOneLine) {
         "stimuli --no-such-flag",
         "bench --no-such-flag",
         "report --no-such-flag",
+        "report s.db -o out --display no-such-display", // the display options of analyze metrics, checked first
+        "report s.db -o out --display-resolution 19x",  // a custom display's bad value
+        "study simulate s.db --observers 3",            // the old spelling of --observer-count
         "pathtraced --no-such-flag",
         "methods --no-such-flag",
         "analyze metrics --no-such-flag",

@@ -177,7 +177,7 @@ check "trial ids of consecutive participants are not guessable" $? "ids $first a
 
 # 5. A quoted newline in a CSV field: answers, then condition names with a newline (a design may use any text;
 #    set in the study file, as a researcher's manifest could), the CSV export read back by analyze scale.
-timeout 120 "$SKINLAB" study simulate "$WORK/study.db" --url "$URL" --observers 3 --seed 2 --label-prefix sim \
+timeout 120 "$SKINLAB" study simulate "$WORK/study.db" --url "$URL" --observer-count 3 --seed 2 --label-prefix sim \
   --truth "$WORK/truth.json" >"$WORK/simulate1.log" 2>&1
 stop_server
 cp "$WORK/study.db" "$WORK/renamed.db"
@@ -191,7 +191,7 @@ check "analyze scale reads that CSV export back" $? "$(tail -n 1 "$WORK/scale.lo
 start_server "$WORK/study.db"
 
 # 11. simulate, run again with the same observers (as after an interruption), resumes.
-timeout 120 "$SKINLAB" study simulate "$WORK/study.db" --url "$URL" --observers 3 --seed 2 --label-prefix sim --truth "$WORK/truth.json" \
+timeout 120 "$SKINLAB" study simulate "$WORK/study.db" --url "$URL" --observer-count 3 --seed 2 --label-prefix sim --truth "$WORK/truth.json" \
   >"$WORK/simulate2.log" 2>&1
 check "study simulate run again resumes" $? "$(tail -n 1 "$WORK/simulate2.log")"
 

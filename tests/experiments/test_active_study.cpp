@@ -250,7 +250,7 @@ TEST(ActiveStudy, RunsEndToEndOverHttpAndItsPlanSurvivesKillNine) {
 
     // The CLI's own simulate runs further observers through the restarted server.
     const CommandResult simulated =
-        runSkinlab({"study", "simulate", files.database.string(), "--observers", "2", "--url",
+        runSkinlab({"study", "simulate", files.database.string(), "--observer-count", "2", "--url",
                     "http://127.0.0.1:" + std::to_string(port), "--truth-factor", "quality", "--label-prefix", "cli"});
     EXPECT_EQ(simulated.exitCode, 0) << simulated.out << simulated.err;
     EXPECT_NE(simulated.out.find("2/2 observers completed, 30 responses acknowledged, 0 rejected"), std::string::npos)

@@ -149,6 +149,16 @@ TEST(StudyCli, CreateStatusExportAndTheirErrors) {
     CommandResult missing = runSkinlab({"study", "status", (files.folder.path() / "nope.db").string()});
     EXPECT_EQ(missing.exitCode, 2);
     EXPECT_EQ(missing.err, "skinlab: error: " + (files.folder.path() / "nope.db").string() + ": no such study file\n");
+
+    // `--observers` is a list of observer counts (study plan, analyze validate); simulate's count is --observer-count.
+    CommandResult oldSpelling = runSkinlab({"study", "simulate", files.database.string(), "--observers", "3"});
+    EXPECT_EQ(oldSpelling.exitCode, 2);
+    EXPECT_EQ(oldSpelling.err, "skinlab: error: --observers: \"3\": study simulate takes the number of observers as "
+                               "--observer-count N (--observers is a list of observer counts, in study plan and "
+                               "analyze validate)\n");
+    CommandResult noCount = runSkinlab({"study", "simulate", files.database.string()});
+    EXPECT_EQ(noCount.exitCode, 2);
+    EXPECT_EQ(noCount.err, "skinlab: error: --observer-count: required (the number of simultaneous observers)\n");
 }
 
 // A set built by the real renderer with a crop and a magnification: `study create` checks the presented images
@@ -255,9 +265,9 @@ TEST(StudyCli, KillNineDuringASessionLosesAndDuplicatesNothing) {
     EXPECT_EQ(check.text(0), "ok");
 
     // The CLI's own simulate, status and export work against the restarted server.
-    CommandResult simulated = runSkinlab({"study", "simulate", files.database.string(), "--observers", "2", "--url",
-                                          "http://127.0.0.1:" + std::to_string(port), "--truth-factor", "quality",
-                                          "--lapse", "0.1", "--label-prefix", "cli"});
+    CommandResult simulated = runSkinlab({"study", "simulate", files.database.string(), "--observer-count", "2",
+                                          "--url", "http://127.0.0.1:" + std::to_string(port), "--truth-factor",
+                                          "quality", "--lapse", "0.1", "--label-prefix", "cli"});
     EXPECT_EQ(simulated.exitCode, 0) << simulated.out << simulated.err;
     EXPECT_NE(simulated.out.find("2/2 observers completed, 54 responses acknowledged, 0 rejected"), std::string::npos)
         << simulated.out;

@@ -55,14 +55,21 @@ TEST(PredictionSection, ParticipantsOwnPixelsPerDegreeMovesThePredictions) {
             .jod;
     };
     const double predicted = jodAt(model.pixelsPerDegree);
+    // Two entries of contract 2 (formats/stimulus_manifest.h), written by its one writer.
+    skinlab::formats::ManifestEntry reference, test;
+    for (auto [entry, id] : {std::pair{&reference, "ref"}, std::pair{&test, "test"}}) {
+        entry->id = id;
+        entry->files = {std::string("exr/") + id + ".exr", std::string("png/") + id + ".png"};
+        entry->sha256 = {std::string(64, '0'), std::string(64, '0')};
+        entry->block = "b";
+        entry->width = 128;
+        entry->height = 96;
+    }
+    reference.reference = true;
+    test.predicted = skinlab::formats::Prediction{"ColorVideoVDP v0.5.6", "standard_fhd",      "ref", predicted,
+                                                  std::string(64, '0'),   std::string(64, '0')};
     const nlohmann::json manifest = {
-        {"stimuli",
-         {{{"id", "ref"}, {"block", "b"}, {"reference", true}, {"files", {{"png", "png/ref.png"}}}},
-          {{"id", "test"},
-           {"block", "b"},
-           {"reference", false},
-           {"files", {{"png", "png/test.png"}}},
-           {"predicted", {{"jod", predicted}, {"display", "standard_fhd"}, {"reference", "ref"}}}}}}};
+        {"stimuli", {skinlab::formats::toJson(reference), skinlab::formats::toJson(test)}}};
     const auto rows = skinlab::report::participantPredictions(
         manifest, folder, {{"P001", model.pixelsPerDegree}, {"P002", 20.0}, {"P003", 80.0}});
     ASSERT_EQ(rows.size(), 3u);

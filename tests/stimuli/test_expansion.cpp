@@ -369,7 +369,7 @@ TEST(StimulusManifest, JsonRoundTripAndCsv) {
     EXPECT_EQ(errorOf([] {
                   manifestFromJson({{"format", "x"}}, "m.json");
               }),
-              "m.json: format: not a skinlab stimulus manifest");
+              "m.json: format: expected \"skinlab-stimuli\"");
 }
 
 // contact.png's captions name a scene file by its factor label, a reference's own scene by its short name, and say
@@ -576,7 +576,7 @@ TEST(ShippedSpecs, EveryMagnifiedCropRendersNatively) {
         for (size_t i = 0; i < plan.selected.size(); ++i) {
             const Stimulus& s = plan.selected[i];
             const std::string where = entry.path().filename().string() + ": " + s.id;
-            const nlohmann::json entryJson = stimulusEntry(s, plan.resolved[i]);
+            const nlohmann::json entryJson = plannedEntryJson(s, plan.resolved[i]);
             EXPECT_EQ(entryJson["presentation"]["method"], "native") << where;
             if (!presents(s.presentation)) continue;
             ++magnified;

@@ -405,7 +405,7 @@ TEST(StimuliImport, ImportedSetThroughStudyAnalysisAndReport) {
         if (std::regex_search(line, match, serving)) port = std::stoi(match[1].str());
     }
     ASSERT_GT(port, 0) << "the server did not start";
-    CommandResult simulated = runSkinlab({"study", "simulate", study.string(), "--observers", "6", "--url",
+    CommandResult simulated = runSkinlab({"study", "simulate", study.string(), "--observer-count", "6", "--url",
                                           "http://127.0.0.1:" + std::to_string(port), "--truth-factor", "quality"});
     ASSERT_EQ(simulated.exitCode, 0) << simulated.out << simulated.err;
     EXPECT_NE(simulated.out.find("6/6 observers completed"), std::string::npos) << simulated.out;

@@ -198,6 +198,18 @@ protected:
 
 const std::vector<std::string> kSmall{"render.width=160", "render.height=90", "shadow.resolution=512"};
 
+// A manifest entry (contract 2, formats/stimulus_manifest.h): the keys every entry carries, and the test's own.
+json manifestEntry(const std::string& id, const json& fields) {
+    json entry = {{"id", id},
+                  {"files", {{"exr", "exr/" + id + ".exr"}, {"png", "png/" + id + ".png"}}},
+                  {"sha256", {{"exr", std::string(64, '0')}, {"png", std::string(64, '0')}}},
+                  {"block", "test"},
+                  {"width", 160},
+                  {"height", 90}};
+    entry.update(fields);
+    return entry;
+}
+
 std::vector<std::string> with(std::vector<std::string> base, const std::vector<std::string>& more) {
     base.insert(base.end(), more.begin(), more.end());
     return base;
@@ -523,17 +535,17 @@ protected:
     void configure(TuneOptions& options) override {
         const auto set = work_ / "set";
         std::filesystem::create_directories(set);
-        const json manifest = {{"format", "skinlab-stimuli"},
-                               {"version", 1},
-                               {"set", "demo"},
-                               {"stimuli",
-                                {{{"id", "head-mid-separable"},
-                                  {"scene", "builtin:head"},
-                                  {"factors", {{"method", "separable"}}},
-                                  {"reference", false},
-                                  {"overrides",
-                                   {"render.width=160", "render.height=90", "camera.view=\"mid\"",
-                                    "sss.method=\"separable\"", "sss.width_mm=2.5"}}}}}};
+        const json manifest = {
+            {"format", "skinlab-stimuli"},
+            {"version", 1},
+            {"set", "demo"},
+            {"stimuli",
+             {manifestEntry("head-mid-separable", {{"scene", "builtin:head"},
+                                                   {"factors", {{"method", "separable"}}},
+                                                   {"reference", false},
+                                                   {"overrides",
+                                                    {"render.width=160", "render.height=90", "camera.view=\"mid\"",
+                                                     "sss.method=\"separable\"", "sss.width_mm=2.5"}}})}}};
         std::ofstream(set / "manifest.json") << manifest.dump(1);
         options.stimulusSets = {set};
     }
@@ -861,14 +873,15 @@ protected:
         std::ofstream(set / "beside.toml") << *renderer::builtinSceneText("halo");
         std::ofstream(work_ / "scenes" / "k.bn") << "not a kernel\n";
         const std::vector<std::string> small{"render.width=96", "render.height=64", "shadow.resolution=256"};
-        const json stimuli = {{{"id", "lab-separable"},
-                               {"scene", "../scenes/lab.toml"},
-                               {"overrides", with(small, {"sss.method=\"separable\""})},
-                               {"resolved", {{"scene", (work_ / "specs" / ".." / "scenes" / "lab.toml").string()}}}},
-                              {{"id", "beside-separable"},
-                               {"scene", "beside.toml"},
-                               {"overrides", with(small, {"sss.method=\"separable\""})},
-                               {"resolved", {{"scene", (work_ / "elsewhere" / "beside.toml").string()}}}}};
+        const json stimuli = {
+            manifestEntry("lab-separable",
+                          {{"scene", "../scenes/lab.toml"},
+                           {"overrides", with(small, {"sss.method=\"separable\""})},
+                           {"resolved", {{"scene", (work_ / "specs" / ".." / "scenes" / "lab.toml").string()}}}}),
+            manifestEntry("beside-separable",
+                          {{"scene", "beside.toml"},
+                           {"overrides", with(small, {"sss.method=\"separable\""})},
+                           {"resolved", {{"scene", (work_ / "elsewhere" / "beside.toml").string()}}}})};
         std::ofstream(set / "manifest.json") << json{
             {"format", "skinlab-stimuli"},
             {"version", 1},

@@ -44,10 +44,12 @@ protected:
         std::string exr = "exr/" + id + ".exr";
         manifest["stimuli"].push_back({{"id", id},
                                        {"files", {{"exr", exr}, {"png", "png/" + id + ".png"}}},
-                                       {"sha256", {{"exr", sha256File(folder / exr)}}},
+                                       {"sha256", {{"exr", sha256File(folder / exr)}, {"png", "not-built"}}},
                                        {"factors", {{"method", method}}},
                                        {"block", block},
-                                       {"reference", reference}});
+                                       {"reference", reference},
+                                       {"width", 32},
+                                       {"height", 32}});
     }
     ComparisonPlan plan(const std::optional<std::string>& reference = std::nullopt) {
         writeFileAtomic(folder / "manifest.json", manifest.dump());
@@ -98,7 +100,7 @@ TEST_F(StimulusSetPairs, ErrorsNameTheManifestAndTheKey) {
                                   "'disc-gaussian'); pick one with --reference ID");
     manifest["stimuli"][2]["reference"] = false;
     manifest["stimuli"][3]["files"].erase("exr");
-    EXPECT_EQ(failureOf(), file + ": stimuli[3].files.exr: missing");
+    EXPECT_EQ(failureOf(), file + ": stimuli[3].files.exr: missing (image metrics read the renders)");
     manifest["format"] = "something-else";
     EXPECT_EQ(failureOf(), file + ": format: expected \"skinlab-stimuli\"");
     fs::remove(folder / "manifest.json");
@@ -106,7 +108,7 @@ TEST_F(StimulusSetPairs, ErrorsNameTheManifestAndTheKey) {
         planStimulusSetComparisons(folder, std::nullopt);
         FAIL() << "no manifest";
     } catch (const InputError& e) {
-        EXPECT_EQ(std::string(e.what()), file + ": file not found (is this a stimulus set folder?)");
+        EXPECT_EQ(std::string(e.what()), file + ": no manifest.json in the stimulus folder");
     }
 }
 
