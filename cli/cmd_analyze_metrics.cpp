@@ -1,6 +1,7 @@
 // `skinlab analyze metrics`: image-difference metrics of renders against a reference (docs/metrics.md).
 #include "analysis/metrics/debiased_error.h"
 #include "analysis/metrics/metrics_run.h"
+#include "analysis/metrics/seed_mean.h"
 #include "cli/commands.h"
 #include "common/error.h"
 
@@ -263,6 +264,26 @@ void registerAnalyzeMetrics(CLI::App& analyze) {
     command->add_option("--display-reflectivity", arguments->displayReflectivity,
                         "Custom display: reflectivity of the screen (0-1, default 0.005)");
     command->callback([arguments] { runAnalyzeMetrics(*arguments); });
+}
+
+void registerAnalyzeSeedMean(CLI::App& analyze) {
+    struct Arguments {
+        std::vector<std::string> seeds;
+        std::string output;
+    };
+    auto arguments = std::make_shared<Arguments>();
+    CLI::App* command = analyze.add_subcommand(
+        "seed-mean",
+        "Average path-traced renders of one scene with independent seeds into one EXR, the path-traced truth for "
+        "analyze metrics --reference (skinlab:truth records the seeds; docs/metrics.md)");
+    command->add_option("seeds", arguments->seeds, "Path-traced renders (sss.method = \"pathtraced\"), one per seed")
+        ->required();
+    command->add_option("-o,--output", arguments->output, "The seed mean, an EXR with the seeds' layout")->required();
+    command->callback([arguments] {
+        const std::vector<std::filesystem::path> seeds(arguments->seeds.begin(), arguments->seeds.end());
+        const auto truth = metrics::writeSeedMean(seeds, arguments->output);
+        spdlog::info("seed-mean: {} seeds {} averaged into {}", seeds.size(), truth["seeds"].dump(), arguments->output);
+    });
 }
 
 } // namespace skinlab::cli
