@@ -2,12 +2,15 @@
 #include "analysis/metrics/debiased_error.h"
 #include "analysis/metrics/metrics_run.h"
 #include "analysis/metrics/seed_mean.h"
+#include "analysis/scaling/renderer_effects.h"
 #include "cli/commands.h"
 #include "common/error.h"
+#include "common/files.h"
 
 #include <array>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -131,6 +134,29 @@ void runDebiased(const AnalyzeMetricsArguments& arguments) {
                  run.tests.size(), seeds.size(), arguments.outputFolder);
 }
 
+// One line per block of a stimulus set whose test renders come from different renderers (skinlab's rasterizer,
+// EEVEE, Cycles): their scores against one reference also differ by what the renderers do apart from SSS.
+void warnAboutMixedRenderers(const std::filesystem::path& stimulusFolder) {
+    nlohmann::json manifest;
+    try {
+        manifest = nlohmann::json::parse(readFile(stimulusFolder / "manifest.json"));
+    } catch (const nlohmann::json::exception&) {
+        return; // the plan has checked the manifest already
+    }
+    std::map<std::string, std::pair<std::vector<std::string>, std::vector<nlohmann::json>>> blocks;
+    for (const nlohmann::json& s : manifest.value("stimuli", nlohmann::json::array())) {
+        if (!s.is_object() || s.value("reference", false)) continue;
+        auto& [names, resolved] = blocks[s.value("block", "")];
+        names.push_back(s.value("id", ""));
+        resolved.push_back(s.value("resolved", nlohmann::json::object()));
+    }
+    for (const auto& [block, conditions] : blocks) {
+        const auto effects = analysis::scaling::sssEffectsWithinRenderers(
+            block, conditions.first, conditions.second, std::vector<double>(conditions.first.size(), 0.0));
+        if (effects.warning) spdlog::warn("metrics: {}", *effects.warning);
+    }
+}
+
 void runAnalyzeMetrics(const AnalyzeMetricsArguments& arguments) {
     if (!arguments.referenceSeeds.empty()) return runDebiased(arguments);
     if (!arguments.compareReference.empty()) throwInput("--compare-reference", "", "only with --reference-seeds");
@@ -145,6 +171,7 @@ void runAnalyzeMetrics(const AnalyzeMetricsArguments& arguments) {
         std::optional<std::string> referenceId;
         if (!arguments.reference.empty()) referenceId = arguments.reference;
         plan = metrics::planStimulusSetComparisons(arguments.stimulusFolder, referenceId);
+        warnAboutMixedRenderers(arguments.stimulusFolder);
         // The set's viewing geometry: the display its predictions were made for, unless --display says otherwise.
         if (plan.display && !arguments.display) {
             display = displayOf(arguments, plan.display);
