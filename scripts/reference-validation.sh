@@ -596,6 +596,10 @@ def competitive_tau(d, score):
     if not a or a["competitive"]["tau_b"]["value"] is None: return "–"
     boot = a["competitive"].get("tau_b_bootstrap_interval_95")
     return f"{a['competitive']['tau_b']['value']:+.2f}" + (f" [{boot[0]:+.2f}, {boot[1]:+.2f}]" if boot else "")
+def truth_seeds_used(name):
+    # The truth measured in metrics-truth-debiased is truth.exr itself (TRUTH_SEEDS) rather than a half of the seeds.
+    record = json.load(open(os.path.join(out, name, "metrics-truth", "metrics.json")))["comparisons"][0]["reference"]["truth"]
+    return all(isinstance(k, int) and k >= 1000 for k in record.get("seeds", []))
 for name in cases:
     path_json = os.path.join(out, name, "metrics-debiased", "debiased.json")
     if not os.path.exists(path_json): continue
@@ -604,7 +608,14 @@ for name in cases:
     half = json.load(open(half_json)) if os.path.exists(half_json) else None
     half_precision = half["truth_precision"]["regions"] if half else None
     scored = [b for b in ["skin", "halo", "bleed"] if (precision[b]["Y"]["best_condition_mse"] is not None)]
-    reference_ok = all(precision[b]["Y"]["compared_reference"]["precise_enough"] for b in scored)
+    # `reference` where it is precise enough, or no less precise than the path-traced truth (measured against
+    # independent seeds when they exist, else the validation seeds' mean from their pairs).
+    worst = lambda ratios: max((r for r in ratios if r is not None), default=float("inf"))
+    reference_worst = worst(precision[b]["Y"]["compared_reference"]["ratio_to_best_condition"] for b in scored)
+    truth_worst = worst((half_precision[b]["Y"]["compared_reference"] if half_precision and os.path.exists(
+                         os.path.join(out, name, "metrics-truth-debiased")) and truth_seeds_used(name) else
+                         precision[b]["Y"]["seed_mean"])["ratio_to_best_condition"] for b in scored)
+    reference_ok = reference_worst <= 0.5 or reference_worst <= truth_worst
     truth_record = json.load(open(os.path.join(out, name, "metrics-truth", "metrics.json")))["comparisons"][0]["reference"]["truth"]
     used = "`reference`" if reference_ok else (f"`pathtraced`, mean of {len(truth_record['seeds'])} seeds × "
                                                f"{truth_record['samples']} samples")
@@ -617,7 +628,8 @@ for name in cases:
                            + (ratio_text(hp['Y'].get('compared_reference'), hp['R'].get('compared_reference')) if hp else "–")
                            + f" | {half_taus if b == 'skin' else ''} | {used} |")
     with open(os.path.join(out, name, "truth.json") + ".tmp", "w") as f:
-        json.dump({"truth": "reference" if reference_ok else "pathtraced-seed-mean", "seeds": seeds,
+        json.dump({"truth": "reference" if reference_ok else "pathtraced-seed-mean",
+                   "record": {"kind": "render", "method": "reference"} if reference_ok else truth_record,
                    "metrics": "metrics-reference" if reference_ok else "metrics-truth"}, f, indent=2)
     os.replace(os.path.join(out, name, "truth.json") + ".tmp", os.path.join(out, name, "truth.json"))
 debiased += colour + table_scores + truth_lines
