@@ -6,6 +6,7 @@ void registerAnalyze(CLI::App& app) {
     analyze->require_subcommand(1);
     registerAnalyzeScale(*analyze);
     registerAnalyzeMetrics(*analyze);
+    registerAnalyzeSeedMean(*analyze);
     registerAnalyzeAgreement(*analyze);
 }
 } // namespace skinlab::cli

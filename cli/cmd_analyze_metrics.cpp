@@ -1,12 +1,16 @@
 // `skinlab analyze metrics`: image-difference metrics of renders against a reference (docs/metrics.md).
 #include "analysis/metrics/debiased_error.h"
 #include "analysis/metrics/metrics_run.h"
+#include "analysis/metrics/seed_mean.h"
+#include "analysis/scaling/renderer_effects.h"
 #include "cli/commands.h"
 #include "cli/options.h"
 #include "common/error.h"
+#include "common/files.h"
 
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -63,6 +67,29 @@ void runDebiased(const AnalyzeMetricsArguments& arguments) {
                  run.tests.size(), seeds.size(), arguments.outputFolder);
 }
 
+// One line per block of a stimulus set whose test renders come from different renderers (skinlab's rasterizer,
+// EEVEE, Cycles): their scores against one reference also differ by what the renderers do apart from SSS.
+void warnAboutMixedRenderers(const std::filesystem::path& stimulusFolder) {
+    nlohmann::json manifest;
+    try {
+        manifest = nlohmann::json::parse(readFile(stimulusFolder / "manifest.json"));
+    } catch (const nlohmann::json::exception&) {
+        return; // the plan has checked the manifest already
+    }
+    std::map<std::string, std::pair<std::vector<std::string>, std::vector<nlohmann::json>>> blocks;
+    for (const nlohmann::json& s : manifest.value("stimuli", nlohmann::json::array())) {
+        if (!s.is_object() || s.value("reference", false)) continue;
+        auto& [names, resolved] = blocks[s.value("block", "")];
+        names.push_back(s.value("id", ""));
+        resolved.push_back(s.value("resolved", nlohmann::json::object()));
+    }
+    for (const auto& [block, conditions] : blocks) {
+        const auto effects = analysis::scaling::sssEffectsWithinRenderers(
+            block, conditions.first, conditions.second, std::vector<double>(conditions.first.size(), 0.0));
+        if (effects.warning) spdlog::warn("metrics: {}", *effects.warning);
+    }
+}
+
 void runAnalyzeMetrics(const AnalyzeMetricsArguments& arguments) {
     if (!arguments.referenceSeeds.empty()) return runDebiased(arguments);
     if (!arguments.compareReference.empty()) throwInput("--compare-reference", "", "only with --reference-seeds");
@@ -77,6 +104,7 @@ void runAnalyzeMetrics(const AnalyzeMetricsArguments& arguments) {
         std::optional<std::string> referenceId;
         if (!arguments.reference.empty()) referenceId = arguments.reference;
         plan = metrics::planStimulusSetComparisons(arguments.stimulusFolder, referenceId);
+        warnAboutMixedRenderers(arguments.stimulusFolder);
         // The set's viewing geometry: the display its predictions were made for, unless --display says otherwise.
         if (plan.display && !arguments.display.name) {
             display = arguments.display.resolve(plan.display);
@@ -173,6 +201,26 @@ void registerAnalyzeMetrics(CLI::App& analyze) {
                       "Display model, the viewing geometry of FLIP and ColorVideoVDP (default: with --stimuli the "
                       "display of the set's predictions, else standard_fhd)");
     command->callback([arguments] { runAnalyzeMetrics(*arguments); });
+}
+
+void registerAnalyzeSeedMean(CLI::App& analyze) {
+    struct Arguments {
+        std::vector<std::string> seeds;
+        std::string output;
+    };
+    auto arguments = std::make_shared<Arguments>();
+    CLI::App* command = analyze.add_subcommand(
+        "seed-mean",
+        "Average path-traced renders of one scene with independent seeds into one EXR, the path-traced truth for "
+        "analyze metrics --reference (skinlab:truth records the seeds; docs/metrics.md)");
+    command->add_option("seeds", arguments->seeds, "Path-traced renders (sss.method = \"pathtraced\"), one per seed")
+        ->required();
+    command->add_option("-o,--output", arguments->output, "The seed mean, an EXR with the seeds' layout")->required();
+    command->callback([arguments] {
+        const std::vector<std::filesystem::path> seeds(arguments->seeds.begin(), arguments->seeds.end());
+        const auto truth = metrics::writeSeedMean(seeds, arguments->output);
+        spdlog::info("seed-mean: {} seeds {} averaged into {}", seeds.size(), truth["seeds"].dump(), arguments->output);
+    });
 }
 
 } // namespace skinlab::cli

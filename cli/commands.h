@@ -19,6 +19,7 @@ namespace skinlab::cli {
 // `skinlab analyze` sub-subcommands, registered by cmd_analyze.cpp on the `analyze` subcommand.
 void registerAnalyzeScale(CLI::App& analyze);     // scale, validate
 void registerAnalyzeMetrics(CLI::App& analyze);   // metrics
+void registerAnalyzeSeedMean(CLI::App& analyze);  // seed-mean
 void registerAnalyzeAgreement(CLI::App& analyze); // agreement
 // `skinlab stimuli import`, registered by cmd_stimuli.cpp on the `stimuli` subcommand.
 void registerStimuliImport(CLI::App& stimuli);

@@ -2,6 +2,7 @@
 
 #include "analysis/agreement/metric_agreement.h"
 #include "analysis/metrics/metrics_run.h"
+#include "analysis/scaling/renderer_effects.h"
 #include "analysis/scaling/responses.h"
 #include "analysis/scaling/screening.h"
 #include "analysis/scaling/scale_analysis.h"
@@ -687,6 +688,44 @@ void writePairMatrix(std::ostringstream& html, const scaling::BlockAnalysis& blo
     html << "</tbody></table>\n";
 }
 
+// Where a block mixes renderers (skinlab's rasterizer, EEVEE, Cycles): a one-line warning, and each SSS
+// condition's effect against its own renderer's no-SSS baseline in JOD.
+void writeRendererEffects(std::ostringstream& html, const ReportData& r, const scaling::BlockAnalysis& block) {
+    std::map<std::string, nlohmann::json> resolvedOf;
+    for (const nlohmann::json& s : r.storedManifest.value("stimuli", nlohmann::json::array()))
+        resolvedOf[s.value("id", "")] = s.value("resolved", nlohmann::json::object());
+    const auto images = r.stimuli.imagesOfBlock.find(block.name);
+    if (images == r.stimuli.imagesOfBlock.end()) return;
+    std::vector<std::string> conditions;
+    std::vector<nlohmann::json> resolved;
+    std::vector<double> scores;
+    for (std::size_t c = 0; c < block.conditions.size(); ++c) {
+        const auto image = std::find_if(images->second.begin(), images->second.end(),
+                                        [&](const ConditionImages& i) { return i.condition == block.conditions[c]; });
+        if (image == images->second.end() || (c < block.measured.size() && !block.measured[c])) continue;
+        conditions.push_back(block.conditions[c]);
+        resolved.push_back(resolvedOf[image->stimulus]);
+        scores.push_back(block.thurstone.scores[static_cast<Eigen::Index>(c)]);
+    }
+    const scaling::RendererEffects effects =
+        scaling::sssEffectsWithinRenderers(block.name, conditions, resolved, scores);
+    if (!effects.warning) return;
+    spdlog::warn("report: {}", *effects.warning);
+    html << "<p class=\"note warn\">Warning: " << h(*effects.warning) << ".</p>";
+    if (effects.effects.empty()) return;
+    html << "<table><thead><tr><th class=\"l\">SSS effect within each renderer</th><th class=\"l\">renderer</th>"
+            "<th class=\"l\">baseline (no SSS)</th><th>JOD − baseline</th></tr></thead><tbody>";
+    for (const scaling::SssEffect& effect : effects.effects)
+        html << "<tr><td class=\"l\">" << h(effect.condition) << "</td><td class=\"l\">" << h(effect.renderer)
+             << "</td><td class=\"l\">" << h(effect.baseline) << "</td><td>" << num(effect.effect) << "</td></tr>";
+    html << "</tbody></table>";
+    if (!effects.withoutBaseline.empty()) {
+        std::string names;
+        for (const std::string& name : effects.withoutBaseline) names += (names.empty() ? "" : ", ") + name;
+        html << "<p class=\"note\">Without a no-SSS baseline of their renderer in this block: " << h(names) << ".</p>";
+    }
+}
+
 void writeScale(std::ostringstream& html, const ReportData& r) {
     html << "<h2 id=\"scale\">Perceptual scale (JOD)</h2><p class=\"note\">Higher = chosen more often. Bars: "
          << num(100.0 * r.scale.options.bootstrap.level, 0) << " % confidence intervals; bars running off the axis end "
@@ -726,6 +765,7 @@ void writeScale(std::ostringstream& html, const ReportData& r) {
                     "(the studentized bootstrap is degenerate there); no standard error is given for it.</p>";
         html << "</tbody></table>";
         for (const std::string& warning : block.warnings) html << "<p class=\"note\">Note: " << h(warning) << "</p>";
+        writeRendererEffects(html, r, block);
         writePairMatrix(html, block, order);
     }
 }

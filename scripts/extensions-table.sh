@@ -9,7 +9,8 @@
 # Environment: SKINLAB (the skinlab executable; default build/release/cli/skinlab), SKINLAB_ASSETS (the shared
 # assets; without the scanned head its set is skipped with a message), PATHTRACED (0: no path-traced reference),
 # PATHTRACED_SAMPLES (its samples, default 64), PATHTRACED_SEEDS (path-traced seeds per reference, default 4, at
-# least 2: the debiased scores), EEVEE (0: no `eevee` row), SETS (a subset of the sets: "halo bleed head"). Needs python3 for the table and blender for the second reference.
+# least 2: the debiased scores), TRUTH (the truth of the error metrics: auto, reference or pathtraced; below),
+# EEVEE (0: no `eevee` row), SETS (a subset of the sets: "halo bleed head"). Needs python3 for the table and blender for the second reference.
 # Writes, under OUT_DIR:
 #   halo/, bleed/, head/   the stimulus sets (stimuli/specs/extensions-*.toml): exr/, png/, manifest, contact.png
 #   */metrics/             metrics.csv, metrics.json and the ΔE00 heat maps with the bands outlined
@@ -20,6 +21,14 @@
 #                          how each score of the table ranks the conditions against Cycles (`--compare-metrics`):
 #                          a score whose τ_b over the 16 conditions closest to Cycles is below 0.8 is withdrawn
 #                          from the block's tables, with the reason printed
+#   */pathtraced/ID-truth.exr, */metrics-truth/   the mean of the path-traced seeds (`skinlab analyze seed-mean`)
+#                          and the block's scores against it: the table's scores where `reference` is not precise
+#                          enough (its debiased MSE against Cycles above half the best condition's in the skin, halo
+#                          or bleed band) and the seed mean is more precise (TRUTH=auto, the default), or always
+#                          (TRUTH=pathtraced), or never
+#                          (TRUTH=reference); each block's tables name the truth they were scored against;
+#                          */metrics-truth-debiased/ ranks those scores against Cycles' debiased ranking (the
+#                          withdrawal rule below applies to them as to the scores against `reference`)
 #   */eevee/, */metrics-eevee/, */metrics-eevee-pathtraced/   each block's scene rendered by `eevee`
 #                          (Blender EEVEE, its own screen-space SSS), scored against the block's reference and
 #                          against the path-traced one: the table's `eevee` row
@@ -91,6 +100,15 @@ m = json.load(open(sys.argv[1]))
 print(next(s["files"]["exr"] for s in m["stimuli"] if s["id"] == sys.argv[2]))' "$dir/manifest.json" "$id")"
     "$skinlab" analyze metrics --reference-seeds "$seed_files" --compare-reference "$reference" "${tests[@]}" \
       --compare-metrics "$dir/metrics/metrics.json" -o "$dir/metrics-debiased/$id" > /dev/null
+    # The path-traced truth: the mean of the seeds (ID-truth.exr) and the block's scores against it.
+    local all_seeds=()
+    IFS=, read -r -a all_seeds <<< "$seed_files"
+    "$skinlab" analyze seed-mean "${all_seeds[@]}" -o "$dir/pathtraced/$id-truth.exr" > /dev/null
+    "$skinlab" analyze metrics --reference "$dir/pathtraced/$id-truth.exr" "${tests[@]}" -o "$dir/metrics-truth/$id" > /dev/null
+    # The scores against the seed mean ranked against Cycles' debiased ranking (the same seeds: optimistic), so that a
+    # score that ranks otherwise than the squared error even against Cycles is withdrawn as well.
+    "$skinlab" analyze metrics --reference-seeds "$seed_files" --compare-reference "$dir/pathtraced/$id-truth.exr" \
+      "${tests[@]}" --compare-metrics "$dir/metrics-truth/$id/metrics.json" -o "$dir/metrics-truth-debiased/$id" > /dev/null
   done < <(python3 -c '
 import json, os, sys
 m = json.load(open(sys.argv[1]))
@@ -130,6 +148,9 @@ print(next(s["files"]["exr"] for s in m["stimuli"] if s["id"] == sys.argv[2]))' 
     if [ -e "$dir/pathtraced/$id.exr" ]; then
       "$skinlab" analyze metrics --reference "$dir/pathtraced/$id.exr" "$exr" -o "$dir/metrics-eevee-pathtraced/$id" > /dev/null
     fi
+    if [ -e "$dir/pathtraced/$id-truth.exr" ]; then
+      "$skinlab" analyze metrics --reference "$dir/pathtraced/$id-truth.exr" "$exr" -o "$dir/metrics-eevee-truth/$id" > /dev/null
+    fi
   done < <(python3 -c '
 import json, os, sys
 m = json.load(open(sys.argv[1]))
@@ -164,12 +185,14 @@ done
 
 # The screen-space methods, from the binary's method table (one name a line).
 methods="$("$skinlab" methods --list --screen-space | paste -sd, -)"
-python3 - "$out" "$methods" "${sets[@]}" <<'PYTHON'
+truth="${TRUTH:-auto}"
+case "$truth" in auto|reference|pathtraced) ;; *) echo "extensions-table: TRUTH=$truth must be auto, reference or pathtraced" >&2; exit 2 ;; esac
+python3 - "$out" "$methods" "$truth" "${sets[@]}" <<'PYTHON'
 # Pivots each set's metrics.json by block × method × extension set. The extension set of a stimulus is read from
 # its resolved [sss] parameters in the manifest, so the table cannot disagree with what was rendered.
 import json, os, sys
 
-out, methods, sets = sys.argv[1], sys.argv[2].split(","), sys.argv[3:]
+out, methods, truth_choice, sets = sys.argv[1], sys.argv[2].split(","), sys.argv[3], sys.argv[4:]
 extension_sets = ["none", "follow-surface", "+cbf", "+lab_weight", "+curvature", "all"]
 
 def extension_set(sss):
@@ -210,6 +233,7 @@ for name in sets:
         pt = os.path.join(out, name, "metrics-eevee-pathtraced", ref_id, "metrics.json")
         c["pathtraced"] = json.load(open(pt))["comparisons"][0] if os.path.exists(pt) else None
         block = next(s["block"] for s in manifest["stimuli"] if s["id"] == ref_id)
+        c["reference_id"] = ref_id
         eevee[block] = c
     # Debiased squared errors against the noise-free path-traced image, per reference (absent: PATHTRACED=0).
     stimulus_of_file = {os.path.normpath(os.path.join(out, name, s["files"]["exr"])): s["id"] for s in manifest["stimuli"]}
@@ -220,18 +244,50 @@ for name in sets:
             d = json.load(open(path))
             d["by_stimulus"] = {stimulus_of_file.get(os.path.normpath(t["test"])): t for t in d["tests"]}
             debiased[s["block"]] = d
+    # The truth of each block's error metrics: `reference` where it is precise enough (its debiased MSE against
+    # Cycles ≤ 0.5 × the best condition's in every band scored: debiased.json, truth_precision) or no less precise
+    # than the seed mean, else the mean of the Cycles seeds (metrics-truth/); TRUTH=reference or pathtraced forces one.
+    against_truth, truth_of_block = {}, {}
+    for s in manifest["stimuli"]:
+        if not s["reference"]: continue
+        path = os.path.join(out, name, "metrics-truth", s["id"], "metrics.json")
+        d = debiased.get(s["block"])
+        if not os.path.exists(path) or d is None or truth_choice == "reference": continue
+        precision = d["truth_precision"]["regions"]
+        scored = [b for b in ["skin", "halo", "bleed"] if precision[b]["Y"]["best_condition_mse"] is not None]
+        ratios = {b: precision[b]["Y"]["compared_reference"]["ratio_to_best_condition"] for b in scored}
+        seed_mean = {b: precision[b]["Y"]["seed_mean"]["ratio_to_best_condition"] for b in scored}
+        worst = lambda r: max((v for v in r.values() if v is not None), default=float("inf"))
+        if truth_choice == "auto" and (worst(ratios) <= 0.5 or worst(ratios) <= worst(seed_mean)):
+            continue  # `reference` is precise enough, or at least as precise as the seed mean
+        truth_of_block[s["block"]] = (
+            f"`pathtraced`, the mean of its {len(d['seeds'])} seeds (`{name}/pathtraced/{s['id']}-truth.exr`): "
+            + ("forced by TRUTH=pathtraced" if truth_choice == "pathtraced" else
+               "`reference` is not precise enough, its debiased MSE against Cycles over the best condition's is "
+               + ", ".join(f"{b} {number(r, 2)}" for b, r in ratios.items()) + " (above 0.5 somewhere)")
+            + "; the seed mean's own: " + ", ".join(f"{b} {number(r, 2)}" for b, r in seed_mean.items())
+            + ("" if worst(seed_mean) <= 0.5 else
+               " (**not precise enough either**: raise PATHTRACED_SEEDS or PATHTRACED_SAMPLES)"))
+        for c in json.load(open(path))["comparisons"]:
+            against_truth[c["test"]["name"]] = c
     table = {}
     for c in metrics["comparisons"]:
         sss = resolved[c["test"]["name"]]["sss"]
         key = (c["block"], sss["method"], extension_set(sss))
+        if c["block"] in truth_of_block: c = dict(against_truth[c["test"]["name"]], block=c["block"])
         table[key] = c
         c["pathtraced"] = against_pathtraced.get(c["test"]["name"])
     for block, c in eevee.items():
+        ref_id = c["reference_id"]
+        truth_path = os.path.join(out, name, "metrics-eevee-truth", ref_id, "metrics.json")
+        if block in truth_of_block and os.path.exists(truth_path):
+            c = dict(json.load(open(truth_path))["comparisons"][0], pathtraced=c["pathtraced"])
         table[(block, "eevee", "follow-surface")] = c
     for block in sorted({k[0] for k in table}):
         reference = next(c["reference"]["name"] for k, c in table.items() if k[0] == block)
         lines += [f"## {name}: block `{block}` (reference `{reference}`)", "",
-                  f"Contact sheet: `{name}/contact.png`; heat maps: `{name}/metrics/heatmaps/`.", ""]
+                  f"Contact sheet: `{name}/contact.png`; heat maps: `{name}/metrics/heatmaps/`.", "",
+                  "Truth of the error metrics: " + truth_of_block.get(block, f"`reference` (`{reference}`)") + ".", ""]
         # Compact pivots, method × extension set, for the bands this block has: the leak energy of halo, bleed and
         # spill, and the mean ΔE00 excess (band mean − interior mean) of halo and bleed.
         pivots = [(band, "leak_energy", f"{band} leak energy") for band in ["halo", "bleed", "spill"]] + \
@@ -242,9 +298,15 @@ for name in sets:
         # conditions closest to Cycles is below 0.8 does not rank the conditions as the path tracer does and is
         # withdrawn from this block's tables.
         withdrawn = {}
+        # Against the seed mean: its scores ranked against Cycles' debiased ranking (metrics-truth-debiased).
         agreement = (debiased.get(block) or {}).get("table_score_agreement", {})
+        if block in truth_of_block:
+            ref_id = next(s["id"] for s in manifest["stimuli"] if s["reference"] and s["block"] == block)
+            path = os.path.join(out, name, "metrics-truth-debiased", ref_id, "debiased.json")
+            agreement = json.load(open(path)).get("table_score_agreement", {}) if os.path.exists(path) else {}
         if agreement:
-            lines += ["Scores against `reference` ranked against Cycles (τ_b [seed jackknife, t] [bootstrap over conditions "
+            against = "the Cycles seed mean" if block in truth_of_block else "`reference`"
+            lines += [f"Scores against {against} ranked against Cycles (τ_b [seed jackknife, t] [bootstrap over conditions "
                       "and seeds], 95 %; 16 closest: the conditions with the smallest debiased error against Cycles in the "
                       "score's band; withdrawn below 0.8 there; docs/pathtraced.md, \"Reading the agreement\"):", "",
                       "| score | τ_b all | τ_b 16 closest | kept |", "|---|---|---|---|"]
@@ -283,11 +345,12 @@ for name in sets:
             own = d["compared_reference"]["regions"][band]
             if not own["pixels"]: continue
             agree = d["ranking_agreement"][band]
-            lo, hi = agree["tau_b_interval_95"]
+            interval = agree["tau_b_interval_95"]  # none with two seeds (no jackknife)
+            interval = "[–]" if not interval else f"[{interval[0]:+.2f}, {interval[1]:+.2f}]"
             lines += [f"{band} band, MSE of Y against the noise-free path-traced image ({len(d['seeds'])} seeds, "
                       f"debiased): `reference` itself {number(own['mse']['value'])} ± {number(own['mse']['standard_error'])}; "
                       f"τ_b between the conditions' rankings under the two references {agree['tau_b']['value']:+.2f} "
-                      f"[{lo:+.2f}, {hi:+.2f}], {agree['concordant_separated_pairs']} of {agree['separated_pairs']} "
+                      f"{interval}, {agree['concordant_separated_pairs']} of {agree['separated_pairs']} "
                       "pairs the path tracer separates ordered alike:", "",
                       "| method | " + " | ".join(extension_sets) + " |", "|---|" + "---|" * len(extension_sets)]
             for method in methods:

@@ -24,6 +24,9 @@
 #   scripts/reference-validation.sh [OUT_DIR] [SIZE] [SAMPLES]       (defaults: out/reference-validation 256 64)
 #
 # Environment: SKINLAB (default build/release/cli/skinlab), SEEDS (path-traced seeds, default 4, at least 2),
+# TRUTH_SEEDS and TRUTH_SAMPLES (the path-traced truth of the error metrics, truth.exr: by default the mean of the
+# SEEDS seeds; with TRUTH_SEEDS ≥ 2 the mean of that many renders of its own at TRUTH_SAMPLES samples, measured
+# against the SEEDS seeds, independent of it),
 # REFERENCE_EDGE_MM (the reference's tessellation, default 1.0 mm, 0.5 mm on bleed, whose paint edge needs it), REFERENCE_NON_SKIN (sss.reference_non_skin of
 # the reference: default "absorbs", the path tracer's boundary; "returns" is the evaluation table's),
 # REFERENCE_CONVEXITY_MM (sss.reference_convexity_mm: default [0.88, 0.32, 0.28], the path tracer's level on convex
@@ -43,6 +46,10 @@ out="${1:-out/reference-validation}"
 size="${2:-256}"
 samples="${3:-64}"
 seeds="${SEEDS:-4}"
+truth_seeds="${TRUTH_SEEDS:-0}"
+truth_samples="${TRUTH_SAMPLES:-$samples}"
+[ "$truth_seeds" -ge 0 ] 2>/dev/null && [ "$truth_seeds" -ne 1 ] || { echo "reference-validation: TRUTH_SEEDS=$truth_seeds must be 0 or at least 2" >&2; exit 2; }
+[ "$truth_samples" -ge 1 ] 2>/dev/null || { echo "reference-validation: TRUTH_SAMPLES=$truth_samples must be a positive number" >&2; exit 2; }
 # The reference's edge length per case: REFERENCE_EDGE_MM for all, or 1 mm and 0.5 mm on bleed (the paint's edge).
 edge_mm_of() { if [ -n "${REFERENCE_EDGE_MM:-}" ]; then echo "$REFERENCE_EDGE_MM"; elif [ "$1" = bleed ]; then echo 0.5; else echo 1.0; fi; }
 edge_mm="${REFERENCE_EDGE_MM:-1.0 (bleed: 0.5)}"
@@ -355,6 +362,38 @@ for name in $cases; do
   for seed in $(seq 1 $((seeds - 1))); do seed_files+=",$dir/pathtraced-seed$seed.exr"; done
   "$skinlab" analyze metrics --reference-seeds "$seed_files" --compare-reference "$dir/set/$ref_exr" "${tests[@]}" \
     --compare-metrics "$dir/metrics-reference/metrics.json" -o "$dir/metrics-debiased" > /dev/null
+  # The path-traced truth (truth.exr) and the error metrics against it (metrics-truth). With TRUTH_SEEDS > 0 it is
+  # the mean of that many renders of its own (seeds 1000, 1001, …, TRUTH_SAMPLES samples each), measured against the
+  # SEEDS validation seeds, which are independent of it (metrics-truth-debiased: its debiased MSE against the best
+  # condition's and the rankings of the error metrics against it). Otherwise it is the mean of the validation seeds,
+  # and with eight or more of them the mean of the first half (truth-half.exr) is measured against the pairs of the
+  # second half.
+  all_seeds=()
+  IFS=, read -r -a all_seeds <<< "$seed_files"
+  rm -rf "$dir/metrics-truth-debiased"
+  if [ "$truth_seeds" -gt 0 ]; then
+    truth_files=()
+    for seed in $(seq 1000 $((999 + truth_seeds))); do
+      render_once "$dir/truth-seed$seed.exr" "$dir/ref.toml" 'sss.method="pathtraced"' "pathtraced.seed=$seed" \
+        "pathtraced.samples=$truth_samples"
+      truth_files+=("$dir/truth-seed$seed.exr")
+    done
+    "$skinlab" analyze seed-mean "${truth_files[@]}" -o "$dir/truth.exr" > /dev/null
+    "$skinlab" analyze metrics --reference "$dir/truth.exr" "${tests[@]}" -o "$dir/metrics-truth" > /dev/null
+    "$skinlab" analyze metrics --reference-seeds "$seed_files" --compare-reference "$dir/truth.exr" "${tests[@]}" \
+      --compare-metrics "$dir/metrics-truth/metrics.json" -o "$dir/metrics-truth-debiased" > /dev/null
+  else
+    "$skinlab" analyze seed-mean "${all_seeds[@]}" -o "$dir/truth.exr" > /dev/null
+    "$skinlab" analyze metrics --reference "$dir/truth.exr" "${tests[@]}" -o "$dir/metrics-truth" > /dev/null
+  fi
+  if [ "$truth_seeds" -eq 0 ] && [ "$seeds" -ge 8 ]; then
+    half=$((seeds / 2))
+    "$skinlab" analyze seed-mean "${all_seeds[@]:0:$half}" -o "$dir/truth-half.exr" > /dev/null
+    "$skinlab" analyze metrics --reference "$dir/truth-half.exr" "${tests[@]}" -o "$dir/metrics-truth-half" > /dev/null
+    other_half="$(IFS=,; echo "${all_seeds[*]:$half}")"
+    "$skinlab" analyze metrics --reference-seeds "$other_half" --compare-reference "$dir/truth-half.exr" "${tests[@]}" \
+      --compare-metrics "$dir/metrics-truth-half/metrics.json" -o "$dir/metrics-truth-debiased" > /dev/null
+  fi
   ran+=("$name")
 done
 
@@ -533,7 +572,67 @@ for name in cases:
         worse = a["without_clearly_worse"]
         table_scores.append(f"| {name} | {score} | {tau_text(a)} | {tau_text(a['competitive'])} | "
                             f"{tau_text(worse)} ({worse['conditions']}) | " + ("–" if tau is None else "yes" if tau >= 0.8 else "**no**") + " |")
-debiased += colour + table_scores
+# The truth of the error metrics: how close each candidate comes to the noise-free Cycles image against the best
+# condition (debiased.json, truth_precision): `reference` (its debiased MSE), the mean of all seeds (σ̄²/S from the
+# seeds' pairs) and, with eight or more seeds, the mean of the first half measured against the second half's pairs;
+# a truth is precise enough at ≤ 0.5 × the best condition's MSE. The truth used (metrics-truth/ when it is the seed
+# mean) is `reference` where it is precise enough in every band scored, else the seed mean.
+truth_lines = ["", "## The truth of the error metrics: precision against the best condition", "",
+               "Squared error of each truth against the noise-free Cycles image over the best condition's debiased "
+               "MSE (Y; R in brackets): `reference`; the mean of the validation seeds (σ̄²/S, from the seeds' "
+               "pairs); the path-traced truth measured against independent seeds (with TRUTH_SEEDS: truth.exr, its "
+               "own renders, against the validation seeds; else, with eight or more seeds, the mean of the first half "
+               "against the second half). Precise enough: ≤ 0.50. τ_b: the error metrics against that truth ranked "
+               "against the independent seeds (16 closest, bootstrap interval).", "",
+               "| case | band | best condition MSE | `reference` | seed mean (validation seeds) | path-traced truth, measured | τ_b skin ΔE00 / halo E / bleed E against it | truth used |",
+               "|---|---|---|---|---|---|---|---|"]
+def ratio_text(entry, red):
+    if not entry: return "–"
+    r, rr = entry["ratio_to_best_condition"], (red or {}).get("ratio_to_best_condition")
+    if r is None: return "–"
+    return f"{r:.2f}" + (f" ({rr:.2f})" if rr is not None else "")
+def competitive_tau(d, score):
+    a = (d or {}).get("table_score_agreement", {}).get(score)
+    if not a or a["competitive"]["tau_b"]["value"] is None: return "–"
+    boot = a["competitive"].get("tau_b_bootstrap_interval_95")
+    return f"{a['competitive']['tau_b']['value']:+.2f}" + (f" [{boot[0]:+.2f}, {boot[1]:+.2f}]" if boot else "")
+def truth_seeds_used(name):
+    # The truth measured in metrics-truth-debiased is truth.exr itself (TRUTH_SEEDS) rather than a half of the seeds.
+    record = json.load(open(os.path.join(out, name, "metrics-truth", "metrics.json")))["comparisons"][0]["reference"]["truth"]
+    return all(isinstance(k, int) and k >= 1000 for k in record.get("seeds", []))
+for name in cases:
+    path_json = os.path.join(out, name, "metrics-debiased", "debiased.json")
+    if not os.path.exists(path_json): continue
+    precision = json.load(open(path_json))["truth_precision"]["regions"]
+    half_json = os.path.join(out, name, "metrics-truth-debiased", "debiased.json")
+    half = json.load(open(half_json)) if os.path.exists(half_json) else None
+    half_precision = half["truth_precision"]["regions"] if half else None
+    scored = [b for b in ["skin", "halo", "bleed"] if (precision[b]["Y"]["best_condition_mse"] is not None)]
+    # `reference` where it is precise enough, or no less precise than the path-traced truth (measured against
+    # independent seeds when they exist, else the validation seeds' mean from their pairs).
+    worst = lambda ratios: max((r for r in ratios if r is not None), default=float("inf"))
+    reference_worst = worst(precision[b]["Y"]["compared_reference"]["ratio_to_best_condition"] for b in scored)
+    truth_worst = worst((half_precision[b]["Y"]["compared_reference"] if half_precision and os.path.exists(
+                         os.path.join(out, name, "metrics-truth-debiased")) and truth_seeds_used(name) else
+                         precision[b]["Y"]["seed_mean"])["ratio_to_best_condition"] for b in scored)
+    reference_ok = reference_worst <= 0.5 or reference_worst <= truth_worst
+    truth_record = json.load(open(os.path.join(out, name, "metrics-truth", "metrics.json")))["comparisons"][0]["reference"]["truth"]
+    used = "`reference`" if reference_ok else (f"`pathtraced`, mean of {len(truth_record['seeds'])} seeds × "
+                                               f"{truth_record['samples']} samples")
+    half_taus = " / ".join(competitive_tau(half, s) for s in ["skin_delta_e00_mean", "halo_leak_energy", "bleed_leak_energy"]) if half else "–"
+    for b in scored:
+        p, hp = precision[b], (half_precision or {}).get(b)
+        truth_lines.append(f"| {name} | {b} | {number(p['Y']['best_condition_mse'])} | "
+                           f"{ratio_text(p['Y'].get('compared_reference'), p['R'].get('compared_reference'))} | "
+                           f"{ratio_text(p['Y']['seed_mean'], p['R']['seed_mean'])} | "
+                           + (ratio_text(hp['Y'].get('compared_reference'), hp['R'].get('compared_reference')) if hp else "–")
+                           + f" | {half_taus if b == 'skin' else ''} | {used} |")
+    with open(os.path.join(out, name, "truth.json") + ".tmp", "w") as f:
+        json.dump({"truth": "reference" if reference_ok else "pathtraced-seed-mean",
+                   "record": {"kind": "render", "method": "reference"} if reference_ok else truth_record,
+                   "metrics": "metrics-reference" if reference_ok else "metrics-truth"}, f, indent=2)
+    os.replace(os.path.join(out, name, "truth.json") + ".tmp", os.path.join(out, name, "truth.json"))
+debiased += colour + table_scores + truth_lines
 lines += debiased
 path = os.path.join(out, "reference-validation.md")
 with open(path + ".tmp", "w") as f:

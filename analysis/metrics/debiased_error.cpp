@@ -237,6 +237,53 @@ double pairTermMean(const std::vector<double>& pairTerms, std::size_t seeds, con
     return count > 0 ? sum / static_cast<double>(count) : notANumber;
 }
 
+JackknifeEstimate seedMeanMse(const SeededTruth& truth, std::size_t quantity, std::size_t region) {
+    const std::size_t seeds = truth.images.size();
+    JackknifeEstimate estimate;
+    estimate.value = estimate.standardError = notANumber;
+    if (seeds < 2 || quantity >= debiasedQuantityCount || region >= debiasedRegionCount) return estimate;
+    const cv::Mat& inside = truth.regions[region];
+    std::vector<double> pairTerms;
+    for (std::size_t i = 0; i < seeds; ++i)
+        for (std::size_t j = i + 1; j < seeds; ++j) {
+            const cv::Mat& a = truth.images[i][quantity];
+            const cv::Mat& b = truth.images[j][quantity];
+            if (a.empty() || b.empty() || inside.empty()) return estimate;
+            double sum = 0.0;
+            std::size_t pixels = 0;
+            const int channels = a.channels();
+            for (int y = 0; y < inside.rows; ++y) {
+                const auto* in = inside.ptr<unsigned char>(y);
+                const auto* left = a.ptr<double>(y);
+                const auto* right = b.ptr<double>(y);
+                for (int x = 0; x < inside.cols; ++x)
+                    if (in[x]) {
+                        for (int c = 0; c < channels; ++c) {
+                            const double d = left[x * channels + c] - right[x * channels + c];
+                            sum += d * d;
+                        }
+                        ++pixels;
+                    }
+            }
+            if (pixels == 0) return estimate;
+            pairTerms.push_back(0.5 * sum / static_cast<double>(pixels));
+        }
+    const double count = static_cast<double>(seeds);
+    std::vector<std::size_t> all(seeds);
+    for (std::size_t k = 0; k < seeds; ++k) all[k] = k;
+    estimate.value = pairTermMean(pairTerms, seeds, all) / count;
+    if (seeds >= 3) {
+        for (std::size_t k = 0; k < seeds; ++k) {
+            std::vector<std::size_t> without;
+            for (std::size_t other = 0; other < seeds; ++other)
+                if (other != k) without.push_back(other);
+            estimate.leaveOneOut.push_back(pairTermMean(pairTerms, seeds, without) / count);
+        }
+        estimate.standardError = jackknifeStandardError(estimate.leaveOneOut);
+    }
+    return estimate;
+}
+
 JackknifeEstimate debiasedDifference(const DebiasedScores& a, const DebiasedScores& b, std::size_t region) {
     JackknifeEstimate difference;
     difference.value = a.mse[region].value - b.mse[region].value;
@@ -613,6 +660,37 @@ void compareWithReference(DebiasedRun& run, const std::vector<DebiasedImages>& i
         }
 }
 
+// Per region and quantity: the best (smallest) debiased MSE among the tests, and how close the two truths come to
+// the noise-free image against it: the seeds' mean (σ̄²/S) and the compared reference (its debiased MSE).
+nlohmann::json truthPrecisionJson(const DebiasedRun& run) {
+    nlohmann::json regions = nlohmann::json::object();
+    for (std::size_t region = 0; region < debiasedRegionCount; ++region) {
+        nlohmann::json quantities = nlohmann::json::object();
+        for (std::size_t quantity = 0; quantity < debiasedQuantityCount; ++quantity) {
+            double best = notANumber;
+            for (const DebiasedScores& test : run.tests) {
+                const double value = test.quantityMse[quantity][region].value;
+                if (std::isfinite(value) && !(value >= best)) best = value;
+            }
+            const auto entry = [&](const JackknifeEstimate& mse) {
+                const double ratio = std::isfinite(mse.value) && best > 0.0 ? mse.value / best : notANumber;
+                return nlohmann::json{{"mse", estimateJson(mse)},
+                                      {"ratio_to_best_condition", finiteOrNull(ratio)},
+                                      {"precise_enough", std::isfinite(ratio) && ratio <= truthPrecisionRatio}};
+            };
+            nlohmann::json item{{"best_condition_mse", finiteOrNull(best)},
+                                {"seed_mean", entry(seedMeanMse(run.truth, quantity, region))}};
+            if (run.compared) item["compared_reference"] = entry(run.compared->quantityMse[quantity][region]);
+            quantities[std::string(debiasedQuantityName(quantity))] = item;
+        }
+        regions[std::string(debiasedRegionName(region))] = quantities;
+    }
+    return {{"criterion", "a truth's debiased MSE against the noise-free image <= " + number(truthPrecisionRatio) +
+                              " x the best condition's"},
+            {"seeds", run.truth.images.size()},
+            {"regions", regions}};
+}
+
 // debiased.csv, debiased.json and, with a compared reference, agreement.csv.
 void writeDebiasedOutputs(const DebiasedRun& run, const std::vector<std::filesystem::path>& seeds,
                           const DebiasedRunOptions& options, const std::filesystem::path& outputFolder) {
@@ -676,6 +754,7 @@ void writeDebiasedOutputs(const DebiasedRun& run, const std::vector<std::filesys
                          "dE*ab^2, debiased to first order)"},
                         {"tests", testsJson}};
     for (const auto& seed : seeds) json["seeds"].push_back(seed.string());
+    json["truth_precision"] = truthPrecisionJson(run);
     std::string agreementCsv;
     if (run.compared) {
         json["compared_reference"] = addRows(*run.compared, static_cast<const ComparedMse*>(nullptr));

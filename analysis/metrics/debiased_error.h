@@ -97,6 +97,16 @@ DebiasedScores scoreDebiased(const SeededTruth& truth, const DebiasedImages& tes
 // gives the estimate itself; all seeds but k its leave-one-out value.
 double pairTermMean(const std::vector<double>& pairTerms, std::size_t seeds, const std::vector<std::size_t>& draw);
 
+// The precision of the seeds' mean as a truth (`skinlab analyze seed-mean`): its squared error against the noise-free
+// image in one quantity and region, σ̄²/S, with σ̄² the per-pixel noise variance of one seed estimated from the
+// pairs, the mean over i < j of ½ (1/|B|) Σ_{p∈B} (r_i,p − r_j,p)² (unbiased: independent seeds differ by twice the
+// variance); the jackknife leaves one seed out of σ̄². NaN where the quantity or the region is empty.
+JackknifeEstimate seedMeanMse(const SeededTruth& truth, std::size_t quantity, std::size_t region);
+
+// A truth is precise enough for the differences it ranks when its squared error against the noise-free image is at
+// most this share of the best condition's.
+inline constexpr double truthPrecisionRatio = 0.5;
+
 // D = MSE(a) − MSE(b) with the jackknife over the seeds both share.
 JackknifeEstimate debiasedDifference(const DebiasedScores& a, const DebiasedScores& b, std::size_t region);
 

@@ -1,9 +1,11 @@
 #include "analysis/metrics/metrics_report.h"
+#include "analysis/metrics/seed_mean.h"
 #include "common/csv.h"
 
 #include "common/version.h"
 
 #include <cmath>
+#include <map>
 #include <cstdio>
 
 namespace skinlab::metrics {
@@ -88,11 +90,18 @@ std::string metricsCsv(const std::vector<ComparisonRecord>& records) {
 nlohmann::json metricsJson(const std::vector<ComparisonRecord>& records, const ReportSettings& settings,
                            const std::vector<std::string>& blocksWithoutReference) {
     nlohmann::json comparisons = nlohmann::json::array();
+    std::map<std::filesystem::path, nlohmann::json> truths; // what each reference is as a truth, read once
     for (const ComparisonRecord& record : records) {
+        auto truth = truths.find(record.job.referencePath);
+        if (truth == truths.end())
+            truth = truths.emplace(record.job.referencePath, describeTruth(record.job.referencePath)).first;
         nlohmann::json bands = nlohmann::json::object();
         for (Band band : allBands) bands[std::string(bandName(band))] = bandJson(record.bands[size_t(band)]);
         comparisons.push_back({
-            {"reference", {{"name", record.job.referenceName}, {"path", record.job.referencePath.string()}}},
+            {"reference",
+             {{"name", record.job.referenceName},
+              {"path", record.job.referencePath.string()},
+              {"truth", truth->second}}},
             {"test",
              {{"name", record.job.testName}, {"path", record.job.testPath.string()}, {"factors", record.job.factors}}},
             {"block", record.job.block},

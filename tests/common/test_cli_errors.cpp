@@ -43,6 +43,9 @@ TEST(CliErrors, EverySubcommandExitsTwoWithOneLine) {
         "methods --no-such-flag",
         "analyze metrics --no-such-flag",
         "analyze agreement --no-such-flag",
+        "analyze seed-mean --no-such-flag",
+        "analyze seed-mean a.exr -o mean.exr",                       // one seed: at least two
+        "analyze seed-mean missing-a.exr missing-b.exr -o mean.exr", // unreadable seeds
         "no-such-subcommand",
     };
     for (const std::string& arguments : cases) {

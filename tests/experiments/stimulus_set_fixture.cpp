@@ -24,6 +24,14 @@ TemporaryFolder::~TemporaryFolder() {
     fs::remove_all(path_, ec);
 }
 
+namespace {
+// The resolved parameters a method name stands for: sss.method, and "eevee-no-sss" for EEVEE without SSS.
+nlohmann::json resolvedOf(const std::string& method) {
+    if (method == "eevee-no-sss") return {{"sss", {{"method", "eevee"}}}, {"eevee", {{"sss", false}}}};
+    return {{"sss", {{"method", method}}}};
+}
+} // namespace
+
 void writeStimulusSet(const fs::path& folder, const StimulusSetSpec& spec) {
     fs::create_directories(folder / "png");
     nlohmann::json manifest{
@@ -60,7 +68,7 @@ void writeStimulusSet(const fs::path& folder, const StimulusSetSpec& spec) {
                  {"reference", isReference},
                  {"width", spec.width},
                  {"height", spec.height},
-                 {"resolved", nlohmann::json::object()},
+                 {"resolved", resolvedOf(methods[m])},
                  {"timings_ms", nlohmann::json::object()}});
         }
     }

@@ -28,7 +28,8 @@ private:
 
 // Writes png/ID.png and manifest.json into `folder`; ids are "<block index>-<method>". Each image has a
 // distinct high-frequency pattern (any resampling would change its pixels). Factor "quality" holds the method's
-// index as a number (usable as --truth-factor).
+// index as a number (usable as --truth-factor). Each stimulus's resolved parameters hold sss.method = its method
+// ("eevee-no-sss": EEVEE with eevee.sss = false).
 void writeStimulusSet(const std::filesystem::path& folder, const StimulusSetSpec& spec = {});
 
 // Writes `text` to folder/name and returns the path.

@@ -43,6 +43,7 @@ void writeSyntheticExr(const std::filesystem::path& path, const SyntheticRender&
         spec.attribute("skinlab:sss_radius_mm", render.sssRadiusMillimetres);
     spec.attribute("skinlab:version", "test");
     spec.attribute("skinlab:resolved", "{}");
+    for (const auto& [key, value] : options.stringAttributes) spec.attribute(key, value);
 
     std::vector<float> pixels(static_cast<size_t>(render.width) * static_cast<size_t>(render.height) * names.size());
     size_t i = 0;

@@ -27,8 +27,9 @@ struct SyntheticRender {
 
 // Which parts to leave out of the written file, to provoke errors.
 struct WriteOptions {
-    std::vector<std::string> omitChannels;   // e.g. {"depth.Z"}
-    std::vector<std::string> omitAttributes; // e.g. {"skinlab:f_px"}
+    std::vector<std::string> omitChannels;               // e.g. {"depth.Z"}
+    std::vector<std::string> omitAttributes;             // e.g. {"skinlab:f_px"}
+    std::map<std::string, std::string> stringAttributes; // added or replacing the defaults, e.g. skinlab:resolved
 };
 
 void writeSyntheticExr(const std::filesystem::path& path, const SyntheticRender& render,

@@ -147,6 +147,38 @@ TEST_F(AnalyzeMetricsCommand, ComparesAStimulusSet) {
     EXPECT_FALSE(fs::exists(path("out/heatmaps")));
 }
 
+// A block of conditions from two renderers (skinlab's separable, EEVEE) gets one warning line; one renderer none.
+TEST_F(AnalyzeMetricsCommand, WarnsWhenABlockMixesRenderers) {
+    const auto runWith = [&](const std::string& secondMethod) {
+        nlohmann::json manifest = {
+            {"format", "skinlab-stimuli"}, {"version", 1}, {"set", "cli"}, {"stimuli", nlohmann::json::array()}};
+        for (auto [id, method, isReference] :
+             {std::tuple{"disc-reference", "reference", true}, std::tuple{"disc-separable", "separable", false},
+              std::tuple{"disc-second", secondMethod.c_str(), false}}) {
+            const std::string exr = std::string("exr/") + id + ".exr";
+            testing::writeSyntheticExr(path(exr), isReference ? reference : blurred);
+            manifest["stimuli"].push_back({{"id", id},
+                                           {"files", {{"exr", exr}}},
+                                           {"sha256", {{"exr", sha256File(path(exr))}}},
+                                           {"factors", {{"method", method}}},
+                                           {"resolved", {{"sss", {{"method", method}}}}},
+                                           {"block", "builtin:disc/mid"},
+                                           {"reference", isReference}});
+        }
+        writeFileAtomic(path("manifest.json"), manifest.dump(2));
+        return runSkinlab("analyze metrics --stimuli " + folder.string() + " -o " + path("out") + " --no-heatmaps");
+    };
+    const CommandResult mixed = runWith("eevee");
+    ASSERT_EQ(mixed.exitCode, 0) << mixed.output;
+    EXPECT_NE(mixed.output.find("builtin:disc/mid: conditions of different renderers (skinlab, eevee) are compared "
+                                "directly"),
+              std::string::npos)
+        << mixed.output;
+    const CommandResult single = runWith("artistic");
+    ASSERT_EQ(single.exitCode, 0) << single.output;
+    EXPECT_EQ(single.output.find("different renderers"), std::string::npos) << single.output;
+}
+
 std::string displayList() {
     std::string list;
     for (const std::string& name : cvvdpDisplayNames()) list += (list.empty() ? "" : ", ") + name;

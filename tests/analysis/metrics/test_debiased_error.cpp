@@ -1,10 +1,15 @@
 // Scoring against several path-traced seeds: the debiased squared error has no noise bias, its jackknife error
 // covers the truth, paired differences and rankings follow the noise-free image (docs/metrics.md).
 #include "analysis/metrics/debiased_error.h"
+#include "analysis/metrics/metrics_run.h"
+#include "analysis/metrics/seed_mean.h"
 #include "common/error.h"
+#include "common/files.h"
 #include "synthetic_render.h"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <OpenImageIO/imageio.h>
 
 #include <cmath>
 #include <filesystem>
@@ -32,8 +37,9 @@ protected:
     }
     void TearDown() override { fs::remove_all(folder); }
 
-    // The noise-free render plus independent Gaussian noise of standard deviation `sigma` per pixel and channel.
-    fs::path writeSeed(int seed, double sigma, int replicate = 0) {
+    // The noise-free render plus independent Gaussian noise of standard deviation `sigma` per pixel and channel,
+    // with the metadata of a path-traced render of seed `seed` (`scene` stands for the rest of skinlab:resolved).
+    fs::path writeSeed(int seed, double sigma, int replicate = 0, const std::string& scene = "head") {
         testing::SyntheticRender noisy = truth;
         noisy.beauty = truth.beauty.clone();
         std::mt19937 random(static_cast<unsigned>(1000 * replicate + seed + 1));
@@ -46,7 +52,13 @@ protected:
                 pixel += cv::Vec3f(n, n, n);
             }
         const fs::path path = folder / ("seed" + std::to_string(replicate) + "-" + std::to_string(seed) + ".exr");
-        testing::writeSyntheticExr(path, noisy);
+        testing::WriteOptions options;
+        options.stringAttributes["skinlab:pathtraced"] = nlohmann::json{{"samples", 64}, {"seed", seed}}.dump();
+        options.stringAttributes["skinlab:resolved"] = nlohmann::json{
+            {"model", scene},
+            {"sss", {{"method", "pathtraced"}}},
+            {"pathtraced", {{"seed", seed}}}}.dump();
+        testing::writeSyntheticExr(path, noisy, options);
         return path;
     }
     // The noise-free render with `offset` added to every skin pixel (a luminance error of exactly `offset`).
@@ -58,6 +70,18 @@ protected:
                 if (truth.mask.at<float>(y, x) >= 0.5f)
                     render.beauty.at<cv::Vec3f>(y, x) += cv::Vec3f(float(offset), float(offset), float(offset));
         return renderLuminance(render, 1.0);
+    }
+    // The noise-free render with `offset` added to every skin pixel, written as a test render.
+    fs::path writeOffset(double offset) const {
+        testing::SyntheticRender render = truth;
+        render.beauty = truth.beauty.clone();
+        for (int y = 0; y < truth.height; ++y)
+            for (int x = 0; x < truth.width; ++x)
+                if (truth.mask.at<float>(y, x) >= 0.5f)
+                    render.beauty.at<cv::Vec3f>(y, x) += cv::Vec3f(float(offset), float(offset), float(offset));
+        const fs::path path = folder / ("offset-" + std::to_string(offset) + ".exr");
+        testing::writeSyntheticExr(path, render);
+        return path;
     }
     static constexpr std::size_t skin = 4;
 
@@ -142,6 +166,99 @@ TEST_F(DebiasedError, ScoresEachChannelAndCielabBesideLuminance) {
     // One noisy seed alone adds the noise variance, 0.03², to the red channel's error.
     EXPECT_GT(scores.quantityPlainMse[1][skin], offset * offset + 0.5 * 0.03 * 0.03);
     EXPECT_EQ(scores.pairTerms[1][skin].size(), 6u);
+}
+
+// The seeds' mean as the truth of the error metrics: its pixels are the mean of the seeds', its squared error against
+// the noise-free image is the noise variance over the seeds (estimated from the seeds' pairs, and measured against
+// independent seeds), and the outputs say which truth was used and whether it is precise enough.
+TEST_F(DebiasedError, TheSeedMeanIsATruthWithTheNoiseVarianceOverItsSeeds) {
+    const double sigma = 0.05;
+    std::vector<fs::path> truthSeeds;
+    std::vector<fs::path> independent;
+    for (int seed = 0; seed < 4; ++seed) truthSeeds.push_back(writeSeed(seed, sigma));
+    for (int seed = 4; seed < 8; ++seed) independent.push_back(writeSeed(seed, sigma));
+    const fs::path truthPath = folder / "truth.exr";
+    const nlohmann::json record = writeSeedMean(truthSeeds, truthPath);
+    EXPECT_EQ(record["kind"], "pathtraced-seed-mean");
+    EXPECT_EQ(record["seeds"], nlohmann::json::array({0, 1, 2, 3}));
+    EXPECT_EQ(describeTruth(truthPath), record);
+    EXPECT_EQ(describeTruth(truthSeeds[0])["method"], "pathtraced");
+    EXPECT_EQ(describeTruth(truthSeeds[0])["seed"], 0);
+
+    // The beauty is the seeds' mean, pixel for pixel; depth and mask are the first seed's.
+    const MetricRender mean = loadMetricRender(truthPath, RenderRole::reference);
+    double largest = 0.0;
+    std::vector<MetricRender> seeds;
+    for (const fs::path& path : truthSeeds) seeds.push_back(loadMetricRender(path, RenderRole::reference));
+    for (int y = 0; y < truth.height; y += 7)
+        for (int x = 0; x < truth.width; x += 5) {
+            float sum = 0.0f;
+            for (const MetricRender& seed : seeds) sum += seed.beauty.at<cv::Vec3f>(y, x)[0];
+            largest = std::max(largest, double(std::abs(mean.beauty.at<cv::Vec3f>(y, x)[0] - sum / 4.0f)));
+            EXPECT_EQ(mean.mask.at<float>(y, x), seeds[0].mask.at<float>(y, x));
+        }
+    EXPECT_LT(largest, 1e-6);
+
+    // From the pairs of the independent seeds: the mean of four has σ²/4 of squared error.
+    const SeededTruth seeded = loadSeededTruth(independent, 1.0, 0.0);
+    const JackknifeEstimate estimated = seedMeanMse(seeded, 0, skin);
+    EXPECT_NEAR(estimated.value, sigma * sigma / 4.0, 0.1 * sigma * sigma / 4.0);
+    EXPECT_EQ(estimated.leaveOneOut.size(), 4u);
+
+    // Measured: the seed mean as the compared truth against the independent seeds. Conditions 0.05 and 0.08 from
+    // the noise-free image: the best one's MSE 2.5e-3, the truth's 6.25e-4, a ratio of 0.25.
+    DebiasedRunOptions options;
+    options.compareReference = truthPath;
+    options.agreement.bootstrapReplicates = 0;
+    const DebiasedRun run =
+        runDebiasedMetrics(independent, {writeOffset(0.05), writeOffset(0.08)}, options, folder / "debiased");
+    ASSERT_TRUE(run.compared);
+    const JackknifeEstimate& measured = run.compared->mse[skin];
+    EXPECT_NEAR(measured.value, sigma * sigma / 4.0, 3.0 * measured.standardError + 0.1 * sigma * sigma / 4.0);
+    const nlohmann::json precision =
+        nlohmann::json::parse(readFile(folder / "debiased" / "debiased.json"))["truth_precision"];
+    EXPECT_EQ(precision["seeds"], 4);
+    const nlohmann::json& y = precision["regions"]["skin"]["Y"];
+    EXPECT_NEAR(y["best_condition_mse"].get<double>(), 0.05 * 0.05, 3.0 * run.tests[0].mse[skin].standardError);
+    EXPECT_NEAR(y["seed_mean"]["ratio_to_best_condition"].get<double>(), 0.25, 0.05);
+    EXPECT_TRUE(y["seed_mean"]["precise_enough"].get<bool>());
+    EXPECT_NEAR(y["compared_reference"]["ratio_to_best_condition"].get<double>(), 0.25, 0.05);
+    EXPECT_TRUE(y["compared_reference"]["precise_enough"].get<bool>());
+    // One seed alone (σ² = 2.5e-3, the best condition's own MSE) is not precise enough.
+    DebiasedRunOptions single;
+    single.compareReference = independent[0];
+    single.agreement.bootstrapReplicates = 0;
+    runDebiasedMetrics(truthSeeds, {writeOffset(0.05), writeOffset(0.08)}, single, folder / "single");
+    const nlohmann::json one =
+        nlohmann::json::parse(readFile(folder / "single" / "debiased.json"))["truth_precision"]["regions"]["skin"]["Y"];
+    EXPECT_GT(one["compared_reference"]["ratio_to_best_condition"].get<double>(), 0.5);
+    EXPECT_FALSE(one["compared_reference"]["precise_enough"].get<bool>());
+
+    // Error metrics against the seed mean say which truth they used.
+    runMetrics(planFileComparisons(truthPath, {writeOffset(0.05)}), {}, folder / "metrics");
+    const nlohmann::json metrics = nlohmann::json::parse(readFile(folder / "metrics" / "metrics.json"));
+    EXPECT_EQ(metrics["comparisons"][0]["reference"]["truth"], record);
+}
+
+TEST_F(DebiasedError, TheSeedMeanRefusesOtherScenesRepeatedSeedsAndOtherRenders) {
+    const fs::path a = writeSeed(0, 0.01);
+    const fs::path b = writeSeed(1, 0.01);
+    const auto refused = [&](const std::vector<fs::path>& seeds, const std::string& expected) {
+        try {
+            writeSeedMean(seeds, folder / "mean.exr");
+            ADD_FAILURE() << "accepted; expected: " << expected;
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+            EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+        }
+        EXPECT_FALSE(fs::exists(folder / "mean.exr"));
+    };
+    refused({a}, "at least two");
+    refused({a, writeSeed(1, 0.01, 1, "ear")}, "seed1-1.exr: skinlab:resolved: differs from");
+    refused({a, b, writeSeed(0, 0.01, 2)}, "seed2-0.exr: skinlab:pathtraced: seed 0 is given twice");
+    const fs::path plain = folder / "plain.exr";
+    testing::writeSyntheticExr(plain, truth);
+    refused({a, plain}, "plain.exr: skinlab:pathtraced: metadata attribute is missing");
 }
 
 TEST(KendallTau, TiesAndKnownValues) {
