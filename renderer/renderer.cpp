@@ -776,8 +776,9 @@ std::vector<float> Renderer::Impl::readDisplay(const Frame& frame) {
 DisplayFrame Renderer::renderDisplay(const RenderRequest& request, bool withLinear) {
     const auto start = std::chrono::steady_clock::now();
     SceneSpec spec = loadSpec(request);
-    if (sss::methodInfo(spec.sss.method).execution == sss::Execution::Cycles)
-        throw InputError(spec.source + ": sss.method: 'pathtraced' renders through Blender; use skinlab render");
+    if (blenderEngineOf(spec.sss))
+        throw InputError(spec.source + ": sss.method: '" + std::string(sss::methodName(spec.sss.method)) +
+                         "' renders through Blender; use skinlab render");
     Impl& impl = *impl_;
     impl.context.makeCurrent();
     Frame frame = impl.loadFrame(spec);

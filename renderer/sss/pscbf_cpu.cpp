@@ -139,7 +139,7 @@ std::vector<Rgb> pscbfPass(const PscbfCpuInputs& inputs, const std::vector<Rgb>&
 }
 
 std::vector<Rgb> applyPscbf(const PscbfCpuInputs& inputs, const std::vector<Rgb>& diffuse, const Kernel& kernel) {
-    SKINLAB_CHECK(kernel.method == SssMethod::Pscbf);
+    SKINLAB_CHECK(methodInfo(kernel.method).execution == Execution::Pscbf);
     SKINLAB_CHECK_EQ(kernel.stages.size(), 1u);
     const KernelStage& stage = kernel.stages[0];
     const std::vector<Rgb> horizontal = pscbfPass(inputs, diffuse, diffuse, stage, BlurAxis::Horizontal);
