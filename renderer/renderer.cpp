@@ -7,6 +7,7 @@
 // changed; render() runs them all, then reads back and writes, both driven by one AOV table (kAovs) → EXR / PNG.
 #include "renderer/renderer.h"
 
+#include "common/check.h"
 #include "common/error.h"
 #include "common/version.h"
 #include "renderer/gl/add_specular_pass.h"
@@ -128,6 +129,31 @@ struct PipelineRun {
     double uploadMs = 0.0;          // upload, camera, Blender and the reference's preparation (CPU, wall clock)
     std::optional<pathtraced::CyclesImage> blender; // sss.method = "pathtraced" / "eevee": Blender's frame
 };
+
+// How the pipeline runs each executor (the Execution of a method's row, sss_params.h): the stages it adds or
+// replaces, one row per executor. The stages ask this table, never a method's name.
+struct ExecutorStages {
+    sss::Execution execution;
+    bool objectSpace; // the SSS stage is the object-space reference, which draws into the lighting targets itself
+    std::optional<pathtraced::BlenderEngine> blender; // Blender renders the frame before the passes
+    const char* timings;                              // its record in render()'s timings ("": none)
+};
+const std::array<ExecutorStages, 6> kExecutorStages{{
+    {sss::Execution::CopyThrough, false, std::nullopt, ""},
+    {sss::Execution::TapPasses, false, std::nullopt, ""},
+    {sss::Execution::Pscbf, false, std::nullopt, ""},
+    {sss::Execution::ObjectSpace, true, std::nullopt, "reference"},
+    {sss::Execution::Cycles, false, pathtraced::BlenderEngine::Cycles, "pathtraced"},
+    {sss::Execution::Eevee, false, pathtraced::BlenderEngine::Eevee, "eevee"},
+}};
+
+const ExecutorStages& stagesOf(const sss::SssParams& params) {
+    const sss::Execution execution = sss::methodInfo(params.method).execution;
+    const auto found = std::find_if(kExecutorStages.begin(), kExecutorStages.end(),
+                                    [&](const ExecutorStages& row) { return row.execution == execution; });
+    SKINLAB_CHECK(found != kExecutorStages.end());
+    return *found;
+}
 
 // A frame read back for render(): every AOV of the table (kAovs order) and the display image (RGB).
 struct FrameImages {
@@ -495,8 +521,7 @@ float Renderer::Impl::runSssPasses(const Frame& frame, const gl::MainPassSetting
     gl::SssStageSettings sssSettings;
     sssSettings.sss = spec.sss;
     sssSettings.transmittance = spec.transmittance;
-    const sss::Execution execution = sss::methodInfo(spec.sss.method).execution;
-    if (execution == sss::Execution::ObjectSpace) {
+    if (stagesOf(spec.sss).objectSpace) {
         // The object-space reference bakes the main pass's shading at the tessellated vertices itself, so it needs
         // the model, the scene and the main pass's settings rather than the screen-space inputs.
         gl::ReferenceInputs referenceInputs = frame.referenceInputs;
@@ -601,10 +626,7 @@ double secondsToMs(double seconds) { return gl::roundMs(seconds * 1000.0); }
 
 // The Blender engine of a method rendered by Blender, none for the others.
 std::optional<pathtraced::BlenderEngine> blenderEngineOf(const sss::SssParams& params) {
-    const sss::Execution execution = sss::methodInfo(params.method).execution;
-    if (execution == sss::Execution::Cycles) return pathtraced::BlenderEngine::Cycles;
-    if (execution == sss::Execution::Eevee) return pathtraced::BlenderEngine::Eevee;
-    return std::nullopt;
+    return stagesOf(params).blender;
 }
 
 // The EXR channels the AOV table takes from a Blender image: "R", "G", "B", "diffuse.*", ..., "depth.Z", "mask.Y".
@@ -730,7 +752,7 @@ PipelineRun Renderer::Impl::runPipeline(Frame& frame, bool everything) {
     if (const auto engine = blenderEngineOf(spec.sss)) run.blender = renderBlender(frame, *engine);
     // sss.method = "reference": its parameters checked and the surface tessellated (cached) before the first pass,
     // so bad input fails with no pass half done.
-    const bool objectSpace = sss::methodInfo(spec.sss.method).execution == sss::Execution::ObjectSpace;
+    const bool objectSpace = stagesOf(spec.sss).objectSpace;
     if (objectSpace) prepareReferenceMethod(frame, spec);
     run.uploadMs = millisecondsSince(uploadStart);
 
@@ -909,12 +931,12 @@ RenderResult Renderer::render(const RenderRequest& request) {
                                {"upload", gl::roundMs(run.uploadMs)},
                                {"readback", gl::roundMs(readbackMs)},
                                {"write", gl::roundMs(writeMs)}};
-    if (sss::methodInfo(spec.sss.method).execution == sss::Execution::ObjectSpace)
-        result.timingsMs["reference"] = gl::roundTimings(impl.referenceMethod.lastRun()); // CPU parts of "sss"
+    const ExecutorStages& stages = stagesOf(spec.sss);
+    if (stages.objectSpace)
+        result.timingsMs[stages.timings] = gl::roundTimings(impl.referenceMethod.lastRun()); // CPU parts of "sss"
     if (run.blender)
-        result.timingsMs[*blenderEngineOf(spec.sss) == pathtraced::BlenderEngine::Eevee ? "eevee" : "pathtraced"] = {
-            {"render", secondsToMs(run.blender->renderSeconds)},
-            {"blender_wall", secondsToMs(run.blender->wallSeconds)}};
+        result.timingsMs[stages.timings] = {{"render", secondsToMs(run.blender->renderSeconds)},
+                                            {"blender_wall", secondsToMs(run.blender->wallSeconds)}};
     result.timingsMs["width"] = spec.width;
     result.timingsMs["height"] = spec.height;
     result.timingsMs["gl_renderer"] = result.glRenderer;
