@@ -5,6 +5,7 @@
 #include "common/files.h"
 #include "common/spec.h"
 #include "renderer/sss/kernel.h"
+#include "renderer/sss/method.h"
 #include "renderer/sss/sss_params.h"
 
 #include <cmath>
@@ -64,9 +65,10 @@ nlohmann::json statisticsJson(const sss::SssParams& params, const sss::Kernel& k
         const auto stats = sss::tapStatistics(stage.taps, beyondMm);
         out["stages"].push_back({{"rms_width_mm", stats.rmsWidthMm}, {"energy_beyond", stats.energyBeyond}});
     }
-    if (params.method == sss::SssMethod::Separable) {
-        // The continuous marginal the taps discretise, at the same surface scale (width_mm / 3).
-        const auto marginal = sss::makeMarginal(params);
+    // The continuous marginal the taps discretise (a method with taps and a physical profile), at the same surface
+    // scale (width_mm / 3).
+    if (const auto marginal = sss::methodInfo(params.method).model->profileMarginal(params);
+        marginal && !kernel.stages.empty()) {
         const double scale = sss::profileScale(params.widthMm);
         std::array<double, 3> rms{}, beyond{};
         for (int c = 0; c < 3; ++c) {

@@ -64,7 +64,7 @@ std::string methodsText(bool screenSpaceOnly) {
     }
     text += "common keys (every method; the lighting passes read them whatever the method: width_mm for "
             "transmittance, the curvature keys for the curvature AOV):\n";
-    const nlohmann::json defaults = sss::sssKeyDefaults(sss::SssMethod::None);
+    const nlohmann::json defaults = sss::sssKeyDefaults(sss::SssMethod{});
     for (const std::string_view key : sss::kCommonSssKeys)
         if (key != "method") text += keyLine(std::string(key), defaults);
     return text;

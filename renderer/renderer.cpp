@@ -1,11 +1,13 @@
 // The renderer's public entry point (renderer.h): scene spec → GL passes → EXR (+ PNG), with timings.
 //
-// Renderer::render runs named steps (docs/architecture.md, "Renderer"): materials (partMaterialsOf), lights
-// (gpuLightsOf), upload, the pass pipeline (Impl::runPasses, one class per pass under renderer/gl/:
-//   shadow map → main pass → background → surface AOVs → transmittance → SSS stage → add specular → tone map),
-// then read back and write, both driven by one AOV table (kAovs) → EXR / PNG.
+// One pipeline of stages (Impl::runPipeline; docs/architecture.md, "Renderer"), each declaring what of the resolved
+// record it reads (StageReads): upload (model, materials, maps, environment) → camera → [Blender, for the methods it
+// renders] → shadows → lighting (main pass → background → surface AOVs → transmittance) → SSS stage → add specular →
+// resolve → tone map, one class per pass under renderer/gl/. renderDisplay re-runs only the stages whose reads
+// changed; render() runs them all, then reads back and writes, both driven by one AOV table (kAovs) → EXR / PNG.
 #include "renderer/renderer.h"
 
+#include "common/check.h"
 #include "common/error.h"
 #include "common/version.h"
 #include "renderer/gl/add_specular_pass.h"
@@ -25,7 +27,7 @@
 #include "renderer/gl/transmittance_pass.h"
 #include "renderer/output/display_output.h"
 #include "renderer/output/exr_writer.h"
-#include "renderer/pathtraced/cycles_render.h"
+#include "renderer/pathtraced/blender_merge.h"
 #include "renderer/sss/eevee_params.h"
 #include "renderer/sss/method.h"
 #include "renderer/scene/builtin_geometry.h"
@@ -119,17 +121,66 @@ struct Frame {
     glm::mat3 environmentFromWorld{1.0f};
     gl::ReferenceInputs referenceInputs; // prepared before the passes (reference method only)
 };
+
+// What one run of the pipeline did.
+struct PipelineRun {
+    std::vector<std::string> reran; // the stages re-run: "upload", "shadows", "lighting", "sss" (the last always)
+    float supportRadiusMm = 0.0f;   // the method's, for skinlab:sss_radius_mm
+    double uploadMs = 0.0;          // upload, camera, Blender and the reference's preparation (CPU, wall clock)
+    std::optional<pathtraced::CyclesImage> blender; // sss.method = "pathtraced" / "eevee": Blender's frame
+};
+
+// How the pipeline runs each executor (the Execution of a method's row, sss_params.h): the stages it adds or
+// replaces, one row per executor. The stages ask this table, never a method's name.
+struct ExecutorStages {
+    sss::Execution execution;
+    bool objectSpace; // the SSS stage is the object-space reference, which draws into the lighting targets itself
+    std::optional<pathtraced::BlenderEngine> blender; // Blender renders the frame before the passes
+    const char* timings;                              // its record in render()'s timings ("": none)
+};
+const std::array<ExecutorStages, 6> kExecutorStages{{
+    {sss::Execution::CopyThrough, false, std::nullopt, ""},
+    {sss::Execution::TapPasses, false, std::nullopt, ""},
+    {sss::Execution::Pscbf, false, std::nullopt, ""},
+    {sss::Execution::ObjectSpace, true, std::nullopt, "reference"},
+    {sss::Execution::Cycles, false, pathtraced::BlenderEngine::Cycles, "pathtraced"},
+    {sss::Execution::Eevee, false, pathtraced::BlenderEngine::Eevee, "eevee"},
+}};
+
+const ExecutorStages& stagesOf(const sss::SssParams& params) {
+    const sss::Execution execution = sss::methodInfo(params.method).execution;
+    const auto found = std::find_if(kExecutorStages.begin(), kExecutorStages.end(),
+                                    [&](const ExecutorStages& row) { return row.execution == execution; });
+    SKINLAB_CHECK(found != kExecutorStages.end());
+    return *found;
+}
+
+// A frame read back for render(): every AOV of the table (kAovs order) and the display image (RGB).
+struct FrameImages {
+    std::vector<std::vector<float>> aovs;
+    std::vector<float> display;
+    pathtraced::BlenderMerge blenderMerge;
+};
 } // namespace
 
 struct Renderer::Impl {
-    // The pass pipeline of one frame (shadow map … tone map); returns the SSS support radius in mm.
-    float runPasses(const Frame& frame);
+    // The stages of one frame, in order (runPipeline; docs/architecture.md, "Renderer").
+    Frame loadFrame(const SceneSpec& spec);
+    void uploadScene(const Frame& frame);
+    void placeCamera(Frame& frame);
+    pathtraced::CyclesImage renderBlender(const Frame& frame, pathtraced::BlenderEngine engine);
+    PipelineRun runPipeline(Frame& frame, bool everything);
     // `shadows` false: the shadow maps of the previous call are kept (same model, lights and shadow settings).
     gl::MainPassSettings runLightingPasses(const Frame& frame, bool shadows = true);
     float runSssPasses(const Frame& frame, const gl::MainPassSettings& mainSettings);
     // sss.method = "reference": its inputs from the uploaded model, its parameters checked and the surface
     // tessellated (cached), before any pass runs.
     void prepareReferenceMethod(Frame& frame, const SceneSpec& spec);
+    // Read-back and write (render()).
+    std::vector<float> readOutput(const Frame& frame, GLuint texture, int channels);
+    std::vector<float> readDisplay(const Frame& frame);
+    FrameImages readFrame(const Frame& frame, PipelineRun& run, bool display);
+    ExrMetadata frameMetadata(const Frame& frame, const PipelineRun& run, const FrameImages& images);
 
     gl::EglContext context;
     gl::ShaderLibrary shaders;
@@ -156,8 +207,8 @@ struct Renderer::Impl {
                         frame.ssaaFactor, mode);
     }
 
-    // renderDisplay's resident state: the uploaded scene and what the frame targets hold. render() uses its own
-    // scene and overwrites the targets, so it clears `lightingKey`. Declared after the context: destroyed before it.
+    // The resident state: the uploaded scene and what the frame targets hold, with the key of what each stage read
+    // in its last run (readsKey; empty: not held). Declared after the context: destroyed before it.
     std::unique_ptr<gl::GpuScene> residentScene;
     std::string residentSceneKey;
     std::string shadowKey;
@@ -393,15 +444,6 @@ std::vector<ExrChannel> exrChannels(const std::vector<std::vector<float>>& readB
 
 } // namespace
 
-// --- the pass pipeline ---------------------------------------------------------------------------------------
-// shadow map → main pass → background → surface AOVs → transmittance → SSS stage (or the object-space reference)
-// → add specular → tone map. Returns the SSS support radius for the EXR metadata.
-float Renderer::Impl::runPasses(const Frame& frame) {
-    timer.reset();
-    const gl::MainPassSettings mainSettings = runLightingPasses(frame);
-    return runSssPasses(frame, mainSettings);
-}
-
 // shadow map → main pass → background → surface AOVs → transmittance: everything the SSS stage reads.
 gl::MainPassSettings Renderer::Impl::runLightingPasses(const Frame& frame, bool shadows) {
     const SceneSpec& spec = *frame.spec;
@@ -479,8 +521,7 @@ float Renderer::Impl::runSssPasses(const Frame& frame, const gl::MainPassSetting
     gl::SssStageSettings sssSettings;
     sssSettings.sss = spec.sss;
     sssSettings.transmittance = spec.transmittance;
-    const sss::Execution execution = sss::methodInfo(spec.sss.method).execution;
-    if (execution == sss::Execution::ObjectSpace) {
+    if (stagesOf(spec.sss).objectSpace) {
         // The object-space reference bakes the main pass's shading at the tessellated vertices itself, so it needs
         // the model, the scene and the main pass's settings rather than the screen-space inputs.
         gl::ReferenceInputs referenceInputs = frame.referenceInputs;
@@ -542,6 +583,77 @@ float Renderer::Impl::runSssPasses(const Frame& frame, const gl::MainPassSetting
     return supportRadiusMm;
 }
 
+namespace {
+// --- what each stage reads -----------------------------------------------------------------------------------
+// A stage of the pipeline declares what of the resolved record it reads: whole tables, or every table but some, and
+// the values it derives from tables it reads only in part. renderDisplay re-runs a stage when what it reads differs
+// from its last run or a stage before it re-ran; render() runs every stage.
+struct StageReads {
+    std::vector<std::string> tables;
+    std::vector<std::string> allTablesBut;
+    nlohmann::json (*partly)(const SceneSpec&) = nullptr;
+};
+
+// The [sss] keys the lighting passes read: the main pass width_mm (for the transmittance), the surface AOVs
+// curvature_measure, both curvature_reference_mm.
+nlohmann::json lightingSssKeys(const SceneSpec& spec) {
+    return {{"curvature_measure", spec.sss.curvatureMeasure},
+            {"curvature_reference_mm", spec.sss.curvatureReferenceMm},
+            {"width_mm", spec.transmittance.enabled ? spec.sss.widthMm : 0.0}};
+}
+
+// upload: the model, its materials and maps, the environment.
+const StageReads kUploadReads{{"scene", "mm_per_unit", "model", "textures", "materials", "skin", "environment"}, {}};
+// shadows: the lights and the shadow settings (not the camera or the exposure).
+const StageReads kShadowReads{{"lights", "shadow"}, {}};
+// lighting (main … transmittance): everything but the tone map and the [sss] keys it does not read.
+const StageReads kLightingReads{{}, {"tone_map", "sss"}, lightingSssKeys};
+// The SSS stage, add specular and tone map read the rest and always run.
+
+std::string readsKey(const SceneSpec& spec, const StageReads& reads) {
+    const nlohmann::json& resolved = spec.resolved;
+    nlohmann::json key = nlohmann::json::object();
+    for (const std::string& table : reads.tables) key[table] = resolved.value(table, nlohmann::json());
+    if (!reads.allTablesBut.empty())
+        for (const auto& [table, value] : resolved.items())
+            if (std::find(reads.allTablesBut.begin(), reads.allTablesBut.end(), table) == reads.allTablesBut.end())
+                key[table] = value;
+    if (reads.partly) key["partly"] = reads.partly(spec);
+    return key.dump();
+}
+
+double secondsToMs(double seconds) { return gl::roundMs(seconds * 1000.0); }
+
+// The Blender engine of a method rendered by Blender, none for the others.
+std::optional<pathtraced::BlenderEngine> blenderEngineOf(const sss::SssParams& params) {
+    return stagesOf(params).blender;
+}
+
+// The EXR channels the AOV table takes from a Blender image: "R", "G", "B", "diffuse.*", ..., "depth.Z", "mask.Y".
+nlohmann::json blenderChannels() {
+    nlohmann::json channels = nlohmann::json::array();
+    for (const Aov& aov : kAovs) {
+        if (!aov.cycles) continue;
+        const std::string layer = aov.layer, letters = aov.channels;
+        if (layer.empty())
+            for (const char c : letters) channels.push_back(std::string(1, c));
+        else channels.push_back(layer + "." + (letters.size() == 1 ? letters : std::string("*")));
+    }
+    return channels;
+}
+
+nlohmann::json cameraJson(const CameraPose& camera) {
+    return {{"position", jsonVec3(camera.position)},
+            {"target", jsonVec3(camera.target)},
+            {"up", jsonVec3(camera.up)},
+            {"fov_y_deg", glm::degrees(camera.fovYRadians)},
+            {"near", camera.nearPlane},
+            {"far", camera.farPlane},
+            {"view", jsonMat4(camera.view)},
+            {"projection", jsonMat4(camera.projection)}};
+}
+} // namespace
+
 void Renderer::Impl::prepareReferenceMethod(Frame& frame, const SceneSpec& spec) {
     frame.referenceInputs.model = frame.model;
     frame.referenceInputs.partMaterials = frame.partMaterials;
@@ -550,82 +662,41 @@ void Renderer::Impl::prepareReferenceMethod(Frame& frame, const SceneSpec& spec)
     referenceMethod.prepare(frame.referenceInputs, spec.sss);
 }
 
-namespace {
-// What the upload depends on: the model, its materials and maps, the environment.
-std::string residentSceneKeyOf(const SceneSpec& spec) {
-    const nlohmann::json& r = spec.resolved;
-    return nlohmann::json{{"scene", r.at("scene")},
-                          {"mm_per_unit", r.value("mm_per_unit", nlohmann::json())},
-                          {"model", r.value("model", nlohmann::json())},
-                          {"textures", r.value("textures", nlohmann::json())},
-                          {"materials", r.value("materials", nlohmann::json())},
-                          {"skin", r.value("skin", nlohmann::json())},
-                          {"environment", r.value("environment", nlohmann::json())}}
-        .dump();
-}
-
-// What the lighting passes depend on: everything but the tone map and the [sss] keys they do not read (the main
-// pass reads width_mm for the transmittance, the surface AOVs curvature_measure, both curvature_reference_mm).
-std::string lightingKeyOf(const SceneSpec& spec) {
-    nlohmann::json r = spec.resolved;
-    r.erase("tone_map");
-    r.erase("sss");
-    r["sss_lighting"] = {{"curvature_measure", spec.sss.curvatureMeasure},
-                         {"curvature_reference_mm", spec.sss.curvatureReferenceMm},
-                         {"width_mm", spec.transmittance.enabled ? spec.sss.widthMm : 0.0}};
-    return r.dump();
-}
-} // namespace
-
-DisplayFrame Renderer::renderDisplay(const RenderRequest& request, bool withLinear) {
-    const auto start = std::chrono::steady_clock::now();
-    SceneSpec spec = loadSpec(request);
-    if (sss::methodInfo(spec.sss.method).execution == sss::Execution::Cycles)
-        throw InputError(spec.source + ": sss.method: 'pathtraced' renders through Blender; use skinlab render");
-    Impl& impl = *impl_;
-    impl.context.makeCurrent();
-    DisplayFrame out;
-
+// --- the stages ----------------------------------------------------------------------------------------------
+Frame Renderer::Impl::loadFrame(const SceneSpec& spec) {
     Frame frame;
     frame.spec = &spec;
-    frame.model = impl.model(spec);
+    frame.model = model(spec);
     frame.partMaterials = partMaterialsOf(spec, *frame.model);
-    const double loadMs = millisecondsSince(start);
+    return frame;
+}
 
-    const auto uploadStart = std::chrono::steady_clock::now();
-    const std::string sceneKey = residentSceneKeyOf(spec);
-    if (!impl.residentScene || impl.residentSceneKey != sceneKey) {
-        impl.residentScene.reset();
-        impl.residentSceneKey.clear();
-        impl.shadowKey.clear();
-        impl.lightingKey.clear();
-        const auto albedoMap = impl.albedoMapOf(spec, *frame.model);
-        const auto normalMap = spec.textures.normal.empty() ? frame.model->normalMap
-                                                            : impl.image(spec.textures.normal, ColorEncoding::Data);
-        const auto specularMap = impl.image(spec.textures.specular, ColorEncoding::Data);
-        const auto occlusionMap = impl.image(spec.textures.occlusion, ColorEncoding::Data);
-        const auto skinMaskMap = impl.image(spec.textures.skinMask, ColorEncoding::Data);
-        const Impl::CachedEnvironment& environment = impl.environment(spec.environment);
-        auto scene = std::make_unique<gl::GpuScene>();
-        scene->uploadModel(*frame.model, frame.partMaterials);
-        scene->uploadMaps(albedoMap.get(), normalMap.get(), specularMap.get(), occlusionMap.get(), skinMaskMap.get());
-        std::array<glm::vec3, 9> irradiance = irradianceCoefficientsSH9(environment.radianceSH);
-        for (glm::vec3& c : irradiance) c *= static_cast<float>(spec.environment.intensity);
-        const bool environmentBackground = spec.environment.background == "environment" && environment.environment;
-        scene->uploadEnvironment(environmentBackground ? environment.environment.get() : nullptr, irradiance);
-        impl.residentScene = std::move(scene);
-        impl.residentSceneKey = sceneKey;
-        out.reran.push_back("upload");
-    }
-    gl::GpuScene& scene = *impl.residentScene;
-    frame.scene = &scene;
-    // The shadow maps depend on the model, the lights and the shadow settings only (not on the camera or the
-    // exposure): kept, with the lights' shadow matrices the shadow pass set, while those stay the same.
-    const std::string shadowKey = sceneKey + nlohmann::json{{"lights", spec.resolved.value("lights", nlohmann::json())},
-                                                            {"shadow", spec.resolved.value("shadow", nlohmann::json())}}
-                                                 .dump();
-    const bool shadows = impl.shadowKey != shadowKey;
-    if (shadows) scene.lights = gpuLightsOf(spec);
+// upload: geometry, maps (a spec's maps replace the ones the model brings, e.g. builtin:head's procedural skin
+// detail) and environment, into a new resident scene.
+void Renderer::Impl::uploadScene(const Frame& frame) {
+    const SceneSpec& spec = *frame.spec;
+    residentScene.reset();
+    const auto albedoMap = albedoMapOf(spec, *frame.model);
+    const auto normalMap =
+        spec.textures.normal.empty() ? frame.model->normalMap : image(spec.textures.normal, ColorEncoding::Data);
+    const auto specularMap = image(spec.textures.specular, ColorEncoding::Data);
+    const auto occlusionMap = image(spec.textures.occlusion, ColorEncoding::Data);
+    const auto skinMaskMap = image(spec.textures.skinMask, ColorEncoding::Data);
+    const CachedEnvironment& cached = environment(spec.environment);
+    auto scene = std::make_unique<gl::GpuScene>();
+    scene->uploadModel(*frame.model, frame.partMaterials);
+    scene->uploadMaps(albedoMap.get(), normalMap.get(), specularMap.get(), occlusionMap.get(), skinMaskMap.get());
+    std::array<glm::vec3, 9> irradiance = irradianceCoefficientsSH9(cached.radianceSH);
+    for (glm::vec3& c : irradiance) c *= static_cast<float>(spec.environment.intensity);
+    const bool environmentBackground = spec.environment.background == "environment" && cached.environment;
+    scene->uploadEnvironment(environmentBackground ? cached.environment.get() : nullptr, irradiance);
+    glFinish();
+    residentScene = std::move(scene);
+}
+
+// The camera framing the skin, the internal size, the exposure and the environment's rotation.
+void Renderer::Impl::placeCamera(Frame& frame) {
+    const SceneSpec& spec = *frame.spec;
     glm::vec3 frameMin, frameMax;
     skinBounds(*frame.model, frame.partMaterials, frameMin, frameMax);
     setInternalSize(frame, spec);
@@ -635,50 +706,125 @@ DisplayFrame Renderer::renderDisplay(const RenderRequest& request, bool withLine
     frame.exposure = static_cast<float>(std::exp2(spec.exposureEv));
     frame.environmentFromWorld = glm::mat3(glm::rotate(
         glm::mat4(1.0f), static_cast<float>(-glm::radians(spec.environment.rotationDeg)), glm::vec3(0, 1, 0)));
-    const bool referenceMethod = sss::methodInfo(spec.sss.method).execution == sss::Execution::ObjectSpace;
-    if (referenceMethod) impl.prepareReferenceMethod(frame, spec);
-    const double uploadMs = millisecondsSince(uploadStart);
+}
 
-    impl.timer.reset();
-    const std::string lightingKey = lightingKeyOf(spec);
-    if (impl.lightingKey != lightingKey) {
-        impl.lightingKey.clear();
-        impl.shadowKey.clear();
-        impl.targets.resize(frame.width, frame.height);
-        impl.residentMainSettings = impl.runLightingPasses(frame, shadows);
-        impl.shadowKey = shadowKey;
-        impl.lightingKey = lightingKey;
-        if (shadows) out.reran.push_back("shadows");
-        out.reran.push_back("lighting");
+// sss.method = "pathtraced" / "eevee": Blender renders the same triangles, camera, lights and environment
+// (renderer/pathtraced, docs/pathtraced.md) before any pass runs, so a missing or failing Blender leaves nothing
+// done. The passes still run (the screen-space stage copies through) for the AOVs Blender does not produce: albedo,
+// normals, transmittance, aux, curvature.
+pathtraced::CyclesImage Renderer::Impl::renderBlender(const Frame& frame, pathtraced::BlenderEngine engine) {
+    const SceneSpec& spec = *frame.spec;
+    pathtraced::BlenderSceneInputs inputs;
+    inputs.spec = &spec;
+    inputs.model = frame.model.get();
+    for (const gl::GpuMaterial& m : frame.partMaterials)
+        inputs.partMaterials.push_back({m.albedo, m.skin, m.glossiness, m.specularIntensity});
+    inputs.camera = frame.camera;
+    inputs.sssWidthMm = spec.sss.widthMm;
+    const auto albedoMap = albedoMapOf(spec, *frame.model);
+    if (spec.skin && !spec.textures.albedo.empty()) inputs.retonedAlbedoMap = albedoMap.get();
+    return pathtraced::renderBlenderFrame(engine, std::move(inputs), frame.exposure);
+}
+
+// The pipeline of one frame: upload → camera → [Blender] → shadows → lighting (main … transmittance) → SSS stage (or
+// the object-space reference) → add specular → resolve → tone map. `everything`: every stage runs (render());
+// otherwise a stage runs when what it reads (StageReads) changed since its last run or a stage before it re-ran.
+PipelineRun Renderer::Impl::runPipeline(Frame& frame, bool everything) {
+    const SceneSpec& spec = *frame.spec;
+    PipelineRun run;
+    const auto uploadStart = std::chrono::steady_clock::now();
+    const std::string uploadKey = readsKey(spec, kUploadReads);
+    const bool upload = everything || !residentScene || residentSceneKey != uploadKey;
+    if (upload) {
+        residentSceneKey.clear();
+        shadowKey.clear();
+        lightingKey.clear();
+        uploadScene(frame);
+        residentSceneKey = uploadKey;
+        run.reran.push_back("upload");
+    }
+    frame.scene = residentScene.get();
+    // The shadow maps are kept, with the lights' shadow matrices the shadow pass set, while what they read stays.
+    const std::string shadowKeyNow = readsKey(spec, kShadowReads);
+    const bool shadows = upload || shadowKey != shadowKeyNow;
+    if (shadows) frame.scene->lights = gpuLightsOf(spec);
+    placeCamera(frame);
+    if (const auto engine = blenderEngineOf(spec.sss)) run.blender = renderBlender(frame, *engine);
+    // sss.method = "reference": its parameters checked and the surface tessellated (cached) before the first pass,
+    // so bad input fails with no pass half done.
+    const bool objectSpace = stagesOf(spec.sss).objectSpace;
+    if (objectSpace) prepareReferenceMethod(frame, spec);
+    run.uploadMs = millisecondsSince(uploadStart);
+
+    timer.reset();
+    const std::string lightingKeyNow = readsKey(spec, kLightingReads);
+    if (shadows || lightingKey != lightingKeyNow) {
+        lightingKey.clear();
+        shadowKey.clear();
+        targets.resize(frame.width, frame.height);
+        residentMainSettings = runLightingPasses(frame, shadows);
+        shadowKey = shadowKeyNow;
+        lightingKey = lightingKeyNow;
+        if (shadows) run.reran.push_back("shadows");
+        run.reran.push_back("lighting");
     }
     // The reference method draws into the frame targets itself: the lighting is not kept after it.
-    if (referenceMethod) impl.lightingKey.clear();
-    if (frame.ssaaFactor > 1) impl.resolvedTargets.resize(spec.width, spec.height);
-    out.supportRadiusMm = impl.runSssPasses(frame, impl.residentMainSettings);
-    out.reran.push_back("sss");
+    if (objectSpace) lightingKey.clear();
+    if (frame.ssaaFactor > 1) resolvedTargets.resize(spec.width, spec.height);
+    run.supportRadiusMm = runSssPasses(frame, residentMainSettings);
+    run.reran.push_back("sss");
+    return run;
+}
+
+// Reads `layer` of the output targets (in the texture's own layout, RGBA32F or R32F: Mesa then copies instead of
+// converting per pixel).
+std::vector<float> Renderer::Impl::readOutput(const Frame& frame, GLuint texture, int channels) {
+    const SceneSpec& spec = *frame.spec;
+    std::vector<float> data(static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height) *
+                            static_cast<std::size_t>(channels));
+    gl::readTexture(texture, spec.width, spec.height, channels, data.data());
+    return data;
+}
+
+// The display image's RGB (of an RGBA read-back).
+std::vector<float> Renderer::Impl::readDisplay(const Frame& frame) {
+    const std::vector<float> rgba = readOutput(frame, output(frame).display.get(), 4);
+    std::vector<float> display(rgba.size() / 4 * 3);
+    for (std::size_t p = 0; p < rgba.size() / 4; ++p)
+        for (std::size_t c = 0; c < 3; ++c) display[p * 3 + c] = rgba[p * 4 + c];
+    return display;
+}
+
+DisplayFrame Renderer::renderDisplay(const RenderRequest& request, bool withLinear) {
+    const auto start = std::chrono::steady_clock::now();
+    SceneSpec spec = loadSpec(request);
+    if (blenderEngineOf(spec.sss))
+        throw InputError(spec.source + ": sss.method: '" + std::string(sss::methodName(spec.sss.method)) +
+                         "' renders through Blender; use skinlab render");
+    Impl& impl = *impl_;
+    impl.context.makeCurrent();
+    Frame frame = impl.loadFrame(spec);
+    const double loadMs = millisecondsSince(start);
+
+    const PipelineRun run = impl.runPipeline(frame, false);
+    DisplayFrame out;
+    out.reran = run.reran;
+    out.supportRadiusMm = run.supportRadiusMm;
     if (withLinear) {
         impl.resolve(frame, &gl::FrameTargets::linearDepth, gl::ResolveMode::Nearest);
         impl.resolve(frame, &gl::FrameTargets::mask, gl::ResolveMode::Average);
     }
 
     const auto readbackStart = std::chrono::steady_clock::now();
-    const gl::FrameTargets& targets = impl.output(frame);
-    const std::size_t pixels = static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height);
-    std::vector<float> rgba(pixels * 4);
-    gl::readTexture(targets.display.get(), spec.width, spec.height, 4, rgba.data());
-    std::vector<float> display(pixels * 3);
-    for (std::size_t p = 0; p < pixels; ++p)
-        for (std::size_t c = 0; c < 3; ++c) display[p * 3 + c] = rgba[p * 4 + c];
-    out.srgb8 = encodeDisplaySrgb8(display);
+    out.srgb8 = encodeDisplaySrgb8(impl.readDisplay(frame));
     if (withLinear) {
-        gl::readTexture(targets.beauty.get(), spec.width, spec.height, 4, rgba.data());
-        out.beauty.resize(pixels * 3);
-        for (std::size_t p = 0; p < pixels; ++p)
+        const gl::FrameTargets& targets = impl.output(frame);
+        const std::vector<float> rgba = impl.readOutput(frame, targets.beauty.get(), 4);
+        out.beauty.resize(rgba.size() / 4 * 3);
+        for (std::size_t p = 0; p < rgba.size() / 4; ++p)
             for (std::size_t c = 0; c < 3; ++c) out.beauty[p * 3 + c] = rgba[p * 4 + c];
-        out.depth.resize(pixels);
-        gl::readTexture(targets.linearDepth.get(), spec.width, spec.height, 1, out.depth.data());
-        out.mask.resize(pixels);
-        gl::readTexture(targets.mask.get(), spec.width, spec.height, 1, out.mask.data());
+        out.depth = impl.readOutput(frame, targets.linearDepth.get(), 1);
+        out.mask = impl.readOutput(frame, targets.mask.get(), 1);
     }
     const double readbackMs = millisecondsSince(readbackStart);
 
@@ -689,236 +835,91 @@ DisplayFrame Renderer::renderDisplay(const RenderRequest& request, bool withLine
     out.resolved = spec.resolved;
     out.timingsMs = impl.timer.json();
     out.timingsMs["cpu"] = {
-        {"load", gl::roundMs(loadMs)}, {"upload", gl::roundMs(uploadMs)}, {"readback", gl::roundMs(readbackMs)}};
+        {"load", gl::roundMs(loadMs)}, {"upload", gl::roundMs(run.uploadMs)}, {"readback", gl::roundMs(readbackMs)}};
     out.timingsMs["call_wall"] = gl::roundMs(millisecondsSince(start));
     return out;
 }
 
-// Long by design: the GL pass sequence of one frame, in order, sharing its targets and timers.
+// --- render(): the display path, every AOV read back, the EXR and PNG written ------------------------------------
+// Every AOV of the table read back at the output size (resolved with anti-aliasing; the beauty is resolved before
+// the tone map already) and, when asked, the display image; a Blender frame merged with them.
+FrameImages Renderer::Impl::readFrame(const Frame& frame, PipelineRun& run, bool display) {
+    const SceneSpec& spec = *frame.spec;
+    if (frame.ssaaFactor > 1) {
+        timer.begin("resolve_aovs");
+        for (const Aov& aov : kAovs)
+            if (aov.texture != &gl::FrameTargets::beauty) resolve(frame, aov.texture, aov.resolve);
+        timer.end();
+    }
+    FrameImages images;
+    for (const Aov& aov : kAovs)
+        images.aovs.push_back(readOutput(frame, (output(frame).*aov.texture).get(), aov.textureChannels));
+    if (run.blender) {
+        pathtraced::RasterizerLayers layers;
+        layers.specular = &images.aovs[aovIndex("specular")];
+        layers.depth = &images.aovs[aovIndex("depth")];
+        layers.mask = &images.aovs[aovIndex("mask")];
+        layers.antialiased = frame.ssaaFactor > 1;
+        layers.fractionalSkin = !spec.textures.skinMask.empty();
+        for (const Vertex& v : frame.model->vertices) layers.fractionalSkin = layers.fractionalSkin || v.skin < 1.0f;
+        images.blenderMerge = pathtraced::mergeRasterizerLayers(*run.blender, *blenderEngineOf(spec.sss), spec, layers);
+    }
+    if (display && run.blender) {
+        // Blender's beauty through the same tone mapper (renderer/shading/tone_mappers.h mirrors the GL pass).
+        images.display.resize(run.blender->beauty.size());
+        for (std::size_t i = 0; i < images.display.size(); ++i)
+            images.display[i] = toneMap(run.blender->beauty[i], spec.toneMapper, static_cast<float>(spec.exponentialK),
+                                        static_cast<float>(spec.filmicWhite));
+    } else if (display) {
+        images.display = readDisplay(frame);
+    }
+    return images;
+}
+
+// The EXR's attributes: the resolved record, versions, camera, scale, SSS support and, for Blender, its record.
+ExrMetadata Renderer::Impl::frameMetadata(const Frame& frame, const PipelineRun& run, const FrameImages& images) {
+    const SceneSpec& spec = *frame.spec;
+    ExrMetadata metadata;
+    metadata.strings["skinlab:resolved"] = spec.resolved.dump();
+    metadata.strings["skinlab:version"] = version();
+    metadata.strings["skinlab:gl_renderer"] = context.renderer();
+    metadata.strings["skinlab:gl_version"] = context.version();
+    metadata.strings["skinlab:camera"] = cameraJson(frame.camera).dump();
+    // The output image's focal length (the passes ran at ssaa_factor × it).
+    metadata.floats["skinlab:f_px"] = frame.camera.focalLengthPixels / static_cast<float>(frame.ssaaFactor);
+    if (spec.window) // the part of the render.width × render.height frame this image is (x y width height, y from the top)
+        metadata.strings["skinlab:window"] = std::to_string(spec.window->x) + " " + std::to_string(spec.window->y) +
+                                             " " + std::to_string(spec.window->width) + " " +
+                                             std::to_string(spec.window->height);
+    metadata.floats["skinlab:mm_per_unit"] = static_cast<float>(spec.mmPerUnit);
+    metadata.floats["skinlab:sss_radius_mm"] = run.supportRadiusMm;
+    if (run.blender)
+        pathtraced::addBlenderMetadata(metadata, *blenderEngineOf(spec.sss), spec, *run.blender, images.blenderMerge,
+                                       blenderChannels());
+    return metadata;
+}
+
 RenderResult Renderer::render(const RenderRequest& request) {
     if (request.exrPath.empty()) throw InputError("render: an output EXR path is required (-o out.exr)");
     const auto loadStart = std::chrono::steady_clock::now();
     SceneSpec spec = loadSpec(request);
     Impl& impl = *impl_;
     impl.context.makeCurrent();
-
-    // --- scene data (CPU): model, materials, maps, environment ----------------------------------------------
-    Frame frame;
-    frame.spec = &spec;
-    frame.model = impl.model(spec);
-    frame.partMaterials = partMaterialsOf(spec, *frame.model);
-    // A spec's maps replace the ones the model brings (builtin:head's procedural skin detail).
-    const auto albedoMap = impl.albedoMapOf(spec, *frame.model);
-    const auto normalMap =
-        spec.textures.normal.empty() ? frame.model->normalMap : impl.image(spec.textures.normal, ColorEncoding::Data);
-    const auto specularMap = impl.image(spec.textures.specular, ColorEncoding::Data);
-    const auto occlusionMap = impl.image(spec.textures.occlusion, ColorEncoding::Data);
-    const auto skinMaskMap = impl.image(spec.textures.skinMask, ColorEncoding::Data);
-    const Impl::CachedEnvironment& environment = impl.environment(spec.environment);
+    Frame frame = impl.loadFrame(spec);
     const double loadMs = millisecondsSince(loadStart);
 
-    // --- upload: geometry, maps, environment, lights; camera and frame targets ------------------------------
-    const auto uploadStart = std::chrono::steady_clock::now();
-    gl::GpuScene scene;
-    frame.scene = &scene;
-    scene.uploadModel(*frame.model, frame.partMaterials);
-    scene.uploadMaps(albedoMap.get(), normalMap.get(), specularMap.get(), occlusionMap.get(), skinMaskMap.get());
-    std::array<glm::vec3, 9> irradiance = irradianceCoefficientsSH9(environment.radianceSH);
-    for (glm::vec3& c : irradiance) c *= static_cast<float>(spec.environment.intensity);
-    const bool environmentBackground = spec.environment.background == "environment" && environment.environment;
-    scene.uploadEnvironment(environmentBackground ? environment.environment.get() : nullptr, irradiance);
-    scene.lights = gpuLightsOf(spec);
-    glm::vec3 frameMin, frameMax;
-    skinBounds(*frame.model, frame.partMaterials, frameMin, frameMax);
-    setInternalSize(frame, spec);
-    frame.camera =
-        frameCamera(spec.camera, frameMin, frameMax, frame.model->boundsMin, frame.model->boundsMax,
-                    spec.frameWidth * frame.ssaaFactor, spec.frameHeight * frame.ssaaFactor, internalWindow(spec));
-    impl.targets.resize(frame.width, frame.height);
-    if (frame.ssaaFactor > 1) impl.resolvedTargets.resize(spec.width, spec.height);
-    frame.exposure = static_cast<float>(std::exp2(spec.exposureEv));
-    frame.environmentFromWorld = glm::mat3(glm::rotate(
-        glm::mat4(1.0f), static_cast<float>(-glm::radians(spec.environment.rotationDeg)), glm::vec3(0, 1, 0)));
-    glFinish();
-    const double uploadMs = millisecondsSince(uploadStart);
-
-    // --- sss.method = "pathtraced": Blender Cycles renders the same triangles, camera, lights and environment
-    // (renderer/pathtraced, docs/pathtraced.md) before any pass runs, so a missing or failing Blender leaves
-    // nothing done. The passes below still run (the screen-space stage copies through) for the AOVs Cycles does
-    // not produce: albedo, normals, transmittance, aux, curvature.
-    // sss.method = "eevee": the same scene handed to Blender EEVEE (docs/pathtraced.md, "EEVEE"), the same way.
-    std::optional<pathtraced::CyclesImage> cycles;
-    const sss::Execution execution = sss::methodInfo(spec.sss.method).execution;
-    const bool eevee = execution == sss::Execution::Eevee;
-    if (execution == sss::Execution::Cycles || eevee) {
-        pathtraced::BlenderSceneInputs cyclesInputs;
-        cyclesInputs.spec = &spec;
-        cyclesInputs.model = frame.model.get();
-        for (const gl::GpuMaterial& m : frame.partMaterials)
-            cyclesInputs.partMaterials.push_back({m.albedo, m.skin, m.glossiness, m.specularIntensity});
-        cyclesInputs.camera = frame.camera;
-        cyclesInputs.sssWidthMm = spec.sss.widthMm;
-        if (spec.skin && !spec.textures.albedo.empty()) cyclesInputs.retonedAlbedoMap = albedoMap.get();
-        if (eevee) {
-            cyclesInputs.params = spec.eevee.sceneParams();
-            cyclesInputs.eeveeSettings = spec.eevee.toJson();
-            cycles = pathtraced::renderWithEevee(cyclesInputs, frame.exposure);
-        } else {
-            cyclesInputs.params = spec.pathtraced;
-            cycles = pathtraced::renderWithCycles(cyclesInputs, frame.exposure);
-        }
-    }
-
-    // --- sss.method = "reference": check its parameters and tessellate (cached) before the first pass, so bad
-    // input fails with no pass half done.
-    const bool referenceMethod = sss::methodInfo(spec.sss.method).execution == sss::Execution::ObjectSpace;
-    if (referenceMethod) impl.prepareReferenceMethod(frame, spec);
-
-    // --- the pass pipeline ----------------------------------------------------------------------------------
-    impl.lightingKey.clear(); // the targets and shadow maps no longer hold renderDisplay's
-    impl.shadowKey.clear();
-    const float supportRadiusMm = impl.runPasses(frame);
-    // Anti-aliasing: every AOV at the output size (the beauty is resolved before the tone map already).
-    if (frame.ssaaFactor > 1) {
-        impl.timer.begin("resolve_aovs");
-        for (const Aov& aov : kAovs)
-            if (aov.texture != &gl::FrameTargets::beauty) impl.resolve(frame, aov.texture, aov.resolve);
-        impl.timer.end();
-    }
-    const gl::FrameTargets& output = impl.output(frame);
-
-    // --- read back: every AOV of the table, and the display image -------------------------------------------
+    PipelineRun run = impl.runPipeline(frame, true);
     const auto readbackStart = std::chrono::steady_clock::now();
-    const int width = spec.width;
-    const int height = spec.height;
-    const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
-    // Read in the textures' own layout (RGBA32F / R32F): Mesa then copies instead of converting per pixel.
-    auto read = [&](GLuint texture, int channels) {
-        std::vector<float> data(pixels * static_cast<std::size_t>(channels));
-        gl::readTexture(texture, width, height, channels, data.data());
-        return data;
-    };
-    std::vector<std::vector<float>> readBack;
-    for (const Aov& aov : kAovs) readBack.push_back(read((output.*aov.texture).get(), aov.textureChannels));
-    const bool rasterizerSpecular =
-        cycles && (eevee ? spec.eevee.specularSource : spec.pathtraced.specularSource) == "rasterizer";
-    if (rasterizerSpecular) {
-        // pathtraced.specular_source / eevee.specular_source = "rasterizer": Blender rendered no specular lobe; its
-        // beauty gets the rasterizer's specular pass (same camera), so only the diffuse/subsurface layer comes
-        // from Blender.
-        const std::vector<float>& specular = readBack[aovIndex("specular")];
-        for (std::size_t p = 0; p < pixels; ++p)
-            for (std::size_t c = 0; c < 3; ++c) {
-                cycles->specular[p * 3 + c] = specular[p * 4 + c];
-                cycles->beauty[p * 3 + c] += specular[p * 4 + c];
-            }
-    }
-    std::vector<float> display;
-    if (!request.pngPath.empty() && cycles) {
-        // Cycles' beauty through the same tone mapper (renderer/shading/tone_mappers.h mirrors the GL pass).
-        display.resize(pixels * 3);
-        for (std::size_t i = 0; i < pixels * 3; ++i)
-            display[i] = toneMap(cycles->beauty[i], spec.toneMapper, static_cast<float>(spec.exponentialK),
-                                 static_cast<float>(spec.filmicWhite));
-    } else if (!request.pngPath.empty()) {
-        const std::vector<float> displayRgba = read(output.display.get(), 4);
-        display.resize(pixels * 3);
-        for (std::size_t p = 0; p < pixels; ++p)
-            for (std::size_t c = 0; c < 3; ++c) display[p * 3 + c] = displayRgba[p * 4 + c];
-    }
+    const FrameImages images = impl.readFrame(frame, run, !request.pngPath.empty());
     const double readbackMs = millisecondsSince(readbackStart);
 
-    // --- write: EXR channels from the AOV table, metadata, PNG ----------------------------------------------
     const auto writeStart = std::chrono::steady_clock::now();
-    bool fractionalSkin = !spec.textures.skinMask.empty();
-    for (const Vertex& v : frame.model->vertices) fractionalSkin = fractionalSkin || v.skin < 1.0f;
-    // Anti-aliasing: Blender's depth and material-index passes do not follow its box filter's coverage (the index
-    // pass keeps the first hit), so the depth and mask of the rasterizer's resolve (same camera and triangles:
-    // nearest depth, skin coverage) replace them, and every method's AOVs mean the same.
-    const bool rasterizerDepthAndMask = cycles && frame.ssaaFactor > 1;
-    if (rasterizerDepthAndMask) {
-        cycles->depth = readBack[aovIndex("depth")];
-        cycles->mask = readBack[aovIndex("mask")];
-        for (float& m : cycles->mask) m = std::clamp(m, 0.0f, 1.0f);
-    } else if (cycles && fractionalSkin) {
-        // A skin-mask map or per-vertex skin below 1: Cycles' index pass only knows the material's flag, so the
-        // rasterizer's mask (same camera, point-sampled) supplies the fraction.
-        const std::vector<float>& mask = readBack[aovIndex("mask")];
-        for (std::size_t p = 0; p < pixels; ++p) cycles->mask[p] *= std::clamp(mask[p], 0.0f, 1.0f);
-    }
-    const std::vector<ExrChannel> channels = exrChannels(readBack, cycles ? &*cycles : nullptr, pixels);
-    const CameraPose& camera = frame.camera;
-    const nlohmann::json cameraJson = {{"position", jsonVec3(camera.position)},
-                                       {"target", jsonVec3(camera.target)},
-                                       {"up", jsonVec3(camera.up)},
-                                       {"fov_y_deg", glm::degrees(camera.fovYRadians)},
-                                       {"near", camera.nearPlane},
-                                       {"far", camera.farPlane},
-                                       {"view", jsonMat4(camera.view)},
-                                       {"projection", jsonMat4(camera.projection)}};
-    ExrMetadata metadata;
-    metadata.strings["skinlab:resolved"] = spec.resolved.dump();
-    metadata.strings["skinlab:version"] = version();
-    metadata.strings["skinlab:gl_renderer"] = impl.context.renderer();
-    metadata.strings["skinlab:gl_version"] = impl.context.version();
-    metadata.strings["skinlab:camera"] = cameraJson.dump();
-    // The output image's focal length (the passes ran at ssaa_factor × it).
-    metadata.floats["skinlab:f_px"] = camera.focalLengthPixels / static_cast<float>(frame.ssaaFactor);
-    if (spec.window) // the part of the render.width × render.height frame this image is (x y width height, y from the top)
-        metadata.strings["skinlab:window"] = std::to_string(spec.window->x) + " " + std::to_string(spec.window->y) +
-                                             " " + std::to_string(spec.window->width) + " " +
-                                             std::to_string(spec.window->height);
-    metadata.floats["skinlab:mm_per_unit"] = static_cast<float>(spec.mmPerUnit);
-    metadata.floats["skinlab:sss_radius_mm"] = supportRadiusMm;
-    if (cycles && eevee) {
-        nlohmann::json record = spec.eevee.toJson();
-        record["blender_version"] = cycles->blenderVersion;
-        record["render_seconds"] = cycles->renderSeconds;
-        record["wall_seconds"] = cycles->wallSeconds;
-        record["channels_from_eevee"] =
-            rasterizerSpecular ? nlohmann::json{"R, G, B: diffuse only", "diffuse.*", "depth.Z", "mask.Y"}
-                               : nlohmann::json{"R", "G", "B", "diffuse.*", "specular.*", "depth.Z", "mask.Y"};
-        if (rasterizerDepthAndMask) {
-            nlohmann::json kept = nlohmann::json::array();
-            for (const auto& channel : record["channels_from_eevee"])
-                if (channel != "depth.Z" && channel != "mask.Y") kept.push_back(channel);
-            record["channels_from_eevee"] = kept;
-        }
-        metadata.strings["skinlab:eevee"] = record.dump();
-        metadata.strings["skinlab:blender_version"] = cycles->blenderVersion;
-        metadata.floats["skinlab:render_seconds"] = static_cast<float>(cycles->renderSeconds);
-    } else if (cycles) {
-        const nlohmann::json params = spec.pathtraced.toJson();
-        nlohmann::json fromCycles = nlohmann::json::array(); // "R", "G", "B", "diffuse.*", ..., "depth.Z", "mask.Y"
-        for (const Aov& aov : kAovs) {
-            if (!aov.cycles) continue;
-            const std::string layer = aov.layer, letters = aov.channels;
-            if (layer.empty())
-                for (const char c : letters) fromCycles.push_back(std::string(1, c));
-            else fromCycles.push_back(layer + "." + (letters.size() == 1 ? letters : std::string("*")));
-        }
-        nlohmann::json channelsFromCycles =
-            params.value("specular_source", "cycles") == "rasterizer"
-                ? nlohmann::json{"R, G, B: diffuse only", "diffuse.*", "depth.Z", "mask.Y"}
-                : fromCycles;
-        if (rasterizerDepthAndMask) {
-            nlohmann::json kept = nlohmann::json::array();
-            for (const auto& channel : channelsFromCycles)
-                if (channel != "depth.Z" && channel != "mask.Y") kept.push_back(channel);
-            channelsFromCycles = kept;
-        }
-        metadata.strings["skinlab:pathtraced"] =
-            nlohmann::json{{"samples", params.at("samples")},           {"seed", params.at("seed")},
-                           {"blender_version", cycles->blenderVersion}, {"render_seconds", cycles->renderSeconds},
-                           {"wall_seconds", cycles->wallSeconds},       {"channels_from_cycles", channelsFromCycles}}
-                .dump();
-        metadata.strings["skinlab:blender_version"] = cycles->blenderVersion;
-        metadata.floats["skinlab:pathtraced_samples"] = static_cast<float>(params.at("samples").get<int>());
-        metadata.floats["skinlab:pathtraced_seed"] = static_cast<float>(params.at("seed").get<int>());
-        metadata.floats["skinlab:render_seconds"] = static_cast<float>(cycles->renderSeconds);
-    }
-    writeExr(request.exrPath, width, height, channels, metadata);
-    if (!request.pngPath.empty()) writePng(request.pngPath, width, height, encodeDisplaySrgb8(display));
+    const std::size_t pixels = static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height);
+    writeExr(request.exrPath, spec.width, spec.height,
+             exrChannels(images.aovs, run.blender ? &*run.blender : nullptr, pixels),
+             impl.frameMetadata(frame, run, images));
+    if (!request.pngPath.empty())
+        writePng(request.pngPath, spec.width, spec.height, encodeDisplaySrgb8(images.display));
     const double writeMs = millisecondsSince(writeStart);
 
     RenderResult result;
@@ -927,19 +928,19 @@ RenderResult Renderer::render(const RenderRequest& request) {
     result.glVersion = impl.context.version();
     result.timingsMs = impl.timer.json();
     result.timingsMs["cpu"] = {{"load", gl::roundMs(loadMs)},
-                               {"upload", gl::roundMs(uploadMs)},
+                               {"upload", gl::roundMs(run.uploadMs)},
                                {"readback", gl::roundMs(readbackMs)},
                                {"write", gl::roundMs(writeMs)}};
-    if (referenceMethod)
-        result.timingsMs["reference"] = gl::roundTimings(impl.referenceMethod.lastRun()); // CPU parts of "sss"
-    if (cycles)
-        result.timingsMs[eevee ? "eevee" : "pathtraced"] = {
-            {"render", gl::roundMs(cycles->renderSeconds * 1000.0)},
-            {"blender_wall", gl::roundMs(cycles->wallSeconds * 1000.0)}};
-    result.timingsMs["width"] = width;
-    result.timingsMs["height"] = height;
+    const ExecutorStages& stages = stagesOf(spec.sss);
+    if (stages.objectSpace)
+        result.timingsMs[stages.timings] = gl::roundTimings(impl.referenceMethod.lastRun()); // CPU parts of "sss"
+    if (run.blender)
+        result.timingsMs[stages.timings] = {{"render", secondsToMs(run.blender->renderSeconds)},
+                                            {"blender_wall", secondsToMs(run.blender->wallSeconds)}};
+    result.timingsMs["width"] = spec.width;
+    result.timingsMs["height"] = spec.height;
     result.timingsMs["gl_renderer"] = result.glRenderer;
-    spdlog::debug("rendered {} ({}x{}): gpu {:.1f} ms, wall {:.1f} ms", spec.source, width, height,
+    spdlog::debug("rendered {} ({}x{}): gpu {:.1f} ms, wall {:.1f} ms", spec.source, spec.width, spec.height,
                   result.timingsMs["gpu_total"].get<double>(), result.timingsMs["wall_total"].get<double>());
     return result;
 }

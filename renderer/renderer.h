@@ -73,7 +73,7 @@ public:
     // the shadow maps when the lights or shadow settings differ; the other lighting passes (main … transmittance)
     // when the camera, size, exposure, transmittance or an [sss] key the main pass reads differ; always the SSS
     // stage, add specular and tone map. The image is the same, byte for byte, as render()'s PNG of the same
-    // request. sss.method = "pathtraced" is refused (InputError): it needs Blender, run it through render().
+    // request. A method Blender renders is refused (InputError naming it): run it through render().
     DisplayFrame renderDisplay(const RenderRequest& request, bool withLinear = false);
     std::string glRenderer() const;
     std::string glVersion() const;

@@ -9,6 +9,7 @@
 #include "renderer/sss/burley_profile.h"
 #include "renderer/sss/gaussian_sum_profile.h"
 #include "renderer/sss/kernel.h"
+#include "renderer/sss/method.h"
 #include "renderer/sss/materials.h"
 #include "renderer/sss/sss_params.h"
 
@@ -251,8 +252,7 @@ nlohmann::json kernelCurves(const TuneConfig& config) {
     out["radius_mm"] = x;
     out["deon"] = curve(deon);
     out["burley"] = curve(burley);
-    if (params.method == sss::SssMethod::Separable || params.method == sss::SssMethod::Reference) {
-        const auto marginal = sss::makeMarginal(params);
+    if (const auto marginal = sss::methodInfo(params.method).model->profileMarginal(params)) {
         out["method_curve"] = curve(*marginal);
         out["method_curve_source"] = marginal->description();
     }

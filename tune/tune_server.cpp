@@ -305,7 +305,7 @@ json TuneServer::schema() const {
         methods.push_back({{"name", info.name},
                            {"screen_space", info.screenSpace()},
                            {"summary", info.summary},
-                           {"slow", !info.screenSpace() && info.execution != sss::Execution::CopyThrough},
+                           {"slow", !info.interactive},
                            {"parameters", parameters}});
     }
     json transmittance = json::array();
@@ -404,7 +404,7 @@ HttpResponse TuneServer::render(const json& body) {
     probe.assetsDir = options_.assetsDir;
     const json resolved = renderer::resolveScene(probe); // bad values: the CLI's one-line error, before any GL
     const std::string method = resolved["sss"].value("method", "none");
-    if (method == "reference" || method == "pathtraced") {
+    if (!sss::findMethod(method)->interactive) {
         // Slow: a background render the page follows (/api/job) and may cancel.
         const std::string id = jobs_->start(config, method, resolved["render"]["width"].get<int>(),
                                             resolved["render"]["height"].get<int>());

@@ -39,7 +39,7 @@ void PscbfMethod::ensureScratch(int width, int height) {
 
 void PscbfMethod::run(const SssStageInputs& inputs, const sss::SssParams& params, const sss::Kernel& kernel,
                       GLuint output) {
-    if (kernel.method != sss::SssMethod::Pscbf || kernel.stages.size() != 1)
+    if (sss::methodInfo(kernel.method).execution != sss::Execution::Pscbf || kernel.stages.size() != 1)
         throw RuntimeError("pscbf method: expected the one-stage pscbf kernel of makeKernel");
     const sss::KernelStage& stage = kernel.stages[0];
     if (stage.taps.empty() || static_cast<int>(stage.taps.size()) > kMaxTaps)

@@ -189,6 +189,15 @@ struct ReferenceMethod::Impl {
                                    std::to_string(bakeHeight) + ")");
         }
     }
+
+    // The three steps of run(), in order.
+    std::vector<float> bake(const ReferenceInputs& inputs, TessellatedModel& mesh);
+    std::vector<glm::vec3> convolve(const TessellatedModel& mesh, const std::vector<float>& baked,
+                                    const sss::SssParams& params, const sss::RadialProfile& profile,
+                                    std::size_t& skinSamples, reference::ConvolutionReport& report,
+                                    std::vector<glm::vec3>& ownShare);
+    void draw(const ReferenceInputs& inputs, const TessellatedModel& mesh, const std::vector<glm::vec3>& convolved,
+              const std::vector<glm::vec3>& ownShare, GLuint output);
 };
 
 ReferenceMethod::ReferenceMethod(ShaderLibrary& shaders) : impl_(std::make_unique<Impl>(shaders)) {}
@@ -201,37 +210,23 @@ void ReferenceMethod::prepare(const ReferenceInputs& inputs, const sss::SssParam
                        cached);
 }
 
-// Long by design: the GL pass sequence of the reference method, in order, sharing its buffers.
-void ReferenceMethod::run(const ReferenceInputs& inputs, const sss::SssParams& params, GLuint output) {
-    Impl& impl = *impl_;
-    const FrameTargets& targets = *inputs.targets;
-    const auto profile = profileOf(params, inputs.source); // refuse a tabulated profile before any work
-    const float edgeMm = static_cast<float>(params.referenceEdgeMm);
-
-    // --- 1. tessellation and samples (cached) ---
-    bool cached = false;
-    TessellatedModel& mesh = impl.tessellated(inputs, edgeMm, params.referenceNonSkin == "absorbs", cached);
-    cached = mesh.renders > 0; // prepare() of this render may have made the entry: count it as this render's
-    ++mesh.renders;
-    const std::size_t vertexCount = mesh.samples.size();
-
-    // --- 2. bake the main pass's shading at every vertex of the skin parts ---
-    const auto bakeStart = std::chrono::steady_clock::now();
-    impl.prepareBakeTarget(vertexCount);
-    glBindFramebuffer(GL_FRAMEBUFFER, impl.bakeFramebuffer.get());
+// Bakes the main pass's shading at every vertex of the skin parts; returns the bake's RGBA (diffuse, mask).
+std::vector<float> ReferenceMethod::Impl::bake(const ReferenceInputs& inputs, TessellatedModel& mesh) {
+    prepareBakeTarget(mesh.samples.size());
+    glBindFramebuffer(GL_FRAMEBUFFER, bakeFramebuffer.get());
     const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
     glClearBufferfv(GL_COLOR, 0, zero);
     glClearBufferfv(GL_COLOR, 7, zero);
-    glViewport(0, 0, kBakeWidth, impl.bakeHeight);
+    glViewport(0, 0, kBakeWidth, bakeHeight);
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_BLEND);
     glDisable(GL_CULL_FACE);
     glEnable(GL_PROGRAM_POINT_SIZE);
-    const GLuint bakeProgram = impl.shaders.program("reference_bake.vert", "main_pass.frag");
+    const GLuint bakeProgram = shaders.program("reference_bake.vert", "main_pass.frag");
     glUseProgram(bakeProgram);
     MainPass::bindShading(bakeProgram, *inputs.scene, inputs.shadowMaps, inputs.mainSettings);
     setUniform(bakeProgram, "bakeWidth", kBakeWidth);
-    setUniform(bakeProgram, "bakeHeight", impl.bakeHeight);
+    setUniform(bakeProgram, "bakeHeight", bakeHeight);
     glBindVertexArray(mesh.pointVertexArray.get());
     for (std::size_t p = 0; p < mesh.parts.size(); ++p) {
         if (!mesh.skinParts[p]) continue;
@@ -245,20 +240,25 @@ void ReferenceMethod::run(const ReferenceInputs& inputs, const sss::SssParams& p
     glDisable(GL_PROGRAM_POINT_SIZE);
     checkGl("reference: bake");
 
-    const std::size_t bakePixels = static_cast<std::size_t>(kBakeWidth) * static_cast<std::size_t>(impl.bakeHeight);
+    const std::size_t bakePixels = static_cast<std::size_t>(kBakeWidth) * static_cast<std::size_t>(bakeHeight);
     std::vector<float> diffuse(bakePixels * 4);
     const auto bytes = static_cast<GLsizei>(bakePixels * 4 * sizeof(float));
-    glGetTextureImage(impl.bakeDiffuse.get(), 0, GL_RGBA, GL_FLOAT, bytes, diffuse.data());
+    glGetTextureImage(bakeDiffuse.get(), 0, GL_RGBA, GL_FLOAT, bytes, diffuse.data());
     checkGl("reference: bake read back");
-    const double bakeMs = millisecondsSince(bakeStart);
+    return diffuse;
+}
 
-    // --- 3. convolution over the surface ---
-    const auto convolveStart = std::chrono::steady_clock::now();
+// The convolution over the surface of the baked radiance.
+std::vector<glm::vec3> ReferenceMethod::Impl::convolve(const TessellatedModel& mesh, const std::vector<float>& baked,
+                                                       const sss::SssParams& params, const sss::RadialProfile& profile,
+                                                       std::size_t& skinSamples, reference::ConvolutionReport& report,
+                                                       std::vector<glm::vec3>& ownShare) {
+    const std::size_t vertexCount = mesh.samples.size();
     reference::SurfaceSamples samples = mesh.samples;
     std::vector<glm::vec3> radiance(vertexCount);
-    std::size_t skinSamples = 0;
+    skinSamples = 0;
     for (std::size_t i = 0; i < vertexCount; ++i) {
-        const float* d = &diffuse[i * 4];
+        const float* d = &baked[i * 4];
         // Transmittance (location 7) is left out on purpose: the convolution at 3-D distances already carries the
         // light of a lit back face through thin parts (the effect transmittance approximates in screen space), so
         // adding it would count that light twice. docs/extensions.md, "The object-space reference".
@@ -279,38 +279,41 @@ void ReferenceMethod::run(const ReferenceInputs& inputs, const sss::SssParams& p
         convolution.convexityMm[c] = params.referenceConvexityMm[c] * scale; // a length: scales with the profile
     }
     convolution.convexityRadiusMinMm = 20.0 * scale; // 20 mm at width 3 mm: the nose tip, the ear's rim
-    convolution.nearFieldMm = 0.5 * edgeMm;          // a seam's twin, a fan's small triangles: near field
+    convolution.nearFieldMm = 0.5 * mesh.edgeMm;     // a seam's twin, a fan's small triangles: near field
     convolution.nonSkin =
         params.referenceNonSkin == "returns" ? reference::NonSkin::Returns : reference::NonSkin::Absorbs;
-    reference::ConvolutionReport report;
     // sss.reference_near_field = "pixel": the near field split off (surface_convolution.h, ownShare); the draw
     // multiplies each vertex's own share by the main pass's E·α at every pixel, so detail finer than the
-    // tessellation keeps its sharpness.
-    // With "vertex" every share is 0 and the far field holds the whole sum.
+    // tessellation keeps its sharpness. With "vertex" every share is 0 and the far field holds the whole sum.
     const bool nearAtPixels = params.referenceNearField == "pixel";
-    std::vector<glm::vec3> ownShare;
-    const std::vector<glm::vec3> convolved = reference::convolveSurface(
-        samples, radiance, *profile, convolution, nullptr, &report, nearAtPixels ? &ownShare : nullptr);
+    std::vector<glm::vec3> convolved = reference::convolveSurface(samples, radiance, profile, convolution, nullptr,
+                                                                  &report, nearAtPixels ? &ownShare : nullptr);
     if (!nearAtPixels) ownShare.assign(vertexCount, glm::vec3(0.0f));
-    const double convolveMs = millisecondsSince(convolveStart);
+    return convolved;
+}
 
-    // --- 4. draw the tessellated skin with the convolved radiance (far field + own share × the pixel's E·α) over
-    // the main pass's diffuse ---
+// Draws the tessellated skin with the convolved radiance (far field + own share × the pixel's E·α) over the main
+// pass's diffuse, into `output`.
+void ReferenceMethod::Impl::draw(const ReferenceInputs& inputs, const TessellatedModel& mesh,
+                                 const std::vector<glm::vec3>& convolved, const std::vector<glm::vec3>& ownShare,
+                                 GLuint output) {
+    const FrameTargets& targets = *inputs.targets;
+    const std::size_t vertexCount = mesh.samples.size();
     // Per vertex: the far field (rgb) and the own share (rgb), reference_draw.vert's layout.
     std::vector<glm::vec4> packed(2 * std::max<std::size_t>(vertexCount, 1), glm::vec4(0.0f));
     for (std::size_t i = 0; i < vertexCount; ++i) {
         packed[2 * i] = glm::vec4(convolved[i], 1.0f);
         packed[2 * i + 1] = glm::vec4(ownShare[i], 0.0f);
     }
-    if (packed.size() > impl.convolvedCapacity || !impl.convolvedBuffer.get()) {
+    if (packed.size() > convolvedCapacity || !convolvedBuffer.get()) {
         GLuint name = 0;
         glCreateBuffers(1, &name);
-        impl.convolvedBuffer = Buffer(name);
+        convolvedBuffer = Buffer(name);
         glNamedBufferStorage(name, static_cast<GLsizeiptr>(packed.size() * sizeof(glm::vec4)), nullptr,
                              GL_DYNAMIC_STORAGE_BIT);
-        impl.convolvedCapacity = packed.size();
+        convolvedCapacity = packed.size();
     }
-    glNamedBufferSubData(impl.convolvedBuffer.get(), 0, static_cast<GLsizeiptr>(packed.size() * sizeof(glm::vec4)),
+    glNamedBufferSubData(convolvedBuffer.get(), 0, static_cast<GLsizeiptr>(packed.size() * sizeof(glm::vec4)),
                          packed.data());
 
     glCopyImageSubData(targets.diffuse.get(), GL_TEXTURE_2D, 0, 0, 0, 0, output, GL_TEXTURE_2D, 0, 0, 0, 0,
@@ -319,13 +322,13 @@ void ReferenceMethod::run(const ReferenceInputs& inputs, const sss::SssParams& p
     // a polygon offset let back faces next to a silhouette pass (the offset's slope term is large there) and paint
     // the far side's colour into rim pixels. reference_draw.frag keeps the fragment whose depth matches the main
     // pass's best, through a depth buffer of its own holding the mismatch.
-    if (impl.drawDepthWidth != targets.width || impl.drawDepthHeight != targets.height) {
-        impl.drawDepth = createTexture2D(GL_DEPTH_COMPONENT32F, targets.width, targets.height);
-        impl.drawDepthWidth = targets.width;
-        impl.drawDepthHeight = targets.height;
+    if (drawDepthWidth != targets.width || drawDepthHeight != targets.height) {
+        drawDepth = createTexture2D(GL_DEPTH_COMPONENT32F, targets.width, targets.height);
+        drawDepthWidth = targets.width;
+        drawDepthHeight = targets.height;
     }
     // A framebuffer per run: the output texture's name is recycled when the frame is resized (as sss_stage.cpp).
-    const Framebuffer drawFramebuffer = createFramebuffer("reference draw", &output, 1, impl.drawDepth.get());
+    const Framebuffer drawFramebuffer = createFramebuffer("reference draw", &output, 1, drawDepth.get());
     glBindFramebuffer(GL_FRAMEBUFFER, drawFramebuffer.get());
     glViewport(0, 0, targets.width, targets.height);
     const float farthest = 1.0f;
@@ -333,12 +336,12 @@ void ReferenceMethod::run(const ReferenceInputs& inputs, const sss::SssParams& p
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glDepthMask(GL_TRUE);
-    const GLuint drawProgram = impl.shaders.program("reference_draw.vert", "reference_draw.frag");
+    const GLuint drawProgram = shaders.program("reference_draw.vert", "reference_draw.frag");
     glUseProgram(drawProgram);
     setUniform(drawProgram, "view", inputs.mainSettings.camera.view);
     setUniform(drawProgram, "projection", inputs.mainSettings.camera.projection);
     setUniform(drawProgram, "depthTolerance", kDepthTolerance);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, impl.convolvedBuffer.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, convolvedBuffer.get());
     glBindTextureUnit(0, targets.diffuse.get());
     glBindTextureUnit(1, targets.mask.get());
     glBindTextureUnit(2, targets.linearDepth.get());
@@ -358,10 +361,33 @@ void ReferenceMethod::run(const ReferenceInputs& inputs, const sss::SssParams& p
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glUseProgram(0);
     checkGl("reference: draw");
+}
+
+// Tessellation and samples (cached) → bake → convolution over the surface → draw.
+void ReferenceMethod::run(const ReferenceInputs& inputs, const sss::SssParams& params, GLuint output) {
+    Impl& impl = *impl_;
+    const auto profile = profileOf(params, inputs.source); // refuse a tabulated profile before any work
+    const float edgeMm = static_cast<float>(params.referenceEdgeMm);
+    bool cached = false;
+    TessellatedModel& mesh = impl.tessellated(inputs, edgeMm, params.referenceNonSkin == "absorbs", cached);
+    cached = mesh.renders > 0; // prepare() of this render may have made the entry: count it as this render's
+    ++mesh.renders;
+
+    const auto bakeStart = std::chrono::steady_clock::now();
+    const std::vector<float> baked = impl.bake(inputs, mesh);
+    const double bakeMs = millisecondsSince(bakeStart);
+    const auto convolveStart = std::chrono::steady_clock::now();
+    std::size_t skinSamples = 0;
+    reference::ConvolutionReport report;
+    std::vector<glm::vec3> ownShare;
+    const std::vector<glm::vec3> convolved =
+        impl.convolve(mesh, baked, params, *profile, skinSamples, report, ownShare);
+    const double convolveMs = millisecondsSince(convolveStart);
+    impl.draw(inputs, mesh, convolved, ownShare, output);
 
     lastRun_ = {{"tessellate_ms", cached ? 0.0 : mesh.tessellateMs},
                 {"cached", cached},
-                {"samples", vertexCount},
+                {"samples", mesh.samples.size()},
                 {"skin_samples", skinSamples},
                 {"bake_readback_ms", bakeMs},
                 {"convolve_ms", convolveMs},

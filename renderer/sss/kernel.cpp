@@ -36,7 +36,8 @@ std::unique_ptr<Marginal> makeMarginal(const SssParams& params) {
     throwInput("", "sss.profile", "'" + params.profile + "' is not one of: deon, burley, file:PATH");
 }
 Kernel makeKernel(const SssParams& params) {
-    if (params.method != SssMethod::None && (params.samples < 3 || params.samples > 101 || params.samples % 2 == 0))
+    if (methodUsesKey(params.method, "samples") &&
+        (params.samples < 3 || params.samples > 101 || params.samples % 2 == 0))
         throwInput("", "sss.samples", std::to_string(params.samples) + " is not an odd number of taps in [3, 101]");
     if (!(params.widthMm > 0.0)) throwInput("", "sss.width_mm", "must be positive");
     // The method's own class (its row of the method table, method_table.cpp) builds the taps.

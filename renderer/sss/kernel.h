@@ -29,7 +29,7 @@ struct KernelStage {
 };
 
 struct Kernel {
-    SssMethod method = SssMethod::None;
+    SssMethod method{}; // "none"
     std::string source; // what the taps were computed from, e.g. "d'Eon six-Gaussian skin profile (marginal)"
     std::vector<KernelStage> stages;
 

@@ -10,6 +10,15 @@ namespace skinlab::renderer::sss {
 
 double Method::supportRadiusMm(const SssParams&, const Kernel& kernel) const { return kernel.supportRadiusMm(); }
 
+std::unique_ptr<Marginal> Method::profileMarginal(const SssParams&) const { return nullptr; }
+
+std::vector<std::string_view> withBlurKeys(std::vector<std::string_view> keys) {
+    for (const std::string_view key :
+         {"follow_surface", "cbf", "cbf_lambda", "lab_weight", "extension_input", "curvature", "curvature_floor"})
+        keys.push_back(key);
+    return keys;
+}
+
 double RadialProfileSupport::supportRadiusMm(const SssParams& params, const Kernel&) const {
     return makeRadialProfile(params)->cutoffRadiusMm(kCutoffTail);
 }

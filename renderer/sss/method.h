@@ -1,7 +1,9 @@
 #pragma once
-// An SSS method as an object: prepared once per parameter set on the CPU (its kernel and support radius), run by the
-// renderer through the one code path its row's Execution names (sss_params.h). Every method — none, the tap-kernel
-// methods, pscbf, reference, pathtraced, eevee — is one class behind a row of the method table (method_table.cpp);
+// An SSS method as one unit: its file under renderer/sss/methods/ holds its class (prepared once per parameter set on
+// the CPU: its kernel and support radius) and the function that declares its row of the method table (MethodInfo,
+// sss_params.h: name, executor — the one code path of the renderer its Execution names —, whether it is interactive,
+// summary, the keys it reads and declares, its defaults). Every method — none, the tap-kernel methods, pscbf,
+// reference, pathtraced, eevee — is registered by one line (method_table.cpp, or SKINLAB_REGISTER_METHOD below);
 // docs/methods.md, "Adding a method", walks through adding one.
 #include "renderer/sss/kernel.h"
 #include "renderer/sss/sss_params.h"
@@ -19,6 +21,9 @@ public:
     // The support radius on the surface, mm (EXR attribute skinlab:sss_radius_mm; the metrics' band widths follow
     // it). Default: the kernel's (Kernel::supportRadiusMm).
     virtual double supportRadiusMm(const SssParams& params, const Kernel& kernel) const;
+    // The 1-D marginal of the physical profile the method integrates against (`skinlab kernel`'s continuous
+    // statistics, `skinlab tune`'s kernel curve); nullptr (the default) for a method without one.
+    virtual std::unique_ptr<Marginal> profileMarginal(const SssParams& params) const;
 };
 
 // Object-space and Blender methods: the radius outside which every channel of the radial profile they use (or are
@@ -28,6 +33,18 @@ public:
     static constexpr double kCutoffTail = 1e-3;
     double supportRadiusMm(const SssParams& params, const Kernel& kernel) const override;
 };
+
+// The [sss] keys every screen-space blur reads besides its own: follow-surface and the thesis' extensions
+// (docs/extensions.md), appended to `keys`.
+std::vector<std::string_view> withBlurKeys(std::vector<std::string_view> keys);
+
+// Registers the method whose row `declaration()` returns (a function returning MethodInfo) at start-up, after the
+// built-in methods: the registration line of a method compiled outside the renderer library, e.g. in a test
+// executable. A built-in method's registration line is its entry in method_table.cpp's list instead (a static
+// library drops an object file nothing refers to, registration included).
+#define SKINLAB_REGISTER_METHOD(declaration)                                                                           \
+    [[maybe_unused]] static const ::skinlab::renderer::sss::SssMethod skinlabRegistered_##declaration =                \
+        ::skinlab::renderer::sss::registerMethod(declaration())
 
 // A method prepared for one parameter set: what the renderer runs.
 struct PreparedMethod {

@@ -1,5 +1,6 @@
-// The method table (sss_params.h, MethodInfo): one row per SSS method, constructing its class (method.h). A method is
-// its class in renderer/sss/methods/ plus its row here (docs/methods.md, "Adding a method").
+// The method table (sss_params.h, MethodInfo): one row per SSS method, each declared by its own file under
+// renderer/sss/methods/ (method.h) and registered by one line, here for the built-in methods (docs/methods.md,
+// "Adding a method").
 #include "common/check.h"
 #include "common/error.h"
 #include "renderer/sss/method.h"
@@ -8,100 +9,57 @@
 
 namespace skinlab::renderer::sss {
 
-// Each method's class, in its own file under renderer/sss/methods/.
-std::shared_ptr<const Method> makeNoneMethod();
-std::shared_ptr<const Method> makeGaussianSumMethod();
-std::shared_ptr<const Method> makeSeparableMethod();
-std::shared_ptr<const Method> makeArtisticMethod();
-std::shared_ptr<const Method> makePscbfMethod();
-std::shared_ptr<const Method> makeReferenceMethod();
-std::shared_ptr<const Method> makePathtracedMethod();
-std::shared_ptr<const Method> makeEeveeMethod();
+// The built-in methods' registration lines, in table order: each names the function of its file under
+// renderer/sss/methods/ that declares its row (name, executor, interactive, summary, keys, defaults, class).
+// "none" comes first: SssMethod{} is its identifier.
+#define SKINLAB_BUILT_IN_METHODS(METHOD)                                                                               \
+    METHOD(noneMethod)                                                                                                 \
+    METHOD(gaussianSumMethod)                                                                                          \
+    METHOD(separableMethod)                                                                                            \
+    METHOD(artisticMethod)                                                                                             \
+    METHOD(pscbfMethod)                                                                                                \
+    METHOD(referenceMethod)                                                                                            \
+    METHOD(pathtracedMethod)                                                                                           \
+    METHOD(eeveeMethod)
+
+#define SKINLAB_DECLARE_METHOD(declaration) MethodInfo declaration();
+SKINLAB_BUILT_IN_METHODS(SKINLAB_DECLARE_METHOD)
+#undef SKINLAB_DECLARE_METHOD
 
 // Defined in sss_params.cpp: adds a registered method's name to the sss.method choices.
 void addMethodChoice(std::string_view name);
 
 namespace {
-// The screen-space blur methods' shared keys: follow-surface and the thesis' extensions (docs/extensions.md).
-#define SKINLAB_BLUR_KEYS                                                                                              \
-    "follow_surface", "cbf", "cbf_lambda", "lab_weight", "extension_input", "curvature", "curvature_floor"
-
-// The rows, built-ins in SssMethod order (the identifiers are the positions).
-std::vector<MethodInfo> builtInRows() {
-    std::vector<MethodInfo> rows{
-        {SssMethod::None,
-         "none",
-         Execution::CopyThrough,
-         "no SSS: the diffuse buffer is copied through",
-         {},
-         {},
-         {},
-         makeNoneMethod()},
-        {SssMethod::GaussianSum,
-         "gaussian-sum",
-         Execution::TapPasses,
-         "Jimenez & Gutierrez 2010: d'Eon's six Gaussians as incremental separable blurs (12 passes)",
-         {"samples", "sampling", "follow_surface_k", SKINLAB_BLUR_KEYS},
-         {},
-         {},
-         makeGaussianSumMethod()},
-        {SssMethod::Separable,
-         "separable",
-         Execution::TapPasses,
-         "Jimenez et al. 2015: two passes with the marginal of a physical profile (d'Eon, Burley or a file)",
-         {"samples", "sampling", "follow_surface_k", "profile", "material", SKINLAB_BLUR_KEYS},
-         {},
-         {},
-         makeSeparableMethod()},
-        {SssMethod::Artistic,
-         "artistic",
-         Execution::TapPasses,
-         "Jimenez's demo kernel (per-channel strength and falloff), two passes",
-         {"samples", "follow_surface_k", "artistic_strength", "artistic_falloff", SKINLAB_BLUR_KEYS},
-         {},
-         {},
-         makeArtisticMethod()},
-        {SssMethod::Pscbf,
-         "pscbf",
-         Execution::Pscbf,
-         "Mikkelsen 2010: pseudo-separable cross-bilateral filter, spike + one Gaussian per channel",
-         {"samples", "pscbf_sigma", SKINLAB_BLUR_KEYS},
-         {},
-         {{"samples", SssParams::kDefaultPscbfSamples}},
-         makePscbfMethod()},
-        {SssMethod::Reference,
-         "reference",
-         Execution::ObjectSpace,
-         "object-space SSS on the tessellated surface (the ground truth of the metrics)",
-         {"profile", "material", "reference_edge_mm", "reference_through_gain", "reference_through_growth_per_mm2",
-          "reference_non_skin", "reference_convexity_mm", "reference_near_field"},
-         {},
-         {},
-         makeReferenceMethod()},
-        {SssMethod::Pathtraced,
-         "pathtraced",
-         Execution::Cycles,
-         "Blender Cycles' random-walk SSS ([pathtraced] table)",
-         {},
-         {},
-         {},
-         makePathtracedMethod()},
-        {SssMethod::Eevee,
-         "eevee",
-         Execution::Eevee,
-         "Blender EEVEE's screen-space SSS ([eevee] table)",
-         {},
-         {},
-         {},
-         makeEeveeMethod()},
-    };
-    for (std::size_t i = 0; i < rows.size(); ++i) SKINLAB_CHECK(static_cast<std::size_t>(rows[i].method) == i);
-    return rows;
+// The checks of a row about to be added to `table`, and its identifier (its position).
+void addRow(std::vector<MethodInfo>& table, MethodInfo row) {
+    const std::string name(row.name);
+    for (const MethodInfo& taken : table)
+        if (taken.name == row.name) throw RuntimeError("method table: '" + name + "' is taken");
+    if (!row.model) throw RuntimeError("method table: '" + name + "' has no class");
+    // Every key of the table so far: the common ones, the shared ones its rows read and their own.
+    std::vector<std::string_view> taken(kCommonSssKeys.begin(), kCommonSssKeys.end());
+    for (const MethodInfo& other : table) {
+        taken.insert(taken.end(), other.keys.begin(), other.keys.end());
+        for (const SssKey& own : other.ownKeys) taken.push_back(own.name);
+    }
+    for (const SssKey& key : row.ownKeys)
+        if (std::find(taken.begin(), taken.end(), key.name) != taken.end())
+            throw RuntimeError("method table: '" + name + "' declares key '" + std::string(key.name) +
+                               "', which another row declares");
+    row.method = static_cast<SssMethod>(table.size());
+    table.push_back(std::move(row));
 }
-#undef SKINLAB_BLUR_KEYS
 
+// The table, the built-in methods first (built on first use, so a method registered from another file's static
+// initialisation comes after them whichever file is initialised first).
 std::vector<MethodInfo>& rows() {
-    static std::vector<MethodInfo> table = builtInRows();
+    static std::vector<MethodInfo> table = [] {
+        std::vector<MethodInfo> builtIn;
+#define SKINLAB_ADD_METHOD(declaration) addRow(builtIn, declaration());
+        SKINLAB_BUILT_IN_METHODS(SKINLAB_ADD_METHOD)
+#undef SKINLAB_ADD_METHOD
+        return builtIn;
+    }();
     return table;
 }
 } // namespace
@@ -121,17 +79,15 @@ const MethodInfo* findMethod(std::string_view name) {
 }
 
 SssMethod registerMethod(MethodInfo row) {
-    if (findMethod(row.name)) throw RuntimeError("method table: '" + std::string(row.name) + "' is taken");
-    if (!row.model) throw RuntimeError("method table: '" + std::string(row.name) + "' has no class");
-    for (const SssKey& key : row.ownKeys)
-        for (const std::string_view taken : allSssKeys())
-            if (key.name == taken)
-                throw RuntimeError("method table: '" + std::string(row.name) + "' declares key '" +
-                                   std::string(key.name) + "', which another row declares");
-    row.method = static_cast<SssMethod>(rows().size());
-    rows().push_back(std::move(row));
+    addRow(rows(), std::move(row));
     addMethodChoice(rows().back().name);
     return rows().back().method;
+}
+
+SssMethod methodId(std::string_view name) {
+    const MethodInfo* info = findMethod(name);
+    SKINLAB_CHECK(info != nullptr);
+    return info->method;
 }
 
 std::vector<std::string> methodNames() {

@@ -12,6 +12,17 @@ namespace {
 constexpr float kMinAxisScale = 0.05f; // kPscbfMinAxisScale of pscbf_blur.frag
 float mix(float x, float y, float a) { return x * (1.0f - a) + y * a; }
 glm::vec3 toVec3(const Rgb& rgb) { return glm::vec3(rgb[0], rgb[1], rgb[2]); }
+
+// The foreshortening of the blur axis on the plane of view normal `n` seen along view ray `w` (pscbf_blur.frag).
+float axisScaleOf(const glm::vec3& n, const glm::vec3& w, bool horizontal) {
+    const float nw = std::abs(glm::dot(n, w));
+    const float along = horizontal ? n.x : n.y;
+    const float across = horizontal ? n.y * w.y : n.x * w.x;
+    const float acrossRay = horizontal ? w.y : w.x;
+    const float denominator =
+        std::sqrt((across + n.z) * (across + n.z) + along * along * (1.0f + acrossRay * acrossRay));
+    return std::max(denominator > 0.0f ? nw / denominator : 1.0f, kMinAxisScale);
+}
 } // namespace
 
 std::vector<Rgb> pscbfPass(const PscbfCpuInputs& inputs, const std::vector<Rgb>& input,
@@ -46,16 +57,7 @@ std::vector<Rgb> pscbfPass(const PscbfCpuInputs& inputs, const std::vector<Rgb>&
                 if (glm::dot(normal, normal) > 0.25f) n = glm::normalize(normal);
             }
             if (glm::dot(n, w) < 0.0f) n = -n;
-            float axisScale = 1.0f;
-            if (hasNormal) {
-                const float nw = std::abs(glm::dot(n, w));
-                const float along = horizontal ? n.x : n.y;
-                const float across = horizontal ? n.y * w.y : n.x * w.x;
-                const float acrossRay = horizontal ? w.y : w.x;
-                const float denominator =
-                    std::sqrt((across + n.z) * (across + n.z) + along * along * (1.0f + acrossRay * acrossRay));
-                axisScale = std::max(denominator > 0.0f ? nw / denominator : 1.0f, kMinAxisScale);
-            }
+            const float axisScale = hasNormal ? axisScaleOf(n, w, horizontal) : 1.0f;
             float pixelsPerMm = f / (surface.mmPerUnit * centreDepth) * axisScale;
             if (extensions.curvature != CurvatureStrategy::Off)
                 pixelsPerMm *= curvatureWidthScale(
@@ -137,7 +139,7 @@ std::vector<Rgb> pscbfPass(const PscbfCpuInputs& inputs, const std::vector<Rgb>&
 }
 
 std::vector<Rgb> applyPscbf(const PscbfCpuInputs& inputs, const std::vector<Rgb>& diffuse, const Kernel& kernel) {
-    SKINLAB_CHECK(kernel.method == SssMethod::Pscbf);
+    SKINLAB_CHECK(methodInfo(kernel.method).execution == Execution::Pscbf);
     SKINLAB_CHECK_EQ(kernel.stages.size(), 1u);
     const KernelStage& stage = kernel.stages[0];
     const std::vector<Rgb> horizontal = pscbfPass(inputs, diffuse, diffuse, stage, BlurAxis::Horizontal);

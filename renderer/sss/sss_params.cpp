@@ -81,10 +81,10 @@ TransmittanceParams readTransmittanceTable(const SpecReader& t) {
 } // namespace
 
 namespace {
-// Long by design: the declaration table of the [sss] keys, one entry per key (name, type, range, unit, doc, field).
-std::vector<SssKey>& sharedSssKeys() {
-    // Built on first use (the choices call methodNames() and materialNames()).
-    static std::vector<SssKey> table{
+// The declarations of the [sss] keys (name, type, range, unit, doc, field), in reading order, in three groups: the
+// method and its kernel, the extensions and curvature, the pscbf and reference keys.
+std::vector<SssKey> kernelSssKeys() {
+    return {
         boundKey({"method", KeyType::Choice, 0, 0, methodNames(), "", "the SSS method (skinlab methods)"},
                  &SssParams::method),
         boundKey({"samples", KeyType::Integer, 3, 101, {}, "taps", "taps per 1-D pass (odd)"}, &SssParams::samples),
@@ -121,6 +121,11 @@ std::vector<SssKey>& sharedSssKeys() {
         boundKey(
             {"artistic_falloff", KeyType::Vec3, 0.0, 1.0, {}, "", "artistic kernel: per-channel falloff (R, G, B)"},
             &SssParams::artisticFalloff),
+    };
+}
+
+std::vector<SssKey> extensionSssKeys() {
+    return {
         boundKey({"cbf", KeyType::Boolean, 0, 0, {}, "", "E1: cross-bilateral weights on the auxiliary image"},
                  &SssParams::cbf),
         boundKey({"cbf_lambda", KeyType::Number, 0.0, 1000.0, {}, "", "E1: lambda of exp(-lambda |F_c - F_tap|)"},
@@ -168,6 +173,11 @@ std::vector<SssKey>& sharedSssKeys() {
                   "mm",
                   "radius at or below which a surface counts as fully curved"},
                  &SssParams::curvatureReferenceMm),
+    };
+}
+
+std::vector<SssKey> pscbfAndReferenceSssKeys() {
+    return {
         boundKey({"pscbf_sigma",
                   KeyType::Choice,
                   0,
@@ -225,6 +235,16 @@ std::vector<SssKey>& sharedSssKeys() {
                   "reference: the near field summed at the vertices or drawn at the pixels (sharp light edges)"},
                  &SssParams::referenceNearField),
     };
+}
+
+std::vector<SssKey>& sharedSssKeys() {
+    // Built on first use (the choices call methodNames() and materialNames()).
+    static std::vector<SssKey> table = [] {
+        std::vector<SssKey> keys = kernelSssKeys();
+        for (std::vector<SssKey> group : {extensionSssKeys(), pscbfAndReferenceSssKeys()})
+            keys.insert(keys.end(), std::make_move_iterator(group.begin()), std::make_move_iterator(group.end()));
+        return keys;
+    }();
     return table;
 }
 } // namespace

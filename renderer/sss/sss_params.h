@@ -18,19 +18,11 @@ class SpecReader;
 
 namespace skinlab::renderer::sss {
 
-// The built-in methods' identifiers (rows 0–7 of the method table, in this order). A method added in its own file
-// (docs/methods.md, "Adding a method") needs no enumerator: it gets the next free value from its row's position
-// (registerMethod, method_table.cpp) and code finds it by name (findMethod).
-enum class SssMethod : int {
-    None,        // diffuse copied through
-    GaussianSum, // Jimenez & Gutierrez 2010: six incremental Gaussian blurs, 12 passes
-    Separable,   // Jimenez et al. 2015: two passes with the marginal of a physical profile
-    Artistic,    // Jimenez's demo kernel (width, strength, falloff), two passes
-    Pscbf,       // Mikkelsen 2010: pseudo-separable cross-bilateral filter, spike + one Gaussian per channel
-    Reference,   // object-space SSS on the tessellated surface (the ground truth of the metrics)
-    Pathtraced,  // Blender Cycles' random walk (renderer/pathtraced; the screen-space stage copies through)
-    Eevee,       // Blender EEVEE's screen-space Christensen–Burley SSS (renderer/pathtraced; copies through here too)
-};
+// A method's identifier: its row's position in the method table, assigned when the method is registered
+// (method_table.cpp). There are no enumerators: code finds a method by name (findMethod, methodId) and asks its row
+// and its class (method.h) what it needs: adding a method adds its registration line and nothing else to any list.
+// SssMethod{} is "none".
+enum class SssMethod : int {};
 
 // How the renderer runs a method: each value is one code path of the renderer, shared by every method that names it,
 // so a method whose kernel is a set of 1-D taps (TapPasses) needs no renderer code of its own.
@@ -92,7 +84,7 @@ constexpr double profileScale(double widthMm) { return widthMm / kProfileWidthMm
 // The typed values of the [sss] table. Which fields the chosen method reads is given by its row of the method
 // table (methodTable()): the reader accepts only those keys, and toJson() writes only those.
 struct SssParams {
-    SssMethod method = SssMethod::None;
+    SssMethod method{}; // "none"
     // Taps per 1-D pass (odd, 3…101). gaussian-sum uses it for each of its 12 passes. Default 21; for pscbf 13,
     // the paper's count (kDefaultSamples, kDefaultPscbfSamples; the reader picks by method when the key is absent).
     static constexpr int kDefaultSamples = 21;
@@ -221,15 +213,18 @@ SssKey ownKey(KeyInfo info, nlohmann::json fallback);
 
 class Method;
 
-// The method table: one row per SSS method, the single list the CLI (`skinlab methods`), the scene reader, the
-// stimulus specs, `skinlab kernel`, the renderer, the benchmarks and the tests that cover "every method" iterate
-// (docs/methods.md, "Adding a method"). `keys` are the shared [sss] keys the method reads besides the keys every
+// The method table: one row per SSS method, declared by the method's own file (renderer/sss/methods/, method.h); the
+// single list the CLI (`skinlab methods`), the scene reader, the stimulus specs, `skinlab kernel`, `skinlab tune`,
+// the renderer, the benchmarks and the tests that cover "every method" iterate (docs/methods.md, "Adding a method"). `keys` are the shared [sss] keys the method reads besides the keys every
 // method reads (kCommonSssKeys), `ownKeys` the keys only it declares; any other [sss] key given with the method is
 // an error naming the key and the method.
 struct MethodInfo {
     SssMethod method;      // assigned from the row's position
     std::string_view name; // sss.method value
     Execution execution;   // how the renderer runs it
+    // Whether live tuning renders it as a slider moves (Renderer::renderDisplay, in milliseconds to a second);
+    // otherwise `skinlab tune` runs it as a background render.
+    bool interactive;
     std::string_view summary;
     std::vector<std::string_view> keys;
     std::vector<SssKey> ownKeys;
@@ -250,14 +245,18 @@ struct MethodInfo {
 inline constexpr std::array<std::string_view, 4> kCommonSssKeys{"method", "width_mm", "curvature_measure",
                                                                 "curvature_reference_mm"};
 
-// Every method, in table order (the built-ins in the order of the SssMethod enum, then registered ones).
+// Every method, in table order (the built-ins in the order of their registration lines, then the ones registered
+// outside the renderer library).
 const std::vector<MethodInfo>& methodTable();
 const MethodInfo& methodInfo(SssMethod method);
 // nullptr when `name` names no method.
 const MethodInfo* findMethod(std::string_view name);
-// Adds a row after the built-in ones (a method defined outside method_table.cpp, e.g. in a test) and returns its
-// identifier. Call before any spec is read (start-up, a test's static set-up): the table is not locked. Throws
-// RuntimeError for a name already taken or a key another row declares differently.
+// The identifier of the method `name` (a check fails for a name that is no method: for code and tests that name a
+// method they know; a spec's value goes through the reader).
+SssMethod methodId(std::string_view name);
+// Adds a method's row after the built-in ones and returns its identifier: what SKINLAB_REGISTER_METHOD does for a
+// method compiled outside the renderer library (method.h). Throws RuntimeError for a name already taken, a row
+// without a class or a key another row declares.
 SssMethod registerMethod(MethodInfo row);
 // Every method name, in table order (for choices and help texts).
 std::vector<std::string> methodNames();

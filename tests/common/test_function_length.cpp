@@ -2,7 +2,7 @@
 // .cpp files of the production folders. A function is a brace block opened at namespace or class scope whose header
 // (the text since the previous ';', '{', '}' or access label) holds a parameter list and no '=' before it; its length
 // runs from the first line of that header to the closing brace. Comments, string and character literals (raw strings too) and preprocessor
-// lines are skipped. renderer/ is reported, not yet enforced (its pipeline is being split into stages).
+// lines are skipped.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -194,10 +194,8 @@ TEST(FunctionLength, NoProductionFunctionIsOver120Lines) {
             }
     std::sort(all.begin(), all.end(), [](const auto& a, const auto& b) { return a.lines > b.lines; });
     for (const LongFunction& f : all) {
-        const bool reportOnly = f.file.rfind("renderer/", 0) == 0;
-        std::printf("%4d  %s  %s%s\n", f.lines, f.name.c_str(), f.file.c_str(),
-                    f.lines > kMaxLines && reportOnly ? "  (renderer/: reported, not enforced)" : "");
-        if (f.lines > kMaxLines && !reportOnly)
+        std::printf("%4d  %s  %s\n", f.lines, f.name.c_str(), f.file.c_str());
+        if (f.lines > kMaxLines)
             ADD_FAILURE() << f.file << ": " << f.name << " is " << f.lines << " lines (at most " << kMaxLines
                           << "): split it into helpers";
     }

@@ -469,6 +469,11 @@ TEST_F(TuneServerTest, SlowMethodRunsInTheBackgroundAndCancels) {
     EXPECT_EQ(after["state"], "cancelled");
     EXPECT_GE(after["elapsed_s"].get<double>(), 0.0) << after.dump(); // read before the process is reaped too
     EXPECT_EQ(c.get("/api/job/image?id=" + id).status, 409);
+    // Every method that is not interactive runs so, EEVEE too (it needs Blender; the live path has none).
+    const json eevee = render(c, with(kSmall, {"sss.method=\"eevee\""}));
+    ASSERT_TRUE(eevee.contains("job")) << eevee.dump();
+    EXPECT_EQ(eevee["job"]["method"], "eevee");
+    EXPECT_EQ(json::parse(post(c, "/api/job/cancel", {{"id", eevee["job"]["id"]}}).body)["cancelled"], true);
 }
 
 TEST_F(TuneServerTest, DifferenceAgainstTheReference) {

@@ -23,6 +23,16 @@ public:
 };
 } // namespace
 
-std::shared_ptr<const Method> makeArtisticMethod() { return std::make_shared<ArtisticMethod>(); }
+MethodInfo artisticMethod() {
+    return {{},
+            "artistic",
+            Execution::TapPasses,
+            true,
+            "Jimenez's demo kernel (per-channel strength and falloff), two passes",
+            withBlurKeys({"samples", "follow_surface_k", "artistic_strength", "artistic_falloff"}),
+            {},
+            {},
+            std::make_shared<ArtisticMethod>()};
+}
 
 } // namespace skinlab::renderer::sss

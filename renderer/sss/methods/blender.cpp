@@ -24,11 +24,28 @@ private:
 };
 } // namespace
 
-std::shared_ptr<const Method> makePathtracedMethod() {
-    return std::make_shared<BlenderMethod>("path-traced (Blender Cycles, random walk)");
+MethodInfo pathtracedMethod() {
+    return {{},
+            "pathtraced",
+            Execution::Cycles,
+            false,
+            "Blender Cycles' random-walk SSS ([pathtraced] table)",
+            {},
+            {},
+            {},
+            std::make_shared<BlenderMethod>("path-traced (Blender Cycles, random walk)")};
 }
-std::shared_ptr<const Method> makeEeveeMethod() {
-    return std::make_shared<BlenderMethod>("Blender EEVEE (screen-space Christensen-Burley)");
+
+MethodInfo eeveeMethod() {
+    return {{},
+            "eevee",
+            Execution::Eevee,
+            false,
+            "Blender EEVEE's screen-space SSS ([eevee] table)",
+            {},
+            {},
+            {},
+            std::make_shared<BlenderMethod>("Blender EEVEE (screen-space Christensen-Burley)")};
 }
 
 } // namespace skinlab::renderer::sss

@@ -32,6 +32,16 @@ public:
 };
 } // namespace
 
-std::shared_ptr<const Method> makeGaussianSumMethod() { return std::make_shared<GaussianSumMethod>(); }
+MethodInfo gaussianSumMethod() {
+    return {{},
+            "gaussian-sum",
+            Execution::TapPasses,
+            true,
+            "Jimenez & Gutierrez 2010: d'Eon's six Gaussians as incremental separable blurs (12 passes)",
+            withBlurKeys({"samples", "sampling", "follow_surface_k"}),
+            {},
+            {},
+            std::make_shared<GaussianSumMethod>()};
+}
 
 } // namespace skinlab::renderer::sss

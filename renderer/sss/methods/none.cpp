@@ -14,6 +14,9 @@ public:
 };
 } // namespace
 
-std::shared_ptr<const Method> makeNoneMethod() { return std::make_shared<NoneMethod>(); }
+MethodInfo noneMethod() {
+    return {{}, "none", Execution::CopyThrough,        true, "no SSS: the diffuse buffer is copied through", {},
+            {}, {},     std::make_shared<NoneMethod>()};
+}
 
 } // namespace skinlab::renderer::sss

@@ -25,6 +25,16 @@ public:
 };
 } // namespace
 
-std::shared_ptr<const Method> makePscbfMethod() { return std::make_shared<PscbfMethod>(); }
+MethodInfo pscbfMethod() {
+    return {{},
+            "pscbf",
+            Execution::Pscbf,
+            true,
+            "Mikkelsen 2010: pseudo-separable cross-bilateral filter, spike + one Gaussian per channel",
+            withBlurKeys({"samples", "pscbf_sigma"}),
+            {},
+            {{"samples", SssParams::kDefaultPscbfSamples}},
+            std::make_shared<PscbfMethod>()};
+}
 
 } // namespace skinlab::renderer::sss

@@ -20,9 +20,20 @@ public:
         kernel.stages.push_back(std::move(stage));
         return kernel;
     }
+    std::unique_ptr<Marginal> profileMarginal(const SssParams& params) const override { return makeMarginal(params); }
 };
 } // namespace
 
-std::shared_ptr<const Method> makeSeparableMethod() { return std::make_shared<SeparableMethod>(); }
+MethodInfo separableMethod() {
+    return {{},
+            "separable",
+            Execution::TapPasses,
+            true,
+            "Jimenez et al. 2015: two passes with the marginal of a physical profile (d'Eon, Burley or a file)",
+            withBlurKeys({"samples", "sampling", "follow_surface_k", "profile", "material"}),
+            {},
+            {},
+            std::make_shared<SeparableMethod>()};
+}
 
 } // namespace skinlab::renderer::sss

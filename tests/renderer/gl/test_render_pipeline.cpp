@@ -2,6 +2,7 @@
 // specular lobe of thesis Eq. 4.5 per pixel against its C++ mirror, the irradiance of a constant environment,
 // shadows, tone mappers + sRGB encoding against their C++ mirrors, the EXR layout, determinism.
 #include "render_test_support.h"
+#include "common/error.h"
 #include "renderer/output/display_output.h"
 #include "renderer/scene/texture.h"
 #include "renderer/shading/specular_brdf.h"
@@ -424,6 +425,27 @@ TEST(RenderPipeline, SameInputsGiveByteIdenticalFiles) {
     }
     EXPECT_EQ(test::readText(folder / "a.exr"), test::readText(folder / "b.exr"));
     EXPECT_EQ(test::readText(folder / "a.png"), test::readText(folder / "b.png"));
+}
+
+// renderDisplay (live tuning) has no Blender: the methods Blender renders are refused with a one-line error naming
+// the method, never shown as the rasterizer's frame without their SSS.
+TEST(RenderPipeline, DisplayRefusesTheMethodsBlenderRenders) {
+    SKINLAB_REQUIRE_RENDERER(renderer);
+    for (const std::string method : {"pathtraced", "eevee"}) {
+        RenderRequest request;
+        request.scene = "builtin:halo";
+        request.method = method;
+        request.width = 32;
+        request.height = 24;
+        try {
+            renderer->renderDisplay(request);
+            ADD_FAILURE() << method << ": rendered without Blender";
+        } catch (const InputError& e) {
+            const std::string message = e.what();
+            EXPECT_NE(message.find("sss.method: '" + method + "'"), std::string::npos) << message;
+            EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+        }
+    }
 }
 
 } // namespace

@@ -141,7 +141,7 @@ TEST(SceneSpec, SssKeyOfAnotherMethodIsAnError) {
         << fromFile;
     const SceneSpec spec =
         loadSceneSpec("builtin:head", {"sss.method=artistic", "sss.artistic_falloff=[1.0, 0.5, 0.5]"}, {});
-    EXPECT_EQ(spec.sss.method, sss::SssMethod::Artistic);
+    EXPECT_EQ(spec.sss.method, sss::methodId("artistic"));
     EXPECT_EQ(spec.sss.artisticFalloff[1], 0.5);
     EXPECT_EQ(spec.resolved["sss"]["artistic_falloff"][1], 0.5);
     EXPECT_FALSE(spec.resolved["sss"].contains("profile")); // separable's key, not artistic's

@@ -62,9 +62,9 @@ TEST(Kernels, EveryStageOfEveryMethodIsNormalisedAndSymmetric) {
         std::string material;
     };
     const std::vector<Case> cases{
-        {SssMethod::Separable, "deon", "skin"},     {SssMethod::Separable, "burley", "skin"},
-        {SssMethod::Separable, "burley", "marble"}, {SssMethod::Separable, "burley", "ketchup"},
-        {SssMethod::Artistic, "deon", "skin"},      {SssMethod::GaussianSum, "deon", "skin"}};
+        {methodId("separable"), "deon", "skin"},     {methodId("separable"), "burley", "skin"},
+        {methodId("separable"), "burley", "marble"}, {methodId("separable"), "burley", "ketchup"},
+        {methodId("artistic"), "deon", "skin"},      {methodId("gaussian-sum"), "deon", "skin"}};
     for (const auto& kase : cases)
         for (TapPlacement placement : {TapPlacement::Quadratic, TapPlacement::Importance})
             for (int samples : {3, 5, 7, 21, 25, 101}) {
@@ -120,7 +120,7 @@ TEST(Kernels, ArtisticBaselineMatchesHandComputedTapsForSevenSamples) {
 TEST(Kernels, ArtisticRangeIsThreeAboveTwentySamplesAndWidthScalesOffsets) {
     EXPECT_NEAR(artisticTaps(21, {1, 1, 1}, {1, 1, 1}).back().offsetMm, 3.0, 1e-12);
     EXPECT_NEAR(artisticTaps(19, {1, 1, 1}, {1, 1, 1}).back().offsetMm, 2.0, 1e-12);
-    SssParams p = paramsFor(SssMethod::Artistic, 25, TapPlacement::Quadratic);
+    SssParams p = paramsFor(methodId("artistic"), 25, TapPlacement::Quadratic);
     p.widthMm = 6.0; // twice the profile scale
     EXPECT_NEAR(makeKernel(p).stages[0].taps.back().offsetMm, 6.0, 1e-12);
 }
@@ -158,7 +158,7 @@ TEST(Kernels, QuadraticTapsHandleBurleysSingularCentre) {
 }
 
 TEST(Kernels, GaussianSumStagesAddUpToDeonVariances) {
-    SssParams p = paramsFor(SssMethod::GaussianSum, 21, TapPlacement::Quadratic);
+    SssParams p = paramsFor(methodId("gaussian-sum"), 21, TapPlacement::Quadratic);
     const Kernel kernel = makeKernel(p);
     ASSERT_EQ(kernel.stages.size(), 6u);
     double variance = 0.0;
@@ -176,9 +176,9 @@ TEST(Kernels, GaussianSumStagesAddUpToDeonVariances) {
 TEST(Kernels, SupportRadiusOfTheCascadeIsThatOfItsWidestGaussian) {
     // Quadratic taps reach the radius leaving 0.2 % of a Gaussian outside: 3.0902 σ. The cascade of incremental
     // stages reaches 3.0902 √7.41 mm (its total variance is d'Eon's widest lobe).
-    const Kernel kernel = makeKernel(paramsFor(SssMethod::GaussianSum, 21, TapPlacement::Quadratic));
+    const Kernel kernel = makeKernel(paramsFor(methodId("gaussian-sum"), 21, TapPlacement::Quadratic));
     EXPECT_NEAR(kernel.supportRadiusMm(), 3.0902 * std::sqrt(7.41), 1e-3);
-    SssParams artistic = paramsFor(SssMethod::Artistic, 25, TapPlacement::Quadratic);
+    SssParams artistic = paramsFor(methodId("artistic"), 25, TapPlacement::Quadratic);
     EXPECT_DOUBLE_EQ(makeKernel(artistic).supportRadiusMm(), 3.0);
     EXPECT_EQ(makeKernel(SssParams{}).supportRadiusMm(), 0.0);
 }
@@ -186,7 +186,7 @@ TEST(Kernels, SupportRadiusOfTheCascadeIsThatOfItsWidestGaussian) {
 TEST(Kernels, SeparableDeonTapsKeepTheMarginalsWidth) {
     GaussianSumProfile deon(deonSkinLobes(), "d'Eon");
     for (TapPlacement placement : {TapPlacement::Quadratic, TapPlacement::Importance}) {
-        const Kernel kernel = makeKernel(paramsFor(SssMethod::Separable, 101, placement));
+        const Kernel kernel = makeKernel(paramsFor(methodId("separable"), 101, placement));
         const auto stats = tapStatistics(kernel.stages[0].taps, 2.0);
         for (int c = 0; c < 3; ++c) {
             // 101 taps: RMS width within 5 % of the continuous marginal's, tail share beyond 2 mm within 0.02.
@@ -199,7 +199,7 @@ TEST(Kernels, SeparableDeonTapsKeepTheMarginalsWidth) {
 
 TEST(Kernels, InconsistentParametersAreInputErrors) {
     try {
-        makeKernel(paramsFor(SssMethod::Separable, 21, TapPlacement::Quadratic, "deon", "marble"));
+        makeKernel(paramsFor(methodId("separable"), 21, TapPlacement::Quadratic, "deon", "marble"));
         FAIL() << "no exception";
     } catch (const skinlab::InputError& e) {
         EXPECT_STREQ(e.what(),
@@ -279,7 +279,7 @@ TEST(TabulatedKernel, PublishedSkin1KernelLoads) {
     }
     // Discretised through the separable method with a file: profile.
     SssParams p;
-    p.method = SssMethod::Separable;
+    p.method = methodId("separable");
     p.profile = "file:" + skin1.string();
     for (TapPlacement placement : {TapPlacement::Quadratic, TapPlacement::Importance}) {
         p.placement = placement;

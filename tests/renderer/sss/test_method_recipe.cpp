@@ -1,8 +1,8 @@
 // The recipe of docs/methods.md, "Adding a method", followed for a throwaway method: a box kernel (equal weights
-// over ±box_half_width_mm on the surface) with one key of its own, written as its class and its row — the row here
-// goes through registerMethod, the same MethodInfo a row of method_table.cpp is. Nothing else of skinlab changes:
-// the reader, the resolved record, the listings, the renderer's shared blur passes and the metrics' support radius
-// all take it from the table (label gl).
+// over ±box_half_width_mm on the surface) with one key of its own. Its file, box_method.cpp (compiled into this
+// test only), holds its class and its row; the line below registers it, as a built-in's line in method_table.cpp
+// does. Nothing else of skinlab changes: the reader, the resolved record, the listings, the renderer's shared blur
+// passes and the metrics' support radius all take it from the table (label gl).
 #include "../gl/render_test_support.h"
 #include "common/error.h"
 #include "renderer/renderer.h"
@@ -13,39 +13,14 @@
 #include <cmath>
 #include <gtest/gtest.h>
 
+namespace skinlab::renderer::sss {
+MethodInfo boxMethod();             // box_method.cpp
+SKINLAB_REGISTER_METHOD(boxMethod); // the registration line
+} // namespace skinlab::renderer::sss
+
 namespace skinlab::renderer {
 namespace {
-
-// --- the method's file: its kernel -----------------------------------------------------------------------------
-class BoxMethod final : public sss::Method {
-public:
-    sss::Kernel kernel(const sss::SssParams& params) const override {
-        const double half = sss::sssKey("box_half_width_mm").get(params).get<double>();
-        sss::KernelStage stage;
-        const int n = params.samples;
-        for (int i = 0; i < n; ++i) {
-            const double w = 1.0 / n;
-            stage.taps.push_back({half * (2.0 * i / (n - 1) - 1.0), {w, w, w}});
-        }
-        stage.accumulate = {1.0, 1.0, 1.0};
-        sss::Kernel kernel;
-        kernel.source = "box kernel (test)";
-        kernel.stages.push_back(std::move(stage));
-        return kernel;
-    }
-};
-
-// --- its row ---------------------------------------------------------------------------------------------------
-const sss::SssMethod kBox = sss::registerMethod(
-    {sss::SssMethod::None, // assigned by the table
-     "box",
-     sss::Execution::TapPasses,
-     "test: equal weights over ±box_half_width_mm",
-     {"samples", "follow_surface", "follow_surface_k"},
-     {sss::ownKey({"box_half_width_mm", sss::KeyType::Number, 0.1, 20.0, {}, "mm", "half width of the box"}, 2.0)},
-     {},
-     std::make_shared<BoxMethod>()});
-
+const sss::SssMethod kBox = sss::methodId("box");
 } // namespace
 
 TEST(MethodRecipe, TheRowReachesEveryListing) {
@@ -55,7 +30,8 @@ TEST(MethodRecipe, TheRowReachesEveryListing) {
     EXPECT_NE(std::find(blur.begin(), blur.end(), "box"), blur.end());
     ASSERT_NE(sss::findMethod("box"), nullptr);
     EXPECT_EQ(sss::findMethod("box")->method, kBox);
-    EXPECT_GE(static_cast<int>(kBox), 8); // after the built-ins, without an enumerator
+    EXPECT_EQ(&sss::methodInfo(kBox), &sss::methodTable().back()); // after the built-ins, without an enumerator
+    EXPECT_TRUE(sss::methodInfo(kBox).interactive);
     const auto keys = sss::methodKeys(kBox);
     EXPECT_NE(std::find(keys.begin(), keys.end(), "box_half_width_mm"), keys.end());
     EXPECT_EQ(sss::sssKeyDefaults(kBox).at("box_half_width_mm"), 2.0);
@@ -64,10 +40,7 @@ TEST(MethodRecipe, TheRowReachesEveryListing) {
     const auto& choices = sss::sssKey("method").choices;
     EXPECT_NE(std::find(choices.begin(), choices.end(), "box"), choices.end());
     // A second row of the same name is refused.
-    EXPECT_THROW(
-        sss::registerMethod(
-            {sss::SssMethod::None, "box", sss::Execution::TapPasses, "", {}, {}, {}, std::make_shared<BoxMethod>()}),
-        RuntimeError);
+    EXPECT_THROW(sss::registerMethod(sss::boxMethod()), RuntimeError);
 }
 
 TEST(MethodRecipe, ItsKeysAreReadCheckedAndRecorded) {

@@ -124,7 +124,7 @@ StageFixture& stageFixture() {
 
 sss::SssParams pscbfParams() {
     sss::SssParams params;
-    params.method = sss::SssMethod::Pscbf;
+    params.method = sss::methodId("pscbf");
     params.samples = sss::kPscbfSamples; // Mikkelsen's 13 taps per axis
     return params;
 }

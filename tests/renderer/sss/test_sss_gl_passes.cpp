@@ -153,12 +153,12 @@ TEST(SssGlPasses, MatchTheCpuReferenceOnATestImage) {
         sss::SssParams p;
         const char* name;
     };
-    const std::vector<Variant> variants{
-        {params(sss::SssMethod::GaussianSum), "gaussian-sum"},
-        {params(sss::SssMethod::Separable), "separable"},
-        {params(sss::SssMethod::Separable, 11, false, sss::TapPlacement::Importance), "separable/importance/no-follow"},
-        {params(sss::SssMethod::Artistic, 25), "artistic"},
-        {params(sss::SssMethod::Artistic, 7, false), "artistic/7/no-follow"}};
+    const std::vector<Variant> variants{{params(sss::methodId("gaussian-sum")), "gaussian-sum"},
+                                        {params(sss::methodId("separable")), "separable"},
+                                        {params(sss::methodId("separable"), 11, false, sss::TapPlacement::Importance),
+                                         "separable/importance/no-follow"},
+                                        {params(sss::methodId("artistic"), 25), "artistic"},
+                                        {params(sss::methodId("artistic"), 7, false), "artistic/7/no-follow"}};
     for (const auto& v : variants) {
         const sss::Kernel kernel = sss::makeKernel(v.p);
         const auto cpu = sss::applyKernel(surface, diffuse, kernel,
@@ -356,7 +356,7 @@ TEST(SssGlPasses, LitExtensionInputCutsAtAShadowTerminator) {
             const float light = x < 48 ? 1.0f : 0.05f;
             for (int c = 0; c < 3; ++c) diffuse[size_t(y) * w + x][c] = light * surface.albedo[0][c];
         }
-    sss::SssParams off = params(sss::SssMethod::Separable);
+    sss::SssParams off = params(sss::methodId("separable"));
     off.followSurface = false;
     sss::SssParams albedo = off, lit = off;
     albedo.labWeight = lit.labWeight = 0.09;
@@ -435,7 +435,8 @@ TEST(SssGlPasses, CurvatureScalesTheSpreadOfAnImpulse) {
     const std::vector<Case> cases{{"reduce-floor", 0.0f, 0.5, 0.5},        {"reduce-floor", 0.0f, 0.3, 0.3},
                                   {"reduce-floor", fullyCurved, 0.5, 1.0}, {"reduce", 0.6f * fullyCurved, 0.5, 0.6},
                                   {"increase", fullyCurved, 0.5, 2.0},     {"increase", 0.0f, 0.5, 1.0}};
-    for (sss::SssMethod method : {sss::SssMethod::Separable, sss::SssMethod::Artistic, sss::SssMethod::GaussianSum}) {
+    for (sss::SssMethod method :
+         {sss::methodId("separable"), sss::methodId("artistic"), sss::methodId("gaussian-sum")}) {
         const Spread off = spreadOf(runOnGpu(plane, impulse, params(method)), w, h, cx, cy, 0);
         for (const auto& k : cases) {
             sss::SssParams p = params(method);

@@ -42,7 +42,7 @@ void renderEveryMethod(Renderer& renderer, const std::string& scene, const std::
     std::vector<std::string> noneOverrides;
     for (const std::string& o : overrides) {
         const std::string key = o.substr(0, o.find('='));
-        if (key.rfind("sss.", 0) != 0 || sss::methodUsesKey(sss::SssMethod::None, key.substr(4)))
+        if (key.rfind("sss.", 0) != 0 || sss::methodUsesKey(sss::methodId("none"), key.substr(4)))
             noneOverrides.push_back(o);
     }
     const ExrImage none = render(renderer, folder, scene, "none", noneOverrides, 64, 48);

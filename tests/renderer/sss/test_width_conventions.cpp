@@ -59,7 +59,7 @@ TEST(ThesisWidth, GaussianSumReplaysTheThesisStep) {
     for (const View v : kViews) {
         const double t = v.tanHalfFov();
         SssParams params;
-        params.method = SssMethod::GaussianSum;
+        params.method = methodId("gaussian-sum");
         params.widthMm = widthMmFromThesisSssWidth(v.sssWidth, v.mmPerUnit, ThesisBlurShader::GaussianSum);
         const Kernel kernel = makeKernel(params);
         ASSERT_EQ(kernel.stages.size(), 6u);

@@ -20,7 +20,7 @@ inline const View kViews[] = {View{0.012, 47.9, 20.0, 2.5, 720.0}, View{1.5, 1.0
 // f_px = (H/2) / tan(fovY/2).
 inline double artisticEdgePixels(double widthMm, const View& v) {
     SssParams params;
-    params.method = SssMethod::Artistic;
+    params.method = methodId("artistic");
     params.samples = 25;
     params.widthMm = widthMm;
     const Kernel kernel = makeKernel(params);
