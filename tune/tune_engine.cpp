@@ -169,8 +169,10 @@ std::string JobRunner::start(const TuneConfig& config, const std::string& method
     for (const auto& [id, job] : jobs_)
         if (job->key == key && (job->status.state == "running" || job->status.state == "done")) return id;
     collectEnded(); // a render that ended since the reaper's last pass (e.g. just cancelled) no longer counts
+    // A cancelled render still exiting does not count either: its threads can outlive its main thread (the process
+    // shows as a zombie before waitpid can collect it), and the reaper ends it after its grace period.
     for (const auto& [id, job] : jobs_)
-        if (job->pid > 0 && job->status.method == method) throw JobBusy(method, id);
+        if (job->pid > 0 && job->status.state == "running" && job->status.method == method) throw JobBusy(method, id);
 
     auto job = std::make_shared<Job>();
     job->status.id = "job" + std::to_string(next_++);
