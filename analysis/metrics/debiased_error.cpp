@@ -21,6 +21,28 @@ namespace {
 
 constexpr double notANumber = std::numeric_limits<double>::quiet_NaN();
 
+// The plain squared error between two images of one quantity over a region (dot product for CIELAB).
+double meanSquaredDifference(const cv::Mat& a, const cv::Mat& b, const cv::Mat& inside) {
+    if (a.empty() || b.empty()) return notANumber;
+    double sum = 0.0;
+    std::size_t pixels = 0;
+    const int channels = a.channels();
+    for (int y = 0; y < inside.rows; ++y) {
+        const auto* in = inside.ptr<unsigned char>(y);
+        const auto* left = a.ptr<double>(y);
+        const auto* right = b.ptr<double>(y);
+        for (int x = 0; x < inside.cols; ++x)
+            if (in[x]) {
+                for (int c = 0; c < channels; ++c) {
+                    const double d = left[x * channels + c] - right[x * channels + c];
+                    sum += d * d;
+                }
+                ++pixels;
+            }
+    }
+    return pixels > 0 ? sum / static_cast<double>(pixels) : notANumber;
+}
+
 // The jackknife's standard error of the leave-one-out estimates θ_(k): √((S−1)/S · Σ (θ_(k) − θ̄)²).
 double jackknifeStandardError(const std::vector<double>& leaveOneOut) {
     const std::size_t seeds = leaveOneOut.size();
@@ -246,27 +268,9 @@ JackknifeEstimate seedMeanMse(const SeededTruth& truth, std::size_t quantity, st
     std::vector<double> pairTerms;
     for (std::size_t i = 0; i < seeds; ++i)
         for (std::size_t j = i + 1; j < seeds; ++j) {
-            const cv::Mat& a = truth.images[i][quantity];
-            const cv::Mat& b = truth.images[j][quantity];
-            if (a.empty() || b.empty() || inside.empty()) return estimate;
-            double sum = 0.0;
-            std::size_t pixels = 0;
-            const int channels = a.channels();
-            for (int y = 0; y < inside.rows; ++y) {
-                const auto* in = inside.ptr<unsigned char>(y);
-                const auto* left = a.ptr<double>(y);
-                const auto* right = b.ptr<double>(y);
-                for (int x = 0; x < inside.cols; ++x)
-                    if (in[x]) {
-                        for (int c = 0; c < channels; ++c) {
-                            const double d = left[x * channels + c] - right[x * channels + c];
-                            sum += d * d;
-                        }
-                        ++pixels;
-                    }
-            }
-            if (pixels == 0) return estimate;
-            pairTerms.push_back(0.5 * sum / static_cast<double>(pixels));
+            const double mean = meanSquaredDifference(truth.images[i][quantity], truth.images[j][quantity], inside);
+            if (std::isnan(mean)) return estimate;
+            pairTerms.push_back(0.5 * mean);
         }
     const double count = static_cast<double>(seeds);
     std::vector<std::size_t> all(seeds);
@@ -495,28 +499,6 @@ const std::vector<TableScore>& tableScores() {
 
 namespace skinlab::metrics {
 namespace {
-
-// The plain squared error between two images of one quantity over a region (dot product for CIELAB).
-double meanSquaredDifference(const cv::Mat& a, const cv::Mat& b, const cv::Mat& inside) {
-    if (a.empty() || b.empty()) return notANumber;
-    double sum = 0.0;
-    std::size_t pixels = 0;
-    const int channels = a.channels();
-    for (int y = 0; y < inside.rows; ++y) {
-        const auto* in = inside.ptr<unsigned char>(y);
-        const auto* left = a.ptr<double>(y);
-        const auto* right = b.ptr<double>(y);
-        for (int x = 0; x < inside.cols; ++x)
-            if (in[x]) {
-                for (int c = 0; c < channels; ++c) {
-                    const double d = left[x * channels + c] - right[x * channels + c];
-                    sum += d * d;
-                }
-                ++pixels;
-            }
-    }
-    return pixels > 0 ? sum / static_cast<double>(pixels) : notANumber;
-}
 
 DebiasedImages loadTestImages(const std::filesystem::path& path, const SeededTruth& truth) {
     const MetricRender render = loadMetricRender(path, RenderRole::test);

@@ -532,25 +532,36 @@ TEST(ShippedSpecs, DemoDesignsStudyEveryBlockTheSetBuilds) {
     fs::remove_all(headlessFolder());
 }
 
-// Every stimulus of every shipped spec resolves against the renderer's scene reader (methods, extension switches
-// and their levels exist; no GL). With $SKINLAB_ASSETS set the thesis specs use the scanned head as shipped;
-// otherwise builtin:head stands in for it.
-TEST(ShippedSpecs, EveryStimulusResolves) {
+namespace {
+// Plans every shipped spec (no rendering): with $SKINLAB_ASSETS set the thesis specs use the scanned head as
+// shipped, otherwise builtin:head stands in for it. One (file name, plan) per spec.
+void planShippedSpecs(std::vector<std::pair<std::string, BuildPlan>>& plans) {
     const fs::path dir = fs::path(SKINLAB_SOURCE_DIR) / "stimuli" / "specs";
     const char* assets = std::getenv("SKINLAB_ASSETS");
     const bool haveHead = assets && *assets && fs::exists(fs::path(assets) / "LeePerrySmith");
     if (!haveHead) std::printf("  $SKINLAB_ASSETS unset: the thesis specs are checked on builtin:head\n");
-    size_t resolved = 0;
     for (const auto& entry : fs::directory_iterator(dir)) {
         if (entry.path().extension() != ".toml") continue;
+        const std::string file = entry.path().filename().string();
         std::vector<std::string> overrides;
-        const fs::path path = !haveHead && needsHead(entry.path().filename().string())
-                                  ? withoutHead(entry.path(), overrides)
-                                  : entry.path();
+        const fs::path path = !haveHead && needsHead(file) ? withoutHead(entry.path(), overrides) : entry.path();
         BuildPlan plan;
         ASSERT_NO_THROW(plan = planBuild(path, overrides, std::nullopt, haveHead ? fs::path(assets) : fs::path()))
-            << entry.path().filename();
-        EXPECT_EQ(plan.resolved.size(), plan.all.size()) << entry.path().filename();
+            << file;
+        plans.emplace_back(file, std::move(plan));
+    }
+}
+} // namespace
+
+// Every stimulus of every shipped spec resolves against the renderer's scene reader (methods, extension switches
+// and their levels exist; no GL). With $SKINLAB_ASSETS set the thesis specs use the scanned head as shipped;
+// otherwise builtin:head stands in for it.
+TEST(ShippedSpecs, EveryStimulusResolves) {
+    std::vector<std::pair<std::string, BuildPlan>> plans;
+    ASSERT_NO_FATAL_FAILURE(planShippedSpecs(plans));
+    size_t resolved = 0;
+    for (const auto& [file, plan] : plans) {
+        EXPECT_EQ(plan.resolved.size(), plan.all.size()) << file;
         resolved += plan.resolved.size();
     }
     fs::remove_all(headlessFolder());
@@ -560,22 +571,13 @@ TEST(ShippedSpecs, EveryStimulusResolves) {
 // No presented PNG of a shipped spec is a nearest-neighbour upsample: every crop or magnification resolves to a
 // native presentation, a render.window of the magnified frame (the renderer draws it; nothing renders here).
 TEST(ShippedSpecs, EveryMagnifiedCropRendersNatively) {
-    const fs::path dir = fs::path(SKINLAB_SOURCE_DIR) / "stimuli" / "specs";
-    const char* assets = std::getenv("SKINLAB_ASSETS");
-    const bool haveHead = assets && *assets && fs::exists(fs::path(assets) / "LeePerrySmith");
+    std::vector<std::pair<std::string, BuildPlan>> plans;
+    ASSERT_NO_FATAL_FAILURE(planShippedSpecs(plans));
     size_t magnified = 0;
-    for (const auto& entry : fs::directory_iterator(dir)) {
-        if (entry.path().extension() != ".toml") continue;
-        std::vector<std::string> overrides;
-        const fs::path path = !haveHead && needsHead(entry.path().filename().string())
-                                  ? withoutHead(entry.path(), overrides)
-                                  : entry.path();
-        BuildPlan plan;
-        ASSERT_NO_THROW(plan = planBuild(path, overrides, std::nullopt, haveHead ? fs::path(assets) : fs::path()))
-            << entry.path().filename();
+    for (const auto& [file, plan] : plans) {
         for (size_t i = 0; i < plan.selected.size(); ++i) {
             const Stimulus& s = plan.selected[i];
-            const std::string where = entry.path().filename().string() + ": " + s.id;
+            const std::string where = file + ": " + s.id;
             const nlohmann::json entryJson = plannedEntryJson(s, plan.resolved[i]);
             EXPECT_EQ(entryJson["presentation"]["method"], "native") << where;
             if (!presents(s.presentation)) continue;

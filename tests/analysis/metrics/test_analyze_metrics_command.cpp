@@ -43,6 +43,23 @@ protected:
         std::error_code ignored;
         if (!HasFailure()) fs::remove_all(folder, ignored);
     }
+    // `count` noisy copies of the reference (Gaussian noise of `sigma` per channel, RNG state firstState + seed) as
+    // exr/seedN.exr: the comma-separated list --reference-seeds takes.
+    std::string writeNoisySeeds(int count, std::uint64_t firstState, double sigma) {
+        std::string seeds;
+        for (int seed = 0; seed < count; ++seed) {
+            testing::SyntheticRender noisy = reference;
+            noisy.beauty = reference.beauty.clone();
+            cv::Mat noise(noisy.beauty.size(), CV_32FC3);
+            cv::theRNG().state = firstState + static_cast<std::uint64_t>(seed);
+            cv::randn(noise, 0.0, sigma);
+            noisy.beauty += noise;
+            const std::string name = "exr/seed" + std::to_string(seed) + ".exr";
+            testing::writeSyntheticExr(path(name), noisy);
+            seeds += (seed ? "," : "") + path(name);
+        }
+        return seeds;
+    }
     void SetUp() override {
         folder =
             fs::temp_directory_path() / ("skinlab-metrics-cli-" + std::to_string(::getpid()) + "-" +
@@ -189,18 +206,7 @@ std::string displayList() {
 // --reference-seeds: the tests against several noisy copies of the truth; --compare-reference ranks them against a
 // second truth. The halo render is worse than the exact one under both.
 TEST_F(AnalyzeMetricsCommand, ScoresAgainstSeededTruthsAndComparesRankings) {
-    std::string seeds;
-    for (int seed = 0; seed < 4; ++seed) {
-        testing::SyntheticRender noisy = reference;
-        noisy.beauty = reference.beauty.clone();
-        cv::Mat noise(noisy.beauty.size(), CV_32FC3);
-        cv::theRNG().state = 77 + seed;
-        cv::randn(noise, 0.0, 0.03);
-        noisy.beauty += noise;
-        const std::string name = "exr/seed" + std::to_string(seed) + ".exr";
-        testing::writeSyntheticExr(path(name), noisy);
-        seeds += (seed ? "," : "") + path(name);
-    }
+    const std::string seeds = writeNoisySeeds(4, 77, 0.03);
     testing::writeSyntheticExr(path("exr/reference.exr"), reference);
     testing::writeSyntheticExr(path("exr/halo.exr"), blurred);
     CommandResult run =
@@ -243,18 +249,7 @@ TEST_F(AnalyzeMetricsCommand, ScoresAgainstSeededTruthsAndComparesRankings) {
 // --compare-metrics: the scores of `analyze metrics --reference` on the same files, each ranked against the seeded
 // truth (table_score_agreement), and agreement.csv with every subset; a metrics.json without a test fails.
 TEST_F(AnalyzeMetricsCommand, RanksTheTableScoresAgainstTheSeededTruth) {
-    std::string seeds;
-    for (int seed = 0; seed < 3; ++seed) {
-        testing::SyntheticRender noisy = reference;
-        noisy.beauty = reference.beauty.clone();
-        cv::Mat noise(noisy.beauty.size(), CV_32FC3);
-        cv::theRNG().state = 91 + seed;
-        cv::randn(noise, 0.0, 0.01);
-        noisy.beauty += noise;
-        const std::string name = "exr/seed" + std::to_string(seed) + ".exr";
-        testing::writeSyntheticExr(path(name), noisy);
-        seeds += (seed ? "," : "") + path(name);
-    }
+    const std::string seeds = writeNoisySeeds(3, 91, 0.01);
     testing::writeSyntheticExr(path("exr/reference.exr"), reference);
     testing::writeSyntheticExr(path("exr/halo.exr"), blurred);
     const std::string tests = path("exr/halo.exr") + " " + path("exr/reference.exr");

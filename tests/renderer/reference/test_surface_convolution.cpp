@@ -41,6 +41,19 @@ double integrateRadial(const RadialProfile& profile, int channel, double rMm) {
     return sum;
 }
 
+// builtin:halo (the sphere, radius 40 mm, and its backdrop) tessellated to 1 mm edges.
+SurfaceSamples haloSphereSamples() {
+    return gatherSurfaceSamples(tessellateSkin(makeHaloScene(200.0f), 1.0f, 1.0f), 1.0f);
+}
+
+// Every stride-th skin sample on the sphere (not the backdrop).
+std::vector<std::uint32_t> haloSphereReceivers(const SurfaceSamples& samples, std::uint32_t stride) {
+    std::vector<std::uint32_t> receivers;
+    for (std::uint32_t i = 0; i < samples.size(); i += stride)
+        if (samples.skin[i] && glm::length(samples.positionMm[i]) < kHaloSphereRadiusMm + 0.5f) receivers.push_back(i);
+    return receivers;
+}
+
 // Step irradiance E = 1 for x > stepX, 0 for x < stepX (stepX between two columns of samples); albedo 1.
 std::vector<glm::vec3> stepIrradiance(const SurfaceSamples& samples, float stepX) {
     std::vector<glm::vec3> irradiance(samples.size());
@@ -199,12 +212,9 @@ TEST(SurfaceConvolution, TheOwnShareSplitsOffTheNearFieldExactly) {
     // of half the edge length (as the reference draws), each share lies in [0, 1 + L_c / R] and holds at least the weight of
     // d'Eon's σ = 80 µm lobe (0.233 in red, 0.455 green, 0.649 blue), also at the poles' small triangles and along
     // the seam's twin vertices. Samples that are not convolved return 0 with share 1.
-    const Model halo = tessellateSkin(makeHaloScene(200.0f), 1.0f, 1.0f);
-    const SurfaceSamples samples = gatherSurfaceSamples(halo, 1.0f);
+    const SurfaceSamples samples = haloSphereSamples();
     const auto profile = makeRadialProfile(profileParams("deon"));
-    std::vector<std::uint32_t> receivers;
-    for (std::uint32_t i = 0; i < samples.size(); i += 5)
-        if (samples.skin[i] && glm::length(samples.positionMm[i]) < kHaloSphereRadiusMm + 0.5f) receivers.push_back(i);
+    const std::vector<std::uint32_t> receivers = haloSphereReceivers(samples, 5);
     ASSERT_GT(receivers.size(), 100u);
     std::vector<glm::vec3> irradiance(samples.size());
     for (std::size_t i = 0; i < samples.size(); ++i)
@@ -315,12 +325,9 @@ TEST(SurfaceConvolution, NonSkinNeighboursAbsorbTheLightCarriedToThem) {
 TEST(SurfaceConvolution, ConvexityGainFollowsTheCurvature) {
     // builtin:halo's sphere (radius 40 mm) under uniform irradiance: the kernel-weighted curvature is 1/R, so the
     // output is α (1 + L_c / R); with L = 0 it is α. A flat plane keeps α whatever L.
-    const Model halo = tessellateSkin(makeHaloScene(200.0f), 1.0f, 1.0f);
-    const SurfaceSamples samples = gatherSurfaceSamples(halo, 1.0f);
+    const SurfaceSamples samples = haloSphereSamples();
     const auto profile = makeRadialProfile(profileParams("deon"));
-    std::vector<std::uint32_t> receivers;
-    for (std::uint32_t i = 0; i < samples.size(); i += 11)
-        if (samples.skin[i] && glm::length(samples.positionMm[i]) < kHaloSphereRadiusMm + 0.5f) receivers.push_back(i);
+    const std::vector<std::uint32_t> receivers = haloSphereReceivers(samples, 11);
     ASSERT_GT(receivers.size(), 100u);
     const std::vector<glm::vec3> uniform(samples.size(), glm::vec3(1.0f));
     ConvolutionSettings convex;
