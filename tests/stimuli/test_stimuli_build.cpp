@@ -888,3 +888,44 @@ TEST_F(StimuliBuild, SlurmDryRunPrintsTheScripts) {
               "skinlab: error: " + gRoot.string() +
                   ": holds no Slurm build (no slurm/jobs.json); submit one with `skinlab stimuli slurm`\n");
 }
+
+// The shipped demo as built: in every block the stimulus without SSS is predicted at least 1 JOD from the block's
+// reference (its truth shows subsurface scattering), the block spreads over at least 1 JOD, and each included
+// extension moves its method by at least 0.3 JOD (docs/stimuli-visibility.md, "The demo blocks").
+TEST_F(StimuliBuild, ShippedDemoBlocksShowScatteringAgainstTheirReference) {
+    const fs::path out = gRoot / "shipped-demo";
+    fs::remove_all(out);
+    const fs::path spec = fs::path(SKINLAB_SOURCE_DIR) / "stimuli" / "specs" / "demo.toml";
+    const CliRun run = runCli({"stimuli", "build", spec.string(), "-o", out.string()});
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    std::map<std::string, double> jod;
+    std::map<std::string, std::pair<double, double>> blockRange; // block → (lowest, highest)
+    const nlohmann::json manifest = manifestOf(out);
+    for (const auto& s : manifest["stimuli"]) {
+        if (s["reference"].get<bool>()) continue;
+        const double j = s["predicted"]["jod"].get<double>();
+        jod[s["id"]] = j;
+        auto [it, fresh] = blockRange.try_emplace(s["block"].get<std::string>(), j, j);
+        it->second = {std::min(it->second.first, j), std::max(it->second.second, j)};
+    }
+    ASSERT_EQ(blockRange.size(), 3u);
+    for (const char* none : {"head-face-none", "halo-silhouette-none", "bleed-patches-none"}) {
+        ASSERT_TRUE(jod.count(none)) << none;
+        EXPECT_LE(jod[none], 9.0) << none;
+    }
+    for (const auto& [block, range] : blockRange) EXPECT_GE(range.second - range.first, 1.0) << block;
+    const std::vector<std::pair<std::string, std::string>> extensions{
+        {"halo-silhouette-separable", "halo-silhouette-separable-no-follow_surface"},
+        {"halo-silhouette-gaussian-sum", "halo-silhouette-gaussian-sum-no-follow_surface"},
+        {"halo-silhouette-separable-no-follow_surface-cbf", "halo-silhouette-separable-no-follow_surface"},
+        {"halo-silhouette-gaussian-sum-no-follow_surface-cbf", "halo-silhouette-gaussian-sum-no-follow_surface"},
+        {"bleed-patches-separable-cbf", "bleed-patches-separable"},
+        {"bleed-patches-separable-lab_weight-0.09", "bleed-patches-separable"},
+        {"bleed-patches-gaussian-sum-cbf", "bleed-patches-gaussian-sum"},
+        {"bleed-patches-gaussian-sum-lab_weight-0.5", "bleed-patches-gaussian-sum"}};
+    for (const auto& [with, without] : extensions) {
+        ASSERT_TRUE(jod.count(with) && jod.count(without)) << with;
+        EXPECT_GE(jod[with] - jod[without], 0.3) << with << " against " << without;
+    }
+    fs::remove_all(out);
+}
