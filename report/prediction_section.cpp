@@ -303,10 +303,7 @@ std::string predictionSectionHtml(const std::vector<PredictionAgreement>& agreem
         for (std::size_t i = 0; i < a.conditions.size(); ++i)
             html << "<tr><td class=\"l\">" << escapeHtml(a.conditions[i]) << "</td><td>"
                  << formatNumber(a.predicted[i], 2) << "</td><td>" << formatNumber(a.measured[i], 2) << "</td><td>"
-                 << (std::isnan(a.low[i]) && std::isnan(a.high[i])
-                         ? std::string("none")
-                         : "[" + formatNumber(a.low[i], 2) + ", " + formatNumber(a.high[i], 2) + "]")
-                 << "</td></tr>";
+                 << intervalText(a.low[i], a.high[i], 2) << "</td></tr>";
         html << "</tbody></table>\n";
     }
     html << "<h3>With each participant's own display</h3>";

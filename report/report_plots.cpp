@@ -78,6 +78,14 @@ std::string formatNumber(double value, int digits) {
     return s;
 }
 
+std::string intervalText(double low, double high, int digits) {
+    if (std::isfinite(low) && std::isfinite(high))
+        return "[" + formatNumber(low, digits) + ", " + formatNumber(high, digits) + "]";
+    if (std::isfinite(low)) return "at least " + formatNumber(low, digits);
+    if (std::isfinite(high)) return "at most " + formatNumber(high, digits);
+    return "none";
+}
+
 std::string correlationIntervalText(double low, double high, int conditions) {
     if (std::isfinite(low) && std::isfinite(high))
         return "[" + formatNumber(low, 2) + ", " + formatNumber(high, 2) + "]";

@@ -38,5 +38,8 @@ std::string correlationIntervalText(double low, double high, int conditions);
 
 // A number for the page: `digits` after the point, "−" for minus, "—" for a non-finite value.
 std::string formatNumber(double value, int digits);
+// An interval on the page: "[a, b]", "at least a" or "at most b" where one end is unbounded (infinite or not a
+// number), "none" where both are.
+std::string intervalText(double low, double high, int digits);
 
 } // namespace skinlab::report

@@ -70,6 +70,15 @@ TEST(ReportPlots, CorrelationIntervalSaysWhyThereIsNone) {
     EXPECT_EQ(html.find("ρ = 1.00 [—, —]"), std::string::npos) << html;
 }
 
+// An interval with an unbounded end says so in words: never "[—, —]" (an infinite end printed as a dash).
+TEST(ReportPlots, UnboundedIntervalsAreWordsNotDashes) {
+    EXPECT_EQ(intervalText(-0.5, 1.25, 2), "[\u22120.50, 1.25]");
+    EXPECT_EQ(intervalText(0.5, INFINITY, 2), "at least 0.50");
+    EXPECT_EQ(intervalText(-INFINITY, 1.0, 2), "at most 1.00");
+    EXPECT_EQ(intervalText(-INFINITY, INFINITY, 2), "none");
+    EXPECT_EQ(intervalText(NAN, NAN, 2), "none");
+}
+
 TEST(ReportPlots, ScatterSkipsUndefinedPoints) {
     std::vector<ScatterPoint> points = {
         {"a", 0.1, 1.0, 0.5, 1.5}, {"b", NAN, 0.0, -0.5, 0.5}, {"c", 0.3, -1.0, -1e9, 1e9}};
