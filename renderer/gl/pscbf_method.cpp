@@ -4,6 +4,7 @@
 #include "renderer/gl/shader_library.h"
 #include "renderer/gl/sss_blur_pass.h"
 #include "renderer/gl/sss_extension_settings.h"
+#include "renderer/sss/methods/pscbf.h"
 #include "renderer/sss/pscbf_kernel.h"
 #include "renderer/sss/skin_model.h"
 
@@ -25,7 +26,7 @@ constexpr int kMaxTaps = 101; // PSCBF_MAX_TAPS of the shader (sss.samples ≤ 1
 PscbfMethod::PscbfMethod(ShaderLibrary& shaders) : shaders_(shaders) {}
 
 glm::dvec3 PscbfMethod::depthSigmaMm(const sss::SssParams& params) {
-    const auto variance = sss::skinPscbfProfile(params).varianceMm2;
+    const auto variance = sss::skinPscbfProfile(params, sss::pscbfParams(params).sigma).varianceMm2;
     const double scale = sss::profileScale(params.widthMm);
     return {std::sqrt(variance[0]) * scale, std::sqrt(variance[1]) * scale, std::sqrt(variance[2]) * scale};
 }

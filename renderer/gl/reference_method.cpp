@@ -5,6 +5,7 @@
 #include "renderer/reference/surface_samples.h"
 #include "renderer/reference/tessellation.h"
 #include "renderer/sss/method.h"
+#include "renderer/sss/methods/reference.h"
 #include "renderer/sss/radial_profile.h"
 
 #include <algorithm>
@@ -206,8 +207,8 @@ ReferenceMethod::~ReferenceMethod() = default;
 void ReferenceMethod::prepare(const ReferenceInputs& inputs, const sss::SssParams& params) {
     profileOf(params, inputs.source);
     bool cached = false;
-    impl_->tessellated(inputs, static_cast<float>(params.referenceEdgeMm), params.referenceNonSkin == "absorbs",
-                       cached);
+    const sss::ReferenceParams own = sss::referenceParams(params); // its own keys
+    impl_->tessellated(inputs, static_cast<float>(own.edgeMm), own.nonSkin == sss::ReferenceNonSkin::Absorbs, cached);
 }
 
 // Bakes the main pass's shading at every vertex of the skin parts; returns the bake's RGBA (diffuse, mask).
@@ -273,19 +274,20 @@ std::vector<glm::vec3> ReferenceMethod::Impl::convolve(const TessellatedModel& m
     // The growth is declared at the profile's own scale (width_mm = 3) and scales with the profile: a profile
     // widened by s has its far-side factor exp(k d²) at d / s, so each Gaussian lobe widens alike at every width.
     const double scale = sss::profileScale(params.widthMm);
+    const sss::ReferenceParams own = sss::referenceParams(params); // its own keys
     for (int c = 0; c < 3; ++c) {
-        convolution.throughGain[c] = params.referenceThroughGain[c];
-        convolution.throughGrowthPerMm2[c] = params.referenceThroughGrowthPerMm2[c] / (scale * scale);
-        convolution.convexityMm[c] = params.referenceConvexityMm[c] * scale; // a length: scales with the profile
+        convolution.throughGain[c] = own.throughGain[c];
+        convolution.throughGrowthPerMm2[c] = own.throughGrowthPerMm2[c] / (scale * scale);
+        convolution.convexityMm[c] = own.convexityMm[c] * scale; // a length: scales with the profile
     }
     convolution.convexityRadiusMinMm = 20.0 * scale; // 20 mm at width 3 mm: the nose tip, the ear's rim
     convolution.nearFieldMm = 0.5 * mesh.edgeMm;     // a seam's twin, a fan's small triangles: near field
     convolution.nonSkin =
-        params.referenceNonSkin == "returns" ? reference::NonSkin::Returns : reference::NonSkin::Absorbs;
+        own.nonSkin == sss::ReferenceNonSkin::Returns ? reference::NonSkin::Returns : reference::NonSkin::Absorbs;
     // sss.reference_near_field = "pixel": the near field split off (surface_convolution.h, ownShare); the draw
     // multiplies each vertex's own share by the main pass's E·α at every pixel, so detail finer than the
     // tessellation keeps its sharpness. With "vertex" every share is 0 and the far field holds the whole sum.
-    const bool nearAtPixels = params.referenceNearField == "pixel";
+    const bool nearAtPixels = own.nearField == sss::ReferenceNearField::Pixel;
     std::vector<glm::vec3> convolved = reference::convolveSurface(samples, radiance, profile, convolution, nullptr,
                                                                   &report, nearAtPixels ? &ownShare : nullptr);
     if (!nearAtPixels) ownShare.assign(vertexCount, glm::vec3(0.0f));
@@ -366,10 +368,11 @@ void ReferenceMethod::Impl::draw(const ReferenceInputs& inputs, const Tessellate
 // Tessellation and samples (cached) → bake → convolution over the surface → draw.
 void ReferenceMethod::run(const ReferenceInputs& inputs, const sss::SssParams& params, GLuint output) {
     Impl& impl = *impl_;
-    const auto profile = profileOf(params, inputs.source); // refuse a tabulated profile before any work
-    const float edgeMm = static_cast<float>(params.referenceEdgeMm);
+    const auto profile = profileOf(params, inputs.source);         // refuse a tabulated profile before any work
+    const sss::ReferenceParams own = sss::referenceParams(params); // its own keys
+    const float edgeMm = static_cast<float>(own.edgeMm);
     bool cached = false;
-    TessellatedModel& mesh = impl.tessellated(inputs, edgeMm, params.referenceNonSkin == "absorbs", cached);
+    TessellatedModel& mesh = impl.tessellated(inputs, edgeMm, own.nonSkin == sss::ReferenceNonSkin::Absorbs, cached);
     cached = mesh.renders > 0; // prepare() of this render may have made the entry: count it as this render's
     ++mesh.renders;
 

@@ -13,9 +13,7 @@ double Method::supportRadiusMm(const SssParams&, const Kernel& kernel) const { r
 std::unique_ptr<Marginal> Method::profileMarginal(const SssParams&) const { return nullptr; }
 
 std::vector<std::string_view> withBlurKeys(std::vector<std::string_view> keys) {
-    for (const std::string_view key :
-         {"follow_surface", "cbf", "cbf_lambda", "lab_weight", "extension_input", "curvature", "curvature_floor"})
-        keys.push_back(key);
+    keys.insert(keys.end(), kBlurKeys.begin(), kBlurKeys.end());
     return keys;
 }
 

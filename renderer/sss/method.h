@@ -8,7 +8,10 @@
 #include "renderer/sss/kernel.h"
 #include "renderer/sss/sss_params.h"
 
+#include <array>
 #include <memory>
+#include <string_view>
+#include <vector>
 
 namespace skinlab::renderer::sss {
 
@@ -35,7 +38,10 @@ public:
 };
 
 // The [sss] keys every screen-space blur reads besides its own: follow-surface and the thesis' extensions
-// (docs/extensions.md), appended to `keys`.
+// (docs/extensions.md). withBlurKeys appends them to a row's `keys`; a method's listing (methodKeys) gives them after
+// its own keys.
+inline constexpr std::array<std::string_view, 7> kBlurKeys{
+    "follow_surface", "cbf", "cbf_lambda", "lab_weight", "extension_input", "curvature", "curvature_floor"};
 std::vector<std::string_view> withBlurKeys(std::vector<std::string_view> keys);
 
 // Registers the method whose row `declaration()` returns (a function returning MethodInfo) at start-up, after the

@@ -133,9 +133,16 @@ std::vector<std::string_view> methodKeys(SssMethod method) {
     std::vector<std::string_view> keys;
     for (const std::string_view k : kCommonSssKeys)
         if (k != "method") keys.push_back(k);
+    // Its kernel's shared keys, its own keys, then the blur keys (kBlurKeys) it reads.
     const MethodInfo& info = methodInfo(method);
-    keys.insert(keys.end(), info.keys.begin(), info.keys.end());
+    const auto isBlurKey = [](std::string_view k) {
+        return std::find(kBlurKeys.begin(), kBlurKeys.end(), k) != kBlurKeys.end();
+    };
+    for (const std::string_view k : info.keys)
+        if (!isBlurKey(k)) keys.push_back(k);
     for (const SssKey& k : info.ownKeys) keys.push_back(k.name);
+    for (const std::string_view k : info.keys)
+        if (isBlurKey(k)) keys.push_back(k);
     return keys;
 }
 

@@ -23,6 +23,17 @@
 
 namespace skinlab::renderer::sss {
 
+// Mikkelsen 2010, Table 1 lists 2.3 / 1.4 / 1.1 for the broad Gaussian and calls the value a "variance" (Eq. 7:
+// "variance σ/K and σ"), so the numbers may be the variance v (mm²) or, as the symbol σ suggests, the standard
+// deviation (mm). Default: variance, the reading the paper's own filter extent r_max = 4.5 mm supports (3 standard
+// deviations of the red Gaussian, 3·√2.3 = 4.55 mm; under the other reading r_max would cut the red Gaussian at 1.96 σ).
+// sss.pscbf_sigma (renderer/sss/methods/pscbf.h).
+enum class PscbfSigma {
+    Variance, // v_c = 2.3 / 1.4 / 1.1 mm²
+    StdDev,   // σ_c = 2.3 / 1.4 / 1.1 mm, v_c = σ_c²
+};
+NLOHMANN_JSON_SERIALIZE_ENUM(PscbfSigma, {{PscbfSigma::Variance, "variance"}, {PscbfSigma::StdDev, "std-dev"}})
+
 struct PscbfProfile {
     std::array<double, 3> spike;       // share of the unblurred irradiance per channel (R, G, B), in [0, 1)
     std::array<double, 3> varianceMm2; // v_c of the broad Gaussian, mm²

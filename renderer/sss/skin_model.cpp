@@ -325,8 +325,8 @@ std::array<double, 3> skinWidthRatio(const SssParams& params) {
     return ratio;
 }
 
-PscbfProfile skinPscbfProfile(const SssParams& params) {
-    PscbfProfile profile = mikkelsenSkinProfile(params.pscbfSigma);
+PscbfProfile skinPscbfProfile(const SssParams& params, PscbfSigma reading) {
+    PscbfProfile profile = mikkelsenSkinProfile(reading);
     if (!params.skinShapeMm) return profile;
     const std::array<double, 3> ratio = skinWidthRatio(params);
     for (int c = 0; c < 3; ++c) profile.varianceMm2[c] *= ratio[c] * ratio[c];
@@ -334,8 +334,7 @@ PscbfProfile skinPscbfProfile(const SssParams& params) {
     return profile;
 }
 
-std::array<double, 3> skinArtisticFalloff(const SssParams& params) {
-    std::array<double, 3> falloff = params.artisticFalloff;
+std::array<double, 3> skinArtisticFalloff(const SssParams& params, std::array<double, 3> falloff) {
     const std::array<double, 3> ratio = skinWidthRatio(params);
     for (int c = 0; c < 3; ++c) falloff[c] *= ratio[c];
     return falloff;

@@ -144,12 +144,12 @@ std::array<double, 3> skinTransmittance(const SssParams& params, double thicknes
 // moment); (1, 1, 1) without [skin]. The Blender radii (fitted to d'Eon's profile) scale by it.
 std::array<double, 3> skinWidthRatio(const SssParams& params);
 
-// pscbf's profile (Mikkelsen 2010, Table 1) with each channel's Gaussian widened by skinWidthRatio (variance × ratio²)
-// and the filter disc r_max by the largest ratio; Mikkelsen's own without [skin].
-PscbfProfile skinPscbfProfile(const SssParams& params);
-// The artistic kernel's per-channel falloff (a width multiplier of its profile) times skinWidthRatio; the key's own
-// value without [skin].
-std::array<double, 3> skinArtisticFalloff(const SssParams& params);
+// pscbf's profile (Mikkelsen 2010, Table 1, read as `reading`: sss.pscbf_sigma) with each channel's Gaussian widened
+// by skinWidthRatio (variance × ratio²) and the filter disc r_max by the largest ratio; Mikkelsen's own without [skin].
+PscbfProfile skinPscbfProfile(const SssParams& params, PscbfSigma reading);
+// The artistic kernel's per-channel falloff `falloff` (sss.artistic_falloff, a width multiplier of its profile) times
+// skinWidthRatio; `falloff` as it is without [skin].
+std::array<double, 3> skinArtisticFalloff(const SssParams& params, std::array<double, 3> falloff);
 
 // --- inversion and re-toning (Jimenez et al. 2010) ------------------------------------------------------------------
 struct ToneEstimate {

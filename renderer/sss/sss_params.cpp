@@ -81,8 +81,9 @@ TransmittanceParams readTransmittanceTable(const SpecReader& t) {
 } // namespace
 
 namespace {
-// The declarations of the [sss] keys (name, type, range, unit, doc, field), in reading order, in three groups: the
-// method and its kernel, the extensions and curvature, the pscbf and reference keys.
+// The declarations of the shared [sss] keys (name, type, range, unit, doc, field), those several methods read, in
+// reading order, in two groups: the method and its kernel, the extensions and curvature. A key only one method reads
+// is declared in that method's file (renderer/sss/methods/, MethodInfo::ownKeys).
 std::vector<SssKey> kernelSssKeys() {
     return {
         boundKey({"method", KeyType::Choice, 0, 0, methodNames(), "", "the SSS method (skinlab methods)"},
@@ -115,12 +116,6 @@ std::vector<SssKey> kernelSssKeys() {
         boundKey({"material", KeyType::Choice, 0, 0, materialNames(), "",
                   "material of the profile (burley: Jensen et al. 2001 media)"},
                  &SssParams::material),
-        boundKey(
-            {"artistic_strength", KeyType::Vec3, 0.0, 1.0, {}, "", "artistic kernel: per-channel strength (R, G, B)"},
-            &SssParams::artisticStrength),
-        boundKey(
-            {"artistic_falloff", KeyType::Vec3, 0.0, 1.0, {}, "", "artistic kernel: per-channel falloff (R, G, B)"},
-            &SssParams::artisticFalloff),
     };
 }
 
@@ -176,73 +171,12 @@ std::vector<SssKey> extensionSssKeys() {
     };
 }
 
-std::vector<SssKey> pscbfAndReferenceSssKeys() {
-    return {
-        boundKey({"pscbf_sigma",
-                  KeyType::Choice,
-                  0,
-                  0,
-                  {"variance", "std-dev"},
-                  "",
-                  "pscbf: how Mikkelsen's Table 1 values are read"},
-                 &SssParams::pscbfSigma),
-        boundKey({"reference_edge_mm",
-                  KeyType::Number,
-                  0.05,
-                  50.0,
-                  {},
-                  "mm",
-                  "reference: longest skin edge after tessellation"},
-                 &SssParams::referenceEdgeMm),
-        boundKey({"reference_through_gain",
-                  KeyType::Vec3,
-                  0.0,
-                  100.0,
-                  {},
-                  "",
-                  "reference: per-channel gain g on light through thin parts"},
-                 &SssParams::referenceThroughGain),
-        boundKey({"reference_through_growth_per_mm2",
-                  KeyType::Vec3,
-                  -1.0,
-                  0.1,
-                  {},
-                  "1/mm²",
-                  "reference: growth of that gain with the distance d through the part, g exp(k d²), k at width_mm 3"},
-                 &SssParams::referenceThroughGrowthPerMm2),
-        boundKey({"reference_non_skin",
-                  KeyType::Choice,
-                  0,
-                  0,
-                  {"absorbs", "returns"},
-                  "",
-                  "reference: light carried to non-skin neighbours leaves the skin or returns to the receiver"},
-                 &SssParams::referenceNonSkin),
-        boundKey({"reference_convexity_mm",
-                  KeyType::Vec3,
-                  -10.0,
-                  10.0,
-                  {},
-                  "mm",
-                  "reference: per-channel length L of the convex-surface gain 1 + L κ, L at width_mm 3"},
-                 &SssParams::referenceConvexityMm),
-        boundKey({"reference_near_field",
-                  KeyType::Choice,
-                  0,
-                  0,
-                  {"vertex", "pixel"},
-                  "",
-                  "reference: the near field summed at the vertices or drawn at the pixels (sharp light edges)"},
-                 &SssParams::referenceNearField),
-    };
-}
-
 std::vector<SssKey>& sharedSssKeys() {
     // Built on first use (the choices call methodNames() and materialNames()).
     static std::vector<SssKey> table = [] {
         std::vector<SssKey> keys = kernelSssKeys();
-        for (std::vector<SssKey> group : {extensionSssKeys(), pscbfAndReferenceSssKeys()})
-            keys.insert(keys.end(), std::make_move_iterator(group.begin()), std::make_move_iterator(group.end()));
+        std::vector<SssKey> extensions = extensionSssKeys();
+        keys.insert(keys.end(), std::make_move_iterator(extensions.begin()), std::make_move_iterator(extensions.end()));
         return keys;
     }();
     return table;
@@ -336,8 +270,6 @@ nlohmann::json keyInfoJson(const KeyInfo& key) {
     if (key.type == KeyType::Choice) out["choices"] = key.choices;
     return out;
 }
-
-std::string_view pscbfSigmaName(PscbfSigma reading) { return reading == PscbfSigma::StdDev ? "std-dev" : "variance"; }
 
 std::string_view placementName(TapPlacement placement) {
     return placement == TapPlacement::Importance ? "importance" : "quadratic";

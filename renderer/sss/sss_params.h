@@ -43,17 +43,7 @@ enum class TapPlacement {
     Importance, // equal-probability cells of the widest channel (Mikkelsen 2010), other channels re-weighted
 };
 
-// Mikkelsen 2010, Table 1 lists 2.3 / 1.4 / 1.1 for the broad Gaussian and calls the value a "variance" (Eq. 7:
-// "variance σ/K and σ"), so the numbers may be the variance v (mm²) or, as the symbol σ suggests, the standard
-// deviation (mm). Default: variance, the reading the paper's own filter extent r_max = 4.5 mm supports (3 standard
-// deviations of the red Gaussian, 3·√2.3 = 4.55 mm; under the other reading r_max would cut the red Gaussian at 1.96 σ).
-enum class PscbfSigma {
-    Variance, // v_c = 2.3 / 1.4 / 1.1 mm²
-    StdDev,   // σ_c = 2.3 / 1.4 / 1.1 mm, v_c = σ_c²
-};
-
 std::string_view methodName(SssMethod method);
-std::string_view pscbfSigmaName(PscbfSigma reading);
 std::string_view placementName(TapPlacement placement);
 
 // The declaration of one key of [sss] or [transmittance]: name, type, range or choices, unit, one-line doc. The
@@ -101,16 +91,12 @@ struct SssParams {
     // stops all light crossing it.
     bool followSurface = true;
     double followSurfaceK = 0.5; // 1/mm
-    // Profile of the separable method: "deon" (six Gaussians), "burley" (normalized diffusion) or "file:PATH"
+    // Profile of the separable and reference methods: "deon" (six Gaussians), "burley" (normalized diffusion) or "file:PATH"
     // (a tabulated .bn kernel, Jimenez et al. 2015 supplementary format).
     std::string profile = "deon";
     // Material of the profile: "skin" (d'Eon's table; for burley, d matched to its second moment) or one of the
     // measured media of Jensen et al. 2001 (skin1, skin2, marble, apple, ketchup, wholemilk; burley only).
     std::string material = "skin";
-    // Artistic kernel (demo baseline): per-channel strength and falloff, each in [0, 1].
-    std::array<double, 3> artisticStrength{0.48, 0.41, 0.28};
-    std::array<double, 3> artisticFalloff{1.0, 0.37, 0.3};
-
     // --- artifact extensions (thesis §3.3; docs/extensions.md), each a switch on every screen-space method ---
     // E1: cross-bilateral weights exp(−λ |F_c − F_tap|) on Mikkelsen's auxiliary image (AOV aux.Y), combined
     // with the follow-surface correction, renormalised, falling back to the unblurred colour where they vanish.
@@ -131,38 +117,9 @@ struct SssParams {
     // The thesis gives no such scale; 20 mm is the radius of the tightest broad facial features (nose tip, ear
     // rims, lips), so those reach c = 1 while cheeks and forehead (60–100 mm) stay at c = 0.2–0.33.
     double curvatureReferenceMm = 20.0;
-    // pscbf: how Table 1's 2.3 / 1.4 / 1.1 are read (PscbfSigma above).
-    PscbfSigma pscbfSigma = PscbfSigma::Variance;
-    // reference method: longest skin edge (mm) after tessellation; irradiance is sampled at the vertices.
-    double referenceEdgeMm = 1.0;
-    // reference method: the light that reaches a receiver from the far side of a thin part (sources whose normal
-    // faces away from the receiver's) is the reflectance profile at the 3-D distance d through the part times a
-    // per-channel gain g_c · exp(k_c d²): referenceThroughGain holds g_c, referenceThroughGrowthPerMm2 k_c (1/mm² at
-    // width_mm = 3; scaled by profileScale⁻² with the profile, so the factor widens each Gaussian lobe of variance v
-    // to v / (1 − 2 k_c v) at every width; renderer/reference/surface_convolution.h). g = 1, k = 0: the profile as it
-    // is; k = 0: a constant gain.
-    // Defaults: fitted to Blender Cycles' random walk on 1, 2, 2.5 and 4 mm skin fins
-    // (scripts/transmittance-calibration.sh; docs/pathtraced.md, "Through-light: calibration").
-    std::array<double, 3> referenceThroughGain{1.181, 5.727, 9.723};
-    std::array<double, 3> referenceThroughGrowthPerMm2{0.04, -0.04, 0.0};
-    // reference method: what becomes of the light the profile carries to non-skin neighbours: "returns" (handed
-    // back to the receiver, as the screen-space methods do: skin is judged as if nothing bordered it) or "absorbs"
-    // (it leaves the skin, as a path tracer's walk ends where the skin's medium ends; the reference validation's
-    // setting). renderer/reference/surface_convolution.h, NonSkin.
-    std::string referenceNonSkin = "returns";
-    // reference method: per-channel length L_c (mm at width_mm = 3, scaled with the profile) of the convex-surface
-    // gain 1 + L_c κ (κ the curvature the kernel sees, 1/mm; renderer/reference/surface_convolution.h). 0 (the
-    // default): a level-neutral reference, as every screen-space method is; the fit to the path tracer's level on a
-    // sphere is in docs/pathtraced.md, "A convex body's level".
-    std::array<double, 3> referenceConvexityMm{0.0, 0.0, 0.0};
-    // reference method: where the near field is drawn: "vertex" (every source's light, the receiver's own included,
-    // summed at the vertices and interpolated across the triangles: detail finer than the edge length is lost) or
-    // "pixel" (the receiver's own term and sources closer than half the edge length, the profile's narrow lobes,
-    // multiply the main pass's E·α at every pixel: a sharp light edge or pore keeps the sharpness those lobes give
-    // it instead of a staircase of the tessellation). renderer/reference/surface_convolution.h, ownShare.
-    std::string referenceNearField = "vertex";
-    // Values of the keys a method declares in its own row (MethodInfo::ownKeys), by key; absent: the declared
-    // default. The built-in methods' keys are the typed fields above.
+    // Values of the keys a method declares in its own file (MethodInfo::ownKeys), by key; absent: the declared
+    // default. The method reads them typed through its own parameter struct (ownParams below, e.g. artisticParams in
+    // renderer/sss/methods/artistic.h).
     nlohmann::json own = nlohmann::json::object();
     // The scene's skin tone ([skin], renderer/sss/skin_model.h), set by the scene reader, not an [sss] key: the
     // six-Gaussian weights refitted to the tone (by lobe, d'Eon's variances) and its Burley shape d (mm per channel),
@@ -211,13 +168,34 @@ BoundKey<Params> boundKey(KeyInfo info, T Params::*field) {
 // A key a method declares in its own row: its value lives in SssParams::own, `fallback` when absent.
 SssKey ownKey(KeyInfo info, nlohmann::json fallback);
 
+// A method's own keys bound to the fields of its own parameter struct `Own` (ArtisticParams, ReferenceParams, ...;
+// declared in the method's file with boundKey, the struct's initialisers being the defaults): the row's declarations
+// (MethodInfo::ownKeys) and the typed read of a parameter set, so the method and its executor read its keys as typed
+// fields, as the shared keys are read from SssParams.
+template <class Own>
+std::vector<SssKey> ownKeys(const std::vector<BoundKey<Own>>& keys) {
+    std::vector<SssKey> declared;
+    for (const BoundKey<Own>& key : keys) declared.push_back(ownKey(key, key.get(Own{})));
+    return declared;
+}
+template <class Own>
+Own ownParams(const SssParams& params, const std::vector<BoundKey<Own>>& keys) {
+    Own own;
+    for (const BoundKey<Own>& key : keys) {
+        const auto value = params.own.find(std::string(key.name));
+        if (value != params.own.end()) key.set(own, *value);
+    }
+    return own;
+}
+
 class Method;
 
 // The method table: one row per SSS method, declared by the method's own file (renderer/sss/methods/, method.h); the
 // single list the CLI (`skinlab methods`), the scene reader, the stimulus specs, `skinlab kernel`, `skinlab tune`,
-// the renderer, the benchmarks and the tests that cover "every method" iterate (docs/methods.md, "Adding a method"). `keys` are the shared [sss] keys the method reads besides the keys every
-// method reads (kCommonSssKeys), `ownKeys` the keys only it declares; any other [sss] key given with the method is
-// an error naming the key and the method.
+// the renderer, the benchmarks and the tests that cover "every method" iterate (docs/methods.md, "Adding a method").
+// `keys` are the shared [sss] keys (sssKeyTable()) the method reads besides the keys every method reads
+// (kCommonSssKeys), `ownKeys` the keys only it reads, declared in its file; any other [sss] key given with the method
+// is an error naming the key and the method.
 struct MethodInfo {
     SssMethod method;      // assigned from the row's position
     std::string_view name; // sss.method value
@@ -288,7 +266,6 @@ nlohmann::json keyInfoJson(const KeyInfo& key);
 
 NLOHMANN_JSON_SERIALIZE_ENUM(TapPlacement,
                              {{TapPlacement::Quadratic, "quadratic"}, {TapPlacement::Importance, "importance"}})
-NLOHMANN_JSON_SERIALIZE_ENUM(PscbfSigma, {{PscbfSigma::Variance, "variance"}, {PscbfSigma::StdDev, "std-dev"}})
 // A method as its name (sss.method); reading an unknown name throws InputError.
 void to_json(nlohmann::json& out, SssMethod method);
 void from_json(const nlohmann::json& in, SssMethod& method);

@@ -6,6 +6,7 @@
 #include "common/error.h"
 #include "common/spec.h"
 #include "renderer/sss/kernel.h"
+#include "renderer/sss/methods/pscbf.h"
 #include "renderer/sss/sss_params.h"
 
 #include <gtest/gtest.h>
@@ -151,10 +152,11 @@ TEST(PscbfKernel, StandardDeviationReading) {
     const toml::table root =
         skinlab::parseTomlString("[sss]\nmethod = \"pscbf\"\npscbf_sigma = \"std-dev\"\n", "s.toml");
     const SssParams params = readSssParams(skinlab::SpecReader(root, "s.toml"));
-    EXPECT_EQ(params.pscbfSigma, PscbfSigma::StdDev);
-    EXPECT_EQ(sssParamsFromJson(params.toJson()).pscbfSigma, PscbfSigma::StdDev);
+    EXPECT_EQ(pscbfParams(params).sigma, PscbfSigma::StdDev);
+    EXPECT_EQ(pscbfParams(sssParamsFromJson(params.toJson())).sigma, PscbfSigma::StdDev);
     SssParams variance = params;
-    variance.pscbfSigma = PscbfSigma::Variance;
+    sssKey("pscbf_sigma").set(variance, PscbfSigma::Variance);
+    EXPECT_EQ(pscbfParams(variance).sigma, PscbfSigma::Variance);
     const double wide = tapStatistics(makeKernel(params).stages.at(0).taps, 10.0).rmsWidthMm[0];
     const double narrow = tapStatistics(makeKernel(variance).stages.at(0).taps, 10.0).rmsWidthMm[0];
     // Truncated to ±4.5 mm the variance reading keeps an RMS near √2.3 = 1.52 mm; the other near 2.0 mm.

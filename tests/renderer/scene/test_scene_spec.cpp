@@ -2,6 +2,7 @@
 #include "common/error.h"
 #include "renderer/scene/builtin_scenes.h"
 #include "renderer/scene/scene_spec.h"
+#include "renderer/sss/methods/artistic.h"
 #include "tests/common/temp_folder.h"
 
 #include <cmath>
@@ -142,7 +143,7 @@ TEST(SceneSpec, SssKeyOfAnotherMethodIsAnError) {
     const SceneSpec spec =
         loadSceneSpec("builtin:head", {"sss.method=artistic", "sss.artistic_falloff=[1.0, 0.5, 0.5]"}, {});
     EXPECT_EQ(spec.sss.method, sss::methodId("artistic"));
-    EXPECT_EQ(spec.sss.artisticFalloff[1], 0.5);
+    EXPECT_EQ(sss::artisticParams(spec.sss).falloff[1], 0.5);
     EXPECT_EQ(spec.resolved["sss"]["artistic_falloff"][1], 0.5);
     EXPECT_FALSE(spec.resolved["sss"].contains("profile")); // separable's key, not artistic's
 }

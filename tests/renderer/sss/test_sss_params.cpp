@@ -4,6 +4,8 @@
 #include "common/error.h"
 #include "common/spec.h"
 #include "renderer/sss/kernel.h"
+#include "renderer/sss/methods/artistic.h"
+#include "renderer/sss/methods/reference.h"
 #include "renderer/sss/width_conventions.h"
 #include "width_views.h"
 
@@ -42,8 +44,8 @@ TEST(SssParams, DefaultsWhenTheTableIsAbsent) {
     EXPECT_TRUE(p.followSurface);
     EXPECT_EQ(p.profile, "deon");
     EXPECT_EQ(p.material, "skin");
-    EXPECT_EQ(p.artisticStrength, (std::array<double, 3>{0.48, 0.41, 0.28}));
-    EXPECT_EQ(p.artisticFalloff, (std::array<double, 3>{1.0, 0.37, 0.3}));
+    EXPECT_EQ(artisticParams(p).strength, (std::array<double, 3>{0.48, 0.41, 0.28}));
+    EXPECT_EQ(artisticParams(p).falloff, (std::array<double, 3>{1.0, 0.37, 0.3}));
 }
 
 TEST(SssParams, ReadsEveryKey) {
@@ -67,8 +69,8 @@ material = "marble"
     EXPECT_EQ(p.material, "marble");
     const SssParams artistic = readSss("[sss]\nmethod = \"artistic\"\nartistic_strength = [0.1, 0.2, 0.3]\n"
                                        "artistic_falloff = [0.4, 0.5, 0.6]\n");
-    EXPECT_EQ(artistic.artisticStrength[0], 0.1);
-    EXPECT_EQ(artistic.artisticFalloff[2], 0.6);
+    EXPECT_EQ(artisticParams(artistic).strength[0], 0.1);
+    EXPECT_EQ(artisticParams(artistic).falloff[2], 0.6);
 }
 
 TEST(SssParams, ErrorsNameFileKeyAndValue) {
@@ -184,12 +186,12 @@ TEST(SssParams, ThesisVariantKeys) {
 // and the key.
 TEST(SssParams, ReferenceThroughLightKeys) {
     const SssParams defaults = readSss("[sss]\nmethod = \"reference\"\n");
-    EXPECT_EQ(defaults.referenceThroughGain, (std::array<double, 3>{1.181, 5.727, 9.723}));
-    EXPECT_EQ(defaults.referenceThroughGrowthPerMm2, (std::array<double, 3>{0.04, -0.04, 0.0}));
+    EXPECT_EQ(referenceParams(defaults).throughGain, (std::array<double, 3>{1.181, 5.727, 9.723}));
+    EXPECT_EQ(referenceParams(defaults).throughGrowthPerMm2, (std::array<double, 3>{0.04, -0.04, 0.0}));
     const SssParams p = readSss("[sss]\nmethod = \"reference\"\nreference_through_gain = [1.72, 5.31, 9.44]\n"
                                 "reference_through_growth_per_mm2 = [0, 0.0, -0.5]\n");
-    EXPECT_EQ(p.referenceThroughGain, (std::array<double, 3>{1.72, 5.31, 9.44}));
-    EXPECT_EQ(p.referenceThroughGrowthPerMm2, (std::array<double, 3>{0.0, 0.0, -0.5}));
+    EXPECT_EQ(referenceParams(p).throughGain, (std::array<double, 3>{1.72, 5.31, 9.44}));
+    EXPECT_EQ(referenceParams(p).throughGrowthPerMm2, (std::array<double, 3>{0.0, 0.0, -0.5}));
     EXPECT_EQ(sssParamsFromJson(p.toJson()).toJson(), p.toJson());
     EXPECT_EQ(p.toJson().at("reference_through_growth_per_mm2"), nlohmann::json({0.0, 0.0, -0.5}));
     const std::string head = "[sss]\nmethod = \"reference\"\nreference_through_growth_per_mm2 = ";
@@ -235,7 +237,7 @@ TEST(SssParams, KeyOfAnotherMethodIsAnError) {
         SssParams p;
         p.method = info.method;
         const nlohmann::json json = p.toJson();
-        EXPECT_EQ(json.size(), kCommonSssKeys.size() + info.keys.size()) << info.name;
+        EXPECT_EQ(json.size(), kCommonSssKeys.size() + info.keys.size() + info.ownKeys.size()) << info.name;
         for (const auto& [key, value] : json.items()) EXPECT_TRUE(methodUsesKey(info.method, key)) << key;
         EXPECT_EQ(sssParamsFromJson(json).toJson(), json) << info.name;
     }
