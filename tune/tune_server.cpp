@@ -403,7 +403,7 @@ HttpResponse TuneServer::render(const json& body) {
     probe.overrides = config.overrides;
     probe.assetsDir = options_.assetsDir;
     const json resolved = renderer::resolveScene(probe); // bad values: the CLI's one-line error, before any GL
-    const std::string method = resolved["sss"].value("method", "none");
+    const std::string method = resolved["sss"].value("method", std::string(sss::methodName(sss::SssMethod{})));
     if (!sss::findMethod(method)->interactive) {
         // Slow: a background render the page follows (/api/job) and may cancel.
         const std::string id = jobs_->start(config, method, resolved["render"]["width"].get<int>(),

@@ -60,7 +60,8 @@ void checkSssParams(const SpecReader& sss, const SssParams& p) {
 }
 
 SssParams readSssTable(const SpecReader& sss) {
-    const SssMethod method = findMethod(sss.choice("method", "none", methodNames()))->method;
+    const SssMethod method =
+        findMethod(sss.choice("method", std::string(methodName(SssMethod{})), methodNames()))->method;
     // A key of another method would be ignored silently: refuse it, naming the key and the method.
     for (const std::string_view key : allSssKeys())
         if (sss.has(key) && !methodUsesKey(method, key)) sss.fail(key, notAParameterMessage(method));
