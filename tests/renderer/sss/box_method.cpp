@@ -1,15 +1,30 @@
 // sss.method = "box" (test only): equal weights over ±box_half_width_mm on the surface, with one key of its own — a
-// method written as docs/methods.md, "Adding a method", says: this file is the whole method (its class and its
-// row), and test_method_recipe.cpp's one SKINLAB_REGISTER_METHOD line registers it.
+// method written as docs/methods.md, "Adding a method", says: this file is the whole method (its class, its own key
+// bound to its typed parameters, and its row), and test_method_recipe.cpp's one SKINLAB_REGISTER_METHOD line
+// registers it.
 #include "renderer/sss/method.h"
 
 namespace skinlab::renderer::sss {
 
 namespace {
+// Its own parameters; the initialisers are the keys' defaults.
+struct BoxParams {
+    double halfWidthMm = 2.0;
+};
+
+// Its own keys, bound to BoxParams.
+const std::vector<BoundKey<BoxParams>>& boxKeys() {
+    static const std::vector<BoundKey<BoxParams>> keys{
+        boundKey({"box_half_width_mm", KeyType::Number, 0.1, 20.0, {}, "mm", "half width of the box"},
+                 &BoxParams::halfWidthMm),
+    };
+    return keys;
+}
+
 class BoxMethod final : public Method {
 public:
     Kernel kernel(const SssParams& params) const override {
-        const double half = sssKey("box_half_width_mm").get(params).get<double>();
+        const double half = ownParams(params, boxKeys()).halfWidthMm;
         KernelStage stage;
         const int n = params.samples;
         for (int i = 0; i < n; ++i) {
@@ -32,7 +47,7 @@ MethodInfo boxMethod() {
             true,
             "test: equal weights over ±box_half_width_mm",
             {"samples", "follow_surface", "follow_surface_k"},
-            {ownKey({"box_half_width_mm", KeyType::Number, 0.1, 20.0, {}, "mm", "half width of the box"}, 2.0)},
+            ownKeys(boxKeys()),
             {},
             std::make_shared<BoxMethod>()};
 }
