@@ -91,8 +91,8 @@ struct SssParams {
     // stops all light crossing it.
     bool followSurface = true;
     double followSurfaceK = 0.5; // 1/mm
-    // Profile of the separable and reference methods: "deon" (six Gaussians), "burley" (normalized diffusion) or "file:PATH"
-    // (a tabulated .bn kernel, Jimenez et al. 2015 supplementary format).
+    // Profile of the separable and reference methods: "deon" (six Gaussians), "burley" (normalized diffusion) or
+    // "file:PATH" (a tabulated .bn kernel, Jimenez et al. 2015 supplementary format).
     std::string profile = "deon";
     // Material of the profile: "skin" (d'Eon's table; for burley, d matched to its second moment) or one of the
     // measured media of Jensen et al. 2001 (skin1, skin2, marble, apple, ketchup, wholemilk; burley only).
