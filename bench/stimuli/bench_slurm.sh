@@ -8,7 +8,7 @@
 #    the start cost of a task (its build time minus the sum of its stimuli);
 #  - whether the merged set equals the local build, hash for hash.
 # Usage: bench/stimuli/bench_slurm.sh SKINLAB SPEC [SHARDS=4] [--set key=value ...]  (as root; needs slurm-wlm,
-# munge, jq; SKINLAB_ASSETS for specs that use the scanned head)
+# munge, jq; SKINLAB_ASSETS for specs that use the scanned head). Exits 77 where the cluster cannot run here.
 set -euo pipefail
 SKINLAB=$(readlink -f "$1")
 SPEC=$(readlink -f "$2")
@@ -17,6 +17,7 @@ shift $(($# < 3 ? $# : 3))
 EXTRA=("$@")
 HERE=$(cd "$(dirname "$0")/../.." && pwd)
 source "$HERE/tests/stimuli/slurm_cluster.sh"
+slurm_cluster_require # exits 77 (skipped) without Slurm, munge, jq, root or cgroups
 
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/skinlab-bench-slurm.XXXXXX")
 trap 'slurm_cluster_stop; rm -rf "$WORK"' EXIT
