@@ -664,7 +664,10 @@ TEST_F(StimuliBuild, SetMetricsReproduceThePredictionsAndVisibilitySpansViewingD
 // and `stimuli visibility` read back; a bad value fails before rendering, a bad recorded one names file and key.
 TEST_F(StimuliBuild, CustomDisplayIsRecordedAndReadBackExactly) {
     const fs::path set = gRoot / "custom-display", metrics = gRoot / "custom-display-metrics";
-    const fs::path spec = writeSpec("custom-display.toml", presentedSpec("custom-display", false));
+    // With SSS, so that the reference carries its scattering radius for the metrics' bands.
+    std::string text = presentedSpec("custom-display", false);
+    text.replace(text.find("method = \"none\""), 15, "method = \"separable\"");
+    const fs::path spec = writeSpec("custom-display.toml", text);
     const std::vector<std::string> build = {"stimuli",    "build",          spec.string(), "-o",
                                             set.string(), "--display-peak", "500",         "--display-contrast",
                                             "2000",       "--display-ppd",  "20",          "--no-contact-sheet"};
