@@ -107,7 +107,8 @@ void runAnalyzeMetrics(const AnalyzeMetricsArguments& arguments) {
         warnAboutMixedRenderers(arguments.stimulusFolder);
         // The set's viewing geometry: the display its predictions were made for, unless --display says otherwise.
         if (plan.display && !arguments.display.name) {
-            display = arguments.display.resolve(plan.display);
+            const metrics::CvvdpDisplayOverrides changes = arguments.display.changes();
+            display = metrics::applyCvvdpOverrides(*plan.recordedDisplay(), changes);
             displaySource = "the set's predictions (manifest.json predicted.display)";
         } else if (plan.display && *arguments.display.name != *plan.display) {
             spdlog::warn("metrics: the set's predictions are on {}, these metrics on --display {}: their "

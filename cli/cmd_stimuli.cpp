@@ -25,7 +25,7 @@ namespace {
 
 struct StimuliOptions {
     bool noPredict = false;
-    std::string display = "standard_fhd"; // build (predictions) and calibrate: the ColorVideoVDP display model
+    DisplayArguments display; // build (predictions) and calibrate: ColorVideoVDP's display, --display and --display-*
     std::string spec;
     std::string output;
     std::string shard;
@@ -93,8 +93,7 @@ void runBuild(const StimuliOptions& o) {
     options.assetsDir = o.assets;
     options.contactSheet = !o.noContactSheet;
     options.predict = !o.noPredict;
-    options.display = o.display;
-    if (options.predict) (void)metrics::cvvdpDisplay(o.display); // an unknown name fails before anything renders
+    if (options.predict) options.display = o.display.resolve(); // a bad display fails before anything renders
     options.progress = o.progress == "bar"     ? stimuli::BuildOptions::ProgressStyle::bar
                        : o.progress == "lines" ? stimuli::BuildOptions::ProgressStyle::lines
                                                : stimuli::BuildOptions::ProgressStyle::automatic;
@@ -280,7 +279,7 @@ void runCalibrate(const StimuliOptions& o) {
     }
     options.tolerance = o.tolerance;
     options.maxProbes = o.maxProbes;
-    options.display = o.display;
+    options.display = o.display.resolve();
     options.stimulus = o.stimulus;
     if (!o.output.empty() && std::filesystem::is_directory(o.output))
         throwInput("-o", "", o.output + " is a folder (give the TOML file to write)");
@@ -336,10 +335,7 @@ void registerStimuli(CLI::App& app) {
     build->add_flag("--no-contact-sheet", options->noContactSheet, "Do not write contact.html / contact.png");
     build->add_flag("--no-predict", options->noPredict,
                     "Do not predict each stimulus's visibility against its block's reference (ColorVideoVDP)");
-    build
-        ->add_option("--display", options->display,
-                     "Display model of the predictions (analysis/metrics/cvvdp/display_models.json)")
-        ->capture_default_str();
+    addDisplayOptions(*build, options->display, "Display model of the predictions (default standard_fhd)");
     build->add_option("--progress", options->progress, "Progress display: auto (bar on a terminal), bar, lines")
         ->check(CLI::IsMember({"auto", "bar", "lines"}));
     build->callback([options] { runBuild(*options); });
@@ -425,7 +421,7 @@ void registerStimuli(CLI::App& app) {
                           "LO,HI searched (default: the smallest and largest level of the spec's factor)");
     calibrate->add_option("--tolerance", options->tolerance, "JOD within which a target counts as reached (0.05)");
     calibrate->add_option("--max-probes", options->maxProbes, "Renders per target at most (24)");
-    calibrate->add_option("--display", options->display, "ColorVideoVDP display model (standard_fhd)");
+    addDisplayOptions(*calibrate, options->display, "ColorVideoVDP display model (default standard_fhd)");
     calibrate->add_option("--stimulus", options->stimulus,
                           "Id of the stimulus whose key varies (default: the first that is not a reference)");
     calibrate->add_option("-o,--output", options->output, "Write the [[factor]] snippet to this file (atomically)");

@@ -2,6 +2,7 @@
 // images from other renderers").
 #include "analysis/metrics/cvvdp.h"
 #include "cli/commands.h"
+#include "cli/options.h"
 #include "stimuli/import.h"
 
 #include <cstdio>
@@ -17,7 +18,7 @@ struct ImportArguments {
     std::string name;
     bool noContactSheet = false;
     bool noPredict = false;
-    std::string display = "standard_fhd";
+    DisplayArguments display; // of the predictions: --display and --display-*
 };
 } // namespace
 
@@ -35,10 +36,7 @@ void registerStimuliImport(CLI::App& stimuli) {
     command->add_flag("--no-contact-sheet", arguments->noContactSheet, "Do not write contact.html / contact.png");
     command->add_flag("--no-predict", arguments->noPredict,
                       "Do not predict each stimulus's visibility against its block's reference (ColorVideoVDP)");
-    command
-        ->add_option("--display", arguments->display,
-                     "Display model of the predictions (analysis/metrics/cvvdp/display_models.json)")
-        ->capture_default_str();
+    addDisplayOptions(*command, arguments->display, "Display model of the predictions (default standard_fhd)");
     command->callback([arguments] {
         stimuli::ImportOptions options;
         options.table = arguments->table;
@@ -47,8 +45,7 @@ void registerStimuliImport(CLI::App& stimuli) {
         options.name = arguments->name;
         options.contactSheet = !arguments->noContactSheet;
         options.predict = !arguments->noPredict;
-        options.display = arguments->display;
-        if (options.predict) (void)metrics::cvvdpDisplay(options.display); // an unknown name fails before writing
+        if (options.predict) options.display = arguments->display.resolve(); // a bad display fails before writing
         const stimuli::ImportSummary summary = stimuli::importStimuli(options);
         std::printf("stimuli: imported set '%s': %zu stimuli in %zu block(s); manifest: %s\n", summary.set.c_str(),
                     summary.stimuli, summary.blocks, summary.manifest.string().c_str());

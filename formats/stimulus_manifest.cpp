@@ -4,6 +4,8 @@
 #include "common/files.h"
 #include "common/hash.h"
 
+#include <cmath>
+#include <limits>
 #include <set>
 
 namespace skinlab::formats {
@@ -62,6 +64,14 @@ public:
             throwInput(file_, key(name), "expected an integer in [1, 16384], not " + value.dump());
         return value.get<int>();
     }
+    // A finite number in [low, high] (`what` says so in the error).
+    double number(const std::string& name, double low, double high, const std::string& what) const {
+        const nlohmann::json& value = required(name);
+        if (!value.is_number() || !std::isfinite(value.get<double>()) || value.get<double>() < low ||
+            value.get<double>() > high)
+            throwInput(file_, key(name), "expected " + what + ", not " + value.dump());
+        return value.get<double>();
+    }
     std::optional<nlohmann::json> optionalObject(const std::string& name) const {
         const nlohmann::json* value = find(name);
         if (!value) return std::nullopt;
@@ -88,28 +98,93 @@ std::string ManifestEntry::factorText(const std::string& name) const {
     return value.is_string() ? value.get<std::string>() : value.dump();
 }
 
-nlohmann::json toJson(const Prediction& p) {
-    return {{"metric", p.metric},
-            {"display", p.display},
-            {"reference", p.reference},
-            {"jod", p.jod},
-            {"reference_png_sha256", p.referencePngSha256},
-            {"png_sha256", p.pngSha256}};
+nlohmann::json toJson(const DisplayModel& d) {
+    nlohmann::json j = {{"description", d.description},
+                        {"eotf", d.eotf},
+                        {"peak_luminance", d.peakLuminance},
+                        {"contrast", d.contrast},
+                        {"ambient_illuminance", d.ambientIlluminance},
+                        {"reflectivity", d.reflectivity},
+                        {"pixels_per_degree", d.pixelsPerDegree}};
+    if (d.resolutionWidth > 0) j["resolution"] = {d.resolutionWidth, d.resolutionHeight};
+    if (d.diagonalInches > 0.0) j["diagonal_in"] = d.diagonalInches;
+    if (d.viewingDistanceMetres > 0.0) j["viewing_distance_m"] = d.viewingDistanceMetres;
+    return j;
 }
 
-nlohmann::json toJson(const ManifestEntry& e) {
+nlohmann::json toJson(const Prediction& p) {
+    nlohmann::json j = {{"metric", p.metric},
+                        {"display", p.display},
+                        {"reference", p.reference},
+                        {"jod", p.jod},
+                        {"reference_png_sha256", p.referencePngSha256},
+                        {"png_sha256", p.pngSha256}};
+    if (p.displayModel) j["display_model"] = toJson(*p.displayModel);
+    return j;
+}
+
+namespace {
+
+DisplayModel displayModelFromJson(const Members& d, const std::string& file) {
+    constexpr double kMax = std::numeric_limits<double>::max();
+    DisplayModel model;
+    model.description = d.optionalString("description");
+    model.eotf = d.string("eotf");
+    model.peakLuminance = d.number("peak_luminance", std::numeric_limits<double>::min(), kMax, "a positive number");
+    model.contrast = d.number("contrast", 1.0, kMax, "a number >= 1");
+    model.ambientIlluminance = d.number("ambient_illuminance", 0.0, kMax, "a number >= 0");
+    model.reflectivity = d.number("reflectivity", 0.0, 1.0, "a number in [0, 1]");
+    model.pixelsPerDegree =
+        d.number("pixels_per_degree", std::numeric_limits<double>::min(), kMax, "a positive number");
+    if (const nlohmann::json* resolution = d.find("resolution")) {
+        const bool pair = resolution->is_array() && resolution->size() == 2 && (*resolution)[0].is_number_integer() &&
+                          (*resolution)[1].is_number_integer() && (*resolution)[0].get<std::int64_t>() > 0 &&
+                          (*resolution)[1].get<std::int64_t>() > 0 && (*resolution)[0].get<std::int64_t>() < 1 << 20 &&
+                          (*resolution)[1].get<std::int64_t>() < 1 << 20;
+        if (!pair)
+            throwInput(file, d.key("resolution"), "expected [WIDTH, HEIGHT] in pixels, not " + resolution->dump());
+        model.resolutionWidth = (*resolution)[0].get<int>();
+        model.resolutionHeight = (*resolution)[1].get<int>();
+    }
+    if (d.find("diagonal_in"))
+        model.diagonalInches = d.number("diagonal_in", std::numeric_limits<double>::min(), kMax, "a positive number");
+    if (d.find("viewing_distance_m"))
+        model.viewingDistanceMetres =
+            d.number("viewing_distance_m", std::numeric_limits<double>::min(), kMax, "a positive number");
+    return model;
+}
+
+} // namespace
+
+namespace {
+// The files an entry lists (a hand-made set may lack one kind): path or sha256 of each.
+nlohmann::json listedFiles(const ManifestEntry& e, const StimulusFiles& values) {
+    nlohmann::json j = nlohmann::json::object();
+    if (!e.files.exr.empty()) j["exr"] = values.exr;
+    if (!e.files.png.empty()) j["png"] = values.png;
+    return j;
+}
+} // namespace
+
+nlohmann::json toPlannedJson(const ManifestEntry& e) {
     nlohmann::json j = {{"id", e.id},
-                        {"files", {{"exr", e.files.exr}, {"png", e.files.png}}},
-                        {"sha256", {{"exr", e.sha256.exr}, {"png", e.sha256.png}}},
+                        {"files", listedFiles(e, e.files)},
                         {"factors", e.factors},
                         {"block", e.block},
                         {"reference", e.reference},
-                        {"width", e.width},
-                        {"height", e.height},
                         {"scene", e.scene},
                         {"overrides", e.overrides},
-                        {"resolved", e.resolved},
-                        {"timings_ms", e.timingsMs}};
+                        {"resolved", e.resolved}};
+    if (e.presentation) j["presentation"] = *e.presentation;
+    return j;
+}
+
+nlohmann::json toJson(const ManifestEntry& e) {
+    nlohmann::json j = toPlannedJson(e);
+    j["sha256"] = listedFiles(e, e.sha256);
+    j["width"] = e.width;
+    j["height"] = e.height;
+    j["timings_ms"] = e.timingsMs;
     if (e.presentation) j["presentation"] = *e.presentation;
     if (e.predicted) j["predicted"] = toJson(*e.predicted);
     if (e.provenance) j["provenance"] = *e.provenance;
@@ -162,6 +237,14 @@ ManifestEntry manifestEntryFromJson(const nlohmann::json& json, const std::strin
         prediction.reference = p.optionalString("reference");
         prediction.referencePngSha256 = p.optionalString("reference_png_sha256");
         prediction.pngSha256 = p.optionalString("png_sha256");
+        if (auto model = p.optionalObject("display_model")) {
+            if (prediction.display != "custom")
+                throwInput(file, p.key("display"),
+                           "\"" + prediction.display + "\" with a display_model: expected \"custom\"");
+            prediction.displayModel = displayModelFromJson(Members(*model, file, p.key("display_model")), file);
+        } else if (prediction.display == "custom") {
+            throwInput(file, p.key("display_model"), "missing: a custom display lists its parameters");
+        }
         e.predicted = prediction;
     }
     return e;

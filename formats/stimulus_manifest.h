@@ -23,15 +23,34 @@ struct StimulusFiles {
     bool operator==(const StimulusFiles&) const = default;
 };
 
+// A custom display (a named model changed by --display-*, whose name is "custom"): every parameter, so that a
+// reader of the set computes on the exact display ("predicted": {"display": "custom", "display_model": {...}}).
+// The fields are those of metrics::CvvdpDisplay (analysis/metrics/cvvdp.h), which converts both ways.
+struct DisplayModel {
+    std::string description;         // "custom display based on ..."
+    std::string eotf;                // "sRGB", "PQ", "HLG", "linear" or a gamma ("2.2")
+    double peakLuminance = 0.0;      // cd/m², > 0
+    double contrast = 0.0;           // peak / black, >= 1
+    double ambientIlluminance = 0.0; // lux, >= 0
+    double reflectivity = 0.0;       // [0, 1]
+    double pixelsPerDegree = 0.0;    // > 0
+    int resolutionWidth = 0;         // the geometry as given; 0 when not (the ppd was given directly)
+    int resolutionHeight = 0;
+    double diagonalInches = 0.0;
+    double viewingDistanceMetres = 0.0;
+    bool operator==(const DisplayModel&) const = default;
+};
+
 // "predicted": ColorVideoVDP of the presented PNG against its block's reference (stimuli/prediction.h). Only the
 // JOD is required; the strings are "" when absent.
 struct Prediction {
     std::string metric;  // "ColorVideoVDP v0.5.6"
-    std::string display; // display model
+    std::string display; // display model: its name in display_models.json, or "custom"
     std::string reference;
     double jod = 0.0;
     std::string referencePngSha256; // the images it was computed on, to tell when it is out of date
     std::string pngSha256;
+    std::optional<DisplayModel> displayModel; // a custom display's parameters ("display_model")
     bool operator==(const Prediction&) const = default;
 };
 
@@ -58,7 +77,11 @@ struct ManifestEntry {
 };
 
 nlohmann::json toJson(const ManifestEntry& entry);
+// An entry before its stimulus is rendered (`stimuli list --format json`): toJson without sha256, width, height,
+// timings_ms, predicted and provenance.
+nlohmann::json toPlannedJson(const ManifestEntry& entry);
 nlohmann::json toJson(const Prediction& prediction);
+nlohmann::json toJson(const DisplayModel& display);
 // The strict reader of one entry; `file` and `index` name it in errors ("FILE: stimuli[INDEX].KEY: ...").
 ManifestEntry manifestEntryFromJson(const nlohmann::json& json, const std::string& file, std::size_t index);
 // Every entry of a manifest's "stimuli" array (ids unique).

@@ -199,7 +199,8 @@ std::vector<ParticipantPrediction> participantPredictions(const nlohmann::json& 
     const std::vector<formats::ManifestEntry> entries = storedManifestEntries(manifest);
     // The predicted stimuli and their references, by block.
     struct Predicted {
-        std::string block, png, referencePng, display;
+        std::string block, png, referencePng;
+        metrics::CvvdpDisplay display; // the prediction's, named or custom
         double jod = 0.0;
     };
     std::map<std::string, std::string> pngOf;
@@ -208,7 +209,10 @@ std::vector<ParticipantPrediction> participantPredictions(const nlohmann::json& 
     for (const formats::ManifestEntry& s : entries)
         if (s.predicted && pngOf.count(s.predicted->reference))
             predicted.push_back({s.block, s.files.png, pngOf[s.predicted->reference],
-                                 s.predicted->display.empty() ? std::string("standard_fhd") : s.predicted->display,
+                                 s.predicted->displayModel
+                                     ? metrics::cvvdpDisplayOf(*s.predicted->displayModel)
+                                     : metrics::cvvdpDisplay(s.predicted->display.empty() ? std::string("standard_fhd")
+                                                                                          : s.predicted->display),
                                  s.predicted->jod});
     if (predicted.empty()) return out;
     std::map<std::string, metrics::MetricRender> images;
@@ -229,8 +233,7 @@ std::vector<ParticipantPrediction> participantPredictions(const nlohmann::json& 
             for (const Predicted& p : predicted) {
                 metrics::CvvdpDisplayOverrides overrides;
                 overrides.pixelsPerDegree = key;
-                const metrics::CvvdpDisplay display =
-                    metrics::applyCvvdpOverrides(metrics::cvvdpDisplay(p.display), overrides);
+                const metrics::CvvdpDisplay display = metrics::applyCvvdpOverrides(p.display, overrides);
                 jods.push_back(metrics::cvvdp(image(p.referencePng), image(p.png), display, false).jod);
             }
             byPpd[key] = std::move(jods);

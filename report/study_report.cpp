@@ -327,7 +327,8 @@ Metrics readMetrics(const ReportOptions& options, const fs::path& stimuliFolder,
             // One viewing geometry: the display the set's predictions were made for (docs/metrics.md).
             // --display names another model; --ppd and --display-* change it.
             metricOptions.metric.display = metrics::applyCvvdpOverrides(
-                metrics::cvvdpDisplay(options.display.value_or(plan.display.value_or("standard_fhd"))),
+                options.display ? metrics::cvvdpDisplay(*options.display)
+                                : plan.recordedDisplay().value_or(metrics::cvvdpDisplay("standard_fhd")),
                 options.displayChanges);
             metricOptions.displaySource = options.display ? "--display"
                                           : plan.display  ? "the set's predictions (manifest.json predicted.display)"

@@ -137,9 +137,9 @@ std::pair<int, int> imageSize(const fs::path& path) {
 }
 
 // Renders one stimulus into temporary files and renames them into place; returns its complete manifest entry.
-nlohmann::json renderStimulus(renderer::Renderer& renderer, const Stimulus& stimulus,
-                              const std::vector<std::string>& overrides, const nlohmann::json& resolved,
-                              const fs::path& dir, const fs::path& assets) {
+formats::ManifestEntry renderStimulus(renderer::Renderer& renderer, const Stimulus& stimulus,
+                                      const std::vector<std::string>& overrides, const nlohmann::json& resolved,
+                                      const fs::path& dir, const fs::path& assets) {
     auto start = std::chrono::steady_clock::now();
     AtomicOutput exr(dir / exrRelativePath(stimulus.id));
     AtomicOutput png(dir / pngRelativePath(stimulus.id));
@@ -163,22 +163,20 @@ nlohmann::json renderStimulus(renderer::Renderer& renderer, const Stimulus& stim
         result.timingsMs.is_object() ? result.timingsMs : nlohmann::json{{"render", result.timingsMs}};
     timings["stimulus_wall"] = secondsSince(start) * 1000.0; // render + write + hash, ms
     entry.timingsMs = timings;
-    return formats::toJson(entry);
+    return entry;
 }
 
 // An earlier entry is still valid when its resolved parameters are identical and both files are intact.
-bool entryStillValid(const nlohmann::json& entry, const nlohmann::json& resolved, const nlohmann::json& presentation,
-                     const fs::path& dir) {
-    if (!entry.contains("resolved") || entry["resolved"] != resolved) return false;
-    if (!entry.contains("presentation") || entry["presentation"] != presentation) return false;
-    try {
-        for (const char* kind : {"exr", "png"}) {
-            fs::path file = dir / entry.at("files").at(kind).get<std::string>();
-            if (!fs::is_regular_file(file)) return false;
-            if (sha256File(file) != entry.at("sha256").at(kind).get<std::string>()) return false;
-        }
-    } catch (const std::exception&) {
-        return false;
+bool entryStillValid(const formats::ManifestEntry& entry, const nlohmann::json& resolved,
+                     const nlohmann::json& presentation, const fs::path& dir) {
+    if (entry.resolved != resolved) return false;
+    if (!entry.presentation || *entry.presentation != presentation) return false;
+    using File = std::pair<const std::string&, const std::string&>; // relative path, sha256
+    for (const File& file : {File{entry.files.exr, entry.sha256.exr}, File{entry.files.png, entry.sha256.png}}) {
+        const auto& [relative, sha256] = file;
+        if (relative.empty()) return false;
+        const fs::path path = dir / relative;
+        if (!fs::is_regular_file(path) || sha256File(path) != sha256) return false;
     }
     return true;
 }
@@ -202,9 +200,7 @@ formats::ManifestEntry stimulusEntry(const Stimulus& stimulus, const nlohmann::j
 }
 
 nlohmann::json plannedEntryJson(const Stimulus& stimulus, const nlohmann::json& resolved) {
-    nlohmann::json json = formats::toJson(stimulusEntry(stimulus, resolved));
-    for (const char* key : {"sha256", "width", "height", "timings_ms"}) json.erase(key);
-    return json;
+    return formats::toPlannedJson(stimulusEntry(stimulus, resolved));
 }
 
 BuildPlan planBuild(const fs::path& specPath, const std::vector<std::string>& specOverrides,
@@ -264,27 +260,23 @@ void warnReplicated(const BuildPlan& plan) {
 
 // The entries of an earlier build of this version that are still valid, by id (the earlier renderer into
 // manifest.renderer).
-std::map<std::string, nlohmann::json> keptEntries(const BuildPlan& plan, const std::optional<Manifest>& existing,
-                                                  const fs::path& dir, Manifest& manifest) {
-    std::map<std::string, nlohmann::json> entries; // id → entry of every stimulus done
+std::map<std::string, formats::ManifestEntry>
+keptEntries(const BuildPlan& plan, const std::optional<Manifest>& existing, const fs::path& dir, Manifest& manifest) {
+    std::map<std::string, formats::ManifestEntry> entries; // id → entry of every stimulus done
     if (existing && existing->renderer.skinlabVersion == version()) {
         manifest.renderer = existing->renderer;
         for (size_t i = 0; i < plan.selected.size(); ++i) {
             const Stimulus& s = plan.selected[i];
-            for (std::size_t k = 0; k < existing->stimuli.size(); ++k) {
-                const nlohmann::json& old = existing->stimuli[k];
-                if (old.value("id", "") != s.id ||
-                    !entryStillValid(old, plan.resolved[i], presentationOf(s, plan.resolved[i]), dir))
+            for (const formats::ManifestEntry& kept : existing->stimuli) {
+                if (kept.id != s.id ||
+                    !entryStillValid(kept, plan.resolved[i], presentationOf(s, plan.resolved[i]), dir))
                     continue;
-                // The earlier entry passed the strict reader when the manifest was read.
-                const formats::ManifestEntry kept =
-                    formats::manifestEntryFromJson(old, (dir / kManifestFile).string(), k);
                 formats::ManifestEntry entry = stimulusEntry(s, plan.resolved[i]);
                 entry.sha256 = kept.sha256;
                 entry.width = kept.width;
                 entry.height = kept.height;
                 entry.timingsMs = kept.timingsMs;
-                entries[s.id] = formats::toJson(entry);
+                entries[s.id] = std::move(entry);
             }
         }
     }
@@ -293,7 +285,7 @@ std::map<std::string, nlohmann::json> keptEntries(const BuildPlan& plan, const s
 
 // The manifest with every entry done so far, in the selection's order; complete once all are there.
 void writeCurrentManifest(const fs::path& dir, const BuildPlan& plan,
-                          const std::map<std::string, nlohmann::json>& entries, Manifest& manifest) {
+                          const std::map<std::string, formats::ManifestEntry>& entries, Manifest& manifest) {
     manifest.stimuli.clear();
     for (const auto& s : plan.selected)
         if (auto it = entries.find(s.id); it != entries.end()) manifest.stimuli.push_back(it->second);
@@ -304,7 +296,7 @@ void writeCurrentManifest(const fs::path& dir, const BuildPlan& plan,
 // Renders the stimuli of toRender (all of them when the kept ones came from another renderer) on options.jobs
 // threads, the manifest rewritten after each; returns how many were rendered.
 size_t renderStimuli(const BuildOptions& options, const BuildPlan& plan, Manifest& manifest,
-                     std::map<std::string, nlohmann::json>& entries, std::vector<size_t>& toRender) {
+                     std::map<std::string, formats::ManifestEntry>& entries, std::vector<size_t>& toRender) {
     const fs::path& dir = options.outputDir;
     auto first = std::make_unique<renderer::Renderer>();
     RendererInfo current{first->glRenderer(), first->glVersion(), version()};
@@ -341,7 +333,7 @@ size_t renderStimuli(const BuildOptions& options, const BuildPlan& plan, Manifes
                 if (k >= toRender.size()) return;
                 const size_t i = toRender[k];
                 auto t0 = std::chrono::steady_clock::now();
-                nlohmann::json entry;
+                formats::ManifestEntry entry;
                 try {
                     entry = renderStimulus(*renderer, plan.selected[i], plan.renderOverrides[i], plan.resolved[i], dir,
                                            options.assetsDir);
@@ -384,7 +376,7 @@ BuildSummary buildSet(const BuildOptions& options) {
     existing = claimOutputFolder(dir, plan.spec.name, options.shard); // re-read: a build may have ended meanwhile
 
     Manifest manifest = manifestHeader(plan.spec, plan.all, options.shard);
-    std::map<std::string, nlohmann::json> entries = keptEntries(plan, existing, dir, manifest);
+    std::map<std::string, formats::ManifestEntry> entries = keptEntries(plan, existing, dir, manifest);
     std::vector<size_t> toRender;
     std::vector<std::string> selectedIds;
     for (size_t i = 0; i < plan.selected.size(); ++i) {

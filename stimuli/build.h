@@ -2,6 +2,7 @@
 // `skinlab stimuli build`: expands a set spec, checks everything that can be checked without rendering (spec,
 // factor levels against the scene spec, assets, output folder), then renders each missing or changed stimulus
 // (EXR with AOVs + display PNG, written atomically), rewriting the manifest atomically after each one.
+#include "analysis/metrics/cvvdp.h"
 #include "stimuli/expansion.h"
 #include "stimuli/manifest.h"
 
@@ -23,9 +24,10 @@ struct BuildOptions {
     std::filesystem::path assetsDir; // empty: $SKINLAB_ASSETS
     bool contactSheet = true;
     enum class ProgressStyle { automatic, bar, lines } progress = ProgressStyle::automatic;
-    // Predicted visibility (stimuli/prediction.h): each stimulus against its block's reference, on this display.
+    // Predicted visibility (stimuli/prediction.h): each stimulus against its block's reference, on this display (a
+    // named model or a custom one, recorded in the manifest).
     bool predict = true;
-    std::string display = "standard_fhd";
+    metrics::CvvdpDisplay display = metrics::cvvdpDisplay("standard_fhd");
 };
 
 // The checked plan of a build: what would be rendered, and each stimulus's resolved scene parameters.

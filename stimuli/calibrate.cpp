@@ -357,8 +357,7 @@ std::pair<const Stimulus*, std::vector<std::string>> calibrationReference(const 
 CalibrationReport calibrateLevels(const CalibrateOptions& options) {
     const auto start = std::chrono::steady_clock::now();
     const std::string key = calibratedKey(options.factor);
-    // Checked before the spec so that a bad number is reported without reading it.
-    metrics::CvvdpDisplay display = metrics::cvvdpDisplay(options.display);
+    const metrics::CvvdpDisplay& display = options.display;
 
     BuildPlan plan = planBuild(options.spec, options.specOverrides, std::nullopt, options.assetsDir);
     const std::string& specName = plan.spec.fileName;

@@ -3,6 +3,8 @@
 // reference is a chosen number of JOD (ColorVideoVDP, analysis/metrics/cvvdp.h), found by bisection on the
 // prediction. The search itself (searchLevels) takes the prediction as a function, so that it is tested without
 // rendering; calibrateLevels renders each probe of one stimulus of a set spec with the set's fixed parameters.
+#include "analysis/metrics/cvvdp.h"
+
 #include <cmath>
 #include <filesystem>
 #include <functional>
@@ -63,8 +65,8 @@ struct CalibrateOptions {
     std::optional<std::pair<double, double>> range; // default: the smallest and largest level of the spec's factor
     double tolerance = 0.05;
     int maxProbes = 24;
-    std::string display = "standard_fhd"; // ColorVideoVDP display model
-    std::string stimulus;                 // id of the stimulus whose parameter varies; empty: the first non-reference
+    metrics::CvvdpDisplay display = metrics::cvvdpDisplay("standard_fhd"); // ColorVideoVDP's (named or custom)
+    std::string stimulus; // id of the stimulus whose parameter varies; empty: the first non-reference
 };
 
 struct CalibrationReport {

@@ -23,13 +23,13 @@ namespace {
 
 struct Block {
     std::string name;
-    std::vector<const nlohmann::json*> stimuli;
+    std::vector<const formats::ManifestEntry*> stimuli;
 };
 
 std::vector<Block> groupByBlock(const Manifest& manifest) {
     std::vector<Block> blocks;
-    for (const auto& s : manifest.stimuli) {
-        std::string name = s.at("block").get<std::string>();
+    for (const formats::ManifestEntry& s : manifest.stimuli) {
+        const std::string& name = s.block;
         auto it = std::find_if(blocks.begin(), blocks.end(), [&](const Block& b) { return b.name == name; });
         if (it == blocks.end()) {
             blocks.push_back({name, {}});
@@ -50,15 +50,14 @@ std::vector<std::string> varyingFactors(const Manifest& manifest, const Block& b
     std::vector<std::string> names;
     for (const auto& f : manifest.factors) names.push_back(f.value("name", ""));
     for (const auto* s : block.stimuli)
-        for (auto it = s->at("factors").begin(); it != s->at("factors").end(); ++it)
+        for (auto it = s->factors.begin(); it != s->factors.end(); ++it)
             if (std::find(names.begin(), names.end(), it.key()) == names.end()) names.push_back(it.key());
     std::vector<std::string> varying;
     for (const auto& name : names) {
         std::string first;
         bool differs = false;
         for (size_t i = 0; i < block.stimuli.size(); ++i) {
-            const auto& f = block.stimuli[i]->at("factors");
-            std::string v = f.contains(name) ? valueText(f[name]) : "";
+            const std::string v = block.stimuli[i]->factorText(name);
             if (i == 0) first = v;
             else if (v != first) differs = true;
         }
@@ -96,19 +95,20 @@ std::string levelText(const Manifest& manifest, const std::string& factor, const
     return text;
 }
 
-std::string caption(const Manifest& manifest, const nlohmann::json& stimulus, const std::vector<std::string>& varying) {
+std::string caption(const Manifest& manifest, const formats::ManifestEntry& stimulus,
+                    const std::vector<std::string>& varying) {
     std::string text;
-    const auto& f = stimulus.at("factors");
+    const nlohmann::json& f = stimulus.factors;
     for (const auto& name : varying)
-        if (f.contains(name)) text += (text.empty() ? "" : " ") + levelText(manifest, name, f[name]);
-    const bool reference = stimulus.at("reference").get<bool>();
+        if (f.contains(name)) text += (text.empty() ? "" : " ") + levelText(manifest, name, f.at(name));
+    const bool reference = stimulus.reference;
     if (reference) text += text.empty() ? "reference" : " (ref)";
-    if (text.empty()) text = stimulus.at("id").get<std::string>();
+    if (text.empty()) text = stimulus.id;
     // The visibility ColorVideoVDP predicts against the block's reference, when the build recorded it (not on the
     // reference itself: 10 JOD by definition).
-    if (!reference && stimulus.contains("predicted") && stimulus["predicted"].contains("jod")) {
+    if (!reference && stimulus.predicted) {
         char jod[64];
-        std::snprintf(jod, sizeof jod, " - predicted %.2f JOD", stimulus["predicted"]["jod"].get<double>());
+        std::snprintf(jod, sizeof jod, " - predicted %.2f JOD", stimulus.predicted->jod);
         text += jod;
     }
     return text;
@@ -150,8 +150,8 @@ std::vector<std::string> wrapCaption(const std::string& caption, int width, int 
 // 960×540 px (rendered natively)" (empty for a whole frame at magnification 1, or an entry without a presentation).
 std::string presentationText(const Block& block, bool ascii = false) {
     const std::string times = ascii ? "x" : "×", arrow = ascii ? "->" : "→";
-    if (block.stimuli.empty() || !block.stimuli.front()->contains("presentation")) return "";
-    const nlohmann::json& p = block.stimuli.front()->at("presentation");
+    if (block.stimuli.empty() || !block.stimuli.front()->presentation) return "";
+    const nlohmann::json& p = *block.stimuli.front()->presentation;
     const nlohmann::json& c = p.at("crop");
     const nlohmann::json& r = p.at("render");
     const int m = p.at("magnification").get<int>();
@@ -258,13 +258,13 @@ std::string html(const Manifest& manifest, const std::vector<Block>& blocks,
         if (visibility) out << visibilityTableHtml(*visibility, block.name);
         out << "<div class=\"grid\">\n";
         for (const auto* s : block.stimuli) {
-            bool reference = s->at("reference").get<bool>();
-            std::string png = s->at("files").at("png").get<std::string>();
+            const bool reference = s->reference;
+            const std::string& png = s->files.png;
             out << "<figure" << (reference ? " class=\"reference\"" : "") << "><a href=\"" << escapeHtml(png)
-                << "\"><img src=\"" << escapeHtml(png) << "\" alt=\"" << escapeHtml(s->at("id").get<std::string>())
-                << "\" loading=\"lazy\"></a>\n<figcaption><div class=\"id\">"
-                << escapeHtml(s->at("id").get<std::string>()) << (reference ? " — reference" : "") << "</div><table>";
-            const auto& f = s->at("factors");
+                << "\"><img src=\"" << escapeHtml(png) << "\" alt=\"" << escapeHtml(s->id)
+                << "\" loading=\"lazy\"></a>\n<figcaption><div class=\"id\">" << escapeHtml(s->id)
+                << (reference ? " — reference" : "") << "</div><table>";
+            const nlohmann::json& f = s->factors;
             for (auto it = f.begin(); it != f.end(); ++it)
                 out << "<tr><td>" << escapeHtml(it.key()) << "</td><td>" << escapeHtml(valueText(it.value()))
                     << "</td></tr>";
@@ -293,8 +293,8 @@ void writePng(const fs::path& path, const Manifest& manifest, const std::vector<
     // Each block's thumbnails keep its stimuli's aspect (blocks may be cropped differently).
     auto thumbHeightOf = [&](const Block& b) {
         const auto& first = *b.stimuli.front();
-        const int imageWidth = std::max(1, first.at("width").get<int>());
-        const int imageHeight = std::max(1, first.at("height").get<int>());
+        const int imageWidth = std::max(1, first.width);
+        const int imageHeight = std::max(1, first.height);
         return std::max(1, static_cast<int>(std::lround(double(thumbWidth) * imageHeight / imageWidth)));
     };
     // Captions wrap at word boundaries to the thumbnail's width, up to kCaptionLines lines (the last one cut).
@@ -339,9 +339,9 @@ void writePng(const fs::path& path, const Manifest& manifest, const std::vector<
             int column = static_cast<int>(i % maxColumns);
             if (i > 0 && column == 0) y += thumbHeight + captionHeight + margin;
             int x = margin + column * (thumbWidth + margin);
-            OIIO::ImageBuf thumb = thumbnail(dir / s.at("files").at("png").get<std::string>(), thumbWidth, thumbHeight);
+            OIIO::ImageBuf thumb = thumbnail(dir / s.files.png, thumbWidth, thumbHeight);
             OIIO::ImageBufAlgo::paste(sheet, x, y, 0, 0, thumb);
-            bool reference = s.at("reference").get<bool>();
+            const bool reference = s.reference;
             const std::vector<std::string> lines =
                 wrapCaption(caption(manifest, s, varying), thumbWidth, kCaptionLines, font);
             for (size_t line = 0; line < lines.size(); ++line)

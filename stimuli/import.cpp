@@ -534,7 +534,8 @@ void writeStimulusImages(const fs::path& dir, const Checked& c) {
 }
 
 // The stimulus's manifest entry.
-nlohmann::json stimulusEntry(const fs::path& dir, const Table& table, const Manifest& manifest, const Checked& c) {
+formats::ManifestEntry stimulusEntry(const fs::path& dir, const Table& table, const Manifest& manifest,
+                                     const Checked& c) {
     nlohmann::json factors = nlohmann::json::object();
     for (const std::string& f : table.factors)
         if (auto it = c.row->factors.find(f); it != c.row->factors.end()) factors[f] = it->second;
@@ -560,7 +561,7 @@ nlohmann::json stimulusEntry(const fs::path& dir, const Table& table, const Mani
     entry.height = c.height;
     entry.scene = factors.value("scene", "");
     entry.provenance = provenance;
-    return formats::toJson(entry);
+    return entry;
 }
 
 } // namespace

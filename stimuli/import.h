@@ -4,6 +4,8 @@
 // `study create`, `analyze metrics` and `report` use it unchanged. The table (CSV or TOML, docs/stimuli.md,
 // "Importing images from other renderers") names each image, its factor levels, block and reference flag, and how
 // its pixels are encoded. Everything is checked before anything is written.
+#include "analysis/metrics/cvvdp.h"
+
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -16,8 +18,8 @@ struct ImportOptions {
     std::filesystem::path images;    // folder the `file` paths are relative to (default: the table's folder)
     std::string name;                // set name (default: the table's `name`, else its file stem)
     bool contactSheet = true;
-    bool predict = true;                  // ColorVideoVDP against each block's reference, as `stimuli build` does
-    std::string display = "standard_fhd"; // display model of the predictions
+    bool predict = true; // ColorVideoVDP against each block's reference, as `stimuli build` does
+    metrics::CvvdpDisplay display = metrics::cvvdpDisplay("standard_fhd"); // of the predictions (named or custom)
 };
 
 struct ImportSummary {

@@ -46,7 +46,8 @@ nlohmann::json toJson(const Manifest& m) {
     if (m.shard) j["shard"] = {{"index", m.shard->index}, {"count", m.shard->count}};
     j["set_ids"] = m.setIds;
     j["complete"] = m.complete;
-    j["stimuli"] = m.stimuli;
+    j["stimuli"] = nlohmann::json::array();
+    for (const formats::ManifestEntry& entry : m.stimuli) j["stimuli"].push_back(formats::toJson(entry));
     return j;
 }
 
@@ -67,8 +68,7 @@ Manifest manifestFromJson(const nlohmann::json& j, const std::string& source) {
         if (j.contains("shard")) m.shard = Shard{j["shard"].at("index").get<int>(), j["shard"].at("count").get<int>()};
         m.setIds = j.at("set_ids").get<std::vector<std::string>>();
         m.complete = j.value("complete", false);
-        formats::manifestEntriesFromJson(j.at("stimuli"), source); // the one strict reader of the entries
-        for (const auto& s : j.at("stimuli")) m.stimuli.push_back(s);
+        m.stimuli = formats::manifestEntriesFromJson(j.at("stimuli"), source); // the one strict reader of the entries
         return m;
     } catch (const nlohmann::json::exception& e) {
         throwInput(source, "", std::string("malformed manifest (") + e.what() + ")");
@@ -94,11 +94,6 @@ void writeManifest(const fs::path& dir, const Manifest& manifest) {
 
 namespace {
 
-std::string jsonText(const nlohmann::json& j) {
-    if (j.is_null()) return "";
-    if (j.is_string()) return j.get<std::string>();
-    return j.dump();
-}
 std::string wallText(const nlohmann::json& j) {
     if (!j.is_number()) return "";
     char buffer[32];
@@ -110,27 +105,20 @@ std::string wallText(const nlohmann::json& j) {
 std::string manifestCsv(const Manifest& m) {
     std::vector<std::string> factorNames;
     for (const auto& f : m.factors) factorNames.push_back(f.at("name").get<std::string>());
-    for (const auto& s : m.stimuli) // extra keys of [[include]]/[[reference]] entries
-        for (auto it = s.at("factors").begin(); it != s.at("factors").end(); ++it)
+    for (const formats::ManifestEntry& s : m.stimuli) // extra keys of [[include]]/[[reference]] entries
+        for (auto it = s.factors.begin(); it != s.factors.end(); ++it)
             if (std::find(factorNames.begin(), factorNames.end(), it.key()) == factorNames.end())
                 factorNames.push_back(it.key());
     std::ostringstream out;
     out << "id,block,reference";
     for (const auto& n : factorNames) out << ',' << csvField(n);
     out << ",exr,png,sha256_exr,sha256_png,width,height,wall_ms\n";
-    for (const auto& s : m.stimuli) {
-        out << csvField(s.at("id").get<std::string>()) << ',' << csvField(s.at("block").get<std::string>()) << ','
-            << (s.at("reference").get<bool>() ? 1 : 0);
-        for (const auto& n : factorNames) {
-            const auto& factors = s.at("factors");
-            out << ',' << (factors.contains(n) ? csvField(jsonText(factors[n])) : "");
-        }
-        const auto& timings = s.value("timings_ms", nlohmann::json::object());
-        out << ',' << csvField(s.at("files").at("exr").get<std::string>()) << ','
-            << csvField(s.at("files").at("png").get<std::string>()) << ','
-            << s.at("sha256").at("exr").get<std::string>() << ',' << s.at("sha256").at("png").get<std::string>() << ','
-            << s.at("width").dump() << ',' << s.at("height").dump() << ','
-            << wallText(timings.value("stimulus_wall", nlohmann::json())) << '\n';
+    for (const formats::ManifestEntry& s : m.stimuli) {
+        out << csvField(s.id) << ',' << csvField(s.block) << ',' << (s.reference ? 1 : 0);
+        for (const auto& n : factorNames) out << ',' << (s.factors.contains(n) ? csvField(s.factorText(n)) : "");
+        out << ',' << csvField(s.files.exr) << ',' << csvField(s.files.png) << ',' << s.sha256.exr << ','
+            << s.sha256.png << ',' << s.width << ',' << s.height << ','
+            << wallText(s.timingsMs.value("stimulus_wall", nlohmann::json())) << '\n';
     }
     return out.str();
 }

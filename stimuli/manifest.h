@@ -36,8 +36,9 @@ struct Manifest {
     nlohmann::json factors = nlohmann::json::array(); // [{name, key, levels: [{value, label}]}]
     std::optional<Shard> shard;                       // present in a shard's folder
     std::vector<std::string> setIds;                  // every id of the whole set, in expansion order (for merge)
-    std::vector<nlohmann::json> stimuli; // entries (contract 2: formats::toJson of a formats::ManifestEntry, checked
-                                         // by formats::manifestEntryFromJson when read), in expansion order
+    // The entries (contract 2), in expansion order: typed from the strict reader (formats::manifestEntryFromJson) to
+    // the one writer (formats::toJson in writeManifest).
+    std::vector<formats::ManifestEntry> stimuli;
     // True when `stimuli` holds every stimulus of this folder's selection (the set, or the shard's slice).
     bool complete = false;
 };

@@ -16,6 +16,10 @@ namespace fs = std::filesystem;
 
 namespace {
 std::string shardName(const Shard& s) { return std::to_string(s.index) + "/" + std::to_string(s.count); }
+// A built stimulus's two files: relative path and sha256 of its EXR, then of its PNG.
+std::vector<std::pair<std::string, std::string>> filesOf(const formats::ManifestEntry& entry) {
+    return {{entry.files.exr, entry.sha256.exr}, {entry.files.png, entry.sha256.png}};
+}
 } // namespace
 
 MergeSummary mergeShards(const std::vector<fs::path>& shardDirs, const fs::path& outputDir, bool contactSheet) {
@@ -75,20 +79,21 @@ MergeSummary mergeShards(const std::vector<fs::path>& shardDirs, const fs::path&
                            first.set + "' is missing");
 
     // Gather the entries in the set's order and check every file against its hash before writing anything.
-    std::map<std::string, std::pair<const nlohmann::json*, size_t>> entries; // id → entry, shard
+    std::map<std::string, std::pair<const formats::ManifestEntry*, size_t>> entries; // id → entry, shard
     for (size_t i = 0; i < shards.size(); ++i)
-        for (const auto& s : shards[i].stimuli) entries[s.at("id").get<std::string>()] = {&s, i};
+        for (const formats::ManifestEntry& s : shards[i].stimuli) entries[s.id] = {&s, i};
     Manifest merged = first;
     merged.shard.reset();
     merged.stimuli.clear();
     for (const auto& id : first.setIds) {
         auto it = entries.find(id);
         if (it == entries.end()) throwInput("merge", "", "stimulus '" + id + "' is in no shard");
-        merged.stimuli.push_back(*it->second.first);
-        for (const char* kind : {"exr", "png"}) {
-            fs::path file = shardDirs[it->second.second] / it->second.first->at("files").at(kind).get<std::string>();
+        const formats::ManifestEntry& entry = *it->second.first;
+        merged.stimuli.push_back(entry);
+        for (const auto& [relative, sha256] : filesOf(entry)) {
+            const fs::path file = shardDirs[it->second.second] / relative;
             if (!fs::is_regular_file(file)) throwInput(file.string(), "", "missing (listed in its shard's manifest)");
-            if (sha256File(file) != it->second.first->at("sha256").at(kind).get<std::string>())
+            if (sha256File(file) != sha256)
                 throwInput(file.string(), "", "sha256 does not match its shard's manifest; rebuild that shard");
         }
     }
@@ -100,10 +105,9 @@ MergeSummary mergeShards(const std::vector<fs::path>& shardDirs, const fs::path&
     (void)existing;
     ensureDirectory(outputDir / "exr");
     ensureDirectory(outputDir / "png");
-    for (const auto& s : merged.stimuli) {
-        const auto& source = entries[s.at("id").get<std::string>()];
-        for (const char* kind : {"exr", "png"}) {
-            std::string relative = s.at("files").at(kind).get<std::string>();
+    for (const formats::ManifestEntry& s : merged.stimuli) {
+        const auto& source = entries[s.id];
+        for (const auto& [relative, sha256] : filesOf(s)) {
             AtomicOutput out(outputDir / relative);
             fs::copy_file(shardDirs[source.second] / relative, out.tempPath(), fs::copy_options::overwrite_existing);
             out.commit();

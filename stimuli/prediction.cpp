@@ -14,43 +14,50 @@ namespace {
 
 constexpr const char* kMetric = "ColorVideoVDP v0.5.6";
 
-std::string pngSha(const nlohmann::json& entry) { return entry.at("sha256").at("png").get<std::string>(); }
+// The display as the manifest records it: its name, and every parameter of a custom one.
+formats::Prediction predictionOn(const metrics::CvvdpDisplay& display) {
+    formats::Prediction prediction;
+    prediction.metric = kMetric;
+    prediction.display = display.name;
+    if (display.name == "custom") prediction.displayModel = metrics::displayModelOf(display);
+    return prediction;
+}
 
 } // namespace
 
 PredictionSummary predictStimuli(const fs::path& dir, Manifest& manifest, const PredictionOptions& options) {
-    const metrics::CvvdpDisplay display = metrics::cvvdpDisplay(options.display);
+    const formats::Prediction on = predictionOn(options.display);
     PredictionSummary summary;
-    std::map<std::string, nlohmann::json*> referenceOf; // block → its reference entry
-    for (nlohmann::json& entry : manifest.stimuli)
-        if (entry.value("reference", false)) referenceOf[entry.at("block").get<std::string>()] = &entry;
+    std::map<std::string, const formats::ManifestEntry*> referenceOf; // block → its reference entry
+    for (const formats::ManifestEntry& entry : manifest.stimuli)
+        if (entry.reference) referenceOf[entry.block] = &entry;
     for (const auto& [block, reference] : referenceOf) {
-        BlockPrediction result{block, reference->at("id").get<std::string>(), 10.0, -1.0, 0, false};
+        BlockPrediction result{block, reference->id, 10.0, -1.0, 0, false};
         metrics::MetricRender referenceImage;
         bool loaded = false;
-        for (nlohmann::json& entry : manifest.stimuli) {
-            if (entry.at("block") != block || entry.value("reference", false)) continue;
+        for (formats::ManifestEntry& entry : manifest.stimuli) {
+            if (entry.block != block || entry.reference) continue;
             // Up to date: same display, same reference image, same test image.
-            const nlohmann::json* old = entry.contains("predicted") ? &entry["predicted"] : nullptr;
-            const bool current = old && old->value("display", "") == options.display &&
-                                 old->value("reference_png_sha256", "") == pngSha(*reference) &&
-                                 old->value("png_sha256", "") == pngSha(entry) && old->contains("jod");
+            const std::optional<formats::Prediction>& old = entry.predicted;
+            const bool current = old && old->display == on.display && old->displayModel == on.displayModel &&
+                                 old->referencePngSha256 == reference->sha256.png && old->pngSha256 == entry.sha256.png;
             if (!current) {
                 if (!loaded) {
-                    referenceImage =
-                        metrics::loadMetricRender(dir / reference->at("files").at("png").get<std::string>(),
-                                                  metrics::RenderRole::test, metrics::ImageEncoding::srgb);
+                    referenceImage = metrics::loadMetricRender(dir / reference->files.png, metrics::RenderRole::test,
+                                                               metrics::ImageEncoding::srgb);
                     loaded = true;
                 }
-                const metrics::MetricRender test =
-                    metrics::loadMetricRender(dir / entry.at("files").at("png").get<std::string>(),
-                                              metrics::RenderRole::test, metrics::ImageEncoding::srgb);
-                const metrics::CvvdpResult r = metrics::cvvdp(referenceImage.beauty, test.beauty, display, false);
-                entry["predicted"] = formats::toJson(formats::Prediction{kMetric, options.display, result.reference,
-                                                                         r.jod, pngSha(*reference), pngSha(entry)});
+                const metrics::MetricRender test = metrics::loadMetricRender(
+                    dir / entry.files.png, metrics::RenderRole::test, metrics::ImageEncoding::srgb);
+                formats::Prediction prediction = on;
+                prediction.reference = result.reference;
+                prediction.jod = metrics::cvvdp(referenceImage.beauty, test.beauty, options.display, false).jod;
+                prediction.referencePngSha256 = reference->sha256.png;
+                prediction.pngSha256 = entry.sha256.png;
+                entry.predicted = prediction;
                 ++summary.predicted;
             }
-            const double jod = entry["predicted"]["jod"].get<double>();
+            const double jod = entry.predicted->jod;
             result.lowest = std::min(result.lowest, jod);
             result.highest = std::max(result.highest, jod);
             ++result.conditions;
@@ -68,8 +75,8 @@ std::vector<std::string> predictionLines(const PredictionSummary& summary, const
     for (const BlockPrediction& b : summary.blocks) {
         std::snprintf(text, sizeof text,
                       "block %s: %d stimuli predicted %.2f–%.2f JOD against %s (ColorVideoVDP, %s; spread %.2f JOD)",
-                      b.block.c_str(), b.conditions, b.lowest, b.highest, b.reference.c_str(), options.display.c_str(),
-                      b.highest - b.lowest);
+                      b.block.c_str(), b.conditions, b.lowest, b.highest, b.reference.c_str(),
+                      options.display.name.c_str(), b.highest - b.lowest);
         lines.push_back(text);
         if (b.invisible) {
             std::snprintf(text, sizeof text,

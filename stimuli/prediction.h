@@ -1,10 +1,11 @@
 #pragma once
 // Predicted visibility of a built set: every stimulus of a block that has a reference render is compared with it by
-// ColorVideoVDP (analysis/metrics/cvvdp.h) on the PNGs a participant would see, on a named display model, and the
+// ColorVideoVDP (analysis/metrics/cvvdp.h) on the PNGs a participant would see, on a named or custom display, and the
 // JOD (10 = indistinguishable from the reference) is recorded in its manifest entry:
 //   "predicted": {"metric": "ColorVideoVDP v0.5.6", "display": "standard_fhd", "reference": ID, "jod": 9.62}
 // A block whose conditions all lie within `invisibleBelow` JOD of each other is reported: a 2AFC study of it would
 // measure (almost) nothing.
+#include "analysis/metrics/cvvdp.h"
 #include "stimuli/manifest.h"
 
 #include <filesystem>
@@ -14,8 +15,10 @@
 namespace skinlab::stimuli {
 
 struct PredictionOptions {
-    std::string display = "standard_fhd"; // a model of analysis/metrics/cvvdp/display_models.json
-    double invisibleBelow = 0.25;         // JOD: the spread under which a block is called invisible
+    // A model of analysis/metrics/cvvdp/display_models.json, or a custom display (a model changed by --display-*,
+    // recorded in full in the manifest: predicted.display_model).
+    metrics::CvvdpDisplay display = metrics::cvvdpDisplay("standard_fhd");
+    double invisibleBelow = 0.25; // JOD: the spread under which a block is called invisible
 };
 
 struct BlockPrediction {
@@ -34,7 +37,7 @@ struct PredictionSummary {
 
 // Adds or refreshes "predicted" on every non-reference stimulus of a block with a reference in `manifest` (which
 // must be complete), reading the PNGs under `dir`. A prediction is kept when its display and reference (by
-// sha256 of both PNGs) are unchanged. Throws InputError for an unknown display name.
+// sha256 of both PNGs) are unchanged.
 PredictionSummary predictStimuli(const std::filesystem::path& dir, Manifest& manifest,
                                  const PredictionOptions& options);
 

@@ -30,8 +30,6 @@ std::string number(double value, const char* format = "%.4g") {
     return text;
 }
 
-std::string pngSha(const nlohmann::json& entry) { return entry.at("sha256").at("png").get<std::string>(); }
-
 // The row's 9-JOD crossing, linear in log ppd.
 void findLimit(VisibilityRow& row, const std::vector<double>& ppd) {
     const auto visible = [](double jod) { return jod < kVisibleBelowJod; };
@@ -74,37 +72,39 @@ VisibilityTable computeVisibility(const fs::path& dir, const Manifest& manifest,
         throwInput((dir / "manifest.json").string(), "", "the set is not complete (build it first)");
 
     VisibilityTable table;
-    std::string name = options.display;
     table.displaySource = "--display";
-    if (name.empty()) {
-        for (const nlohmann::json& s : manifest.stimuli)
-            if (s.contains("predicted") && s["predicted"].contains("display"))
-                name = s["predicted"]["display"].get<std::string>();
-        table.displaySource = name.empty() ? "default" : "the set's predictions";
-        if (name.empty()) name = "standard_fhd";
+    if (!options.display.empty()) {
+        table.display = metrics::cvvdpDisplay(options.display);
+    } else {
+        // The display of the set's predictions, named or custom (recorded in full), else the default.
+        const formats::Prediction* recorded = nullptr;
+        for (const formats::ManifestEntry& s : manifest.stimuli)
+            if (s.predicted && !s.predicted->display.empty()) recorded = &*s.predicted;
+        table.displaySource = recorded ? "the set's predictions" : "default";
+        table.display = !recorded                ? metrics::cvvdpDisplay("standard_fhd")
+                        : recorded->displayModel ? metrics::cvvdpDisplayOf(*recorded->displayModel)
+                                                 : metrics::cvvdpDisplay(recorded->display);
     }
-    table.display = metrics::cvvdpDisplay(name);
     table.pixelsPerDegree = options.pixelsPerDegree;
     for (double p : table.pixelsPerDegree)
         if (const auto d = viewingDistanceAt(table.display, p)) table.distanceMetres.push_back(*d);
     if (table.distanceMetres.size() != table.pixelsPerDegree.size()) table.distanceMetres.clear();
 
     // Rows: every non-reference stimulus of a block with a reference, in manifest order.
-    std::map<std::string, const nlohmann::json*> referenceOf;
-    for (const nlohmann::json& s : manifest.stimuli)
-        if (s.value("reference", false)) referenceOf.emplace(s.at("block").get<std::string>(), &s);
+    std::map<std::string, const formats::ManifestEntry*> referenceOf;
+    for (const formats::ManifestEntry& s : manifest.stimuli)
+        if (s.reference) referenceOf.emplace(s.block, &s);
     if (referenceOf.empty())
         throwInput((dir / "manifest.json").string(), "", "no block has a reference stimulus: nothing to compare with");
-    std::vector<std::pair<const nlohmann::json*, const nlohmann::json*>> pairs; // test, reference
-    for (const nlohmann::json& s : manifest.stimuli) {
-        const auto found = referenceOf.find(s.at("block").get<std::string>());
+    std::vector<std::pair<const formats::ManifestEntry*, const formats::ManifestEntry*>> pairs; // test, reference
+    for (const formats::ManifestEntry& s : manifest.stimuli) {
+        const auto found = referenceOf.find(s.block);
         if (found == referenceOf.end() || &s == found->second) continue;
         pairs.emplace_back(&s, found->second);
-        table.rows.push_back({s.at("block").get<std::string>(), found->second->at("id").get<std::string>(),
-                              s.at("id").get<std::string>(), std::vector<double>(table.pixelsPerDegree.size(), 10.0),
+        table.rows.push_back({s.block, found->second->id, s.id, std::vector<double>(table.pixelsPerDegree.size(), 10.0),
                               std::nullopt, false, false});
-        table.pngSha256[s.at("id").get<std::string>()] = pngSha(s);
-        table.pngSha256[found->second->at("id").get<std::string>()] = pngSha(*found->second);
+        table.pngSha256[s.id] = s.sha256.png;
+        table.pngSha256[found->second->id] = found->second->sha256.png;
     }
 
     // Rows block by block (blocks in order of their first stimulus), stimuli in manifest order inside a block.
@@ -118,7 +118,7 @@ VisibilityTable computeVisibility(const fs::path& dir, const Manifest& manifest,
         std::stable_sort(index.begin(), index.end(),
                          [&](size_t a, size_t b) { return rank(table.rows[a].block) < rank(table.rows[b].block); });
         std::vector<VisibilityRow> rows;
-        std::vector<std::pair<const nlohmann::json*, const nlohmann::json*>> sortedPairs;
+        std::vector<std::pair<const formats::ManifestEntry*, const formats::ManifestEntry*>> sortedPairs;
         for (size_t i : index) {
             rows.push_back(table.rows[i]);
             sortedPairs.push_back(pairs[i]);
@@ -129,12 +129,11 @@ VisibilityTable computeVisibility(const fs::path& dir, const Manifest& manifest,
     // Each image decoded once; every (row, ppd) a task.
     std::map<std::string, cv::Mat> images; // stimulus id → linear display RGB
     for (const auto& [test, reference] : pairs)
-        for (const nlohmann::json* s : {test, reference}) {
-            const std::string id = s->at("id").get<std::string>();
-            if (!images.count(id))
-                images[id] = metrics::loadMetricRender(dir / s->at("files").at("png").get<std::string>(),
-                                                       metrics::RenderRole::test, metrics::ImageEncoding::srgb)
-                                 .beauty;
+        for (const formats::ManifestEntry* s : {test, reference}) {
+            if (!images.count(s->id))
+                images[s->id] = metrics::loadMetricRender(dir / s->files.png, metrics::RenderRole::test,
+                                                          metrics::ImageEncoding::srgb)
+                                    .beauty;
         }
     std::vector<metrics::CvvdpDisplay> displays;
     for (double p : table.pixelsPerDegree) {
@@ -315,7 +314,7 @@ std::optional<nlohmann::json> currentVisibility(const fs::path& dir, const Manif
     if (json.value("format", "") != "skinlab-visibility" || !json.contains("png_sha256")) return std::nullopt;
     // Every image compared must be the one the manifest lists now, and every stimulus with a reference covered.
     std::map<std::string, std::string> shaOf;
-    for (const nlohmann::json& s : manifest.stimuli) shaOf[s.at("id").get<std::string>()] = pngSha(s);
+    for (const formats::ManifestEntry& s : manifest.stimuli) shaOf[s.id] = s.sha256.png;
     for (const auto& [id, sha] : json["png_sha256"].items())
         if (!shaOf.count(id) || shaOf[id] != sha.get<std::string>()) return std::nullopt;
     return json;

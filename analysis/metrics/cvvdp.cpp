@@ -477,6 +477,29 @@ CvvdpDisplay applyCvvdpOverrides(CvvdpDisplay display, const CvvdpDisplayOverrid
     return display;
 }
 
+formats::DisplayModel displayModelOf(const CvvdpDisplay& d) {
+    return {d.description,        d.eotf,           d.peakLuminance,        d.contrast,
+            d.ambientIlluminance, d.reflectivity,   d.pixelsPerDegree,      d.resolutionWidth,
+            d.resolutionHeight,   d.diagonalInches, d.viewingDistanceMetres};
+}
+
+CvvdpDisplay cvvdpDisplayOf(const formats::DisplayModel& m) {
+    CvvdpDisplay d;
+    d.name = "custom";
+    d.description = m.description;
+    d.eotf = m.eotf;
+    d.peakLuminance = m.peakLuminance;
+    d.contrast = m.contrast;
+    d.ambientIlluminance = m.ambientIlluminance;
+    d.reflectivity = m.reflectivity;
+    d.pixelsPerDegree = m.pixelsPerDegree;
+    d.resolutionWidth = m.resolutionWidth;
+    d.resolutionHeight = m.resolutionHeight;
+    d.diagonalInches = m.diagonalInches;
+    d.viewingDistanceMetres = m.viewingDistanceMetres;
+    return d;
+}
+
 std::string describeCvvdpDisplay(const CvvdpDisplay& d) {
     std::ostringstream out;
     out.precision(5);

@@ -9,6 +9,8 @@
 // yellow-violet) of DKL, each decomposed into a decimated Laplacian pyramid of Weber contrast, weighted by the
 // castleCSF sensitivity at the local background luminance, passed through cross-channel mutual masking, pooled
 // over space, bands and channels, and mapped to JOD (10 = no visible difference).
+#include "formats/stimulus_manifest.h"
+
 #include <array>
 #include <optional>
 #include <string>
@@ -72,6 +74,11 @@ struct CvvdpDisplayOverrides {
     }
 };
 CvvdpDisplay applyCvvdpOverrides(CvvdpDisplay display, const CvvdpDisplayOverrides& overrides);
+
+// A display as a stimulus manifest records a custom one (formats::DisplayModel), and back (named "custom"): the
+// parameters round-trip exactly, so that metrics read back the display a set's predictions were made on.
+formats::DisplayModel displayModelOf(const CvvdpDisplay& display);
+CvvdpDisplay cvvdpDisplayOf(const formats::DisplayModel& model);
 
 // One line: "NAME: ppd P, peak Y cd/m², black B, reflected R cd/m², EOTF".
 std::string describeCvvdpDisplay(const CvvdpDisplay& display);

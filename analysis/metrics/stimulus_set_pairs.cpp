@@ -39,6 +39,12 @@ struct StimulusEntry {
 
 } // namespace
 
+std::optional<CvvdpDisplay> ComparisonPlan::recordedDisplay() const {
+    if (displayModel) return cvvdpDisplayOf(*displayModel);
+    if (display) return cvvdpDisplay(*display);
+    return std::nullopt;
+}
+
 ComparisonPlan planStimulusSetComparisons(const fs::path& stimulusFolder,
                                           const std::optional<std::string>& referenceId) {
     // The one strict reader of contract 2 (formats/stimulus_manifest.h).
@@ -48,6 +54,7 @@ ComparisonPlan planStimulusSetComparisons(const fs::path& stimulusFolder,
 
     std::vector<StimulusEntry> entries;
     std::optional<std::string> display;
+    std::optional<formats::DisplayModel> displayModel;
     for (size_t i = 0; i < manifest.stimuli.size(); ++i) {
         const formats::ManifestEntry& stimulus = manifest.stimuli[i];
         const std::string where = "stimuli[" + std::to_string(i) + "].";
@@ -73,7 +80,12 @@ ComparisonPlan planStimulusSetComparisons(const fs::path& stimulusFolder,
                 throwInput(file, where + "predicted.display",
                            "\"" + named + "\" differs from \"" + *display +
                                "\" of an earlier stimulus (predict the set again on one display)");
+            if (display && displayModel != stimulus.predicted->displayModel)
+                throwInput(file, where + "predicted.display_model",
+                           "differs from the custom display of an earlier stimulus (predict the set again on one "
+                           "display)");
             display = named;
+            displayModel = stimulus.predicted->displayModel;
         }
         entries.push_back(std::move(entry));
     }
@@ -106,6 +118,7 @@ ComparisonPlan planStimulusSetComparisons(const fs::path& stimulusFolder,
 
     ComparisonPlan plan;
     plan.display = display;
+    plan.displayModel = displayModel;
     // The presented images, when every stimulus lists one (a set built or imported by skinlab does).
     const bool presented =
         std::all_of(entries.begin(), entries.end(), [](const StimulusEntry& e) { return !e.png.empty(); });

@@ -1,6 +1,9 @@
 #pragma once
 // Which renders to compare with which reference: either files named on the command line, or every stimulus of a
 // stimulus set (manifest.json, contract 2) against the reference stimulus of its block.
+#include "analysis/metrics/cvvdp.h"
+#include "formats/stimulus_manifest.h"
+
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -30,6 +33,11 @@ struct ComparisonPlan {
     // Stimulus sets: the display model the manifest's predictions used ("predicted": {"display": ...}), when
     // any stimulus has one: the viewing geometry of the set's design.
     std::optional<std::string> display;
+    // ... and, when that is "custom", its every parameter ("predicted": {"display_model": ...}).
+    std::optional<formats::DisplayModel> displayModel;
+
+    // That display (InputError for a name that is no model): nullopt when no stimulus has a prediction.
+    std::optional<CvvdpDisplay> recordedDisplay() const;
 };
 
 // One reference file against each test file. Throws InputError when two tests share a file stem.

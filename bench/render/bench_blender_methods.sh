@@ -8,12 +8,13 @@
 #   EEVEE is run at eevee.taa_samples = 1 and = TAA (default 16): (render_TAA − render_1) / (TAA − 1) is the cost
 #   of one more EEVEE frame, SSS included, without compilation.
 # Usage: bench/render/bench_blender_methods.sh SKINLAB [SCENE=builtin:head] [SIZES="640x360 1280x720"] [TAA=16]
-# Prints a Markdown table and writes blender-methods.csv in the current folder.
+# Prints a Markdown table and writes blender-methods.csv in the current folder. Exits 77 when blender is missing.
 set -euo pipefail
 SKINLAB=$(readlink -f "$1")
 SCENE=${2:-builtin:head}
 SIZES=${3:-"640x360 1280x720"}
 TAA=${4:-16}
+command -v blender >/dev/null || { echo "SKIPPED: blender not found (scripts/install-deps.sh installs it)"; exit 77; }
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/skinlab-bench-blender.XXXXXX")
 trap 'rm -rf "$WORK"' EXIT
 

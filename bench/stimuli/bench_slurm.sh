@@ -8,7 +8,7 @@
 #    the start cost of a task (its build time minus the sum of its stimuli);
 #  - whether the merged set equals the local build, hash for hash.
 # Usage: bench/stimuli/bench_slurm.sh SKINLAB SPEC [SHARDS=4] [--set key=value ...]  (as root; needs slurm-wlm,
-# munge, jq; SKINLAB_ASSETS for specs that use the scanned head)
+# munge, jq; SKINLAB_ASSETS for specs that use the scanned head). Exits 77 where the cluster cannot run here.
 set -euo pipefail
 SKINLAB=$(readlink -f "$1")
 SPEC=$(readlink -f "$2")
@@ -17,9 +17,13 @@ shift $(($# < 3 ? $# : 3))
 EXTRA=("$@")
 HERE=$(cd "$(dirname "$0")/../.." && pwd)
 source "$HERE/tests/stimuli/slurm_cluster.sh"
+slurm_cluster_require # exits 77 (skipped) without Slurm, munge, jq, root or cgroups
 
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/skinlab-bench-slurm.XXXXXX")
-trap 'slurm_cluster_stop; rm -rf "$WORK"' EXIT
+# The cluster's sockets need short paths (a sockaddr_un holds 108 bytes): always under /tmp.
+CLUSTER=$(mktemp -d /tmp/skinlab-slurm.XXXXXX)
+trap 'slurm_cluster_stop; rm -rf "$WORK" "$CLUSTER"' EXIT
+trap 'exit 143' TERM INT
 
 echo "machine: $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg) at the start, $(date -u +%Y-%m-%dT%H:%M:%SZ)"
 t0=$(date +%s.%N)
@@ -37,7 +41,7 @@ jq -r --arg wall "$(awk -v a="$t0" -v b="$t1" 'BEGIN {print b - a}')" '
   "$WORK/local/manifest.json"
 jq -r '.stimuli[] | select(.reference) | "  reference \(.id): \(.timings_ms.stimulus_wall / 1000 * 10 | round / 10) s"' "$WORK/local/manifest.json"
 
-slurm_cluster_start "$WORK/cluster" >/dev/null
+slurm_cluster_start "$CLUSTER" >/dev/null
 t0=$(date +%s.%N)
 out=$("$SKINLAB" stimuli slurm "$SPEC" -o "$WORK/slurm" --shards "$SHARDS" "${EXTRA[@]}")
 array=$(echo "$out" | sed -n "s/.*array job \([0-9]*\) .*merge job \([0-9]*\) .*/\1/p")

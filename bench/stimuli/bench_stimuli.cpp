@@ -75,7 +75,7 @@ int main(int argc, char** argv) {
         // Visibility against viewing distance (`stimuli visibility`): every condition at 6 pixels per degree.
         const std::optional<skinlab::stimuli::Manifest> manifest = skinlab::stimuli::readManifest(setDir);
         if (manifest && std::any_of(manifest->stimuli.begin(), manifest->stimuli.end(),
-                                    [](const nlohmann::json& s) { return s.value("reference", false); })) {
+                                    [](const skinlab::formats::ManifestEntry& s) { return s.reference; })) {
             const skinlab::stimuli::VisibilityTable table =
                 skinlab::stimuli::computeVisibility(setDir, *manifest, skinlab::stimuli::VisibilityOptions{});
             std::printf("visibility      %.1f s  (%zu conditions x %zu pixels per degree, 2 threads)\n", table.seconds,

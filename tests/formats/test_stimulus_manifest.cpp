@@ -93,6 +93,59 @@ TEST(StimulusManifestEntry, ErrorsNameFileKeyAndValue) {
               "set/manifest.json: stimuli[3].files: expected an exr or a png path");
 }
 
+// A custom display is recorded with every parameter and reads back equal (a prediction stays current); a bad
+// recorded value names the file, the key and the value.
+TEST(StimulusManifestEntry, CustomDisplayRoundTripsAndIsCheckedStrictly) {
+    ManifestEntry entry = builtEntry();
+    entry.predicted->display = "custom";
+    entry.predicted->displayModel = DisplayModel{
+        "custom display based on 24-inch FHD", "sRGB", 500.0, 2000.0, 0.0, 0.005, 20.0, 1920, 1080, 24.0, 0.1 + 0.2};
+    const nlohmann::json json = toJson(entry);
+    EXPECT_EQ(json["predicted"]["display_model"]["resolution"], nlohmann::json({1920, 1080}));
+    const ManifestEntry back = manifestEntryFromJson(nlohmann::json::parse(json.dump()), "m.json", 0);
+    EXPECT_EQ(back.predicted, entry.predicted) << "every double reads back exactly";
+    // Without a geometry only the ppd is written.
+    entry.predicted->displayModel->resolutionWidth = entry.predicted->displayModel->resolutionHeight = 0;
+    entry.predicted->displayModel->diagonalInches = entry.predicted->displayModel->viewingDistanceMetres = 0.0;
+    EXPECT_FALSE(toJson(entry)["predicted"]["display_model"].contains("resolution"));
+    EXPECT_EQ(manifestEntryFromJson(toJson(entry), "m.json", 0).predicted, entry.predicted);
+
+    const nlohmann::json good = json;
+    auto failure = [&](const std::function<void(nlohmann::json&)>& change) {
+        nlohmann::json changed = good;
+        change(changed["predicted"]);
+        return errorOf([&] { manifestEntryFromJson(changed, "set/manifest.json", 2); });
+    };
+    EXPECT_EQ(failure([](nlohmann::json& p) { p["display_model"]["contrast"] = 0.5; }),
+              "set/manifest.json: stimuli[2].predicted.display_model.contrast: expected a number >= 1, not 0.5");
+    EXPECT_EQ(failure([](nlohmann::json& p) { p["display_model"]["pixels_per_degree"] = -3; }),
+              "set/manifest.json: stimuli[2].predicted.display_model.pixels_per_degree: expected a positive "
+              "number, not -3");
+    EXPECT_EQ(failure([](nlohmann::json& p) { p["display_model"]["reflectivity"] = 2; }),
+              "set/manifest.json: stimuli[2].predicted.display_model.reflectivity: expected a number in [0, 1], "
+              "not 2");
+    EXPECT_EQ(failure([](nlohmann::json& p) { p["display_model"].erase("peak_luminance"); }),
+              "set/manifest.json: stimuli[2].predicted.display_model.peak_luminance: missing");
+    EXPECT_EQ(failure([](nlohmann::json& p) { p["display_model"]["resolution"] = {1920}; }),
+              "set/manifest.json: stimuli[2].predicted.display_model.resolution: expected [WIDTH, HEIGHT] in pixels, "
+              "not [1920]");
+    EXPECT_EQ(failure([](nlohmann::json& p) { p["display"] = "standard_fhd"; }),
+              "set/manifest.json: stimuli[2].predicted.display: \"standard_fhd\" with a display_model: expected "
+              "\"custom\"");
+    EXPECT_EQ(failure([](nlohmann::json& p) { p.erase("display_model"); }),
+              "set/manifest.json: stimuli[2].predicted.display_model: missing: a custom display lists its parameters");
+}
+
+// An entry of a hand-made set that lists one kind of file is written back with that kind only.
+TEST(StimulusManifestEntry, EntryWithOneKindOfFileRoundTrips) {
+    const nlohmann::json renders = {
+        {"id", "a"}, {"files", {{"exr", "exr/a.exr"}}}, {"sha256", {{"exr", "aa"}}}, {"block", "b"}};
+    const nlohmann::json written = toJson(manifestEntryFromJson(renders, "m.json", 0));
+    EXPECT_EQ(written["files"], renders["files"]);
+    EXPECT_EQ(written["sha256"], renders["sha256"]);
+    EXPECT_EQ(toJson(manifestEntryFromJson(written, "m.json", 0)), written);
+}
+
 TEST(StimulusManifestFile, ReadsTheFolderStrictly) {
     test_support::TempFolder folder;
     const std::string file = (folder.path() / "manifest.json").string();

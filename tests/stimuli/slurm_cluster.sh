@@ -1,5 +1,7 @@
-# A single-node Slurm cluster in a temporary folder, for tests (sourced by slurm_cluster_test.sh).
+# A single-node Slurm cluster in a temporary folder, for tests (sourced by slurm_cluster_test.sh and
+# bench/stimuli/bench_slurm.sh).
 #
+#   slurm_cluster_require     exits 77 (skipped) when this host cannot run it
 #   slurm_cluster_start DIR   writes DIR/munge.key, DIR/slurm.conf, starts munged, slurmctld and slurmd on
 #                             loopback ports that are free now, waits until the node is idle, exports SLURM_CONF
 #   slurm_cluster_stop        stops the daemons it started (by pid) and prints their logs on failure
@@ -9,6 +11,23 @@
 # calling user (root in CI; SlurmUser and SlurmdUser are set to it).
 
 SLURM_CLUSTER_PIDS=()
+
+# Exits 77 (skipped, with the reason) unless this host can run the cluster: the Slurm and munge programs, jq, root
+# (slurmd starts jobs as their user) and a cgroup filesystem (Slurm 22.05's slurmd initialises its cgroup plugin
+# even with proctrack/linuxproc and task/none, and fails to start without one, e.g. in a chroot whose /sys was
+# bind-mounted without its submounts).
+slurm_cluster_require() {
+  local tool
+  for tool in munged slurmctld slurmd sbatch squeue scontrol sinfo scancel; do
+    command -v "$tool" >/dev/null ||
+      { echo "SKIPPED: $tool not found: install slurm-wlm and munge (scripts/install-deps.sh)"; exit 77; }
+  done
+  command -v jq >/dev/null || { echo "SKIPPED: jq not found: install jq (scripts/install-deps.sh)"; exit 77; }
+  [ "$(id -u)" = 0 ] || { echo "SKIPPED: slurmd must run as root to start jobs (CI runs this as root)"; exit 77; }
+  awk '$2 == "/sys/fs/cgroup" { found = 1 } END { exit !found }' /proc/mounts ||
+    { echo "SKIPPED: no cgroup filesystem at /sys/fs/cgroup, which slurmd needs (in a chroot: mount --rbind /sys)"
+      exit 77; }
+}
 
 # A TCP port nobody listens on now (random in 20000-59999, checked against /proc/net/tcp*).
 slurm_cluster_free_port() {

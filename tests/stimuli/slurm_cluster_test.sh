@@ -20,17 +20,8 @@ skip() {
   echo "SKIPPED: $*"
   exit 77
 }
-for tool in munged slurmctld slurmd sbatch squeue scontrol sinfo scancel; do
-  command -v "$tool" >/dev/null || skip "$tool not found: install slurm-wlm and munge (scripts/install-deps.sh)"
-done
-command -v jq >/dev/null || skip "jq not found: install jq (scripts/install-deps.sh)"
-[ "$(id -u)" = 0 ] || skip "slurmd must run as root to start jobs (CI runs this test as root)"
-# Slurm 22.05's slurmd initialises its cgroup plugin even with proctrack/linuxproc and task/none, and fails to start
-# without a cgroup filesystem (e.g. a chroot whose /sys was bind-mounted without its submounts).
-awk '$2 == "/sys/fs/cgroup" { found = 1 } END { exit !found }' /proc/mounts ||
-  skip "no cgroup filesystem at /sys/fs/cgroup, which slurmd needs (in a chroot: mount --rbind /sys)"
-
 source "$SOURCE_DIR/tests/stimuli/slurm_cluster.sh"
+slurm_cluster_require
 
 # Short paths: the munge socket path must fit a sockaddr_un (108 bytes).
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/skinlab-slurm.XXXXXX")

@@ -2,6 +2,7 @@
 //  - sss.width_mm of the separable method on builtin:bleed, calibrated to 0.5 JOD from the spec's [[reference]] (the
 //    same scene without SSS; at 96×64 on the standard_fhd display, 100 mm gives about 1 JOD); the written [[factor]] snippet is pasted into the spec, the set is built, and
 //    ColorVideoVDP on the built PNGs must give the target within the tolerance;
+//  - a custom display (--display-*) is the one predicted on and named in the output;
 //  - bad input (a key that is not numeric, a bad number, a reference level inside the range) fails with one line
 //    naming the option and exit status 2, before anything is rendered.
 // Skips with a message when no EGL platform works.
@@ -142,6 +143,21 @@ TEST_F(StimuliCalibrate, CalibratedLevelGivesTheTargetDifferenceInTheBuiltSet) {
     EXPECT_NEAR(10.0 - jod, target, tolerance) << "width_mm " << width << "\n" << calibrate.output;
 }
 
+// A custom display (--display-*, as in `stimuli build` and `analyze metrics`) is the one predicted on and named.
+TEST_F(StimuliCalibrate, CustomDisplayIsTheOnePredictedOn) {
+    const fs::path levels = root_ / "levels-custom.toml";
+    CliRun calibrate =
+        run({"stimuli", "calibrate", spec_.string(), "--factor", "sss.width_mm", "--range", "0.25,100", "--target-jod",
+             "0.5", "--max-probes", "1", "--display-ppd", "20", "--display-peak", "500", "-o", levels.string()});
+    ASSERT_EQ(calibrate.exitCode, 0) << calibrate.output;
+    EXPECT_NE(calibrate.output.find("display custom: 20 pixels/degree, peak 500 cd/m²"), std::string::npos)
+        << calibrate.output;
+    std::ifstream in(levels);
+    std::stringstream text;
+    text << in.rdbuf();
+    EXPECT_NE(text.str().find("# display custom: 20 pixels/degree, peak 500 cd/m²"), std::string::npos) << text.str();
+}
+
 TEST_F(StimuliCalibrate, BadInputIsOneLineNamingTheOption) {
     struct Case {
         std::vector<std::string> extra;
@@ -159,6 +175,8 @@ TEST_F(StimuliCalibrate, BadInputIsOneLineNamingTheOption) {
         {{"--factor", "sss.artistic_strength", "--target-jod", "1", "--range", "0,1"}, "--factor"},
         {{"--factor", "sss.width_mm", "--target-jod", "1", "--range", "0.5,4", "--stimulus", "nope"}, "--stimulus"},
         {{"--factor", "sss.width_mm", "--target-jod", "1", "--range", "0.5,4", "--display", "nope"}, "--display"},
+        {{"--factor", "sss.width_mm", "--target-jod", "1", "--range", "0.5,4", "--display-contrast", "0.5"},
+         "--display-contrast: 0.5 must be a number >= 1"},
     };
     for (const auto& c : cases) {
         std::vector<std::string> args = {"stimuli", "calibrate", spec_.string()};

@@ -343,15 +343,15 @@ TEST(StimulusManifest, JsonRoundTripAndCsv) {
     std::vector<Stimulus> all = expand(s);
     Manifest m = manifestHeader(s, all, Shard{2, 3});
     m.renderer = {"llvmpipe", "4.5", "0.1.0"};
-    nlohmann::json entry = {{"id", "head-mid-none"},
-                            {"files", {{"exr", "exr/head-mid-none.exr"}, {"png", "png/head-mid-none.png"}}},
-                            {"sha256", {{"exr", "aa"}, {"png", "bb"}}},
-                            {"factors", {{"scene", "builtin:head"}, {"view", "mid"}, {"method", "none"}}},
-                            {"block", "builtin:head/mid"},
-                            {"reference", false},
-                            {"width", 96},
-                            {"height", 64},
-                            {"timings_ms", {{"stimulus_wall", 12.5}}}};
+    skinlab::formats::ManifestEntry entry;
+    entry.id = "head-mid-none";
+    entry.files = {"exr/head-mid-none.exr", "png/head-mid-none.png"};
+    entry.sha256 = {"aa", "bb"};
+    entry.factors = {{"scene", "builtin:head"}, {"view", "mid"}, {"method", "none"}};
+    entry.block = "builtin:head/mid";
+    entry.width = 96;
+    entry.height = 64;
+    entry.timingsMs = {{"stimulus_wall", 12.5}};
     m.stimuli.push_back(entry);
     nlohmann::json j = toJson(m);
     EXPECT_EQ(j["format"], "skinlab-stimuli");
@@ -387,11 +387,16 @@ TEST(ContactSheet, CaptionsUseLabelsAndSayPredicted) {
           {"key", "sss.cbf"},
           {"levels", {{{"value", "true"}, {"label", "cbf"}}, {{"value", "false"}, {"label", "no-cbf"}}}}}});
     auto entry = [&](const std::string& id, nlohmann::json factors, bool reference, double jod) {
-        return nlohmann::json{{"id", id},
-                              {"block", "patches"},
-                              {"factors", factors},
-                              {"reference", reference},
-                              {"predicted", {{"jod", jod}}}};
+        skinlab::formats::ManifestEntry e;
+        e.id = id;
+        e.block = "patches";
+        e.factors = std::move(factors);
+        e.reference = reference;
+        if (!reference) {
+            e.predicted = skinlab::formats::Prediction{};
+            e.predicted->jod = jod;
+        }
+        return e;
     };
     m.stimuli = {entry("a", {{"scene", scene}, {"method", "separable"}, {"sss.cbf", "true"}}, false, 8.1666),
                  entry("b", {{"scene", scene}, {"method", "none"}, {"sss.cbf", "false"}}, false, 9.5),

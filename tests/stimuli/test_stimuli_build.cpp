@@ -7,6 +7,7 @@
 //  - shards 1/2 + 2/2 merged equal the full build (ids, order, hashes);
 //  - a cropped and magnified set built twice, in different seconds, once killed and resumed, gives byte-identical
 //    image files;
+//  - a custom display (--display-*) is recorded in the manifest and read back exactly by the metrics;
 //  - bad input that needs the scene spec (unknown factor key or level, missing asset, folder of another set)
 //    fails with one line before anything is rendered.
 // Skips with a message when no EGL platform works.
@@ -657,6 +658,92 @@ TEST_F(StimuliBuild, SetMetricsReproduceThePredictionsAndVisibilitySpansViewingD
     run = runCli({"stimuli", "visibility", shown.string(), "--ppd", "40,20"});
     EXPECT_EQ(run.exitCode, 2) << run.output;
     EXPECT_NE(run.output.find("--ppd: 20 is not larger than the value before it"), std::string::npos) << run.output;
+}
+
+// A custom display (a model changed by --display-*) predicts, is recorded in full, and is what `analyze metrics`
+// and `stimuli visibility` read back; a bad value fails before rendering, a bad recorded one names file and key.
+TEST_F(StimuliBuild, CustomDisplayIsRecordedAndReadBackExactly) {
+    const fs::path set = gRoot / "custom-display", metrics = gRoot / "custom-display-metrics";
+    // With SSS, so that the reference carries its scattering radius for the metrics' bands.
+    std::string text = presentedSpec("custom-display", false);
+    text.replace(text.find("method = \"none\""), 15, "method = \"separable\"");
+    const fs::path spec = writeSpec("custom-display.toml", text);
+    const std::vector<std::string> build = {"stimuli",    "build",          spec.string(), "-o",
+                                            set.string(), "--display-peak", "500",         "--display-contrast",
+                                            "2000",       "--display-ppd",  "20",          "--no-contact-sheet"};
+    CliRun run = runCli(build);
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    skinlab::metrics::CvvdpDisplayOverrides changes;
+    changes.peakLuminance = 500.0;
+    changes.contrast = 2000.0;
+    changes.pixelsPerDegree = 20.0;
+    const skinlab::metrics::CvvdpDisplay display =
+        skinlab::metrics::applyCvvdpOverrides(skinlab::metrics::cvvdpDisplay("standard_fhd"), changes);
+    const nlohmann::json m = manifestOf(set);
+    std::map<std::string, std::string> referencePng; // block → PNG
+    for (const auto& s : m["stimuli"])
+        if (s["reference"].get<bool>()) referencePng[s["block"]] = s["files"]["png"];
+    std::map<std::string, double> predicted;
+    for (const auto& s : m["stimuli"]) {
+        if (s["reference"].get<bool>()) continue;
+        const nlohmann::json& p = s["predicted"];
+        EXPECT_EQ(p["display"], "custom");
+        EXPECT_EQ(p["display_model"]["peak_luminance"], 500.0);
+        EXPECT_EQ(p["display_model"]["contrast"], 2000.0);
+        EXPECT_EQ(p["display_model"]["pixels_per_degree"], 20.0);
+        EXPECT_EQ(p["display_model"]["eotf"], display.eotf);
+        using namespace skinlab::metrics;
+        const auto reference =
+            loadMetricRender(set / referencePng.at(s["block"]), RenderRole::test, ImageEncoding::srgb);
+        const auto test =
+            loadMetricRender(set / s["files"]["png"].get<std::string>(), RenderRole::test, ImageEncoding::srgb);
+        EXPECT_EQ(p["jod"].get<double>(), cvvdp(reference.beauty, test.beauty, display, false).jod) << s["id"];
+        predicted[s["id"]] = p["jod"].get<double>();
+    }
+    ASSERT_EQ(predicted.size(), 4u);
+    // The same build again renders nothing and predicts the same JOD on the same display: the same manifest.
+    const std::string before = skinlab::sha256File(set / "manifest.json");
+    run = runCli(build);
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    EXPECT_EQ(skinlab::sha256File(set / "manifest.json"), before) << run.output;
+    EXPECT_NE(run.output.find("(ColorVideoVDP, custom;"), std::string::npos) << run.output;
+
+    // The metrics of the set use the recorded display: its ppd for FLIP and ColorVideoVDP, its JOD.
+    run = runCli({"analyze", "metrics", "--stimuli", set.string(), "--no-heatmaps", "-o", metrics.string()});
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    std::ifstream metricsFile(metrics / "metrics.json");
+    const nlohmann::json scores = nlohmann::json::parse(metricsFile);
+    EXPECT_EQ(scores["settings"]["viewing"]["display"], "custom");
+    EXPECT_EQ(scores["settings"]["viewing"]["pixels_per_degree"].get<double>(), 20.0);
+    for (const auto& c : scores["comparisons"])
+        EXPECT_NEAR(c["cvvdp_jod"].get<double>(), predicted.at(c["test"]["name"]), 0.05) << c["test"]["name"];
+    // Visibility at the recorded display's own ppd is the prediction.
+    run = runCli({"stimuli", "visibility", set.string(), "--ppd", "10,20,40"});
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    std::ifstream visibilityFile(set / "visibility.json");
+    const nlohmann::json visibility = nlohmann::json::parse(visibilityFile);
+    EXPECT_EQ(visibility["display"]["name"], "custom");
+    for (const auto& row : visibility["rows"])
+        EXPECT_NEAR(row["jod"][1].get<double>(), predicted.at(row["stimulus"]), 1e-9) << row["stimulus"];
+
+    // A bad value is one line naming the option, before anything renders.
+    const fs::path refused = gRoot / "custom-display-refused";
+    run = runCli({"stimuli", "build", spec.string(), "-o", refused.string(), "--display-contrast", "0.5"});
+    EXPECT_EQ(run.exitCode, 2) << run.output;
+    EXPECT_NE(run.output.find("--display-contrast: 0.5 must be a number >= 1"), std::string::npos) << run.output;
+    EXPECT_FALSE(fs::exists(refused));
+    // A bad recorded display names the file, the key and the value.
+    nlohmann::json broken = m;
+    std::size_t index = 0;
+    while (broken["stimuli"][index]["reference"].get<bool>()) ++index;
+    broken["stimuli"][index]["predicted"]["display_model"]["contrast"] = 0.5;
+    std::ofstream(set / "manifest.json") << broken.dump(2);
+    run = runCli({"analyze", "metrics", "--stimuli", set.string(), "--no-heatmaps", "-o", metrics.string()});
+    EXPECT_EQ(run.exitCode, 2) << run.output;
+    EXPECT_NE(run.output.find("manifest.json: stimuli[" + std::to_string(index) +
+                              "].predicted.display_model.contrast: expected a number >= 1, not 0.5"),
+              std::string::npos)
+        << run.output;
 }
 
 namespace {

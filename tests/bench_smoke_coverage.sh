@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Every benchmark has a smoke run in ctest (bench/CMakeLists.txt, skinlab_bench_smoke): each program that a
+# bench/ CMakeLists.txt adds (add_executable) and each shell benchmark (bench/**/*.sh but the smoke runner) is named
+# as the command of a smoke run, so that a benchmark cannot rot unnoticed. Argument: the source folder.
+set -euo pipefail
+bench="$1/bench"
+smokes=$(sed -n '/skinlab_bench_smoke(/,/)/p' "$bench/CMakeLists.txt" | grep -o 'COMMAND [^ )]*' | awk '{print $2}')
+missing=()
+benchmarks=0
+for program in $(grep -rhoE 'add_executable\([A-Za-z0-9_]+' "$bench" --include=CMakeLists.txt | sed 's/add_executable(//'); do
+  benchmarks=$((benchmarks + 1))
+  grep -qx "$program" <<< "$smokes" || missing+=("$program")
+done
+while IFS= read -r script; do
+  relative=${script#"$bench"/}
+  [ "$relative" = smoke_run.sh ] && continue
+  benchmarks=$((benchmarks + 1))
+  grep -qx "$relative" <<< "$smokes" || missing+=("bench/$relative")
+done < <(find "$bench" -name '*.sh' | sort)
+if [ "${#missing[@]}" -gt 0 ]; then
+  echo "bench_smoke_coverage: ${#missing[@]} of $benchmarks benchmarks have no smoke run in bench/CMakeLists.txt: ${missing[*]}" >&2
+  exit 1
+fi
+echo "bench_smoke_coverage: all $benchmarks benchmarks have a smoke run"
