@@ -273,6 +273,12 @@ EOF
   common_tail
 }
 
+# The rasterizer's environment light of a case's stimuli: the scanned head's HDR environment is integrated exactly
+# (environment.irradiance = "exact"), as Cycles does; its 9 SH coefficients light the head's sides and the ear a fifth
+# too bright (docs/pathtraced.md, "The ear rim and the environment light"). Constant environments keep the
+# coefficients, exact there. Set here, not in the scene files, which the path-traced renders' stamps hold.
+environment_fixed() { if [ "$1" = scan ]; then echo 'environment = { irradiance = "exact" }'; fi; }
+
 # The 24 screen-space conditions of stimuli/specs/extensions-*.toml and the object-space reference.
 set_spec() {  # set_spec NAME TEST_SCENE REF_SCENE
   cat <<EOF
@@ -285,6 +291,7 @@ block = ["scene"]
 [fixed]
 render = { width = $size, height = $size, exposure_ev = 0.0 }
 tone_map = { operator = "filmic" }
+$(environment_fixed "$1")
 
 [[factor]]
 name = "scene"
