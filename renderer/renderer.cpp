@@ -221,6 +221,7 @@ struct Renderer::Impl {
     struct CachedEnvironment {
         std::shared_ptr<const Environment> environment;
         std::array<glm::vec3, 9> radianceSH;
+        std::shared_ptr<const Environment> irradiance; // environment.irradiance = "exact": E(n) by normal
     };
     std::map<std::string, CachedEnvironment> environments;
 
@@ -283,15 +284,18 @@ struct Renderer::Impl {
         if (spec.file.empty())
             key = "constant|" + std::to_string(spec.radiance.x) + "," + std::to_string(spec.radiance.y) + "," +
                   std::to_string(spec.radiance.z);
+        key += "|" + spec.irradiance;
         if (auto found = environments.find(key); found != environments.end()) return found->second;
         CachedEnvironment cached;
         if (spec.file.empty()) {
             // A constant environment L has radiance SH (L·√(4π), 0, ...); computed through the same projection.
             const Environment constant = makeConstantEnvironment(spec.radiance);
-            cached.radianceSH = projectSH9(constant);
+            cached.radianceSH = projectSH9(constant); // exact for a constant: "exact" needs no map here
         } else {
             auto loaded = std::make_shared<const Environment>(loadEnvironment(spec.file));
             cached.radianceSH = projectSH9(*loaded);
+            if (spec.irradiance == "exact")
+                cached.irradiance = std::make_shared<const Environment>(irradianceMap(*loaded));
             cached.environment = loaded;
         }
         if (environments.size() > 8) environments.clear();
@@ -689,7 +693,13 @@ void Renderer::Impl::uploadScene(const Frame& frame) {
     std::array<glm::vec3, 9> irradiance = irradianceCoefficientsSH9(cached.radianceSH);
     for (glm::vec3& c : irradiance) c *= static_cast<float>(spec.environment.intensity);
     const bool environmentBackground = spec.environment.background == "environment" && cached.environment;
-    scene->uploadEnvironment(environmentBackground ? cached.environment.get() : nullptr, irradiance);
+    std::unique_ptr<Environment> irradianceByNormal; // the irradiance map times the intensity
+    if (cached.irradiance) {
+        irradianceByNormal = std::make_unique<Environment>(*cached.irradiance);
+        for (glm::vec3& e : irradianceByNormal->pixels) e *= static_cast<float>(spec.environment.intensity);
+    }
+    scene->uploadEnvironment(environmentBackground ? cached.environment.get() : nullptr, irradiance,
+                             irradianceByNormal.get());
     glFinish();
     residentScene = std::move(scene);
 }

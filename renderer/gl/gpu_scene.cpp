@@ -90,9 +90,20 @@ void GpuScene::uploadMaps(const Image* albedo, const Image* normal, const Image*
     }
 }
 
-void GpuScene::uploadEnvironment(const Environment* environment,
-                                 const std::array<glm::vec3, 9>& irradianceCoefficients) {
+void GpuScene::uploadEnvironment(const Environment* environment, const std::array<glm::vec3, 9>& irradianceCoefficients,
+                                 const Environment* irradiance) {
     irradiance_ = irradianceCoefficients;
+    irradianceMap_.reset();
+    if (irradiance) {
+        irradianceMap_ = createTexture2D(GL_RGB32F, irradiance->width, irradiance->height);
+        glTextureSubImage2D(irradianceMap_.get(), 0, 0, 0, irradiance->width, irradiance->height, GL_RGB, GL_FLOAT,
+                            irradiance->pixels.data());
+        glTextureParameteri(irradianceMap_.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTextureParameteri(irradianceMap_.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTextureParameteri(irradianceMap_.get(), GL_TEXTURE_WRAP_S, GL_REPEAT); // u wraps around the horizon
+        glTextureParameteri(irradianceMap_.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+        checkGl("uploading the irradiance map");
+    }
     environmentMap_.reset();
     if (!environment) return;
     environmentMap_ = createTexture2D(GL_RGB32F, environment->width, environment->height);

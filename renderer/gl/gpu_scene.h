@@ -54,8 +54,11 @@ public:
     // Optional maps (nullptr: absent). Albedo is linear already (decoded by loadTexture); mipmapped.
     void uploadMaps(const Image* albedo, const Image* normal, const Image* specular, const Image* occlusion,
                     const Image* skinMask);
-    // Equirect radiance texture (for the background) and the irradiance SH coefficients (A_l L_lm).
-    void uploadEnvironment(const Environment* environment, const std::array<glm::vec3, 9>& irradianceCoefficients);
+    // Equirect radiance texture (for the background), the irradiance SH coefficients (A_l L_lm) and, for
+    // environment.irradiance = "exact", the irradiance map (renderer/scene/environment.h, irradianceMap; nullptr:
+    // the shader evaluates the SH coefficients).
+    void uploadEnvironment(const Environment* environment, const std::array<glm::vec3, 9>& irradianceCoefficients,
+                           const Environment* irradiance = nullptr);
 
     void drawAll() const; // all parts, no material uniforms (shadow pass)
     const std::vector<GpuPart>& parts() const { return parts_; }
@@ -67,7 +70,8 @@ public:
     GLuint occlusionMap() const { return occlusionMap_.get(); }
     GLuint skinMaskMap() const { return skinMaskMap_.get(); }
     GLuint environmentMap() const { return environmentMap_.get(); }
-    GLuint fallbackMap() const { return fallbackMap_.get(); } // 1×1 white, bound where a map is absent
+    GLuint irradianceMap() const { return irradianceMap_.get(); } // 0: none (the SH coefficients light)
+    GLuint fallbackMap() const { return fallbackMap_.get(); }     // 1×1 white, bound where a map is absent
     const std::array<glm::vec3, 9>& irradianceCoefficients() const { return irradiance_; }
 
     std::vector<GpuLight> lights;
@@ -77,7 +81,8 @@ private:
     Buffer vertexBuffer_;
     Buffer indexBuffer_;
     std::vector<GpuPart> parts_;
-    Texture albedoMap_, normalMap_, specularMap_, occlusionMap_, skinMaskMap_, environmentMap_, fallbackMap_;
+    Texture albedoMap_, normalMap_, specularMap_, occlusionMap_, skinMaskMap_, environmentMap_, irradianceMap_,
+        fallbackMap_;
     std::array<glm::vec3, 9> irradiance_{};
 };
 

@@ -10,6 +10,8 @@ namespace skinlab::renderer::gl {
 namespace {
 // Texture unit of the raw shadow-map depths (main_pass.frag `shadowDepths`).
 constexpr GLuint kShadowDepthUnit = 6;
+// Texture unit of the irradiance map (main_pass.frag `irradianceMap`, environment.irradiance = "exact").
+constexpr GLuint kIrradianceMapUnit = 7;
 // The sampler object that reads the shadow maps with compare mode off (the texture itself compares, for PCF),
 // created by bindShading and deleted by unbindShading in the same context.
 GLuint shadowDepthSampler = 0;
@@ -23,6 +25,8 @@ void MainPass::bindShading(GLuint program, const GpuScene& scene, GLuint shadowM
     setUniform(program, "pcfRadius", settings.pcfRadius);
     setUniform(program, "environmentFromWorld", settings.environmentFromWorld);
     setUniformArray(program, "irradianceSH", scene.irradianceCoefficients().data(), 9);
+    setUniform(program, "hasIrradianceMap", scene.irradianceMap() ? 1 : 0);
+    glBindTextureUnit(kIrradianceMapUnit, scene.irradianceMap() ? scene.irradianceMap() : scene.fallbackMap());
 
     const int lightCount = static_cast<int>(scene.lights.size());
     setUniform(program, "lightCount", lightCount);

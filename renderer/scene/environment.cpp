@@ -8,6 +8,7 @@
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <vector>
 
 namespace skinlab::renderer {
 namespace {
@@ -165,6 +166,55 @@ glm::vec3 irradianceSH9(const std::array<glm::vec3, 9>& radianceCoefficients, co
     glm::vec3 irradiance(0.0f);
     for (int i = 0; i < 9; ++i) irradiance += coefficients[i] * basis[i];
     return irradiance;
+}
+
+Environment irradianceMap(const Environment& environment, int width, int height) {
+    // Radiance averaged over blocks of texels (weighted by solid angle) to at most 2·width × 2·height.
+    const int coarseWidth = std::min(environment.width, 2 * width);
+    const int coarseHeight = std::min(environment.height, 2 * height);
+    const auto rowSolidAngle = [](int y, int rows, int columns) {
+        return 2.0 * std::numbers::pi / columns *
+               (std::cos(std::numbers::pi * y / rows) - std::cos(std::numbers::pi * (y + 1) / rows));
+    };
+    std::vector<glm::dvec3> sums(static_cast<std::size_t>(coarseWidth) * coarseHeight, glm::dvec3(0.0));
+    for (int y = 0; y < environment.height; ++y) {
+        const int cy = y * coarseHeight / environment.height;
+        const double solidAngle = rowSolidAngle(y, environment.height, environment.width);
+        for (int x = 0; x < environment.width; ++x)
+            sums[static_cast<std::size_t>(cy) * coarseWidth + x * coarseWidth / environment.width] +=
+                glm::dvec3(environment.texel(x, y)) * solidAngle;
+    }
+    // Each coarse texel: its radiance times its solid angle (the blocks' sums), at its centre direction.
+    struct Source {
+        glm::dvec3 direction;
+        glm::dvec3 power;
+    };
+    std::vector<Source> sources;
+    sources.reserve(sums.size());
+    for (int y = 0; y < coarseHeight; ++y)
+        for (int x = 0; x < coarseWidth; ++x) {
+            const glm::dvec3& power = sums[static_cast<std::size_t>(y) * coarseWidth + x];
+            if (power == glm::dvec3(0.0)) continue;
+            sources.push_back({glm::dvec3(equirectDirection((static_cast<float>(x) + 0.5f) / coarseWidth,
+                                                            (static_cast<float>(y) + 0.5f) / coarseHeight)),
+                               power});
+        }
+    Environment map;
+    map.width = width;
+    map.height = height;
+    map.pixels.resize(static_cast<std::size_t>(width) * height);
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            const glm::dvec3 normal(equirectDirection((static_cast<float>(x) + 0.5f) / static_cast<float>(width),
+                                                      (static_cast<float>(y) + 0.5f) / static_cast<float>(height)));
+            glm::dvec3 irradiance(0.0);
+            for (const Source& source : sources) {
+                const double cosine = glm::dot(normal, source.direction);
+                if (cosine > 0.0) irradiance += source.power * cosine;
+            }
+            map.pixels[static_cast<std::size_t>(y) * width + x] = glm::vec3(irradiance);
+        }
+    return map;
 }
 
 } // namespace skinlab::renderer

@@ -232,9 +232,12 @@ void readEnvironment(const SpecReader& root, const PathResolver& paths, SceneSpe
     if (e.background != "color" && environment.has("background_color"))
         environment.fail("background_color", "only applies to environment.background = color");
     e.backgroundColor = toVec3(environment.vec3("background_color", {0, 0, 0}, 0.0, 1e6));
+    e.irradiance = environment.choice("irradiance", "sh9", {"sh9", "exact"});
     resolved["environment"] = {{"file", environmentFile},    {"radiance", jsonVec3(e.radiance)},
                                {"intensity", e.intensity},   {"rotation_deg", e.rotationDeg},
                                {"background", e.background}, {"background_color", jsonVec3(e.backgroundColor)}};
+    // Recorded when set: the records (and so the stimulus sets' cache keys) of scenes without it stay as they were.
+    if (e.irradiance != "sh9") resolved["environment"]["irradiance"] = e.irradiance;
 }
 
 // [render]: image size and exposure.

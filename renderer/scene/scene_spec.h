@@ -69,6 +69,10 @@ struct EnvironmentSpec {
     double rotationDeg = 0.0;               // about +Y
     std::string background = "environment"; // environment | color
     glm::vec3 backgroundColor{0, 0, 0};     // radiance when background = color
+    // The rasterizer's diffuse environment light: "sh9" — 9 spherical-harmonic coefficients (R&H 2001; exact for a
+    // constant environment and a sky over black); "exact" — the cosine integral itself, tabulated by normal
+    // (irradianceMap), as a path tracer integrates it.
+    std::string irradiance = "sh9";
 };
 
 // render.ssaa_factor: its default (samples per pixel along each axis) and range; the internal size (image size ×

@@ -82,9 +82,17 @@ uniform vec3 transmittanceWeight5;
 
 uniform vec3 irradianceSH[9];        // A_l * L_lm (renderer/scene/environment.h), environment frame
 uniform mat3 environmentFromWorld;   // inverse of the environment's rotation about +Y
+uniform int hasIrradianceMap;        // 1: environment.irradiance = "exact", E(n) read from irradianceMap
+layout(binding = 7) uniform sampler2D irradianceMap;  // E(n), equirectangular by normal (irradianceMap())
 
-// Irradiance E(n) from 9 SH coefficients (Ramamoorthi & Hanrahan 2001), same basis as shBasis9().
+// Irradiance E(n): the irradiance map's bilinear value at the normal's equirectangular coordinates
+// (renderer/scene/environment.h), or from 9 SH coefficients (Ramamoorthi & Hanrahan 2001), same basis as shBasis9().
 vec3 irradiance(vec3 n) {
+    if (hasIrradianceMap != 0) {
+        const float pi = 3.14159265358979;
+        n = normalize(n);
+        return texture(irradianceMap, vec2(0.5 + atan(n.x, -n.z) / (2.0 * pi), acos(clamp(n.y, -1.0, 1.0)) / pi)).rgb;
+    }
     return irradianceSH[0] * 0.282095 + irradianceSH[1] * (0.488603 * n.y) + irradianceSH[2] * (0.488603 * n.z) +
            irradianceSH[3] * (0.488603 * n.x) + irradianceSH[4] * (1.092548 * n.x * n.y) +
            irradianceSH[5] * (1.092548 * n.y * n.z) + irradianceSH[6] * (0.315392 * (3.0 * n.z * n.z - 1.0)) +

@@ -128,6 +128,52 @@ TEST(RenderPipeline, ConstantEnvironmentGivesAlbedoTimesRadiance) {
         }
 }
 
+// environment.irradiance = "exact" against "sh9": a dim sky of radiance 0.1 with a small sun of 1000 straight behind
+// the plane (−Z, the environment image's centre). The plane, facing +Z, sees only the sky: E = π · 0.1, so its albedo
+// 0.5 reflects 0.05. The irradiance map gives that (within the quadrature of the sky's texels, 1 %); nine SH
+// coefficients ring the sun's light onto the far hemisphere (its clamped-cosine approximation at 180° is 1/16 of the
+// peak), several times the sky's light.
+TEST(RenderPipeline, ExactEnvironmentIrradianceLeavesASunBehindThePlaneOut) {
+    SKINLAB_REQUIRE_RENDERER(renderer);
+    TempFolder folder("irradiance");
+    const int width = 64, height = 32;
+    std::vector<float> pixels(static_cast<std::size_t>(width * height * 3), 0.1f);
+    for (int y = 15; y < 17; ++y)
+        for (int x = 31; x < 33; ++x)
+            for (int c = 0; c < 3; ++c) pixels[static_cast<std::size_t>((y * width + x) * 3 + c)] = 1000.0f;
+    const std::string hdr = (folder / "sun-behind.exr").string();
+    {
+        auto out = OIIO::ImageOutput::create(hdr);
+        ASSERT_TRUE(out && out->open(hdr, OIIO::ImageSpec(width, height, 3, OIIO::TypeDesc::FLOAT)));
+        ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()));
+        out->close();
+    }
+    // builtin:bleed's flat patch facing +Z, all of it skin of albedo 0.5, lit by the environment file alone.
+    const std::filesystem::path scene = folder / "plane.toml";
+    std::ofstream(scene) << "mm_per_unit = 1.0\n[model]\nsource = \"builtin:bleed\"\n"
+                         << "[[materials]]\nname = \"*\"\nalbedo = [0.5, 0.5, 0.5]\nskin = true\n"
+                         << "[camera]\nview = \"mid\"\n[tone_map]\noperator = \"linear\"\n"
+                         << "[environment]\nfile = \"" << hdr << "\"\nbackground = \"color\"\n";
+    for (const char* irradiance : {"sh9", "exact"}) {
+        RenderRequest request;
+        request.scene = scene.string();
+        request.overrides = {std::string("environment.irradiance=\"") + irradiance + "\""};
+        request.width = 64;
+        request.height = 48;
+        request.exrPath = folder / (std::string(irradiance) + ".exr");
+        renderer->render(request);
+    }
+    const ExrImage sh9 = readExr(folder / "sh9.exr");
+    const ExrImage map = readExr(folder / "exact.exr");
+    ASSERT_GT(countSkinPixels(map), 500);
+    for (int y = 0; y < map.height; ++y)
+        for (int x = 0; x < map.width; ++x) {
+            if (map.at("mask.Y", x, y) != 1.0f) continue;
+            ASSERT_NEAR(map.at("diffuse.G", x, y), 0.05f, 0.01f * 0.05f) << x << "," << y;
+            ASSERT_GT(sh9.at("diffuse.G", x, y), 2.0f * 0.05f) << x << "," << y;
+        }
+}
+
 TEST(RenderPipeline, ExposureScalesBeautyAndAovsByPowersOfTwo) {
     SKINLAB_REQUIRE_RENDERER(renderer);
     TempFolder folder("exposure");

@@ -89,6 +89,14 @@ TEST(SceneSpec, OverridesChangeValuesAndAreRecordedInTheResolvedParameters) {
     EXPECT_EQ(spec.resolved["tone_map"]["operator"], "reinhard");
     // Later overrides win.
     EXPECT_EQ(loadSceneSpec("builtin:halo", {"render.height=100", "render.height=64"}, {}).height, 64);
+    // environment.irradiance: recorded when set, so the records of scenes without it stay as they were.
+    EXPECT_EQ(spec.environment.irradiance, "sh9");
+    EXPECT_FALSE(spec.resolved["environment"].contains("irradiance"));
+    const SceneSpec exact = loadSceneSpec("builtin:head", {"environment.irradiance=\"exact\""}, {});
+    EXPECT_EQ(exact.environment.irradiance, "exact");
+    EXPECT_EQ(exact.resolved["environment"]["irradiance"], "exact");
+    EXPECT_EQ(errorOf("builtin:head", {"environment.irradiance=\"sh3\""}),
+              "builtin:head: environment.irradiance: 'sh3' is not one of: sh9, exact");
 }
 
 TEST(SceneSpec, ErrorMessagesNameFileKeyAndValue) {
