@@ -26,9 +26,10 @@
 #   scripts/reference-validation.sh [OUT_DIR] [SIZE] [SAMPLES]       (defaults: out/reference-validation 256 64)
 #
 # Environment: SKINLAB (default build/release/cli/skinlab), SEEDS (path-traced seeds, default 4, at least 2),
-# TRUTH_SEEDS and TRUTH_SAMPLES (the path-traced truth of the error metrics, truth.exr: by default the mean of the
-# SEEDS seeds; with TRUTH_SEEDS ≥ 2 the mean of that many renders of its own at TRUTH_SAMPLES samples, measured
-# against the SEEDS seeds, independent of it),
+# TRUTH_SEEDS and TRUTH_SAMPLES (the path-traced truth of the error metrics, truth.exr: with TRUTH_SEEDS ≥ 2 the mean
+# of that many renders of its own at TRUTH_SAMPLES samples, measured against the SEEDS seeds, independent of it;
+# with TRUTH_SEEDS=0 the mean of the SEEDS seeds. Default: on head 10 and on scan 14 renders of 384 samples, the
+# precision docs/pathtraced.md measures as enough to rank with; on the other cases 0),
 # REFERENCE_EDGE_MM (the reference's tessellation, default 1.0 mm, 0.5 mm on bleed, whose paint edge needs it), REFERENCE_NON_SKIN (sss.reference_non_skin of
 # the reference: default "absorbs", the path tracer's boundary; "returns" is the evaluation table's),
 # REFERENCE_CONVEXITY_MM (sss.reference_convexity_mm: default [0.88, 0.32, 0.28], the path tracer's level on convex
@@ -48,10 +49,20 @@ out="${1:-out/reference-validation}"
 size="${2:-256}"
 samples="${3:-64}"
 seeds="${SEEDS:-4}"
-truth_seeds="${TRUTH_SEEDS:-0}"
-truth_samples="${TRUTH_SAMPLES:-$samples}"
-[ "$truth_seeds" -ge 0 ] 2>/dev/null && [ "$truth_seeds" -ne 1 ] || { echo "reference-validation: TRUTH_SEEDS=$truth_seeds must be 0 or at least 2" >&2; exit 2; }
-[ "$truth_samples" -ge 1 ] 2>/dev/null || { echo "reference-validation: TRUTH_SAMPLES=$truth_samples must be a positive number" >&2; exit 2; }
+if [ -n "${TRUTH_SEEDS:-}" ]; then
+  [ "$TRUTH_SEEDS" -ge 0 ] 2>/dev/null && [ "$TRUTH_SEEDS" -ne 1 ] || { echo "reference-validation: TRUTH_SEEDS=$TRUTH_SEEDS must be 0 or at least 2" >&2; exit 2; }
+fi
+if [ -n "${TRUTH_SAMPLES:-}" ]; then
+  [ "$TRUTH_SAMPLES" -ge 1 ] 2>/dev/null || { echo "reference-validation: TRUTH_SAMPLES=$TRUTH_SAMPLES must be a positive number" >&2; exit 2; }
+fi
+# The truth's renders per case: TRUTH_SEEDS if given, else 10 on head and 14 on scan (at 384 samples; their measured
+# precision, docs/pathtraced.md "The truth of the error metrics") and 0 (the mean of the SEEDS seeds) elsewhere.
+truth_seeds_of() {
+  if [ -n "${TRUTH_SEEDS:-}" ]; then echo "$TRUTH_SEEDS"; else case "$1" in head) echo 10 ;; scan) echo 14 ;; *) echo 0 ;; esac; fi
+}
+truth_samples_of() {
+  if [ -n "${TRUTH_SAMPLES:-}" ]; then echo "$TRUTH_SAMPLES"; elif [ -z "${TRUTH_SEEDS:-}" ]; then echo 384; else echo "$samples"; fi
+}
 # The reference's edge length per case: REFERENCE_EDGE_MM for all, or 1 mm and 0.5 mm on bleed (the paint's edge).
 edge_mm_of() { if [ -n "${REFERENCE_EDGE_MM:-}" ]; then echo "$REFERENCE_EDGE_MM"; elif [ "$1" = bleed ]; then echo 0.5; else echo 1.0; fi; }
 edge_mm="${REFERENCE_EDGE_MM:-1.0 (bleed: 0.5)}"
@@ -377,6 +388,8 @@ for name in $cases; do
   # condition's and the rankings of the error metrics against it). Otherwise it is the mean of the validation seeds,
   # and with eight or more of them the mean of the first half (truth-half.exr) is measured against the pairs of the
   # second half.
+  truth_seeds="$(truth_seeds_of "$name")"
+  truth_samples="$(truth_samples_of "$name")"
   all_seeds=()
   IFS=, read -r -a all_seeds <<< "$seed_files"
   rm -rf "$dir/metrics-truth-debiased"
