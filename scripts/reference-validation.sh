@@ -638,10 +638,10 @@ truth_lines = ["", "## The truth of the error metrics: precision against the bes
                "MSE (Y; R in brackets): `reference`; the mean of the validation seeds (σ̄²/S, from the seeds' "
                "pairs); the path-traced truth measured against independent seeds (with TRUTH_SEEDS: truth.exr, its "
                "own renders, against the validation seeds; else, with eight or more seeds, the mean of the first half "
-               "against the second half). Precise enough: ≤ 0.50. τ_b: the error metrics against that truth ranked "
-               "against the independent seeds (16 closest, bootstrap interval).", "",
-               "| case | band | best condition MSE | `reference` | seed mean (validation seeds) | path-traced truth, measured | τ_b skin ΔE00 / halo E / bleed E against it | truth used |",
-               "|---|---|---|---|---|---|---|---|"]
+               "against the second half). Precise enough: ≤ 0.50. τ_b: the conditions' squared error (Y) and the error metrics "
+               "against that truth ranked against the independent seeds (16 closest, bootstrap interval).", "",
+               "| case | band | best condition MSE | `reference` | seed mean (validation seeds) | path-traced truth, measured | τ_b 16 closest: squared error against it | τ_b skin ΔE00 / halo E / bleed E against it | truth used |",
+               "|---|---|---|---|---|---|---|---|---|"]
 def ratio_text(entry, red):
     if not entry: return "–"
     r, rr = entry["ratio_to_best_condition"], (red or {}).get("ratio_to_best_condition")
@@ -649,6 +649,12 @@ def ratio_text(entry, red):
     return f"{r:.2f}" + (f" ({rr:.2f})" if rr is not None else "")
 def competitive_tau(d, score):
     a = (d or {}).get("table_score_agreement", {}).get(score)
+    if not a or a["competitive"]["tau_b"]["value"] is None: return "–"
+    boot = a["competitive"].get("tau_b_bootstrap_interval_95")
+    return f"{a['competitive']['tau_b']['value']:+.2f}" + (f" [{boot[0]:+.2f}, {boot[1]:+.2f}]" if boot else "")
+def band_tau(d, band):
+    # The conditions' squared error against the measured truth ranked against the independent seeds (16 closest).
+    a = (d or {}).get("ranking_agreement", {}).get(band)
     if not a or a["competitive"]["tau_b"]["value"] is None: return "–"
     boot = a["competitive"].get("tau_b_bootstrap_interval_95")
     return f"{a['competitive']['tau_b']['value']:+.2f}" + (f" [{boot[0]:+.2f}, {boot[1]:+.2f}]" if boot else "")
@@ -682,7 +688,7 @@ for name in cases:
                            f"{ratio_text(p['Y'].get('compared_reference'), p['R'].get('compared_reference'))} | "
                            f"{ratio_text(p['Y']['seed_mean'], p['R']['seed_mean'])} | "
                            + (ratio_text(hp['Y'].get('compared_reference'), hp['R'].get('compared_reference')) if hp else "–")
-                           + f" | {half_taus if b == 'skin' else ''} | {used} |")
+                           + f" | {band_tau(half, b)} | {half_taus if b == 'skin' else ''} | {used} |")
     with open(os.path.join(out, name, "truth.json") + ".tmp", "w") as f:
         json.dump({"truth": "reference" if reference_ok else "pathtraced-seed-mean",
                    "record": {"kind": "render", "method": "reference"} if reference_ok else truth_record,
