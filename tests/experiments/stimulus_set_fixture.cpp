@@ -3,26 +3,11 @@
 #include "common/files.h"
 #include "common/hash.h"
 
-#include <atomic>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
-#include <unistd.h>
 
 namespace skinlab::experiments::test_support {
 namespace fs = std::filesystem;
-
-TemporaryFolder::TemporaryFolder(const std::string& stem) {
-    static std::atomic<int> counter{0};
-    path_ = fs::temp_directory_path() /
-            ("skinlab-" + stem + "-" + std::to_string(::getpid()) + "-" + std::to_string(counter.fetch_add(1)));
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-}
-
-TemporaryFolder::~TemporaryFolder() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-}
 
 namespace {
 // The resolved parameters a method name stands for: sss.method, and "eevee-no-sss" for EEVEE without SSS.

@@ -1,6 +1,8 @@
 #pragma once
 // Builds a small stimulus set (tiny PNGs + manifest.json, contract 2) in a fresh temporary folder, so the
 // experiment tests never need the renderer.
+#include "tests/common/temp_folder.h"
+
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -15,16 +17,8 @@ struct StimulusSetSpec {
     int height = 16;
 };
 
-// A fresh folder under the system temp dir, removed by the destructor.
-class TemporaryFolder {
-public:
-    explicit TemporaryFolder(const std::string& stem);
-    ~TemporaryFolder();
-    const std::filesystem::path& path() const { return path_; }
-
-private:
-    std::filesystem::path path_;
-};
+// A fresh folder under the build folder's tests-tmp/, removed by the destructor (tests/common/temp_folder.h).
+using skinlab::test_support::TempFolder;
 
 // Writes png/ID.png and manifest.json into `folder`; ids are "<block index>-<method>". Each image has a
 // distinct high-frequency pattern (any resampling would change its pixels). Factor "quality" holds the method's

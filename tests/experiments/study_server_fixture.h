@@ -34,7 +34,7 @@ public:
     std::string fingerprint() const;
 
 private:
-    TemporaryFolder folder_;
+    TempFolder folder_;
     std::filesystem::path database_;
     std::unique_ptr<StudyStore> store_;
     std::unique_ptr<StudyServer> server_;

@@ -23,7 +23,7 @@ using namespace skinlab::experiments;
 using namespace skinlab::analysis::scaling::active;
 using skinlab::combineSeed;
 using skinlab::SeededRandom;
-using skinlab::experiments::test_support::TemporaryFolder;
+using skinlab::experiments::test_support::TempFolder;
 
 namespace {
 
@@ -59,7 +59,7 @@ bool connected(int m, const std::vector<std::pair<int, int>>& edges) {
 }
 
 StudyDefinition makeStudy(const std::string& designToml) {
-    TemporaryFolder folder("active");
+    TempFolder folder("active");
     test_support::writeStimulusSet(folder.path(), {});
     return resolveStudy(parseStudyDesign(designToml, "D.toml"), readStimulusManifest(folder.path()));
 }

@@ -43,7 +43,7 @@ const std::map<std::string, double> kTruth = {
     {"reference", 2.0}, {"reference-like", 1.2}, {"separable", 1.0}, {"artistic", 0.0}, {"flat", -1.5}};
 
 struct StudyFiles {
-    TemporaryFolder folder{"active"};
+    TempFolder folder{"active"};
     fs::path stimuli = folder.path() / "stimuli";
     fs::path design;
     fs::path database = folder.path() / "study.db";

@@ -452,7 +452,7 @@ TEST(OnlineStudy, AnalyzeScaleDropsFlaggedTrialsFromEveryFormat) {
 }
 
 TEST(OnlineStudy, AStudyFileFromBeforeOnlineStudiesOpensAndGainsTheirTables) {
-    TemporaryFolder folder("online-old");
+    TempFolder folder("online-old");
     writeStimulusSet(folder.path() / "stimuli");
     const fs::path database = folder.path() / "study.db";
     createStudy(folder.path() / "stimuli", writeText(folder.path(), "design.toml", design("")), {}, database);

@@ -40,7 +40,7 @@ blank = 2
 )";
 
 struct StudyFiles {
-    TemporaryFolder folder{"cli"};
+    TempFolder folder{"cli"};
     fs::path stimuli = folder.path() / "stimuli";
     fs::path design;
     fs::path database = folder.path() / "study.db";
@@ -164,7 +164,7 @@ TEST(StudyCli, CreateStatusExportAndTheirErrors) {
 // A set built by the real renderer with a crop and a magnification: `study create` checks the presented images
 // (the crop magnified, what a participant sees), not the render, against the design's viewport.
 TEST(StudyCli, CreateRefusesPresentedStimuliLargerThanTheViewport) {
-    TemporaryFolder folder{"cli-magnified"};
+    TempFolder folder{"cli-magnified"};
     // 40 × 30 renders; a 20 × 15 crop magnified 16× is presented at 320 × 240, two side by side 640 px wide.
     const fs::path spec = writeText(folder.path(), "tiny.toml", R"(
 [set]

@@ -304,7 +304,7 @@ TEST(StudyBackup, CopyWhileAnswersAreWrittenHoldsAConsistentPrefix) {
 }
 
 TEST(NginxSiteConfig, FillsTheTemplateAndRefusesValuesNginxWouldMisread) {
-    TemporaryFolder folder("nginx-config");
+    TempFolder folder("nginx-config");
     const auto cert =
         writeText(folder.path(), "cert.pem", "-----BEGIN CERTIFICATE-----\nMIIB\n-----END CERTIFICATE-----\n");
     const auto key =

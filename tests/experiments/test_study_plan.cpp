@@ -92,7 +92,7 @@ TEST(StudyPlan, PowerGrowsWithObservers) {
 // built without predictions is refused, naming the stimulus.
 TEST(StudyPlan, TruthFromThePredictionsInTheManifest) {
     using namespace skinlab::experiments::test_support;
-    TemporaryFolder folder("plan-truth");
+    TempFolder folder("plan-truth");
     const std::filesystem::path stimuli = folder.path() / "stimuli";
     writeStimulusSet(stimuli);
     const std::filesystem::path design = writeText(folder.path(), "design.toml", "title = \"t\"\nseed = 3\n");

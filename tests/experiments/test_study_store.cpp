@@ -38,7 +38,7 @@ blank = 1
 )";
 
 struct StudyFile {
-    TemporaryFolder folder{"store"};
+    TempFolder folder{"store"};
     fs::path database = folder.path() / "study.db";
     std::unique_ptr<StudyStore> store;
     StudyFile() {

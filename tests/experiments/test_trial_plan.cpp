@@ -10,12 +10,12 @@
 #include <set>
 
 using namespace skinlab::experiments;
-using skinlab::experiments::test_support::TemporaryFolder;
+using skinlab::experiments::test_support::TempFolder;
 
 namespace {
 
 StudyDefinition makeStudy(const std::string& designToml, const test_support::StimulusSetSpec& spec = {}) {
-    TemporaryFolder folder("plan");
+    TempFolder folder("plan");
     test_support::writeStimulusSet(folder.path(), spec);
     const StimulusManifest manifest = readStimulusManifest(folder.path());
     return resolveStudy(parseStudyDesign(designToml, "D.toml"), manifest);

@@ -64,7 +64,7 @@ std::set<std::string> scaledIn(const nlohmann::json& scale) {
 } // namespace
 
 TEST(ReportExclusion, ReportAndAnalyzeScaleLeaveOutTheSameObservers) {
-    TemporaryFolder folder("report-exclusion");
+    TempFolder folder("report-exclusion");
     StimulusSetSpec spec;
     spec.blocks = {"scene:a/mid"};
     spec.withReference = false; // no image metrics: the test is about the observers

@@ -35,7 +35,7 @@ void participate(StudyStore& store, const std::string& label) {
 }
 
 std::string reportOf(const std::vector<std::string>& methods, const std::string& stem) {
-    TemporaryFolder folder(stem);
+    TempFolder folder(stem);
     StimulusSetSpec spec;
     spec.blocks = {"builtin:head/mid"};
     spec.methods = methods;

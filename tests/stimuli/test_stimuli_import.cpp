@@ -19,7 +19,7 @@ namespace fs = std::filesystem;
 using skinlab::experiments::test_support::ChildProcess;
 using skinlab::experiments::test_support::CommandResult;
 using skinlab::experiments::test_support::runCommand;
-using skinlab::experiments::test_support::TemporaryFolder;
+using skinlab::experiments::test_support::TempFolder;
 using skinlab::experiments::test_support::writeText;
 
 namespace {
@@ -93,7 +93,7 @@ void expectHashes(const fs::path& dir, const nlohmann::json& manifest) {
 } // namespace
 
 TEST(StimuliImport, CsvTableOfPngJpegAndExrImages) {
-    TemporaryFolder folder("import-csv");
+    TempFolder folder("import-csv");
     const fs::path root = folder.path();
     const int w = 20, h = 12;
     writeImage(root / "img" / "Unreal Close.png", w, h, OIIO::TypeDesc::UINT8, pattern(w, h, 1), 4);
@@ -193,7 +193,7 @@ TEST(StimuliImport, CsvTableOfPngJpegAndExrImages) {
 }
 
 TEST(StimuliImport, TomlTableWithBlocksIdsAndAnImagesFolder) {
-    TemporaryFolder folder("import-toml");
+    TempFolder folder("import-toml");
     const fs::path root = folder.path();
     for (const char* block : {"close", "mid"}) {
         const int w = std::string(block) == "close" ? 16 : 24; // blocks may differ in size
@@ -272,7 +272,7 @@ TEST(StimuliImport, TomlTableWithBlocksIdsAndAnImagesFolder) {
 
 // Each bad table: exit code 2, exactly one line naming the table, the line and the column, nothing written.
 TEST(StimuliImport, RefusesBadTablesWithOneLineAndWritesNothing) {
-    TemporaryFolder folder("import-bad");
+    TempFolder folder("import-bad");
     const fs::path root = folder.path();
     writeImage(root / "a.png", 8, 6, OIIO::TypeDesc::UINT8, pattern(8, 6, 1));
     writeImage(root / "b.png", 8, 6, OIIO::TypeDesc::UINT8, pattern(8, 6, 2));
@@ -352,7 +352,7 @@ TEST(StimuliImport, RefusesBadTablesWithOneLineAndWritesNothing) {
 // An imported set is a set like a built one: a study of it runs, is analysed, and reported with image metrics
 // against the imported references.
 TEST(StimuliImport, ImportedSetThroughStudyAnalysisAndReport) {
-    TemporaryFolder folder("import-e2e");
+    TempFolder folder("import-e2e");
     const fs::path root = folder.path();
     const int w = 32, h = 24;
     // Block a's reference carries a depth image and a skin mask (the left half), so its metrics have bands; block
