@@ -9,6 +9,7 @@
 
 #include "analysis/metrics/cvvdp.h"
 #include "analysis/metrics/metric_render.h"
+#include "tests/common/temp_folder.h"
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -39,7 +40,8 @@ void writeSet(const fs::path& folder) {
 } // namespace
 
 TEST(PredictionSection, ParticipantsOwnPixelsPerDegreeMovesThePredictions) {
-    const fs::path folder = fs::temp_directory_path() / ("skinlab-prediction-" + std::to_string(::getpid()));
+    const skinlab::test_support::TempFolder temp;
+    const fs::path& folder = temp.path();
     writeSet(folder);
     const skinlab::metrics::CvvdpDisplay model = skinlab::metrics::cvvdpDisplay("standard_fhd");
     auto jodAt = [&](double ppd) {
@@ -82,7 +84,6 @@ TEST(PredictionSection, ParticipantsOwnPixelsPerDegreeMovesThePredictions) {
     EXPECT_GT(jodAt(80.0), predicted);
     EXPECT_FALSE(rows[1].orderChanged); // one condition: no order to change
     EXPECT_EQ(rows[1].stimuli, 1);
-    fs::remove_all(folder);
 }
 
 namespace {

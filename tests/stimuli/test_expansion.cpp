@@ -9,6 +9,7 @@
 #include "stimuli/output_folder.h"
 #include "stimuli/presentation.h"
 #include "stimuli/set_spec.h"
+#include "tests/common/temp_folder.h"
 
 #include <algorithm>
 #include <cstdio>
@@ -19,7 +20,6 @@
 #include <map>
 #include <set>
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 namespace fs = std::filesystem;
 using namespace skinlab::stimuli;
@@ -407,9 +407,8 @@ TEST(ContactSheet, CaptionsUseLabelsAndSayPredicted) {
 }
 
 TEST(StimulusOutputFolder, RefusesForeignFolders) {
-    fs::path dir = fs::path(SKINLAB_BINARY_DIR) / "tests-tmp" / "stimuli-folder";
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    const skinlab::test_support::TempFolder temp;
+    const fs::path& dir = temp.path();
     EXPECT_FALSE(claimOutputFolder(dir, "demo", std::nullopt).has_value()); // empty: fine
     std::ofstream(dir / "notes.txt") << "mine";
     EXPECT_EQ(errorOf([&] { claimOutputFolder(dir, "demo", std::nullopt); }),
@@ -437,10 +436,8 @@ bool needsHead(const std::string& file) {
 
 // The spec to read without the scanned head, and its overrides: set.scene=builtin:head where the head is the set's
 // scene; where it is a level of the scene factor (demo-scan.toml), a copy of the spec in a temporary folder with
-// that level builtin:head and the other scene files' paths absolute.
-fs::path headlessFolder() { return fs::temp_directory_path() / ("skinlab-headless-" + std::to_string(::getpid())); }
-
-fs::path withoutHead(const fs::path& spec, std::vector<std::string>& overrides) {
+// that level builtin:head and the other scene files' paths absolute (in `folder`, which outlives the spec's use).
+fs::path withoutHead(const fs::path& spec, std::vector<std::string>& overrides, const fs::path& folder) {
     std::ifstream in(spec);
     std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     const std::string head = "\"../../renderer/scenes/lee-perry-smith.toml\"";
@@ -454,16 +451,15 @@ fs::path withoutHead(const fs::path& spec, std::vector<std::string>& overrides) 
     const std::string absolute = "\"" + (fs::path(SKINLAB_SOURCE_DIR) / "renderer").string() + "/";
     for (size_t p = text.find(relative); p != std::string::npos; p = text.find(relative, p + absolute.size()))
         text.replace(p, relative.size(), absolute);
-    const fs::path copy = headlessFolder();
-    fs::create_directories(copy);
-    std::ofstream(copy / spec.filename()) << text;
-    return copy / spec.filename();
+    std::ofstream(folder / spec.filename()) << text;
+    return folder / spec.filename();
 }
 } // namespace
 
 // The shipped specs parse and expand to the documented counts (docs/stimuli.md). The thesis specs' scene is
 // swapped for builtin:head with a --set override so this runs without the scanned head.
 TEST(ShippedSpecs, ExpandToTheDocumentedCounts) {
+    const skinlab::test_support::TempFolder headless;
     const fs::path dir = fs::path(SKINLAB_SOURCE_DIR) / "stimuli" / "specs";
     const std::vector<std::pair<std::string, size_t>> expected = {{"demo.toml", 26},
                                                                   {"demo-scan.toml", 26},
@@ -487,7 +483,7 @@ TEST(ShippedSpecs, ExpandToTheDocumentedCounts) {
     EXPECT_EQ(specs, expected.size()) << "a spec was added or removed: update this test and docs/stimuli.md";
     for (const auto& [file, count] : expected) {
         std::vector<std::string> overrides;
-        const fs::path path = needsHead(file) ? withoutHead(dir / file, overrides) : dir / file;
+        const fs::path path = needsHead(file) ? withoutHead(dir / file, overrides, headless.path()) : dir / file;
         SetSpec s = readSetSpec(path, overrides);
         std::vector<Stimulus> all = expand(s);
         EXPECT_EQ(all.size(), count) << file;
@@ -502,7 +498,6 @@ TEST(ShippedSpecs, ExpandToTheDocumentedCounts) {
             EXPECT_NE(std::find(fixedKeys.begin(), fixedKeys.end(), key), fixedKeys.end()) << file << " " << key;
     }
     std::vector<Stimulus> demo = expand(readSetSpec(dir / "demo.toml"));
-    fs::remove_all(headlessFolder());
     EXPECT_EQ(demo.front().id, "head-face-none");
     EXPECT_EQ(demo.back().id, "bleed-true-mask-edge-patches-reference"); // the references come last
     // Three blocks (the face, the silhouette and the patches), each with one reference and its own presentation.
@@ -514,11 +509,12 @@ TEST(ShippedSpecs, ExpandToTheDocumentedCounts) {
 // The demo's study designs study every block their stimulus set builds (scripts/demo.sh renders them all), and each
 // condition is a stimulus id of the set.
 TEST(ShippedSpecs, DemoDesignsStudyEveryBlockTheSetBuilds) {
+    const skinlab::test_support::TempFolder headless;
     const fs::path specs = fs::path(SKINLAB_SOURCE_DIR) / "stimuli" / "specs";
     const fs::path designs = fs::path(SKINLAB_SOURCE_DIR) / "experiments" / "designs";
     for (const std::string file : {"demo.toml", "demo-scan.toml"}) {
         std::vector<std::string> overrides;
-        const fs::path path = needsHead(file) ? withoutHead(specs / file, overrides) : specs / file;
+        const fs::path path = needsHead(file) ? withoutHead(specs / file, overrides, headless.path()) : specs / file;
         const std::vector<Stimulus> all = expand(readSetSpec(path, overrides));
         std::set<std::string> blocks, ids;
         for (const Stimulus& st : all) {
@@ -534,13 +530,12 @@ TEST(ShippedSpecs, DemoDesignsStudyEveryBlockTheSetBuilds) {
             EXPECT_TRUE(ids.count(id)) << file << ": " << id;
         }
     }
-    fs::remove_all(headlessFolder());
 }
 
 namespace {
 // Plans every shipped spec (no rendering): with $SKINLAB_ASSETS set the thesis specs use the scanned head as
 // shipped, otherwise builtin:head stands in for it. One (file name, plan) per spec.
-void planShippedSpecs(std::vector<std::pair<std::string, BuildPlan>>& plans) {
+void planShippedSpecs(std::vector<std::pair<std::string, BuildPlan>>& plans, const fs::path& headless) {
     const fs::path dir = fs::path(SKINLAB_SOURCE_DIR) / "stimuli" / "specs";
     const char* assets = std::getenv("SKINLAB_ASSETS");
     const bool haveHead = assets && *assets && fs::exists(fs::path(assets) / "LeePerrySmith");
@@ -549,7 +544,8 @@ void planShippedSpecs(std::vector<std::pair<std::string, BuildPlan>>& plans) {
         if (entry.path().extension() != ".toml") continue;
         const std::string file = entry.path().filename().string();
         std::vector<std::string> overrides;
-        const fs::path path = !haveHead && needsHead(file) ? withoutHead(entry.path(), overrides) : entry.path();
+        const fs::path path =
+            !haveHead && needsHead(file) ? withoutHead(entry.path(), overrides, headless) : entry.path();
         BuildPlan plan;
         ASSERT_NO_THROW(plan = planBuild(path, overrides, std::nullopt, haveHead ? fs::path(assets) : fs::path()))
             << file;
@@ -562,22 +558,23 @@ void planShippedSpecs(std::vector<std::pair<std::string, BuildPlan>>& plans) {
 // and their levels exist; no GL). With $SKINLAB_ASSETS set the thesis specs use the scanned head as shipped;
 // otherwise builtin:head stands in for it.
 TEST(ShippedSpecs, EveryStimulusResolves) {
+    const skinlab::test_support::TempFolder headless;
     std::vector<std::pair<std::string, BuildPlan>> plans;
-    ASSERT_NO_FATAL_FAILURE(planShippedSpecs(plans));
+    ASSERT_NO_FATAL_FAILURE(planShippedSpecs(plans, headless.path()));
     size_t resolved = 0;
     for (const auto& [file, plan] : plans) {
         EXPECT_EQ(plan.resolved.size(), plan.all.size()) << file;
         resolved += plan.resolved.size();
     }
-    fs::remove_all(headlessFolder());
     EXPECT_GT(resolved, 80u);
 }
 
 // No presented PNG of a shipped spec is a nearest-neighbour upsample: every crop or magnification resolves to a
 // native presentation, a render.window of the magnified frame (the renderer draws it; nothing renders here).
 TEST(ShippedSpecs, EveryMagnifiedCropRendersNatively) {
+    const skinlab::test_support::TempFolder headless;
     std::vector<std::pair<std::string, BuildPlan>> plans;
-    ASSERT_NO_FATAL_FAILURE(planShippedSpecs(plans));
+    ASSERT_NO_FATAL_FAILURE(planShippedSpecs(plans, headless.path()));
     size_t magnified = 0;
     for (const auto& [file, plan] : plans) {
         for (size_t i = 0; i < plan.selected.size(); ++i) {
@@ -596,7 +593,6 @@ TEST(ShippedSpecs, EveryMagnifiedCropRendersNatively) {
                 << where;
         }
     }
-    fs::remove_all(headlessFolder());
     EXPECT_GT(magnified, 40u);
 }
 

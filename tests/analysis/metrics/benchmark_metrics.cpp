@@ -7,6 +7,7 @@
 #include "analysis/metrics/render_comparison.h"
 
 #include "synthetic_render.h"
+#include "tests/common/temp_folder.h"
 
 #include <benchmark/benchmark.h>
 
@@ -15,27 +16,29 @@
 namespace {
 namespace fs = std::filesystem;
 using namespace skinlab::metrics;
+// The synthetic renders' namespace, by a name apart from GoogleTest's ::testing (tests/common/temp_folder.h).
+namespace synthetic = skinlab::metrics::testing;
 
 constexpr int width = 1280;
 constexpr int height = 720;
 
 struct Fixture {
-    fs::path folder = fs::temp_directory_path() / "skinlab-bench-metrics";
+    // The folder lives as long as the fixture (the process) and is removed at exit.
+    skinlab::test_support::TempFolder temp{"bench-metrics"};
+    fs::path folder = temp.path();
     fs::path referencePath = folder / "reference.exr";
     fs::path testPath = folder / "test.exr";
     Fixture() {
-        fs::remove_all(folder);
-        fs::create_directories(folder);
-        testing::DiscScene scene;
+        synthetic::DiscScene scene;
         scene.size = height;
         scene.width = width;
         scene.farPlaneIsSkin = true;
         scene.stripeHalfWidth = 0.02;
-        testing::SyntheticRender reference = testing::renderDiscScene(scene);
-        testing::SyntheticRender test = reference;
+        synthetic::SyntheticRender reference = synthetic::renderDiscScene(scene);
+        synthetic::SyntheticRender test = reference;
         test.beauty = cv::Mat(reference.beauty * 1.05); // every pixel differs: the full ΔE00 cost
-        testing::writeSyntheticExr(referencePath, reference);
-        testing::writeSyntheticExr(testPath, test);
+        synthetic::writeSyntheticExr(referencePath, reference);
+        synthetic::writeSyntheticExr(testPath, test);
     }
 };
 

@@ -3,6 +3,7 @@
 #include "common/files.h"
 #include "common/hash.h"
 #include "synthetic_render.h"
+#include "tests/common/temp_folder.h"
 
 #include <gtest/gtest.h>
 
@@ -39,10 +40,7 @@ CommandResult runSkinlab(const std::string& arguments) {
 class AnalyzeMetricsCommand : public ::testing::Test {
 protected:
     // A passing test leaves nothing behind; a failing one keeps its files to look at.
-    void TearDown() override {
-        std::error_code ignored;
-        if (!HasFailure()) fs::remove_all(folder, ignored);
-    }
+    void TearDown() override { temp.keep = HasFailure(); }
     // `count` noisy copies of the reference (Gaussian noise of `sigma` per channel, RNG state firstState + seed) as
     // exr/seedN.exr: the comma-separated list --reference-seeds takes.
     std::string writeNoisySeeds(int count, std::uint64_t firstState, double sigma) {
@@ -61,10 +59,6 @@ protected:
         return seeds;
     }
     void SetUp() override {
-        folder =
-            fs::temp_directory_path() / ("skinlab-metrics-cli-" + std::to_string(::getpid()) + "-" +
-                                         std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-        fs::remove_all(folder);
         fs::create_directories(folder / "exr");
         scene.size = 128;
         scene.stripeHalfWidth = 0.02;
@@ -80,7 +74,8 @@ protected:
             }
     }
     std::string path(const std::string& name) const { return (folder / name).string(); }
-    fs::path folder;
+    test_support::TempFolder temp;
+    fs::path folder = temp.path();
     testing::DiscScene scene;
     testing::SyntheticRender reference;
     testing::SyntheticRender blurred;

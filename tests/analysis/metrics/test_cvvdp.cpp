@@ -3,6 +3,7 @@
 #include "analysis/metrics/cvvdp.h"
 #include "analysis/metrics/metric_render.h"
 #include "common/error.h"
+#include "tests/common/temp_folder.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -262,9 +263,8 @@ TEST(Cvvdp, MorePixelsPerDegreeMakesABlurLessVisible) {
 // Linear EXR input: read through the metrics loader (float → linear), the same JOD as the in-memory images;
 // values above 1 clip at the display's peak, and a brighter display makes the same relative change more visible.
 TEST(Cvvdp, LinearExrInputAndDisplayPeak) {
-    const fs::path folder = fs::temp_directory_path() / "skinlab-test-cvvdp";
-    fs::remove_all(folder);
-    fs::create_directories(folder);
+    const skinlab::test_support::TempFolder temp;
+    const fs::path& folder = temp.path();
     cv::Mat reference = texturedImage(200, 150) * 1.5f; // HDR: some values above 1
     cv::Mat test = blurred(reference, 1.5);
     auto writeExr = [&](const fs::path& path, const cv::Mat& image) {
@@ -280,7 +280,6 @@ TEST(Cvvdp, LinearExrInputAndDisplayPeak) {
     const CvvdpDisplay fhd = cvvdpDisplay("standard_fhd");
     const double fromFiles = cvvdp(loadLinear(folder / "reference.exr"), loadLinear(folder / "test.exr"), fhd).jod;
     EXPECT_DOUBLE_EQ(fromFiles, cvvdp(reference, test, fhd).jod);
-    fs::remove_all(folder);
 
     // Clipping: differences only above 1 are invisible.
     cv::Mat brighter = reference.clone();

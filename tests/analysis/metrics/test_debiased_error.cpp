@@ -6,6 +6,7 @@
 #include "common/error.h"
 #include "common/files.h"
 #include "synthetic_render.h"
+#include "tests/common/temp_folder.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -17,8 +18,6 @@
 #include <string>
 #include <vector>
 
-#include <unistd.h>
-
 namespace skinlab::metrics {
 namespace {
 namespace fs = std::filesystem;
@@ -26,16 +25,10 @@ namespace fs = std::filesystem;
 class DebiasedError : public ::testing::Test {
 protected:
     void SetUp() override {
-        folder =
-            fs::temp_directory_path() / ("skinlab-debiased-" + std::to_string(::getpid()) + "-" +
-                                         std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-        fs::remove_all(folder);
-        fs::create_directories(folder);
         scene.size = 96;
         scene.farPlaneIsSkin = false;
         truth = testing::renderDiscScene(scene);
     }
-    void TearDown() override { fs::remove_all(folder); }
 
     // The noise-free render plus independent Gaussian noise of standard deviation `sigma` per pixel and channel,
     // with the metadata of a path-traced render of seed `seed` (`scene` stands for the rest of skinlab:resolved).
@@ -85,7 +78,8 @@ protected:
     }
     static constexpr std::size_t skin = 4;
 
-    fs::path folder;
+    test_support::TempFolder temp;
+    fs::path folder = temp.path();
     testing::DiscScene scene;
     testing::SyntheticRender truth;
 };

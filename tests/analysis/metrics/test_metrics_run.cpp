@@ -4,6 +4,7 @@
 #include "common/error.h"
 #include "common/files.h"
 #include "synthetic_render.h"
+#include "tests/common/temp_folder.h"
 
 #include <gtest/gtest.h>
 
@@ -13,7 +14,6 @@
 
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
-#include <unistd.h>
 
 namespace skinlab::metrics {
 namespace {
@@ -23,16 +23,8 @@ using testing::SyntheticRender;
 class MetricsRun : public ::testing::Test {
 protected:
     // A passing test leaves nothing behind; a failing one keeps its files to look at.
-    void TearDown() override {
-        std::error_code ignored;
-        if (!HasFailure()) fs::remove_all(folder, ignored);
-    }
+    void TearDown() override { temp.keep = HasFailure(); }
     void SetUp() override {
-        folder =
-            fs::temp_directory_path() / ("skinlab-metrics-run-" + std::to_string(::getpid()) + "-" +
-                                         std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-        fs::remove_all(folder);
-        fs::create_directories(folder);
         testing::DiscScene scene;
         scene.size = 96;
         scene.stripeHalfWidth = 0.02;
@@ -54,7 +46,8 @@ protected:
         }
         return "";
     }
-    fs::path folder;
+    test_support::TempFolder temp;
+    fs::path folder = temp.path();
     fs::path output;
     SyntheticRender render;
 };
@@ -200,9 +193,8 @@ namespace {
 // A render without SSS (method "none") stores skinlab:sss_radius_mm = 0; as a test render its radius is never
 // used, so it is compared like any other.
 TEST(MetricsRunTestRender, ZeroRadiusOfATestRenderIsIgnored) {
-    fs::path folder = fs::temp_directory_path() / ("skinlab-metrics-zero-radius-" + std::to_string(::getpid()));
-    fs::remove_all(folder);
-    fs::create_directories(folder);
+    const test_support::TempFolder temp;
+    const fs::path& folder = temp.path();
     testing::DiscScene scene;
     scene.size = 48;
     SyntheticRender reference = testing::renderDiscScene(scene);
@@ -213,7 +205,6 @@ TEST(MetricsRunTestRender, ZeroRadiusOfATestRenderIsIgnored) {
     auto records = runMetrics(planFileComparisons(folder / "ref.exr", {folder / "none.exr"}), {}, folder / "out");
     ASSERT_EQ(records.size(), 1u);
     EXPECT_EQ(records[0].image.flipMean, 0.0);
-    fs::remove_all(folder);
 }
 } // namespace
 } // namespace skinlab::metrics

@@ -9,6 +9,7 @@
 #include "common/error.h"
 #include "common/files.h"
 #include "synthetic_render.h"
+#include "tests/common/temp_folder.h"
 
 #include <gtest/gtest.h>
 
@@ -19,7 +20,6 @@
 
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
-#include <unistd.h>
 
 namespace skinlab::metrics {
 namespace {
@@ -28,16 +28,8 @@ namespace fs = std::filesystem;
 class PlainImages : public ::testing::Test {
 protected:
     // A passing test leaves nothing behind; a failing one keeps its files to look at.
-    void TearDown() override {
-        std::error_code ignored;
-        if (!HasFailure()) fs::remove_all(folder, ignored);
-    }
+    void TearDown() override { temp.keep = HasFailure(); }
     void SetUp() override {
-        folder =
-            fs::temp_directory_path() / ("skinlab-plain-images-" + std::to_string(::getpid()) + "-" +
-                                         std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-        fs::remove_all(folder);
-        fs::create_directories(folder);
         output = folder / "out";
         // An 8-bit RGB gradient with a square, and a copy with the square brighter (BGR for OpenCV).
         reference.create(60, 80, CV_8UC3);
@@ -82,7 +74,8 @@ protected:
         out->close();
         return path;
     }
-    fs::path folder, output;
+    test_support::TempFolder temp;
+    fs::path folder = temp.path(), output;
     cv::Mat reference, test;
 };
 

@@ -4,39 +4,19 @@
 #include "analysis/metrics/render_comparison.h"
 
 #include "synthetic_render.h"
+#include "tests/common/temp_folder.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <unistd.h>
 
 namespace skinlab::metrics {
 namespace {
 namespace fs = std::filesystem;
 using testing::DiscScene;
 using testing::SyntheticRender;
-
-// An empty scratch folder, removed again when the test passes (a failing one keeps its files to look at).
-class ScratchFolder {
-public:
-    explicit ScratchFolder(const std::string& name)
-        : path_(fs::temp_directory_path() / ("skinlab-metrics-" + name + "-" + std::to_string(::getpid()))) {
-        fs::remove_all(path_);
-        fs::create_directories(path_);
-    }
-    ~ScratchFolder() {
-        std::error_code ignored;
-        if (!::testing::Test::HasFailure()) fs::remove_all(path_, ignored);
-    }
-    ScratchFolder(const ScratchFolder&) = delete;
-    ScratchFolder& operator=(const ScratchFolder&) = delete;
-    operator const fs::path&() const { return path_; }
-
-private:
-    fs::path path_;
-};
 
 // Writes both renders as EXR and compares them through the file path a user's renders take.
 ComparisonResult compareFiles(const fs::path& folder, const SyntheticRender& reference, const SyntheticRender& test,
@@ -57,9 +37,9 @@ DiscScene sceneWithEveryBand(int size) {
 }
 
 TEST(RenderComparison, IdenticalRendersScoreZeroEverywhere) {
-    const ScratchFolder folder("identity");
+    const test_support::TempFolder folder;
     SyntheticRender render = testing::renderDiscScene(sceneWithEveryBand(160));
-    ComparisonResult result = compareFiles(folder, render, render);
+    ComparisonResult result = compareFiles(folder.path(), render, render);
     EXPECT_EQ(cv::countNonZero(result.deltaE00), 0);
     for (const RegionScores* region : {&result.image, &result.skin}) {
         EXPECT_TRUE(std::isinf(region->psnrDecibels));
@@ -81,7 +61,7 @@ TEST(RenderComparison, IdenticalRendersScoreZeroEverywhere) {
 // the excess over the interior is 0, the spill band (non-skin) is untouched, and the leak energy of a band is
 // 0.05·N_band / (N_skin·Y_skin), because the RGB→Y row sums to 1.
 TEST(RenderComparison, UniformSkinChangeGivesKnownScores) {
-    const ScratchFolder folder("uniform");
+    const test_support::TempFolder folder;
     SyntheticRender reference = testing::renderDiscScene(sceneWithEveryBand(160));
     SyntheticRender test = reference;
     test.beauty = reference.beauty.clone();
@@ -89,7 +69,7 @@ TEST(RenderComparison, UniformSkinChangeGivesKnownScores) {
         for (int x = 0; x < test.width; ++x)
             if (reference.mask.at<float>(y, x) >= 0.5f)
                 test.beauty.at<cv::Vec3f>(y, x) += cv::Vec3f(0.05f, 0.05f, 0.05f);
-    ComparisonResult result = compareFiles(folder, reference, test);
+    ComparisonResult result = compareFiles(folder.path(), reference, test);
 
     const cv::Vec3f skinColour(0.6f, 0.4f, 0.3f); // renderDiscScene's skin
     const cv::Vec3f farColour(0.3f, 0.3f, 0.35f); // the far plane, skin here too
@@ -148,7 +128,7 @@ SyntheticRender withEdgeErrors(const DiscScene& scene, const SyntheticRender& re
 
 // docs/metrics.md: energy scores agree within 5% between 512² and 1024² renders of the same scene.
 TEST(RenderComparison, LeakEnergiesAreResolutionIndependent) {
-    const ScratchFolder folder("resolution");
+    const test_support::TempFolder folder;
     const double errorWidth = 0.8 * 0.008; // 80% of r_w = 8 mm, so the error lies inside the bands
     BandScores scores[2][4];
     double haloFraction[2] = {};
@@ -156,7 +136,7 @@ TEST(RenderComparison, LeakEnergiesAreResolutionIndependent) {
     for (int size : {512, 1024}) {
         DiscScene scene = sceneWithEveryBand(size);
         SyntheticRender reference = testing::renderDiscScene(scene);
-        ComparisonResult result = compareFiles(folder, reference, withEdgeErrors(scene, reference, errorWidth));
+        ComparisonResult result = compareFiles(folder.path(), reference, withEdgeErrors(scene, reference, errorWidth));
         for (Band band : allBands) scores[index][static_cast<size_t>(band)] = result.band(band);
         haloFraction[index] = result.band(Band::halo).fractionOfImage;
         ++index;

@@ -5,11 +5,11 @@
 #include "common/files.h"
 #include "common/hash.h"
 #include "synthetic_render.h"
+#include "tests/common/temp_folder.h"
 
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <unistd.h>
 
 namespace skinlab::metrics {
 namespace {
@@ -18,15 +18,8 @@ namespace fs = std::filesystem;
 class StimulusSetPairs : public ::testing::Test {
 protected:
     // A passing test leaves nothing behind; a failing one keeps its files to look at.
-    void TearDown() override {
-        std::error_code ignored;
-        if (!HasFailure()) fs::remove_all(folder, ignored);
-    }
+    void TearDown() override { temp.keep = HasFailure(); }
     void SetUp() override {
-        folder =
-            fs::temp_directory_path() / ("skinlab-metrics-set-" + std::to_string(::getpid()) + "-" +
-                                         std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-        fs::remove_all(folder);
         fs::create_directories(folder / "exr");
         testing::DiscScene scene;
         scene.size = 32;
@@ -63,7 +56,8 @@ protected:
         }
         return "";
     }
-    fs::path folder;
+    test_support::TempFolder temp;
+    fs::path folder = temp.path();
     nlohmann::json manifest;
 };
 
