@@ -7,6 +7,7 @@
 #include "renderer/scene/builtin_scenes.h"
 #include "renderer/sss/sss_params.h"
 #include "tests/common/cli_run.h"
+#include "tests/common/temp_folder.h"
 #include "tune/tune_server.h"
 
 #include <atomic>
@@ -53,14 +54,6 @@ bool eglAvailable() {
 
 #define REQUIRE_EGL()                                                                                                  \
     if (!eglAvailable()) GTEST_SKIP() << "no EGL/OpenGL 4.5 context: " << eglFailure()
-
-std::filesystem::path temporaryFolder(const std::string& name) {
-    const auto folder =
-        std::filesystem::temp_directory_path() / ("skinlab-tune-test-" + name + "-" + std::to_string(::getpid()));
-    std::filesystem::remove_all(folder);
-    std::filesystem::create_directories(folder);
-    return folder;
-}
 
 std::vector<unsigned char> decodeBase64(const std::string& text) {
     std::vector<unsigned char> out;
@@ -133,7 +126,6 @@ class TuneServerTest : public ::testing::Test {
 protected:
     void SetUp() override {
         REQUIRE_EGL();
-        work_ = temporaryFolder(::testing::UnitTest::GetInstance()->current_test_info()->name());
         TuneOptions options;
         options.scenes = {"builtin:head", "builtin:halo"};
         options.exportDir = work_ / "exports";
@@ -149,7 +141,6 @@ protected:
         if (server_) server_->stop();
         if (thread_.joinable()) thread_.join();
         server_.reset();
-        if (!work_.empty()) std::filesystem::remove_all(work_);
     }
     virtual void configure(TuneOptions&) {}
 
@@ -188,7 +179,8 @@ protected:
         return json::parse(answer.body);
     }
 
-    std::filesystem::path work_;
+    test_support::TempFolder folder_;
+    const std::filesystem::path work_ = folder_.path();
     std::string token_;
     std::string pageToken_;
     std::unique_ptr<TuneServer> server_;
@@ -745,7 +737,8 @@ TEST_F(TuneServerBlockedSignalsTest, OneReferenceAtATimeAndCancelEndsIt) {
 
 TEST(TuneCli, SigtermStopsPromptlyAndEndsRenders) {
     REQUIRE_EGL();
-    const auto work = temporaryFolder("sigterm");
+    const test_support::TempFolder folder;
+    const auto& work = folder.path();
     SpawnOptions options;
     options.output = work / "out.txt";
     const pid_t tune =
@@ -792,7 +785,6 @@ TEST(TuneCli, SigtermStopsPromptlyAndEndsRenders) {
     EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;
     for (pid_t r : renders) EXPECT_NE(::kill(r, 0), 0) << "render " << r << " outlived skinlab tune";
     EXPECT_NE(readAll(options.output).find("stopped"), std::string::npos);
-    std::filesystem::remove_all(work);
 }
 
 // A scene file, an assets folder and a stimulus set: the folders the page may name files in.
@@ -923,10 +915,10 @@ TEST_F(TuneServerBuiltSetTest, OpenFindsTheScenesTheBuildRendered) {
 TEST(TuneServerOptions, BeyondLoopbackOnlyWithAToken) {
     TuneOptions options;
     options.host = "0.0.0.0";
-    options.workDir = temporaryFolder("options");
+    const test_support::TempFolder folder;
+    options.workDir = folder.path();
     options.executable = SKINLAB_CLI;
     EXPECT_THROW(TuneServer server(options), InputError);
-    std::filesystem::remove_all(options.workDir);
 }
 
 } // namespace
