@@ -7,15 +7,14 @@
 // refused with a page saying why. The export must hold one participant with the platform ids, the session's viewing
 // conditions and pixels per degree, and exactly the hidden and unfocused trials flagged.
 // Usage: node online_session.test.mjs /path/to/skinlab     Exit 0 pass, 1 fail, 77 skip.
-import { spawn, spawnSync } from 'node:child_process';
+import { spawnSync } from 'node:child_process';
 import { createHash } from 'node:crypto';
 import fs from 'node:fs';
 import http from 'node:http';
 import os from 'node:os';
 import path from 'node:path';
-import readline from 'node:readline';
 import { fileURLToPath } from 'node:url';
-import { encodePng, CHROMIUM, FLAGS, loadPlaywright } from './study_fixture.mjs';
+import { encodePng, CHROMIUM, FLAGS, loadPlaywright, serve } from './study_fixture.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const cli = process.argv[2];
@@ -72,15 +71,7 @@ const created = spawnSync(cli, ['study', 'create', '--stimuli', path.join(work, 
 if (created.status !== 0) { console.error(created.stderr); process.exit(1); }
 const TRIALS = 5; // 1 practice + 3 pairs + 1 catch
 
-const server = spawn(cli, ['study', 'serve', database, '--port', '0', '--token', 'browser-researcher-token-0123'],
-  { stdio: ['ignore', 'pipe', 'inherit'] });
-const port = await new Promise((resolve, reject) => {
-  const timer = setTimeout(() => reject(new Error('server did not start')), 20000);
-  readline.createInterface({ input: server.stdout }).on('line', (line) => {
-    const m = /serving .* on http:\/\/127\.0\.0\.1:(\d+)\//.exec(line);
-    if (m) { clearTimeout(timer); resolve(Number(m[1])); }
-  });
-});
+const { process: server, port } = await serve(cli, database, ['--token', 'browser-researcher-token-0123']);
 const PID = '5f8a1b2c3d4e5f6a7b8c9d0e', STUDY_ID = '60aa1b2c3d4e5f6a7b8c9d11', SESSION_ID = '60bb1b2c3d4e5f6a7b8c9d22';
 const link = `http://127.0.0.1:${port}/?PROLIFIC_PID=${PID}&STUDY_ID=${STUDY_ID}&SESSION_ID=${SESSION_ID}`;
 

@@ -3,13 +3,12 @@
 // in Debian's headless Chromium (playwright-core): every image loads, every table is filled, no NaN/inf/undefined
 // is shown, every number of the findings links to an element of the page, and a full-page screenshot.
 // Usage: node report.test.mjs /path/to/skinlab [SCREENSHOT.png]     Exit 0 pass, 1 fail, 77 skip.
-import { spawn, spawnSync } from 'node:child_process';
+import { spawnSync } from 'node:child_process';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
-import readline from 'node:readline';
 import { fileURLToPath } from 'node:url';
-import { CHROMIUM, FLAGS, loadPlaywright } from './study_fixture.mjs';
+import { CHROMIUM, FLAGS, loadPlaywright, serve } from './study_fixture.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const cli = process.argv[2];
@@ -57,14 +56,7 @@ const database = path.join(work, 'study.db');
 run(['study', 'create', '--stimuli', path.join(work, 'stimuli'), '--design', path.join(work, 'design.toml'), '-o', database]);
 fs.writeFileSync(path.join(work, 'truth.json'), JSON.stringify({ none: 0, 'gaussian-sum': 1.2, separable: 1.6, artistic: 0.6 }));
 
-const server = spawn(cli, ['study', 'serve', database, '--port', '0'], { stdio: ['ignore', 'pipe', 'inherit'] });
-const url = await new Promise((resolve, reject) => {
-  const timer = setTimeout(() => reject(new Error('server did not start')), 20000);
-  readline.createInterface({ input: server.stdout }).on('line', (line) => {
-    const m = /serving .* on (http:\/\/127\.0\.0\.1:\d+\/)/.exec(line);
-    if (m) { clearTimeout(timer); resolve(m[1]); }
-  });
-});
+const { process: server, url } = await serve(cli, database);
 try {
   run(['study', 'simulate', database, '--observer-count', '8', '--truth', path.join(work, 'truth.json'), '--seed', '3',
     '--random', '1', '--url', url]);

@@ -1,4 +1,4 @@
-// Shared by the deployment and dashboard tests: a tiny stimulus set and study, `skinlab study serve` started on an
+// Shared by the browser tests: a tiny stimulus set and study, `skinlab study serve` and `skinlab tune` started on an
 // ephemeral port, a participant session driven with the keyboard, and HTTP(S) requests from a chosen local address.
 import { spawn, spawnSync } from 'node:child_process';
 import { createHash } from 'node:crypto';
@@ -81,18 +81,32 @@ export function createStudy(cli, work, { methods = ['reference-like', 'separable
   return database;
 }
 
-// `skinlab study serve DB --port 0 ARGS...`; resolves { process, port } once it prints its address.
-export async function serve(cli, database, args = []) {
-  const server = spawn(cli, ['study', 'serve', database, '--port', '0', ...args], { stdio: ['ignore', 'pipe', 'inherit'] });
-  const port = await new Promise((resolve, reject) => {
-    const timer = setTimeout(() => reject(new Error('server did not start')), 20000);
-    server.on('exit', (code) => reject(new Error('server exited with ' + code)));
+// Starts `cli ARGS...` and resolves { process, port, url } once a line of its output matches `address` (its first
+// group: the server's http://127.0.0.1:PORT/ address); rejects if it cannot start, exits first or prints no address
+// within `timeoutMs` (then it is stopped).
+function startServer(cli, args, address, timeoutMs, name) {
+  const server = spawn(cli, args, { stdio: ['ignore', 'pipe', 'inherit'] });
+  return new Promise((resolve, reject) => {
+    const timer = setTimeout(() => { server.kill('SIGTERM'); reject(new Error(name + ' did not start')); }, timeoutMs);
+    server.on('exit', (code) => { clearTimeout(timer); reject(new Error(name + ' exited with ' + code)); });
+    server.on('error', (e) => { clearTimeout(timer); reject(new Error(name + ' did not start: ' + e.message)); });
     readline.createInterface({ input: server.stdout }).on('line', (line) => {
-      const m = /serving .* on http:\/\/127\.0\.0\.1:(\d+)\//.exec(line);
-      if (m) { clearTimeout(timer); resolve(Number(m[1])); }
+      const m = address.exec(line);
+      if (m) { clearTimeout(timer); resolve({ process: server, port: Number(new URL(m[1]).port), url: m[1] }); }
     });
   });
-  return { process: server, port };
+}
+
+// `skinlab study serve DB --port 0 ARGS...`; resolves { process, port, url } once it prints its address.
+export function serve(cli, database, args = []) {
+  return startServer(cli, ['study', 'serve', database, '--port', '0', ...args],
+    /serving .* on (http:\/\/127\.0\.0\.1:\d+\/)/, 20000, 'server');
+}
+
+// `skinlab tune --port 0 ARGS...`; resolves { process, port, url } once it prints its address.
+export function serveTune(cli, args = []) {
+  return startServer(cli, ['tune', '--port', '0', ...args], /tuning on (http:\/\/127\.0\.0\.1:\d+\/)/, 30000,
+    'skinlab tune');
 }
 
 export function freePort() {

@@ -5,15 +5,14 @@
 // With "active" as second argument the study is an active design (pairs = "active", test trials planned batch by
 // batch while the session runs); the same checks apply.
 // Usage: node study_session.test.mjs /path/to/skinlab [active]     Exit 0 pass, 1 fail, 77 skip.
-import { spawn, spawnSync } from 'node:child_process';
+import { spawnSync } from 'node:child_process';
 import { createHash } from 'node:crypto';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
-import readline from 'node:readline';
 import zlib from 'node:zlib';
 import { fileURLToPath } from 'node:url';
-import { encodePng, CHROMIUM, FLAGS, loadPlaywright } from './study_fixture.mjs';
+import { encodePng, CHROMIUM, FLAGS, loadPlaywright, serve } from './study_fixture.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const cli = process.argv[2];
@@ -102,15 +101,7 @@ if (created.status !== 0) { console.error(created.stderr); process.exit(1); }
 const TRIALS = 5; // 1 practice + 3 pairs (active: 3 planned test trials, batches of 2) + 1 catch
 
 // --- the real server ---
-const server = spawn(cli, ['study', 'serve', database, '--port', '0', '--token', 'browser-researcher-token-0123'],
-  { stdio: ['ignore', 'pipe', 'inherit'] });
-const port = await new Promise((resolve, reject) => {
-  const timer = setTimeout(() => reject(new Error('server did not start')), 20000);
-  readline.createInterface({ input: server.stdout }).on('line', (line) => {
-    const m = /serving .* on http:\/\/127\.0\.0\.1:(\d+)\//.exec(line);
-    if (m) { clearTimeout(timer); resolve(Number(m[1])); }
-  });
-});
+const { process: server, port } = await serve(cli, database, ['--token', 'browser-researcher-token-0123']);
 const base = `http://127.0.0.1:${port}/`;
 const sourceImages = new Map(); // URL → decoded PNG as served
 async function served(url) {

@@ -3,13 +3,12 @@
 // typed bad value shows the same one line as `skinlab render` prints, and two tabs tune at once, each getting its
 // own image. Real server, real EGL rendering (llvmpipe).
 // Usage: node tune.test.mjs /path/to/skinlab [SCREENSHOT.png]     Exit 0 pass, 1 fail, 77 skip.
-import { spawn, spawnSync } from 'node:child_process';
+import { spawnSync } from 'node:child_process';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
-import readline from 'node:readline';
 import { fileURLToPath } from 'node:url';
-import { CHROMIUM, FLAGS, loadPlaywright } from './study_fixture.mjs';
+import { CHROMIUM, FLAGS, loadPlaywright, serveTune } from './study_fixture.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const cli = process.argv[2];
@@ -22,19 +21,13 @@ function check(condition, message) {
 }
 
 const work = fs.mkdtempSync(path.join(os.tmpdir(), 'skinlab-tune-browser-'));
-const server = spawn(cli, ['tune', '--port', '0', '--width', '320', '--height', '180', '--export-dir', work],
-  { stdio: ['ignore', 'pipe', 'inherit'] });
+let server = null;
 let browser = null;
 let exitCode = 1;
 try {
-  const url = await new Promise((resolve, reject) => {
-    const timer = setTimeout(() => reject(new Error('server did not start')), 30000);
-    server.on('exit', (code) => reject(new Error('skinlab tune exited ' + code)));
-    readline.createInterface({ input: server.stdout }).on('line', (line) => {
-      const m = /tuning on (http:\/\/127\.0\.0\.1:\d+\/)/.exec(line);
-      if (m) { clearTimeout(timer); resolve(m[1]); }
-    });
-  });
+  const started = await serveTune(cli, ['--width', '320', '--height', '180', '--export-dir', work]);
+  server = started.process;
+  const { url } = started;
   browser = await chromium.launch({ executablePath: CHROMIUM, headless: true, args: FLAGS });
   const context = await browser.newContext({ viewport: { width: 1400, height: 1000 } });
   const page = await context.newPage();
@@ -133,7 +126,7 @@ try {
   exitCode = 1;
 } finally {
   if (browser) await browser.close();
-  server.kill('SIGTERM');
+  if (server) server.kill('SIGTERM');
   fs.rmSync(work, { recursive: true, force: true });
 }
 console.log(exitCode === 0 ? 'PASS' : `${failures} failure(s)`);

@@ -5,14 +5,12 @@
 // render may start. Then the tuning page itself exports (its token and JSON accepted), is asked before it replaces
 // a file, and keeps the file when the user says no. Real server, real EGL rendering (llvmpipe).
 // Usage: node tune_cross_site.test.mjs /path/to/skinlab     Exit 0 pass, 1 fail, 77 skip.
-import { spawn } from 'node:child_process';
 import fs from 'node:fs';
 import http from 'node:http';
 import os from 'node:os';
 import path from 'node:path';
-import readline from 'node:readline';
 import { fileURLToPath } from 'node:url';
-import { CHROMIUM, FLAGS, loadPlaywright } from './study_fixture.mjs';
+import { CHROMIUM, FLAGS, loadPlaywright, serveTune } from './study_fixture.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const cli = process.argv[2];
@@ -80,21 +78,14 @@ const exportDir = path.join(work, 'exports');
 fs.mkdirSync(exportDir);
 const original = '# the researcher\'s own tuned scene\n[sss]\nmethod = "separable"\n';
 fs.writeFileSync(path.join(exportDir, 'tuned.toml'), original);
-const server = spawn(cli, ['tune', '--port', '0', '--width', '160', '--height', '90', '--export-dir', exportDir],
-  { stdio: ['ignore', 'pipe', 'inherit'] });
+let server = null;
 let browser = null;
 let other = null;
 let exitCode = 1;
 try {
-  const url = await new Promise((resolve, reject) => {
-    const timer = setTimeout(() => reject(new Error('server did not start')), 30000);
-    server.on('exit', (code) => reject(new Error('skinlab tune exited ' + code)));
-    readline.createInterface({ input: server.stdout }).on('line', (line) => {
-      const m = /tuning on (http:\/\/127\.0\.0\.1:\d+\/)/.exec(line);
-      if (m) { clearTimeout(timer); resolve(m[1]); }
-    });
-  });
-  const port = Number(new URL(url).port);
+  const started = await serveTune(cli, ['--width', '160', '--height', '90', '--export-dir', exportDir]);
+  server = started.process;
+  const { url, port } = started;
   // The other site: its own port on loopback.
   other = http.createServer((req, res) => {
     const target = req.url.startsWith('/localhost') ? `http://localhost:${port}/` : url;
@@ -156,7 +147,7 @@ try {
 } finally {
   if (browser) await browser.close();
   if (other) other.close();
-  server.kill('SIGTERM');
+  if (server) server.kill('SIGTERM');
   fs.rmSync(work, { recursive: true, force: true });
 }
 console.log(exitCode === 0 ? 'PASS' : `${failures} failure(s)`);
