@@ -28,7 +28,7 @@
 # Environment: SKINLAB (default build/release/cli/skinlab), SEEDS (path-traced seeds, default 4, at least 2),
 # TRUTH_SEEDS and TRUTH_SAMPLES (the path-traced truth of the error metrics, truth.exr: with TRUTH_SEEDS ≥ 2 the mean
 # of that many renders of its own at TRUTH_SAMPLES samples, measured against the SEEDS seeds, independent of it;
-# with TRUTH_SEEDS=0 the mean of the SEEDS seeds. Default: on head 10 and on scan 14 renders of 384 samples, the
+# with TRUTH_SEEDS=0 the mean of the SEEDS seeds. Default: on head 10 and on scan 18 renders of 384 samples, the
 # precision docs/pathtraced.md measures as enough to rank with; on the other cases 0),
 # REFERENCE_EDGE_MM (the reference's tessellation, default 1.0 mm, 0.5 mm on bleed, whose paint edge needs it), REFERENCE_NON_SKIN (sss.reference_non_skin of
 # the reference: default "absorbs", the path tracer's boundary; "returns" is the evaluation table's),
@@ -55,10 +55,10 @@ fi
 if [ -n "${TRUTH_SAMPLES:-}" ]; then
   [ "$TRUTH_SAMPLES" -ge 1 ] 2>/dev/null || { echo "reference-validation: TRUTH_SAMPLES=$TRUTH_SAMPLES must be a positive number" >&2; exit 2; }
 fi
-# The truth's renders per case: TRUTH_SEEDS if given, else 10 on head and 14 on scan (at 384 samples; their measured
+# The truth's renders per case: TRUTH_SEEDS if given, else 10 on head and 18 on scan (at 384 samples; their measured
 # precision, docs/pathtraced.md "The truth of the error metrics") and 0 (the mean of the SEEDS seeds) elsewhere.
 truth_seeds_of() {
-  if [ -n "${TRUTH_SEEDS:-}" ]; then echo "$TRUTH_SEEDS"; else case "$1" in head) echo 10 ;; scan) echo 14 ;; *) echo 0 ;; esac; fi
+  if [ -n "${TRUTH_SEEDS:-}" ]; then echo "$TRUTH_SEEDS"; else case "$1" in head) echo 10 ;; scan) echo 18 ;; *) echo 0 ;; esac; fi
 }
 truth_samples_of() {
   if [ -n "${TRUTH_SAMPLES:-}" ]; then echo "$TRUTH_SAMPLES"; elif [ -z "${TRUTH_SEEDS:-}" ]; then echo 384; else echo "$samples"; fi
