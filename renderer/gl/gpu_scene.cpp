@@ -90,28 +90,30 @@ void GpuScene::uploadMaps(const Image* albedo, const Image* normal, const Image*
     }
 }
 
+namespace {
+// An equirectangular map as a linear-filtered RGB32F texture whose u wraps around the horizon.
+Texture uploadEquirect(const Environment& map) {
+    Texture texture = createTexture2D(GL_RGB32F, map.width, map.height);
+    glTextureSubImage2D(texture.get(), 0, 0, 0, map.width, map.height, GL_RGB, GL_FLOAT, map.pixels.data());
+    glTextureParameteri(texture.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(texture.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTextureParameteri(texture.get(), GL_TEXTURE_WRAP_S, GL_REPEAT);
+    return texture;
+}
+} // namespace
+
 void GpuScene::uploadEnvironment(const Environment* environment, const std::array<glm::vec3, 9>& irradianceCoefficients,
                                  const Environment* irradiance) {
     irradiance_ = irradianceCoefficients;
     irradianceMap_.reset();
     if (irradiance) {
-        irradianceMap_ = createTexture2D(GL_RGB32F, irradiance->width, irradiance->height);
-        glTextureSubImage2D(irradianceMap_.get(), 0, 0, 0, irradiance->width, irradiance->height, GL_RGB, GL_FLOAT,
-                            irradiance->pixels.data());
-        glTextureParameteri(irradianceMap_.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-        glTextureParameteri(irradianceMap_.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-        glTextureParameteri(irradianceMap_.get(), GL_TEXTURE_WRAP_S, GL_REPEAT); // u wraps around the horizon
+        irradianceMap_ = uploadEquirect(*irradiance);
         glTextureParameteri(irradianceMap_.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
         checkGl("uploading the irradiance map");
     }
     environmentMap_.reset();
     if (!environment) return;
-    environmentMap_ = createTexture2D(GL_RGB32F, environment->width, environment->height);
-    glTextureSubImage2D(environmentMap_.get(), 0, 0, 0, environment->width, environment->height, GL_RGB, GL_FLOAT,
-                        environment->pixels.data());
-    glTextureParameteri(environmentMap_.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTextureParameteri(environmentMap_.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTextureParameteri(environmentMap_.get(), GL_TEXTURE_WRAP_S, GL_REPEAT); // u wraps around the horizon
+    environmentMap_ = uploadEquirect(*environment);
     checkGl("uploading the environment");
 }
 
